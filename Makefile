@@ -1,0 +1,38 @@
+# eoam-sumo: every target creates the virtual environment when it is missing.
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.installed
+OUT    ?= out
+
+.PHONY: run test tables bench lint network clean
+
+$(STAMP): pyproject.toml
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[test]'
+	touch $(STAMP)
+
+## The main job: the paper's Table 2 (64 co-simulations), printed beside the paper's.
+run: $(STAMP)
+	$(BIN)/eoam-sumo batch scenarios/table2.toml --out $(OUT)/table2 --jobs 2
+	cat $(OUT)/table2/table2.md
+
+test: $(STAMP)
+	$(BIN)/python -m pytest
+
+tables: $(STAMP)
+	$(BIN)/eoam-sumo tables --out tables --jobs 2
+
+bench: $(STAMP)
+	$(BIN)/eoam-sumo bench --out $(OUT)/bench
+
+lint: $(STAMP)
+	$(BIN)/ruff check eoam_sumo tests
+
+## Rebuild networks/*.net.xml from the plain XML sources with netconvert.
+network: $(STAMP)
+	$(BIN)/python -m eoam_sumo.netbuild networks
+
+clean:
+	rm -rf $(VENV) $(OUT)

@@ -1,0 +1,3 @@
+from eoam_sumo.cli import main
+
+raise SystemExit(main())
