@@ -1,0 +1,1 @@
+"""Experiment batches: run a matrix's cases in parallel, export results.csv and Table 2."""

@@ -1,0 +1,199 @@
+"""The ``eoam-sumo`` command line: tables, run, batch, plot, bench.
+
+Bad input ends with one line on stderr naming the file or value and exit status 2; the
+library raises, only this module prints and exits.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+
+from eoam_sumo import __version__
+from eoam_sumo.errors import InputError
+
+EXIT_BAD_INPUT = 2
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports a usage error as one line (no usage block) with status 2."""
+
+    def error(self, message: str):  # noqa: D102 - argparse API
+        raise InputError(f"{self.prog}: {message}")
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} must be >= 1")
+    return value
+
+
+def _finite(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    return value
+
+
+def _mu(text: str) -> float:
+    value = _finite(text)
+    if not 0.0 < value <= 1.2:
+        raise argparse.ArgumentTypeError(f"mu {text} is outside (0, 1.2]")
+    return value
+
+
+def _speed_kmh(text: str) -> float:
+    value = _finite(text)
+    if value <= 0.0:
+        raise argparse.ArgumentTypeError(f"speed {text} km/h must be > 0")
+    return value
+
+
+def _distance_or_none(text: str) -> float | None:
+    if text.lower() == "none":
+        return None
+    value = _finite(text)
+    if value < 0.0:
+        raise argparse.ArgumentTypeError(f"distance {text} m must be >= 0 (or 'none')")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="eoam-sumo", description=__doc__.splitlines()[0])
+    parser.add_argument("--version", action="version", version=f"eoam-sumo {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    p = sub.add_parser("tables", help="build the lookup tables and DMM phase boundaries")
+    p.add_argument("--out", type=Path, default=Path("tables"), help="output folder")
+    p.add_argument("--jobs", type=_positive_int, default=1, help="parallel processes")
+    p.add_argument("--speeds-kmh", type=_speed_kmh, nargs="+", help="speed grid (km/h)")
+    p.add_argument("--mu", type=_mu, nargs="+", help="friction grid")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+    p = sub.add_parser("run", help="one co-simulation of a SUMO scenario")
+    p.add_argument("cfg", type=Path, help="the scenario's .sumocfg")
+    p.add_argument("--speed-kmh", type=_speed_kmh, help="ego initial speed (km/h)")
+    p.add_argument("--mu", type=_mu, help="surface friction for every lane")
+    p.add_argument("--oncoming-m", type=_distance_or_none, default=None,
+                   help="add an oncoming car this far ahead (m), or 'none'")
+    p.add_argument("--ego", default="ego", help="the ego vehicle's id (default: ego)")
+    p.add_argument("--out", type=Path, default=Path("out/run"), help="output folder")
+    p.add_argument("--max-time-s", type=_finite, default=40.0, help="simulated time limit")
+    p.add_argument("--tables", type=Path, help="lookup tables folder (default: tables/)")
+    p.add_argument("--gui", action="store_true", help="run in sumo-gui through TraCI")
+
+    p = sub.add_parser("batch", help="run every case of an experiment matrix")
+    p.add_argument("matrix", type=Path, help="experiment matrix (.toml)")
+    p.add_argument("--out", type=Path, default=Path("out/batch"), help="output folder")
+    p.add_argument("--jobs", type=_positive_int, default=1, help="parallel processes")
+    p.add_argument("--scheduler", help="Dask scheduler address, or 'local' for a LocalCluster")
+    p.add_argument("--resume", action="store_true", help="run only the cases not yet done")
+    p.add_argument("--timeout-s", type=_finite, default=300.0, help="per-case time limit")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+    p = sub.add_parser("plot", help="plots of a run, a batch or a tables folder")
+    p.add_argument("folder", type=Path, help="a run, batch or tables output folder")
+    p.add_argument("--out", type=Path, help="where to put the PNGs (default: the folder)")
+
+    p = sub.add_parser("bench", help="the performance benchmark")
+    p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder")
+    p.add_argument("--quick", action="store_true", help="tiny settings (for tests)")
+    return parser
+
+
+def _writable_dir(path: Path) -> Path:
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        probe = path / ".eoam-write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:
+        raise InputError(f"output folder {path} cannot be written: {exc.strerror}") from None
+    return path
+
+
+def _cmd_tables(args) -> int:
+    from eoam_sumo.offline.build import build_tables
+
+    out = _writable_dir(args.out)
+    build_tables(out, jobs=args.jobs, speeds_kmh=args.speeds_kmh, mus=args.mu,
+                 progress=not args.no_progress)
+    print(f"tables written to {out}")
+    return 0
+
+
+def _cmd_run(args) -> int:
+    from eoam_sumo.sim.cosim import RunSettings, run_case
+    from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
+
+    if not args.cfg.is_file():
+        raise InputError(f"{args.cfg}: no such scenario file")
+    if args.max_time_s <= 0:
+        raise InputError(f"--max-time-s {args.max_time_s} must be > 0")
+    out = _writable_dir(args.out)
+    overrides = ScenarioOverrides(
+        ego_speed_mps=None if args.speed_kmh is None else args.speed_kmh / 3.6,
+        mu=args.mu,
+        oncoming_start_m=args.oncoming_m,
+    )
+    settings = RunSettings(
+        max_time_s=args.max_time_s, ego_id=args.ego, gui=args.gui, use_traci=args.gui,
+        tables_dir=args.tables,
+    )
+    s = run_case(args.cfg, overrides, out, settings)
+    print(
+        f"{s['outcome']}: collision_with={s['collision_with']} "
+        f"impact={s['impact_speed_mps']:.1f} m/s modes={s['modes_visited']} "
+        f"fcw={s['fcw_raised']} mu={s['mu']:.2f} sim={s['sim_time_s']:.2f} s "
+        f"rtf={s['realtime_factor']:.0f} -> {out}"
+    )
+    return 0
+
+
+def _cmd_batch(args) -> int:
+    from eoam_sumo.batch.runner import run_batch_cli
+
+    return run_batch_cli(args)
+
+
+def _cmd_plot(args) -> int:
+    from eoam_sumo.plotting.dispatch import plot_folder
+
+    if not args.folder.is_dir():
+        raise InputError(f"{args.folder}: no such folder")
+    for path in plot_folder(args.folder, _writable_dir(args.out or args.folder)):
+        print(path)
+    return 0
+
+
+def _cmd_bench(args) -> int:
+    from eoam_sumo.bench import run_bench_cli
+
+    return run_bench_cli(_writable_dir(args.out), quick=args.quick)
+
+
+_COMMANDS = {
+    "tables": _cmd_tables, "run": _cmd_run, "batch": _cmd_batch,
+    "plot": _cmd_plot, "bench": _cmd_bench,
+}
+
+
+def main(argv: list[str] | None = None) -> int:
+    try:
+        args = build_parser().parse_args(argv)
+        return _COMMANDS[args.command](args)
+    except InputError as exc:
+        print(f"eoam-sumo: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("eoam-sumo: interrupted", file=sys.stderr)
+        return 130

@@ -1,0 +1,21 @@
+"""Online controllers: steering (paper eq. 38), longitudinal PIDs (sec. 9), path references."""
+
+from eoam_sumo.control.longitudinal import (
+    LongitudinalController,
+    LongitudinalGains,
+    Pid,
+    resistance_force_n,
+)
+from eoam_sumo.control.reference import PathReference
+from eoam_sumo.control.steering import SteeringController, SteeringGains, understeer_gradient
+
+__all__ = [
+    "LongitudinalController",
+    "LongitudinalGains",
+    "PathReference",
+    "Pid",
+    "SteeringController",
+    "SteeringGains",
+    "resistance_force_n",
+    "understeer_gradient",
+]

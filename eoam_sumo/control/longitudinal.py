@@ -1,0 +1,147 @@
+"""Longitudinal control: acceleration PID during the EOAM, speed PID otherwise (paper sec. 9).
+
+During the lane change the reference is the optimised longitudinal acceleration of the lookup
+table at the current differential x-position (eq. 14-29 offline); outside it a speed PID holds
+the set speed, standing in for the high-level ARV system. Both act on a net longitudinal force
+``m * a + F_res(v)`` that is split into a drive force (rear axle, >= 0) and a brake force
+(>= 0), never both. The drive force is capped by eq. 37 (mu times the engine limit) and the
+brake force by the largest force that does not lock a wheel (the ego has no ABS, eq. 33).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+from eoam_sumo.params import AIR_DENSITY_KGPM3, G_MPS2, VehicleParams
+
+
+@dataclass(frozen=True)
+class LongitudinalGains:
+    """PID gains and limits of the two longitudinal loops (acceleration in m/s^2 units)."""
+
+    accel_kp: float = 0.6  # [-] per m/s^2 of acceleration error
+    accel_ki_per_s: float = 3.0  # [1/s]
+    accel_kd_s: float = 0.01  # [s]
+    accel_integral_limit_mps2: float = 3.0  # integrator clamp [m/s^2]
+    speed_kp_per_s: float = 1.5  # [1/s] acceleration demand per m/s of speed error
+    speed_ki_per_s2: float = 0.1  # [1/s^2]
+    speed_kd: float = 0.05  # [-] per m/s^2 of speed-error rate
+    speed_integral_limit_mps2: float = 1.0  # integrator clamp [m/s^2]
+    speed_accel_limit_g: float = 0.25  # |demand| <= this * mu * g (comfort, traction) [-]
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if not (math.isfinite(v) and v >= 0.0):
+                raise ValueError(f"longitudinal gain {f.name}={v!r} must be finite and >= 0")
+        if self.speed_accel_limit_g <= 0.0:
+            raise ValueError("speed_accel_limit_g must be > 0")
+
+
+def resistance_force_n(params: VehicleParams, speed_mps: float) -> float:
+    """Rolling resistance plus aerodynamic drag at a forward speed [N]."""
+    if speed_mps <= 0.0:
+        return 0.0
+    return params.mass_kg * G_MPS2 * params.rolling_resistance_coeff + (
+        0.5 * AIR_DENSITY_KGPM3 * params.drag_area_m2 * speed_mps * speed_mps
+    )
+
+
+class Pid:
+    """Discrete PID on an error, derivative on the error, clamped conditional integration."""
+
+    __slots__ = ("i_limit", "integral", "kd", "ki", "kp", "prev_error")
+
+    def __init__(self, kp: float, ki: float, kd: float, i_limit: float):
+        self.kp, self.ki, self.kd, self.i_limit = kp, ki, kd, i_limit
+        self.reset()
+
+    def reset(self) -> None:
+        self.integral = 0.0
+        self.prev_error = None
+
+    def update(self, error: float, dt_s: float, lo: float, hi: float) -> float:
+        """Output clipped to [lo, hi]; the integrator does not wind up against the clip."""
+        deriv = 0.0 if self.prev_error is None or dt_s <= 0.0 else (error - self.prev_error) / dt_s
+        self.prev_error = error
+        trial = self.integral + self.ki * error * dt_s
+        trial = max(-self.i_limit, min(trial, self.i_limit))
+        out = self.kp * error + trial + self.kd * deriv
+        if out > hi:
+            if error < 0.0:
+                self.integral = trial
+            return hi
+        if out < lo:
+            if error > 0.0:
+                self.integral = trial
+            return lo
+        self.integral = trial
+        return out
+
+
+class LongitudinalController:
+    """Acceleration and speed PIDs producing (drive_force_n, brake_force_n)."""
+
+    __slots__ = ("_accel", "_alim_g", "_drag", "_fmax", "_m", "_pmax", "_res0", "_speed")
+
+    def __init__(self, params: VehicleParams, gains: LongitudinalGains = LongitudinalGains()):
+        self._m = params.mass_kg
+        self._res0 = params.mass_kg * G_MPS2 * params.rolling_resistance_coeff
+        self._drag = 0.5 * AIR_DENSITY_KGPM3 * params.drag_area_m2
+        self._fmax = params.max_drive_force_n
+        self._pmax = params.max_drive_power_w
+        g = gains
+        self._accel = Pid(g.accel_kp, g.accel_ki_per_s, g.accel_kd_s, g.accel_integral_limit_mps2)
+        self._speed = Pid(g.speed_kp_per_s, g.speed_ki_per_s2, g.speed_kd, g.speed_integral_limit_mps2)
+        self._alim_g = g.speed_accel_limit_g * G_MPS2
+
+    def reset(self) -> None:
+        """Clear both integrators (called at every switch of longitudinal loop)."""
+        self._accel.reset()
+        self._speed.reset()
+
+    def _resistance(self, v: float) -> float:
+        return self._res0 + self._drag * v * v if v > 0.0 else 0.0
+
+    def drive_limit_n(self, speed_mps: float, mu: float) -> float:
+        """Largest drive force: engine force and power limits scaled by mu (eq. 37)."""
+        f = self._fmax
+        if speed_mps > 1.0 and self._pmax / speed_mps < f:
+            f = self._pmax / speed_mps
+        return mu * f
+
+    def split(self, net_force_n: float, speed_mps: float, mu: float, brake_limit_n: float):
+        """(drive, brake) realising a net force within the drive and no-lock brake limits."""
+        if net_force_n > 0.0:
+            lim = self.drive_limit_n(speed_mps, mu)
+            return (min(lim, net_force_n)), 0.0
+        f = -net_force_n
+        return 0.0, (min(brake_limit_n, f))
+
+    def track_accel(
+        self, ax_ref: float, ax_mps2: float, speed_mps: float, mu: float, brake_limit_n: float,
+        dt_s: float,
+    ):
+        """Acceleration PID with feedforward m*ax_ref + F_res: (drive, brake)."""
+        m = self._m
+        res = self._resistance(speed_mps)
+        lo = -(brake_limit_n + res) / m - ax_ref
+        hi = (self.drive_limit_n(speed_mps, mu) - res) / m - ax_ref
+        corr = self._accel.update(ax_ref - ax_mps2, dt_s, lo, hi)
+        return self.split(m * (ax_ref + corr) + res, speed_mps, mu, brake_limit_n)
+
+    def track_speed(
+        self, speed_ref_mps: float, speed_mps: float, mu: float, brake_limit_n: float, dt_s: float
+    ):
+        """Speed PID giving an acceleration demand (|a| <= limit * mu * g): (drive, brake, a)."""
+        lim = self._alim_g * mu
+        a = self._speed.update(speed_ref_mps - speed_mps, dt_s, -lim, lim)
+        drive, brake = self.split(
+            self._m * a + self._resistance(speed_mps), speed_mps, mu, brake_limit_n
+        )
+        return drive, brake, a
+
+    def hold_brake(self, brake_limit_n: float):
+        """Limit braking without locking (modes 1 and 3): (drive, brake)."""
+        return 0.0, brake_limit_n

@@ -1,0 +1,130 @@
+"""Steering control: feedforward + lookahead feedback + yaw damping (paper eq. 38).
+
+* Feedforward from the reference curvature kappa (path plus road) with the steady-state
+  understeer of the single-track model: delta_ff = (L + K_us v^2) kappa, where
+  K_us = m (b / C_f - a / C_r) / L [rad per m/s^2] (Gillespie 1992, eq. 6-29).
+* Feedback on the lookahead error e_la = e + x_la sin(e_psi) (lateral error plus lookahead
+  distance times heading error), the potential-field lane keeping of Rossetter & Gerdes (2006)
+  and Talvala & Gerdes (2008): delta_fb = -k_la e_la.
+* Yaw damping on the yaw-rate error against the path: delta_yd = -k_r (r - v kappa).
+
+Gain schedule. With the kinematic lateral response e'' = v^2 delta / (L + K_us v^2), the
+feedback alone gives e'' + (v k_la x_la / L_eff) e' + (v^2 k_la / L_eff) e = 0; choosing
+k_la = omega^2 L_eff / v^2 and x_la = 2 zeta v / omega makes the error dynamics a second-order
+system of natural frequency omega and damping ratio zeta at every speed. omega is scaled with
+sqrt(mu) because the friction-limited path is itself slower by 1/sqrt(mu) (design.md sec. 5);
+the speed used in the schedule is floored to keep the gains finite near standstill.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+from eoam_sumo.params import VehicleParams
+
+
+@dataclass(frozen=True)
+class SteeringGains:
+    """Design values of the steering schedule."""
+
+    natural_freq_radps: float = 1.2  # omega of the lateral-error dynamics at mu = 1 [rad/s]
+    damping_ratio: float = 0.9  # zeta of the lateral-error dynamics [-]
+    min_lookahead_m: float = 4.0  # floor of x_la [m]
+    schedule_min_speed_mps: float = 5.0  # speed floor used in the schedule [m/s]
+    yaw_damping_s: float = 0.06  # k_r [rad per rad/s]
+    friction_exponent: float = 0.5  # omega scales with mu**exponent [-]
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if not (math.isfinite(v) and v >= 0.0):
+                raise ValueError(f"steering gain {f.name}={v!r} must be finite and >= 0")
+        for name in ("natural_freq_radps", "damping_ratio", "schedule_min_speed_mps"):
+            if getattr(self, name) <= 0.0:
+                raise ValueError(f"steering gain {name} must be > 0")
+
+
+def understeer_gradient(params: VehicleParams) -> float:
+    """K_us = m (b / C_f - a / C_r) / L [rad per m/s^2] (axle cornering stiffnesses)."""
+    return (
+        params.mass_kg
+        * (
+            params.cg_to_rear_m / params.cornering_stiffness_front_npr
+            - params.cg_to_front_m / params.cornering_stiffness_rear_npr
+        )
+        / params.wheelbase_m
+    )
+
+
+class SteeringController:
+    """Eq. 38 steering law; ``command`` returns the clipped road-wheel angle and its parts."""
+
+    __slots__ = (
+        "_L",
+        "_fexp",
+        "_kr",
+        "_kus",
+        "_max",
+        "_mu",
+        "_vmin",
+        "_w",
+        "_wmu",
+        "_xmin",
+        "_z",
+    )
+
+    def __init__(self, params: VehicleParams, gains: SteeringGains = SteeringGains()):
+        self._L = params.wheelbase_m
+        self._kus = understeer_gradient(params)
+        self._max = params.max_steer_rad
+        self._w = gains.natural_freq_radps
+        self._z = gains.damping_ratio
+        self._xmin = gains.min_lookahead_m
+        self._vmin = gains.schedule_min_speed_mps
+        self._kr = gains.yaw_damping_s
+        self._fexp = gains.friction_exponent
+        self._mu = -1.0
+        self._wmu = self._w
+
+    def schedule(self, speed_mps: float, mu: float) -> tuple[float, float]:
+        """(k_la [rad/m], x_la [m]) at this speed and friction."""
+        if mu != self._mu:
+            self._mu = mu
+            self._wmu = self._w * mu**self._fexp
+        w = self._wmu
+        v = max(self._vmin, speed_mps)
+        x_la = 2.0 * self._z * v / w
+        x_la = max(x_la, self._xmin)
+        return w * w * (self._L + self._kus * v * v) / (v * v), x_la
+
+    def command(
+        self,
+        speed_mps: float,
+        yaw_rate_radps: float,
+        lateral_error_m: float,
+        heading_error_rad: float,
+        curvature_1pm: float,
+        preview_curvature_1pm: float,
+        mu: float,
+    ) -> tuple[float, float, float, float, float]:
+        """(delta, delta_ff, delta_fb, delta_yd, lookahead_error_m), delta clipped to the lock.
+
+        ``lateral_error_m`` and ``heading_error_rad`` are ego minus reference (left positive);
+        ``curvature_1pm`` is the reference curvature here (path plus road, left positive), the
+        yaw-rate reference; ``preview_curvature_1pm`` the one a preview distance ahead, used by
+        the feedforward to make up for the steering and tyre lags.
+        """
+        v = max(0.0, speed_mps)
+        k_la, x_la = self.schedule(v, mu)
+        e_la = lateral_error_m + x_la * math.sin(heading_error_rad)
+        ff = (self._L + self._kus * v * v) * preview_curvature_1pm
+        fb = -k_la * e_la
+        yd = -self._kr * (yaw_rate_radps - v * curvature_1pm)
+        delta = ff + fb + yd
+        lim = self._max
+        if delta > lim:
+            delta = lim
+        elif delta < -lim:
+            delta = -lim
+        return delta, ff, fb, yd, e_la

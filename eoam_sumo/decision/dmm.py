@@ -1,0 +1,186 @@
+"""Decision-making module (DMM): the phase-diagram sectors A-G and the action each asks for.
+
+The phase diagram (paper sec. 5-6, Figures 11, 14, 15) places the ego-obstacle pair by its
+relative distance d and relative closing speed v. Its boundaries at v, from the offline
+tables, are the minimum clearing distance with the optimised acceleration profile S (eq. 32),
+its buffered version Sb, the stopping distance B0 (eq. 33), its buffered version Bb, and the
+time-to-collision line T = TTC * v (eq. 34). The sectors are:
+
+====== ================================ ============ =========================================
+sector region                           action       meaning
+====== ================================ ============ =========================================
+A      d <= S and d <= B0               LIMIT_BRAKE  imminent: neither steer nor brake avoids
+C      d <= S and d > B0                BRAKE        braking alone still stops in time
+F      S < d <= Sb and d <= Bb          STEER        steer (braking would need its buffer)
+B      S < d <= Sb and d > Bb           STEER        steer with the steering buffer
+D      d > Sb and d <= Bb               BRAKE        brake to soften the steer to come
+E      d > Sb, d > Bb and d <= T        FCW          forward-collision warning only
+G      otherwise (or v <= 0)            NONE         nothing to do
+====== ================================ ============ =========================================
+
+For any fixed v the sectors follow each other in the order A, C, F, B, D, E, G as d grows
+(some may be empty), so the urgency never increases with distance.
+"""
+
+from __future__ import annotations
+
+import math
+from enum import Enum
+
+
+class Action(Enum):
+    """What a DMM sector asks the ego to do."""
+
+    NONE = "none"
+    FCW = "fcw"
+    BRAKE = "brake"
+    STEER = "steer"
+    LIMIT_BRAKE = "limit_brake"
+
+
+class Sector(Enum):
+    """DMM phase-diagram sector (paper Figure 14)."""
+
+    A = "A"
+    B = "B"
+    C = "C"
+    D = "D"
+    E = "E"
+    F = "F"
+    G = "G"
+
+    @property
+    def action(self) -> Action:
+        return _ACTION[self]
+
+    @property
+    def warns(self) -> bool:
+        """Forward-collision warning raised in this sector (A-F)."""
+        return self is not Sector.G
+
+
+_ACTION = {
+    Sector.A: Action.LIMIT_BRAKE,
+    Sector.B: Action.STEER,
+    Sector.C: Action.BRAKE,
+    Sector.D: Action.BRAKE,
+    Sector.E: Action.FCW,
+    Sector.F: Action.STEER,
+    Sector.G: Action.NONE,
+}
+
+#: Sectors in order of increasing distance for a fixed closing speed.
+SECTOR_ORDER = (Sector.A, Sector.C, Sector.F, Sector.B, Sector.D, Sector.E, Sector.G)
+
+
+def classify(
+    range_m: float,
+    rel_speed_mps: float,
+    clear_m: float,
+    clear_buffered_m: float,
+    stop_m: float,
+    stop_buffered_m: float,
+    ttc_s: float,
+) -> Sector:
+    """Sector of the phase point (range, closing speed) given the boundaries at that speed.
+
+    A non-finite range or closing speed, or one that is not closing (v <= 0), is sector G.
+    """
+    d, v = range_m, rel_speed_mps
+    if not (v > 0.0 and math.isfinite(v) and math.isfinite(d)):
+        return Sector.G
+    if d <= clear_m:
+        return Sector.A if d <= stop_m else Sector.C
+    if d <= clear_buffered_m:
+        return Sector.F if d <= stop_buffered_m else Sector.B
+    if d <= stop_buffered_m:
+        return Sector.D
+    if d <= ttc_s * v:
+        return Sector.E
+    return Sector.G
+
+
+def dmm_sector(boundary, range_m: float, rel_speed_mps: float) -> Sector:
+    """Sector for a ``Boundary`` (offline tables) evaluated at the current closing speed."""
+    return classify(
+        range_m,
+        rel_speed_mps,
+        boundary.clear_opt_m,
+        boundary.clear_buffered_m,
+        boundary.stop_m,
+        boundary.stop_buffered_m,
+        boundary.ttc_s,
+    )
+
+
+class BoundaryCurve:
+    """The DMM boundaries at one friction sampled on a uniform closing-speed grid from 0.
+
+    Built once per friction value from ``boundaries.at(mu, v)`` for v in the tables' speed
+    range [v_lo, v_hi]; ``sector`` then costs one index and a linear blend. Above v_hi the
+    values at v_hi are used. Below v_lo (slow closing, where the tables stop) the boundaries
+    are extended to v = 0 by their physics instead of being held, which would place a slowly
+    closing obstacle several metres ahead in a steering sector: the stopping distance scales
+    as v^2 (eq. 33), the clearing distances and both buffers follow the straight line through
+    the two lowest table speeds (the quintic's duration does not depend on speed, so the
+    clearing distance grows about linearly in v), floored at 0.
+    """
+
+    __slots__ = ("_inv", "_n", "_rows", "mu")
+
+    def __init__(self, boundaries, mu: float, speed_lo_mps: float, speed_hi_mps: float,
+                 step_mps: float = 0.25):
+        if not (0.0 < speed_lo_mps < speed_hi_mps and step_mps > 0.0):
+            raise ValueError(
+                f"bad boundary grid: {speed_lo_mps!r}..{speed_hi_mps!r} step {step_mps!r}"
+            )
+        n = max(math.ceil(speed_hi_mps / step_mps), 2)
+        step = speed_hi_mps / n
+
+        def table_row(v):
+            b = boundaries.at(mu, v)
+            row = (float(b.clear_opt_m), float(b.clear_buffered_m), float(b.stop_m),
+                   float(b.stop_buffered_m), float(b.ttc_s))
+            if not all(math.isfinite(x) for x in row):
+                raise ValueError(f"non-finite DMM boundary at mu={mu}, v={v}")
+            return row
+
+        # (S, Sb - S, Bb - B0) at the two lowest table speeds: extended linearly below v_lo
+        lo, lo2 = table_row(speed_lo_mps), table_row(min(speed_lo_mps + step_mps, speed_hi_mps))
+        base = (lo[0], lo[1] - lo[0], lo[3] - lo[2])
+        slope_dv = min(step_mps, speed_hi_mps - speed_lo_mps)
+        slope = tuple((b2 - b1) / slope_dv
+                      for b1, b2 in zip(base, (lo2[0], lo2[1] - lo2[0], lo2[3] - lo2[2])))
+        rows = []
+        for i in range(n + 1):
+            v = i * step
+            if v >= speed_lo_mps:
+                rows.append(table_row(v))
+                continue
+            clear, clear_buf, stop_buf = (
+                max(b + (v - speed_lo_mps) * k, 0.0) for b, k in zip(base, slope)
+            )
+            stop = lo[2] * (v / speed_lo_mps) ** 2
+            rows.append((clear, clear + clear_buf, stop, stop + stop_buf, lo[4]))
+        self.mu = mu
+        self._inv, self._n, self._rows = 1.0 / step, n, rows
+
+    def at(self, rel_speed_mps: float) -> tuple[float, float, float, float, float]:
+        """(S, Sb, B0, Bb, ttc) at a closing speed >= 0."""
+        u = rel_speed_mps * self._inv
+        if u <= 0.0:
+            return self._rows[0]
+        i = int(u)
+        if i >= self._n:
+            return self._rows[self._n]
+        w = u - i
+        a, b = self._rows[i], self._rows[i + 1]
+        return (a[0] + w * (b[0] - a[0]), a[1] + w * (b[1] - a[1]), a[2] + w * (b[2] - a[2]),
+                a[3] + w * (b[3] - a[3]), a[4] + w * (b[4] - a[4]))
+
+    def sector(self, range_m: float, rel_speed_mps: float) -> Sector:
+        """Sector of (range, closing speed); G when not closing or not finite."""
+        if not (rel_speed_mps > 0.0 and math.isfinite(rel_speed_mps)):
+            return Sector.G
+        s, sb, b0, bb, ttc = self.at(rel_speed_mps)
+        return classify(range_m, rel_speed_mps, s, sb, b0, bb, ttc)

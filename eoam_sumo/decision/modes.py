@@ -1,0 +1,74 @@
+"""EOAM discrete modes of operation 0-5 (paper sec. 3.2, Figure 2) and their transitions.
+
+``next_mode`` is the whole mode machine as a pure function of the current mode and the events
+the controller derives from perception and ego motion in one step:
+
+* 0 NORMAL -> 1 on a BRAKE or LIMIT_BRAKE sector; -> 2 on a STEER sector, or -> 3 when an
+  oncoming vehicle is seen at the moment the steer is asked.
+* 1 UPDATE BRAKE -> 3 when an oncoming vehicle is seen; -> 2 on a STEER sector; -> 0 when the
+  threat is gone (no obstacle in the path, or it clearly pulls away).
+* 2 UPDATE STEER+BRAKE -> 3 (oncoming before the point of no return, sec. 8.1) or 4 (after
+  it); -> 5 when the manoeuvre timer expires.
+* 3 ONCOMING BRAKE: terminal (limit braking in lane to standstill).
+* 4 ONCOMING STEER+BRAKE -> 5 once the desired position in the next lane is reached.
+* 5 RETURN -> 0 once settled in the original lane (hand-back to the high-level system).
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+from eoam_sumo.decision.dmm import Action
+
+
+class Mode(IntEnum):
+    """Modes of operation of the EOAM module (paper sec. 3.2)."""
+
+    NORMAL = 0
+    UPDATE_BRAKE = 1
+    UPDATE_STEER_BRAKE = 2
+    ONCOMING_BRAKE = 3
+    ONCOMING_STEER_BRAKE = 4
+    RETURN = 5
+
+
+_BRAKING = (Action.BRAKE, Action.LIMIT_BRAKE)
+
+
+def next_mode(
+    mode: Mode,
+    action: Action,
+    *,
+    oncoming: bool,
+    past_ponr: bool,
+    timer_expired: bool,
+    reached_next_lane: bool,
+    settled: bool,
+    threat_gone: bool,
+) -> Mode:
+    """The mode after one step; at most one transition per call."""
+    if mode is Mode.NORMAL:
+        if action is Action.STEER:
+            return Mode.ONCOMING_BRAKE if oncoming else Mode.UPDATE_STEER_BRAKE
+        if action in _BRAKING:
+            return Mode.UPDATE_BRAKE
+        return mode
+    if mode is Mode.UPDATE_BRAKE:
+        if oncoming:
+            return Mode.ONCOMING_BRAKE
+        if action is Action.STEER:
+            return Mode.UPDATE_STEER_BRAKE
+        if threat_gone:
+            return Mode.NORMAL
+        return mode
+    if mode is Mode.UPDATE_STEER_BRAKE:
+        if oncoming:
+            return Mode.ONCOMING_STEER_BRAKE if past_ponr else Mode.ONCOMING_BRAKE
+        if timer_expired:
+            return Mode.RETURN
+        return mode
+    if mode is Mode.ONCOMING_STEER_BRAKE:
+        return Mode.RETURN if reached_next_lane else mode
+    if mode is Mode.RETURN:
+        return Mode.NORMAL if settled else mode
+    return mode

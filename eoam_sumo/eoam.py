@@ -1,0 +1,323 @@
+"""The online EOAM module: one decision + control step per SUMO step (paper sec. 3, 5-6, 8-9).
+
+Every step the controller places the sensed obstacle in the DMM phase diagram (sectors A-G),
+advances the mode machine 0-5 (point of no return, manoeuvre timer, return, hand-back), builds
+the lateral and longitudinal references of the active mode and runs the steering (eq. 38) and
+longitudinal controllers. It sees only ego measurements and radar-derived perception.
+
+References per mode (road frame of the ego's original lane, d left positive):
+
+* 0 NORMAL, 1 UPDATE BRAKE: keep the lane centre (d = 0); 0 holds the initial speed with the
+  speed PID, 1 brakes at the no-lock limit.
+* 2 / 4 STEER+BRAKE: the table lane change (trigger speed and friction) from the offset at the
+  trigger to one lane width to the left; the table acceleration profile tracked by the
+  acceleration PID until the end of the path, then the speed reached is held.
+* 3 ONCOMING BRAKE: limit braking, straight, back to the lane centre, to standstill.
+* 5 RETURN: the same table shape, at the current speed and friction, scaled from the current
+  offset back to d = 0, at the speed held when the return began.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+
+from eoam_sumo.control.longitudinal import LongitudinalController, LongitudinalGains
+from eoam_sumo.control.reference import PathReference
+from eoam_sumo.control.steering import SteeringController, SteeringGains
+from eoam_sumo.decision.dmm import Action, BoundaryCurve, Sector
+from eoam_sumo.decision.modes import Mode, next_mode
+from eoam_sumo.params import VehicleParams
+
+_TWO_PI = 2.0 * math.pi
+
+
+@dataclass(frozen=True, slots=True)
+class EgoMeasurement:
+    """Ego state in the road frame of its original lane (s along, d left of its centre)."""
+
+    time_s: float
+    vx_mps: float
+    vy_mps: float
+    yaw_rate_radps: float
+    ax_mps2: float
+    ay_mps2: float
+    s_m: float
+    d_m: float
+    e_yaw_rad: float
+    road_curvature_1pm: float
+    mu: float
+    lane_width_m: float
+
+
+@dataclass(frozen=True, slots=True)
+class Perception:
+    """Radar-derived view: the in-path obstacle (None when nothing) and oncoming traffic."""
+
+    aro_range_m: float | None = None
+    aro_range_rate_mps: float | None = None
+    oncoming_detected: bool = False
+
+
+@dataclass(frozen=True, slots=True)
+class Command:
+    """Actuator commands for the next step plus what the controller decided, for logging."""
+
+    steer_cmd_rad: float
+    drive_force_cmd_n: float
+    brake_force_cmd_n: float
+    mode: int
+    fcw: bool
+    sector: str
+    ax_target_mps2: float
+    y_target_m: float
+    dx_m: float
+    lateral_error_m: float
+    lookahead_error_m: float
+    steer_ff_rad: float
+    steer_fb_rad: float
+    steer_yd_rad: float
+    speed_target_mps: float
+
+
+@dataclass(frozen=True)
+class EoamSettings:
+    """Tunable values of the EOAM logic (the paper's defaults where it gives them)."""
+
+    ponr_fraction: float = 0.3  # point of no return / lane-change height (sec. 8.1)
+    manoeuvre_time_s: float = 8.0  # steering manoeuvre timer before RETURN (sec. 3.1 step 5)
+    arrive_tolerance_m: float = 0.25  # mode 4: next lane reached within this of its target
+    settle_offset_m: float = 0.2  # mode 5 -> 0: |d| below this ...
+    settle_heading_rad: float = 0.02  # ... and |e_yaw| below this ...
+    settle_dwell_s: float = 0.5  # ... for this long after the return path ended
+    release_opening_speed_mps: float = 0.5  # mode 1 -> 0: obstacle pulls away faster than this
+    limit_brake_fraction: float = 1.0  # share of the no-lock brake force used as limit braking
+    reference_step_m: float = 0.25  # dx spacing of the sampled manoeuvre reference
+    preview_time_s: float = 0.25  # feedforward curvature taken this far ahead on the path
+    boundary_step_mps: float = 0.25  # closing-speed spacing of the sampled DMM boundaries
+    steering: SteeringGains = field(default_factory=SteeringGains)
+    longitudinal: LongitudinalGains = field(default_factory=LongitudinalGains)
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if isinstance(v, float) and not (math.isfinite(v) and v >= 0.0):
+                raise ValueError(f"EOAM setting {f.name}={v!r} must be finite and >= 0")
+        if not 0.0 < self.ponr_fraction < 1.0:
+            raise ValueError(f"ponr_fraction={self.ponr_fraction} must be in (0, 1)")
+        if not 0.0 < self.limit_brake_fraction <= 1.0:
+            raise ValueError(f"limit_brake_fraction={self.limit_brake_fraction} must be in (0, 1]")
+        for name in ("manoeuvre_time_s", "reference_step_m", "boundary_step_mps",
+                     "settle_offset_m", "settle_heading_rad", "arrive_tolerance_m"):
+            if getattr(self, name) <= 0.0:
+                raise ValueError(f"EOAM setting {name} must be > 0")
+
+
+_MEAS_FIELDS = tuple(f.name for f in fields(EgoMeasurement))
+
+
+class EoamController:
+    """Decision (DMM, modes 0-5) and control (steering, longitudinal) of the ego."""
+
+    def __init__(self, params: VehicleParams, tables, settings: EoamSettings = EoamSettings()):
+        self.params = params
+        self.tables = tables
+        self.settings = settings
+        self._steer = SteeringController(params, settings.steering)
+        self._long = LongitudinalController(params, settings.longitudinal)
+        grid = [float(v) for v in tables.speed_grid_mps]
+        self._v_lo, self._v_hi = min(grid), max(grid)
+        self._mass = params.mass_kg
+        self._curve: BoundaryCurve | None = None
+        self._brake_mu = math.nan
+        self._decel = 0.0
+        self._brake_limit = 0.0
+        self._initial_speed: float | None = None
+        self.reset_state()
+
+    # ----------------------------------------------------------------------------- lifecycle
+    def reset_state(self) -> None:
+        """Back to NORMAL with no manoeuvre and an empty history (keeps the set speed)."""
+        self.mode = Mode.NORMAL
+        self.modes_visited: list[int] = [0]
+        self.fcw_raised = False
+        self.sector = ""
+        self._path: PathReference | None = None
+        self._s0 = 0.0
+        self._t_steer = 0.0
+        self._height = 0.0
+        self._settle_since: float | None = None
+        self._hold_speed: float | None = None
+        self._long.reset()
+
+    def reset(self, initial_speed_mps: float) -> None:
+        """Start a run: NORMAL, holding ``initial_speed_mps`` with the speed PID."""
+        v = float(initial_speed_mps)
+        if not (math.isfinite(v) and v >= 0.0):
+            raise ValueError(f"initial_speed_mps={initial_speed_mps!r} must be finite and >= 0")
+        self._initial_speed = v
+        self.reset_state()
+
+    # ----------------------------------------------------------------------------- helpers
+    def _friction(self, mu: float) -> None:
+        """Refresh what depends on the sensed friction: brake limit and DMM boundaries."""
+        if mu == self._brake_mu:
+            return
+        if not 0.0 < mu:
+            raise ValueError(f"friction mu={mu!r} must be > 0")
+        self._brake_mu = mu
+        self._decel = float(self.tables.max_decel_mps2(mu))
+        self._brake_limit = (
+            self.settings.limit_brake_fraction * self._mass * self._decel
+        )
+        self._curve = BoundaryCurve(
+            self.tables.boundaries, mu, self._v_lo, self._v_hi, self.settings.boundary_step_mps
+        )
+
+    def _table_speed(self, speed_mps: float) -> float:
+        return min(max(speed_mps, self._v_lo), self._v_hi)
+
+    def _start_path(self, meas: EgoMeasurement, start: float, height: float) -> None:
+        v = meas.vx_mps
+        traj = self.tables.trajectory(meas.mu, self._table_speed(v))
+        self._path = PathReference(
+            traj, start_offset_m=start, height_m=height, speed_mps=v,
+            step_m=self.settings.reference_step_m,
+        )
+        self._s0 = meas.s_m
+        self._settle_since = None
+        self._long.reset()
+
+    def _enter(self, mode: Mode, meas: EgoMeasurement) -> None:
+        """Entry actions of a new mode."""
+        if mode is Mode.UPDATE_STEER_BRAKE:
+            self._hold_speed = None
+            self._height = meas.lane_width_m
+            self._t_steer = meas.time_s
+            self._start_path(meas, meas.d_m, meas.lane_width_m)
+        elif mode is Mode.RETURN:
+            self._hold_speed = meas.vx_mps
+            self._start_path(meas, meas.d_m, -meas.d_m)
+        elif mode is Mode.ONCOMING_STEER_BRAKE:
+            return
+        else:
+            self._path = None
+            self._long.reset()
+        if int(mode) not in self.modes_visited:
+            self.modes_visited.append(int(mode))
+
+    # ----------------------------------------------------------------------------- the step
+    def step(self, meas: EgoMeasurement, perception: Perception, dt_s: float) -> Command:
+        """One decision + control step; commands hold until the next call."""
+        if self._initial_speed is None:
+            raise ValueError("EoamController.reset(initial_speed_mps) must be called first")
+        for name in _MEAS_FIELDS:
+            if not math.isfinite(getattr(meas, name)):
+                raise ValueError(f"ego measurement {name}={getattr(meas, name)!r} is not finite")
+        mu = meas.mu
+        self._friction(mu)
+        st = self.settings
+        t, v, d = meas.time_s, meas.vx_mps, meas.d_m
+
+        # ---- DMM: sector of the in-path obstacle (none when nothing is sensed) -------------
+        rng = perception.aro_range_m
+        rate = perception.aro_range_rate_mps
+        if rng is not None and math.isfinite(rng):
+            closing = -rate if rate is not None and math.isfinite(rate) else 0.0
+            sector = self._curve.sector(rng, closing)
+            action = sector.action
+            threat_gone = closing < -st.release_opening_speed_mps
+        else:
+            sector = None
+            action = Action.NONE
+            threat_gone = True
+        oncoming = bool(perception.oncoming_detected)
+
+        # ---- mode machine --------------------------------------------------------------
+        mode = self.mode
+        path = self._path
+        dx = meas.s_m - self._s0 if path is not None else 0.0
+        travel = d - path.start_offset_m if path is not None else 0.0
+        height = self._height
+        settled = False
+        if mode is Mode.RETURN and path is not None and dx >= path.length_m:
+            if abs(d) <= st.settle_offset_m and abs(_wrap(meas.e_yaw_rad)) <= st.settle_heading_rad:
+                if self._settle_since is None:
+                    self._settle_since = t
+                settled = t - self._settle_since >= st.settle_dwell_s - 1e-9
+            else:
+                self._settle_since = None
+        new = next_mode(
+            mode,
+            action,
+            oncoming=oncoming,
+            past_ponr=travel >= st.ponr_fraction * height,
+            timer_expired=t - self._t_steer >= st.manoeuvre_time_s - 1e-9,
+            reached_next_lane=(
+                travel >= height - st.arrive_tolerance_m
+                or (path is not None and dx >= path.length_m)
+            ),
+            settled=settled,
+            threat_gone=threat_gone,
+        )
+        if new is not mode:
+            self.mode = mode = new
+            self._enter(new, meas)
+            path = self._path
+            dx = meas.s_m - self._s0 if path is not None else 0.0
+
+        # ---- references ------------------------------------------------------------------
+        y_ref = yaw_ref = kappa_ref = kappa_ff = 0.0
+        if mode is Mode.NORMAL:
+            drive, brake, ax_target = self._long.track_speed(
+                self._initial_speed, v, mu, self._brake_limit, dt_s
+            )
+            v_target = self._initial_speed
+        elif mode is Mode.UPDATE_BRAKE or mode is Mode.ONCOMING_BRAKE:
+            drive, brake = self._long.hold_brake(self._brake_limit)
+            ax_target = -self._brake_limit / self._mass
+            v_target = 0.0
+        else:
+            y_ref, yaw_ref, kappa_ref, ax_ref, v_plan = path.at(dx)
+            kappa_ff = path.at(dx + v * st.preview_time_s)[2]
+            in_path = dx < path.length_m
+            if in_path and mode is not Mode.RETURN:
+                drive, brake = self._long.track_accel(
+                    ax_ref, meas.ax_mps2, v, mu, self._brake_limit, dt_s
+                )
+                ax_target, v_target = ax_ref, v_plan
+            else:
+                if self._hold_speed is None:
+                    self._hold_speed = v
+                    self._long.reset()
+                drive, brake, ax_target = self._long.track_speed(
+                    self._hold_speed, v, mu, self._brake_limit, dt_s
+                )
+                v_target = self._hold_speed
+            if not in_path:
+                kappa_ref = kappa_ff = yaw_ref = 0.0
+
+        # ---- steering (eq. 38) --------------------------------------------------------------
+        e_lat = d - y_ref
+        delta, ff, fb, yd, e_la = self._steer.command(
+            v, meas.yaw_rate_radps, e_lat, _wrap(meas.e_yaw_rad - yaw_ref),
+            kappa_ref + meas.road_curvature_1pm, kappa_ff + meas.road_curvature_1pm, mu,
+        )
+
+        warns = sector is not None and sector is not Sector.G
+        fcw = warns or mode in (Mode.UPDATE_BRAKE, Mode.UPDATE_STEER_BRAKE,
+                                Mode.ONCOMING_BRAKE, Mode.ONCOMING_STEER_BRAKE)
+        if fcw:
+            self.fcw_raised = True
+        self.sector = sector.value if sector is not None else ""
+        return Command(
+            delta, drive, brake, int(mode), fcw, self.sector, ax_target, y_ref, dx,
+            e_lat, e_la, ff, fb, yd, v_target,
+        )
+
+
+def _wrap(angle_rad: float) -> float:
+    """Angle wrapped to [-pi, pi)."""
+    if -math.pi <= angle_rad < math.pi:
+        return angle_rad
+    return (angle_rad + math.pi) % _TWO_PI - math.pi

@@ -1,0 +1,229 @@
+"""Experiment matrices: a TOML sweep of one SUMO scenario over oncoming traffic x speed x friction.
+
+The format is documented in ``scenarios/table2.toml`` (the paper's Table 2, 4 x 4 x 4 = 64 runs).
+Cases come in the paper's Table 2 order: traffic outermost (no oncoming car first, then the
+oncoming start distances in file order), then ego speed, then friction, then the optional ARO
+stop parameters, each in file order.
+"""
+
+from __future__ import annotations
+
+import csv
+import difflib
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from eoam_sumo.errors import InputError
+from eoam_sumo.sim.sumo_adapter import MU_MAX, ScenarioOverrides
+
+DEFAULT_MAX_TIME_S = 40.0
+NO_ONCOMING = "none"
+SCHEMA = {
+    "scenario": ("sumocfg", "max_time_s"),
+    "sweep": ("ego_speed_kmh", "mu", "oncoming_start_m", "aro_hold_s", "aro_decel_mps2"),
+    "paper": ("table",),
+}
+REQUIRED = {"scenario": ("sumocfg",), "sweep": ("ego_speed_kmh", "mu")}
+PAPER_COLUMNS = ("oncoming_start_m", "ego_speed_kmh", "mu", "outcome")
+OUTCOMES = ("none", "green", "yellow", "orange", "red")
+
+
+def _id_number(value: float) -> str:
+    """Filesystem-safe, unique text of a number: 165, 92.5, 1.0 (friction keeps its decimal)."""
+    return (str(int(value)) if value.is_integer() else repr(value)).replace("+", "")
+
+
+def _mu_text(value: float) -> str:
+    return repr(float(value)).replace("+", "")
+
+
+@dataclass(frozen=True)
+class Case:
+    """One co-simulation of a matrix; None for an ARO parameter keeps the route file's value."""
+
+    case_id: str
+    sumocfg: Path
+    ego_speed_kmh: float
+    mu: float
+    oncoming_start_m: float | None
+    aro_hold_s: float | None
+    aro_decel_mps2: float | None
+    max_time_s: float
+
+    def overrides(self) -> ScenarioOverrides:
+        return ScenarioOverrides(
+            ego_speed_mps=self.ego_speed_kmh / 3.6,
+            mu=self.mu,
+            oncoming_start_m=self.oncoming_start_m,
+            aro_hold_s=self.aro_hold_s,
+            aro_decel_mps2=self.aro_decel_mps2,
+        )
+
+
+@dataclass(frozen=True)
+class Matrix:
+    """A checked experiment matrix (see :func:`load_matrix`)."""
+
+    path: Path
+    sumocfg: Path
+    max_time_s: float
+    ego_speeds_kmh: tuple[float, ...]
+    mus: tuple[float, ...]
+    oncoming_starts_m: tuple[float | None, ...]
+    aro_holds_s: tuple[float, ...]
+    aro_decels_mps2: tuple[float, ...]
+    paper_table: Path | None = None
+
+    def cases(self) -> list[Case]:
+        """Every case, in the paper's Table 2 order (traffic, speed, friction, ARO stop)."""
+        traffic = sorted(self.oncoming_starts_m, key=lambda d: d is not None)  # stable: none first
+        holds = self.aro_holds_s or (None,)
+        decels = self.aro_decels_mps2 or (None,)
+        cases = []
+        for onc in traffic:
+            for speed in self.ego_speeds_kmh:
+                for mu in self.mus:
+                    for hold in holds:
+                        for decel in decels:
+                            parts = [f"onc-{NO_ONCOMING if onc is None else _id_number(onc)}",
+                                     f"v{_id_number(speed)}", f"mu{_mu_text(mu)}"]
+                            if hold is not None:
+                                parts.append(f"hold{_id_number(hold)}")
+                            if decel is not None:
+                                parts.append(f"dec{_id_number(decel)}")
+                            cases.append(Case("_".join(parts), self.sumocfg, speed, mu, onc, hold,
+                                              decel, self.max_time_s))
+        return cases
+
+    def paper_outcomes(self) -> dict[str, str]:
+        """case_id -> the paper's outcome colour for the cases the ``[paper] table`` covers."""
+        if self.paper_table is None:
+            return {}
+        published = load_paper_table(self.paper_table)
+        return {c.case_id: published[key] for c in self.cases()
+                if (key := (c.oncoming_start_m, c.ego_speed_kmh, c.mu)) in published}
+
+
+def load_paper_table(path: Path) -> dict[tuple[float | None, float, float], str]:
+    """(oncoming_start_m or None, ego_speed_kmh, mu) -> outcome from a CSV like the paper's Table 2."""
+    path = Path(path)
+    try:
+        with path.open(newline="", encoding="utf-8") as fh:
+            rows = list(csv.DictReader(fh))
+            header = tuple(rows[0].keys()) if rows else ()
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read the paper table: {exc}") from exc
+    missing = [c for c in PAPER_COLUMNS if c not in header]
+    if missing:
+        raise InputError(f"{path}: the paper table needs the column '{missing[0]}'")
+    table = {}
+    for line, row in enumerate(rows, start=2):
+        try:
+            onc = None if row["oncoming_start_m"].strip() in ("", NO_ONCOMING) else float(row["oncoming_start_m"])
+            key = (onc, float(row["ego_speed_kmh"]), float(row["mu"]))
+        except (ValueError, AttributeError) as exc:
+            raise InputError(f"{path}, line {line}: not a number: {exc}") from exc
+        if row["outcome"] not in OUTCOMES:
+            raise InputError(f"{path}, line {line}: outcome {row['outcome']!r} is not one of "
+                             f"{', '.join(OUTCOMES)}")
+        table[key] = row["outcome"]
+    return table
+
+
+def _unknown(path: Path, where: str, key: str, valid: tuple[str, ...]) -> InputError:
+    close = difflib.get_close_matches(key, valid, n=1)
+    hint = f"; did you mean '{close[0]}'?" if close else f" (valid: {', '.join(valid)})"
+    return InputError(f"{path}: unknown {where} '{key}'{hint}")
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _number_list(path: Path, key: str, values, *, minimum: float, inclusive: bool,
+                 maximum: float | None = None, allow_none: bool = False) -> tuple:
+    where = f"[sweep] {key}"
+    if not isinstance(values, list):
+        raise InputError(f"{path}: {where} must be a list, not {values!r}")
+    if not values:
+        raise InputError(f"{path}: {where} is an empty list")
+    out = []
+    for v in values:
+        if allow_none and v == NO_ONCOMING:
+            item = None
+        elif not _is_number(v):
+            expected = f"a number or \"{NO_ONCOMING}\"" if allow_none else "a number"
+            raise InputError(f"{path}: {where} value {v!r} is not {expected}")
+        elif (v < minimum if inclusive else v <= minimum) or (maximum is not None and v > maximum):
+            low = "[" if inclusive else "("
+            high = f"{maximum:g}]" if maximum is not None else "inf)"
+            raise InputError(f"{path}: {where} value {v!r} is outside {low}{minimum:g}, {high}")
+        else:
+            item = float(v)
+        if item in out:
+            raise InputError(f"{path}: {where} lists {v!r} twice")
+        out.append(item)
+    return tuple(out)
+
+
+def load_matrix(path: Path) -> Matrix:
+    """Read and check an experiment-matrix TOML file; InputError names the file and the key."""
+    path = Path(path)
+    try:
+        with path.open("rb") as fh:
+            doc = tomllib.load(fh)
+    except FileNotFoundError as exc:
+        raise InputError(f"matrix file {path} not found") from exc
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read the matrix file: {exc}") from exc
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: malformed TOML: {exc}") from exc
+    for table, body in doc.items():
+        if table not in SCHEMA:
+            raise _unknown(path, "table", table, tuple(SCHEMA))
+        if not isinstance(body, dict):
+            raise InputError(f"{path}: '{table}' must be a table ([{table}])")
+        for key in body:
+            if key not in SCHEMA[table]:
+                raise _unknown(path, f"key in [{table}]", key, SCHEMA[table])
+    for table, keys in REQUIRED.items():
+        if table not in doc:
+            raise InputError(f"{path}: missing table [{table}]")
+        for key in keys:
+            if key not in doc[table]:
+                raise InputError(f"{path}: [{table}] needs the key '{key}'")
+    scenario, sweep = doc["scenario"], doc["sweep"]
+    sumocfg = _existing_file(path, "[scenario] sumocfg", scenario["sumocfg"])
+    max_time = scenario.get("max_time_s", DEFAULT_MAX_TIME_S)
+    if not _is_number(max_time) or max_time <= 0:
+        raise InputError(f"{path}: [scenario] max_time_s = {max_time!r} must be a number > 0")
+    paper = None
+    if "table" in doc.get("paper", {}):
+        paper = _existing_file(path, "[paper] table", doc["paper"]["table"])
+    return Matrix(
+        path=path,
+        sumocfg=sumocfg,
+        max_time_s=float(max_time),
+        ego_speeds_kmh=_number_list(path, "ego_speed_kmh", sweep["ego_speed_kmh"], minimum=0.0,
+                                    inclusive=False),
+        mus=_number_list(path, "mu", sweep["mu"], minimum=0.0, inclusive=False, maximum=MU_MAX),
+        oncoming_starts_m=_number_list(path, "oncoming_start_m",
+                                       sweep.get("oncoming_start_m", [NO_ONCOMING]),
+                                       minimum=0.0, inclusive=True, allow_none=True),
+        aro_holds_s=(_number_list(path, "aro_hold_s", sweep["aro_hold_s"], minimum=0.0,
+                                  inclusive=True) if "aro_hold_s" in sweep else ()),
+        aro_decels_mps2=(_number_list(path, "aro_decel_mps2", sweep["aro_decel_mps2"], minimum=0.0,
+                                      inclusive=False) if "aro_decel_mps2" in sweep else ()),
+        paper_table=paper,
+    )
+
+
+def _existing_file(path: Path, where: str, value) -> Path:
+    if not isinstance(value, str) or not value.strip():
+        raise InputError(f"{path}: {where} = {value!r} must be a file name (a string)")
+    resolved = (path.parent / value).resolve()
+    if not resolved.is_file():
+        raise InputError(f"{path}: {where} = {value!r}: file {resolved} not found")
+    return resolved

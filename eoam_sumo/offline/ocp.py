@@ -1,0 +1,202 @@
+"""Minimum-distance lane change: the nonlinear optimal control problem of eqs. 14-29 in CasADi.
+
+Minimise x(t_f) (eq. 14) over the free final time t_f, subject to the design model
+(``model.dynamics``, eqs. 15-20), x(0) = 0 and the given entry speed (eqs. 21-22, 24), the
+lateral offset y(t_f) = y_f (eq. 23), the friction ellipse of each axle (eqs. 25, 28), the
+steering angle limits (eqs. 26-27), the brake limit and the engine limit (eq. 29).
+
+Final conditions imposed besides eq. 23, so that the ego ends parallel and settled in the next
+lane: lateral speed, yaw angle, yaw rate and steering angle all zero at t_f.
+
+Transcription: direct multiple shooting, ``settings.ocp_intervals`` intervals of t_f / N,
+piecewise-constant controls (steering rate, longitudinal force), ``settings.rk_substeps``
+RK4 steps per interval; the path constraints hold at every RK step start. IPOPT solves it; the
+problem is built once per ``LaneChangeOcp`` with the entry speed and the friction as parameters.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from eoam_sumo.offline.design import DesignSettings
+from eoam_sumo.offline.inverse import inverse_dynamics
+from eoam_sumo.offline.model import N_CONTROLS, N_STATES, dynamics, split_force
+from eoam_sumo.offline.quintic import quintic_lateral, quintic_path
+from eoam_sumo.params import G_MPS2, VehicleParams
+
+_STATE_SCALE = np.array([100.0, 30.0, 3.5, 5.0, 0.2, 0.5, 0.1])
+_TIME_SCALE_S = 3.0
+
+
+class OcpError(RuntimeError):
+    """An optimal lane change that failed or broke its constraints (names speed and friction)."""
+
+
+@dataclass(frozen=True)
+class OcpSolution:
+    """A (candidate) optimal lane change: node states (N+1, 7) and interval controls (N, 2)."""
+
+    speed_mps: float
+    mu: float
+    duration_s: float
+    states: np.ndarray
+    controls: np.ndarray
+    iterations: int = 0
+
+    @property
+    def distance_m(self) -> float:
+        """x(t_f), the cost of eq. 14."""
+        return float(self.states[-1, 0])
+
+
+def solver_options(settings: DesignSettings) -> dict:
+    """The CasADi/IPOPT options (also written to metadata.json)."""
+    return {
+        "print_time": False,
+        "ipopt.print_level": 0,
+        "ipopt.sb": "yes",
+        "ipopt.tol": settings.ipopt_tol,
+        "ipopt.max_iter": settings.ipopt_max_iter,
+    }
+
+
+def _step_function(params: VehicleParams, substeps: int) -> ca.Function:
+    """One interval of RK4 sub-steps: (x, u, mu, dt) -> (x_next, path-constraint values)."""
+    x = ca.SX.sym("x", N_STATES)
+    u = ca.SX.sym("u", N_CONTROLS)
+    mu = ca.SX.sym("mu")
+    dt = ca.SX.sym("dt")
+
+    def f(xs):
+        xdot, out = dynamics(xs, u, mu, params, ca)
+        return ca.vertcat(*xdot), out
+
+    h = dt / substeps
+    xk = x
+    path = []
+    for _ in range(substeps):
+        k1, out = f(xk)
+        path += [out.ellipse_front, out.ellipse_rear, out.vx_body_mps]
+        k2, _ = f(xk + 0.5 * h * k1)
+        k3, _ = f(xk + 0.5 * h * k2)
+        k4, _ = f(xk + h * k3)
+        xk = xk + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+    return ca.Function("rk4_interval", [x, u, mu, dt], [xk, ca.vertcat(*path)])
+
+
+class LaneChangeOcp:
+    """The lane-change OCP built once; ``solve`` per entry speed and friction."""
+
+    def __init__(self, params: VehicleParams, settings: DesignSettings):
+        self.params = params
+        self.settings = settings
+        n = settings.ocp_intervals
+        p = params
+        opti = ca.Opti()
+        self._z = opti.variable(N_STATES, n + 1)
+        self._w = opti.variable(N_CONTROLS, n)
+        self._tau = opti.variable()
+        self._v0 = opti.parameter()
+        self._mu = opti.parameter()
+        mg = p.mass_kg * G_MPS2
+        self._control_scale = np.array([p.max_steer_rate_radps, mg])
+        xs = ca.diag(ca.DM(_STATE_SCALE)) @ self._z
+        us = ca.diag(ca.DM(self._control_scale)) @ self._w
+        t_f = _TIME_SCALE_S * self._tau
+        step = _step_function(p, settings.rk_substeps).map(n)
+        x_next, path = step(xs[:, :-1], us, ca.repmat(self._mu, 1, n), ca.repmat(t_f / n, 1, n))
+        opti.subject_to(self._z[:, 1:] == x_next / ca.DM(_STATE_SCALE))
+        # eqs. 21, 22, 24 (steering starts centred)
+        opti.subject_to(xs[:, 0] == ca.vertcat(0.0, self._v0, 0.0, 0.0, 0.0, 0.0, 0.0))
+        # eq. 23 and the settled end: no lateral speed, yaw, yaw rate or steering
+        opti.subject_to(xs[2:, -1] == ca.vertcat(settings.lane_change_m, 0.0, 0.0, 0.0, 0.0))
+        for j in range(settings.rk_substeps):
+            opti.subject_to(ca.vec(path[3 * j:3 * j + 2, :]) <= 1.0)  # eqs. 25, 28
+            opti.subject_to(path[3 * j + 2, :] >= settings.min_speed_mps)
+        steer = xs[6, :]
+        opti.subject_to(opti.bounded(-p.max_steer_rad, steer, p.max_steer_rad))  # eqs. 26-27
+        opti.subject_to(opti.bounded(-settings.max_yaw_rad, xs[4, :], settings.max_yaw_rad))
+        opti.subject_to(opti.bounded(-1.0, self._w[0, :], 1.0))  # steering rate limit
+        drive = split_force(us[1, :])[1]
+        opti.subject_to(opti.bounded(-p.max_brake_force_n, us[1, :], p.max_drive_force_n))
+        opti.subject_to(drive * xs[1, :-1] <= p.max_drive_power_w)  # eq. 29, power
+        opti.subject_to(opti.bounded(0.1 / _TIME_SCALE_S, self._tau, 30.0 / _TIME_SCALE_S))
+        dw = self._w[:, 1:] - self._w[:, :-1]
+        opti.minimize(xs[0, -1] + settings.regularisation * ca.sumsqr(dw))  # eq. 14
+        opti.solver("ipopt", solver_options(settings))
+        self._opti = opti
+
+    def solve(self, speed_mps: float, mu: float, guess: OcpSolution) -> OcpSolution:
+        """Solve for this entry speed and friction from ``guess``; raise ``OcpError`` on failure."""
+        opti = self._opti
+        opti.set_value(self._v0, speed_mps)
+        opti.set_value(self._mu, mu)
+        opti.set_initial(self._z, (guess.states / _STATE_SCALE).T)
+        opti.set_initial(self._w, (guess.controls / self._control_scale).T)
+        opti.set_initial(self._tau, guess.duration_s / _TIME_SCALE_S)
+        sol = opti.solve_limited()
+        stats = opti.stats()
+        if not stats["success"]:
+            raise OcpError(
+                f"optimal lane change at mu={mu:g}, {speed_mps * 3.6:g} km/h did not converge: "
+                f"IPOPT {stats['return_status']} after {stats['iter_count']} iterations")
+        return OcpSolution(
+            speed_mps=float(speed_mps),
+            mu=float(mu),
+            duration_s=float(sol.value(self._tau)) * _TIME_SCALE_S,
+            states=np.asarray(sol.value(self._z)).T * _STATE_SCALE,
+            controls=np.asarray(sol.value(self._w)).T * self._control_scale,
+            iterations=int(stats["iter_count"]),
+        )
+
+
+def quintic_guess(speed_mps: float, mu: float, params: VehicleParams,
+                  settings: DesignSettings) -> OcpSolution:
+    """Initial guess: the quintic at constant speed with its inverse-dynamics steering."""
+    n = settings.ocp_intervals
+    t_f = settings.quintic_time_s(mu)
+    path = quintic_path(speed_mps, t_f, settings.lane_change_m, samples=4 * n + 1)
+    inv = inverse_dynamics(path, params, mu)
+    t = np.linspace(0.0, t_f, n + 1)
+    idx = np.arange(0, 4 * n + 1, 4)
+    _, dy, _, _ = quintic_lateral(t, t_f, settings.lane_change_m)
+    steer = np.clip(inv.steer_rad[idx], -params.max_steer_rad, params.max_steer_rad)
+    steer[-1] = 0.0
+    states = np.column_stack([
+        speed_mps * t, np.full(n + 1, speed_mps), path.y_m[idx], dy, inv.yaw_rad[idx],
+        inv.yaw_rate_radps[idx], steer])
+    steer_rate = np.clip(np.diff(steer) / (t_f / n), -params.max_steer_rate_radps,
+                         params.max_steer_rate_radps)
+    controls = np.column_stack([steer_rate, np.zeros(n)])
+    return OcpSolution(float(speed_mps), float(mu), t_f, states, controls)
+
+
+def rescaled_guess(previous: OcpSolution, speed_mps: float) -> OcpSolution:
+    """Warm start from the solution at a neighbouring speed: distances scale with speed."""
+    ratio = speed_mps / previous.speed_mps
+    states = previous.states.copy()
+    states[:, 0] *= ratio
+    states[:, 1] *= ratio
+    return OcpSolution(float(speed_mps), previous.mu, previous.duration_s, states,
+                       previous.controls.copy())
+
+
+def solve_chain(ocp: LaneChangeOcp, mu: float, speeds_mps, on_solved=None) -> list[OcpSolution]:
+    """Solve the speeds in order for one friction, each warm-started from the previous one.
+
+    The first speed starts from ``quintic_guess``. ``on_solved(solution)`` is called after each.
+    """
+    solutions = []
+    for v in speeds_mps:
+        if solutions:
+            guess = rescaled_guess(solutions[-1], v)
+        else:
+            guess = quintic_guess(v, mu, ocp.params, ocp.settings)
+        sol = ocp.solve(v, mu, guess)
+        solutions.append(sol)
+        if on_solved is not None:
+            on_solved(sol)
+    return solutions

@@ -1,0 +1,117 @@
+"""Build the plant's step as one CasADi SX function and compile it to a cached C library.
+
+The SX graph holds all ``substeps`` RK4 steps of ``model.rhs`` (``integrator.advance`` on
+CasADi symbols), so one call of the compiled function advances a whole co-simulation step.
+The C source comes from ``casadi.CodeGenerator``; it is compiled with the system C compiler
+(``$CC``, else ``gcc``, else ``cc``) into a cache directory, keyed by a hash of the source and
+the compiler command, so a changed model or parameter set gets a new library. The library is
+written to a temporary file and renamed into place, so concurrent builders are safe.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import os
+import shlex
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+import casadi
+
+from eoam_sumo.params import VehicleParams
+from eoam_sumo.plant.integrator import advance
+from eoam_sumo.plant.model import INPUT_NAMES, STATE_NAMES
+from eoam_sumo.plant.ops import CASADI_OPS
+
+FUNCTION_NAME = "eoam_plant_step"
+C_FLAGS = ("-O2", "-shared", "-fPIC", "-ffp-contract=off")
+"""``-ffp-contract=off``: no fused multiply-adds, so the C code rounds like the reference."""
+
+CACHE_ENV = "EOAM_SUMO_CACHE_DIR"
+
+
+@functools.lru_cache(maxsize=16)
+def step_function(params: VehicleParams, dt_s: float, substeps: int) -> casadi.Function:
+    """SX function ``(x[9], u[3], mu) -> (x_next[9], y[len(OUTPUT_NAMES)])``."""
+    x = casadi.SX.sym("x", len(STATE_NAMES))
+    u = casadi.SX.sym("u", len(INPUT_NAMES))
+    mu = casadi.SX.sym("mu")
+    x_next, y = advance(
+        [x[i] for i in range(x.numel())],
+        [u[i] for i in range(u.numel())],
+        mu,
+        params,
+        dt_s,
+        substeps,
+        CASADI_OPS,
+    )
+    return casadi.Function(
+        FUNCTION_NAME,
+        [x, u, mu],
+        [casadi.vertcat(*x_next), casadi.vertcat(*y)],
+        ["x", "u", "mu"],
+        ["x_next", "y"],
+    )
+
+
+def c_source(fn: casadi.Function) -> str:
+    """Self-contained C source of ``fn`` (CasADi's calling convention, 64-bit ``casadi_int``)."""
+    gen = casadi.CodeGenerator(
+        f"{fn.name()}.c", {"with_header": False, "casadi_int": "long long int"}
+    )
+    gen.add(fn)
+    return gen.dump()
+
+
+def default_cache_dir() -> Path:
+    """``$EOAM_SUMO_CACHE_DIR``, else ``$XDG_CACHE_HOME/eoam_sumo``, else ``~/.cache/eoam_sumo``."""
+    if os.environ.get(CACHE_ENV):
+        return Path(os.environ[CACHE_ENV])
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "eoam_sumo"
+
+
+def find_compiler() -> list[str] | None:
+    """The C compiler command (``$CC`` split like a shell would, else gcc, else cc), or None."""
+    if os.environ.get("CC"):
+        cmd = shlex.split(os.environ["CC"])
+        path = shutil.which(cmd[0])
+        return [path, *cmd[1:]] if path else None
+    for name in ("gcc", "cc"):
+        path = shutil.which(name)
+        if path:
+            return [path]
+    return None
+
+
+def build_library(source: str, cache_dir: Path, compiler: list[str]) -> Path:
+    """Compile ``source`` into ``cache_dir`` unless already there; return the library path.
+
+    Raises ``RuntimeError`` with the compiler's message when compilation fails and
+    ``OSError`` when the directory cannot be written.
+    """
+    key = hashlib.sha256("\0".join([source, *compiler, *C_FLAGS]).encode()).hexdigest()[:24]
+    target = Path(cache_dir) / f"{FUNCTION_NAME}_{key}.so"
+    if target.exists():
+        return target
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=".tmp", dir=target.parent)
+    os.close(fd)
+    try:
+        proc = subprocess.run(
+            [*compiler, *C_FLAGS, "-x", "c", "-", "-o", tmp, "-lm"],
+            input=source.encode(),
+            capture_output=True,
+            check=False,
+        )
+        if proc.returncode != 0:
+            message = proc.stderr.decode(errors="replace").strip()[-2000:]
+            raise RuntimeError(f"C compiler {compiler[0]} failed: {message}")
+        os.replace(tmp, target)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+    return target

@@ -1,0 +1,35 @@
+"""Plain-Python reference plant: the same model and RK4, evaluated with Python floats.
+
+Slow (pure Python) but independent of CasADi's code generation and of the C compiler; the
+tests hold the compiled ``Plant`` to it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from eoam_sumo.params import VehicleParams
+from eoam_sumo.plant.integrator import advance
+from eoam_sumo.plant.ops import FLOAT_OPS
+from eoam_sumo.plant.stepping import check_mu, validate_step
+
+
+class ReferencePlant:
+    """Same interface as ``Plant``: ``step(x, u, mu) -> (x_next, y)`` over ``substeps * dt_s``."""
+
+    def __init__(self, params: VehicleParams, dt_s: float = 1e-3, substeps: int = 10):
+        validate_step(params, dt_s, substeps)
+        self.params = params
+        self.dt_s = float(dt_s)
+        self.substeps = substeps
+
+    @property
+    def step_s(self) -> float:
+        """Time advanced by one ``step`` call [s]."""
+        return self.dt_s * self.substeps
+
+    def step(self, x, u, mu: float) -> tuple[np.ndarray, np.ndarray]:
+        xs = [float(v) for v in x]
+        us = [float(v) for v in u]
+        x_next, y = advance(xs, us, check_mu(mu), self.params, self.dt_s, self.substeps, FLOAT_OPS)
+        return np.array(x_next, dtype=float), np.array(y, dtype=float)

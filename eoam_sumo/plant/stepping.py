@@ -1,0 +1,63 @@
+"""What both plant implementations share: step-size checks and initial states."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from eoam_sumo.params import AIR_DENSITY_KGPM3, G_MPS2, VehicleParams
+from eoam_sumo.plant.model import BRAKE, DRIVE, STATE_NAMES, STEER, VX, YAW, X, Y
+
+MAX_DT_S = 0.005
+"""Largest RK4 sub-step accepted: keeps ``dt * C / (m * SLIP_SPEED_FLOOR_MPS)`` and the creep
+ramp's stiffness well inside RK4's stability region (|lambda dt| < 2.78)."""
+
+
+def validate_step(params: VehicleParams, dt_s: float, substeps: int) -> None:
+    """Raise ``ValueError`` unless ``0 < dt_s <= MAX_DT_S``, ``substeps >= 1`` and every
+    actuator lag is at least ``dt_s`` (a shorter lag would make the fixed-step RK4 unstable)."""
+    if isinstance(substeps, bool) or not isinstance(substeps, int) or substeps < 1:
+        raise ValueError(f"substeps={substeps!r} must be an int >= 1")
+    if not (isinstance(dt_s, (int, float)) and 0.0 < dt_s <= MAX_DT_S):
+        raise ValueError(f"dt_s={dt_s!r} must be in (0, {MAX_DT_S}] s")
+    for name in ("steer_lag_s", "drive_lag_s", "brake_lag_s"):
+        if getattr(params, name) < dt_s:
+            raise ValueError(
+                f"vehicle parameter {name}={getattr(params, name)} must be >= dt_s={dt_s}"
+            )
+
+
+def check_mu(mu: float) -> float:
+    """The surface friction as a float; ``ValueError`` unless finite and > 0."""
+    mu = float(mu)
+    if not (0.0 < mu < math.inf):
+        raise ValueError(f"mu={mu!r} must be finite and > 0")
+    return mu
+
+
+def initial_state(
+    x_m: float,
+    y_m: float,
+    yaw_rad: float,
+    speed_mps: float,
+    *,
+    steer_rad: float = 0.0,
+    drive_force_n: float = 0.0,
+    brake_force_n: float = 0.0,
+) -> np.ndarray:
+    """State vector (``STATE_NAMES`` order) of a vehicle at ``(x_m, y_m)`` heading ``yaw_rad``
+    moving straight at ``speed_mps >= 0``; actuator states zero unless given."""
+    if not speed_mps >= 0.0:
+        raise ValueError(f"speed_mps={speed_mps!r} must be >= 0")
+    x = np.zeros(len(STATE_NAMES))
+    x[X], x[Y], x[YAW], x[VX] = x_m, y_m, yaw_rad, speed_mps
+    x[STEER], x[DRIVE], x[BRAKE] = steer_rad, drive_force_n, brake_force_n
+    return x
+
+
+def cruise_drive_force_n(params: VehicleParams, speed_mps: float) -> float:
+    """Drive force [N] that holds ``speed_mps`` on a straight level road: aerodynamic drag plus
+    rolling resistance, as in ``model.rhs``."""
+    drag_n = 0.5 * AIR_DENSITY_KGPM3 * params.drag_area_m2 * speed_mps * speed_mps
+    return drag_n + params.rolling_resistance_coeff * params.mass_kg * G_MPS2

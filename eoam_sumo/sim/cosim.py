@@ -1,0 +1,276 @@
+"""The co-simulation step loop (design card: SUMO + radar + EOAM logic + plant + write-back).
+
+Two rates: SUMO and the EOAM decision/control run every ``step_s`` (10 ms by default); the
+plant integrates at ``plant_dt_s`` (1 ms) inside each SUMO step, all sub-steps in one compiled
+call. Per SUMO step: sense (radar on SUMO's context subscription), decide and control, advance
+the plant, write the ego pose back with ``moveToXY``, step SUMO, check contact with every
+other vehicle on oriented boxes at each plant sub-step, log.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, Perception
+from eoam_sumo.errors import InputError
+from eoam_sumo.offline.tables import LookupTables, default_tables_dir
+from eoam_sumo.params import VehicleParams, ego_e_class_sedan
+from eoam_sumo.plant import Plant, initial_state
+from eoam_sumo.sim.geometry import OrientedBox, box_distance, contact
+from eoam_sumo.sim.outcome import classify_outcome, role_of
+from eoam_sumo.sim.radar import Radar, RadarSettings, Target
+from eoam_sumo.sim.roadframe import RoadFrame
+from eoam_sumo.sim.runlog import RunLog
+from eoam_sumo.sim.sumo_adapter import ScenarioOverrides, SumoSession
+
+
+@dataclass(frozen=True)
+class RunSettings:
+    """Rates, limits and sub-settings of one co-simulation run."""
+
+    step_s: float = 0.01  # SUMO and decision/control step [s]; whole milliseconds in SUMO
+    plant_dt_s: float = 0.001  # plant integration step [s]
+    max_time_s: float = 40.0  # simulated time limit [s]
+    settle_s: float = 2.0  # run on this long after the hand-back or a stop [s]
+    ego_id: str = "ego"
+    gui: bool = False
+    use_traci: bool = False
+    tables_dir: Path | None = None
+    radar: RadarSettings = field(default_factory=RadarSettings)
+    eoam: EoamSettings = field(default_factory=EoamSettings)
+
+    def __post_init__(self) -> None:
+        ms = self.step_s * 1000.0
+        if self.step_s <= 0 or abs(ms - round(ms)) > 1e-9:
+            raise ValueError(f"step_s={self.step_s} must be a positive whole number of ms")
+        n = self.step_s / self.plant_dt_s
+        if self.plant_dt_s <= 0 or abs(n - round(n)) > 1e-9:
+            raise ValueError(f"plant_dt_s={self.plant_dt_s} must divide step_s={self.step_s}")
+        if self.max_time_s <= 0:
+            raise ValueError(f"max_time_s={self.max_time_s} must be > 0")
+
+    @property
+    def substeps(self) -> int:
+        return round(self.step_s / self.plant_dt_s)
+
+
+def _nav_deg(yaw_rad: float) -> float:
+    """SUMO navigation angle (degrees clockwise from north) of a math yaw."""
+    return (90.0 - math.degrees(yaw_rad)) % 360.0
+
+
+class CoSimulation:
+    """One run of a SUMO scenario with the ego driven by the plant under the EOAM logic."""
+
+    def __init__(
+        self,
+        cfg: Path,
+        overrides: ScenarioOverrides = ScenarioOverrides(),
+        settings: RunSettings = RunSettings(),
+        params: VehicleParams | None = None,
+    ):
+        self.cfg = Path(cfg)
+        self.overrides = overrides
+        self.settings = settings
+        self.params = params or ego_e_class_sedan()
+        tables_dir = settings.tables_dir or default_tables_dir()
+        self.tables = LookupTables.load(tables_dir, params=self.params)
+        if overrides.ego_speed_mps is not None:
+            self._check_speed(overrides.ego_speed_mps)
+        self.plant = Plant(self.params, dt_s=settings.plant_dt_s, substeps=settings.substeps)
+        self.radar = Radar(settings.radar)
+
+    def _check_speed(self, speed_mps: float) -> None:
+        top = self.tables.speed_grid_mps[-1]
+        if not 0.0 < speed_mps <= top + 1e-9:
+            raise InputError(
+                f"ego speed {speed_mps * 3.6:.1f} km/h is outside the tables' range "
+                f"(0, {top * 3.6:.0f}] km/h"
+            )
+
+    def run(self) -> tuple[dict, RunLog]:
+        st = self.settings
+        p = self.params
+        wall0 = time.perf_counter()
+        session = SumoSession.start(
+            self.cfg, self.overrides, ego_id=st.ego_id, step_length_s=st.step_s,
+            gui=st.gui, use_traci=st.use_traci,
+        )
+        try:
+            return self._loop(session, wall0)
+        finally:
+            session.close()
+
+    def _loop(self, session: SumoSession, wall0: float) -> tuple[dict, RunLog]:
+        st, p = self.settings, self.params
+        ego = session.ego_body()
+        self._check_speed(ego.speed_mps)
+        road = RoadFrame(session.ego_lane_centreline())
+        lane_width = session.lane_width_m
+        x = initial_state(ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps)
+        ctrl = EoamController(p, self.tables, st.eoam)
+        ctrl.reset(ego.speed_mps)
+        mu0 = session.friction_at_ego()
+        sense_radius = st.radar.range_m + 20.0
+        steps = int(round(st.max_time_s / st.step_s))
+        log = RunLog(steps + 1)
+        ax = ay = 0.0
+        first_contact = None
+        min_gap_aro = math.inf
+        max_lat_offset = 0.0
+        stop_at = None
+        idx = {n: i for i, n in enumerate(("x", "y", "yaw", "vx", "vy", "r"))}
+        front = p.cg_to_front_bumper_m
+        t = session.time_s
+        prev_bodies = {}
+        for _ in range(steps):
+            # --- sense: the world at time t -------------------------------------------------
+            X, Y, yaw, vx, vy, r = (float(x[i]) for i in range(6))
+            s, d, road_yaw = road.project(X, Y)
+            mu = session.friction_at_ego()
+            bodies = session.nearby(sense_radius)
+            cy, sy = math.cos(yaw), math.sin(yaw)
+            report = self.radar.scan(
+                (X + front * cy, Y + front * sy), yaw, vx,
+                road, [Target(b.x_m, b.y_m, b.yaw_rad, b.speed_mps, b.length_m, b.width_m)
+                       for b in bodies],
+                lane_width,
+            )
+            perception = Perception(
+                report.in_path_range_m, report.in_path_range_rate_mps, report.oncoming_detected
+            )
+            meas = EgoMeasurement(
+                t, vx, vy, r, ax, ay, s, d, yaw - road_yaw, road.curvature_at(s), mu, lane_width
+            )
+            # --- decide and control ----------------------------------------------------------
+            cmd = ctrl.step(meas, perception, st.step_s)
+            log.add(t, x, ax, ay, s, d, meas.e_yaw_rad, mu, cmd, perception)
+            # --- plant: all sub-steps of this SUMO step in one call --------------------------
+            x_prev = x
+            x, y_out = self.plant.step(
+                x, (cmd.steer_cmd_rad, cmd.drive_force_cmd_n, cmd.brake_force_cmd_n), mu
+            )
+            ax, ay = float(y_out[0]), float(y_out[1])
+            # --- write back and step SUMO ----------------------------------------------------
+            Xn, Yn, yawn = float(x[0]), float(x[1]), float(x[2])
+            session.move_ego(
+                Xn + front * math.cos(yawn), Yn + front * math.sin(yawn),
+                _nav_deg(yawn), max(float(x[3]), 0.0),
+            )
+            session.step()
+            t = session.time_s
+            # --- ground truth: contact on oriented boxes at every plant sub-step -------------
+            bodies_now = session.nearby(sense_radius)
+            ego_box = OrientedBox.from_axis_point(
+                Xn, Yn, yawn, p.length_m, p.width_m, p.cg_to_front_bumper_m
+            )
+            for b in bodies_now:
+                box = OrientedBox(b.x_m, b.y_m, b.yaw_rad, b.length_m, b.width_m)
+                role = role_of(b, road, lane_width)
+                if role == "aro":
+                    min_gap_aro = min(min_gap_aro, box_distance(ego_box, box))
+                if first_contact is None:
+                    hit = self._substep_contact(x_prev, x, b, prev_bodies.get(b.vid))
+                    if hit is not None:
+                        first_contact = (hit, role, t)
+            prev_bodies = {b.vid: b for b in bodies_now}
+            max_lat_offset = max(max_lat_offset, abs(d))
+            # --- end of run ------------------------------------------------------------------
+            if first_contact is not None:
+                break
+            if stop_at is None and self._finished(ctrl, x):
+                stop_at = t + st.settle_s
+            if stop_at is not None and t >= stop_at - 1e-9:
+                break
+            if s > road.length_m - 50.0:
+                break
+        X, Y, yaw = float(x[0]), float(x[1]), float(x[2])
+        s, d, road_yaw = road.project(X, Y)
+        log.add(t, x, ax, ay, s, d, yaw - road_yaw, session.friction_at_ego(), None, None)
+        contact_info, role, t_contact = first_contact or (None, "none", None)
+        outcome = classify_outcome(
+            modes_visited=ctrl.modes_visited,
+            max_lateral_offset_m=max_lat_offset,
+            lane_width_m=lane_width,
+            contact=contact_info,
+            role=role,
+            final_offset_m=d,
+            final_speed_mps=max(float(x[3]), 0.0),
+        )
+        wall = time.perf_counter() - wall0
+        sim_time = t
+        summary = {
+            "outcome": outcome.colour,
+            "collision_with": outcome.collision_with,
+            "impact_speed_mps": round(outcome.impact_speed_mps, 6),
+            "contact_kind": contact_info.kind if contact_info else "none",
+            "contact_time_s": t_contact,
+            "reason": outcome.reason,
+            "modes_visited": list(ctrl.modes_visited),
+            "fcw_raised": bool(ctrl.fcw_raised),
+            "mu": mu0,
+            "min_gap_aro_m": None if math.isinf(min_gap_aro) else round(min_gap_aro, 6),
+            "max_abs_lat_accel_mps2": round(log.max_abs("ay_mps2"), 6),
+            "max_lateral_offset_m": round(max_lat_offset, 6),
+            "final_lateral_offset_m": round(d, 6),
+            "final_speed_mps": round(max(float(x[3]), 0.0), 6),
+            "ego_initial_speed_mps": round(ego.speed_mps, 6),
+            "sim_time_s": round(sim_time, 6),
+            "wall_time_s": wall,
+            "realtime_factor": sim_time / wall if wall > 0 else math.inf,
+        }
+        return summary, log
+
+    def _finished(self, ctrl: EoamController, x) -> bool:
+        """The EOAM is over: handed back to NORMAL after a manoeuvre, or stopped."""
+        modes = ctrl.modes_visited
+        if len(modes) > 1 and ctrl.mode == 0:
+            return True
+        return ctrl.mode in (1, 3) and float(x[3]) < 0.05
+
+    def _substep_contact(self, x_prev, x_next, body, body_prev):
+        """First contact at any plant sub-step between ego and body, poses interpolated."""
+        p = self.params
+        n = self.settings.substeps
+        b0 = body_prev or body
+        for k in range(1, n + 1):
+            w = k / n
+            ex = x_prev[0] + w * (x_next[0] - x_prev[0])
+            ey = x_prev[1] + w * (x_next[1] - x_prev[1])
+            eyaw = x_prev[2] + w * (x_next[2] - x_prev[2])
+            bx = b0.x_m + w * (body.x_m - b0.x_m)
+            by = b0.y_m + w * (body.y_m - b0.y_m)
+            byaw = body.yaw_rad
+            ebox = OrientedBox.from_axis_point(
+                float(ex), float(ey), float(eyaw), p.length_m, p.width_m, p.cg_to_front_bumper_m
+            )
+            obox = OrientedBox(bx, by, byaw, body.length_m, body.width_m)
+            speed = float(x_prev[3] + w * (x_next[3] - x_prev[3]))
+            ve = (speed * math.cos(eyaw), speed * math.sin(eyaw))
+            vb = (body.speed_mps * math.cos(byaw), body.speed_mps * math.sin(byaw))
+            hit = contact(ebox, obox, ve, vb)
+            if hit is not None:
+                return hit
+        return None
+
+
+def run_case(
+    cfg: Path,
+    overrides: ScenarioOverrides = ScenarioOverrides(),
+    out_dir: Path | None = None,
+    settings: RunSettings = RunSettings(),
+    extra: dict | None = None,
+) -> dict:
+    """Run one case; write ``timeseries.csv`` and ``summary.json`` to ``out_dir`` if given."""
+    summary, log = CoSimulation(cfg, overrides, settings).run()
+    if extra:
+        summary = {**extra, **summary}
+    if out_dir is not None:
+        from eoam_sumo.sim.runlog import write_run
+
+        write_run(Path(out_dir), summary, log)
+    return summary
+

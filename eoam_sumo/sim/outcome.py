@@ -1,0 +1,211 @@
+"""Outcome colour of a run (paper sec. 11, design.md sec. 3.4) from ground truth.
+
+Inputs are the first contact found on the oriented boxes (``geometry.contact`` with the ego as
+box ``a``), the ground-truth role of the body hit (``role_of``, from its position and motion,
+never its id), the EOAM mode history and the ego's lateral offsets in the road frame of its
+original lane (left positive).
+
+Definitions:
+
+* lane change made: the largest |lateral offset| of the ego during the run reached the point
+  of no return, ``point_of_no_return_fraction`` (0.3, paper sec. 8.1) of the lane width; past
+  it the EOAM logic is committed to the lane change, before it an oncoming vehicle still turns
+  the manoeuvre into straight-line limit braking (yellow, not orange or red);
+* back in lane: |final lateral offset| <= ``in_lane_tolerance_m``;
+* stopped: final speed <= ``stopped_speed_mps``.
+
+Rules, in order:
+
+1. no contact and no mode other than 0 (NORMAL): ``none``;
+2. no contact otherwise: ``green``; the reason says whether the lane change was completed and
+   the ego returned, or it stopped behind the obstacle; a run that ended before the ego was
+   back in lane or stopped is still green (nothing was hit) and the reason says so;
+3. front against front (``head_on`` or ``oblique``) with the oncoming vehicle: ``red``, with or
+   without a lane change (a frontal hit on oncoming traffic is the most severe outcome);
+4. no lane change and the ego's front hit a body that is not oncoming (front-to-rear or
+   frontal, not a side contact): ``yellow`` (direct hit at reduced speed, paper sec. 8.1);
+5. every other contact: ``orange`` (lateral or offset contact: side contact with the oncoming
+   vehicle, any contact after a lane change with the ARO or a parked car, any side contact,
+   the ego hit from behind).
+
+``collision_with`` is the role of the body hit; a body of role ``other`` (moving with the
+traffic outside the ego lane band, e.g. a car overtaking in the next lane) is reported as
+``aro``, the class of in-lane obstacles, because the summary contract has no ``other``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+from eoam_sumo.sim.geometry import Contact
+from eoam_sumo.sim.radar import (
+    LANE_MARGIN_M,
+    ONCOMING_SPEED_MPS,
+    STATIONARY_SPEED_MPS,
+    RoadProjection,
+)
+
+COLOURS = ("none", "green", "yellow", "orange", "red")
+ROLES = ("aro", "oncoming", "parked", "other")
+_COLLISION_WITH = {"aro": "aro", "oncoming": "oncoming", "parked": "parked", "other": "aro"}
+_ROLE_NAMES = {
+    "aro": "the ARO",
+    "oncoming": "the oncoming vehicle",
+    "parked": "a parked car",
+    "other": "another road user (reported as aro)",
+}
+
+
+class Body(Protocol):
+    """Anything with a ground-truth centre, heading and speed (a ``radar.Target``, a SUMO body)."""
+
+    x_m: float
+    y_m: float
+    yaw_rad: float
+    speed_mps: float
+
+
+def role_of(
+    body: Body,
+    road_frame: RoadProjection,
+    lane_width_m: float,
+    *,
+    in_lane_at_start: bool = False,
+    stationary_speed_mps: float = STATIONARY_SPEED_MPS,
+    oncoming_speed_mps: float = ONCOMING_SPEED_MPS,
+    lane_margin_m: float = LANE_MARGIN_M,
+) -> str:
+    """Ground-truth role of a body relative to the ego's original lane (``road_frame``).
+
+    ``oncoming``: moving against the road direction faster than ``oncoming_speed_mps``;
+    ``aro``: otherwise, when its centre is inside the ego lane band (half-width lane_width/2 +
+    lane_margin_m) or it was the vehicle ahead in the ego lane at the start
+    (``in_lane_at_start``); ``parked``: slower than ``stationary_speed_mps`` outside the band;
+    ``other``: the rest. Thresholds default to the radar's, so roles and radar classes agree.
+    """
+    if not lane_width_m > 0.0:
+        raise ValueError(f"lane_width_m={lane_width_m} must be > 0")
+    _, d, road_yaw = road_frame.project(body.x_m, body.y_m)
+    if body.speed_mps * math.cos(body.yaw_rad - road_yaw) < -oncoming_speed_mps:
+        return "oncoming"
+    if in_lane_at_start or abs(d) < 0.5 * lane_width_m + lane_margin_m:
+        return "aro"
+    if abs(body.speed_mps) < stationary_speed_mps:
+        return "parked"
+    return "other"
+
+
+@dataclass(frozen=True)
+class OutcomeSettings:
+    """Thresholds that turn the end state of a run into the facts the colours need."""
+
+    point_of_no_return_fraction: float = 0.3  # of the lane width (paper sec. 8.1: 0.3 x 3.5 m)
+    # ego centre within 0.5 m of the lane centre: a 1.85 m wide car keeps >= 0.3 m to the
+    # markers of a 3.5 m lane
+    in_lane_tolerance_m: float = 0.5
+    stopped_speed_mps: float = 0.1  # "stopped" at the end of the run
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.point_of_no_return_fraction <= 1.0:
+            raise ValueError(
+                f"point_of_no_return_fraction={self.point_of_no_return_fraction} must be in (0, 1]"
+            )
+        for name in ("in_lane_tolerance_m", "stopped_speed_mps"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v > 0.0):
+                raise ValueError(f"OutcomeSettings.{name}={v!r} must be finite and > 0")
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """Colour of a run, what was hit, how fast, and a one-line reason."""
+
+    colour: str
+    collision_with: str
+    impact_speed_mps: float
+    reason: str
+
+
+def _manoeuvre_phrase(modes: set[int], lane_change: bool) -> str:
+    if lane_change:
+        return "lane change"
+    if 3 in modes:
+        return "limit braking chosen (oncoming seen before the point of no return)"
+    if 1 in modes:
+        return "limit braking chosen by the DMM"
+    if modes & {2, 4, 5}:
+        return "lane change started but the point of no return not reached"
+    return "no EOAM intervention"
+
+
+def classify_outcome(
+    modes_visited: Sequence[int],
+    max_lateral_offset_m: float,
+    lane_width_m: float,
+    contact: Contact | None = None,
+    role: str = "none",
+    final_offset_m: float = 0.0,
+    final_speed_mps: float = 0.0,
+    settings: OutcomeSettings = OutcomeSettings(),
+) -> Outcome:
+    """Colour of a run by the rules of the module docstring.
+
+    ``modes_visited``: EOAM modes 0-5 in order of first visit; ``max_lateral_offset_m``: the
+    largest |d| of the ego during the run; ``contact``: the first contact with the ego as box
+    ``a`` (None if nothing was hit) and ``role`` the role of the other body (``role_of``);
+    ``final_offset_m`` and ``final_speed_mps``: the ego's d and speed when the run ended.
+    """
+    modes = set(modes_visited)
+    if not modes <= {0, 1, 2, 3, 4, 5}:
+        raise ValueError(f"modes_visited={list(modes_visited)} must hold mode numbers 0-5")
+    for name, v in (("max_lateral_offset_m", max_lateral_offset_m),
+                    ("final_offset_m", final_offset_m), ("final_speed_mps", final_speed_mps)):
+        if not math.isfinite(v):
+            raise ValueError(f"{name}={v!r} must be finite")
+    if not lane_width_m > 0.0:
+        raise ValueError(f"lane_width_m={lane_width_m} must be > 0")
+    lane_change = abs(max_lateral_offset_m) >= settings.point_of_no_return_fraction * lane_width_m
+    if contact is None:
+        return _no_contact(modes, lane_change, final_offset_m, final_speed_mps, settings)
+    if role not in ROLES:
+        raise ValueError(f"role={role!r} of the body hit must be one of {ROLES}")
+    what = _ROLE_NAMES[role]
+    v = contact.impact_speed_mps
+    done = _manoeuvre_phrase(modes, lane_change)
+    frontal = contact.kind in ("head_on", "oblique")
+    if role == "oncoming" and frontal:
+        how = "head-on" if contact.kind == "head_on" else "offset/oblique head-on"
+        colour, reason = "red", f"{done}, {how} with the oncoming vehicle at {v:.1f} m/s"
+    elif (
+        not lane_change and role != "oncoming" and contact.face_a == "front"
+        and contact.kind != "side"
+    ):
+        colour, reason = "yellow", f"{done}, front hit {what} at {v:.1f} m/s"
+    else:
+        how = contact.kind.replace("_", "-")
+        part = f"ego {contact.face_a} against its {contact.face_b}"
+        colour, reason = "orange", f"{done}, {how} contact with {what} ({part}) at {v:.1f} m/s"
+    return Outcome(colour, _COLLISION_WITH[role], v, reason)
+
+
+def _no_contact(
+    modes: set[int], lane_change: bool, final_offset_m: float, final_speed_mps: float,
+    settings: OutcomeSettings,
+) -> Outcome:
+    if not modes - {0}:
+        return Outcome("none", "none", 0.0, "no manoeuvre needed, no contact")
+    in_lane = abs(final_offset_m) <= settings.in_lane_tolerance_m
+    stopped = final_speed_mps <= settings.stopped_speed_mps
+    if lane_change:
+        reason = (
+            "lane change completed, returned to lane, no contact" if in_lane
+            else "lane change completed, no contact, not back in lane when the run ended"
+        )
+    elif stopped:
+        reason = "stopped behind the obstacle, no contact"
+    else:
+        reason = "braked without contact, still moving when the run ended"
+    return Outcome("green", "none", 0.0, reason)

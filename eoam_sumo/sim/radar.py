@@ -1,0 +1,258 @@
+"""Forward radar model on plain target lists: detection, range, range rate, classification.
+
+The radar sits at the centre of the ego's front bumper and looks along the ego's heading
+(paper sec. 10.1, Figures 16 and 18: a long-range radar with a narrow field of view that
+does not see the ARO 120 m ahead at the start). SUMO only supplies the candidate list; all
+geometry is here, on ground-truth boxes (no ids are used).
+
+Detection: a target is seen when some part of its box lies within ``range_m`` of the radar
+and inside the field of view. This is computed exactly as the distance from the radar to the
+part of the box inside the field-of-view cone: the box's nearest point when that lies in the
+cone, otherwise the first crossing of the box by one of the two edge rays of the cone (this
+also covers the corners and the nearest point of the rear face). That distance is the
+reported range. Occlusion is ignored: a target hidden behind another is still seen.
+
+Measurements per detection: range to the nearest visible point, range rate (relative velocity
+projected on the line of sight to that point, negative when closing; ego velocity taken
+along its heading), bearing, and the road-frame station and lateral offset of the target's
+centre from the road frame of the ego's ORIGINAL lane (``project(x, y) -> (s, d, road_yaw)``,
+d positive to the left; e.g. ``eoam_sumo.sim.roadframe.RoadFrame``). "In path" is therefore
+relative to the lane the ego started in, also while it is in the other lane or returning: the
+ARO stays the in-path object the DMM tracks until it leaves the field of view (paper sec. 6.1).
+
+Classification (lane band half-width = lane_width_m / 2 + lane_margin_m, on the centre's d;
+road speed = target speed times the cosine of its heading relative to the road):
+
+* ``oncoming``: road speed below -oncoming_speed_mps and the centre not right of the lane
+  band (in the ego lane or any lane to its left; a wrong-way driver in the ego lane counts);
+* ``in_path``: centre ahead of the ego's front bumper along the road, inside the lane band,
+  and moving with the road direction or stopped (road speed above -stationary_speed_mps);
+* ``stationary_side``: speed below stationary_speed_mps and the centre outside the lane band
+  (parked cars; never in path, never oncoming);
+* ``other``: everything else (e.g. traffic in another lane moving with the ego).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Protocol
+
+from eoam_sumo.sim.geometry import OrientedBox
+
+#: Below this speed a target counts as stopped [m/s]: SUMO reports exactly 0 for parked and
+#: stopped vehicles, and automotive radars resolve Doppler to about 0.1-0.3 m/s.
+STATIONARY_SPEED_MPS = 0.5
+#: Moving against the road direction faster than this is oncoming traffic [m/s] (7 km/h,
+#: well above the stationary threshold, far below the 20 m/s oncoming ARO of sec. 10.2).
+ONCOMING_SPEED_MPS = 2.0
+#: The ego lane band reaches this far beyond each lane marker [m]: a 1.8 m wide car whose
+#: centre is 0.5 m outside the marker still covers 0.4 m of the lane; a parked car 1.5 m
+#: beyond the marker (centre ~2.4 m beyond) and an oncoming car centred in the next lane
+#: (1.75 m beyond) are outside.
+LANE_MARGIN_M = 0.5
+
+CATEGORIES = ("in_path", "oncoming", "stationary_side", "other")
+
+
+class RoadProjection(Protocol):
+    """Road frame of the ego's original lane (``eoam_sumo.sim.roadframe.RoadFrame``)."""
+
+    def project(self, x: float, y: float) -> tuple[float, float, float]:
+        """(s_m, d_m, road_yaw_rad) of a network point; d positive to the left."""
+        ...
+
+
+@dataclass(frozen=True)
+class RadarSettings:
+    """Radar coverage and the classification thresholds (reasons at the module constants)."""
+
+    range_m: float = 100.0  # long-range radar; the ARO at 120 m is outside at start (Fig. 18)
+    fov_deg: float = 18.0  # full horizontal field of view, narrow forward beam
+    stationary_speed_mps: float = STATIONARY_SPEED_MPS
+    oncoming_speed_mps: float = ONCOMING_SPEED_MPS
+    lane_margin_m: float = LANE_MARGIN_M
+
+    def __post_init__(self) -> None:
+        for name in ("range_m", "fov_deg", "stationary_speed_mps", "oncoming_speed_mps",
+                     "lane_margin_m"):
+            v = getattr(self, name)
+            if not math.isfinite(v) or v < 0.0:
+                raise ValueError(f"RadarSettings.{name}={v!r} must be finite and >= 0")
+        if self.range_m <= 0.0:
+            raise ValueError(f"RadarSettings.range_m={self.range_m} must be > 0")
+        if not 0.0 < self.fov_deg < 180.0:
+            raise ValueError(f"RadarSettings.fov_deg={self.fov_deg} must be in (0, 180)")
+        if self.oncoming_speed_mps < self.stationary_speed_mps:
+            raise ValueError(
+                f"RadarSettings.oncoming_speed_mps={self.oncoming_speed_mps} must be >= "
+                f"stationary_speed_mps={self.stationary_speed_mps}"
+            )
+
+
+@dataclass(frozen=True, slots=True)
+class Target:
+    """Ground truth of another road user: box centre, heading, speed along it, size."""
+
+    x_m: float
+    y_m: float
+    yaw_rad: float
+    speed_mps: float
+    length_m: float
+    width_m: float
+    box: OrientedBox = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if not math.isfinite(self.speed_mps):
+            raise ValueError(f"Target.speed_mps={self.speed_mps!r} must be finite")
+        object.__setattr__(
+            self, "box", OrientedBox(self.x_m, self.y_m, self.yaw_rad, self.length_m, self.width_m)
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class Detection:
+    """One detected target: measurements, road-frame position and class."""
+
+    index: int  # position in the scanned target list (for logging only)
+    range_m: float
+    range_rate_mps: float  # negative when closing
+    bearing_rad: float  # of the measured point from the boresight, left positive
+    s_m: float  # road-frame station of the target's centre
+    d_m: float  # road-frame lateral offset of the target's centre, left positive
+    road_speed_mps: float  # target speed along the road direction, negative against it
+    category: str
+
+
+@dataclass(frozen=True, slots=True)
+class RadarReport:
+    """What the EOAM logic uses (nearest in-path target, oncoming flag) plus all detections."""
+
+    in_path_range_m: float | None
+    in_path_range_rate_mps: float | None
+    oncoming_detected: bool
+    detections: tuple[Detection, ...]  # sorted by range
+    in_path_index: int | None = None  # target-list index of the nearest in-path target
+
+
+def _ray_entry_m(box: OrientedBox, ox: float, oy: float, ux: float, uy: float) -> float:
+    """Distance along the ray (origin o, unit direction u) to where it enters the box, or inf."""
+    lox, loy = box.to_local(ox, oy)
+    lux = box.cos_yaw * ux + box.sin_yaw * uy
+    luy = -box.sin_yaw * ux + box.cos_yaw * uy
+    t_in, t_out = 0.0, math.inf
+    for o, u, h in ((lox, lux, box.half_length_m), (loy, luy, box.half_width_m)):
+        if abs(u) < 1e-12:
+            if abs(o) > h:
+                return math.inf
+            continue
+        t1, t2 = (-h - o) / u, (h - o) / u
+        if t1 > t2:
+            t1, t2 = t2, t1
+        t_in, t_out = max(t_in, t1), min(t_out, t2)
+        if t_in > t_out:
+            return math.inf
+    return t_in
+
+
+class Radar:
+    """Radar at the ego's front bumper; ``scan`` turns ground truth into a ``RadarReport``."""
+
+    def __init__(self, settings: RadarSettings = RadarSettings()):
+        self.settings = settings
+        self._half_fov_rad = math.radians(0.5 * settings.fov_deg)
+        self._cos_half_fov = math.cos(self._half_fov_rad)
+
+    def visible_range_m(
+        self, origin_xy: tuple[float, float], yaw_rad: float, box: OrientedBox
+    ) -> float:
+        """Distance from the radar to the part of ``box`` inside the field-of-view cone (inf if
+        none); the box is detected when this is within ``range_m``."""
+        return self._visible_point(origin_xy[0], origin_xy[1], yaw_rad, box)[0]
+
+    def _visible_point(
+        self, ox: float, oy: float, yaw_rad: float, box: OrientedBox
+    ) -> tuple[float, float, float]:
+        """(distance, x, y) of the point of ``box`` inside the cone nearest to the radar."""
+        px, py = box.nearest_point(ox, oy)
+        rx, ry = px - ox, py - oy
+        r = math.hypot(rx, ry)
+        if r <= 1e-9 or rx * math.cos(yaw_rad) + ry * math.sin(yaw_rad) >= (
+            r * self._cos_half_fov - 1e-12
+        ):
+            return r, px, py
+        best = (math.inf, ox, oy)
+        for side in (1.0, -1.0):
+            ang = yaw_rad + side * self._half_fov_rad
+            ux, uy = math.cos(ang), math.sin(ang)
+            t = _ray_entry_m(box, ox, oy, ux, uy)
+            if t < best[0]:
+                best = (t, ox + t * ux, oy + t * uy)
+        return best
+
+    def scan(
+        self,
+        ego_front_xy: tuple[float, float],
+        ego_yaw_rad: float,
+        ego_speed_mps: float,
+        road_frame: RoadProjection,
+        targets: Sequence[Target],
+        lane_width_m: float,
+    ) -> RadarReport:
+        """Detect and classify ``targets`` seen from the ego's front bumper (rules: module doc)."""
+        if not lane_width_m > 0.0:
+            raise ValueError(f"lane_width_m={lane_width_m} must be > 0")
+        st = self.settings
+        ox, oy = ego_front_xy
+        bx, by = math.cos(ego_yaw_rad), math.sin(ego_yaw_rad)
+        evx, evy = ego_speed_mps * bx, ego_speed_mps * by
+        ego_s = road_frame.project(ox, oy)[0]
+        band_m = 0.5 * lane_width_m + st.lane_margin_m
+        detections = []
+        for index, tgt in enumerate(targets):
+            box = tgt.box
+            dx, dy = box.x_m - ox, box.y_m - oy
+            reach = st.range_m + box.radius_m
+            if dx * dx + dy * dy > reach * reach:
+                continue
+            rng, px, py = self._visible_point(ox, oy, ego_yaw_rad, box)
+            if rng > st.range_m:
+                continue
+            if rng > 1e-9:
+                lx, ly = (px - ox) / rng, (py - oy) / rng
+            else:
+                norm = math.hypot(dx, dy)
+                lx, ly = (dx / norm, dy / norm) if norm > 1e-9 else (bx, by)
+            tvx, tvy = tgt.speed_mps * box.cos_yaw, tgt.speed_mps * box.sin_yaw
+            range_rate = (tvx - evx) * lx + (tvy - evy) * ly
+            bearing = math.atan2(bx * ly - by * lx, bx * lx + by * ly)
+            s, d, road_yaw = road_frame.project(box.x_m, box.y_m)
+            road_speed = tgt.speed_mps * math.cos(box.yaw_rad - road_yaw)
+            category = self._classify(s > ego_s, d, tgt.speed_mps, road_speed, band_m)
+            detections.append(
+                Detection(index, rng, range_rate, bearing, s, d, road_speed, category)
+            )
+        detections.sort(key=lambda det: det.range_m)
+        in_path = next((det for det in detections if det.category == "in_path"), None)
+        return RadarReport(
+            in_path_range_m=None if in_path is None else in_path.range_m,
+            in_path_range_rate_mps=None if in_path is None else in_path.range_rate_mps,
+            oncoming_detected=any(det.category == "oncoming" for det in detections),
+            detections=tuple(detections),
+            in_path_index=None if in_path is None else in_path.index,
+        )
+
+    def _classify(
+        self, ahead: bool, d_m: float, speed_mps: float, road_speed_mps: float, band_m: float
+    ) -> str:
+        st = self.settings
+        if road_speed_mps < -st.oncoming_speed_mps and d_m > -band_m:
+            return "oncoming"
+        if abs(d_m) < band_m:
+            if ahead and road_speed_mps > -st.stationary_speed_mps:
+                return "in_path"
+            return "other"
+        if abs(speed_mps) < st.stationary_speed_mps:
+            return "stationary_side"
+        return "other"

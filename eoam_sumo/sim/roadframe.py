@@ -1,0 +1,95 @@
+"""Road frame of a manoeuvre: station and lateral offset along the ego's original lane.
+
+The EOAM geometry (paper sec. 4.2-4.3) is written in a frame attached to the lane the ego
+starts in: ``s_m`` along its centre line, ``d_m`` the lateral offset (left positive, towards
+the oncoming lane), and the road heading. The centre line is a polyline taken from the SUMO
+network, so curved and user-made roads work as well as the paper's straight one.
+"""
+
+from __future__ import annotations
+
+import math
+from bisect import bisect_right
+from collections.abc import Sequence
+
+
+class RoadFrame:
+    """Projection of points onto a polyline centre line (station, offset, heading, curvature)."""
+
+    def __init__(self, points: Sequence[Sequence[float]]):
+        pts = [(float(p[0]), float(p[1])) for p in points]
+        # drop repeated points, which give zero-length segments
+        clean = [pts[0]]
+        for p in pts[1:]:
+            if math.hypot(p[0] - clean[-1][0], p[1] - clean[-1][1]) > 1e-6:
+                clean.append(p)
+        if len(clean) < 2:
+            raise ValueError("road centre line needs at least two distinct points")
+        self._x = [p[0] for p in clean]
+        self._y = [p[1] for p in clean]
+        self._s = [0.0]
+        self._hx, self._hy, self._len = [], [], []
+        for i in range(len(clean) - 1):
+            dx, dy = self._x[i + 1] - self._x[i], self._y[i + 1] - self._y[i]
+            seg = math.hypot(dx, dy)
+            self._hx.append(dx / seg)
+            self._hy.append(dy / seg)
+            self._len.append(seg)
+            self._s.append(self._s[-1] + seg)
+        self._hint = 0
+
+    @property
+    def length_m(self) -> float:
+        return self._s[-1]
+
+    def _project_segment(self, i: int, x: float, y: float) -> tuple[float, float, float]:
+        """(squared distance, along, signed lateral) of (x, y) against segment i, clamped."""
+        rx, ry = x - self._x[i], y - self._y[i]
+        along = rx * self._hx[i] + ry * self._hy[i]
+        lat = -rx * self._hy[i] + ry * self._hx[i]
+        if along < 0.0 and i > 0:
+            along = 0.0
+        elif along > self._len[i] and i < len(self._len) - 1:
+            along = self._len[i]
+        px = self._x[i] + along * self._hx[i]
+        py = self._y[i] + along * self._hy[i]
+        return (x - px) ** 2 + (y - py) ** 2, along, lat
+
+    def project(self, x: float, y: float) -> tuple[float, float, float]:
+        """(s_m, d_m, road_yaw_rad) of a point; searches near the last answer first."""
+        n = len(self._len)
+        lo, hi = max(0, self._hint - 2), min(n, self._hint + 3)
+        best = None
+        for i in range(lo, hi):
+            cand = self._project_segment(i, x, y) + (i,)
+            if best is None or cand[0] < best[0]:
+                best = cand
+        # a point far from the local window (first call, jumps): full search
+        if best[0] > 25.0 and n > hi - lo:
+            for i in range(n):
+                cand = self._project_segment(i, x, y) + (i,)
+                if cand[0] < best[0]:
+                    best = cand
+        _, along, lat, i = best
+        self._hint = i
+        return self._s[i] + along, lat, math.atan2(self._hy[i], self._hx[i])
+
+    def point_at(self, s_m: float, d_m: float = 0.0) -> tuple[float, float, float]:
+        """(x, y, road_yaw) of the point at station s and offset d (extrapolated at the ends)."""
+        i = min(max(bisect_right(self._s, s_m) - 1, 0), len(self._len) - 1)
+        along = s_m - self._s[i]
+        hx, hy = self._hx[i], self._hy[i]
+        return (
+            self._x[i] + along * hx - d_m * hy,
+            self._y[i] + along * hy + d_m * hx,
+            math.atan2(hy, hx),
+        )
+
+    def curvature_at(self, s_m: float) -> float:
+        """Signed curvature (1/m) from the heading change at the nearest polyline vertex."""
+        i = min(max(bisect_right(self._s, s_m) - 1, 0), len(self._len) - 1)
+        if i + 1 >= len(self._len):
+            return 0.0
+        dyaw = math.atan2(self._hy[i + 1], self._hx[i + 1]) - math.atan2(self._hy[i], self._hx[i])
+        dyaw = (dyaw + math.pi) % (2.0 * math.pi) - math.pi
+        return dyaw / (0.5 * (self._len[i] + self._len[i + 1]))

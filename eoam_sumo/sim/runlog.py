@@ -1,0 +1,91 @@
+"""Preallocated per-step log of a co-simulation run and its files (timeseries.csv, summary.json).
+
+One row per SUMO step, written into a preallocated float array (no pandas in the loop);
+pandas is imported only when the run is written out.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+#: timeseries.csv columns (design.md 3.3 first, then the rest), SI units in the names.
+COLUMNS = (
+    "time_s", "mode", "fcw", "x_m", "y_m", "yaw_rad", "vx_mps", "vy_mps", "yaw_rate_radps",
+    "ax_mps2", "ay_mps2", "steer_rad", "ax_target_mps2", "y_target_m", "aro_range_m",
+    "aro_range_rate_mps",
+    "s_m", "lateral_offset_m", "heading_error_rad", "dx_m", "lateral_error_m",
+    "lookahead_error_m", "steer_cmd_rad", "steer_ff_rad", "steer_fb_rad", "steer_yd_rad",
+    "drive_force_n", "brake_force_n", "drive_force_cmd_n", "brake_force_cmd_n",
+    "speed_target_mps", "mu", "oncoming_detected", "sector",
+)
+_INT_COLUMNS = ("mode", "fcw", "oncoming_detected")
+_NAN = math.nan
+
+
+class RunLog:
+    """Fixed-size float log; ``add`` writes one row, ``frame()`` gives a pandas DataFrame."""
+
+    def __init__(self, rows: int):
+        self.buf = np.full((rows, len(COLUMNS)), _NAN)
+        self.n = 0
+        self._col = {c: i for i, c in enumerate(COLUMNS)}
+
+    def add(self, t, x, ax, ay, s, d, e_yaw, mu, cmd, perception) -> None:
+        """Log the state ``x`` at time ``t`` with the command decided from it (None at the end)."""
+        if self.n >= len(self.buf):
+            return
+        nan = _NAN
+        if perception is not None and perception.aro_range_m is not None:
+            rng, rate = perception.aro_range_m, perception.aro_range_rate_mps
+        else:
+            rng = rate = nan
+        onc = float(perception.oncoming_detected) if perception is not None else nan
+        if cmd is not None:
+            c = (cmd.mode, float(cmd.fcw), cmd.ax_target_mps2, cmd.y_target_m, cmd.dx_m,
+                 cmd.lateral_error_m, cmd.lookahead_error_m, cmd.steer_cmd_rad, cmd.steer_ff_rad,
+                 cmd.steer_fb_rad, cmd.steer_yd_rad, cmd.drive_force_cmd_n,
+                 cmd.brake_force_cmd_n, cmd.speed_target_mps,
+                 float(ord(cmd.sector)) if cmd.sector else nan)
+        else:
+            c = (nan,) * 15
+        self.buf[self.n] = (
+            t, c[0], c[1], x[0], x[1], x[2], x[3], x[4], x[5], ax, ay, x[6], c[2], c[3], rng,
+            rate, s, d, e_yaw, c[4], c[5], c[6], c[7], c[8], c[9], c[10], x[7], x[8], c[11],
+            c[12], c[13], mu, onc, c[14],
+        )
+        self.n += 1
+
+    def column(self, name: str) -> np.ndarray:
+        return self.buf[: self.n, self._col[name]]
+
+    def max_abs(self, name: str) -> float:
+        col = self.column(name)
+        col = col[np.isfinite(col)]
+        return float(np.max(np.abs(col))) if col.size else 0.0
+
+    def frame(self):
+        import pandas as pd
+
+        df = pd.DataFrame(self.buf[: self.n], columns=COLUMNS)
+        for c in _INT_COLUMNS:
+            df[c] = df[c].astype("Int64")
+        df["sector"] = [chr(int(v)) if np.isfinite(v) else "" for v in df["sector"]]
+        return df
+
+
+def _atomic_write_text(path: Path, text: str) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def write_run(out_dir: Path, summary: dict, log: RunLog) -> None:
+    """Write ``timeseries.csv`` then ``summary.json`` (each atomically) into ``out_dir``."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    _atomic_write_text(out_dir / "timeseries.csv", log.frame().to_csv(index=False, float_format="%.9g"))
+    _atomic_write_text(out_dir / "summary.json", json.dumps(summary, indent=2, sort_keys=False) + "\n")

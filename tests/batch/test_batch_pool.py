@@ -1,0 +1,102 @@
+"""The worker pool: long-lived workers, results per task, crashes, exceptions and timeouts.
+
+The task functions below are test-only workers (the pool takes the task function as a
+parameter); they are imported by name in the worker processes.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import time
+
+import pytest
+
+from eoam_sumo.batch.pool import TaskResult, run_dask, run_local
+
+
+def square_with_pid(payload):
+    return {"square": payload * payload, "pid": os.getpid()}
+
+
+def misbehave(payload):
+    kind, value = payload
+    if kind == "segfault":
+        os.kill(os.getpid(), signal.SIGSEGV)
+    if kind == "exit":
+        os._exit(3)
+    if kind == "raise":
+        raise ValueError(f"bad value {value}\nsecond line")
+    if kind == "hang":
+        time.sleep(600)
+    if kind == "print":
+        os.write(1, b"native code printing on stdout\n")
+    return {"value": value, "pid": os.getpid()}
+
+
+def _by_key(results):
+    out = {}
+    for r in results:
+        assert isinstance(r, TaskResult)
+        assert r.key not in out, f"task {r.key} reported twice"
+        out[r.key] = r
+    return out
+
+
+def test_every_task_once_in_long_lived_workers():
+    tasks = [(f"t{i}", i) for i in range(8)]
+    results = _by_key(run_local(square_with_pid, tasks, jobs=2, timeout_s=120))
+    assert set(results) == {k for k, _ in tasks}
+    for key, payload in tasks:
+        assert results[key].ok and results[key].value["square"] == payload * payload
+    pids = {r.value["pid"] for r in results.values()}
+    assert 1 <= len(pids) <= 2  # two workers ran eight tasks: none was started per task
+    assert os.getpid() not in pids
+
+
+def test_crash_exception_and_stdout_noise_cost_only_their_task():
+    tasks = [
+        ("a", ("ok", 1)), ("segv", ("segfault", 0)), ("b", ("ok", 2)), ("exit", ("exit", 0)),
+        ("raise", ("raise", 7)), ("noise", ("print", 3)), ("c", ("ok", 4)),
+    ]
+    results = _by_key(run_local(misbehave, tasks, jobs=1, timeout_s=120))
+    assert set(results) == {k for k, _ in tasks}
+    assert [results[k].value["value"] for k in ("a", "b", "noise", "c")] == [1, 2, 3, 4]
+    assert not results["segv"].ok and "died" in results["segv"].error
+    assert "SIGSEGV" in results["segv"].error
+    assert not results["exit"].ok and "exit status 3" in results["exit"].error
+    err = results["raise"].error
+    assert err.startswith("ValueError: bad value 7") and "\n" not in err
+    # an exception does not cost the worker: the next task ran in the same process
+    assert results["noise"].value["pid"] == results["c"].value["pid"]
+    # the crash did: a new worker took over after it
+    assert results["a"].value["pid"] != results["b"].value["pid"]
+
+
+def test_hung_task_is_killed_at_its_timeout_and_the_rest_run():
+    tasks = [("hang", ("hang", 0)), ("x", ("ok", 1)), ("y", ("ok", 2))]
+    results = _by_key(run_local(misbehave, tasks, jobs=2, timeout_s=3.0))
+    assert results["hang"].error == "timed out after 3 s (worker killed)"
+    assert results["x"].value["value"] == 1 and results["y"].value["value"] == 2
+
+
+def test_worker_that_cannot_start_raises():
+    with pytest.raises(RuntimeError, match="ended before its first task"):
+        list(run_local(square_with_pid, [("t", 1)], preload=("no_such_module_for_eoam",)))
+
+
+@pytest.mark.parametrize("kwargs", [{"jobs": 0}, {"jobs": 1.5}, {"timeout_s": 0.0}])
+def test_bad_settings_are_rejected(kwargs):
+    with pytest.raises(ValueError):
+        list(run_local(square_with_pid, [("t", 1)], **kwargs))
+
+
+def test_dask_driver_handles_a_crash_like_the_local_one():
+    from dask.distributed import Client, LocalCluster
+
+    tasks = [("a", ("ok", 1)), ("segv", ("segfault", 0)), ("b", ("ok", 2))]
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        results = _by_key(run_dask(misbehave, tasks, client, timeout_s=120))
+    assert results["a"].value["value"] == 1 and results["b"].value["value"] == 2
+    assert "SIGSEGV" in results["segv"].error

@@ -1,0 +1,103 @@
+"""Longitudinal controllers: force split, limits, PID convergence on a lagged point mass."""
+
+import math
+
+import pytest
+
+from eoam_sumo.control import LongitudinalController, LongitudinalGains, Pid, resistance_force_n
+from eoam_sumo.params import ego_e_class_sedan
+
+P = ego_e_class_sedan()
+
+
+def point_mass(ctrl_fn, v0, seconds, dt=0.01, sub=10):
+    """m v' = F_drive - F_brake - F_res with first-order actuator lags (the plant's actuators)."""
+    v, fd, fb, ax = v0, 0.0, 0.0, 0.0
+    trace = []
+    for k in range(int(round(seconds / dt))):
+        drive, brake = ctrl_fn(k * dt, v, ax)
+        assert drive >= 0.0 and brake >= 0.0 and drive * brake == 0.0
+        h = dt / sub
+        for _ in range(sub):
+            fd += (drive - fd) * h / P.drive_lag_s
+            fb += (brake - fb) * h / P.brake_lag_s
+            ax = (fd - fb - resistance_force_n(P, v)) / P.mass_kg
+            v += ax * h
+        trace.append((k * dt, v, ax))
+    return trace
+
+
+def test_split_never_both_and_limits():
+    c = LongitudinalController(P)
+    assert c.split(1000.0, 30.0, 1.0, 5000.0) == (1000.0, 0.0)
+    assert c.split(-1000.0, 30.0, 1.0, 5000.0) == (0.0, 1000.0)
+    assert c.split(-9000.0, 30.0, 1.0, 5000.0) == (0.0, 5000.0)
+    # eq. 37: mu times the engine limit (force below ~27.7 m/s, power above)
+    assert c.split(1e6, 10.0, 0.3, 5000.0) == (pytest.approx(0.3 * P.max_drive_force_n), 0.0)
+    assert c.split(1e6, 40.0, 1.0, 5000.0)[0] == pytest.approx(P.max_drive_power_w / 40.0)
+
+
+def test_hold_brake_is_the_given_limit():
+    assert LongitudinalController(P).hold_brake(12345.0) == (0.0, 12345.0)
+
+
+def test_resistance_closed_form():
+    v = 30.0
+    expected = P.mass_kg * 9.81 * P.rolling_resistance_coeff + 0.5 * 1.2 * P.drag_area_m2 * v * v
+    assert resistance_force_n(P, v) == pytest.approx(expected)
+    assert resistance_force_n(P, 0.0) == 0.0
+
+
+@pytest.mark.parametrize(("v0", "v_ref", "mu"), [(30.0, 33.3, 1.0), (25.0, 20.0, 0.3)])
+def test_speed_pid_reaches_the_set_speed(v0, v_ref, mu):
+    c = LongitudinalController(P)
+    brake_limit = 0.8 * mu * P.mass_kg * 9.81
+    trace = point_mass(
+        lambda t, v, ax: c.track_speed(v_ref, v, mu, brake_limit, 0.01)[:2], v0, 40.0
+    )
+    final = [v for t, v, _ in trace if t > 35.0]
+    assert max(abs(v - v_ref) for v in final) < 0.05
+    # acceleration demand bounded by the comfort/traction limit
+    lim = LongitudinalGains().speed_accel_limit_g * mu * 9.81
+    assert max(abs(ax) for _, _, ax in trace) < lim + 0.1
+    overshoot = max((v - v_ref) * math.copysign(1.0, v_ref - v0) for _, v, _ in trace)
+    assert overshoot < 0.15
+
+
+@pytest.mark.parametrize("mu", [1.0, 0.3])
+def test_acceleration_pid_tracks_a_profile(mu):
+    c = LongitudinalController(P)
+    brake_limit = 0.8 * mu * P.mass_kg * 9.81
+
+    def ref(t):
+        return -4.0 * mu if t < 3.0 else 0.5 * mu
+
+    trace = point_mass(
+        lambda t, v, ax: c.track_accel(ref(t), ax, v, mu, brake_limit, 0.01), 30.0, 6.0
+    )
+    for t_lo, t_hi in ((1.5, 3.0), (4.5, 6.0)):
+        errs = [abs(ax - ref(t)) for t, _, ax in trace if t_lo <= t < t_hi]
+        assert max(errs) < 0.03
+
+
+def test_acceleration_never_asks_above_the_brake_limit():
+    c = LongitudinalController(P)
+    for _ in range(200):
+        drive, brake = c.track_accel(-20.0, 0.0, 30.0, 1.0, 9000.0, 0.01)
+        assert drive == 0.0 and brake == 9000.0
+
+
+def test_pid_does_not_wind_up_while_clipped():
+    pid = Pid(kp=1.0, ki=10.0, kd=0.0, i_limit=100.0)
+    for _ in range(1000):
+        assert pid.update(5.0, 0.01, -1.0, 1.0) == 1.0
+    assert pid.integral <= 1.0  # integrated only while not pushing further into the clip
+    # the error reverses: the output leaves the clip at once
+    assert pid.update(-0.5, 0.01, -1.0, 1.0) < 1.0
+
+
+def test_gains_validate():
+    with pytest.raises(ValueError, match="accel_kp"):
+        LongitudinalGains(accel_kp=-1.0)
+    with pytest.raises(ValueError, match="speed_accel_limit_g"):
+        LongitudinalGains(speed_accel_limit_g=0.0)

@@ -1,0 +1,95 @@
+"""Friction bounds for arbitrary inputs (hypothesis) and a locked front axle that cannot steer.
+
+What is measured: the body's acceleration produced by the tyres, ``(ax + F_drag / m, ay)``
+from the outputs, and, independently of the outputs, the change of the ground-frame velocity
+over each 10 ms step, which may exceed ``mu g`` only by the aerodynamic drag.
+"""
+
+import math
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from eoam_sumo.params import AIR_DENSITY_KGPM3, G_MPS2
+from eoam_sumo.plant import OUTPUT_NAMES, STATE_NAMES, initial_state
+
+S = {name: i for i, name in enumerate(STATE_NAMES)}
+Y = {name: i for i, name in enumerate(OUTPUT_NAMES)}
+
+segment = st.tuples(
+    st.floats(-0.8, 0.8),  # steering command [rad], beyond the 35 deg lock on purpose
+    st.floats(0.0, 9000.0),  # drive command [N], beyond the maximum on purpose
+    st.floats(0.0, 25000.0),  # brake command [N]
+    st.floats(0.1, 1.2),  # surface friction
+    st.integers(1, 40),  # steps the segment is held
+)
+
+
+def world_velocity(x):
+    c, s = math.cos(x[S["yaw_rad"]]), math.sin(x[S["yaw_rad"]])
+    vx, vy = x[S["vx_mps"]], x[S["vy_mps"]]
+    return np.array([vx * c - vy * s, vx * s + vy * c])
+
+
+@settings(max_examples=200, deadline=None, derandomize=True)
+@given(
+    speed=st.floats(0.0, 46.0),
+    yaw=st.floats(-math.pi, math.pi),
+    segments=st.lists(segment, min_size=1, max_size=6),
+)
+def test_tyres_never_exceed_friction_and_state_stays_finite(plant, params, speed, yaw, segments):
+    m, g = params.mass_kg, G_MPS2
+    k_drag = 0.5 * AIR_DENSITY_KGPM3 * params.drag_area_m2
+    x = initial_state(0.0, 0.0, yaw, speed)
+    for steer, drive, brake, mu, hold in segments:
+        u = np.array([steer, drive, brake])
+        for _ in range(hold):
+            x_next, y = plant.step(x, u, mu)
+            assert np.all(np.isfinite(x_next)) and np.all(np.isfinite(y))
+            assert x_next[S["vx_mps"]] >= 0.0
+            assert abs(x_next[S["steer_rad"]]) <= params.max_steer_rad * (1 + 1e-12)
+            assert math.isclose(y[Y["fz_front_n"]] + y[Y["fz_rear_n"]], m * g, rel_tol=1e-12)
+            for axle in ("front", "rear"):
+                force = math.hypot(y[Y[f"fx_{axle}_n"]], y[Y[f"fy_{axle}_n"]])
+                assert force <= mu * y[Y[f"fz_{axle}_n"]] * (1 + 1e-9) + 1e-2
+            tyre_accel = math.hypot(y[Y["ax_mps2"]] + y[Y["drag_force_n"]] / m, y[Y["ay_mps2"]])
+            assert tyre_accel <= mu * g * (1 + 1e-9) + 1e-5
+            fastest = max(x[S["vx_mps"]], x_next[S["vx_mps"]]) + 0.1
+            dv = np.linalg.norm(world_velocity(x_next) - world_velocity(x)) / plant.step_s
+            assert dv <= 1.05 * mu * g + k_drag * fastest**2 / m
+            x = x_next
+
+
+def run_braked_turn(plant, mu, brake_n, steer_rad, steps=100):
+    """80 km/h straight, brake actuator at ``brake_n``, then steer; returns the history."""
+    x = initial_state(0.0, 0.0, 0.0, 80.0 / 3.6, brake_force_n=brake_n)
+    u = np.array([steer_rad, 0.0, brake_n])
+    history = []
+    for _ in range(steps):
+        x, y = plant.step(x, u, mu)
+        history.append((x, y))
+    return history
+
+
+def test_locked_front_axle_gives_no_steering_response(plant):
+    steer = math.radians(5.0)
+    # 1.8 kN on ice: the front brake (65 %) exceeds mu Fz_f, the rear one stays below mu Fz_r.
+    locked = run_braked_turn(plant, 0.1, 1800.0, steer)
+    for x, y in locked:
+        assert y[Y["front_locked"]] == 1.0 and y[Y["rear_locked"]] == 0.0
+        assert abs(x[S["yaw_rate_radps"]]) < 1e-9
+        assert abs(x[S["y_m"]]) < 1e-9
+    assert locked[-1][0][S["steer_rad"]] > 0.9 * steer  # the wheels ARE steered
+    # The same steering with the brakes off turns the car.
+    rolling = run_braked_turn(plant, 0.1, 0.0, steer)
+    assert rolling[-1][0][S["yaw_rate_radps"]] > 0.02
+    assert rolling[-1][0][S["y_m"]] > 0.2
+
+
+def test_fully_locked_car_slides_straight_on_ice(plant, params):
+    history = run_braked_turn(plant, 0.1, params.max_brake_force_n, math.radians(10.0))
+    assert all(y[Y["front_locked"]] == 1.0 and y[Y["rear_locked"]] == 1.0 for _, y in history)
+    assert max(abs(x[S["yaw_rate_radps"]]) for x, _ in history) < 1e-9
+    decel = -history[-1][1][Y["ax_mps2"]] - history[-1][1][Y["drag_force_n"]] / params.mass_kg
+    assert math.isclose(decel, params.sliding_friction_ratio * 0.1 * G_MPS2, rel_tol=1e-3)

@@ -1,0 +1,173 @@
+"""Experiment matrices: the Table 2 file, the case order, and rejection of bad input."""
+
+import csv
+import math
+import re
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from eoam_sumo.errors import InputError
+from eoam_sumo.matrix import load_matrix, load_paper_table
+from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
+
+ROOT = Path(__file__).resolve().parents[1]
+TABLE2 = ROOT / "scenarios" / "table2.toml"
+PAPER_CSV = ROOT / "scenarios" / "paper_table2.csv"
+
+
+def test_table2_has_the_papers_64_cases_in_the_papers_order():
+    matrix = load_matrix(TABLE2)
+    cases = matrix.cases()
+    with PAPER_CSV.open(newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(cases) == len(rows) == 64
+    for case, row in zip(cases, rows):
+        onc = None if row["oncoming_start_m"] == "" else float(row["oncoming_start_m"])
+        assert (case.oncoming_start_m, case.ego_speed_kmh, case.mu) == (
+            onc, float(row["ego_speed_kmh"]), float(row["mu"]))
+        assert case.sumocfg == (ROOT / "scenarios" / "baseline.sumocfg").resolve()
+        assert case.max_time_s == 40.0
+    assert cases[0].case_id == "onc-none_v165_mu1.0"
+    assert cases[-1].case_id == "onc-300_v55_mu0.1"
+    assert len({c.case_id for c in cases}) == 64
+    assert all(re.fullmatch(r"[A-Za-z0-9._-]+", c.case_id) for c in cases)
+
+
+def test_paper_outcomes_match_the_published_table():
+    matrix = load_matrix(TABLE2)
+    outcomes = matrix.paper_outcomes()
+    assert len(outcomes) == 64
+    assert outcomes["onc-none_v165_mu0.1"] == "yellow"
+    assert outcomes["onc-300_v165_mu0.7"] == "red"
+    assert outcomes["onc-400_v120_mu0.7"] == "orange"
+    assert load_paper_table(PAPER_CSV)[(None, 90.0, 0.1)] == "orange"
+
+
+def test_case_overrides_convert_units():
+    case = load_matrix(TABLE2).cases()[17]  # oncoming 500 m, 165 km/h, mu 0.7
+    ov = case.overrides()
+    assert isinstance(ov, ScenarioOverrides)
+    assert ov.ego_speed_mps == pytest.approx(165.0 / 3.6, rel=1e-12)
+    assert (ov.mu, ov.oncoming_start_m, ov.aro_hold_s, ov.aro_decel_mps2) == (0.7, 500.0, None, None)
+
+
+def _write(tmp_path: Path, body: str, name: str = "m.toml") -> Path:
+    (tmp_path / "s.sumocfg").write_text("<configuration/>")
+    path = tmp_path / name
+    path.write_text(body)
+    return path
+
+
+GOOD_SCENARIO = '[scenario]\nsumocfg = "s.sumocfg"\n'
+GOOD_SWEEP = "[sweep]\nego_speed_kmh = [120]\nmu = [1.0]\n"
+
+
+def test_optional_aro_keys_extend_the_sweep_and_the_ids(tmp_path):
+    path = _write(tmp_path, GOOD_SCENARIO + GOOD_SWEEP
+                  + 'oncoming_start_m = [300, "none"]\naro_hold_s = [2.0, 0.5]\naro_decel_mps2 = [8.0]\n')
+    cases = load_matrix(path).cases()
+    assert [c.case_id for c in cases] == [
+        "onc-none_v120_mu1.0_hold2_dec8", "onc-none_v120_mu1.0_hold0.5_dec8",
+        "onc-300_v120_mu1.0_hold2_dec8", "onc-300_v120_mu1.0_hold0.5_dec8",
+    ]
+    assert cases[1].overrides().aro_hold_s == 0.5
+    assert cases[1].overrides().aro_decel_mps2 == 8.0
+    assert cases[0].max_time_s == 40.0  # documented default
+
+
+BAD = [
+    ("unknown table", GOOD_SCENARIO + GOOD_SWEEP + "[sweeps]\nmu = [1.0]\n", "sweeps", "sweep"),
+    ("top-level key", "foo = 1\n" + GOOD_SCENARIO + GOOD_SWEEP, "foo", None),
+    ("misspelt key", GOOD_SCENARIO + "[sweep]\nego_speed_kph = [120]\nmu = [1.0]\n",
+     "ego_speed_kph", "ego_speed_kmh"),
+    ("misspelt scenario key", '[scenario]\nsumocfg = "s.sumocfg"\nmax_time = 3\n' + GOOD_SWEEP,
+     "max_time", "max_time_s"),
+    ("not a list", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [120]\nmu = 1.0\n", "mu", None),
+    ("string value", GOOD_SCENARIO + '[sweep]\nego_speed_kmh = [120]\nmu = ["dry"]\n', "mu", None),
+    ("bool value", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [true]\nmu = [1.0]\n", "ego_speed_kmh", None),
+    ("mu zero", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [120]\nmu = [0.0]\n", "mu", None),
+    ("mu too high", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [120]\nmu = [1.5]\n", "mu", None),
+    ("zero speed", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [0]\nmu = [1.0]\n", "ego_speed_kmh", None),
+    ("negative speed", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [-90]\nmu = [1.0]\n",
+     "ego_speed_kmh", None),
+    ("negative distance", GOOD_SCENARIO + GOOD_SWEEP + "oncoming_start_m = [-5]\n",
+     "oncoming_start_m", None),
+    ("word distance", GOOD_SCENARIO + GOOD_SWEEP + 'oncoming_start_m = ["far"]\n',
+     "oncoming_start_m", None),
+    ("empty list", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [120]\nmu = []\n", "mu", None),
+    ("duplicate", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [120, 120.0]\nmu = [1.0]\n",
+     "ego_speed_kmh", None),
+    ("duplicate none", GOOD_SCENARIO + GOOD_SWEEP + 'oncoming_start_m = ["none", "none"]\n',
+     "oncoming_start_m", None),
+    ("zero decel", GOOD_SCENARIO + GOOD_SWEEP + "aro_decel_mps2 = [0.0]\n", "aro_decel_mps2", None),
+    ("missing sumocfg file", '[scenario]\nsumocfg = "nope.sumocfg"\n' + GOOD_SWEEP, "sumocfg", None),
+    ("sumocfg not a string", "[scenario]\nsumocfg = 3\n" + GOOD_SWEEP, "sumocfg", None),
+    ("no sumocfg key", "[scenario]\nmax_time_s = 10.0\n" + GOOD_SWEEP, "sumocfg", None),
+    ("no mu key", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [120]\n", "mu", None),
+    ("no scenario table", GOOD_SWEEP, "scenario", None),
+    ("bad max time", '[scenario]\nsumocfg = "s.sumocfg"\nmax_time_s = -1.0\n' + GOOD_SWEEP,
+     "max_time_s", None),
+    ("missing paper table", GOOD_SCENARIO + GOOD_SWEEP + '[paper]\ntable = "none.csv"\n', "table", None),
+    ("malformed toml", GOOD_SCENARIO + "[sweep\nmu = [1.0]\n", "TOML", None),
+]
+
+
+@pytest.mark.parametrize("body,key,suggestion", [b[1:] for b in BAD], ids=[b[0] for b in BAD])
+def test_bad_matrix_is_rejected_naming_file_and_key(tmp_path, body, key, suggestion):
+    path = _write(tmp_path, body)
+    with pytest.raises(InputError) as err:
+        load_matrix(path)
+    message = str(err.value)
+    assert str(path) in message
+    assert key in message
+    if suggestion is not None:
+        assert f"did you mean '{suggestion}'" in message
+
+
+def test_missing_matrix_file_is_an_input_error(tmp_path):
+    with pytest.raises(InputError, match="not found"):
+        load_matrix(tmp_path / "absent.toml")
+
+
+def test_bad_paper_table_names_the_line(tmp_path):
+    bad = tmp_path / "paper.csv"
+    bad.write_text("oncoming_start_m,ego_speed_kmh,mu,outcome\n,165,1.0,green\n,120,1.0,purple\n")
+    with pytest.raises(InputError, match="line 3"):
+        load_paper_table(bad)
+    bad.write_text("speed,mu,outcome\n165,1.0,green\n")
+    with pytest.raises(InputError, match="oncoming_start_m"):
+        load_paper_table(bad)
+
+
+def _toml_number(x):
+    return repr(x)
+
+
+speeds = st.lists(st.one_of(st.integers(1, 300), st.floats(0.5, 300.0)), min_size=1, max_size=5,
+                  unique_by=float)
+mus = st.lists(st.floats(0.01, 1.2), min_size=1, max_size=4, unique=True)
+distances = st.lists(st.one_of(st.just("none"), st.integers(0, 2000), st.floats(0.0, 2000.0)),
+                     min_size=1, max_size=4,
+                     unique_by=lambda d: d if isinstance(d, str) else float(d))
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(speeds=speeds, mus=mus, distances=distances)
+def test_any_valid_sweep_gives_one_uniquely_named_case_per_combination(tmp_path, speeds, mus, distances):
+    def arr(values):
+        return "[" + ", ".join('"none"' if v == "none" else _toml_number(v) for v in values) + "]"
+
+    path = _write(tmp_path, GOOD_SCENARIO + f"[sweep]\nego_speed_kmh = {arr(speeds)}\n"
+                  f"mu = {arr(mus)}\noncoming_start_m = {arr(distances)}\n")
+    cases = load_matrix(path).cases()
+    assert len(cases) == len(speeds) * len(mus) * len(distances)
+    assert len({c.case_id for c in cases}) == len(cases)
+    assert all(re.fullmatch(r"[A-Za-z0-9._-]+", c.case_id) for c in cases)
+    # traffic outermost with "none" first, then speed, then friction, each in file order
+    traffic = [None] * ("none" in distances) + [float(d) for d in distances if d != "none"]
+    expected = [(d, float(v), float(m)) for d in traffic for v in speeds for m in mus]
+    assert [(c.oncoming_start_m, c.ego_speed_kmh, c.mu) for c in cases] == expected
+    assert all(math.isclose(c.overrides().ego_speed_mps * 3.6, c.ego_speed_kmh) for c in cases)
