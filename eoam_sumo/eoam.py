@@ -27,7 +27,7 @@ from eoam_sumo.control.reference import PathReference
 from eoam_sumo.control.steering import SteeringController, SteeringGains
 from eoam_sumo.decision.dmm import Action, BoundaryCurve, Sector
 from eoam_sumo.decision.modes import Mode, next_mode
-from eoam_sumo.params import VehicleParams
+from eoam_sumo.params import G_MPS2, VehicleParams
 
 _TWO_PI = 2.0 * math.pi
 
@@ -92,6 +92,7 @@ class EoamSettings:
     settle_dwell_s: float = 0.5  # ... for this long after the return path ended
     release_opening_speed_mps: float = 0.5  # mode 1 -> 0: obstacle pulls away faster than this
     limit_brake_fraction: float = 1.0  # share of the no-lock brake force used as limit braking
+    ellipse_margin: float = 1.1  # |ay| is inflated by this in the friction-ellipse brake cap
     reference_step_m: float = 0.25  # dx spacing of the sampled manoeuvre reference
     preview_time_s: float = 0.25  # feedforward curvature taken this far ahead on the path
     boundary_step_mps: float = 0.25  # closing-speed spacing of the sampled DMM boundaries
@@ -266,43 +267,50 @@ class EoamController:
             path = self._path
             dx = meas.s_m - self._s0 if path is not None else 0.0
 
-        # ---- references ------------------------------------------------------------------
-        y_ref = yaw_ref = kappa_ref = kappa_ff = 0.0
+        # ---- lateral reference (lane centre unless a path is active) and steering, eq. 38 ----
+        y_ref = yaw_ref = kappa_ref = kappa_ff = ax_ref = v_plan = 0.0
+        in_path = False
+        if path is not None:
+            y_ref, yaw_ref, kappa_ref, ax_ref, v_plan = path.at(dx)
+            in_path = dx < path.length_m
+            if in_path:
+                kappa_ff = path.at(dx + v * st.preview_time_s)[2]
+            else:
+                yaw_ref = kappa_ref = 0.0
+        e_lat = d - y_ref
+        road_kappa = meas.road_curvature_1pm
+        delta, ff, fb, yd, e_la = self._steer.command(
+            v, meas.yaw_rate_radps, e_lat, _wrap(meas.e_yaw_rad - yaw_ref),
+            kappa_ref + road_kappa, kappa_ff + road_kappa, mu,
+        )
+
+        # ---- longitudinal ------------------------------------------------------------------
+        # No ABS: the straight-line no-lock brake force, shrunk by the friction ellipse so that
+        # the lateral acceleration in use (measured, or asked by the steering) keeps its tyre
+        # force; a locked axle would have none.
+        ay_use = max(abs(meas.ay_mps2), abs(self._steer.lateral_accel(v, delta)))
+        q = st.ellipse_margin * ay_use / (mu * G_MPS2)
+        brake_limit = self._brake_limit * math.sqrt(1.0 - q * q) if q < 1.0 else 0.0
         if mode is Mode.NORMAL:
             drive, brake, ax_target = self._long.track_speed(
-                self._initial_speed, v, mu, self._brake_limit, dt_s
+                self._initial_speed, v, mu, brake_limit, dt_s
             )
             v_target = self._initial_speed
         elif mode is Mode.UPDATE_BRAKE or mode is Mode.ONCOMING_BRAKE:
-            drive, brake = self._long.hold_brake(self._brake_limit)
-            ax_target = -self._brake_limit / self._mass
+            drive, brake = self._long.hold_brake(brake_limit)
+            ax_target = -brake_limit / self._mass
             v_target = 0.0
+        elif in_path and mode is not Mode.RETURN:
+            drive, brake = self._long.track_accel(ax_ref, meas.ax_mps2, v, mu, brake_limit, dt_s)
+            ax_target, v_target = ax_ref, v_plan
         else:
-            y_ref, yaw_ref, kappa_ref, ax_ref, v_plan = path.at(dx)
-            kappa_ff = path.at(dx + v * st.preview_time_s)[2]
-            in_path = dx < path.length_m
-            if in_path and mode is not Mode.RETURN:
-                drive, brake = self._long.track_accel(
-                    ax_ref, meas.ax_mps2, v, mu, self._brake_limit, dt_s
-                )
-                ax_target, v_target = ax_ref, v_plan
-            else:
-                if self._hold_speed is None:
-                    self._hold_speed = v
-                    self._long.reset()
-                drive, brake, ax_target = self._long.track_speed(
-                    self._hold_speed, v, mu, self._brake_limit, dt_s
-                )
-                v_target = self._hold_speed
-            if not in_path:
-                kappa_ref = kappa_ff = yaw_ref = 0.0
-
-        # ---- steering (eq. 38) --------------------------------------------------------------
-        e_lat = d - y_ref
-        delta, ff, fb, yd, e_la = self._steer.command(
-            v, meas.yaw_rate_radps, e_lat, _wrap(meas.e_yaw_rad - yaw_ref),
-            kappa_ref + meas.road_curvature_1pm, kappa_ff + meas.road_curvature_1pm, mu,
-        )
+            if self._hold_speed is None:
+                self._hold_speed = v
+                self._long.reset()
+            drive, brake, ax_target = self._long.track_speed(
+                self._hold_speed, v, mu, brake_limit, dt_s
+            )
+            v_target = self._hold_speed
 
         warns = sector is not None and sector is not Sector.G
         fcw = warns or mode in (Mode.UPDATE_BRAKE, Mode.UPDATE_STEER_BRAKE,

@@ -87,14 +87,27 @@ class Matrix:
                 for mu in self.mus:
                     for hold in holds:
                         for decel in decels:
-                            parts = [f"onc-{NO_ONCOMING if onc is None else _id_number(onc)}",
-                                     f"v{_id_number(speed)}", f"mu{_mu_text(mu)}"]
+                            parts = [
+                                f"onc-{NO_ONCOMING if onc is None else _id_number(onc)}",
+                                f"v{_id_number(speed)}",
+                                f"mu{_mu_text(mu)}",
+                            ]
                             if hold is not None:
                                 parts.append(f"hold{_id_number(hold)}")
                             if decel is not None:
                                 parts.append(f"dec{_id_number(decel)}")
-                            cases.append(Case("_".join(parts), self.sumocfg, speed, mu, onc, hold,
-                                              decel, self.max_time_s))
+                            cases.append(
+                                Case(
+                                    "_".join(parts),
+                                    self.sumocfg,
+                                    speed,
+                                    mu,
+                                    onc,
+                                    hold,
+                                    decel,
+                                    self.max_time_s,
+                                )
+                            )
         return cases
 
     def paper_outcomes(self) -> dict[str, str]:
@@ -102,12 +115,15 @@ class Matrix:
         if self.paper_table is None:
             return {}
         published = load_paper_table(self.paper_table)
-        return {c.case_id: published[key] for c in self.cases()
-                if (key := (c.oncoming_start_m, c.ego_speed_kmh, c.mu)) in published}
+        return {
+            c.case_id: published[key]
+            for c in self.cases()
+            if (key := (c.oncoming_start_m, c.ego_speed_kmh, c.mu)) in published
+        }
 
 
 def load_paper_table(path: Path) -> dict[tuple[float | None, float, float], str]:
-    """(oncoming_start_m or None, ego_speed_kmh, mu) -> outcome from a CSV like the paper's Table 2."""
+    """(oncoming_start_m or None, ego_speed_kmh, mu) -> outcome, from a CSV like the paper's."""
     path = Path(path)
     try:
         with path.open(newline="", encoding="utf-8") as fh:
@@ -121,13 +137,19 @@ def load_paper_table(path: Path) -> dict[tuple[float | None, float, float], str]
     table = {}
     for line, row in enumerate(rows, start=2):
         try:
-            onc = None if row["oncoming_start_m"].strip() in ("", NO_ONCOMING) else float(row["oncoming_start_m"])
+            onc = (
+                None
+                if row["oncoming_start_m"].strip() in ("", NO_ONCOMING)
+                else float(row["oncoming_start_m"])
+            )
             key = (onc, float(row["ego_speed_kmh"]), float(row["mu"]))
         except (ValueError, AttributeError) as exc:
             raise InputError(f"{path}, line {line}: not a number: {exc}") from exc
         if row["outcome"] not in OUTCOMES:
-            raise InputError(f"{path}, line {line}: outcome {row['outcome']!r} is not one of "
-                             f"{', '.join(OUTCOMES)}")
+            raise InputError(
+                f"{path}, line {line}: outcome {row['outcome']!r} is not one of "
+                f"{', '.join(OUTCOMES)}"
+            )
         table[key] = row["outcome"]
     return table
 
@@ -142,8 +164,16 @@ def _is_number(value) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
-def _number_list(path: Path, key: str, values, *, minimum: float, inclusive: bool,
-                 maximum: float | None = None, allow_none: bool = False) -> tuple:
+def _number_list(
+    path: Path,
+    key: str,
+    values,
+    *,
+    minimum: float,
+    inclusive: bool,
+    maximum: float | None = None,
+    allow_none: bool = False,
+) -> tuple:
     where = f"[sweep] {key}"
     if not isinstance(values, list):
         raise InputError(f"{path}: {where} must be a list, not {values!r}")
@@ -154,7 +184,7 @@ def _number_list(path: Path, key: str, values, *, minimum: float, inclusive: boo
         if allow_none and v == NO_ONCOMING:
             item = None
         elif not _is_number(v):
-            expected = f"a number or \"{NO_ONCOMING}\"" if allow_none else "a number"
+            expected = f'a number or "{NO_ONCOMING}"' if allow_none else "a number"
             raise InputError(f"{path}: {where} value {v!r} is not {expected}")
         elif (v < minimum if inclusive else v <= minimum) or (maximum is not None and v > maximum):
             low = "[" if inclusive else "("
@@ -206,16 +236,30 @@ def load_matrix(path: Path) -> Matrix:
         path=path,
         sumocfg=sumocfg,
         max_time_s=float(max_time),
-        ego_speeds_kmh=_number_list(path, "ego_speed_kmh", sweep["ego_speed_kmh"], minimum=0.0,
-                                    inclusive=False),
+        ego_speeds_kmh=_number_list(
+            path, "ego_speed_kmh", sweep["ego_speed_kmh"], minimum=0.0, inclusive=False
+        ),
         mus=_number_list(path, "mu", sweep["mu"], minimum=0.0, inclusive=False, maximum=MU_MAX),
-        oncoming_starts_m=_number_list(path, "oncoming_start_m",
-                                       sweep.get("oncoming_start_m", [NO_ONCOMING]),
-                                       minimum=0.0, inclusive=True, allow_none=True),
-        aro_holds_s=(_number_list(path, "aro_hold_s", sweep["aro_hold_s"], minimum=0.0,
-                                  inclusive=True) if "aro_hold_s" in sweep else ()),
-        aro_decels_mps2=(_number_list(path, "aro_decel_mps2", sweep["aro_decel_mps2"], minimum=0.0,
-                                      inclusive=False) if "aro_decel_mps2" in sweep else ()),
+        oncoming_starts_m=_number_list(
+            path,
+            "oncoming_start_m",
+            sweep.get("oncoming_start_m", [NO_ONCOMING]),
+            minimum=0.0,
+            inclusive=True,
+            allow_none=True,
+        ),
+        aro_holds_s=(
+            _number_list(path, "aro_hold_s", sweep["aro_hold_s"], minimum=0.0, inclusive=True)
+            if "aro_hold_s" in sweep
+            else ()
+        ),
+        aro_decels_mps2=(
+            _number_list(
+                path, "aro_decel_mps2", sweep["aro_decel_mps2"], minimum=0.0, inclusive=False
+            )
+            if "aro_decel_mps2" in sweep
+            else ()
+        ),
         paper_table=paper,
     )
 

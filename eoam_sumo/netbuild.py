@@ -45,7 +45,8 @@ def declared_frictions(edg_file: Path) -> dict[str, float]:
                     frictions[lane_id] = float(lane.get("friction"))
                 except ValueError as exc:
                     raise InputError(
-                        f"{edg_file}: lane {lane_id} friction={lane.get('friction')!r} is not a number"
+                        f"{edg_file}: lane {lane_id} friction={lane.get('friction')!r} "
+                        "is not a number"
                     ) from exc
     return frictions
 
@@ -58,13 +59,15 @@ def write_frictions(net_text: str, frictions: dict[str, float]) -> str:
         lane_id = match.group(1)
         if lane_id not in frictions or " friction=" in tag:
             return tag
-        return tag.replace(f'id="{lane_id}"', f'id="{lane_id}" friction="{frictions[lane_id]:.2f}"', 1)
+        return tag.replace(
+            f'id="{lane_id}"', f'id="{lane_id}" friction="{frictions[lane_id]:.2f}"', 1
+        )
 
     return re.sub(r'<lane id="([^"]+)"[^>]*>', add, net_text)
 
 
 def build_network(nod_file: Path) -> Path:
-    """Run netconvert on ``NAME.nod.xml`` + ``NAME.edg.xml``; returns the written ``NAME.net.xml``."""
+    """Run netconvert on ``NAME.nod.xml`` + ``NAME.edg.xml``; returns ``NAME.net.xml``."""
     import sumolib
 
     nod_file = Path(nod_file)
@@ -74,19 +77,27 @@ def build_network(nod_file: Path) -> Path:
     if not edg_file.is_file():
         raise InputError(f"{nod_file}: no matching edge file {edg_file.name}")
     out_file = directory / f"{name}.net.xml"
-    args = [sumolib.checkBinary("netconvert"), "--node-files", nod_file.name,
-            "--edge-files", edg_file.name]
+    args = [
+        sumolib.checkBinary("netconvert"),
+        "--node-files",
+        nod_file.name,
+        "--edge-files",
+        edg_file.name,
+    ]
     for suffix, option in ((".con.xml", "--connection-files"), (".typ.xml", "--type-files")):
         if (directory / f"{name}{suffix}").is_file():
             args += [option, f"{name}{suffix}"]
     args += [*NETCONVERT_OPTIONS, "--output-file", out_file.name]
-    done = subprocess.run(args, cwd=directory, env=_sumo_env(), capture_output=True, text=True,
-                          check=False)
+    done = subprocess.run(
+        args, cwd=directory, env=_sumo_env(), capture_output=True, text=True, check=False
+    )
     if done.returncode != 0:
         raise RuntimeError(f"netconvert failed on {nod_file}: {done.stderr.strip()}")
     text = write_frictions(out_file.read_text(encoding="utf-8"), declared_frictions(edg_file))
-    note = (f"<!-- lane friction written explicitly by eoam_sumo.netbuild {__version__} "
-            f"from {edg_file.name} -->\n")
+    note = (
+        f"<!-- lane friction written explicitly by eoam_sumo.netbuild {__version__} "
+        f"from {edg_file.name} -->\n"
+    )
     head, sep, body = text.partition("<net ")
     out_file.write_text(head + note + "\n" + sep + body, encoding="utf-8")
     return out_file

@@ -27,7 +27,10 @@ def test_table2_has_the_papers_64_cases_in_the_papers_order():
     for case, row in zip(cases, rows):
         onc = None if row["oncoming_start_m"] == "" else float(row["oncoming_start_m"])
         assert (case.oncoming_start_m, case.ego_speed_kmh, case.mu) == (
-            onc, float(row["ego_speed_kmh"]), float(row["mu"]))
+            onc,
+            float(row["ego_speed_kmh"]),
+            float(row["mu"]),
+        )
         assert case.sumocfg == (ROOT / "scenarios" / "baseline.sumocfg").resolve()
         assert case.max_time_s == 40.0
     assert cases[0].case_id == "onc-none_v165_mu1.0"
@@ -51,7 +54,12 @@ def test_case_overrides_convert_units():
     ov = case.overrides()
     assert isinstance(ov, ScenarioOverrides)
     assert ov.ego_speed_mps == pytest.approx(165.0 / 3.6, rel=1e-12)
-    assert (ov.mu, ov.oncoming_start_m, ov.aro_hold_s, ov.aro_decel_mps2) == (0.7, 500.0, None, None)
+    assert (ov.mu, ov.oncoming_start_m, ov.aro_hold_s, ov.aro_decel_mps2) == (
+        0.7,
+        500.0,
+        None,
+        None,
+    )
 
 
 def _write(tmp_path: Path, body: str, name: str = "m.toml") -> Path:
@@ -66,12 +74,18 @@ GOOD_SWEEP = "[sweep]\nego_speed_kmh = [120]\nmu = [1.0]\n"
 
 
 def test_optional_aro_keys_extend_the_sweep_and_the_ids(tmp_path):
-    path = _write(tmp_path, GOOD_SCENARIO + GOOD_SWEEP
-                  + 'oncoming_start_m = [300, "none"]\naro_hold_s = [2.0, 0.5]\naro_decel_mps2 = [8.0]\n')
+    path = _write(
+        tmp_path,
+        GOOD_SCENARIO
+        + GOOD_SWEEP
+        + 'oncoming_start_m = [300, "none"]\naro_hold_s = [2.0, 0.5]\naro_decel_mps2 = [8.0]\n',
+    )
     cases = load_matrix(path).cases()
     assert [c.case_id for c in cases] == [
-        "onc-none_v120_mu1.0_hold2_dec8", "onc-none_v120_mu1.0_hold0.5_dec8",
-        "onc-300_v120_mu1.0_hold2_dec8", "onc-300_v120_mu1.0_hold0.5_dec8",
+        "onc-none_v120_mu1.0_hold2_dec8",
+        "onc-none_v120_mu1.0_hold0.5_dec8",
+        "onc-300_v120_mu1.0_hold2_dec8",
+        "onc-300_v120_mu1.0_hold0.5_dec8",
     ]
     assert cases[1].overrides().aro_hold_s == 0.5
     assert cases[1].overrides().aro_decel_mps2 == 8.0
@@ -81,36 +95,88 @@ def test_optional_aro_keys_extend_the_sweep_and_the_ids(tmp_path):
 BAD = [
     ("unknown table", GOOD_SCENARIO + GOOD_SWEEP + "[sweeps]\nmu = [1.0]\n", "sweeps", "sweep"),
     ("top-level key", "foo = 1\n" + GOOD_SCENARIO + GOOD_SWEEP, "foo", None),
-    ("misspelt key", GOOD_SCENARIO + "[sweep]\nego_speed_kph = [120]\nmu = [1.0]\n",
-     "ego_speed_kph", "ego_speed_kmh"),
-    ("misspelt scenario key", '[scenario]\nsumocfg = "s.sumocfg"\nmax_time = 3\n' + GOOD_SWEEP,
-     "max_time", "max_time_s"),
+    (
+        "misspelt key",
+        GOOD_SCENARIO + "[sweep]\nego_speed_kph = [120]\nmu = [1.0]\n",
+        "ego_speed_kph",
+        "ego_speed_kmh",
+    ),
+    (
+        "misspelt scenario key",
+        '[scenario]\nsumocfg = "s.sumocfg"\nmax_time = 3\n' + GOOD_SWEEP,
+        "max_time",
+        "max_time_s",
+    ),
     ("not a list", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [120]\nmu = 1.0\n", "mu", None),
     ("string value", GOOD_SCENARIO + '[sweep]\nego_speed_kmh = [120]\nmu = ["dry"]\n', "mu", None),
-    ("bool value", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [true]\nmu = [1.0]\n", "ego_speed_kmh", None),
+    (
+        "bool value",
+        GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [true]\nmu = [1.0]\n",
+        "ego_speed_kmh",
+        None,
+    ),
     ("mu zero", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [120]\nmu = [0.0]\n", "mu", None),
     ("mu too high", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [120]\nmu = [1.5]\n", "mu", None),
-    ("zero speed", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [0]\nmu = [1.0]\n", "ego_speed_kmh", None),
-    ("negative speed", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [-90]\nmu = [1.0]\n",
-     "ego_speed_kmh", None),
-    ("negative distance", GOOD_SCENARIO + GOOD_SWEEP + "oncoming_start_m = [-5]\n",
-     "oncoming_start_m", None),
-    ("word distance", GOOD_SCENARIO + GOOD_SWEEP + 'oncoming_start_m = ["far"]\n',
-     "oncoming_start_m", None),
+    (
+        "zero speed",
+        GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [0]\nmu = [1.0]\n",
+        "ego_speed_kmh",
+        None,
+    ),
+    (
+        "negative speed",
+        GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [-90]\nmu = [1.0]\n",
+        "ego_speed_kmh",
+        None,
+    ),
+    (
+        "negative distance",
+        GOOD_SCENARIO + GOOD_SWEEP + "oncoming_start_m = [-5]\n",
+        "oncoming_start_m",
+        None,
+    ),
+    (
+        "word distance",
+        GOOD_SCENARIO + GOOD_SWEEP + 'oncoming_start_m = ["far"]\n',
+        "oncoming_start_m",
+        None,
+    ),
     ("empty list", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [120]\nmu = []\n", "mu", None),
-    ("duplicate", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [120, 120.0]\nmu = [1.0]\n",
-     "ego_speed_kmh", None),
-    ("duplicate none", GOOD_SCENARIO + GOOD_SWEEP + 'oncoming_start_m = ["none", "none"]\n',
-     "oncoming_start_m", None),
+    (
+        "duplicate",
+        GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [120, 120.0]\nmu = [1.0]\n",
+        "ego_speed_kmh",
+        None,
+    ),
+    (
+        "duplicate none",
+        GOOD_SCENARIO + GOOD_SWEEP + 'oncoming_start_m = ["none", "none"]\n',
+        "oncoming_start_m",
+        None,
+    ),
     ("zero decel", GOOD_SCENARIO + GOOD_SWEEP + "aro_decel_mps2 = [0.0]\n", "aro_decel_mps2", None),
-    ("missing sumocfg file", '[scenario]\nsumocfg = "nope.sumocfg"\n' + GOOD_SWEEP, "sumocfg", None),
+    (
+        "missing sumocfg file",
+        '[scenario]\nsumocfg = "nope.sumocfg"\n' + GOOD_SWEEP,
+        "sumocfg",
+        None,
+    ),
     ("sumocfg not a string", "[scenario]\nsumocfg = 3\n" + GOOD_SWEEP, "sumocfg", None),
     ("no sumocfg key", "[scenario]\nmax_time_s = 10.0\n" + GOOD_SWEEP, "sumocfg", None),
     ("no mu key", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [120]\n", "mu", None),
     ("no scenario table", GOOD_SWEEP, "scenario", None),
-    ("bad max time", '[scenario]\nsumocfg = "s.sumocfg"\nmax_time_s = -1.0\n' + GOOD_SWEEP,
-     "max_time_s", None),
-    ("missing paper table", GOOD_SCENARIO + GOOD_SWEEP + '[paper]\ntable = "none.csv"\n', "table", None),
+    (
+        "bad max time",
+        '[scenario]\nsumocfg = "s.sumocfg"\nmax_time_s = -1.0\n' + GOOD_SWEEP,
+        "max_time_s",
+        None,
+    ),
+    (
+        "missing paper table",
+        GOOD_SCENARIO + GOOD_SWEEP + '[paper]\ntable = "none.csv"\n',
+        "table",
+        None,
+    ),
     ("malformed toml", GOOD_SCENARIO + "[sweep\nmu = [1.0]\n", "TOML", None),
 ]
 
@@ -146,22 +212,33 @@ def _toml_number(x):
     return repr(x)
 
 
-speeds = st.lists(st.one_of(st.integers(1, 300), st.floats(0.5, 300.0)), min_size=1, max_size=5,
-                  unique_by=float)
+speeds = st.lists(
+    st.one_of(st.integers(1, 300), st.floats(0.5, 300.0)), min_size=1, max_size=5, unique_by=float
+)
 mus = st.lists(st.floats(0.01, 1.2), min_size=1, max_size=4, unique=True)
-distances = st.lists(st.one_of(st.just("none"), st.integers(0, 2000), st.floats(0.0, 2000.0)),
-                     min_size=1, max_size=4,
-                     unique_by=lambda d: d if isinstance(d, str) else float(d))
+distances = st.lists(
+    st.one_of(st.just("none"), st.integers(0, 2000), st.floats(0.0, 2000.0)),
+    min_size=1,
+    max_size=4,
+    unique_by=lambda d: d if isinstance(d, str) else float(d),
+)
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
 @given(speeds=speeds, mus=mus, distances=distances)
-def test_any_valid_sweep_gives_one_uniquely_named_case_per_combination(tmp_path, speeds, mus, distances):
+def test_any_valid_sweep_gives_one_uniquely_named_case_per_combination(
+    tmp_path, speeds, mus, distances
+):
     def arr(values):
         return "[" + ", ".join('"none"' if v == "none" else _toml_number(v) for v in values) + "]"
 
-    path = _write(tmp_path, GOOD_SCENARIO + f"[sweep]\nego_speed_kmh = {arr(speeds)}\n"
-                  f"mu = {arr(mus)}\noncoming_start_m = {arr(distances)}\n")
+    path = _write(
+        tmp_path,
+        GOOD_SCENARIO + f"[sweep]\nego_speed_kmh = {arr(speeds)}\n"
+        f"mu = {arr(mus)}\noncoming_start_m = {arr(distances)}\n",
+    )
     cases = load_matrix(path).cases()
     assert len(cases) == len(speeds) * len(mus) * len(distances)
     assert len({c.case_id for c in cases}) == len(cases)

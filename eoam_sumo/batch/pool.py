@@ -75,7 +75,7 @@ def _child_main() -> None:
                 return
             try:
                 out.send(("ok", func(payload)))
-            except Exception as exc:  # the task's failure is the parent's result, not ours
+            except Exception as exc:  # noqa: BLE001 - any task failure is a result to report
                 traceback.print_exc(file=sys.stderr)
                 out.send(("error", _one_line(f"{type(exc).__name__}: {exc}")))
     except (EOFError, BrokenPipeError):
@@ -86,7 +86,7 @@ class _Worker:
     """One worker process as seen by the parent: start, dispatch, receive, kill."""
 
     def __init__(self, preload: Sequence[str]):
-        self.log = tempfile.TemporaryFile()
+        self.log = tempfile.TemporaryFile()  # noqa: SIM115 - lives as long as the worker
         self.proc = subprocess.Popen(
             [sys.executable, "-c", "from eoam_sumo.batch.pool import _child_main; _child_main()"],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.log,
@@ -127,7 +127,8 @@ class _Worker:
             self.dead = True
             reason = self._death_reason()
             if not self.busy:
-                raise RuntimeError(f"a worker process ended before its first task: {reason}") from None
+                raise RuntimeError(
+                    f"a worker process ended before its first task: {reason}") from None
             key, self.key = self.key, None
             return TaskResult(key, error=f"worker process died ({reason})")
         if msg[0] == "ready":
@@ -223,7 +224,12 @@ def run_local(
                 if w.ready and not w.busy and pending:
                     key, payload = pending.popleft()
                     w.dispatch(func, key, payload, timeout_s)
-            wait_s = max(min(w.deadline for w in workers) - time.monotonic(), 0.0)
+            if not pending:  # nothing left to hand out: let idle workers go
+                for w in [w for w in workers if w.ready and not w.busy]:
+                    workers.remove(w)
+                    w.close()
+            waiting = [w for w in workers if w.busy or not w.ready]
+            wait_s = max(min(w.deadline for w in waiting) - time.monotonic(), 0.0)
             for conn in wait([w.recv_conn for w in workers], timeout=wait_s):
                 w = next(w for w in workers if w.recv_conn is conn)
                 result = w.receive()
@@ -233,7 +239,7 @@ def run_local(
                 if result is not None:
                     yield result
             now = time.monotonic()
-            for w in [w for w in workers if w.deadline <= now and (w.busy or not w.ready)]:
+            for w in [w for w in workers if (w.busy or not w.ready) and w.deadline <= now]:
                 workers.remove(w)
                 result = w.expire()
                 w.close()
@@ -292,7 +298,8 @@ def run_dask(
         key = futures.pop(fut)
         try:
             result = fut.result()
-        except Exception as exc:  # the cluster's failure belongs in the results, not a crash
-            result = TaskResult(key, error=_one_line(f"dask task failed: {type(exc).__name__}: {exc}"))
+        except Exception as exc:  # noqa: BLE001 - a cluster failure is a failed case
+            error = f"dask task failed: {type(exc).__name__}: {exc}"
+            result = TaskResult(key, error=_one_line(error))
         fut.release()
         yield result

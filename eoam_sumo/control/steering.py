@@ -98,6 +98,10 @@ class SteeringController:
         x_la = max(x_la, self._xmin)
         return w * w * (self._L + self._kus * v * v) / (v * v), x_la
 
+    def lateral_accel(self, speed_mps: float, steer_rad: float) -> float:
+        """Steady-state lateral acceleration v^2 delta / (L + K_us v^2) a steer angle asks for."""
+        return speed_mps * speed_mps * steer_rad / (self._L + self._kus * speed_mps * speed_mps)
+
     def command(
         self,
         speed_mps: float,

@@ -52,10 +52,12 @@ class DesignSettings:
     max_quintic_time_s: float = _p(
         6.0, "s", DESIGN + ": upper bound of T; binds only below mu 0.07 and keeps the lane "
         "change well inside the 8 s manoeuvre timer (design.md sec. 4)")
-    ocp_intervals: int = _p(40, "-", DESIGN + ": multiple-shooting intervals (speed vs. accuracy)")
-    rk_substeps: int = _p(2, "-", DESIGN + ": RK4 steps per interval (stiff tyres at low speed)")
-    min_speed_mps: float = _p(
-        1.0, "m/s", DESIGN + ": floor on the body longitudinal speed (slip angles undefined at 0)")
+    ocp_intervals: int = _p(40, "-", DESIGN + ": collocation intervals (speed vs. accuracy)")
+    collocation_degree: int = _p(3, "-", DESIGN + ": Radau collocation points per interval")
+    min_speed_fraction: float = _p(
+        0.5, "-", DESIGN + ": the body speed stays above this fraction of the entry speed: the "
+        "EOAM is a lane change, a manoeuvre shedding more speed is braking (the stopping "
+        "boundary covers it); also keeps the slip angles defined")
     max_yaw_rad: float = _p(math.radians(45.0), "rad", DESIGN + ": bound keeping the OCP regular")
     regularisation: float = _p(
         1e-4, "m", DESIGN + ": weight of the squared control steps (in units of m g and the steer "
@@ -82,7 +84,7 @@ class DesignSettings:
     def __post_init__(self) -> None:
         positive = (
             "lane_change_m", "obstacle_width_m", "dx_step_m", "lat_accel_fraction",
-            "max_quintic_time_s", "min_speed_mps", "max_yaw_rad", "ipopt_tol",
+            "max_quintic_time_s", "min_speed_fraction", "max_yaw_rad", "ipopt_tol",
             "verify_lateral_tol_m", "verify_distance_tol_m", "verify_lat_speed_tol_mps",
             "verify_yaw_tol_rad", "verify_yaw_rate_tol_radps", "verify_ellipse_tol",
         )
@@ -95,12 +97,14 @@ class DesignSettings:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0.0):
                 raise ValueError(f"design setting {name}={v!r} must be a finite number >= 0")
-        for name in ("ocp_intervals", "rk_substeps", "ipopt_max_iter"):
+        for name in ("ocp_intervals", "collocation_degree", "ipopt_max_iter"):
             v = getattr(self, name)
             if not (isinstance(v, int) and v >= 1):
                 raise ValueError(f"design setting {name}={v!r} must be an integer >= 1")
         if self.ocp_intervals < 10:
             raise ValueError(f"ocp_intervals={self.ocp_intervals} must be >= 10")
+        if self.min_speed_fraction >= 1.0:
+            raise ValueError(f"min_speed_fraction={self.min_speed_fraction} must be < 1")
         if self.lat_accel_fraction > 1.0:
             raise ValueError(f"lat_accel_fraction={self.lat_accel_fraction} must be <= 1")
         _check_grid("speeds_kmh", self.speeds_kmh, 0.0, 400.0)

@@ -8,10 +8,11 @@ steering angle limits (eqs. 26-27), the brake limit and the engine limit (eq. 29
 Final conditions imposed besides eq. 23, so that the ego ends parallel and settled in the next
 lane: lateral speed, yaw angle, yaw rate and steering angle all zero at t_f.
 
-Transcription: direct multiple shooting, ``settings.ocp_intervals`` intervals of t_f / N,
-piecewise-constant controls (steering rate, longitudinal force), ``settings.rk_substeps``
-RK4 steps per interval; the path constraints hold at every RK step start. IPOPT solves it; the
-problem is built once per ``LaneChangeOcp`` with the entry speed and the friction as parameters.
+Transcription: direct collocation (Radau, ``settings.collocation_degree`` points in each of
+``settings.ocp_intervals`` intervals of t_f / N; A-stable, as the friction-scaled tyres make the
+lateral dynamics stiff at low speed), piecewise-constant controls (steering rate, longitudinal
+force); the path constraints hold at every collocation point. IPOPT solves it; the problem is
+built once per ``LaneChangeOcp`` with the entry speed and the friction as parameters.
 """
 
 from __future__ import annotations
@@ -45,6 +46,8 @@ class OcpSolution:
     states: np.ndarray
     controls: np.ndarray
     iterations: int = 0
+    colloc_states: np.ndarray | None = None  # (N * degree, 7), interval-major
+    multipliers: np.ndarray | None = None  # constraint multipliers (for warm starts)
 
     @property
     def distance_m(self) -> float:
@@ -56,6 +59,11 @@ def solver_options(settings: DesignSettings) -> dict:
     """The CasADi/IPOPT options (also written to metadata.json)."""
     return {
         "print_time": False,
+        "expand": True,
+        "ipopt.warm_start_init_point": "yes",
+        "ipopt.warm_start_bound_push": 1e-6,
+        "ipopt.warm_start_mult_bound_push": 1e-6,
+        "ipopt.mu_init": 1e-4,
         "ipopt.print_level": 0,
         "ipopt.sb": "yes",
         "ipopt.tol": settings.ipopt_tol,
@@ -63,28 +71,36 @@ def solver_options(settings: DesignSettings) -> dict:
     }
 
 
-def _step_function(params: VehicleParams, substeps: int) -> ca.Function:
-    """One interval of RK4 sub-steps: (x, u, mu, dt) -> (x_next, path-constraint values)."""
-    x = ca.SX.sym("x", N_STATES)
+def _interval_function(params: VehicleParams, degree: int) -> ca.Function:
+    """Radau collocation on one interval: (x0, xc, u, mu, h) -> (defects, x_end, path values).
+
+    ``xc`` holds the states at the ``degree`` collocation points (7 x degree); the defects are
+    h f(x_j, u) - sum_r C[r, j] x_r; path values are (ellipse front, ellipse rear, body speed)
+    at each collocation point.
+    """
+    tau = np.concatenate(([0.0], ca.collocation_points(degree, "radau")))
+    deriv = np.zeros((degree + 1, degree + 1))
+    for r in range(degree + 1):
+        others = [tau[q] for q in range(degree + 1) if q != r]
+        poly = np.poly1d([1.0])
+        for q in others:
+            poly *= np.poly1d([1.0, -q]) / (tau[r] - q)
+        dpoly = poly.deriv()
+        deriv[r, :] = [dpoly(t) for t in tau]
+    x0 = ca.SX.sym("x0", N_STATES)
+    xc = ca.SX.sym("xc", N_STATES, degree)
     u = ca.SX.sym("u", N_CONTROLS)
     mu = ca.SX.sym("mu")
-    dt = ca.SX.sym("dt")
-
-    def f(xs):
-        xdot, out = dynamics(xs, u, mu, params, ca)
-        return ca.vertcat(*xdot), out
-
-    h = dt / substeps
-    xk = x
-    path = []
-    for _ in range(substeps):
-        k1, out = f(xk)
+    h = ca.SX.sym("h")
+    points = ca.horzcat(x0, xc)
+    defects, path = [], []
+    for j in range(1, degree + 1):
+        xdot, out = dynamics(points[:, j], u, mu, params, ca)
+        slope = sum(deriv[r, j] * points[:, r] for r in range(degree + 1))
+        defects.append(h * ca.vertcat(*xdot) - slope)
         path += [out.ellipse_front, out.ellipse_rear, out.vx_body_mps]
-        k2, _ = f(xk + 0.5 * h * k1)
-        k3, _ = f(xk + 0.5 * h * k2)
-        k4, _ = f(xk + h * k3)
-        xk = xk + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-    return ca.Function("rk4_interval", [x, u, mu, dt], [xk, ca.vertcat(*path)])
+    return ca.Function("radau_interval", [x0, xc, u, mu, h],
+                       [ca.horzcat(*defects), points[:, degree], ca.vertcat(*path)])
 
 
 class LaneChangeOcp:
@@ -93,29 +109,34 @@ class LaneChangeOcp:
     def __init__(self, params: VehicleParams, settings: DesignSettings):
         self.params = params
         self.settings = settings
-        n = settings.ocp_intervals
+        n, d = settings.ocp_intervals, settings.collocation_degree
         p = params
         opti = ca.Opti()
         self._z = opti.variable(N_STATES, n + 1)
+        self._zc = opti.variable(N_STATES, n * d)
         self._w = opti.variable(N_CONTROLS, n)
         self._tau = opti.variable()
         self._v0 = opti.parameter()
         self._mu = opti.parameter()
         mg = p.mass_kg * G_MPS2
         self._control_scale = np.array([p.max_steer_rate_radps, mg])
-        xs = ca.diag(ca.DM(_STATE_SCALE)) @ self._z
+        scale = ca.diag(ca.DM(_STATE_SCALE))
+        xs = scale @ self._z
+        xc = scale @ self._zc
         us = ca.diag(ca.DM(self._control_scale)) @ self._w
         t_f = _TIME_SCALE_S * self._tau
-        step = _step_function(p, settings.rk_substeps).map(n)
-        x_next, path = step(xs[:, :-1], us, ca.repmat(self._mu, 1, n), ca.repmat(t_f / n, 1, n))
-        opti.subject_to(self._z[:, 1:] == x_next / ca.DM(_STATE_SCALE))
+        interval = _interval_function(p, d).map(n)
+        defects, x_end, path = interval(
+            xs[:, :-1], xc, us, ca.repmat(self._mu, 1, n), ca.repmat(t_f / n, 1, n))
+        opti.subject_to(ca.vec(defects / ca.repmat(ca.DM(_STATE_SCALE), 1, n * d)) == 0.0)
+        opti.subject_to(self._z[:, 1:] == x_end / ca.DM(_STATE_SCALE))
         # eqs. 21, 22, 24 (steering starts centred)
         opti.subject_to(xs[:, 0] == ca.vertcat(0.0, self._v0, 0.0, 0.0, 0.0, 0.0, 0.0))
         # eq. 23 and the settled end: no lateral speed, yaw, yaw rate or steering
         opti.subject_to(xs[2:, -1] == ca.vertcat(settings.lane_change_m, 0.0, 0.0, 0.0, 0.0))
-        for j in range(settings.rk_substeps):
+        for j in range(d):
             opti.subject_to(ca.vec(path[3 * j:3 * j + 2, :]) <= 1.0)  # eqs. 25, 28
-            opti.subject_to(path[3 * j + 2, :] >= settings.min_speed_mps)
+            opti.subject_to(path[3 * j + 2, :] >= settings.min_speed_fraction * self._v0)
         steer = xs[6, :]
         opti.subject_to(opti.bounded(-p.max_steer_rad, steer, p.max_steer_rad))  # eqs. 26-27
         opti.subject_to(opti.bounded(-settings.max_yaw_rad, xs[4, :], settings.max_yaw_rad))
@@ -128,6 +149,7 @@ class LaneChangeOcp:
         opti.minimize(xs[0, -1] + settings.regularisation * ca.sumsqr(dw))  # eq. 14
         opti.solver("ipopt", solver_options(settings))
         self._opti = opti
+        self._degree = d
 
     def solve(self, speed_mps: float, mu: float, guess: OcpSolution) -> OcpSolution:
         """Solve for this entry speed and friction from ``guess``; raise ``OcpError`` on failure."""
@@ -135,8 +157,14 @@ class LaneChangeOcp:
         opti.set_value(self._v0, speed_mps)
         opti.set_value(self._mu, mu)
         opti.set_initial(self._z, (guess.states / _STATE_SCALE).T)
+        colloc = guess.colloc_states
+        if colloc is None:
+            colloc = _interpolate_nodes(guess.states, self._degree)
+        opti.set_initial(self._zc, (colloc / _STATE_SCALE).T)
         opti.set_initial(self._w, (guess.controls / self._control_scale).T)
         opti.set_initial(self._tau, guess.duration_s / _TIME_SCALE_S)
+        if guess.multipliers is not None:
+            opti.set_initial(opti.lam_g, guess.multipliers)
         sol = opti.solve_limited()
         stats = opti.stats()
         if not stats["success"]:
@@ -150,7 +178,17 @@ class LaneChangeOcp:
             states=np.asarray(sol.value(self._z)).T * _STATE_SCALE,
             controls=np.asarray(sol.value(self._w)).T * self._control_scale,
             iterations=int(stats["iter_count"]),
+            colloc_states=np.asarray(sol.value(self._zc)).T * _STATE_SCALE,
+            multipliers=np.asarray(sol.value(opti.lam_g)).ravel(),
         )
+
+
+def _interpolate_nodes(states: np.ndarray, degree: int) -> np.ndarray:
+    """Collocation-point states linearly interpolated between the nodes (a guess)."""
+    tau = np.asarray(ca.collocation_points(degree, "radau"))
+    a, b = states[:-1], states[1:]
+    points = [a + t * (b - a) for t in tau]
+    return np.stack(points, axis=1).reshape(-1, states.shape[1])
 
 
 def quintic_guess(speed_mps: float, mu: float, params: VehicleParams,
@@ -180,8 +218,11 @@ def rescaled_guess(previous: OcpSolution, speed_mps: float) -> OcpSolution:
     states = previous.states.copy()
     states[:, 0] *= ratio
     states[:, 1] *= ratio
+    colloc = previous.colloc_states.copy()
+    colloc[:, :2] *= ratio
     return OcpSolution(float(speed_mps), previous.mu, previous.duration_s, states,
-                       previous.controls.copy())
+                       previous.controls.copy(), colloc_states=colloc,
+                       multipliers=previous.multipliers)
 
 
 def solve_chain(ocp: LaneChangeOcp, mu: float, speeds_mps, on_solved=None) -> list[OcpSolution]:

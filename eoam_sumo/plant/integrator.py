@@ -3,20 +3,17 @@
 from __future__ import annotations
 
 from eoam_sumo.params import VehicleParams
-from eoam_sumo.plant.model import VX, outputs, rhs
+from eoam_sumo.plant.model import outputs, rhs
 
 
 def rk4_step(x, u, mu, params: VehicleParams, dt_s: float, ops) -> list:
-    """One RK4 step of ``dt_s`` with inputs and friction held; then ``vx >= 0`` (no reversing:
-    the brake and rolling-resistance forces vanish at rest, see ``tyres.CREEP_SPEED_MPS``)."""
+    """One RK4 step of ``dt_s`` with inputs and friction held."""
     k1 = rhs(x, u, mu, params, ops)
     k2 = rhs([xi + 0.5 * dt_s * ki for xi, ki in zip(x, k1)], u, mu, params, ops)
     k3 = rhs([xi + 0.5 * dt_s * ki for xi, ki in zip(x, k2)], u, mu, params, ops)
     k4 = rhs([xi + dt_s * ki for xi, ki in zip(x, k3)], u, mu, params, ops)
     sixth = dt_s / 6.0
-    x_next = [xi + sixth * (a + 2.0 * b + 2.0 * c + d) for xi, a, b, c, d in zip(x, k1, k2, k3, k4)]
-    x_next[VX] = ops.fmax(x_next[VX], 0.0)
-    return x_next
+    return [xi + sixth * (a + 2.0 * b + 2.0 * c + d) for xi, a, b, c, d in zip(x, k1, k2, k3, k4)]
 
 
 def advance(x, u, mu, params: VehicleParams, dt_s: float, substeps: int, ops):

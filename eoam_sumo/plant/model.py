@@ -16,6 +16,12 @@ iteration. Drag ``0.5 rho CdA vx |vx|``; drive on the rear axle only, limited by
 force and by power / speed; brake split front/rear by ``brake_front_share``; first-order lags
 for the steering (rate limited), drive and brake actuators.
 
+Low speed: brake and rolling-resistance forces ramp in over ``CREEP_SPEED_MPS`` and slip
+quotients use ``max(|v_long|, SLIP_SPEED_FLOOR_MPS)``, so there is no singularity at rest and
+a braked vehicle comes to rest and stays there without reversing. ``vx`` is NOT clamped: it
+turns negative only when the body yaws more than 90 deg from its path (a spin), which the
+tyres handle as a wheel rolling backwards; clamping it would delete momentum mid-spin.
+
 ``x``, ``u`` are sequences of scalars (floats, or CasADi SX/MX elements) in the order of
 ``STATE_NAMES`` and ``INPUT_NAMES``; ``mu`` is the peak surface friction under the vehicle.
 """

@@ -10,6 +10,7 @@ import numpy as np
 
 from eoam_sumo.params import VehicleParams
 from eoam_sumo.plant.integrator import advance
+from eoam_sumo.plant.model import INPUT_NAMES, STATE_NAMES
 from eoam_sumo.plant.ops import FLOAT_OPS
 from eoam_sumo.plant.stepping import check_mu, validate_step
 
@@ -31,5 +32,10 @@ class ReferencePlant:
     def step(self, x, u, mu: float) -> tuple[np.ndarray, np.ndarray]:
         xs = [float(v) for v in x]
         us = [float(v) for v in u]
+        if len(xs) != len(STATE_NAMES) or len(us) != len(INPUT_NAMES):
+            raise ValueError(
+                f"x needs {len(STATE_NAMES)} and u {len(INPUT_NAMES)} values, "
+                f"got {len(xs)} and {len(us)}"
+            )
         x_next, y = advance(xs, us, check_mu(mu), self.params, self.dt_s, self.substeps, FLOAT_OPS)
         return np.array(x_next, dtype=float), np.array(y, dtype=float)

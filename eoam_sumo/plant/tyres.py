@@ -14,8 +14,8 @@ from __future__ import annotations
 from typing import NamedTuple
 
 SLIP_SPEED_FLOOR_MPS = 1.0
-"""Floor of the wheel's longitudinal speed in the slip-angle quotient: keeps the tyre's
-low-speed lateral stiffness C / (m v) bounded for the fixed-step integrator."""
+"""Floor of the wheel's longitudinal speed |v_long| in the slip-angle quotient: keeps the
+tyre's low-speed lateral stiffness C / (m v) bounded for the fixed-step integrator."""
 
 CREEP_SPEED_MPS = 0.1
 """Speed over which brake and rolling-resistance forces ramp in from zero (they oppose motion
@@ -68,7 +68,9 @@ def axle_force(
     Rolling axle (Pacejka 2012 sec. 3.2.3, friction ellipse with longitudinal priority): the
     wheel-frame longitudinal force is the drive minus the brake and rolling resistance, clipped
     to ``mu Fz``; the lateral force is Fiala with its peak derated to
-    ``sqrt((mu Fz)^2 - Fx^2)`` (Hindiyeh & Gerdes 2014).
+    ``sqrt((mu Fz)^2 - Fx^2)`` (Hindiyeh & Gerdes 2014). A drive force above ``mu Fz`` (wheel
+    spin) is clipped to it and so leaves no lateral force. Brake and rolling resistance oppose
+    the wheel's rolling direction, so a wheel rolling backwards (in a spin) is handled too.
 
     No ABS: the brush tyre at slip angle alpha reaches full sliding when the longitudinal
     force reaches ``mu Fz cos(alpha)``; a brake force (net of drive) above that LOCKS the
@@ -78,7 +80,7 @@ def axle_force(
     """
     v_long = vx_mps * cos_steer + vy_mps * sin_steer
     v_lat = -vx_mps * sin_steer + vy_mps * cos_steer
-    tan_slip = v_lat / ops.fmax(v_long, SLIP_SPEED_FLOOR_MPS)
+    tan_slip = v_lat / ops.fmax(ops.fabs(v_long), SLIP_SPEED_FLOOR_MPS)
     cos_slip = 1.0 / ops.sqrt(1.0 + tan_slip * tan_slip)
     capacity_n = mu * fz_n
     creep = ops.fmin(ops.fmax(v_long / CREEP_SPEED_MPS, -1.0), 1.0)
@@ -100,7 +102,7 @@ def axle_force(
     )
     return AxleForce(
         fx_n=ops.if_else(locked, -slide * vx_mps, fx_roll_n),
-        fy_n=fy_roll_n,
+        fy_n=ops.if_else(locked, -slide * vy_mps, fy_roll_n),
         locked=locked,
         tan_slip=tan_slip,
     )

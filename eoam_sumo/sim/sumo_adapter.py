@@ -1,10 +1,12 @@
 """The one module that talks to Eclipse SUMO: libsumo for runs, TraCI only for the GUI.
 
-A :class:`SumoSession` loads a ``.sumocfg`` after checking its files, advances SUMO to the ego's
-departure, re-inserts the ego there at the requested speed (moveToXY before the insertion
-step, design sec. 6) and makes that step, applies the :class:`ScenarioOverrides` (surface friction, an added oncoming car, the
-ARO's emergency stop) and then answers the co-simulation's queries: the ego's reference line,
-the bodies around the ego (one context subscription) and the friction under the ego.
+A :class:`SumoSession` loads a ``.sumocfg`` after checking its files, applies the
+:class:`ScenarioOverrides` (surface friction, an added oncoming car, the ARO's emergency stop),
+advances SUMO to the ego's departure and makes the step that inserts the ego at the requested
+speed (moveToXY before the insertion step, design sec. 6). It then answers the co-simulation's
+queries: the ego's reference line, the bodies around the ego (one context subscription) and
+the friction under the ego. The ego is re-inserted as a copy of its route-file vehicle (route,
+type, departLane/departPos and ``<param>``s kept; other attributes and its stops dropped).
 
 Scripted stop (paper sec. 10.1, Figure 19): a vehicle with the ``<param>`` ``eoam.aro_hold_s``
 and ``eoam.aro_decel_mps2`` keeps its departure speed for ``aro_hold_s`` after departing, then
@@ -18,14 +20,18 @@ the yaw counter-clockwise from +x in rad.
 
 from __future__ import annotations
 
+import contextlib
+import gzip
 import math
 import os
 import shutil
+import subprocess
 import tempfile
 import uuid
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Self
 
 import numpy as np
 
@@ -42,16 +48,23 @@ SCRIPTED_SPEED_MODE = 25  # safe speed, right of way, red lights; no accel/decel
 ONCOMING_SPEED_MODE = 0  # constant speed even when the ego is mapped onto its lane
 NO_LANE_CHANGES = 0
 PARKING_BIT = 2  # bit of VAR_STOPSTATE set while a vehicle is parked
-ENFORCED_OPTIONS = (("--collision.action", "none"), ("--time-to-teleport", "-1"),
-                    ("--no-warnings", "true"), ("--no-step-log", "true"))
+ENFORCED_OPTIONS = (
+    ("--collision.action", "none"),
+    ("--time-to-teleport", "-1"),
+    ("--no-warnings", "true"),
+    ("--no-step-log", "true"),
+)
 SPEED_LIMIT_WORDS = ("max", "desired", "speedLimit")
+TRACI_RETRIES = 600  # x 50 ms: time SUMO may take to load before TraCI gives up
+PROCESS_EXIT_S = 10.0  # time a closed SUMO server process gets to exit
 
 _open_libsumo: list[SumoSession] = []  # libsumo runs one simulation per process
 
 
-def _number(name: str, value, *, minimum: float, inclusive: bool = True,
-            maximum: float | None = None) -> float:
-    """``value`` as a float, or InputError naming ``name`` when it is not a finite number in range."""
+def _number(
+    name: str, value, *, minimum: float, inclusive: bool = True, maximum: float | None = None
+) -> float:
+    """``value`` as a float; InputError naming ``name`` unless it is a finite number in range."""
     ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
     ok = ok and (value >= minimum if inclusive else value > minimum)
     ok = ok and (maximum is None or value <= maximum)
@@ -130,12 +143,17 @@ class ScenarioFiles:
     opposite_lanes: dict  # lane id -> id of its <neigh> (opposite-direction) lane
 
 
+def _xml_source(path: Path):
+    """The file to parse: SUMO reads gzip-compressed XML (``*.gz``) too."""
+    return gzip.open(path) if path.suffix == ".gz" else path
+
+
 def _parse_xml(path: Path, what: str) -> ET.Element:
     if not path.is_file():
         raise InputError(f"{what} {path} not found")
     try:
-        return ET.parse(path).getroot()
-    except ET.ParseError as exc:
+        return ET.parse(_xml_source(path)).getroot()
+    except (ET.ParseError, OSError) as exc:
         raise InputError(f"{path}: malformed XML: {exc}") from exc
 
 
@@ -145,7 +163,7 @@ def _read_net(path: Path) -> dict:
         raise InputError(f"net-file {path} not found")
     opposite, lane_id, first = {}, None, True
     try:
-        for event, elem in ET.iterparse(path, events=("start", "end")):
+        for event, elem in ET.iterparse(_xml_source(path), events=("start", "end")):
             if first:
                 if elem.tag != "net":
                     raise InputError(f"{path}: not a SUMO network (root element <{elem.tag}>)")
@@ -156,7 +174,7 @@ def _read_net(path: Path) -> dict:
                 opposite[lane_id] = elem.get("lane")
             elif event == "end" and elem.tag in ("edge", "junction", "connection", "tlLogic"):
                 elem.clear()
-    except ET.ParseError as exc:
+    except (ET.ParseError, OSError) as exc:
         raise InputError(f"{path}: malformed XML: {exc}") from exc
     return opposite
 
@@ -184,14 +202,20 @@ def check_scenario(cfg: Path, ego_id: str = "ego") -> ScenarioFiles:
     routes = _option_files(root, cfg, "route-files")
     additionals = _option_files(root, cfg, "additional-files")
     vehicles = {}
-    for path, what in [(p, "route file") for p in routes] + [(p, "additional file") for p in additionals]:
+    for path, what in [(p, "route file") for p in routes] + [
+        (p, "additional file") for p in additionals
+    ]:
         for elem in _parse_xml(path, what).iter():
             if elem.tag in ("vehicle", "trip") and elem.get("id") is not None:
                 params = {p.get("key"): p.get("value") for p in elem.findall("param")}
-                vehicles[elem.get("id")] = VehicleSpec(elem.get("id"), path, dict(elem.attrib), params)
+                vehicles[elem.get("id")] = VehicleSpec(
+                    elem.get("id"), path, dict(elem.attrib), params
+                )
     if ego_id not in vehicles:
         searched = ", ".join(p.name for p in routes + additionals) or "no route files"
-        raise InputError(f"{cfg}: no vehicle '{ego_id}' in its route or additional files ({searched})")
+        raise InputError(
+            f"{cfg}: no vehicle '{ego_id}' in its route or additional files ({searched})"
+        )
     return ScenarioFiles(cfg, nets[0], routes, additionals, vehicles, opposite)
 
 
@@ -223,7 +247,10 @@ def _scripted_stops(files: ScenarioFiles, overrides: ScenarioOverrides) -> dict:
         is_aro = spec.params.get(ROLE_KEY) == "aro"
         aro_seen = aro_seen or is_aro
         values = {}
-        for key, override in ((HOLD_KEY, overrides.aro_hold_s), (DECEL_KEY, overrides.aro_decel_mps2)):
+        for key, override in (
+            (HOLD_KEY, overrides.aro_hold_s),
+            (DECEL_KEY, overrides.aro_decel_mps2),
+        ):
             if is_aro and override is not None:
                 values[key] = override
             elif key in spec.params:
@@ -232,15 +259,25 @@ def _scripted_stops(files: ScenarioFiles, overrides: ScenarioOverrides) -> dict:
             continue
         missing = [k for k in (HOLD_KEY, DECEL_KEY) if k not in values]
         if missing:
-            raise InputError(f"{spec.source}: vehicle '{spec.vid}' has a scripted stop but no "
-                             f"<param key=\"{missing[0]}\">")
-        hold = _number(f"{spec.source}: vehicle '{spec.vid}' {HOLD_KEY}", values[HOLD_KEY], minimum=0.0)
-        decel = _number(f"{spec.source}: vehicle '{spec.vid}' {DECEL_KEY}", values[DECEL_KEY],
-                        minimum=0.0, inclusive=False)
+            raise InputError(
+                f"{spec.source}: vehicle '{spec.vid}' has a scripted stop but no "
+                f'<param key="{missing[0]}">'
+            )
+        hold = _number(
+            f"{spec.source}: vehicle '{spec.vid}' {HOLD_KEY}", values[HOLD_KEY], minimum=0.0
+        )
+        decel = _number(
+            f"{spec.source}: vehicle '{spec.vid}' {DECEL_KEY}",
+            values[DECEL_KEY],
+            minimum=0.0,
+            inclusive=False,
+        )
         stops[spec.vid] = (hold, decel)
     if not aro_seen and (overrides.aro_hold_s is not None or overrides.aro_decel_mps2 is not None):
-        raise InputError(f"{files.cfg}: aro_hold_s/aro_decel_mps2 given but no vehicle has "
-                         f"<param key=\"{ROLE_KEY}\" value=\"aro\">")
+        raise InputError(
+            f"{files.cfg}: aro_hold_s/aro_decel_mps2 given but no vehicle has "
+            f'<param key="{ROLE_KEY}" value="aro">'
+        )
     return stops
 
 
@@ -284,12 +321,21 @@ def yaw_rad(nav_angle_deg: float) -> float:
 class SumoSession:
     """One running SUMO scenario with the ego under external control. Use :meth:`start`."""
 
-    def __init__(self, api, errors, files: ScenarioFiles, overrides: ScenarioOverrides,
-                 ego_id: str, step_length_s: float, workdir: Path, uses_libsumo: bool) -> None:
-        self._api, self._errors, self._files = api, errors, files
+    def __init__(
+        self,
+        api,
+        constants,
+        errors: tuple,
+        files: ScenarioFiles,
+        overrides: ScenarioOverrides,
+        ego_id: str,
+        step_length_s: float,
+        workdir: Path,
+        process=None,
+    ) -> None:
+        self._api, self._tc, self._errors, self._files = api, constants, errors, files
         self._overrides, self.ego_id, self._dt = overrides, ego_id, step_length_s
-        self._workdir, self._uses_libsumo = workdir, uses_libsumo
-        self._tc = api.constants
+        self._workdir, self._process = workdir, process
         self._veh, self._lane, self._sim = api.vehicle, api.lane, api.simulation
         self._closed = False
         self._time_s = self._sim.getTime()
@@ -299,28 +345,52 @@ class SumoSession:
         self._pending_stops = set(self._stops)
         self._scripts: dict[str, _Script] = {}
         self._ctx_radius_m: float | None = None
-        self._ctx_vars = [self._tc.VAR_POSITION, self._tc.VAR_ANGLE, self._tc.VAR_SPEED,
-                          self._tc.VAR_TYPE, self._tc.VAR_STOPSTATE]
-        self._ego_vars = [self._tc.VAR_POSITION, self._tc.VAR_ANGLE, self._tc.VAR_SPEED,
-                          self._tc.VAR_LANE_ID]
+        self._ctx_vars = [
+            self._tc.VAR_POSITION,
+            self._tc.VAR_ANGLE,
+            self._tc.VAR_SPEED,
+            self._tc.VAR_TYPE,
+            self._tc.VAR_STOPSTATE,
+        ]
+        self._ego_vars = [
+            self._tc.VAR_POSITION,
+            self._tc.VAR_ANGLE,
+            self._tc.VAR_SPEED,
+            self._tc.VAR_LANE_ID,
+        ]
         self._ego_mu = 1.0
+        self.ego_depart_time_s = self._time_s
         self.oncoming_id: str | None = None
-        self.roles = {vid: s.params[ROLE_KEY] for vid, s in files.vehicles.items() if ROLE_KEY in s.params}
+        self.roles = {
+            vid: s.params[ROLE_KEY] for vid, s in files.vehicles.items() if ROLE_KEY in s.params
+        }
 
     # ----------------------------------------------------------------------------- start
     @classmethod
-    def start(cls, cfg: Path, overrides: ScenarioOverrides = ScenarioOverrides(), *,
-              ego_id: str = "ego", step_length_s: float = 0.01, gui: bool = False,
-              use_traci: bool = False, extra_args: tuple[str, ...] = ()) -> SumoSession:
+    def start(
+        cls,
+        cfg: Path,
+        overrides: ScenarioOverrides = ScenarioOverrides(),
+        *,
+        ego_id: str = "ego",
+        step_length_s: float = 0.01,
+        gui: bool = False,
+        use_traci: bool = False,
+        extra_args: tuple[str, ...] = (),
+    ) -> SumoSession:
         """Check the files, start SUMO, advance it to the ego's departure and make the step
         that inserts the ego at the requested speed; on return the ego is in SUMO and every
         query answers. ``gui`` runs ``sumo-gui`` through TraCI, ``use_traci`` plain ``sumo``
         through TraCI; otherwise libsumo (in-process, one session per process)."""
         if not isinstance(overrides, ScenarioOverrides):
-            raise TypeError(f"overrides must be a ScenarioOverrides, not {type(overrides).__name__}")
+            raise TypeError(
+                f"overrides must be a ScenarioOverrides, not {type(overrides).__name__}"
+            )
         step = _number("step_length_s", step_length_s, minimum=0.0, inclusive=False)
         if abs(step * 1000.0 - round(step * 1000.0)) > 1e-9:
-            raise InputError(f"step_length_s={step_length_s!r} must be a whole number of milliseconds")
+            raise InputError(
+                f"step_length_s={step_length_s!r} must be a whole number of milliseconds"
+            )
         extra = tuple(str(a) for a in extra_args)
         files = check_scenario(Path(cfg), ego_id)
         _scripted_stops(files, overrides)
@@ -334,9 +404,16 @@ class SumoSession:
             raise RuntimeError("a libsumo session is already open in this process; close it first")
         workdir = Path(tempfile.mkdtemp(prefix="eoam-sumo-"))
         error_log = workdir / "sumo-errors.log"
-        cmd = [sumolib.checkBinary("sumo-gui" if gui else "sumo"), "-c", str(files.cfg),
-               "--step-length", f"{step:.3f}", "--error-log", str(error_log)]
-        given = {a for a in extra if a.startswith("-")}
+        cmd = [
+            sumolib.checkBinary("sumo-gui" if gui else "sumo"),
+            "-c",
+            str(files.cfg),
+            "--step-length",
+            f"{step:.3f}",
+            "--error-log",
+            str(error_log),
+        ]
+        given = {a.split("=", 1)[0] for a in extra if a.startswith("-")}
         for option, value in ENFORCED_OPTIONS:
             if option not in given:
                 cmd += [option, value]
@@ -345,18 +422,14 @@ class SumoSession:
         cmd += list(extra)
         try:
             if via_traci:
-                import subprocess
-
                 import traci
 
                 errors = (traci.exceptions.TraCIException, traci.exceptions.FatalTraCIError)
-                label = f"eoam-{uuid.uuid4().hex}"
                 try:
-                    traci.start(cmd, label=label, stdout=subprocess.DEVNULL)
+                    api, process = _traci_connect(cmd)
                 except (*errors, OSError) as exc:
                     raise InputError(_start_error(files.cfg, error_log, exc)) from exc
-                api = traci.getConnection(label)
-                api.constants = traci.constants
+                constants = traci.constants
             else:
                 import libsumo
 
@@ -365,29 +438,36 @@ class SumoSession:
                     libsumo.start(cmd)
                 except errors as exc:
                     raise InputError(_start_error(files.cfg, error_log, exc)) from exc
-                api = libsumo
+                api, constants, process = libsumo, libsumo.constants, None
         except BaseException:
             shutil.rmtree(workdir, ignore_errors=True)
             raise
-        session = cls(api, errors, files, overrides, ego_id, step, workdir, not via_traci)
-        if not via_traci:
-            _open_libsumo.append(session)
+        session = None
         try:
+            session = cls(api, constants, errors, files, overrides, ego_id, step, workdir, process)
+            if not via_traci:
+                _open_libsumo.append(session)
             session._set_up()
-        except errors as exc:
-            session.close()
-            raise InputError(f"{files.cfg}: SUMO refused the scenario set-up: {exc}") from exc
-        except BaseException:
-            session.close()
-            raise
+        except BaseException as exc:
+            if session is not None:
+                session._release()
+            else:
+                _shut_down(api, process)
+            detail = _start_error(files.cfg, error_log, exc) if isinstance(exc, errors) else None
+            shutil.rmtree(workdir, ignore_errors=True)
+            if detail is None:
+                raise
+            raise InputError(detail) from exc
         return session
 
     def _set_up(self) -> None:
         spec = self._files.vehicles[self.ego_id]
         depart = _float_attr(spec, "depart", spec.attrs.get("depart", "0"))
         if depart < self._time_s - 1e-9:
-            raise InputError(f"{spec.source}: vehicle '{self.ego_id}' departs at {depart:g} s, "
-                             f"before the simulation begins ({self._time_s:g} s)")
+            raise InputError(
+                f"{spec.source}: vehicle '{self.ego_id}' departs at {depart:g} s, "
+                f"before the simulation begins ({self._time_s:g} s)"
+            )
         if self._overrides.mu is not None:
             for lane_id in self._lane.getIDList():
                 self._lane.setFriction(lane_id, self._overrides.mu)
@@ -417,8 +497,15 @@ class SumoSession:
         veh.remove(ego)
         route_id = f"eoam.route.{ego}.{uuid.uuid4().hex[:8]}"
         self._api.route.add(route_id, edges)
-        veh.add(ego, route_id, self._ego_type, depart="now", departLane=str(lane_index),
-                departPos=f"{pos:.6f}", departSpeed=f"{speed:.6f}")
+        veh.add(
+            ego,
+            route_id,
+            self._ego_type,
+            depart="now",
+            departLane=str(lane_index),
+            departPos=repr(float(pos)),
+            departSpeed=repr(float(speed)),
+        )
         for key, value in spec.params.items():
             veh.setParameter(ego, key, value)
         veh.setSpeedMode(ego, EGO_SPEED_MODE)
@@ -431,8 +518,10 @@ class SumoSession:
         self._lane_index = lane_index
         self._start_lane_id = lane_id
         self.lane_width_m = float(self._lane.getWidth(lane_id))
-        self.left_lane_exists = (lane_index < self._api.edge.getLaneNumber(edges[0]) - 1
-                                 or lane_id in self._files.opposite_lanes)
+        self.left_lane_exists = (
+            lane_index < self._api.edge.getLaneNumber(edges[0]) - 1
+            or lane_id in self._files.opposite_lanes
+        )
         self._ego_mu = self._friction(lane_id)
         self._ego_front_start = (x, y)
         self._centreline = self._build_centreline()
@@ -444,12 +533,16 @@ class SumoSession:
             vclass = self._api.vehicletype.getVehicleClass(self._ego_type)
             for i in range(n_lanes):
                 allowed = self._lane.getAllowed(f"{edge}_{i}")
-                if (not allowed or vclass in allowed) and vclass not in self._lane.getDisallowed(f"{edge}_{i}"):
+                if (not allowed or vclass in allowed) and vclass not in self._lane.getDisallowed(
+                    f"{edge}_{i}"
+                ):
                     return i
             raise InputError(f"{spec.source}: no lane of edge '{edge}' allows vehicle '{spec.vid}'")
         if not text.isdigit() or int(text) >= n_lanes:
-            raise InputError(f"{spec.source}: vehicle '{spec.vid}' departLane={text!r}: the ego needs "
-                             f"a lane index below {n_lanes} (or 'first')")
+            raise InputError(
+                f"{spec.source}: vehicle '{spec.vid}' departLane={text!r}: the ego needs "
+                f"a lane index below {n_lanes} (or 'first')"
+            )
         return int(text)
 
     def _ego_depart_pos(self, spec: VehicleSpec, lane_len: float) -> float:
@@ -459,8 +552,10 @@ class SumoSession:
         pos = _float_attr(spec, "departPos", text)
         pos = pos + lane_len if pos < 0 else pos
         if not 0.0 <= pos <= lane_len:
-            raise InputError(f"{spec.source}: vehicle '{spec.vid}' departPos={text!r} is off its "
-                             f"{lane_len:.2f} m start lane")
+            raise InputError(
+                f"{spec.source}: vehicle '{spec.vid}' departPos={text!r} is off its "
+                f"{lane_len:.2f} m start lane"
+            )
         return pos
 
     def _ego_speed(self, spec: VehicleSpec, lane_id: str) -> float:
@@ -468,7 +563,9 @@ class SumoSession:
             return self._overrides.ego_speed_mps
         text = spec.attrs.get("departSpeed", "0")
         if text in SPEED_LIMIT_WORDS:
-            return min(self._lane.getMaxSpeed(lane_id), self._api.vehicletype.getMaxSpeed(self._ego_type))
+            return min(
+                self._lane.getMaxSpeed(lane_id), self._api.vehicletype.getMaxSpeed(self._ego_type)
+            )
         speed = _float_attr(spec, "departSpeed", text)
         return _number(f"{spec.source}: vehicle '{spec.vid}' departSpeed", speed, minimum=0.0)
 
@@ -493,18 +590,25 @@ class SumoSession:
         s_ego, _ = project(self._centreline, *self._ego_front_start)
         total = _arclength(self._centreline)[-1]
         if s_ego + distance > total:
-            raise InputError(f"oncoming_start_m={distance:g}: the ego's route ends "
-                             f"{total - s_ego:.1f} m ahead of the ego")
+            raise InputError(
+                f"oncoming_start_m={distance:g}: the ego's route ends "
+                f"{total - s_ego:.1f} m ahead of the ego"
+            )
         px, py, _ = point_at(self._centreline, s_ego + distance)
         opposite = []  # per route edge: the opposite lane of its leftmost lane, or None
         for edge in self._route_edges:
             leftmost = f"{edge}_{self._api.edge.getLaneNumber(edge) - 1}"
             opposite.append(self._files.opposite_lanes.get(leftmost))
-        candidates = [(project(np.asarray(self._lane.getShape(o), float), px, py), k, o)
-                      for k, o in enumerate(opposite) if o is not None]
+        candidates = [
+            (project(np.asarray(self._lane.getShape(o), float), px, py), k, o)
+            for k, o in enumerate(opposite)
+            if o is not None
+        ]
         if not candidates:
-            raise InputError(f"{self._files.net_file}: the ego's lane {self._start_lane_id} has no "
-                             "opposite lane (<neigh lane=...>) for the oncoming car")
+            raise InputError(
+                f"{self._files.net_file}: the ego's lane {self._start_lane_id} has no "
+                "opposite lane (<neigh lane=...>) for the oncoming car"
+            )
         (s_opp, _), k, lane_id = min(candidates, key=lambda c: c[0][1])
         edges = []
         for o in reversed(opposite[: k + 1]):
@@ -528,8 +632,15 @@ class SumoSession:
         route_id = f"eoam.route.{vid}.{uuid.uuid4().hex[:8]}"
         self._api.route.add(route_id, edges)
         index = int(lane_id.rsplit("_", 1)[1])  # SUMO lane ids are <edge>_<index>
-        veh.add(vid, route_id, "oncoming", depart="now", departLane=str(index),
-                departPos=f"{pos:.6f}", departSpeed=f"{speed:.6f}")
+        veh.add(
+            vid,
+            route_id,
+            "oncoming",
+            depart="now",
+            departLane=str(index),
+            departPos=repr(float(pos)),
+            departSpeed=repr(float(speed)),
+        )
         veh.setParameter(vid, ROLE_KEY, "oncoming")
         veh.setSpeedMode(vid, ONCOMING_SPEED_MODE)
         veh.setLaneChangeMode(vid, NO_LANE_CHANGES)
@@ -553,7 +664,9 @@ class SumoSession:
     def _start_stop(self, vid: str) -> None:
         hold, decel = self._stops[vid]
         self._pending_stops.discard(vid)
-        self._scripts[vid] = _Script(self._veh.getDeparture(vid) + hold, decel, self._veh.getSpeed(vid))
+        self._scripts[vid] = _Script(
+            self._veh.getDeparture(vid) + hold, decel, self._veh.getSpeed(vid)
+        )
         self._veh.setSpeedMode(vid, SCRIPTED_SPEED_MODE)
         self._veh.subscribe(vid, [self._tc.VAR_SPEED, self._tc.VAR_LANE_ID])
 
@@ -571,7 +684,9 @@ class SumoSession:
                 if res[self._tc.VAR_LANE_ID]:
                     script.mu = self._friction(res[self._tc.VAR_LANE_ID])
                 decel = min(script.decel_mps2, script.mu * G_MPS2)
-                cmd = max(0.0, res[self._tc.VAR_SPEED] - decel * min(self._dt, t_next - script.hold_end_s))
+                cmd = max(
+                    0.0, res[self._tc.VAR_SPEED] - decel * min(self._dt, t_next - script.hold_end_s)
+                )
             if cmd != script.last_cmd_mps:
                 self._veh.setSpeed(vid, cmd)
                 script.last_cmd_mps = cmd
@@ -617,8 +732,11 @@ class SumoSession:
     def lane_ids(self) -> list[str]:
         return list(self._lane.getIDList())
 
-    def move_ego(self, x_front_m: float, y_front_m: float, angle_nav_deg: float, speed_mps: float) -> None:
-        """Place the ego's front bumper for the next step (keepRoute=2: any lane, incl. opposite)."""
+    def move_ego(
+        self, x_front_m: float, y_front_m: float, angle_nav_deg: float, speed_mps: float
+    ) -> None:
+        """Place the ego's front bumper for the next step (keepRoute=2: any lane, even opposite)."""
+        self._check_open()
         self._veh.moveToXY(self.ego_id, "", -1, x_front_m, y_front_m, angle_nav_deg, keepRoute=2)
         self._veh.setSpeed(self.ego_id, speed_mps)
 
@@ -629,27 +747,46 @@ class SumoSession:
             dims = self._dims_cache[type_id] = (types.getLength(type_id), types.getWidth(type_id))
         return dims
 
-    def _body(self, vid: str, front: tuple, angle_deg: float, speed: float, type_id: str,
-              stop_state: int) -> Body:
+    def _body(
+        self, vid: str, front: tuple, angle_deg: float, speed: float, type_id: str, stop_state: int
+    ) -> Body:
         length, width = self._dims(type_id)
         yaw = yaw_rad(angle_deg)
         half = 0.5 * length
-        return Body(vid, front[0] - half * math.cos(yaw), front[1] - half * math.sin(yaw), yaw,
-                    speed, length, width, bool(stop_state & PARKING_BIT))
+        return Body(
+            vid,
+            front[0] - half * math.cos(yaw),
+            front[1] - half * math.sin(yaw),
+            yaw,
+            speed,
+            length,
+            width,
+            bool(stop_state & PARKING_BIT),
+        )
 
     def nearby(self, radius_m: float) -> list[Body]:
-        """Every other vehicle within ``radius_m`` of the ego (one context subscription)."""
+        """Every other vehicle whose SUMO position (front bumper) is within ``radius_m`` of the
+        ego's, from one context subscription (renewed only when the radius changes)."""
         self._check_open()
         if radius_m != self._ctx_radius_m:
             _number("radius_m", radius_m, minimum=0.0, inclusive=False)
-            self._veh.subscribeContext(self.ego_id, self._tc.CMD_GET_VEHICLE_VARIABLE, radius_m,
-                                       self._ctx_vars)
+            self._veh.subscribeContext(
+                self.ego_id, self._tc.CMD_GET_VEHICLE_VARIABLE, radius_m, self._ctx_vars
+            )
             self._ctx_radius_m = radius_m
         tc = self._tc
-        return [self._body(vid, r[tc.VAR_POSITION], r[tc.VAR_ANGLE], r[tc.VAR_SPEED], r[tc.VAR_TYPE],
-                           r[tc.VAR_STOPSTATE])
-                for vid, r in sorted(self._veh.getContextSubscriptionResults(self.ego_id).items())
-                if vid != self.ego_id]
+        return [
+            self._body(
+                vid,
+                r[tc.VAR_POSITION],
+                r[tc.VAR_ANGLE],
+                r[tc.VAR_SPEED],
+                r[tc.VAR_TYPE],
+                r[tc.VAR_STOPSTATE],
+            )
+            for vid, r in sorted(self._veh.getContextSubscriptionResults(self.ego_id).items())
+            if vid != self.ego_id
+        ]
 
     def _ego_results(self) -> dict:
         self._check_open()
@@ -662,15 +799,22 @@ class SumoSession:
         """The ego as SUMO sees it."""
         r = self._ego_results()
         tc = self._tc
-        return self._body(self.ego_id, r[tc.VAR_POSITION], r[tc.VAR_ANGLE], r[tc.VAR_SPEED],
-                          self._ego_type, 0)
+        return self._body(
+            self.ego_id, r[tc.VAR_POSITION], r[tc.VAR_ANGLE], r[tc.VAR_SPEED], self._ego_type, 0
+        )
 
     def body(self, vid: str) -> Body:
         """Any vehicle by id (getters; for checks, not for the step loop)."""
         self._check_open()
         veh = self._veh
-        return self._body(vid, veh.getPosition(vid), veh.getAngle(vid), veh.getSpeed(vid),
-                          veh.getTypeID(vid), veh.getStopState(vid))
+        return self._body(
+            vid,
+            veh.getPosition(vid),
+            veh.getAngle(vid),
+            veh.getSpeed(vid),
+            veh.getTypeID(vid),
+            veh.getStopState(vid),
+        )
 
     def vehicle_ids(self) -> list[str]:
         return list(self._veh.getIDList())
@@ -686,31 +830,70 @@ class SumoSession:
         if self._closed:
             raise RuntimeError("the SUMO session is closed")
 
-    def close(self) -> None:
-        """End SUMO (idempotent)."""
+    def _release(self) -> None:
+        """End SUMO, keeping the session's working directory."""
         if self._closed:
             return
         self._closed = True
-        try:
-            self._api.close()
-        except self._errors:
-            pass
-        finally:
-            if self in _open_libsumo:
-                _open_libsumo.remove(self)
-            shutil.rmtree(self._workdir, ignore_errors=True)
+        if self in _open_libsumo:
+            _open_libsumo.remove(self)
+        _shut_down(self._api, self._process)
 
-    def __enter__(self) -> SumoSession:
+    def close(self) -> None:
+        """End SUMO (idempotent)."""
+        self._release()
+        shutil.rmtree(self._workdir, ignore_errors=True)
+
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *exc) -> None:
         self.close()
 
 
-def _start_error(cfg: Path, error_log: Path, exc: BaseException) -> str:
+def _shut_down(api, process) -> None:
+    """Close the connection to SUMO (errors of an already dead SUMO ignored), end its process."""
+    with contextlib.suppress(Exception):
+        api.close()
+    _end_process(process)
+
+
+def _end_process(process) -> None:
+    """Wait for a SUMO server process to end (it was told to close or failed), else kill it."""
+    if process is None:
+        return
     try:
-        lines = [ln.strip() for ln in error_log.read_text(errors="replace").splitlines() if ln.strip()]
+        process.wait(timeout=PROCESS_EXIT_S)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait()
+
+
+def _traci_connect(cmd: list[str]):
+    """Start SUMO as a TraCI server and connect, polling every 50 ms (traci.start waits 1 s
+    and prints while it retries)."""
+    import io
+
+    import sumolib
+    import traci
+
+    port = sumolib.miscutils.getFreeSocketPort()
+    proc = subprocess.Popen([*cmd, "--remote-port", str(port)], stdout=subprocess.DEVNULL)
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):
+            conn = traci.connect(port, numRetries=TRACI_RETRIES, waitBetweenRetries=0.05)
+    except BaseException:
+        _end_process(proc)
+        raise
+    return conn, proc
+
+
+def _start_error(cfg: Path, error_log: Path, exc: BaseException) -> str:
+    """One line with SUMO's own error messages (its error log, else the exception's text)."""
+    try:
+        text = error_log.read_text(errors="replace")
     except OSError:
-        lines = []
-    detail = "; ".join(ln.removeprefix("Error: ") for ln in lines) or str(exc)
-    return f"{cfg}: SUMO could not load the scenario: {detail}"
+        text = ""
+    lines = [ln.strip().removeprefix("Error: ") for ln in (text or str(exc)).splitlines()]
+    detail = " ".join(ln for ln in lines if ln and ln != "Quitting (on error).")
+    return f"{cfg}: SUMO could not load the scenario: {detail or type(exc).__name__}"

@@ -12,7 +12,7 @@ import time
 
 import pytest
 
-from eoam_sumo.batch.pool import TaskResult, run_dask, run_local
+from eoam_sumo.batch.pool import TaskResult, run_local
 
 
 def square_with_pid(payload):
@@ -89,14 +89,3 @@ def test_worker_that_cannot_start_raises():
 def test_bad_settings_are_rejected(kwargs):
     with pytest.raises(ValueError):
         list(run_local(square_with_pid, [("t", 1)], **kwargs))
-
-
-def test_dask_driver_handles_a_crash_like_the_local_one():
-    from dask.distributed import Client, LocalCluster
-
-    tasks = [("a", ("ok", 1)), ("segv", ("segfault", 0)), ("b", ("ok", 2))]
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as cluster, Client(cluster) as client:
-        results = _by_key(run_dask(misbehave, tasks, client, timeout_s=120))
-    assert results["a"].value["value"] == 1 and results["b"].value["value"] == 2
-    assert "SIGSEGV" in results["segv"].error

@@ -26,9 +26,19 @@ def steady_state_steer(v, radius):
 @pytest.mark.parametrize("radius", [50.0, 200.0, -400.0])
 def test_feedforward_is_the_steady_state_steer(v, radius):
     ctrl = SteeringController(P)
-    delta, ff, fb, yd, e_la = ctrl.command(v, v / radius, 0.0, 0.0, 1.0 / radius, 1.0)
+    delta, ff, fb, yd, e_la = ctrl.command(v, v / radius, 0.0, 0.0, 1.0 / radius, 1.0 / radius, 1.0)
     assert fb == 0.0 and yd == 0.0 and e_la == 0.0
     assert ff == pytest.approx(steady_state_steer(v, radius), rel=1e-9)
+
+
+def test_feedforward_uses_the_preview_curvature_and_yaw_damping_the_current_one():
+    ctrl = SteeringController(P)
+    v, k_now, k_ahead = 30.0, 0.002, 0.005
+    _, ff, _, yd, _ = ctrl.command(v, v * k_now, 0.0, 0.0, k_now, k_ahead, 1.0)
+    assert ff == pytest.approx(steady_state_steer(v, 1.0 / k_ahead), rel=1e-9)
+    assert yd == 0.0  # yaw rate equals v times the curvature here
+    # and the steady lateral acceleration of the feedforward angle is v^2 kappa
+    assert ctrl.lateral_accel(v, ff) == pytest.approx(v * v * k_ahead, rel=1e-9)
 
 
 def test_understeer_gradient_sign_and_value():
@@ -39,19 +49,19 @@ def test_understeer_gradient_sign_and_value():
 
 def test_feedback_and_yaw_damping_oppose_the_error():
     ctrl = SteeringController(P)
-    _, _, fb, _, e_la = ctrl.command(30.0, 0.0, 0.5, 0.0, 0.0, 1.0)
+    _, _, fb, _, e_la = ctrl.command(30.0, 0.0, 0.5, 0.0, 0.0, 0.0, 1.0)
     assert e_la == pytest.approx(0.5) and fb < 0.0  # left of the path: steer right
-    _, _, fb2, _, e_la2 = ctrl.command(30.0, 0.0, 0.0, 0.02, 0.0, 1.0)
+    _, _, fb2, _, e_la2 = ctrl.command(30.0, 0.0, 0.0, 0.02, 0.0, 0.0, 1.0)
     assert e_la2 > 0.0 and fb2 < 0.0  # heading left of the path: steer right
-    _, _, _, yd, _ = ctrl.command(30.0, 0.1, 0.0, 0.0, 0.0, 1.0)
+    _, _, _, yd, _ = ctrl.command(30.0, 0.1, 0.0, 0.0, 0.0, 0.0, 1.0)
     assert yd < 0.0
 
 
 def test_clipped_to_the_steering_lock():
     ctrl = SteeringController(P)
-    delta, *_ = ctrl.command(10.0, 0.0, -50.0, 0.0, 0.0, 1.0)
+    delta, *_ = ctrl.command(10.0, 0.0, -50.0, 0.0, 0.0, 0.0, 1.0)
     assert delta == P.max_steer_rad
-    delta, *_ = ctrl.command(10.0, 0.0, 50.0, 0.0, 0.0, 1.0)
+    delta, *_ = ctrl.command(10.0, 0.0, 50.0, 0.0, 0.0, 0.0, 1.0)
     assert delta == -P.max_steer_rad
 
 

@@ -71,6 +71,33 @@ def test_partial_brake_without_lock_matches_constant_deceleration(plant_no_drag,
     assert x[0] == pytest.approx(V0_MPS**2 / (2 * decel), rel=0.005)
 
 
+@pytest.mark.parametrize(("mu", "brake_n"), [(1.0, 6000.0), (0.1, 1800.0), (0.1, 22000.0)])
+def test_normal_loads_carry_the_longitudinal_load_transfer(plant, params, mu, brake_n):
+    # Quasi-static pitch balance: Fz_f = (m g b - h Fx) / L with Fx the tyre force sum, here
+    # solved in closed form for each lock state (rolling axles deliver brake + rolling
+    # resistance; a locked axle slides at mu_slide Fz).
+    p, m_g = params, params.mass_kg * G_MPS2
+    x = initial_state(0.0, 0.0, 0.0, 80.0 / 3.6, brake_force_n=brake_n)
+    _, y = plant.step(x, np.array([0.0, 0.0, brake_n]), mu)
+    front_locked, rear_locked = y[YOUT["front_locked"]], y[YOUT["rear_locked"]]
+    slide, rr, h, length = (
+        p.sliding_friction_ratio * mu,
+        p.rolling_resistance_coeff,
+        p.cg_height_m,
+        p.wheelbase_m,
+    )
+    # -Fx = k_f Fz_f + k_r Fz_r + c with Fz_r = m g - Fz_f.
+    k_f = slide if front_locked else rr
+    k_r = slide if rear_locked else rr
+    c = (0.0 if front_locked else p.brake_front_share * brake_n) + (
+        0.0 if rear_locked else (1 - p.brake_front_share) * brake_n
+    )
+    fz_front = (m_g * p.cg_to_rear_m + h * (k_r * m_g + c)) / (length - h * (k_f - k_r))
+    assert (front_locked, rear_locked) == {6000.0: (0, 0), 1800.0: (1, 0), 22000.0: (1, 1)}[brake_n]
+    assert y[YOUT["fz_front_n"]] == pytest.approx(fz_front, rel=2e-4)
+    assert y[YOUT["fz_rear_n"]] == pytest.approx(m_g - fz_front, rel=2e-4)
+
+
 def test_vehicle_stays_at_rest_under_brake_and_never_reverses(plant, params):
     x, _ = brake_to_rest(plant, 0.7, params.max_brake_force_n)
     resting = x.copy()

@@ -18,7 +18,7 @@ def manoeuvre(steps=400):
     2 s, where the brake locks the front axle. Yields (u, mu) per step."""
     for k in range(steps):
         t = k * 0.01
-        steer = math.radians(4.0) * math.sin(2 * math.pi * t / 3.0) if t < 3.0 else 0.0
+        steer = math.radians(1.0) * math.sin(2 * math.pi * t / 3.0) if t < 3.0 else 0.0
         brake = 9000.0 if 1.0 <= t < 2.6 else 0.0
         drive = 2500.0 if t >= 3.0 else 0.0
         yield np.array([steer, drive, brake]), (0.8 if t < 2.0 else 0.3)
@@ -136,6 +136,8 @@ def test_bad_step_inputs_are_rejected(plant, params):
             ReferencePlant(params).step(x, np.zeros(3), mu)
     with pytest.raises(ValueError):
         plant.step(x[:5], np.zeros(3), 0.5)
+    with pytest.raises(ValueError):
+        ReferencePlant(params).step(x, np.zeros(2), 0.5)
     with pytest.raises(ValueError, match="speed_mps"):
         initial_state(0.0, 0.0, 0.0, -1.0)
     with pytest.raises(ValueError, match="steer_lag_s"):

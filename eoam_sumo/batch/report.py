@@ -1,0 +1,213 @@
+"""Table 2 of a batch: our outcome colours beside the paper's (markdown and image).
+
+Rows are the traffic (no oncoming car, then each oncoming start distance) by initial ego
+speed, columns the surface friction, as in the paper's Table 2; rows and columns follow the
+order of the results (the matrix's order). Each cell holds our colour and the paper's; every
+cell that differs is numbered and listed below the table with a link to the case's
+``summary.json`` and the reason for its outcome. A batch without a published counterpart (a
+user's own sweep) gets the same grid with our colours only, and the list covers every case
+that was not green.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+COLOURS = ("green", "yellow", "orange", "red", "none")
+FAILED = "failed"
+MARKERS = {"green": "🟩", "yellow": "🟨", "orange": "🟧", "red": "🟥", "none": "⬜",
+           FAILED: "⚠️"}
+#: Paper sec. 11 colour definitions, shortened.
+LEGEND = {
+    "green": "lane change completed without collision and back in lane (or stopped, no contact)",
+    "yellow": "straight-line limit braking chosen, front hit on the ARO at reduced speed",
+    "orange": "lane change made, lateral (side) contact",
+    "red": "lane change made, head-on (direct or offset) hit on the oncoming vehicle",
+    "none": "no manoeuvre needed, nothing hit",
+    FAILED: "the case did not finish (see the error)",
+}
+TABLE_MD = "table2.md"
+TABLE_PNG = "table2.png"
+_EXTRA_PARAMS = (("aro_hold_s", "ARO hold {:g} s"), ("aro_decel_mps2", "ARO decel {:g} m/s²"))
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One case in the grid: our colour (or 'failed'), the paper's (None if unpublished)."""
+
+    case_id: str
+    ours: str
+    paper: str | None
+    case_dir: str
+    detail: str
+
+    @property
+    def compared(self) -> bool:
+        return self.paper is not None
+
+    @property
+    def agrees(self) -> bool:
+        return self.paper is not None and self.ours == self.paper
+
+
+@dataclass(frozen=True)
+class OutcomeGrid:
+    """Rows x friction columns of cells; ``rows[i]`` is (traffic label, speed label)."""
+
+    rows: tuple[tuple[str, str], ...]
+    mus: tuple[float, ...]
+    cells: dict[tuple[int, int], Cell]
+    has_paper: bool
+
+    @property
+    def agreeing(self) -> int:
+        return sum(c.agrees for c in self.cells.values())
+
+    @property
+    def compared(self) -> int:
+        return sum(c.compared for c in self.cells.values())
+
+    def differing(self) -> list[Cell]:
+        """Cells to explain, in table order: those that differ from the paper (paper mode) or
+        that were not green (own sweep)."""
+        keys = sorted(self.cells)
+        if self.has_paper:
+            return [self.cells[k] for k in keys if self.cells[k].compared
+                    and not self.cells[k].agrees]
+        return [self.cells[k] for k in keys if self.cells[k].ours != "green"]
+
+
+def traffic_label(oncoming_start_m: float) -> str:
+    if oncoming_start_m is None or (isinstance(oncoming_start_m, float)
+                                    and math.isnan(oncoming_start_m)):
+        return "No oncoming"
+    return f"Oncoming, {oncoming_start_m:g} m"
+
+
+def _detail(row) -> str:
+    """One line on why the case ended as it did."""
+    if row["status"] != "ok":
+        return f"failed: {row['error']}"
+    parts = [str(row["reason"]) if row["reason"] else "no reason recorded"]
+    if row["modes_visited"]:
+        parts.append(f"modes {row['modes_visited']}")
+    if row["collision_with"] and row["collision_with"] != "none":
+        v = float(row["impact_speed_mps"])
+        parts.append(f"hit {row['collision_with']} ({row['contact_kind']}) at {v:.1f} m/s "
+                     f"({v * 3.6:.0f} km/h)")
+    else:
+        parts.append("no contact")
+    return "; ".join(parts)
+
+
+def outcome_grid(results: pd.DataFrame) -> OutcomeGrid:
+    """The grid of a results frame (``runner.read_results``), the paper's colours from its
+    ``paper_outcome`` column (empty where unpublished)."""
+    varying = [(col, fmt) for col, fmt in _EXTRA_PARAMS
+               if results[col].notna().any() and results[col].nunique(dropna=False) > 1]
+    rows: list[tuple[str, str]] = []
+    mus: list[float] = []
+    cells = {}
+    for _, row in results.iterrows():
+        speed = f"{row['ego_speed_kmh']:g} km/h"
+        extra = [fmt.format(row[col]) for col, fmt in varying if pd.notna(row[col])]
+        key = (traffic_label(row["oncoming_start_m"]), ", ".join([speed, *extra]))
+        if key not in rows:
+            rows.append(key)
+        if row["mu"] not in mus:
+            mus.append(row["mu"])
+        ours = row["outcome"] if row["status"] == "ok" else FAILED
+        cells[(rows.index(key), mus.index(row["mu"]))] = Cell(
+            row["case_id"], ours, row["paper_outcome"] or None, row["case_dir"], _detail(row))
+    return OutcomeGrid(tuple(rows), tuple(mus), cells,
+                       has_paper=any(c.paper for c in cells.values()))
+
+
+def mu_text(mu: float) -> str:
+    """Friction as the paper writes it: 1.0, 0.7, 0.35."""
+    return f"{mu:.1f}" if round(mu, 1) == mu else f"{mu:g}"
+
+
+def _mark(colour: str | None) -> str:
+    return "—" if colour is None else f"{MARKERS.get(colour, '')} {colour}"
+
+
+def _counts(colours: list[str]) -> str:
+    return ", ".join(f"{colours.count(c)} {c}" for c in (*COLOURS, FAILED) if colours.count(c))
+
+
+def _ref(cell: Cell, n: int) -> str:
+    """The cell's note number, linked to its summary.json (failed cases have none)."""
+    return f"#{n}" if cell.ours == FAILED else f"[#{n}]({cell.case_dir}/summary.json)"
+
+
+def table2_markdown(grid: OutcomeGrid, title: str = "Table 2") -> str:
+    """The grid as markdown: ours / paper per cell, the agreement count, the differences."""
+    listed = {c.case_id: i for i, c in enumerate(grid.differing(), start=1)}
+    lines = [f"# {title}: EOAM outcomes" + (" — this run / the paper" if grid.has_paper else ""),
+             ""]
+    ours = [c.ours for c in grid.cells.values()]
+    if grid.has_paper:
+        lines += [
+            ("Each cell: **ours** / paper (Lowe & Guvenc, Table 2). "
+             f"**{grid.agreeing}/{grid.compared} cells agree.**"),
+            "",
+            f"- ours: {_counts(ours)}",
+            f"- paper: {_counts([c.paper for c in grid.cells.values() if c.paper])}",
+            "",
+        ]
+    else:
+        lines += [f"Our outcomes ({len(ours)} cases): {_counts(ours)}.", ""]
+    lines.append("| Traffic | Initial ego speed | "
+                 + " | ".join(f"{mu_text(mu)} surface mu" for mu in grid.mus) + " |")
+    lines.append("|---|---|" + "---|" * len(grid.mus))
+    previous = None
+    for i, (traffic, speed) in enumerate(grid.rows):
+        cols = []
+        for j in range(len(grid.mus)):
+            cell = grid.cells.get((i, j))
+            if cell is None:
+                cols.append("")
+                continue
+            text = f"**{_mark(cell.ours)}**"
+            if grid.has_paper:
+                text += f" / {_mark(cell.paper)}"
+            if cell.case_id in listed:
+                text += f" {'✗ ' if grid.has_paper else ''}{_ref(cell, listed[cell.case_id])}"
+            cols.append(text)
+        lines.append(f"| {traffic if traffic != previous else ''} | {speed} | "
+                     + " | ".join(cols) + " |")
+        previous = traffic
+    lines += ["", "Legend: " + "; ".join(f"{MARKERS[c]} {c}: {LEGEND[c]}" for c in LEGEND), ""]
+    differing = grid.differing()
+    heading = "Cells that differ from the paper" if grid.has_paper else "Cases that were not green"
+    lines += [f"## {heading} ({len(differing)})", ""]
+    where = {cell.case_id: key for key, cell in grid.cells.items()}
+    for n, cell in enumerate(differing, start=1):
+        (traffic, speed), mu = grid.rows[where[cell.case_id][0]], grid.mus[where[cell.case_id][1]]
+        versus = f"ours {_mark(cell.ours)}" + (f", paper {_mark(cell.paper)}" if cell.paper else "")
+        link = ("" if cell.ours == FAILED
+                else f" [{cell.case_dir}/summary.json]({cell.case_dir}/summary.json)")
+        lines.append(f"{n}. **{traffic}, {speed}, mu {mu_text(mu)}** — {versus}: "
+                     f"{cell.detail}.{link}")
+    if not differing:
+        lines.append("None.")
+    return "\n".join(lines) + "\n"
+
+
+def write_report(out_dir: Path, results: pd.DataFrame) -> list[Path]:
+    """Write ``table2.md`` and ``table2.png`` of a results frame into ``out_dir``."""
+    from eoam_sumo.plotting.batch_plots import plot_table2
+
+    out_dir = Path(out_dir)
+    grid = outcome_grid(results)
+    md = out_dir / TABLE_MD
+    tmp = md.with_name(md.name + ".tmp")
+    tmp.write_text(table2_markdown(grid), encoding="utf-8")
+    os.replace(tmp, md)
+    return [md, plot_table2(grid, out_dir / TABLE_PNG)]

@@ -1,0 +1,37 @@
+"""``eoam-sumo plot FOLDER``: the plots that fit the kind of output folder given."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from eoam_sumo.errors import InputError
+
+
+def plot_folder(folder: Path, out_dir: Path) -> list[Path]:
+    """Plot a run folder (summary.json), a batch folder (results.csv) or a tables folder
+    (phase_boundaries.csv) into ``out_dir``; return the PNGs written."""
+    folder, out_dir = Path(folder), Path(out_dir)
+    if (folder / "results.csv").is_file():
+        from eoam_sumo.plotting.batch_plots import plot_batch
+
+        return plot_batch(folder, out_dir)
+    if (folder / "summary.json").is_file():
+        from eoam_sumo.plotting.run_plots import plot_run
+
+        if not (folder / "timeseries.csv").is_file():
+            raise InputError(f"{folder}: has summary.json but no timeseries.csv")
+        return plot_run(folder, out_dir)
+    if (folder / "phase_boundaries.csv").is_file():
+        from eoam_sumo.plotting.offline_plots import plot_accel_profiles, plot_phase_diagrams
+
+        return [*_paths(plot_phase_diagrams(folder, out_dir)),
+                *_paths(plot_accel_profiles(folder, out_dir))]
+    raise InputError(f"{folder}: not a run (summary.json), batch (results.csv) or tables "
+                     "(phase_boundaries.csv) folder")
+
+
+def _paths(result) -> list[Path]:
+    """A plot function's return: one path or a list of paths."""
+    if isinstance(result, (str, Path)):
+        return [Path(result)]
+    return [Path(p) for p in result]

@@ -1,0 +1,269 @@
+"""Plots of one co-simulation run folder (``timeseries.csv`` + ``summary.json``), after the
+paper's Figures 21-24 for its 120 km/h dry case:
+
+* ``phase_trace.png`` (Fig. 21): the ARO's range against the closing speed (-range rate)
+  as the radar saw it, on the DMM phase diagram (sectors A-G shaded, boundaries drawn) of
+  the run's friction, coloured by EOAM mode;
+* ``dynamics.png`` (Fig. 22): mode, FCW, speed and acceleration (target vs actual),
+  lateral position (target vs actual), lateral and lookahead errors, differential x;
+* ``steering.png`` (Fig. 23): the steering components (feedforward, feedback, yaw damping,
+  total command, actual road-wheel angle), hand-wheel angle, lateral acceleration, yaw rate;
+* ``gg.png`` (Fig. 24): longitudinal against lateral acceleration inside the friction
+  circle of radius mu g.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+
+from eoam_sumo.params import G_MPS2, ego_e_class_sedan
+from eoam_sumo.plotting.batch_plots import save
+
+MODE_NAMES = {0: "0 NORMAL", 1: "1 UPDATE BRAKE", 2: "2 STEER+BRAKE", 3: "3 ONCOMING BRAKE",
+              4: "4 ONCOMING STEER+BRAKE", 5: "5 RETURN"}
+MODE_COLOURS = {0: "#757575", 1: "#1e88e5", 2: "#43a047", 3: "#fdd835", 4: "#fb8c00",
+                5: "#8e24aa"}
+SECTOR_COLOURS = {"A": "#ef9a9a", "C": "#ffcc80", "F": "#c5e1a5", "B": "#81c784",
+                  "D": "#90caf9", "E": "#fff59d", "G": "#ffffff"}
+_TARGET = {"color": "black", "linestyle": "--", "linewidth": 1.2}
+_ACTUAL = {"color": "#1e88e5", "linewidth": 1.6}
+
+
+def load_run(case_dir: Path) -> tuple[dict, pd.DataFrame]:
+    """A run folder's summary and time series."""
+    case_dir = Path(case_dir)
+    summary = json.loads((case_dir / "summary.json").read_text(encoding="utf-8"))
+    return summary, pd.read_csv(case_dir / "timeseries.csv")
+
+
+def run_title(summary: dict) -> str:
+    """'120 km/h, μ = 1.0, no oncoming: green (reason)' from a summary."""
+    case = summary.get("case") or {}
+    speed_kmh = case.get("ego_speed_kmh") or 3.6 * summary.get("ego_initial_speed_mps", math.nan)
+    onc = case.get("oncoming_start_m")
+    traffic = "no oncoming" if onc is None else f"oncoming from {onc:g} m"
+    return (f"{speed_kmh:.0f} km/h, μ = {summary['mu']:.2g}, {traffic}: "
+            f"{summary['outcome']} ({summary.get('reason', '')})")
+
+
+def _mode_spans(ax, ts: pd.DataFrame) -> None:
+    """Shade the time axis by EOAM mode."""
+    mode = ts["mode"].to_numpy()
+    t = ts["time_s"].to_numpy()
+    start = 0
+    for k in range(1, len(mode) + 1):
+        if k == len(mode) or mode[k] != mode[start]:
+            if np.isfinite(mode[start]):
+                ax.axvspan(t[start], t[min(k, len(t) - 1)],
+                           color=MODE_COLOURS.get(int(mode[start]), "white"), alpha=0.10, lw=0)
+            start = k
+
+
+def _mode_legend(modes) -> list[Line2D]:
+    return [Line2D([], [], marker="s", linestyle="", markersize=8, color=MODE_COLOURS[m],
+                   label=MODE_NAMES[m]) for m in sorted(modes)]
+
+
+def _modes_in(ts: pd.DataFrame) -> set[int]:
+    return {int(m) for m in ts["mode"].dropna().unique()}
+
+
+def plot_dynamics(case_dir: Path, out_dir: Path) -> Path:
+    """Figure 22: modes, FCW, speed, acceleration, lateral position and errors, dx."""
+    summary, ts = load_run(case_dir)
+    t = ts["time_s"]
+    fig = Figure(figsize=(14, 11), layout="constrained")
+    axes = fig.subplots(4, 2, sharex=True).ravel()
+    panels = [
+        ("EOAM mode", [("mode", "mode", {"drawstyle": "steps-post", **_ACTUAL})], "-"),
+        ("forward-collision warning", [("fcw", "FCW flag", {"drawstyle": "steps-post",
+                                                            **_ACTUAL})], "-"),
+        ("longitudinal speed", [("vx_mps", "actual", _ACTUAL),
+                                ("speed_target_mps", "target", _TARGET)], "m/s"),
+        ("longitudinal acceleration", [("ax_mps2", "actual", _ACTUAL),
+                                       ("ax_target_mps2", "target", _TARGET)], "m/s²"),
+        ("lateral position (left +)", [("lateral_offset_m", "actual", _ACTUAL),
+                                       ("y_target_m", "target", _TARGET)], "m"),
+        ("lateral offset error", [("lateral_error_m", "lateral error", _ACTUAL)], "m"),
+        ("lateral lookahead error", [("lookahead_error_m", "lookahead error", _ACTUAL)], "m"),
+        ("differential x-position (lookup-table input)", [("dx_m", "dx", _ACTUAL)], "m"),
+    ]
+    for ax, (title, lines, unit) in zip(axes, panels):
+        _mode_spans(ax, ts)
+        for column, label, style in lines:
+            ax.plot(t, ts[column], label=label, **style)
+        ax.set_title(title, fontsize=10)
+        ax.set_ylabel(f"[{unit}]" if unit != "-" else "")
+        ax.grid(alpha=0.3)
+        if len(lines) > 1:
+            ax.legend(fontsize=8, loc="best")
+    axes[0].set_yticks(range(6), [MODE_NAMES[m] for m in range(6)], fontsize=7)
+    axes[1].set_yticks([0, 1], ["off", "on"])
+    for ax in axes[-2:]:
+        ax.set_xlabel("time [s]")
+    fig.legend(handles=_mode_legend(_modes_in(ts)), loc="outside lower center",
+               ncols=6, fontsize=8, title="background: EOAM mode", title_fontsize=8)
+    fig.suptitle("EOAM dynamics (cf. paper Figure 22) — " + run_title(summary), fontsize=11)
+    return save(fig, Path(out_dir) / "dynamics.png")
+
+
+def plot_steering(case_dir: Path, out_dir: Path) -> Path:
+    """Figure 23: steering components, hand-wheel angle, lateral acceleration, yaw rate."""
+    summary, ts = load_run(case_dir)
+    ratio = ego_e_class_sedan().steering_ratio
+    t = ts["time_s"]
+    fig = Figure(figsize=(13, 9), layout="constrained")
+    axes = fig.subplots(2, 2, sharex=True).ravel()
+    deg = math.degrees(1.0)
+    for column, label, colour in (("steer_ff_rad", "feedforward", "#43a047"),
+                                  ("steer_fb_rad", "feedback", "#1e88e5"),
+                                  ("steer_yd_rad", "yaw damping", "#8e24aa"),
+                                  ("steer_cmd_rad", "total command", "black")):
+        axes[0].plot(t, ts[column] * deg, label=label, color=colour, linewidth=1.3)
+    axes[0].plot(t, ts["steer_rad"] * deg, label="actual (actuator)", color="#e53935",
+                 linestyle="--", linewidth=1.3)
+    axes[0].set_title("road-wheel steering angle and its components", fontsize=10)
+    axes[0].set_ylabel("[deg]")
+    axes[0].legend(fontsize=8)
+    axes[1].plot(t, ts["steer_rad"] * deg * ratio, **_ACTUAL)
+    axes[1].set_title(f"hand-wheel angle (steering ratio {ratio:g})", fontsize=10)
+    axes[1].set_ylabel("[deg]")
+    axes[2].plot(t, ts["ay_mps2"], **_ACTUAL)
+    mu_g = summary["mu"] * G_MPS2
+    for sign in (1, -1):
+        axes[2].axhline(sign * mu_g, color="#e53935", linestyle=":", linewidth=1)
+    axes[2].set_title(f"lateral acceleration (dotted: ±μg = ±{mu_g:.2f} m/s²)", fontsize=10)
+    axes[2].set_ylabel("[m/s²]")
+    axes[3].plot(t, ts["yaw_rate_radps"] * deg, **_ACTUAL)
+    axes[3].set_title("yaw rate", fontsize=10)
+    axes[3].set_ylabel("[deg/s]")
+    for ax in axes:
+        _mode_spans(ax, ts)
+        ax.grid(alpha=0.3)
+    for ax in axes[2:]:
+        ax.set_xlabel("time [s]")
+    fig.legend(handles=_mode_legend(_modes_in(ts)), loc="outside lower center", ncols=6,
+               fontsize=8, title="background: EOAM mode", title_fontsize=8)
+    fig.suptitle("Steering, lateral acceleration and yaw rate (cf. paper Figure 23) — "
+                 + run_title(summary), fontsize=11)
+    return save(fig, Path(out_dir) / "steering.png")
+
+
+def plot_gg(case_dir: Path, out_dir: Path) -> Path:
+    """Figure 24: the g-g diagram with the friction circle of radius mu g."""
+    summary, ts = load_run(case_dir)
+    mu_g = summary["mu"] * G_MPS2
+    fig = Figure(figsize=(7.5, 7.5), layout="constrained")
+    ax = fig.add_subplot()
+    angle = np.linspace(0.0, 2.0 * np.pi, 361)
+    ax.plot(mu_g * np.cos(angle), mu_g * np.sin(angle), color="#e53935", linewidth=1.5,
+            label=f"friction circle μg = {mu_g:.2f} m/s²")
+    for mode in sorted(_modes_in(ts)):
+        sel = ts[ts["mode"] == mode]
+        ax.scatter(sel["ay_mps2"], sel["ax_mps2"], s=5, color=MODE_COLOURS[mode],
+                   label=MODE_NAMES[mode])
+    lim = 1.15 * max(mu_g, float(np.nanmax(np.abs(ts[["ax_mps2", "ay_mps2"]].to_numpy()))))
+    ax.set_xlim(-lim, lim)
+    ax.set_ylim(-lim, lim)
+    ax.set_aspect("equal")
+    ax.axhline(0, color="0.6", linewidth=0.6)
+    ax.axvline(0, color="0.6", linewidth=0.6)
+    ax.set_xlabel("lateral acceleration a_y [m/s²] (left +)")
+    ax.set_ylabel("longitudinal acceleration a_x [m/s²]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="upper right", markerscale=3)
+    ax.set_title("g-g diagram (cf. paper Figure 24)\n" + run_title(summary), fontsize=10)
+    return save(fig, Path(out_dir) / "gg.png")
+
+
+def _sector_map(curve, v_max: float, d_max: float, n: int = 300):
+    """Sector letters on an n x n grid of closing speed x range."""
+    vs = np.linspace(v_max / n, v_max, n)
+    ds = np.linspace(0.0, d_max, n)
+    return vs, ds, [[curve.sector(d, v).value for v in vs] for d in ds]
+
+
+def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = None) -> Path:
+    """Figure 21: the radar's ARO phase trace on the DMM phase diagram of the run's friction.
+
+    The boundaries come from the lookup tables (``tables_dir``, default the repository's
+    ``tables/``); without readable tables the trace is drawn alone and the title says why.
+    """
+    from eoam_sumo.decision.dmm import SECTOR_ORDER, BoundaryCurve
+
+    summary, ts = load_run(case_dir)
+    mu = summary["mu"]
+    seen = ts[np.isfinite(ts["aro_range_m"]) & np.isfinite(ts["aro_range_rate_mps"])]
+    closing = -seen["aro_range_rate_mps"]
+    v_max = max(float(closing.max()) if len(seen) else 0.0,
+                summary.get("ego_initial_speed_mps", 0.0) * 0.7, 5.0) * 1.15
+    d_max = max(float(seen["aro_range_m"].max()) if len(seen) else 0.0, 20.0) * 1.1
+    fig = Figure(figsize=(10, 7), layout="constrained")
+    ax = fig.add_subplot()
+    note = ""
+    try:
+        from eoam_sumo.offline.tables import LookupTables, default_tables_dir
+
+        tables = LookupTables.load(Path(tables_dir) if tables_dir else default_tables_dir())
+        grid = tables.speed_grid_mps
+        v_lo = float(grid[0]) if grid[0] > 0 else float(grid[1])
+        curve = BoundaryCurve(tables.boundaries, mu, v_lo, float(grid[-1]))
+    except (ImportError, OSError, ValueError) as exc:
+        curve, note = None, f"\n(phase boundaries not drawn: {exc})"
+    if curve is not None:
+        vs, ds, letters = _sector_map(curve, v_max, d_max)
+        order = [s.value for s in SECTOR_ORDER]
+        index = np.array([[order.index(x) for x in row] for row in letters])
+        from matplotlib.colors import ListedColormap
+
+        cmap = ListedColormap([SECTOR_COLOURS[s] for s in order])
+        ax.imshow(index, origin="lower", extent=(0, v_max, 0, d_max), aspect="auto",
+                  cmap=cmap, vmin=-0.5, vmax=len(order) - 0.5, alpha=0.8,
+                  interpolation="nearest")
+        for k, letter in enumerate(order):
+            rr, cc = np.nonzero(index == k)
+            if len(rr) > 50:
+                ax.text(vs[int(np.median(cc))], ds[int(np.median(rr))], letter, fontsize=16,
+                        fontweight="bold", ha="center", va="center", color="0.25")
+        bounds = np.array([curve.at(v) for v in vs])
+        for col, label, style in ((0, "S: min. clearing distance (opt. accel.)", "-"),
+                                  (1, "Sb: buffered clearing distance", "--"),
+                                  (2, "B0: stopping distance", "-"),
+                                  (3, "Bb: buffered stopping distance", "--")):
+            colour = "#2e7d32" if col < 2 else "#1565c0"
+            ax.plot(vs, bounds[:, col], style, color=colour, linewidth=1.4, label=label)
+        ax.plot(vs, bounds[:, 4] * vs, ":", color="#6d4c41", linewidth=1.4,
+                label=f"T: TTC line ({bounds[0, 4]:g} s)")
+    for mode in sorted(_modes_in(seen)):
+        sel = seen[seen["mode"] == mode]
+        ax.scatter(-sel["aro_range_rate_mps"], sel["aro_range_m"], s=9,
+                   color=MODE_COLOURS[mode], edgecolors="black", linewidths=0.2,
+                   label=f"trace, mode {MODE_NAMES[mode]}", zorder=3)
+    if len(seen):
+        ax.annotate("first sensed", (closing.iloc[0], seen["aro_range_m"].iloc[0]),
+                    xytext=(10, 10), textcoords="offset points", fontsize=9,
+                    arrowprops={"arrowstyle": "->"})
+        ax.annotate("last sensed", (closing.iloc[-1], seen["aro_range_m"].iloc[-1]),
+                    xytext=(10, -15), textcoords="offset points", fontsize=9,
+                    arrowprops={"arrowstyle": "->"})
+    ax.set_xlim(0, v_max)
+    ax.set_ylim(0, d_max)
+    ax.set_xlabel("closing speed to the ARO (−range rate) [m/s]")
+    ax.set_ylabel("range to the ARO [m]")
+    ax.legend(fontsize=8, loc="upper left", framealpha=0.9)
+    ax.set_title(f"DMM phase diagram at μ = {mu:.2g} with the ARO phase trace "
+                 f"(cf. paper Figure 21)\n{run_title(summary)}{note}", fontsize=10)
+    return save(fig, Path(out_dir) / "phase_trace.png")
+
+
+def plot_run(case_dir: Path, out_dir: Path, tables_dir: Path | None = None) -> list[Path]:
+    """Every run plot of a run folder."""
+    return [plot_phase_trace(case_dir, out_dir, tables_dir), plot_dynamics(case_dir, out_dir),
+            plot_steering(case_dir, out_dir), plot_gg(case_dir, out_dir)]

@@ -1,0 +1,170 @@
+"""The batch engine's bookkeeping with test-only case functions (no SUMO): rows, order,
+failures, timeouts and resume. The real co-simulation runs are in test_batch_real_runs.py.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from eoam_sumo.batch import runner
+from eoam_sumo.batch.runner import COLUMNS, TIMING_COLUMNS, run_batch
+from eoam_sumo.errors import InputError
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def _fake_summary(case) -> dict:
+    """A deterministic summary from the case's parameters."""
+    colour = "green" if case.mu >= 0.5 else "yellow"
+    return {
+        "outcome": colour, "collision_with": "none" if colour == "green" else "aro",
+        "impact_speed_mps": 0.0 if colour == "green" else round(case.ego_speed_kmh / 10, 3),
+        "contact_kind": "none", "reason": f"fake run, mu {case.mu}", "modes_visited": [0, 1],
+        "fcw_raised": True, "mu": case.mu, "min_gap_aro_m": None, "sim_time_s": 12.0,
+        "wall_time_s": time.perf_counter() % 1.0, "realtime_factor": 1.0 + time.time() % 1.0,
+    }
+
+
+def fake_case(task):
+    """Writes its files like the real case function (direct or returned) and counts calls."""
+    summary = _fake_summary(task.case)
+    files = {"summary.json": json.dumps(summary).encode(),
+             "timeseries.csv": b"time_s,lateral_offset_m,mode\n0.0,0.0,0\n"}
+    if task.case_dir is None:
+        return {"summary": summary, "files": files}
+    task.case_dir.mkdir(parents=True, exist_ok=True)
+    for name, data in files.items():
+        (task.case_dir / name).write_bytes(data)
+    with open(task.case_dir / "calls.txt", "a") as fh:
+        fh.write("call\n")
+    return {"summary": summary, "files": None}
+
+
+def crash_one(task):
+    """Dies in native-crash fashion for the 90 km/h, mu 0.3 case."""
+    if task.case.ego_speed_kmh == 90 and task.case.mu == 0.3:
+        os._exit(9)
+    return fake_case(task)
+
+
+def hang_one(task):
+    if task.case.ego_speed_kmh == 120 and task.case.mu == 1.0:
+        time.sleep(600)
+    return fake_case(task)
+
+
+def raise_one(task):
+    if task.case.mu == 0.3:
+        raise RuntimeError("SUMO said no\nsecond line")
+    return fake_case(task)
+
+
+@pytest.fixture
+def matrix(tmp_path):
+    path = tmp_path / "m.toml"
+    path.write_text(
+        f'[scenario]\nsumocfg = "{REPO / "scenarios" / "baseline.sumocfg"}"\n'
+        "[sweep]\nego_speed_kmh = [120, 90]\nmu = [1.0, 0.3]\n"
+        'oncoming_start_m = ["none", 400]\n'
+        f'[paper]\ntable = "{REPO / "scenarios" / "paper_table2.csv"}"\n')
+    return path
+
+
+def _stable(path: Path) -> pd.DataFrame:
+    frame = pd.read_csv(path, dtype=str, keep_default_na=False)
+    return frame.drop(columns=list(TIMING_COLUMNS))
+
+
+def test_rows_in_matrix_order_whatever_the_jobs(tmp_path, matrix):
+    one = run_batch(matrix, tmp_path / "j1", jobs=1, progress=False, case_func=fake_case)
+    run_batch(matrix, tmp_path / "j2", jobs=2, progress=False, case_func=fake_case)
+    assert list(one["case_id"]) == [
+        "onc-none_v120_mu1.0", "onc-none_v120_mu0.3", "onc-none_v90_mu1.0",
+        "onc-none_v90_mu0.3", "onc-400_v120_mu1.0", "onc-400_v120_mu0.3",
+        "onc-400_v90_mu1.0", "onc-400_v90_mu0.3"]
+    a, b = _stable(tmp_path / "j1" / "results.csv"), _stable(tmp_path / "j2" / "results.csv")
+    pd.testing.assert_frame_equal(a, b)
+    assert tuple(pd.read_csv(tmp_path / "j1" / "results.csv").columns) == COLUMNS
+    row = a.iloc[4]
+    assert (row["oncoming_start_m"], row["modes_visited"], row["status"]) == ("400.0", "0-1", "ok")
+    assert a.iloc[0]["oncoming_start_m"] == ""  # no oncoming car: empty
+    # the paper's colours from the matrix's [paper] table
+    assert list(a["paper_outcome"]) == ["green", "green", "green", "green",
+                                        "green", "orange", "orange", "yellow"]
+    assert (tmp_path / "j2" / "cases" / "onc-400_v90_mu0.3" / "summary.json").is_file()
+    assert (tmp_path / "j2" / "table2.md").is_file() and (tmp_path / "j2" / "table2.png").is_file()
+
+
+def test_crash_and_exception_are_failed_rows_and_the_rest_complete(tmp_path, matrix):
+    res = run_batch(matrix, tmp_path / "c", jobs=2, progress=False, case_func=crash_one)
+    failed = res[res["status"] == "failed"]
+    assert list(failed["case_id"]) == ["onc-none_v90_mu0.3", "onc-400_v90_mu0.3"]
+    assert all(e == "worker process died (exit status 9)" for e in failed["error"])
+    assert failed["outcome"].eq("").all()
+    assert (res["status"] == "ok").sum() == 6
+    res = run_batch(matrix, tmp_path / "e", jobs=1, progress=False, case_func=raise_one)
+    failed = res[res["status"] == "failed"]
+    assert len(failed) == 4
+    assert set(failed["error"]) == {"RuntimeError: SUMO said no | second line"}
+    md = (tmp_path / "e" / "table2.md").read_text(encoding="utf-8")
+    assert "failed: RuntimeError: SUMO said no | second line" in md
+
+
+def test_a_case_past_its_timeout_is_killed_and_recorded(tmp_path, matrix):
+    res = run_batch(matrix, tmp_path / "t", jobs=2, timeout_s=4.0, progress=False,
+                    case_func=hang_one)
+    failed = res[res["status"] == "failed"].set_index("case_id")["error"]
+    assert dict(failed) == {cid: "timed out after 4 s (worker killed)"
+                            for cid in ("onc-none_v120_mu1.0", "onc-400_v120_mu1.0")}
+    assert (res["status"] == "ok").sum() == 6
+
+
+def test_resume_reruns_only_failed_and_missing_cases(tmp_path, matrix):
+    ref = run_batch(matrix, tmp_path / "ref", jobs=1, progress=False, case_func=fake_case)
+    out = tmp_path / "r"
+    run_batch(matrix, out, jobs=2, progress=False, case_func=crash_one)
+    # an interrupted batch: rows out of order, one row missing, the last one cut short
+    lines = (out / "results.csv").read_text().splitlines(keepends=True)
+    header, rows = lines[0], lines[1:]
+    kept = [rows[5], rows[0], rows[3], rows[2], rows[1][: len(rows[1]) // 2]]
+    (out / "results.csv").write_text(header + "".join(kept))
+    res = run_batch(matrix, out, jobs=2, resume=True, progress=False, case_func=fake_case)
+    pd.testing.assert_frame_equal(_stable(out / "results.csv"),
+                                  _stable(tmp_path / "ref" / "results.csv"))
+    assert (res["status"] == "ok").all()
+    calls = {cid: (out / "cases" / cid / "calls.txt").read_text().count("call")
+             for cid in ref["case_id"]}
+    # rows 0, 2, 5 were kept: one call. Rows 1 (cut short), 4, 6 (missing) ran again: two.
+    # Rows 3 and 7 had crashed before counting their first call: one, from the resume.
+    ids = list(ref["case_id"])
+    assert calls == {cid: 2 if i in (1, 4, 6) else 1 for i, cid in enumerate(ids)}
+
+
+def test_dask_local_cluster_gives_the_same_results(tmp_path, matrix):
+    run_batch(matrix, tmp_path / "j1", jobs=1, progress=False, case_func=fake_case)
+    run_batch(matrix, tmp_path / "dask", jobs=2, scheduler="local", progress=False,
+              case_func=crash_one)
+    a = _stable(tmp_path / "j1" / "results.csv")
+    b = _stable(tmp_path / "dask" / "results.csv")
+    crashed = b["status"] == "failed"
+    assert list(b.loc[crashed, "case_id"]) == ["onc-none_v90_mu0.3", "onc-400_v90_mu0.3"]
+    pd.testing.assert_frame_equal(a[~crashed], b[~crashed])
+    # files came back through Dask and were written on this side
+    case_dir = tmp_path / "dask" / "cases" / "onc-none_v120_mu1.0"
+    assert json.loads((case_dir / "summary.json").read_text())["outcome"] == "green"
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"jobs": 0}, "--jobs"), ({"timeout_s": 0.0}, "--timeout-s"),
+    ({"scheduler": "tcp://127.0.0.1:9"}, "cannot connect to the Dask scheduler"),
+])
+def test_bad_settings_are_input_errors(tmp_path, matrix, kwargs, message, monkeypatch):
+    monkeypatch.setattr(runner, "DASK_CONNECT_TIMEOUT_S", 1.0)
+    with pytest.raises(InputError, match=message):
+        run_batch(matrix, tmp_path / "x", progress=False, case_func=fake_case, **kwargs)

@@ -1,0 +1,174 @@
+"""Real SUMO co-simulation runs of small scenarios (issue 6 must-shows)."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from eoam_sumo.params import G_MPS2
+from eoam_sumo.sim.cosim import RunSettings, run_case
+from eoam_sumo.sim.runlog import COLUMNS
+from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
+
+ROOT = Path(__file__).resolve().parents[2]
+BASELINE = ROOT / "scenarios" / "baseline.sumocfg"
+PARKED = ROOT / "scenarios" / "parked_only.sumocfg"
+CONTRACT_COLUMNS = (
+    "time_s, mode, fcw, x_m, y_m, yaw_rad, vx_mps, vy_mps, yaw_rate_radps, ax_mps2, ay_mps2, "
+    "steer_rad, ax_target_mps2, y_target_m, aro_range_m, aro_range_rate_mps"
+).split(", ")
+SUMMARY_KEYS = (
+    "outcome collision_with impact_speed_mps modes_visited fcw_raised mu min_gap_aro_m "
+    "max_abs_lat_accel_mps2 sim_time_s wall_time_s"
+).split()
+
+
+def _run(cfg, tmp_path, **over):
+    settings = RunSettings(max_time_s=over.pop("max_time_s", 30.0))
+    out = tmp_path / "run"
+    summary = run_case(cfg, ScenarioOverrides(**over), out, settings)
+    return summary, out
+
+
+def test_parked_cars_only_trigger_nothing(tmp_path):
+    summary, out = _run(PARKED, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0, max_time_s=12.0)
+    assert summary["outcome"] == "none"
+    assert summary["collision_with"] == "none"
+    assert summary["modes_visited"] == [0]
+    assert summary["fcw_raised"] is False
+    ts = pd.read_csv(out / "timeseries.csv")
+    assert ts["aro_range_m"].isna().all(), "a parked car was reported in the ego's path"
+    assert ts["mode"].dropna().eq(0).all()
+
+
+def test_120_kmh_dry_no_oncoming_is_green_with_return_and_hand_back(tmp_path):
+    summary, out = _run(BASELINE, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0)
+    assert summary["outcome"] == "green", summary["reason"]
+    modes = summary["modes_visited"]
+    assert 2 in modes and 5 in modes
+    assert modes[0] == 0 and summary["fcw_raised"] is True
+    ts = pd.read_csv(out / "timeseries.csv")
+    # handed back: NORMAL again after RETURN, back in the own lane centre
+    assert ts["mode"].dropna().iloc[-1] == 0
+    assert abs(ts["lateral_offset_m"].iloc[-1]) < 0.3
+    assert ts["lateral_offset_m"].max() > 3.0  # it really went into the next lane
+    assert summary["max_abs_lat_accel_mps2"] <= 1.1 * 1.0 * G_MPS2
+    # contract of the files
+    for col in CONTRACT_COLUMNS:
+        assert col in ts.columns
+    assert list(ts.columns) == list(COLUMNS)
+    saved = json.loads((out / "summary.json").read_text())
+    for key in SUMMARY_KEYS:
+        assert key in saved
+    assert saved["mu"] == pytest.approx(1.0)
+    assert saved["min_gap_aro_m"] > 0.0
+    # one row per SUMO step of 10 ms
+    assert ts["time_s"].diff().dropna().round(6).eq(0.01).all()
+
+
+def test_120_kmh_dry_oncoming_300_m_is_not_red(tmp_path):
+    summary, _ = _run(BASELINE, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0, oncoming_start_m=300.0)
+    assert summary["outcome"] in {"green", "yellow", "orange"}, summary["reason"]
+    assert summary["outcome"] != "red"
+
+
+def _write_user_scenario(folder: Path) -> Path:
+    """A scenario unlike ours: other ids, 3.2 m lanes, friction in the net, a halted car."""
+    (folder / "road.nod.xml").write_text(textwrap.dedent("""\
+        <nodes>
+          <node id="west" x="0" y="50"/>
+          <node id="east" x="2500" y="50"/>
+        </nodes>"""))
+    (folder / "road.edg.xml").write_text(textwrap.dedent("""\
+        <edges>
+          <edge id="main_fwd" from="west" to="east" numLanes="1" speed="40" width="3.2"
+                spreadType="right"/>
+          <edge id="main_back" from="east" to="west" numLanes="1" speed="40" width="3.2"
+                spreadType="right"/>
+        </edges>"""))
+    import sumolib
+
+    netconvert = sumolib.checkBinary("netconvert")
+    subprocess.run(
+        [netconvert, "-n", str(folder / "road.nod.xml"), "-e", str(folder / "road.edg.xml"),
+         "--opposites.guess", "true", "--no-turnarounds", "true",
+         "-o", str(folder / "road.net.xml")],
+        check=True, capture_output=True,
+    )
+    (folder / "cars.rou.xml").write_text(textwrap.dedent("""\
+        <routes>
+          <vType id="sedan" length="4.8" width="1.8" accel="3" decel="9" sigma="0"/>
+          <vType id="truck" length="8.0" width="2.4" accel="1" decel="6" sigma="0"/>
+          <route id="r" edges="main_fwd"/>
+          <vehicle id="broken_down" type="truck" route="r" depart="0" departPos="400"
+                   departSpeed="0">
+            <stop lane="main_fwd_0" endPos="408" duration="1000"/>
+          </vehicle>
+          <vehicle id="ego" type="sedan" route="r" depart="0" departPos="150"
+                   departSpeed="25"/>
+        </routes>"""))
+    cfg = folder / "user.sumocfg"
+    cfg.write_text(textwrap.dedent("""\
+        <configuration>
+          <input>
+            <net-file value="road.net.xml"/>
+            <route-files value="cars.rou.xml"/>
+          </input>
+          <time><step-length value="0.01"/></time>
+        </configuration>"""))
+    return cfg
+
+
+def test_user_scenario_with_halted_car_gets_a_sensible_outcome(tmp_path):
+    cfg = _write_user_scenario(tmp_path)
+    summary, out = _run(cfg, tmp_path, mu=0.7, max_time_s=30.0)
+    # the halted truck is seen, a manoeuvre is made and nothing is hit at speed
+    assert summary["fcw_raised"] is True
+    assert summary["outcome"] in {"green", "yellow"}, summary["reason"]
+    assert summary["modes_visited"][0] == 0 and len(summary["modes_visited"]) > 1
+    ts = pd.read_csv(out / "timeseries.csv")
+    assert ts["aro_range_m"].notna().any()
+    assert summary["mu"] == pytest.approx(0.7)
+
+
+def test_cli_run_prints_one_line_and_writes_files(tmp_path):
+    out = tmp_path / "cli"
+    proc = subprocess.run(
+        [sys.executable, "-m", "eoam_sumo", "run", str(BASELINE), "--speed-kmh", "90",
+         "--mu", "1.0", "--out", str(out), "--max-time-s", "25"],
+        capture_output=True, text=True, timeout=300,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert len(proc.stdout.strip().splitlines()) == 1
+    assert (out / "timeseries.csv").is_file() and (out / "summary.json").is_file()
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["outcome"] in {"green", "yellow", "orange", "red", "none"}
+    assert math.isfinite(summary["sim_time_s"])
+
+
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["run", "missing.sumocfg"], "missing.sumocfg"),
+        (["run", str(BASELINE), "--mu", "1.5"], "1.5"),
+        (["run", str(BASELINE), "--speed-kmh", "400"], "400"),
+        (["run", str(BASELINE), "--oncoming-m", "-5"], "-5"),
+        (["run", str(BASELINE), "--bogus"], "--bogus"),
+    ],
+)
+def test_cli_bad_input_is_one_line_and_status_2(tmp_path, args, needle):
+    proc = subprocess.run(
+        [sys.executable, "-m", "eoam_sumo", *args, "--out", str(tmp_path / "o")],
+        capture_output=True, text=True, timeout=120, cwd=tmp_path,
+    )
+    assert proc.returncode == 2
+    lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and needle in lines[0], proc.stderr
+    assert "Traceback" not in proc.stderr

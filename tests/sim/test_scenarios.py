@@ -1,0 +1,426 @@
+"""The SUMO experiment world in real SUMO runs: network, scenarios, adapter, overrides."""
+
+import gzip
+import math
+import shutil
+import tempfile
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sumolib
+
+from eoam_sumo import netbuild
+from eoam_sumo.errors import InputError
+from eoam_sumo.params import (
+    G_MPS2,
+    aro_d_class_minivan,
+    ego_e_class_sedan,
+    oncoming_sedan,
+    parked_car,
+)
+from eoam_sumo.sim.sumo_adapter import ScenarioOverrides, SumoSession, nav_angle_deg, yaw_rad
+
+ROOT = Path(__file__).resolve().parents[2]
+NETWORKS = ROOT / "networks"
+SCENARIOS = ROOT / "scenarios"
+BASELINE = SCENARIOS / "baseline.sumocfg"
+PARKED_ONLY = SCENARIOS / "parked_only.sumocfg"
+NET = sumolib.net.readNet(str(NETWORKS / "highway.net.xml"), withInternal=True)
+EGO_LANE = NET.getLane("E0_0")
+RIGHT_MARKER_Y = EGO_LANE.getShape()[0][1] - EGO_LANE.getWidth() / 2.0  # from the network file
+
+
+def _route_vehicle(path: Path, vid: str) -> tuple[dict, dict]:
+    """(attributes, params) of a vehicle as written in a route file: the test's truth."""
+    for elem in ET.parse(path).getroot().iter("vehicle"):
+        if elem.get("id") == vid:
+            return dict(elem.attrib), {p.get("key"): p.get("value") for p in elem.iter("param")}
+    raise AssertionError(f"{vid} not in {path}")
+
+
+EGO_ATTRS, _ = _route_vehicle(SCENARIOS / "baseline.rou.xml", "ego")
+ARO_ATTRS, ARO_PARAMS = _route_vehicle(SCENARIOS / "baseline.rou.xml", "aro")
+
+
+@pytest.fixture(autouse=True)
+def sumo_scratch_in_tmp_path(tmp_path, monkeypatch):
+    """The adapter's scratch directory (SUMO's error log) goes under tmp_path; none may remain."""
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
+    yield
+    assert list(scratch.iterdir()) == []
+
+
+@pytest.fixture
+def open_session():
+    """Start sessions through this; every one is closed at the end of the test."""
+    sessions = []
+
+    def start(cfg, overrides=None, **kwargs):
+        overrides = ScenarioOverrides() if overrides is None else overrides
+        session = SumoSession.start(cfg, overrides, **kwargs)
+        sessions.append(session)
+        return session
+
+    yield start
+    for session in sessions:
+        session.close()
+
+
+def _front(body):
+    return (
+        body.x_m + 0.5 * body.length_m * math.cos(body.yaw_rad),
+        body.y_m + 0.5 * body.length_m * math.sin(body.yaw_rad),
+    )
+
+
+# --------------------------------------------------------------------------- network
+def test_committed_network_is_what_netconvert_builds_from_the_sources(tmp_path):
+    for name in ("highway.nod.xml", "highway.edg.xml"):
+        shutil.copy(NETWORKS / name, tmp_path / name)
+    (built,) = netbuild.build_all(tmp_path)
+
+    def lanes(path):
+        root = ET.parse(path).getroot()
+        return {
+            lane.get("id"): (dict(lane.attrib), [n.get("lane") for n in lane.iter("neigh")])
+            for lane in root.iter("lane")
+        }
+
+    assert lanes(built) == lanes(NETWORKS / "highway.net.xml")
+
+
+def test_highway_geometry_and_surface():
+    assert set(NET.getEdges(withInternal=False)) == {NET.getEdge("E0"), NET.getEdge("-E0")}
+    onc_lane = NET.getLane("-E0_0")
+    for lane in (EGO_LANE, onc_lane):
+        assert lane.getWidth() == 3.5
+        assert lane.getLength() == pytest.approx(4000.0)
+        assert lane.getSpeed() * 3.6 >= 165.0
+    root = ET.parse(NETWORKS / "highway.net.xml").getroot()
+    assert {ln.get("id"): ln.get("friction") for ln in root.iter("lane")} == {
+        "E0_0": "1.00",
+        "-E0_0": "1.00",
+    }
+    # oncoming lane directly to the left of the eastbound ego lane, sharing the centre line
+    assert onc_lane.getShape()[0][1] - EGO_LANE.getShape()[0][1] == pytest.approx(3.5)
+    assert EGO_LANE.getShape()[-1][0] > EGO_LANE.getShape()[0][0]
+
+
+def test_netbuild_command_needs_a_directory(tmp_path, capsys):
+    assert netbuild.main([]) == 2
+    assert netbuild.main([str(tmp_path / "missing")]) == 2
+    assert "missing" in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------- ego and vTypes
+@pytest.mark.parametrize("speed_kmh", [55.0, 165.0])
+def test_ego_is_present_at_the_requested_speed_from_the_first_step(open_session, speed_kmh):
+    speed = speed_kmh / 3.6
+    s = open_session(BASELINE, ScenarioOverrides(ego_speed_mps=speed))
+    assert s.time_s == pytest.approx(float(EGO_ATTRS["depart"]) + s.step_length_s)
+    ego = s.ego_body()
+    assert ego.speed_mps == pytest.approx(speed, abs=1e-9)
+    front = _front(ego)
+    assert front == pytest.approx(
+        (float(EGO_ATTRS["departPos"]), EGO_LANE.getShape()[0][1]), abs=1e-6
+    )
+    assert ego.yaw_rad == pytest.approx(0.0, abs=1e-9)
+    aro = s.body("aro")
+    rear_aro = aro.x_m - 0.5 * aro.length_m
+    assert rear_aro - front[0] == pytest.approx(120.0, abs=1e-6)  # the stated ego-ARO gap
+    for _ in range(5):
+        s.step()
+        assert s.vehicle_speed("ego") == pytest.approx(speed, abs=1e-9)
+
+
+def test_vehicle_types_have_the_preset_footprints(open_session):
+    s = open_session(BASELINE, ScenarioOverrides(oncoming_start_m=300.0))
+    ego, aro, onc = s.ego_body(), s.body("aro"), s.body(s.oncoming_id)
+    parked = [b for b in s.nearby(1000.0) if b.parked]
+    for body, preset in [
+        (ego, ego_e_class_sedan()),
+        (aro, aro_d_class_minivan()),
+        (onc, oncoming_sedan()),
+    ] + [(p, parked_car()) for p in parked]:
+        assert (body.length_m, body.width_m) == (preset.length_m, preset.width_m)
+    assert len(parked) == 8
+
+
+# --------------------------------------------------------------------------- ARO stop
+@pytest.mark.parametrize("mu,decel_override", [(1.0, None), (0.3, None), (1.0, 3.0)])
+def test_aro_holds_then_stops_no_harder_than_the_surface_allows(open_session, mu, decel_override):
+    s = open_session(
+        BASELINE, ScenarioOverrides(ego_speed_mps=5.0, mu=mu, aro_decel_mps2=decel_override)
+    )
+    v0 = float(ARO_ATTRS["departSpeed"])
+    assert v0 == pytest.approx(60.0 / 3.6, abs=1e-5)
+    hold_end = float(ARO_ATTRS["depart"]) + float(ARO_PARAMS["eoam.aro_hold_s"])
+    decel = (
+        decel_override if decel_override is not None else float(ARO_PARAMS["eoam.aro_decel_mps2"])
+    )
+    allowed = min(decel, mu * G_MPS2)
+    t_stop = hold_end + v0 / allowed
+    log = []
+    while s.time_s < t_stop + 1.0:
+        aro = s.body("aro")
+        log.append((s.time_s, aro.speed_mps, aro.x_m, aro.y_m, s.vehicle_lane("aro")))
+        s.step()
+    t, v, x, y, lanes = (np.array(c) if i < 4 else c for i, c in enumerate(zip(*log)))
+    holding = t <= hold_end + 1e-9
+    assert np.all(np.abs(v[holding] - v0) < 1e-9)
+    expected = np.maximum(0.0, v0 - allowed * (t[~holding] - hold_end))
+    assert np.max(np.abs(v[~holding] - expected)) < 1e-6
+    decel_seen = -np.diff(v) / s.step_length_s
+    assert decel_seen.max() <= allowed + 1e-6
+    assert decel_seen.max() == pytest.approx(allowed, rel=1e-6)
+    stopped = t >= t_stop + 0.02
+    assert stopped.sum() > 50
+    assert np.all(v[stopped] == 0.0)
+    assert np.ptp(x[stopped]) == 0.0
+    assert set(lanes) == {"E0_0"}
+    assert np.all(y == pytest.approx(EGO_LANE.getShape()[0][1]))
+
+
+# --------------------------------------------------------------------------- oncoming
+def test_oncoming_car_starts_at_the_distance_and_keeps_20_mps(open_session):
+    s = open_session(BASELINE, ScenarioOverrides(ego_speed_mps=10.0, oncoming_start_m=300.0))
+    onc_lane = NET.getLane("-E0_0")
+    ego, onc = s.ego_body(), s.body(s.oncoming_id)
+    assert s.roles[s.oncoming_id] == "oncoming"
+    assert s.vehicle_lane(s.oncoming_id) == onc_lane.getID()
+    assert _front(onc)[0] - _front(ego)[0] == pytest.approx(300.0, abs=1e-6)
+    assert onc.y_m == pytest.approx(onc_lane.getShape()[0][1])
+    assert abs(onc.yaw_rad) == pytest.approx(math.pi)  # heading west, towards the ego
+    x0, t0 = _front(onc)[0], s.time_s
+    for _ in range(100):
+        s.step()
+        assert s.vehicle_speed(s.oncoming_id) == pytest.approx(20.0, abs=1e-9)
+    # the ego moves into the oncoming lane 40 m ahead of it: SUMO must not make it brake
+    gap_front = _front(s.body(s.oncoming_id))[0] - 40.0
+    for k in range(150):
+        s.move_ego(gap_front + 0.1 * k, onc_lane.getShape()[0][1], 90.0, 10.0)
+        s.step()
+        assert s.vehicle_speed(s.oncoming_id) == pytest.approx(20.0, abs=1e-9)
+        assert "ego" in s.vehicle_ids()
+    assert x0 - _front(s.body(s.oncoming_id))[0] == pytest.approx(20.0 * (s.time_s - t0), abs=1e-6)
+
+
+def test_move_ego_into_the_opposite_lane_and_back(open_session):
+    s = open_session(BASELINE, ScenarioOverrides(ego_speed_mps=20.0))
+    length = s.ego_body().length_m
+    for y_lane, lane_id in [(1.75, "-E0_0"), (-1.75, "E0_0")]:
+        x_front = _front(s.ego_body())[0] + 0.2
+        s.move_ego(x_front, y_lane, 90.0, 20.0)
+        s.step()
+        ego = s.ego_body()
+        assert s.vehicle_lane("ego") == lane_id
+        assert (ego.x_m, ego.y_m) == pytest.approx((x_front - length / 2.0, y_lane), abs=1e-9)
+        assert ego.speed_mps == pytest.approx(20.0)
+    # a yawed pose: the centre lies half a length behind the front along the heading
+    yaw = math.radians(4.0)
+    s.move_ego(x_front + 0.2, -1.2, nav_angle_deg(yaw), 20.0)
+    s.step()
+    ego = s.ego_body()
+    assert ego.yaw_rad == pytest.approx(yaw, abs=1e-9)
+    assert _front(ego) == pytest.approx((x_front + 0.2, -1.2), abs=1e-9)
+
+
+# --------------------------------------------------------------------------- parked cars
+def test_parked_cars_sit_beside_the_ego_lane_and_never_in_it(open_session):
+    s = open_session(PARKED_ONLY)
+    ego_front_x = _front(s.ego_body())[0]
+    ahead = sorted(_front(b)[0] - ego_front_x for b in s.nearby(1000.0))
+    assert len(ahead) == 8 and 0.0 < ahead[0] and ahead[-1] <= 850.0  # the first ~800 m
+    assert min(np.diff(ahead)) > 50.0
+    for _ in range(400):
+        parked = s.nearby(1000.0)
+        assert len(parked) == 8 and all(b.parked for b in parked)
+        for b in parked:
+            near_side_y = b.y_m + b.width_m / 2.0
+            assert RIGHT_MARKER_Y - near_side_y == pytest.approx(1.5, abs=1e-9)
+            assert b.yaw_rad == pytest.approx(0.0, abs=1e-9)
+            assert s.vehicle_lane(b.vid) == ""
+        s.step()
+    assert s.ego_body().x_m > ego_front_x + ahead[0]  # the ego drove past the first one
+    assert "aro" not in s.vehicle_ids()
+
+
+# --------------------------------------------------------------------------- friction
+def test_friction_override_sets_every_lane(open_session):
+    s = open_session(BASELINE, ScenarioOverrides(mu=0.3))
+    assert s.lane_ids() and all(
+        s.lane_friction(lane) == pytest.approx(0.3) for lane in s.lane_ids()
+    )
+    assert s.friction_at_ego() == pytest.approx(0.3)
+    s.close()
+    s = open_session(BASELINE)
+    assert s.friction_at_ego() == pytest.approx(1.0)  # the network's own surface
+    assert s.lane_width_m == 3.5 and s.left_lane_exists
+    line = s.ego_lane_centreline()
+    assert line.shape == (2, 2)
+    assert line == pytest.approx(np.array(EGO_LANE.getShape()))
+
+
+# --------------------------------------------------------------------------- TraCI path
+def test_traci_path_with_plain_sumo(open_session):
+    s = open_session(
+        BASELINE,
+        ScenarioOverrides(ego_speed_mps=55.0 / 3.6, oncoming_start_m=400.0),
+        use_traci=True,
+    )
+    assert s.ego_body().speed_mps == pytest.approx(55.0 / 3.6)
+    for _ in range(20):
+        s.step()
+    assert s.vehicle_speed("aro") == pytest.approx(float(ARO_ATTRS["departSpeed"]))
+    ids = {b.vid for b in s.nearby(450.0)}
+    assert {"aro", s.oncoming_id} <= ids
+    s.close()
+    s.close()  # idempotent
+
+
+# --------------------------------------------------------------------------- a user's scenario
+USER_NODES = """<nodes>
+  <node id="a" x="0" y="0" type="priority"/><node id="b" x="500" y="0" type="priority"/>
+  <node id="c" x="900" y="300" type="priority"/>
+</nodes>"""
+USER_EDGES = """<edges>
+  <edge id="road1" from="a" to="b" numLanes="1" speed="40" width="3.2">
+    <lane index="0" friction="0.6"><neigh lane="back1_0"/></lane></edge>
+  <edge id="road2" from="b" to="c" numLanes="1" speed="40" width="3.2">
+    <lane index="0" friction="0.6"><neigh lane="back2_0"/></lane></edge>
+  <edge id="back2" from="c" to="b" numLanes="1" speed="40" width="3.2">
+    <lane index="0" friction="0.6"><neigh lane="road2_0"/></lane></edge>
+  <edge id="back1" from="b" to="a" numLanes="1" speed="40" width="3.2">
+    <lane index="0" friction="0.6"><neigh lane="road1_0"/></lane></edge>
+</edges>"""
+USER_ROUTES = """<routes>
+  <vType id="car" length="4.5" width="1.8" sigma="0"/>
+  <vehicle id="blocker" type="car" depart="0" departPos="150" departSpeed="10">
+    <route edges="road1 road2"/>
+    <stop lane="road1_0" endPos="260" duration="1000"/>
+  </vehicle>
+  <vehicle id="ego" type="car" depart="0" departSpeed="12"><route edges="road1 road2"/></vehicle>
+</routes>"""
+USER_CFG = """<configuration><input><net-file value="user.net.xml"/>
+  <route-files value="user.rou.xml.gz"/></input></configuration>"""
+
+
+@pytest.fixture
+def user_scenario(tmp_path):
+    (tmp_path / "user.nod.xml").write_text(USER_NODES)
+    (tmp_path / "user.edg.xml").write_text(USER_EDGES)
+    netbuild.build_all(tmp_path)
+    (tmp_path / "user.rou.xml.gz").write_bytes(gzip.compress(USER_ROUTES.encode()))
+    (tmp_path / "user.sumocfg").write_text(USER_CFG)
+    return tmp_path
+
+
+def test_a_users_scenario_with_its_own_network_and_a_plain_stop(open_session, user_scenario):
+    net = sumolib.net.readNet(str(user_scenario / "user.net.xml"))
+    shape1 = np.array(net.getLane("road1_0").getShape())
+    s = open_session(user_scenario / "user.sumocfg", ScenarioOverrides(oncoming_start_m=700.0))
+    ego = s.ego_body()
+    assert ego.speed_mps == pytest.approx(12.0)  # the file's departSpeed
+    # departPos "base": the front bumper one vehicle length into the first lane
+    start_dir = (shape1[1] - shape1[0]) / np.linalg.norm(shape1[1] - shape1[0])
+    assert _front(ego) == pytest.approx(tuple(shape1[0] + 4.5 * start_dir), abs=1e-6)
+    assert s.lane_width_m == pytest.approx(3.2)
+    assert s.friction_at_ego() == pytest.approx(0.6)
+    line = s.ego_lane_centreline()
+    both = np.vstack([shape1, net.getLane("road2_0").getShape()])
+    assert line[0] == pytest.approx(both[0]) and line[-1] == pytest.approx(both[-1])
+    # the oncoming car starts on the opposite lane of the second edge, 700 m along the road
+    assert s.vehicle_lane(s.oncoming_id) == "back2_0"
+    seg = np.hypot(*np.diff(both, axis=0).T)
+    along = np.concatenate(([0.0], np.cumsum(seg)))
+    onc_front = _front(s.body(s.oncoming_id))
+    k = int(np.argmin(np.hypot(both[:, 0] - onc_front[0], both[:, 1] - onc_front[1])))
+    i = min(k, len(both) - 2)
+    d = both[i + 1] - both[i]
+    s_onc = along[i] + np.dot(np.array(onc_front) - both[i], d) / np.dot(d, d) * seg[i]
+    assert s_onc - 4.5 == pytest.approx(700.0, abs=1.0)
+    for _ in range(2500):
+        s.step()
+    assert s.vehicle_speed("blocker") == 0.0
+    assert s.vehicle_lane("blocker") == "road1_0"
+
+
+# --------------------------------------------------------------------------- bad input
+def _cfg(tmp_path, routes: str) -> Path:
+    net = NETWORKS / "highway.net.xml"
+    cfg = tmp_path / "bad.sumocfg"
+    cfg.write_text(
+        f'<configuration><input><net-file value="{net}"/>'
+        f'<route-files value="{routes}"/></input></configuration>'
+    )
+    return cfg
+
+
+def test_bad_scenarios_are_input_errors_naming_the_file(tmp_path):
+    with pytest.raises(InputError, match="missing.sumocfg"):
+        SumoSession.start(tmp_path / "missing.sumocfg")
+    broken = tmp_path / "broken.sumocfg"
+    broken.write_text("<configuration><input>")
+    with pytest.raises(InputError, match="broken.sumocfg: malformed XML"):
+        SumoSession.start(broken)
+    with pytest.raises(InputError, match="nowhere.rou.xml"):
+        SumoSession.start(_cfg(tmp_path, str(tmp_path / "nowhere.rou.xml")))
+    with pytest.raises(InputError, match="no vehicle 'ego'"):
+        SumoSession.start(_cfg(tmp_path, str(SCENARIOS / "parked.rou.xml")))
+    with pytest.raises(InputError, match="no vehicle 'nobody'"):
+        SumoSession.start(BASELINE, ego_id="nobody")
+    with pytest.raises(InputError, match="eoam.role"):
+        SumoSession.start(PARKED_ONLY, ScenarioOverrides(aro_hold_s=1.0))
+    with pytest.raises(InputError, match="step_length_s"):
+        SumoSession.start(BASELINE, step_length_s=0.0105)
+
+
+@pytest.mark.parametrize("use_traci", [False, True])
+def test_sumos_own_load_errors_become_input_errors(tmp_path, use_traci):
+    bad_route = tmp_path / "bad.rou.xml"
+    bad_route.write_text(
+        '<routes><vehicle id="ego" depart="0"><route edges="nowhere"/></vehicle></routes>'
+    )
+    with pytest.raises(InputError, match="bad.sumocfg: SUMO could not load .*'nowhere'"):
+        SumoSession.start(_cfg(tmp_path, str(bad_route)), use_traci=use_traci)
+
+
+@pytest.mark.parametrize(
+    "kwargs,name",
+    [
+        ({"mu": 0.0}, "mu"),
+        ({"mu": 1.3}, "mu"),
+        ({"ego_speed_mps": -1.0}, "ego_speed_mps"),
+        ({"oncoming_start_m": -3.0}, "oncoming_start_m"),
+        ({"oncoming_speed_mps": math.nan}, "oncoming_speed_mps"),
+        ({"aro_hold_s": -0.5}, "aro_hold_s"),
+        ({"aro_decel_mps2": 0.0}, "aro_decel_mps2"),
+        ({"mu": True}, "mu"),
+    ],
+)
+def test_overrides_validate_themselves(kwargs, name):
+    with pytest.raises(ValueError, match=name):
+        ScenarioOverrides(**kwargs)
+
+
+def test_one_libsumo_session_at_a_time_and_close_is_final(open_session):
+    s = open_session(PARKED_ONLY)
+    with pytest.raises(RuntimeError, match="already open"):
+        SumoSession.start(PARKED_ONLY)
+    s.close()
+    s.close()
+    with pytest.raises(RuntimeError, match="closed"):
+        s.step()
+    with SumoSession.start(PARKED_ONLY) as again:
+        again.step()
+        assert again.ego_body().speed_mps == pytest.approx(float(EGO_ATTRS["departSpeed"]))
+
+
+def test_angle_conversions_round_trip():
+    for yaw in np.linspace(-math.pi + 1e-9, math.pi, 13):
+        assert yaw_rad(nav_angle_deg(yaw)) == pytest.approx(yaw, abs=1e-12)
+    assert nav_angle_deg(0.0) == 90.0 and yaw_rad(0.0) == pytest.approx(math.pi / 2)
