@@ -27,7 +27,7 @@ from eoam_sumo.control.reference import PathReference
 from eoam_sumo.control.steering import SteeringController, SteeringGains
 from eoam_sumo.decision.dmm import Action, BoundaryCurve, Sector
 from eoam_sumo.decision.modes import Mode, next_mode
-from eoam_sumo.params import G_MPS2, VehicleParams
+from eoam_sumo.params import VehicleParams
 
 _TWO_PI = 2.0 * math.pi
 
@@ -91,10 +91,10 @@ class EoamSettings:
     settle_heading_rad: float = 0.02  # ... and |e_yaw| below this ...
     settle_dwell_s: float = 0.5  # ... for this long after the return path ended
     release_opening_speed_mps: float = 0.5  # mode 1 -> 0: obstacle pulls away faster than this
-    limit_brake_fraction: float = 1.0  # share of the no-lock brake force used as limit braking
-    ellipse_margin: float = 1.1  # |ay| is inflated by this in the friction-ellipse brake cap
+    min_steer_speed_mps: float = 20.0 / 3.6  # below it a STEER sector brakes instead
+    limit_brake_fraction: float = 0.95  # share of the no-lock brake force used as limit braking
     reference_step_m: float = 0.25  # dx spacing of the sampled manoeuvre reference
-    preview_time_s: float = 0.25  # feedforward curvature taken this far ahead on the path
+    preview_time_s: float = 0.3  # feedforward curvature taken this far ahead on the path
     boundary_step_mps: float = 0.25  # closing-speed spacing of the sampled DMM boundaries
     steering: SteeringGains = field(default_factory=SteeringGains)
     longitudinal: LongitudinalGains = field(default_factory=LongitudinalGains)
@@ -126,8 +126,7 @@ class EoamController:
         self.settings = settings
         self._steer = SteeringController(params, settings.steering)
         self._long = LongitudinalController(params, settings.longitudinal)
-        grid = [float(v) for v in tables.speed_grid_mps]
-        self._v_lo, self._v_hi = min(grid), max(grid)
+        self._v_hi = max(float(v) for v in tables.speed_grid_mps)
         self._mass = params.mass_kg
         self._curve: BoundaryCurve | None = None
         self._brake_mu = math.nan
@@ -172,15 +171,12 @@ class EoamController:
             self.settings.limit_brake_fraction * self._mass * self._decel
         )
         self._curve = BoundaryCurve(
-            self.tables.boundaries, mu, self._v_lo, self._v_hi, self.settings.boundary_step_mps
+            self.tables.boundaries, mu, self._v_hi, self.settings.boundary_step_mps
         )
-
-    def _table_speed(self, speed_mps: float) -> float:
-        return min(max(speed_mps, self._v_lo), self._v_hi)
 
     def _start_path(self, meas: EgoMeasurement, start: float, height: float) -> None:
         v = meas.vx_mps
-        traj = self.tables.trajectory(meas.mu, self._table_speed(v))
+        traj = self.tables.trajectory(meas.mu, v)  # clamped to the tables' speed grid
         self._path = PathReference(
             traj, start_offset_m=start, height_m=height, speed_mps=v,
             step_m=self.settings.reference_step_m,
@@ -227,6 +223,8 @@ class EoamController:
             closing = -rate if rate is not None and math.isfinite(rate) else 0.0
             sector = self._curve.sector(rng, closing)
             action = sector.action
+            if action is Action.STEER and v < st.min_steer_speed_mps:
+                action = Action.BRAKE  # too slow for a lane change: braking needs less room
             threat_gone = closing < -st.release_opening_speed_mps
         else:
             sector = None
@@ -284,31 +282,30 @@ class EoamController:
             kappa_ref + road_kappa, kappa_ff + road_kappa, mu,
         )
 
-        # ---- longitudinal ------------------------------------------------------------------
-        # No ABS: the straight-line no-lock brake force, shrunk by the friction ellipse so that
-        # the lateral acceleration in use (measured, or asked by the steering) keeps its tyre
-        # force; a locked axle would have none.
+        # ---- longitudinal: force limits from the friction ellipse with the lateral acceleration
+        # in use (measured, or asked by this steering command), then the loop of the mode -----
         ay_use = max(abs(meas.ay_mps2), abs(self._steer.lateral_accel(v, delta)))
-        q = st.ellipse_margin * ay_use / (mu * G_MPS2)
-        brake_limit = self._brake_limit * math.sqrt(1.0 - q * q) if q < 1.0 else 0.0
+        drive_lim, brake_lim = self._long.limits(v, mu, ay_use, self._brake_limit)
         if mode is Mode.NORMAL:
             drive, brake, ax_target = self._long.track_speed(
-                self._initial_speed, v, mu, brake_limit, dt_s
+                self._initial_speed, v, mu, drive_lim, brake_lim, dt_s
             )
             v_target = self._initial_speed
         elif mode is Mode.UPDATE_BRAKE or mode is Mode.ONCOMING_BRAKE:
-            drive, brake = self._long.hold_brake(brake_limit)
-            ax_target = -brake_limit / self._mass
+            drive, brake = 0.0, brake_lim  # limit braking without locking
+            ax_target = -brake_lim / self._mass
             v_target = 0.0
         elif in_path and mode is not Mode.RETURN:
-            drive, brake = self._long.track_accel(ax_ref, meas.ax_mps2, v, mu, brake_limit, dt_s)
+            drive, brake = self._long.track_accel(
+                ax_ref, meas.ax_mps2, v, drive_lim, brake_lim, dt_s
+            )
             ax_target, v_target = ax_ref, v_plan
         else:
             if self._hold_speed is None:
                 self._hold_speed = v
                 self._long.reset()
             drive, brake, ax_target = self._long.track_speed(
-                self._hold_speed, v, mu, brake_limit, dt_s
+                self._hold_speed, v, mu, drive_lim, brake_lim, dt_s
             )
             v_target = self._hold_speed
 

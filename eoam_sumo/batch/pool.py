@@ -100,7 +100,10 @@ class _Worker:
         self.key: str | None = None
         self.timeout_s = STARTUP_TIMEOUT_S
         self.deadline = time.monotonic() + STARTUP_TIMEOUT_S
-        self.send_conn.send(("init", list(sys.path), tuple(preload)))
+        try:
+            self.send_conn.send(("init", list(sys.path), tuple(preload)))
+        except OSError:
+            pass  # died at once: end of file on its pipe reports it
 
     @property
     def busy(self) -> bool:

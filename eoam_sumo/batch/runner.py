@@ -71,9 +71,10 @@ def result_row(case: Case, result: TaskResult, paper_outcome: str | None = None)
                oncoming_start_m=case.oncoming_start_m, aro_hold_s=case.aro_hold_s,
                aro_decel_mps2=case.aro_decel_mps2, case_dir=case_dir_of(case.case_id),
                sumocfg=str(case.sumocfg))
-    summary = result.value["summary"] if result.ok else None
-    if summary is None:
-        row.update(status="failed", error=_one_line(result.error or "no summary returned"))
+    summary = result.value.get("summary") if isinstance(result.value, dict) else None
+    if not result.ok or not isinstance(summary, dict):
+        row.update(status="failed",
+                   error=_one_line(result.error or "the case function returned no summary"))
         return row
     row["status"] = "ok"
     for key, value in summary.items():
@@ -172,12 +173,18 @@ def _finalise(path: Path, cases: list[Case], paper: dict[str, str]) -> pd.DataFr
     return read_results(path)
 
 
-def _write_case_files(case_dir: Path, files: dict[str, bytes]) -> None:
-    case_dir.mkdir(parents=True, exist_ok=True)
-    for name in CASE_FILES:
-        tmp = case_dir / (name + ".tmp")
-        tmp.write_bytes(files[name])
-        os.replace(tmp, case_dir / name)
+def _store_case_files(case_dir: Path, result: TaskResult, ok: bool) -> None:
+    """Write the files a remote case sent back; a failed case leaves no older run's files."""
+    files = result.value.get("files") if ok else None
+    if files:
+        case_dir.mkdir(parents=True, exist_ok=True)
+        for name in CASE_FILES:
+            tmp = case_dir / (name + ".tmp")
+            tmp.write_bytes(files[name])
+            os.replace(tmp, case_dir / name)
+    elif not ok:
+        for name in CASE_FILES:
+            (case_dir / name).unlink(missing_ok=True)
 
 
 @contextlib.contextmanager
@@ -186,7 +193,8 @@ def _dask_client(scheduler: str, jobs: int):
     try:
         from dask.distributed import Client, LocalCluster
     except ImportError as exc:
-        raise InputError(f"--scheduler needs dask.distributed, which is not installed: {exc}")
+        raise InputError(
+            f"--scheduler needs dask.distributed, which is not installed: {exc}") from exc
     if scheduler == "local":
         with LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True,
                           dashboard_address=None) as cluster, Client(cluster) as client:
@@ -200,19 +208,19 @@ def _dask_client(scheduler: str, jobs: int):
         yield client
 
 
-def _results(todo: list[Case], out_dir: Path, jobs: int, scheduler: str | None,
+def _results(to_run: list[Case], out_dir: Path, jobs: int, scheduler: str | None,
              timeout_s: float, case_func: Callable, tables_dir: Path | None,
              ) -> Iterator[tuple[Case, TaskResult]]:
-    by_id = {c.case_id: c for c in todo}
+    by_id = {c.case_id: c for c in to_run}
     preload = PRELOAD if case_func is run_matrix_case else ()
     if scheduler is None:
         tasks = [(c.case_id, CaseTask(c, out_dir / case_dir_of(c.case_id), tables_dir))
-                 for c in todo]
+                 for c in to_run]
         with contextlib.closing(run_local(case_func, tasks, jobs, timeout_s, preload)) as it:
             for result in it:
                 yield by_id[result.key], result
         return
-    tasks = [(c.case_id, CaseTask(c, None, tables_dir)) for c in todo]
+    tasks = [(c.case_id, CaseTask(c, None, tables_dir)) for c in to_run]
     with (_dask_client(scheduler, jobs) as client,
           contextlib.closing(run_dask(case_func, tasks, client, timeout_s, preload)) as it):
         for result in it:
@@ -259,17 +267,16 @@ def run_batch(
     kept = (_kept_rows(results_path, cases) if resume and results_path.is_file()
             else pd.DataFrame(columns=list(COLUMNS), dtype=str))
     done = set(kept["case_id"])
-    todo = [c for c in cases if c.case_id not in done]
+    to_run = [c for c in cases if c.case_id not in done]
     log = _RowLog(results_path, kept)
     bar = tqdm(total=len(cases), initial=len(done), unit="case", desc="cases", file=sys.stderr,
                disable=not progress, dynamic_ncols=True)
     failed = 0
     try:
-        for case, result in _results(todo, out_dir, jobs, scheduler, timeout_s, case_func,
+        for case, result in _results(to_run, out_dir, jobs, scheduler, timeout_s, case_func,
                                      tables_dir):
-            if result.ok and result.value.get("files"):
-                _write_case_files(out_dir / case_dir_of(case.case_id), result.value["files"])
             row = result_row(case, result, paper.get(case.case_id))
+            _store_case_files(out_dir / case_dir_of(case.case_id), result, row["status"] == "ok")
             log.add(row)
             failed += row["status"] != "ok"
             bar.set_postfix(failed=failed, refresh=False)

@@ -1,11 +1,18 @@
 """Longitudinal control: acceleration PID during the EOAM, speed PID otherwise (paper sec. 9).
 
 During the lane change the reference is the optimised longitudinal acceleration of the lookup
-table at the current differential x-position (eq. 14-29 offline); outside it a speed PID holds
-the set speed, standing in for the high-level ARV system. Both act on a net longitudinal force
-``m * a + F_res(v)`` that is split into a drive force (rear axle, >= 0) and a brake force
-(>= 0), never both. The drive force is capped by eq. 37 (mu times the engine limit) and the
-brake force by the largest force that does not lock a wheel (the ego has no ABS, eq. 33).
+table at the current differential x-position (eqs. 14-29 offline); outside it a speed PID
+holds the set speed, standing in for the high-level ARV system. Both act on a net longitudinal
+force ``m a + F_res(v)`` that is split into a drive force (rear axle, >= 0) and a brake force
+(>= 0), never both.
+
+Force limits (``limits``): the ego has no ABS and no traction control, so the controller itself
+must never ask for a force that locks or spins a wheel. The brake force is at most the largest
+straight-line force that locks no axle (eq. 33's deceleration times m); the drive force at most
+eq. 37 (mu times the engine limit) and a share of the rear axle's static friction. Both shrink
+with the friction ellipse sqrt(1 - q^2), q = margin |a_y| / (mu g), so that the lateral
+acceleration in use keeps its tyre force: a locked or spinning axle has none, and a saturated
+rear axle spins the car.
 """
 
 from __future__ import annotations
@@ -29,14 +36,17 @@ class LongitudinalGains:
     speed_kd: float = 0.05  # [-] per m/s^2 of speed-error rate
     speed_integral_limit_mps2: float = 1.0  # integrator clamp [m/s^2]
     speed_accel_limit_g: float = 0.25  # |demand| <= this * mu * g (comfort, traction) [-]
+    ellipse_margin: float = 1.1  # |a_y| inflated by this in the friction-ellipse caps [-]
+    traction_fraction: float = 0.8  # drive <= this * mu * static rear axle load [-]
 
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
             if not (math.isfinite(v) and v >= 0.0):
                 raise ValueError(f"longitudinal gain {f.name}={v!r} must be finite and >= 0")
-        if self.speed_accel_limit_g <= 0.0:
-            raise ValueError("speed_accel_limit_g must be > 0")
+        for name in ("speed_accel_limit_g", "ellipse_margin", "traction_fraction"):
+            if getattr(self, name) <= 0.0:
+                raise ValueError(f"longitudinal gain {name} must be > 0")
 
 
 def resistance_force_n(params: VehicleParams, speed_mps: float) -> float:
@@ -83,17 +93,24 @@ class Pid:
 class LongitudinalController:
     """Acceleration and speed PIDs producing (drive_force_n, brake_force_n)."""
 
-    __slots__ = ("_accel", "_alim_g", "_drag", "_fmax", "_m", "_pmax", "_res0", "_speed")
+    __slots__ = ("_accel", "_alim_g", "_drag", "_fmax", "_m", "_margin", "_pmax", "_rear_n",
+                 "_res0", "_speed")
 
     def __init__(self, params: VehicleParams, gains: LongitudinalGains = LongitudinalGains()):
+        g = gains
         self._m = params.mass_kg
         self._res0 = params.mass_kg * G_MPS2 * params.rolling_resistance_coeff
         self._drag = 0.5 * AIR_DENSITY_KGPM3 * params.drag_area_m2
         self._fmax = params.max_drive_force_n
         self._pmax = params.max_drive_power_w
-        g = gains
+        self._rear_n = (
+            g.traction_fraction * params.mass_kg * G_MPS2 * params.cg_to_front_m
+            / params.wheelbase_m
+        )
+        self._margin = g.ellipse_margin / G_MPS2
         self._accel = Pid(g.accel_kp, g.accel_ki_per_s, g.accel_kd_s, g.accel_integral_limit_mps2)
-        self._speed = Pid(g.speed_kp_per_s, g.speed_ki_per_s2, g.speed_kd, g.speed_integral_limit_mps2)
+        self._speed = Pid(g.speed_kp_per_s, g.speed_ki_per_s2, g.speed_kd,
+                          g.speed_integral_limit_mps2)
         self._alim_g = g.speed_accel_limit_g * G_MPS2
 
     def reset(self) -> None:
@@ -104,44 +121,41 @@ class LongitudinalController:
     def _resistance(self, v: float) -> float:
         return self._res0 + self._drag * v * v if v > 0.0 else 0.0
 
-    def drive_limit_n(self, speed_mps: float, mu: float) -> float:
-        """Largest drive force: engine force and power limits scaled by mu (eq. 37)."""
-        f = self._fmax
-        if speed_mps > 1.0 and self._pmax / speed_mps < f:
-            f = self._pmax / speed_mps
-        return mu * f
+    def limits(
+        self, speed_mps: float, mu: float, lateral_accel_mps2: float, no_lock_brake_n: float
+    ) -> tuple[float, float]:
+        """(drive, brake) force limits at this speed, friction and lateral acceleration."""
+        q = self._margin * abs(lateral_accel_mps2) / mu
+        ellipse = math.sqrt(1.0 - q * q) if q < 1.0 else 0.0
+        drive = self._fmax
+        if speed_mps > 1.0 and self._pmax / speed_mps < drive:
+            drive = self._pmax / speed_mps
+        drive = mu * min(drive, self._rear_n)
+        return drive * ellipse, no_lock_brake_n * ellipse
 
-    def split(self, net_force_n: float, speed_mps: float, mu: float, brake_limit_n: float):
-        """(drive, brake) realising a net force within the drive and no-lock brake limits."""
+    @staticmethod
+    def split(net_force_n: float, drive_limit_n: float, brake_limit_n: float):
+        """(drive, brake) realising a net force within the limits; never both."""
         if net_force_n > 0.0:
-            lim = self.drive_limit_n(speed_mps, mu)
-            return (min(lim, net_force_n)), 0.0
-        f = -net_force_n
-        return 0.0, (min(brake_limit_n, f))
+            return min(net_force_n, drive_limit_n), 0.0
+        return 0.0, min(-net_force_n, brake_limit_n)
 
-    def track_accel(
-        self, ax_ref: float, ax_mps2: float, speed_mps: float, mu: float, brake_limit_n: float,
-        dt_s: float,
-    ):
+    def track_accel(self, ax_ref: float, ax_mps2: float, speed_mps: float,
+                    drive_limit_n: float, brake_limit_n: float, dt_s: float):
         """Acceleration PID with feedforward m*ax_ref + F_res: (drive, brake)."""
         m = self._m
         res = self._resistance(speed_mps)
         lo = -(brake_limit_n + res) / m - ax_ref
-        hi = (self.drive_limit_n(speed_mps, mu) - res) / m - ax_ref
-        corr = self._accel.update(ax_ref - ax_mps2, dt_s, lo, hi)
-        return self.split(m * (ax_ref + corr) + res, speed_mps, mu, brake_limit_n)
+        hi = (drive_limit_n - res) / m - ax_ref
+        corr = self._accel.update(ax_ref - ax_mps2, dt_s, lo, max(hi, lo))
+        return self.split(m * (ax_ref + corr) + res, drive_limit_n, brake_limit_n)
 
-    def track_speed(
-        self, speed_ref_mps: float, speed_mps: float, mu: float, brake_limit_n: float, dt_s: float
-    ):
+    def track_speed(self, speed_ref_mps: float, speed_mps: float, mu: float,
+                    drive_limit_n: float, brake_limit_n: float, dt_s: float):
         """Speed PID giving an acceleration demand (|a| <= limit * mu * g): (drive, brake, a)."""
         lim = self._alim_g * mu
         a = self._speed.update(speed_ref_mps - speed_mps, dt_s, -lim, lim)
         drive, brake = self.split(
-            self._m * a + self._resistance(speed_mps), speed_mps, mu, brake_limit_n
+            self._m * a + self._resistance(speed_mps), drive_limit_n, brake_limit_n
         )
         return drive, brake, a
-
-    def hold_brake(self, brake_limit_n: float):
-        """Limit braking without locking (modes 1 and 3): (drive, brake)."""
-        return 0.0, brake_limit_n

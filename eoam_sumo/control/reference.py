@@ -79,3 +79,4 @@ class PathReference:
             ax[i] + w * (ax[j] - ax[i]),
             v[i] + w * (v[j] - v[i]),
         )
+

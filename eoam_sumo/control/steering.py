@@ -28,11 +28,11 @@ from eoam_sumo.params import VehicleParams
 class SteeringGains:
     """Design values of the steering schedule."""
 
-    natural_freq_radps: float = 1.2  # omega of the lateral-error dynamics at mu = 1 [rad/s]
-    damping_ratio: float = 0.9  # zeta of the lateral-error dynamics [-]
+    natural_freq_radps: float = 1.6  # omega of the lateral-error dynamics at mu = 1 [rad/s]
+    damping_ratio: float = 1.1  # zeta of the lateral-error dynamics [-]
     min_lookahead_m: float = 4.0  # floor of x_la [m]
     schedule_min_speed_mps: float = 5.0  # speed floor used in the schedule [m/s]
-    yaw_damping_s: float = 0.06  # k_r [rad per rad/s]
+    yaw_damping_s: float = 0.22  # k_r [rad per rad/s]
     friction_exponent: float = 0.5  # omega scales with mu**exponent [-]
 
     def __post_init__(self) -> None:

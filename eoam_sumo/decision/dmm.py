@@ -114,54 +114,28 @@ def dmm_sector(boundary, range_m: float, rel_speed_mps: float) -> Sector:
 
 
 class BoundaryCurve:
-    """The DMM boundaries at one friction sampled on a uniform closing-speed grid from 0.
+    """The DMM boundaries at one friction sampled on a uniform closing-speed grid.
 
-    Built once per friction value from ``boundaries.at(mu, v)`` for v in the tables' speed
-    range [v_lo, v_hi]; ``sector`` then costs one index and a linear blend. Above v_hi the
-    values at v_hi are used. Below v_lo (slow closing, where the tables stop) the boundaries
-    are extended to v = 0 by their physics instead of being held, which would place a slowly
-    closing obstacle several metres ahead in a steering sector: the stopping distance scales
-    as v^2 (eq. 33), the clearing distances and both buffers follow the straight line through
-    the two lowest table speeds (the quintic's duration does not depend on speed, so the
-    clearing distance grows about linearly in v), floored at 0.
+    Built once per friction value from ``boundaries.at(mu, v)`` for v in [0, v_max] (below
+    the tables' lowest speed the boundaries object itself scales them towards 0); ``at`` and
+    ``sector`` then cost one index and a linear blend. Above v_max the top row is used.
     """
 
     __slots__ = ("_inv", "_n", "_rows", "mu")
 
-    def __init__(self, boundaries, mu: float, speed_lo_mps: float, speed_hi_mps: float,
-                 step_mps: float = 0.25):
-        if not (0.0 < speed_lo_mps < speed_hi_mps and step_mps > 0.0):
-            raise ValueError(
-                f"bad boundary grid: {speed_lo_mps!r}..{speed_hi_mps!r} step {step_mps!r}"
-            )
-        n = max(math.ceil(speed_hi_mps / step_mps), 2)
-        step = speed_hi_mps / n
-
-        def table_row(v):
-            b = boundaries.at(mu, v)
+    def __init__(self, boundaries, mu: float, speed_max_mps: float, step_mps: float = 0.25):
+        if not (speed_max_mps > 0.0 and step_mps > 0.0):
+            raise ValueError(f"bad boundary grid: 0..{speed_max_mps!r} step {step_mps!r}")
+        n = max(math.ceil(speed_max_mps / step_mps), 1)
+        step = speed_max_mps / n
+        rows = []
+        for i in range(n + 1):
+            b = boundaries.at(mu, i * step)
             row = (float(b.clear_opt_m), float(b.clear_buffered_m), float(b.stop_m),
                    float(b.stop_buffered_m), float(b.ttc_s))
             if not all(math.isfinite(x) for x in row):
-                raise ValueError(f"non-finite DMM boundary at mu={mu}, v={v}")
-            return row
-
-        # (S, Sb - S, Bb - B0) at the two lowest table speeds: extended linearly below v_lo
-        lo, lo2 = table_row(speed_lo_mps), table_row(min(speed_lo_mps + step_mps, speed_hi_mps))
-        base = (lo[0], lo[1] - lo[0], lo[3] - lo[2])
-        slope_dv = min(step_mps, speed_hi_mps - speed_lo_mps)
-        slope = tuple((b2 - b1) / slope_dv
-                      for b1, b2 in zip(base, (lo2[0], lo2[1] - lo2[0], lo2[3] - lo2[2])))
-        rows = []
-        for i in range(n + 1):
-            v = i * step
-            if v >= speed_lo_mps:
-                rows.append(table_row(v))
-                continue
-            clear, clear_buf, stop_buf = (
-                max(b + (v - speed_lo_mps) * k, 0.0) for b, k in zip(base, slope)
-            )
-            stop = lo[2] * (v / speed_lo_mps) ** 2
-            rows.append((clear, clear + clear_buf, stop, stop + stop_buf, lo[4]))
+                raise ValueError(f"non-finite DMM boundary at mu={mu}, v={i * step}")
+            rows.append(row)
         self.mu = mu
         self._inv, self._n, self._rows = 1.0 / step, n, rows
 

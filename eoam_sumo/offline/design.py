@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from eoam_sumo.params import G_MPS2, aro_d_class_minivan
 
 PAPER = "Lowe & Guvenc 2022 (the paper)"
-DESIGN = "project design choice, see the reason"
+DESIGN = "design choice"
 
 
 def _p(default, unit: str, source: str):
@@ -60,8 +60,10 @@ class DesignSettings:
         "boundary covers it); also keeps the slip angles defined")
     max_yaw_rad: float = _p(math.radians(45.0), "rad", DESIGN + ": bound keeping the OCP regular")
     regularisation: float = _p(
-        1e-4, "m", DESIGN + ": weight of the squared control steps (in units of m g and the steer "
-        "rate limit) added to the cost x(t_f) so that singular arcs have a unique solution")
+        0.3, "m", DESIGN + ": weight of the squared steps between intervals of the controls "
+        "(scaled by mu m g and the steer-rate limit) added to the cost x(t_f): removes the chatter "
+        "of the bang-bang optimum along the friction limit (a smooth, trackable, slightly "
+        "suboptimal profile, cf. the paper's 'suboptimal' profiles) and makes it unique")
     ipopt_tol: float = _p(1e-8, "-", "IPOPT default (tight, so warm starts reach the same optimum)")
     ipopt_max_iter: int = _p(1000, "-", DESIGN)
     verify_lateral_tol_m: float = _p(0.03, "m", DESIGN + ": re-simulated final y vs y_f")

@@ -2,8 +2,10 @@
 
 Given the path (curvature K(s) and its derivative) driven with its own speed profile, the
 single-track model (eqs. 1-3) is solved for the axle lateral forces, the slip angles through
-the friction-scaled linear-saturating tyre (eqs. 6, 35), the body sideslip and the steering
-road-wheel angle. The sideslip rate is neglected (quasi-steady): r = V K. From the lateral
+the friction-scaled linear-saturating tyre (eqs. 6, 35), the body sideslip beta and the
+steering road-wheel angle. Quasi-steady: the sideslip rate is neglected, so the yaw rate is
+r = V K and the heading Psi = theta - beta (a few fixed-point passes resolve the coupling
+through beta and the steer angle). From the lateral
 forces, the friction ellipse of each axle (with longitudinal load transfer), the brake split,
 the brake force limit and the engine limit (eq. 29) give the least and the largest
 longitudinal acceleration available at each point (Figure 7).

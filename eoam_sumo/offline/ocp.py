@@ -11,7 +11,7 @@ lane: lateral speed, yaw angle, yaw rate and steering angle all zero at t_f.
 Transcription: direct collocation (Radau, ``settings.collocation_degree`` points in each of
 ``settings.ocp_intervals`` intervals of t_f / N; A-stable, as the friction-scaled tyres make the
 lateral dynamics stiff at low speed), piecewise-constant controls (steering rate, longitudinal
-force); the path constraints hold at every collocation point. IPOPT solves it; the problem is
+force); the path constraints hold at every interval start and collocation point. IPOPT solves it; the problem is
 built once per ``LaneChangeOcp`` with the entry speed and the friction as parameters.
 """
 
@@ -47,7 +47,6 @@ class OcpSolution:
     controls: np.ndarray
     iterations: int = 0
     colloc_states: np.ndarray | None = None  # (N * degree, 7), interval-major
-    multipliers: np.ndarray | None = None  # constraint multipliers (for warm starts)
 
     @property
     def distance_m(self) -> float:
@@ -60,10 +59,6 @@ def solver_options(settings: DesignSettings) -> dict:
     return {
         "print_time": False,
         "expand": True,
-        "ipopt.warm_start_init_point": "yes",
-        "ipopt.warm_start_bound_push": 1e-6,
-        "ipopt.warm_start_mult_bound_push": 1e-6,
-        "ipopt.mu_init": 1e-4,
         "ipopt.print_level": 0,
         "ipopt.sb": "yes",
         "ipopt.tol": settings.ipopt_tol,
@@ -76,7 +71,7 @@ def _interval_function(params: VehicleParams, degree: int) -> ca.Function:
 
     ``xc`` holds the states at the ``degree`` collocation points (7 x degree); the defects are
     h f(x_j, u) - sum_r C[r, j] x_r; path values are (ellipse front, ellipse rear, body speed)
-    at each collocation point.
+    at the interval start (with this interval's control) and at each collocation point.
     """
     tau = np.concatenate(([0.0], ca.collocation_points(degree, "radau")))
     deriv = np.zeros((degree + 1, degree + 1))
@@ -94,11 +89,12 @@ def _interval_function(params: VehicleParams, degree: int) -> ca.Function:
     h = ca.SX.sym("h")
     points = ca.horzcat(x0, xc)
     defects, path = [], []
-    for j in range(1, degree + 1):
+    for j in range(degree + 1):
         xdot, out = dynamics(points[:, j], u, mu, params, ca)
-        slope = sum(deriv[r, j] * points[:, r] for r in range(degree + 1))
-        defects.append(h * ca.vertcat(*xdot) - slope)
         path += [out.ellipse_front, out.ellipse_rear, out.vx_body_mps]
+        if j > 0:
+            slope = sum(deriv[r, j] * points[:, r] for r in range(degree + 1))
+            defects.append(h * ca.vertcat(*xdot) - slope)
     return ca.Function("radau_interval", [x0, xc, u, mu, h],
                        [ca.horzcat(*defects), points[:, degree], ca.vertcat(*path)])
 
@@ -134,7 +130,7 @@ class LaneChangeOcp:
         opti.subject_to(xs[:, 0] == ca.vertcat(0.0, self._v0, 0.0, 0.0, 0.0, 0.0, 0.0))
         # eq. 23 and the settled end: no lateral speed, yaw, yaw rate or steering
         opti.subject_to(xs[2:, -1] == ca.vertcat(settings.lane_change_m, 0.0, 0.0, 0.0, 0.0))
-        for j in range(d):
+        for j in range(d + 1):
             opti.subject_to(ca.vec(path[3 * j:3 * j + 2, :]) <= 1.0)  # eqs. 25, 28
             opti.subject_to(path[3 * j + 2, :] >= settings.min_speed_fraction * self._v0)
         steer = xs[6, :]
@@ -145,7 +141,9 @@ class LaneChangeOcp:
         opti.subject_to(opti.bounded(-p.max_brake_force_n, us[1, :], p.max_drive_force_n))
         opti.subject_to(drive * xs[1, :-1] <= p.max_drive_power_w)  # eq. 29, power
         opti.subject_to(opti.bounded(0.1 / _TIME_SCALE_S, self._tau, 30.0 / _TIME_SCALE_S))
-        dw = self._w[:, 1:] - self._w[:, :-1]
+        # control steps relative to the steer-rate limit and to the friction force mu m g
+        dw = ca.vertcat(self._w[0, 1:] - self._w[0, :-1],
+                        (self._w[1, 1:] - self._w[1, :-1]) / self._mu)
         opti.minimize(xs[0, -1] + settings.regularisation * ca.sumsqr(dw))  # eq. 14
         opti.solver("ipopt", solver_options(settings))
         self._opti = opti
@@ -163,8 +161,6 @@ class LaneChangeOcp:
         opti.set_initial(self._zc, (colloc / _STATE_SCALE).T)
         opti.set_initial(self._w, (guess.controls / self._control_scale).T)
         opti.set_initial(self._tau, guess.duration_s / _TIME_SCALE_S)
-        if guess.multipliers is not None:
-            opti.set_initial(opti.lam_g, guess.multipliers)
         sol = opti.solve_limited()
         stats = opti.stats()
         if not stats["success"]:
@@ -179,7 +175,6 @@ class LaneChangeOcp:
             controls=np.asarray(sol.value(self._w)).T * self._control_scale,
             iterations=int(stats["iter_count"]),
             colloc_states=np.asarray(sol.value(self._zc)).T * _STATE_SCALE,
-            multipliers=np.asarray(sol.value(opti.lam_g)).ravel(),
         )
 
 
@@ -221,17 +216,17 @@ def rescaled_guess(previous: OcpSolution, speed_mps: float) -> OcpSolution:
     colloc = previous.colloc_states.copy()
     colloc[:, :2] *= ratio
     return OcpSolution(float(speed_mps), previous.mu, previous.duration_s, states,
-                       previous.controls.copy(), colloc_states=colloc,
-                       multipliers=previous.multipliers)
+                       previous.controls.copy(), colloc_states=colloc)
 
 
 def solve_chain(ocp: LaneChangeOcp, mu: float, speeds_mps, on_solved=None) -> list[OcpSolution]:
-    """Solve the speeds in order for one friction, each warm-started from the previous one.
+    """Solve one friction's speeds from the highest down, each warm-started from the previous.
 
-    The first speed starts from ``quintic_guess``. ``on_solved(solution)`` is called after each.
+    The highest speed starts from ``quintic_guess`` (fast lane changes converge easily from
+    it); ``on_solved(solution)`` is called after each. Returns the solutions, highest first.
     """
     solutions = []
-    for v in speeds_mps:
+    for v in sorted(speeds_mps, reverse=True):
         if solutions:
             guess = rescaled_guess(solutions[-1], v)
         else:

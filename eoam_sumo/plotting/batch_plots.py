@@ -20,6 +20,7 @@ OUTCOME_COLOURS = {
     "none": "#bdbdbd", "failed": "#616161",
 }
 _MISSING = "#ffffff"
+_STYLES = ("-", "--", "-.", ":")
 LANE_WIDTH_M = 3.5  # paper sec. 10.1 (lane change height)
 PONR_M = 0.3 * LANE_WIDTH_M  # point of no return (paper sec. 8.1)
 
@@ -98,8 +99,9 @@ def _panel(ax, batch_dir: Path, rows: pd.DataFrame, label_of, cmap_name: str) ->
     cmap = _colormap(cmap_name)
     for k, (_, row) in enumerate(rows.iterrows()):
         ts = _offsets(batch_dir, row["case_dir"])
-        colour = cmap(0.35 + 0.6 * k / max(len(rows) - 1, 1))
-        ax.plot(ts["time_s"], ts["lateral_offset_m"], color=colour, linewidth=1.6,
+        colour = cmap(0.45 + 0.55 * k / max(len(rows) - 1, 1))
+        ax.plot(ts["time_s"], ts["lateral_offset_m"], color=colour, linewidth=1.8,
+                linestyle=_STYLES[k % len(_STYLES)],
                 label=f"{label_of(row)} ({row['outcome']})")
         ax.plot(ts["time_s"].iloc[-1], ts["lateral_offset_m"].iloc[-1], marker="s",
                 markersize=9, color=OUTCOME_COLOURS.get(row["outcome"], _MISSING),
@@ -130,6 +132,8 @@ def plot_lateral_offsets(batch_dir: Path, results: pd.DataFrame, out_dir: Path,
     ``speed_kmh`` defaults to 120 km/h when the batch has it, else its most common speed;
     None is returned when the batch has no finished case at that speed.
     """
+    from eoam_sumo.batch.report import mu_text
+
     ok = results[results["status"] == "ok"]
     if ok.empty:
         return None
@@ -145,11 +149,11 @@ def plot_lateral_offsets(batch_dir: Path, results: pd.DataFrame, out_dir: Path,
         "oncoming_start_m", ascending=False, na_position="first")
     fig = Figure(figsize=(13, 5.2), layout="constrained")
     left, right = fig.subplots(1, 2, sharey=True)
-    _panel(left, batch_dir, no_onc, lambda r: f"μ = {r['mu']:g}", "viridis")
+    _panel(left, batch_dir, no_onc, lambda r: f"μ = {mu_text(r['mu'])}", "Blues")
     left.set_title(f"{speed_kmh:g} km/h, no oncoming traffic, across frictions")
     _panel(right, batch_dir, dry, lambda r: "no oncoming" if pd.isna(r["oncoming_start_m"])
-           else f"oncoming from {r['oncoming_start_m']:g} m", "plasma")
-    right.set_title(f"{speed_kmh:g} km/h, μ = {top_mu:g}, across oncoming start distances")
+           else f"oncoming from {r['oncoming_start_m']:g} m", "Purples")
+    right.set_title(f"{speed_kmh:g} km/h, μ = {mu_text(top_mu)}, across oncoming start distances")
     fig.suptitle("Ego lateral position during the EOAM (cf. paper Figure 25)")
     return save(fig, Path(out_dir) / f"lateral_offsets_{speed_kmh:g}kmh.png")
 

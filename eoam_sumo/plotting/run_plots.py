@@ -23,6 +23,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from eoam_sumo.batch.report import mu_text
 from eoam_sumo.params import G_MPS2, ego_e_class_sedan
 from eoam_sumo.plotting.batch_plots import save
 
@@ -49,7 +50,7 @@ def run_title(summary: dict) -> str:
     speed_kmh = case.get("ego_speed_kmh") or 3.6 * summary.get("ego_initial_speed_mps", math.nan)
     onc = case.get("oncoming_start_m")
     traffic = "no oncoming" if onc is None else f"oncoming from {onc:g} m"
-    return (f"{speed_kmh:.0f} km/h, μ = {summary['mu']:.2g}, {traffic}: "
+    return (f"{speed_kmh:.0f} km/h, μ = {mu_text(summary['mu'])}, {traffic}: "
             f"{summary['outcome']} ({summary.get('reason', '')})")
 
 
@@ -193,8 +194,9 @@ def _sector_map(curve, v_max: float, d_max: float, n: int = 300):
 def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = None) -> Path:
     """Figure 21: the radar's ARO phase trace on the DMM phase diagram of the run's friction.
 
-    The boundaries come from the lookup tables (``tables_dir``, default the repository's
-    ``tables/``); without readable tables the trace is drawn alone and the title says why.
+    The boundaries come from ``phase_boundaries.csv`` in ``tables_dir`` (default: the
+    repository's ``tables/``); without readable tables the trace is drawn alone and the title
+    says why.
     """
     from eoam_sumo.decision.dmm import SECTOR_ORDER, BoundaryCurve
 
@@ -209,12 +211,12 @@ def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = No
     ax = fig.add_subplot()
     note = ""
     try:
-        from eoam_sumo.offline.tables import LookupTables, default_tables_dir
+        from eoam_sumo.offline.tables import PhaseBoundaries, default_tables_dir
 
-        tables = LookupTables.load(Path(tables_dir) if tables_dir else default_tables_dir())
-        grid = tables.speed_grid_mps
+        boundaries = PhaseBoundaries.load(Path(tables_dir or default_tables_dir()))
+        grid = boundaries.speed_grid_mps
         v_lo = float(grid[0]) if grid[0] > 0 else float(grid[1])
-        curve = BoundaryCurve(tables.boundaries, mu, v_lo, float(grid[-1]))
+        curve = BoundaryCurve(boundaries, mu, v_lo, float(grid[-1]))
     except (ImportError, OSError, ValueError) as exc:
         curve, note = None, f"\n(phase boundaries not drawn: {exc})"
     if curve is not None:
@@ -258,7 +260,7 @@ def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = No
     ax.set_xlabel("closing speed to the ARO (−range rate) [m/s]")
     ax.set_ylabel("range to the ARO [m]")
     ax.legend(fontsize=8, loc="upper left", framealpha=0.9)
-    ax.set_title(f"DMM phase diagram at μ = {mu:.2g} with the ARO phase trace "
+    ax.set_title(f"DMM phase diagram at μ = {mu_text(mu)} with the ARO phase trace "
                  f"(cf. paper Figure 21)\n{run_title(summary)}{note}", fontsize=10)
     return save(fig, Path(out_dir) / "phase_trace.png")
 

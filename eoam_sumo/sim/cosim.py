@@ -106,6 +106,7 @@ class CoSimulation:
 
     def _loop(self, session: SumoSession, wall0: float) -> tuple[dict, RunLog]:
         st, p = self.settings, self.params
+        clock = time.perf_counter
         ego = session.ego_body()
         self._check_speed(ego.speed_mps)
         road = RoadFrame(session.ego_lane_centreline())
@@ -117,26 +118,29 @@ class CoSimulation:
         sense_radius = st.radar.range_m + 20.0
         steps = int(round(st.max_time_s / st.step_s))
         log = RunLog(steps + 1)
+        prof = self.profile = dict.fromkeys(("sense", "control", "plant", "sumo", "contact"), 0.0)
+        front = p.cg_to_front_bumper_m
+        ego_radius = 0.5 * math.hypot(p.length_m, p.width_m)
         ax = ay = 0.0
         first_contact = None
         min_gap_aro = math.inf
         max_lat_offset = 0.0
         stop_at = None
-        idx = {n: i for i, n in enumerate(("x", "y", "yaw", "vx", "vy", "r"))}
-        front = p.cg_to_front_bumper_m
-        t = session.time_s
-        prev_bodies = {}
-        for _ in range(steps):
-            # --- sense: the world at time t -------------------------------------------------
-            X, Y, yaw, vx, vy, r = (float(x[i]) for i in range(6))
+        t = t_start = session.time_s
+        bodies = session.nearby(sense_radius)
+        loop0 = clock()
+        n_steps = 0
+        for n_steps in range(1, steps + 1):
+            # --- sense: the world at time t ---------------------------------------------------
+            c0 = clock()
+            X, Y, yaw, vx, vy, r = x[:6].tolist()
             s, d, road_yaw = road.project(X, Y)
             mu = session.friction_at_ego()
-            bodies = session.nearby(sense_radius)
             cy, sy = math.cos(yaw), math.sin(yaw)
             report = self.radar.scan(
-                (X + front * cy, Y + front * sy), yaw, vx,
-                road, [Target(b.x_m, b.y_m, b.yaw_rad, b.speed_mps, b.length_m, b.width_m)
-                       for b in bodies],
+                (X + front * cy, Y + front * sy), yaw, vx, road,
+                [Target(b.x_m, b.y_m, b.yaw_rad, b.speed_mps, b.length_m, b.width_m)
+                 for b in bodies],
                 lane_width,
             )
             perception = Perception(
@@ -145,40 +149,56 @@ class CoSimulation:
             meas = EgoMeasurement(
                 t, vx, vy, r, ax, ay, s, d, yaw - road_yaw, road.curvature_at(s), mu, lane_width
             )
-            # --- decide and control ----------------------------------------------------------
+            # --- decide and control -------------------------------------------------------------
+            c1 = clock()
             cmd = ctrl.step(meas, perception, st.step_s)
+            c2 = clock()
             log.add(t, x, ax, ay, s, d, meas.e_yaw_rad, mu, cmd, perception)
-            # --- plant: all sub-steps of this SUMO step in one call --------------------------
+            # --- plant: all sub-steps of this SUMO step in one call -----------------------------
+            c3 = clock()
             x_prev = x
             x, y_out = self.plant.step(
                 x, (cmd.steer_cmd_rad, cmd.drive_force_cmd_n, cmd.brake_force_cmd_n), mu
             )
             ax, ay = float(y_out[0]), float(y_out[1])
-            # --- write back and step SUMO ----------------------------------------------------
-            Xn, Yn, yawn = float(x[0]), float(x[1]), float(x[2])
+            # --- write back and step SUMO -------------------------------------------------------
+            c4 = clock()
+            Xn, Yn, yawn, vxn = x[:4].tolist()
             session.move_ego(
                 Xn + front * math.cos(yawn), Yn + front * math.sin(yawn),
-                _nav_deg(yawn), max(float(x[3]), 0.0),
+                _nav_deg(yawn), max(vxn, 0.0),
             )
             session.step()
             t = session.time_s
-            # --- ground truth: contact on oriented boxes at every plant sub-step -------------
-            bodies_now = session.nearby(sense_radius)
-            ego_box = OrientedBox.from_axis_point(
-                Xn, Yn, yawn, p.length_m, p.width_m, p.cg_to_front_bumper_m
-            )
-            for b in bodies_now:
-                box = OrientedBox(b.x_m, b.y_m, b.yaw_rad, b.length_m, b.width_m)
+            bodies_next = session.nearby(sense_radius)
+            # --- ground truth: oriented-box contact at every plant sub-step ---------------------
+            c5 = clock()
+            before = {b.vid: b for b in bodies}
+            for b in bodies_next:
+                dist = math.hypot(b.x_m - Xn, b.y_m - Yn)
+                if dist > 40.0:
+                    continue
                 role = role_of(b, road, lane_width)
                 if role == "aro":
+                    box = OrientedBox(b.x_m, b.y_m, b.yaw_rad, b.length_m, b.width_m)
+                    ego_box = OrientedBox.from_axis_point(
+                        Xn, Yn, yawn, p.length_m, p.width_m, front
+                    )
                     min_gap_aro = min(min_gap_aro, box_distance(ego_box, box))
-                if first_contact is None:
-                    hit = self._substep_contact(x_prev, x, b, prev_bodies.get(b.vid))
+                sweep = 2.0 + 0.5 * math.hypot(b.length_m, b.width_m)
+                if first_contact is None and dist < ego_radius + sweep:
+                    hit = self._substep_contact(x_prev, x, b, before.get(b.vid))
                     if hit is not None:
                         first_contact = (hit, role, t)
-            prev_bodies = {b.vid: b for b in bodies_now}
+            bodies = bodies_next
             max_lat_offset = max(max_lat_offset, abs(d))
-            # --- end of run ------------------------------------------------------------------
+            c6 = clock()
+            prof["sense"] += c1 - c0
+            prof["control"] += c2 - c1
+            prof["plant"] += c4 - c3
+            prof["sumo"] += c5 - c4
+            prof["contact"] += c6 - c5
+            # --- end of run ---------------------------------------------------------------------
             if first_contact is not None:
                 break
             if stop_at is None and self._finished(ctrl, x):
@@ -187,6 +207,8 @@ class CoSimulation:
                 break
             if s > road.length_m - 50.0:
                 break
+        prof["loop_wall_s"] = clock() - loop0
+        prof["steps"] = n_steps
         X, Y, yaw = float(x[0]), float(x[1]), float(x[2])
         s, d, road_yaw = road.project(X, Y)
         log.add(t, x, ax, ay, s, d, yaw - road_yaw, session.friction_at_ego(), None, None)
@@ -201,7 +223,7 @@ class CoSimulation:
             final_speed_mps=max(float(x[3]), 0.0),
         )
         wall = time.perf_counter() - wall0
-        sim_time = t
+        sim_time = t - t_start
         summary = {
             "outcome": outcome.colour,
             "collision_with": outcome.collision_with,
@@ -220,7 +242,7 @@ class CoSimulation:
             "ego_initial_speed_mps": round(ego.speed_mps, 6),
             "sim_time_s": round(sim_time, 6),
             "wall_time_s": wall,
-            "realtime_factor": sim_time / wall if wall > 0 else math.inf,
+            "realtime_factor": sim_time / prof["loop_wall_s"],
         }
         return summary, log
 
@@ -248,8 +270,10 @@ class CoSimulation:
                 float(ex), float(ey), float(eyaw), p.length_m, p.width_m, p.cg_to_front_bumper_m
             )
             obox = OrientedBox(bx, by, byaw, body.length_m, body.width_m)
-            speed = float(x_prev[3] + w * (x_next[3] - x_prev[3]))
-            ve = (speed * math.cos(eyaw), speed * math.sin(eyaw))
+            vx = float(x_prev[3] + w * (x_next[3] - x_prev[3]))
+            vy = float(x_prev[4] + w * (x_next[4] - x_prev[4]))
+            ce, se = math.cos(eyaw), math.sin(eyaw)
+            ve = (vx * ce - vy * se, vx * se + vy * ce)
             vb = (body.speed_mps * math.cos(byaw), body.speed_mps * math.sin(byaw))
             hit = contact(ebox, obox, ve, vb)
             if hit is not None:

@@ -56,20 +56,24 @@ class RoadFrame:
         return (x - px) ** 2 + (y - py) ** 2, along, lat
 
     def project(self, x: float, y: float) -> tuple[float, float, float]:
-        """(s_m, d_m, road_yaw_rad) of a point; searches near the last answer first."""
-        n = len(self._len)
-        lo, hi = max(0, self._hint - 2), min(n, self._hint + 3)
+        """(s_m, d_m, road_yaw_rad) of a point: walks the polyline from the last answer, then
+        keeps the nearer of the final segment and its neighbours (corners of the polyline)."""
+        last = len(self._len) - 1
+        i = self._hint
+        step = 0
+        for _ in range(last + 1):
+            _, along, _ = self._project_segment(i, x, y)
+            if along >= self._len[i] and i < last and step >= 0:
+                i, step = i + 1, 1
+            elif along <= 0.0 and i > 0 and step <= 0:
+                i, step = i - 1, -1
+            else:
+                break
         best = None
-        for i in range(lo, hi):
-            cand = self._project_segment(i, x, y) + (i,)
+        for j in range(max(0, i - 1), min(last, i + 1) + 1):
+            cand = self._project_segment(j, x, y) + (j,)
             if best is None or cand[0] < best[0]:
                 best = cand
-        # a point far from the local window (first call, jumps): full search
-        if best[0] > 25.0 and n > hi - lo:
-            for i in range(n):
-                cand = self._project_segment(i, x, y) + (i,)
-                if cand[0] < best[0]:
-                    best = cand
         _, along, lat, i = best
         self._hint = i
         return self._s[i] + along, lat, math.atan2(self._hy[i], self._hx[i])

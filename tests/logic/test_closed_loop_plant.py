@@ -10,7 +10,7 @@ import math
 
 import pytest
 
-from eoam_sumo.eoam import EgoMeasurement, EoamController, Perception
+from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, Perception
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import AIR_DENSITY_KGPM3, G_MPS2, aro_d_class_minivan, ego_e_class_sedan
 from eoam_sumo.plant import OUTPUT_NAMES, Plant, initial_state
@@ -84,3 +84,71 @@ def simulate(tables, plant, speed_mps, mu, obstacle_rear_m, detect_m, seconds):
         if hit:
             break
     return log, ctrl
+
+
+def steer_detection_range(tables, mu, speed_mps):
+    """A first-detection range just inside the buffered steering boundary (sector F or B), as
+    when the phase point crosses Sb: the obstacle appears (cut-in, or radar pick-up late)."""
+    b = tables.boundaries.at(mu, speed_mps)
+    assert b.clear_buffered_m - b.clear_opt_m > 1.0
+    return b.clear_buffered_m - 0.5
+
+
+def lane_change_case(tables, plant, speed_mps, mu):
+    detect = steer_detection_range(tables, mu, speed_mps)
+    log, ctrl = simulate(tables, plant, speed_mps, mu, P.cg_to_front_bumper_m + detect + 0.3,
+                         detect, seconds=30.0)
+    return log, ctrl
+
+
+def check_lane_change(log, ctrl, mu, *, lane_tol_m, overshoot_m, ellipse, return_tol_m):
+    assert not any(r["hit"] for r in log), "the ego touched the obstacle"
+    assert ctrl.modes_visited == [0, 2, 5] and ctrl.mode == 0, ctrl.modes_visited
+    steer = [r for r in log if r["mode"] == 2]
+    # lane change: settled in the next lane when the manoeuvre timer ends, small overshoot
+    assert abs(steer[-1]["y"] - LANE) <= lane_tol_m
+    assert max(r["y"] for r in steer) <= LANE + overshoot_m
+    # inside the friction ellipse (tyre forces: the measured acceleration less aero drag)
+    assert max(r["tyre_accel"] for r in log) <= ellipse * mu * 9.81
+    assert not any(r["locked"] for r in log), "a wheel locked"
+    # handed back in the original lane, and it stays there
+    back = next(i for i, r in enumerate(log) if r["mode"] == 0 and r["t"] > steer[-1]["t"])
+    assert all(abs(r["y"]) <= return_tol_m for r in log[back:])
+    assert abs(log[-1]["yaw"]) < 0.01
+
+
+def test_lane_change_120kmh_dry(tables, plant):
+    """120 km/h, mu 1.0: 3.5 +/- 0.3 m, overshoot < 0.5 m, |a| <= 1.05 mu g, back within 0.2 m."""
+    log, ctrl = lane_change_case(tables, plant, 120 / 3.6, 1.0)
+    check_lane_change(log, ctrl, 1.0, lane_tol_m=0.3, overshoot_m=0.5, ellipse=1.05,
+                      return_tol_m=0.2)
+
+
+def test_lane_change_120kmh_snow(tables, plant):
+    """120 km/h, mu 0.3: the same bounds (the slower, longer manoeuvre still fits the timer)."""
+    log, ctrl = lane_change_case(tables, plant, 120 / 3.6, 0.3)
+    check_lane_change(log, ctrl, 0.3, lane_tol_m=0.3, overshoot_m=0.5, ellipse=1.05,
+                      return_tol_m=0.2)
+
+
+def test_braking_stops_behind_the_obstacle(tables, plant):
+    """80 km/h on snow (mu 0.3), seen at 100 m: sector D brakes, and braking at the no-lock
+    limit leaves the phase point outside the steering sectors: a stop behind the obstacle."""
+    speed, mu, rear = 80 / 3.6, 0.3, 140.0
+    log, ctrl = simulate(tables, plant, speed, mu, rear, 100.0, seconds=15.0)
+    assert not any(r["hit"] for r in log), "the ego hit the obstacle"
+    assert ctrl.modes_visited == [0, 1] and ctrl.fcw_raised
+    sectors = {r["cmd"].sector for r in log}
+    assert "D" in sectors and not sectors & {"A", "B", "C", "F"}
+    assert log[-1]["vx"] < 0.05
+    gap = rear - (log[-1]["x"] + P.cg_to_front_bumper_m)
+    assert 0.0 < gap < 15.0
+    assert abs(log[-1]["y"]) < 0.05
+    # no wheel locked while moving (a held brake at rest counts as locked in the plant)
+    assert not any(r["locked"] for r in log if r["vx"] > 0.5)
+    # limit braking: the share of the no-lock deceleration (plus drag), never beyond it
+    a_lim = tables.max_decel_mps2(mu)
+    share = EoamSettings().limit_brake_fraction
+    braking = [r["ax"] for r in log if r["mode"] == 1 and r["vx"] > 3.0]
+    assert min(braking) >= -(a_lim + 0.1)
+    assert sorted(braking)[len(braking) // 2] == pytest.approx(-share * a_lim, abs=0.15)

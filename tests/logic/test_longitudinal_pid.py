@@ -27,18 +27,33 @@ def point_mass(ctrl_fn, v0, seconds, dt=0.01, sub=10):
     return trace
 
 
-def test_split_never_both_and_limits():
+def test_split_never_both_and_within_limits():
+    split = LongitudinalController.split
+    assert split(1000.0, 3000.0, 5000.0) == (1000.0, 0.0)
+    assert split(-1000.0, 3000.0, 5000.0) == (0.0, 1000.0)
+    assert split(-9000.0, 3000.0, 5000.0) == (0.0, 5000.0)
+    assert split(9000.0, 3000.0, 5000.0) == (3000.0, 0.0)
+
+
+def test_force_limits_engine_traction_and_friction_ellipse():
     c = LongitudinalController(P)
-    assert c.split(1000.0, 30.0, 1.0, 5000.0) == (1000.0, 0.0)
-    assert c.split(-1000.0, 30.0, 1.0, 5000.0) == (0.0, 1000.0)
-    assert c.split(-9000.0, 30.0, 1.0, 5000.0) == (0.0, 5000.0)
-    # eq. 37: mu times the engine limit (force below ~27.7 m/s, power above)
-    assert c.split(1e6, 10.0, 0.3, 5000.0) == (pytest.approx(0.3 * P.max_drive_force_n), 0.0)
-    assert c.split(1e6, 40.0, 1.0, 5000.0)[0] == pytest.approx(P.max_drive_power_w / 40.0)
-
-
-def test_hold_brake_is_the_given_limit():
-    assert LongitudinalController(P).hold_brake(12345.0) == (0.0, 12345.0)
+    g = LongitudinalGains()
+    rear_load = P.mass_kg * 9.81 * P.cg_to_front_m / P.wheelbase_m
+    # straight, low speed: the lesser of eq. 37 (mu times the engine force) and the traction share
+    drive, brake = c.limits(10.0, 1.0, 0.0, 12000.0)
+    assert drive == pytest.approx(min(P.max_drive_force_n, g.traction_fraction * rear_load))
+    assert brake == 12000.0
+    # power limit at speed
+    assert c.limits(40.0, 1.0, 0.0, 1.0)[0] == pytest.approx(P.max_drive_power_w / 40.0)
+    # on ice the rear axle's friction binds: a share of mu times its static load
+    assert c.limits(20.0, 0.1, 0.0, 1.0)[0] == pytest.approx(0.1 * g.traction_fraction * rear_load)
+    # lateral acceleration in use shrinks both by the friction ellipse
+    ay = 0.5 * 9.81 / g.ellipse_margin
+    d2, b2 = c.limits(10.0, 1.0, ay, 12000.0)
+    assert b2 == pytest.approx(12000.0 * math.sqrt(0.75))
+    assert d2 == pytest.approx(drive * math.sqrt(0.75))
+    # nothing left once the lateral acceleration uses all the friction
+    assert c.limits(10.0, 0.3, 0.3 * 9.81, 12000.0) == (0.0, 0.0)
 
 
 def test_resistance_closed_form():
@@ -53,7 +68,8 @@ def test_speed_pid_reaches_the_set_speed(v0, v_ref, mu):
     c = LongitudinalController(P)
     brake_limit = 0.8 * mu * P.mass_kg * 9.81
     trace = point_mass(
-        lambda t, v, ax: c.track_speed(v_ref, v, mu, brake_limit, 0.01)[:2], v0, 40.0
+        lambda t, v, ax: c.track_speed(v_ref, v, mu, *c.limits(v, mu, 0.0, brake_limit), 0.01)[:2],
+        v0, 40.0,
     )
     final = [v for t, v, _ in trace if t > 35.0]
     assert max(abs(v - v_ref) for v in final) < 0.05
@@ -73,7 +89,8 @@ def test_acceleration_pid_tracks_a_profile(mu):
         return -4.0 * mu if t < 3.0 else 0.5 * mu
 
     trace = point_mass(
-        lambda t, v, ax: c.track_accel(ref(t), ax, v, mu, brake_limit, 0.01), 30.0, 6.0
+        lambda t, v, ax: c.track_accel(ref(t), ax, v, *c.limits(v, mu, 0.0, brake_limit), 0.01),
+        30.0, 6.0,
     )
     for t_lo, t_hi in ((1.5, 3.0), (4.5, 6.0)):
         errs = [abs(ax - ref(t)) for t, _, ax in trace if t_lo <= t < t_hi]
@@ -83,7 +100,7 @@ def test_acceleration_pid_tracks_a_profile(mu):
 def test_acceleration_never_asks_above_the_brake_limit():
     c = LongitudinalController(P)
     for _ in range(200):
-        drive, brake = c.track_accel(-20.0, 0.0, 30.0, 1.0, 9000.0, 0.01)
+        drive, brake = c.track_accel(-20.0, 0.0, 30.0, 4000.0, 9000.0, 0.01)
         assert drive == 0.0 and brake == 9000.0
 
 
@@ -101,3 +118,5 @@ def test_gains_validate():
         LongitudinalGains(accel_kp=-1.0)
     with pytest.raises(ValueError, match="speed_accel_limit_g"):
         LongitudinalGains(speed_accel_limit_g=0.0)
+    with pytest.raises(ValueError, match="traction_fraction"):
+        LongitudinalGains(traction_fraction=0.0)

@@ -1,0 +1,161 @@
+"""The performance benchmark (``eoam-sumo bench``): what users wait for, measured in one run.
+
+Figures (design.md 3.3 keys first):
+- ``realtime_factor``: simulated seconds per wall second of the co-simulation step loop for
+  the 120 km/h, mu 1.0, no-oncoming case (plant at 1 ms, logging on), median of repeats;
+- ``sumo_only_realtime_factor``: the same scenario stepped by SUMO alone, SUMO driving the ego;
+- ``tables_wall_s``: a full ``eoam-sumo tables`` build with 2 jobs;
+- ``batch_wall_s`` / ``batch_cases`` / ``jobs``: the Table 2 batch with 2 jobs;
+- per-step costs of decision + control and of the plant, plant sub-steps per second;
+- ``peak_rss_mb`` of one ``eoam-sumo run`` in its own process.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+BASELINE = ROOT / "scenarios" / "baseline.sumocfg"
+TABLE2 = ROOT / "scenarios" / "table2.toml"
+SPEED_MPS = 120 / 3.6
+TARGETS = {
+    "realtime_factor": (">=", 100.0),
+    "cosim_over_sumo_cost": ("<=", 10.0),
+    "batch_wall_s": ("<=", 60.0),
+    "tables_wall_s": ("<=", 60.0),
+    "control_us_per_step": ("<=", 50.0),
+    "peak_rss_mb": ("<=", 300.0),
+}
+
+
+def _cosim(repeats: int) -> dict:
+    from eoam_sumo.sim.cosim import CoSimulation, RunSettings
+    from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
+
+    over = ScenarioOverrides(ego_speed_mps=SPEED_MPS, mu=1.0)
+    sim = CoSimulation(BASELINE, over, RunSettings())
+    runs = []
+    for _ in range(repeats):
+        summary, _log = sim.run()
+        prof = dict(sim.profile)
+        prof["sim_time_s"] = summary["sim_time_s"]
+        prof["wall_time_s"] = summary["wall_time_s"]
+        runs.append(prof)
+    med = {k: statistics.median(r[k] for r in runs) for k in runs[0]}
+    steps = med["steps"]
+    substeps = sim.settings.substeps
+    return {
+        "realtime_factor": med["sim_time_s"] / med["loop_wall_s"],
+        "realtime_factor_with_startup": med["sim_time_s"] / med["wall_time_s"],
+        "cosim_sim_time_s": med["sim_time_s"],
+        "cosim_steps": steps,
+        "control_us_per_step": 1e6 * med["control"] / steps,
+        "plant_us_per_step": 1e6 * med["plant"] / steps,
+        "sense_us_per_step": 1e6 * med["sense"] / steps,
+        "sumo_us_per_step": 1e6 * med["sumo"] / steps,
+        "contact_us_per_step": 1e6 * med["contact"] / steps,
+        "plant_substeps_per_s": substeps * steps / med["plant"],
+    }
+
+
+def _sumo_only(sim_time_s: float, repeats: int) -> float:
+    from eoam_sumo.sim.sumo_adapter import ScenarioOverrides, SumoSession
+
+    steps = max(1, int(round(sim_time_s / 0.01)))
+    rates = []
+    for _ in range(repeats):
+        session = SumoSession.start(BASELINE, ScenarioOverrides(ego_speed_mps=SPEED_MPS, mu=1.0))
+        try:
+            t0 = time.perf_counter()
+            for _ in range(steps):
+                session.step()
+            rates.append(steps * 0.01 / (time.perf_counter() - t0))
+        finally:
+            session.close()
+    return statistics.median(rates)
+
+
+def _peak_rss_mb(out_dir: Path) -> float:
+    """Peak resident memory of one ``eoam-sumo run`` (its own process, from wait4)."""
+    cmd = [sys.executable, "-m", "eoam_sumo", "run", str(BASELINE), "--speed-kmh", "120",
+           "--mu", "1.0", "--out", str(out_dir)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _pid, status, usage = os.wait4(proc.pid, 0)
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    if proc.returncode != 0:
+        raise RuntimeError(f"benchmark run failed: {proc.stderr.read().decode().strip()}")
+    return usage.ru_maxrss / 1024.0  # kB on Linux
+
+
+def _tables(out_dir: Path, quick: bool) -> float:
+    from eoam_sumo.offline.build import build_tables
+
+    t0 = time.perf_counter()
+    if quick:
+        build_tables(out_dir, jobs=2, speeds_kmh=[100.0, 120.0], mus=[1.0], progress=False)
+    else:
+        build_tables(out_dir, jobs=2, progress=False)
+    return time.perf_counter() - t0
+
+
+def _batch(out_dir: Path, quick: bool) -> tuple[float, int]:
+    from eoam_sumo.batch.runner import run_batch
+
+    matrix = TABLE2
+    if quick:
+        matrix = out_dir / "quick.toml"
+        matrix.write_text(
+            f'[scenario]\nsumocfg = "{BASELINE.as_posix()}"\nmax_time_s = 20.0\n'
+            "[sweep]\nego_speed_kmh = [120]\nmu = [1.0, 0.7]\n"
+        )
+    t0 = time.perf_counter()
+    results = run_batch(matrix, out_dir / "batch", jobs=2, progress=False)
+    return time.perf_counter() - t0, len(results)
+
+
+def run_bench(out_dir: Path, quick: bool = False) -> dict:
+    """Measure every figure; ``quick`` uses tiny settings (one repeat, 2-case batch)."""
+    repeats = 1 if quick else 5
+    with tempfile.TemporaryDirectory(prefix="eoam-bench-") as tmp:
+        tmp = Path(tmp)
+        result = {"quick": quick, "jobs": 2}
+        result["peak_rss_mb"] = _peak_rss_mb(tmp / "rss")
+        result.update(_cosim(repeats))
+        result["sumo_only_realtime_factor"] = _sumo_only(result["cosim_sim_time_s"], repeats)
+        result["cosim_over_sumo_cost"] = (
+            result["sumo_only_realtime_factor"] / result["realtime_factor"]
+        )
+        result["tables_wall_s"] = _tables(tmp / "tables", quick)
+        result["batch_wall_s"], result["batch_cases"] = _batch(tmp, quick)
+    result["targets"] = {
+        k: {"target": f"{op} {v:g}", "met": (result[k] >= v) if op == ">=" else (result[k] <= v)}
+        for k, (op, v) in TARGETS.items()
+    }
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / "bench.json").write_text(json.dumps(result, indent=2) + "\n")
+    return result
+
+
+def format_table(result: dict) -> str:
+    rows = [(k, v) for k, v in result.items() if isinstance(v, (int, float)) and k != "quick"]
+    width = max(len(k) for k, _ in rows)
+    lines = [f"{'figure':<{width}}  value        target"]
+    for k, v in rows:
+        tgt = result["targets"].get(k)
+        mark = "" if tgt is None else f"{tgt['target']:<9} {'met' if tgt['met'] else 'MISSED'}"
+        lines.append(f"{k:<{width}}  {v:<12.4g} {mark}")
+    return "\n".join(lines)
+
+
+def run_bench_cli(out_dir: Path, quick: bool = False) -> int:
+    result = run_bench(out_dir, quick)
+    print(format_table(result))
+    print(f"written {out_dir / 'bench.json'}")
+    return 0

@@ -1,0 +1,255 @@
+"""The offline tables at run time: loading, the metadata check and fast interpolation.
+
+Files (written by ``build.build_tables``): ``phase_boundaries.csv`` (DMM boundaries per
+friction and relative speed), ``lookup_tables.npz`` (the 3D lookup tables of sec. 8.2:
+differential x-distance x entry speed x friction) and ``metadata.json``.
+
+Interpolation rules:
+
+- friction: linear between the grid frictions; below the lowest the tables do not apply
+  (``check_run`` raises ``InputError``), above the highest the highest is used (a grippier
+  surface needs less distance, so this is conservative); linear interpolation of the convex
+  1/mu-like boundaries overestimates them between grid frictions (conservative too);
+- boundaries in relative speed: linear within the grid, scaled linearly to 0 at zero relative
+  speed below the lowest grid speed (no closing speed, nothing to avoid; TTC itself is kept),
+  clamped to the top row above the highest (only an obstacle moving towards the ego closes
+  faster than the ego drives, and runs above the grid are refused by ``check_run``);
+- trajectories in entry speed: linear within the grid, clamped to the lowest grid speed below
+  it and to the highest above it (``check_run`` refuses runs above the grid);
+- in differential x: linear between the rows of the uniform grid; before 0 the first row,
+  past the manoeuvre's end the final values (y = h, ax = 0, yaw = 0, curvature = 0, steer 0).
+"""
+
+from __future__ import annotations
+
+import bisect
+import csv
+import json
+import os
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+
+from eoam_sumo.errors import InputError
+from eoam_sumo.offline.boundaries import max_decel_no_lock_mps2
+from eoam_sumo.params import VehicleParams, describe, ego_e_class_sedan
+
+CSV_NAME = "phase_boundaries.csv"
+NPZ_NAME = "lookup_tables.npz"
+METADATA_NAME = "metadata.json"
+FORMAT_VERSION = 1
+TABLE_NAMES = ("y_m", "ax_mps2", "yaw_rad", "curvature_1pm", "steer_rad")
+BOUNDARY_COLUMNS = ("stop_distance_m", "stop_distance_buffered_m", "clear_distance_const_m",
+                    "clear_distance_opt_m", "clear_distance_buffered_m", "ttc_s")
+
+
+def default_tables_dir() -> Path:
+    """``$EOAM_TABLES_DIR`` if set, else the repository's ``tables/``."""
+    env = os.environ.get("EOAM_TABLES_DIR")
+    if env:
+        return Path(env)
+    return Path(__file__).resolve().parents[2] / "tables"
+
+
+class Boundary(NamedTuple):
+    """DMM boundaries at one friction and relative speed (m, and the TTC in s)."""
+
+    stop_m: float
+    stop_buffered_m: float
+    clear_const_m: float
+    clear_opt_m: float
+    clear_buffered_m: float
+    ttc_s: float
+
+
+def _bracket(grid: list, value: float) -> tuple[int, int, float]:
+    """Indices and weight of ``value`` in an increasing grid, clamped at both ends."""
+    if value <= grid[0]:
+        return 0, 0, 0.0
+    if value >= grid[-1]:
+        n = len(grid) - 1
+        return n, n, 0.0
+    j = bisect.bisect_right(grid, value)
+    return j - 1, j, (value - grid[j - 1]) / (grid[j] - grid[j - 1])
+
+
+class PhaseBoundaries:
+    """The DMM boundaries of ``phase_boundaries.csv`` with bilinear interpolation."""
+
+    def __init__(self, mu_grid, speed_grid_mps, rows):
+        self.mu_grid = tuple(mu_grid)  # increasing
+        self.speed_grid_mps = tuple(speed_grid_mps)  # increasing
+        self._mus = list(self.mu_grid)
+        self._speeds = list(self.speed_grid_mps)
+        self._rows = rows  # rows[i_mu][i_speed] = tuple of BOUNDARY_COLUMNS
+
+    @classmethod
+    def load(cls, directory) -> PhaseBoundaries:
+        """Read ``phase_boundaries.csv`` (``#`` lines are comments)."""
+        path = Path(directory) / CSV_NAME
+        try:
+            text = path.read_text()
+        except OSError as exc:
+            raise InputError(f"{path}: cannot read the phase boundaries ({exc.strerror}); "
+                             "run `eoam-sumo tables`") from None
+        lines = [ln for ln in text.splitlines() if ln and not ln.startswith("#")]
+        table: dict[float, dict[float, tuple]] = {}
+        try:
+            for rec in csv.DictReader(lines):
+                mu = float(rec["mu"])
+                speed = float(rec["speed_kmh"]) / 3.6
+                table.setdefault(mu, {})[speed] = tuple(float(rec[c]) for c in BOUNDARY_COLUMNS)
+        except (KeyError, ValueError, TypeError) as exc:
+            raise InputError(f"{path}: malformed phase boundaries ({exc})") from None
+        mus = sorted(table)
+        if not mus:
+            raise InputError(f"{path}: no phase boundaries")
+        speeds = sorted(table[mus[0]])
+        if any(sorted(table[mu]) != speeds for mu in mus):
+            raise InputError(f"{path}: every friction must have the same speed grid")
+        rows = [[table[mu][v] for v in speeds] for mu in mus]
+        return cls(mus, speeds, rows)
+
+    def _row(self, i_mu: int, i_v: int, j_v: int, w_v: float) -> list:
+        a, b = self._rows[i_mu][i_v], self._rows[i_mu][j_v]
+        return [x + w_v * (y - x) for x, y in zip(a, b)]
+
+    def at(self, mu: float, rel_speed_mps: float) -> Boundary:
+        """Boundaries at this friction and relative (closing) speed; see the module rules."""
+        i_m, j_m, w_m = _bracket(self._mus, mu)
+        v = rel_speed_mps
+        speeds = self._speeds
+        scale = 1.0
+        if v < speeds[0]:
+            scale = max(v, 0.0) / speeds[0]
+            v = speeds[0]
+        i_v, j_v, w_v = _bracket(speeds, v)
+        lo = self._row(i_m, i_v, j_v, w_v)
+        if j_m != i_m:
+            hi = self._row(j_m, i_v, j_v, w_v)
+            lo = [x + w_m * (y - x) for x, y in zip(lo, hi)]
+        return Boundary(lo[0] * scale, lo[1] * scale, lo[2] * scale, lo[3] * scale,
+                        lo[4] * scale, lo[5])
+
+
+class Trajectory:
+    """One manoeuvre's reference, blended once at the trigger; ``at(dx)`` is pure arithmetic."""
+
+    __slots__ = ("_cols", "_final", "_inv_step", "_last", "length_m")
+
+    def __init__(self, length_m: float, step_m: float, columns: np.ndarray, final: tuple):
+        self.length_m = float(length_m)
+        self._inv_step = 1.0 / step_m
+        self._last = columns.shape[1] - 1
+        self._cols = tuple(c.tolist() for c in columns)
+        self._final = final
+
+    def at(self, dx_m: float) -> tuple[float, float, float, float, float]:
+        """(y_m, ax_mps2, yaw_rad, curvature_1pm, steer_rad) at differential x ``dx_m``."""
+        f = dx_m * self._inv_step
+        if f <= 0.0:
+            y, ax, yaw, k, st = self._cols
+            return y[0], ax[0], yaw[0], k[0], st[0]
+        i = int(f)
+        if i >= self._last:
+            return self._final
+        w = f - i
+        y, ax, yaw, k, st = self._cols
+        return (y[i] + w * (y[i + 1] - y[i]), ax[i] + w * (ax[i + 1] - ax[i]),
+                yaw[i] + w * (yaw[i + 1] - yaw[i]), k[i] + w * (k[i + 1] - k[i]),
+                st[i] + w * (st[i + 1] - st[i]))
+
+
+class LookupTables:
+    """The 3D lookup tables and the phase boundaries of one build."""
+
+    def __init__(self, arrays: dict, boundaries: PhaseBoundaries, metadata: dict,
+                 params: VehicleParams):
+        self.mu_grid = tuple(float(m) for m in arrays["mu_grid"])  # increasing
+        self.speed_grid_mps = tuple(float(v) for v in arrays["speed_grid_mps"])  # increasing
+        self.dx_step_m = float(arrays["dx_step_m"])
+        self.lane_change_m = float(arrays["lane_change_m"])
+        self.length_m = np.asarray(arrays["length_m"], dtype=float)  # (n_mu, n_speed)
+        self._tables = np.stack([np.asarray(arrays[n], dtype=float) for n in TABLE_NAMES])
+        self.boundaries = boundaries
+        self.metadata = metadata
+        self.params = params
+        self._mus = list(self.mu_grid)
+        self._speeds = list(self.speed_grid_mps)
+
+    @classmethod
+    def load(cls, directory=None, params: VehicleParams | None = None) -> LookupTables:
+        """Load a tables folder; refuse it (``InputError``) if built for other parameters."""
+        folder = Path(directory) if directory is not None else default_tables_dir()
+        params = params or ego_e_class_sedan()
+        meta_path = folder / METADATA_NAME
+        try:
+            metadata = json.loads(meta_path.read_text())
+        except OSError as exc:
+            raise InputError(f"{meta_path}: cannot read the tables' metadata ({exc.strerror}); "
+                             "run `eoam-sumo tables`") from None
+        except json.JSONDecodeError as exc:
+            raise InputError(f"{meta_path}: malformed JSON ({exc.msg}, line {exc.lineno})") from None
+        _check_metadata(meta_path, metadata, params)
+        npz_path = folder / NPZ_NAME
+        try:
+            with np.load(npz_path) as data:
+                arrays = {k: data[k] for k in data.files}
+        except (OSError, ValueError) as exc:
+            raise InputError(f"{npz_path}: cannot read the lookup tables ({exc}); "
+                             "run `eoam-sumo tables`") from None
+        missing = [k for k in TABLE_NAMES + ("mu_grid", "speed_grid_mps", "dx_step_m",
+                                             "length_m", "lane_change_m") if k not in arrays]
+        if missing:
+            raise InputError(f"{npz_path}: missing arrays {', '.join(missing)}; "
+                             "run `eoam-sumo tables`")
+        boundaries = PhaseBoundaries.load(folder)
+        return cls(arrays, boundaries, metadata, params)
+
+    def check_run(self, mu: float, speed_mps: float) -> None:
+        """Refuse (``InputError``) a run the tables do not cover: entry speed above the grid or
+        friction below it."""
+        top = self.speed_grid_mps[-1]
+        if not 0.0 < speed_mps <= top + 1e-9:
+            raise InputError(f"ego speed {speed_mps * 3.6:.1f} km/h is outside the tables' "
+                             f"range (0, {top * 3.6:.0f}] km/h; rebuild with `eoam-sumo tables "
+                             "--speeds-kmh ...`")
+        if mu < self.mu_grid[0] - 1e-9:
+            raise InputError(f"mu {mu:g} is below the tables' lowest friction "
+                             f"{self.mu_grid[0]:g}; rebuild with `eoam-sumo tables --mu ...`")
+
+    def max_decel_mps2(self, mu: float) -> float:
+        """Largest straight-line deceleration without locking an axle at this friction."""
+        return max_decel_no_lock_mps2(self.params, min(mu, self.mu_grid[-1]))
+
+    def trajectory(self, mu: float, speed_mps: float) -> Trajectory:
+        """The manoeuvre reference for this friction and entry speed (bilinear blend, once)."""
+        i_m, j_m, w_m = _bracket(self._mus, mu)
+        i_v, j_v, w_v = _bracket(self._speeds, speed_mps)
+        corners = ((i_m, i_v, (1 - w_m) * (1 - w_v)), (i_m, j_v, (1 - w_m) * w_v),
+                   (j_m, i_v, w_m * (1 - w_v)), (j_m, j_v, w_m * w_v))
+        lengths = self.length_m
+        rows = int(max(lengths[m, v] for m, v, _ in corners) / self.dx_step_m) + 3
+        rows = min(rows, self._tables.shape[-1])
+        cols = sum(c * self._tables[:, m, v, :rows] for m, v, c in corners)
+        length = sum(c * lengths[m, v] for m, v, c in corners)
+        final = (self.lane_change_m, 0.0, 0.0, 0.0, 0.0)
+        return Trajectory(length, self.dx_step_m, cols, final)
+
+
+def _check_metadata(path: Path, metadata: dict, params: VehicleParams) -> None:
+    if metadata.get("format") != FORMAT_VERSION:
+        raise InputError(f"{path}: tables format {metadata.get('format')!r} is not "
+                         f"{FORMAT_VERSION}; run `eoam-sumo tables`")
+    stored = metadata.get("vehicle", {})
+    wanted = describe(params)
+    diffs = [name for name, rec in wanted.items()
+             if not isinstance(stored.get(name), dict) or stored[name].get("value") != rec["value"]]
+    diffs += [name for name in stored if name not in wanted]
+    if diffs:
+        shown = ", ".join(
+            f"{n} (tables {stored.get(n, {}).get('value')!r}, in use "
+            f"{wanted.get(n, {}).get('value')!r})" for n in diffs[:3])
+        raise InputError(f"{path}: the tables were built for other vehicle parameters: {shown}; "
+                         "run `eoam-sumo tables` to rebuild them")
