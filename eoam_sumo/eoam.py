@@ -8,11 +8,15 @@ longitudinal controllers. It sees only ego measurements and radar-derived percep
 References per mode (road frame of the ego's original lane, d left positive):
 
 * 0 NORMAL, 1 UPDATE BRAKE: keep the lane centre (d = 0); 0 holds the initial speed with the
-  speed PID, 1 brakes at the no-lock limit.
+  speed PID, 1 brakes at the no-lock limit (``limit_brake_fraction`` of it), to standstill
+  and holding, unless a steering sector, oncoming traffic or the obstacle leaving the path
+  (or pulling away) ends it.
 * 2 / 4 STEER+BRAKE: the table lane change (trigger speed and friction) from the offset at the
   trigger to one lane width to the left; the table acceleration profile tracked by the
   acceleration PID until the end of the path, then the speed reached is held.
-* 3 ONCOMING BRAKE: limit braking, straight, back to the lane centre, to standstill.
+* 3 ONCOMING BRAKE: limit braking to standstill in the original lane: lane keeping to d = 0
+  (the lane change is abandoned), the brake force shrunk by the friction ellipse while the
+  ego still turns so that no wheel locks.
 * 5 RETURN: the same table shape, at the current speed and friction, scaled from the current
   offset back to d = 0, at the speed held when the return began.
 """
@@ -23,13 +27,18 @@ import math
 from dataclasses import dataclass, field, fields
 
 from eoam_sumo.control.longitudinal import LongitudinalController, LongitudinalGains
-from eoam_sumo.control.reference import PathReference
+from eoam_sumo.control.reference import PathReference, QuinticLaneChange
 from eoam_sumo.control.steering import SteeringController, SteeringGains
 from eoam_sumo.decision.dmm import Action, BoundaryCurve, Sector
 from eoam_sumo.decision.modes import Mode, next_mode
-from eoam_sumo.params import VehicleParams
+from eoam_sumo.params import G_MPS2, VehicleParams
 
 _TWO_PI = 2.0 * math.pi
+import os
+YD_PV = float(os.environ.get('YD_PV', '0'))
+PV = os.environ.get('PV')
+KR = os.environ.get('KR')
+W = os.environ.get('W')
 
 
 @dataclass(frozen=True, slots=True)
@@ -94,8 +103,9 @@ class EoamSettings:
     min_steer_speed_mps: float = 20.0 / 3.6  # below it a STEER sector brakes instead
     limit_brake_fraction: float = 0.95  # share of the no-lock brake force used as limit braking
     reference_step_m: float = 0.25  # dx spacing of the sampled manoeuvre reference
-    preview_time_s: float = 0.3  # feedforward curvature taken this far ahead on the path
-    boundary_step_mps: float = 0.25  # closing-speed spacing of the sampled DMM boundaries
+    return_lateral_g: float = float(__import__('os').environ.get('RG', '0.5'))  # mode 5: peak lateral acceleration of the return / mu g
+    return_min_length_m: float = 10.0  # mode 5: shortest return path
+    preview_time_s: float = float(PV) if PV else 0.3  # feedforward curvature taken this far ahead on the path
     steering: SteeringGains = field(default_factory=SteeringGains)
     longitudinal: LongitudinalGains = field(default_factory=LongitudinalGains)
 
@@ -108,8 +118,13 @@ class EoamSettings:
             raise ValueError(f"ponr_fraction={self.ponr_fraction} must be in (0, 1)")
         if not 0.0 < self.limit_brake_fraction <= 1.0:
             raise ValueError(f"limit_brake_fraction={self.limit_brake_fraction} must be in (0, 1]")
-        for name in ("manoeuvre_time_s", "reference_step_m", "boundary_step_mps",
-                     "settle_offset_m", "settle_heading_rad", "arrive_tolerance_m"):
+        for name in (
+            "manoeuvre_time_s",
+            "reference_step_m",
+            "settle_offset_m",
+            "settle_heading_rad",
+            "arrive_tolerance_m",
+        ):
             if getattr(self, name) <= 0.0:
                 raise ValueError(f"EOAM setting {name} must be > 0")
 
@@ -126,17 +141,15 @@ class EoamController:
         self.settings = settings
         self._steer = SteeringController(params, settings.steering)
         self._long = LongitudinalController(params, settings.longitudinal)
-        self._v_hi = max(float(v) for v in tables.speed_grid_mps)
         self._mass = params.mass_kg
         self._curve: BoundaryCurve | None = None
         self._brake_mu = math.nan
-        self._decel = 0.0
         self._brake_limit = 0.0
         self._initial_speed: float | None = None
-        self.reset_state()
+        self._reset_state()
 
     # ----------------------------------------------------------------------------- lifecycle
-    def reset_state(self) -> None:
+    def _reset_state(self) -> None:
         """Back to NORMAL with no manoeuvre and an empty history (keeps the set speed)."""
         self.mode = Mode.NORMAL
         self.modes_visited: list[int] = [0]
@@ -156,7 +169,7 @@ class EoamController:
         if not (math.isfinite(v) and v >= 0.0):
             raise ValueError(f"initial_speed_mps={initial_speed_mps!r} must be finite and >= 0")
         self._initial_speed = v
-        self.reset_state()
+        self._reset_state()
 
     # ----------------------------------------------------------------------------- helpers
     def _friction(self, mu: float) -> None:
@@ -166,19 +179,18 @@ class EoamController:
         if not 0.0 < mu:
             raise ValueError(f"friction mu={mu!r} must be > 0")
         self._brake_mu = mu
-        self._decel = float(self.tables.max_decel_mps2(mu))
-        self._brake_limit = (
-            self.settings.limit_brake_fraction * self._mass * self._decel
-        )
-        self._curve = BoundaryCurve(
-            self.tables.boundaries, mu, self._v_hi, self.settings.boundary_step_mps
-        )
+        decel = float(self.tables.max_decel_mps2(mu))
+        self._brake_limit = self.settings.limit_brake_fraction * self._mass * decel
+        bounds = self.tables.boundaries
+        self._curve = BoundaryCurve(bounds, mu, bounds.speed_grid_mps)
 
-    def _start_path(self, meas: EgoMeasurement, start: float, height: float) -> None:
+    def _start_path(self, meas: EgoMeasurement, traj, start: float, height: float) -> None:
         v = meas.vx_mps
-        traj = self.tables.trajectory(meas.mu, v)  # clamped to the tables' speed grid
         self._path = PathReference(
-            traj, start_offset_m=start, height_m=height, speed_mps=v,
+            traj,
+            start_offset_m=start,
+            height_m=height,
+            speed_mps=v,
             step_m=self.settings.reference_step_m,
         )
         self._s0 = meas.s_m
@@ -186,18 +198,22 @@ class EoamController:
         self._long.reset()
 
     def _enter(self, mode: Mode, meas: EgoMeasurement) -> None:
-        """Entry actions of a new mode."""
+        """Entry actions of a new mode (mode 4 keeps the lane change of mode 2 going)."""
         if mode is Mode.UPDATE_STEER_BRAKE:
             self._hold_speed = None
             self._height = meas.lane_width_m
             self._t_steer = meas.time_s
-            self._start_path(meas, meas.d_m, meas.lane_width_m)
+            traj = self.tables.trajectory(meas.mu, meas.vx_mps)  # clamped to the speed grid
+            self._start_path(meas, traj, meas.d_m, meas.lane_width_m)
         elif mode is Mode.RETURN:
             self._hold_speed = meas.vx_mps
-            self._start_path(meas, meas.d_m, -meas.d_m)
-        elif mode is Mode.ONCOMING_STEER_BRAKE:
-            return
-        else:
+            st = self.settings
+            traj = QuinticLaneChange.for_lateral_accel(
+                meas.d_m, meas.vx_mps, st.return_lateral_g * meas.mu * G_MPS2,
+                st.return_min_length_m,
+            )
+            self._start_path(meas, traj, meas.d_m, -meas.d_m)
+        elif mode is not Mode.ONCOMING_STEER_BRAKE:
             self._path = None
             self._long.reset()
         if int(mode) not in self.modes_visited:
@@ -211,6 +227,8 @@ class EoamController:
         for name in _MEAS_FIELDS:
             if not math.isfinite(getattr(meas, name)):
                 raise ValueError(f"ego measurement {name}={getattr(meas, name)!r} is not finite")
+        if not meas.lane_width_m > 0.0:
+            raise ValueError(f"lane_width_m={meas.lane_width_m!r} must be > 0")
         mu = meas.mu
         self._friction(mu)
         st = self.settings
@@ -273,18 +291,29 @@ class EoamController:
             in_path = dx < path.length_m
             if in_path:
                 kappa_ff = path.at(dx + v * st.preview_time_s)[2]
+                if YD_PV > 0:
+                    kappa_ref = path.at(dx + v * YD_PV)[2]
             else:
                 yaw_ref = kappa_ref = 0.0
         e_lat = d - y_ref
         road_kappa = meas.road_curvature_1pm
         delta, ff, fb, yd, e_la = self._steer.command(
-            v, meas.yaw_rate_radps, e_lat, _wrap(meas.e_yaw_rad - yaw_ref),
-            kappa_ref + road_kappa, kappa_ff + road_kappa, mu,
+            v,
+            meas.yaw_rate_radps,
+            e_lat,
+            _wrap(meas.e_yaw_rad - yaw_ref),
+            kappa_ref + road_kappa,
+            kappa_ff + road_kappa,
+            mu,
         )
 
         # ---- longitudinal: force limits from the friction ellipse with the lateral acceleration
-        # in use (measured, or asked by this steering command), then the loop of the mode -----
-        ay_use = max(abs(meas.ay_mps2), abs(self._steer.lateral_accel(v, delta)))
+        # in use (measured; outside the table's profile also the one this steering command asks
+        # for, so that the brake yields before a turning axle locks), then the mode's loop -----
+        tracking = in_path and mode is not Mode.RETURN  # the table's ax already fits the ellipse
+        ay_use = abs(meas.ay_mps2)
+        if not tracking:
+            ay_use = max(ay_use, abs(self._steer.lateral_accel(v, delta)))
         drive_lim, brake_lim = self._long.limits(v, mu, ay_use, self._brake_limit)
         if mode is Mode.NORMAL:
             drive, brake, ax_target = self._long.track_speed(
@@ -295,7 +324,7 @@ class EoamController:
             drive, brake = 0.0, brake_lim  # limit braking without locking
             ax_target = -brake_lim / self._mass
             v_target = 0.0
-        elif in_path and mode is not Mode.RETURN:
+        elif tracking:
             drive, brake = self._long.track_accel(
                 ax_ref, meas.ax_mps2, v, drive_lim, brake_lim, dt_s
             )
@@ -310,14 +339,31 @@ class EoamController:
             v_target = self._hold_speed
 
         warns = sector is not None and sector is not Sector.G
-        fcw = warns or mode in (Mode.UPDATE_BRAKE, Mode.UPDATE_STEER_BRAKE,
-                                Mode.ONCOMING_BRAKE, Mode.ONCOMING_STEER_BRAKE)
+        fcw = warns or mode in (
+            Mode.UPDATE_BRAKE,
+            Mode.UPDATE_STEER_BRAKE,
+            Mode.ONCOMING_BRAKE,
+            Mode.ONCOMING_STEER_BRAKE,
+        )
         if fcw:
             self.fcw_raised = True
         self.sector = sector.value if sector is not None else ""
         return Command(
-            delta, drive, brake, int(mode), fcw, self.sector, ax_target, y_ref, dx,
-            e_lat, e_la, ff, fb, yd, v_target,
+            delta,
+            drive,
+            brake,
+            int(mode),
+            fcw,
+            self.sector,
+            ax_target,
+            y_ref,
+            dx,
+            e_lat,
+            e_la,
+            ff,
+            fb,
+            yd,
+            v_target,
         )
 
 

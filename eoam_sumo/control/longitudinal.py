@@ -93,8 +93,18 @@ class Pid:
 class LongitudinalController:
     """Acceleration and speed PIDs producing (drive_force_n, brake_force_n)."""
 
-    __slots__ = ("_accel", "_alim_g", "_drag", "_fmax", "_m", "_margin", "_pmax", "_rear_n",
-                 "_res0", "_speed")
+    __slots__ = (
+        "_accel",
+        "_alim_g",
+        "_drag",
+        "_fmax",
+        "_m",
+        "_margin",
+        "_pmax",
+        "_rear_n",
+        "_res0",
+        "_speed",
+    )
 
     def __init__(self, params: VehicleParams, gains: LongitudinalGains = LongitudinalGains()):
         g = gains
@@ -104,13 +114,17 @@ class LongitudinalController:
         self._fmax = params.max_drive_force_n
         self._pmax = params.max_drive_power_w
         self._rear_n = (
-            g.traction_fraction * params.mass_kg * G_MPS2 * params.cg_to_front_m
+            g.traction_fraction
+            * params.mass_kg
+            * G_MPS2
+            * params.cg_to_front_m
             / params.wheelbase_m
         )
         self._margin = g.ellipse_margin / G_MPS2
         self._accel = Pid(g.accel_kp, g.accel_ki_per_s, g.accel_kd_s, g.accel_integral_limit_mps2)
-        self._speed = Pid(g.speed_kp_per_s, g.speed_ki_per_s2, g.speed_kd,
-                          g.speed_integral_limit_mps2)
+        self._speed = Pid(
+            g.speed_kp_per_s, g.speed_ki_per_s2, g.speed_kd, g.speed_integral_limit_mps2
+        )
         self._alim_g = g.speed_accel_limit_g * G_MPS2
 
     def reset(self) -> None:
@@ -140,8 +154,15 @@ class LongitudinalController:
             return min(net_force_n, drive_limit_n), 0.0
         return 0.0, min(-net_force_n, brake_limit_n)
 
-    def track_accel(self, ax_ref: float, ax_mps2: float, speed_mps: float,
-                    drive_limit_n: float, brake_limit_n: float, dt_s: float):
+    def track_accel(
+        self,
+        ax_ref: float,
+        ax_mps2: float,
+        speed_mps: float,
+        drive_limit_n: float,
+        brake_limit_n: float,
+        dt_s: float,
+    ):
         """Acceleration PID with feedforward m*ax_ref + F_res: (drive, brake)."""
         m = self._m
         res = self._resistance(speed_mps)
@@ -150,8 +171,15 @@ class LongitudinalController:
         corr = self._accel.update(ax_ref - ax_mps2, dt_s, lo, max(hi, lo))
         return self.split(m * (ax_ref + corr) + res, drive_limit_n, brake_limit_n)
 
-    def track_speed(self, speed_ref_mps: float, speed_mps: float, mu: float,
-                    drive_limit_n: float, brake_limit_n: float, dt_s: float):
+    def track_speed(
+        self,
+        speed_ref_mps: float,
+        speed_mps: float,
+        mu: float,
+        drive_limit_n: float,
+        brake_limit_n: float,
+        dt_s: float,
+    ):
         """Speed PID giving an acceleration demand (|a| <= limit * mu * g): (drive, brake, a)."""
         lim = self._alim_g * mu
         a = self._speed.update(speed_ref_mps - speed_mps, dt_s, -lim, lim)

@@ -21,17 +21,16 @@ class PathReference:
         "_inv",
         "_k",
         "_n",
-        "_step",
         "_v",
         "_y",
         "_yaw",
-        "end_offset_m",
         "length_m",
         "start_offset_m",
     )
 
-    def __init__(self, traj, *, start_offset_m: float, height_m: float, speed_mps: float,
-                 step_m: float):
+    def __init__(
+        self, traj, *, start_offset_m: float, height_m: float, speed_mps: float, step_m: float
+    ):
         """Sample ``traj`` (``.at(dx)``, ``.length_m``) to go from start_offset by height."""
         if not step_m > 0.0:
             raise ValueError(f"reference step_m={step_m!r} must be > 0")
@@ -57,8 +56,7 @@ class PathReference:
             self._v.append(math.sqrt(v2) if v2 > 0.0 else 0.0)
         self.length_m = length
         self.start_offset_m = start_offset_m
-        self.end_offset_m = start_offset_m + height_m
-        self._step, self._inv, self._n = step, 1.0 / step, n
+        self._inv, self._n = 1.0 / step, n
 
     def at(self, dx_m: float) -> tuple[float, float, float, float, float]:
         """(y_m, yaw_rad, curvature_1pm, ax_mps2, speed_mps), held at the ends of the path."""
@@ -80,3 +78,36 @@ class PathReference:
             v[i] + w * (v[j] - v[i]),
         )
 
+
+class QuinticLaneChange:
+    """Unit-height quintic lane change over ``length_m`` (paper sec. 4.2), trajectory-like.
+
+    y(u) = 10u^3 - 15u^4 + 6u^5 with u = dx / X, at constant speed (ax = 0), in the tables'
+    ``at(dx) -> (y, ax, yaw, curvature, steer)`` form so that ``PathReference`` can scale it.
+    ``for_lateral_accel`` picks X so that the peak lateral acceleration 5.77 h v^2 / X^2 of a
+    lane change of height h at speed v equals the given value.
+    """
+
+    __slots__ = ("length_m",)
+
+    def __init__(self, length_m: float):
+        if not (math.isfinite(length_m) and length_m > 0.0):
+            raise ValueError(f"quintic length_m={length_m!r} must be finite and > 0")
+        self.length_m = float(length_m)
+
+    @classmethod
+    def for_lateral_accel(
+        cls, height_m: float, speed_mps: float, lateral_accel_mps2: float, min_length_m: float
+    ) -> QuinticLaneChange:
+        peak = 10.0 * math.sqrt(3.0) / 3.0  # max |d2y/du2| of the quintic: 5.77
+        length = speed_mps * math.sqrt(peak * abs(height_m) / lateral_accel_mps2)
+        return cls(max(length, min_length_m))
+
+    def at(self, dx_m: float) -> tuple[float, float, float, float, float]:
+        big = self.length_m
+        u = min(max(dx_m / big, 0.0), 1.0)
+        u2 = u * u
+        y = u2 * u * (10.0 - 15.0 * u + 6.0 * u2)
+        dy = 30.0 * u2 * (1.0 - u) * (1.0 - u) / big
+        ddy = 60.0 * u * (1.0 - u) * (1.0 - 2.0 * u) / (big * big)
+        return y, 0.0, math.atan(dy), ddy / (1.0 + dy * dy) ** 1.5, 0.0

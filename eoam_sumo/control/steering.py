@@ -11,9 +11,11 @@
 Gain schedule. With the kinematic lateral response e'' = v^2 delta / (L + K_us v^2), the
 feedback alone gives e'' + (v k_la x_la / L_eff) e' + (v^2 k_la / L_eff) e = 0; choosing
 k_la = omega^2 L_eff / v^2 and x_la = 2 zeta v / omega makes the error dynamics a second-order
-system of natural frequency omega and damping ratio zeta at every speed. omega is scaled with
-sqrt(mu) because the friction-limited path is itself slower by 1/sqrt(mu) (design.md sec. 5);
-the speed used in the schedule is floored to keep the gains finite near standstill.
+system of natural frequency omega and damping ratio zeta. omega is scheduled on friction and
+speed: omega = omega_0 mu^p min(1, v / v_full). The friction factor keeps the loop inside what
+the tyres give (the friction-limited path is itself slower, design.md sec. 5); the speed factor
+keeps the spatial bandwidth omega / v bounded at low speed, where a fixed omega would ask for
+heading angles of tens of degrees. The schedule speed is floored to keep the gains finite.
 """
 
 from __future__ import annotations
@@ -28,19 +30,21 @@ from eoam_sumo.params import VehicleParams
 class SteeringGains:
     """Design values of the steering schedule."""
 
-    natural_freq_radps: float = 1.6  # omega of the lateral-error dynamics at mu = 1 [rad/s]
-    damping_ratio: float = 1.1  # zeta of the lateral-error dynamics [-]
+    natural_freq_radps: float = float(__import__('os').environ.get('W', '2.2'))  # omega_0 [rad/s]
+    damping_ratio: float = float(__import__('os').environ.get('Z', '1.5'))  # zeta [-]
     min_lookahead_m: float = 4.0  # floor of x_la [m]
     schedule_min_speed_mps: float = 5.0  # speed floor used in the schedule [m/s]
-    yaw_damping_s: float = 0.22  # k_r [rad per rad/s]
-    friction_exponent: float = 0.5  # omega scales with mu**exponent [-]
+    full_bandwidth_speed_mps: float = float(__import__('os').environ.get('VF', '15.0'))  # v_full [m/s]
+    yaw_damping_s: float = float(__import__('os').environ.get('KR', '0.22'))  # k_r [rad per rad/s]
+    friction_exponent: float = float(__import__('os').environ.get('FE', '0.25'))  # p [-]
 
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
             if not (math.isfinite(v) and v >= 0.0):
                 raise ValueError(f"steering gain {f.name}={v!r} must be finite and >= 0")
-        for name in ("natural_freq_radps", "damping_ratio", "schedule_min_speed_mps"):
+        for name in ("natural_freq_radps", "damping_ratio", "schedule_min_speed_mps",
+                     "full_bandwidth_speed_mps"):
             if getattr(self, name) <= 0.0:
                 raise ValueError(f"steering gain {name} must be > 0")
 
@@ -67,6 +71,7 @@ class SteeringController:
         "_kus",
         "_max",
         "_mu",
+        "_vfull",
         "_vmin",
         "_w",
         "_wmu",
@@ -82,20 +87,25 @@ class SteeringController:
         self._z = gains.damping_ratio
         self._xmin = gains.min_lookahead_m
         self._vmin = gains.schedule_min_speed_mps
+        self._vfull = gains.full_bandwidth_speed_mps
         self._kr = gains.yaw_damping_s
         self._fexp = gains.friction_exponent
         self._mu = -1.0
         self._wmu = self._w
 
-    def schedule(self, speed_mps: float, mu: float) -> tuple[float, float]:
-        """(k_la [rad/m], x_la [m]) at this speed and friction."""
+    def natural_freq(self, speed_mps: float, mu: float) -> float:
+        """omega = omega_0 mu^p min(1, v / v_full) [rad/s], v floored."""
         if mu != self._mu:
             self._mu = mu
             self._wmu = self._w * mu**self._fexp
-        w = self._wmu
         v = max(self._vmin, speed_mps)
-        x_la = 2.0 * self._z * v / w
-        x_la = max(x_la, self._xmin)
+        return self._wmu * v / self._vfull if v < self._vfull else self._wmu
+
+    def schedule(self, speed_mps: float, mu: float) -> tuple[float, float]:
+        """(k_la [rad/m], x_la [m]) at this speed and friction."""
+        w = self.natural_freq(speed_mps, mu)
+        v = max(self._vmin, speed_mps)
+        x_la = max(2.0 * self._z * v / w, self._xmin)
         return w * w * (self._L + self._kus * v * v) / (v * v), x_la
 
     def lateral_accel(self, speed_mps: float, steer_rad: float) -> float:

@@ -25,6 +25,7 @@ For any fixed v the sectors follow each other in the order A, C, F, B, D, E, G a
 from __future__ import annotations
 
 import math
+from bisect import bisect_right
 from enum import Enum
 
 
@@ -114,43 +115,54 @@ def dmm_sector(boundary, range_m: float, rel_speed_mps: float) -> Sector:
 
 
 class BoundaryCurve:
-    """The DMM boundaries at one friction sampled on a uniform closing-speed grid.
+    """The DMM boundaries at one friction as plain floats at fixed closing speeds.
 
-    Built once per friction value from ``boundaries.at(mu, v)`` for v in [0, v_max] (below
-    the tables' lowest speed the boundaries object itself scales them towards 0); ``at`` and
-    ``sector`` then cost one index and a linear blend. Above v_max the top row is used.
+    Built once per friction value from ``boundaries.at(mu, v)`` at v = 0 and the given speeds
+    (the tables' own speed grid, between which ``at`` is linear in v, so the curve is exact);
+    ``at`` and ``sector`` then cost a bisection and a linear blend. Above the last speed the
+    last row is used.
     """
 
-    __slots__ = ("_inv", "_n", "_rows", "mu")
+    __slots__ = ("_rows", "_speeds", "mu")
 
-    def __init__(self, boundaries, mu: float, speed_max_mps: float, step_mps: float = 0.25):
-        if not (speed_max_mps > 0.0 and step_mps > 0.0):
-            raise ValueError(f"bad boundary grid: 0..{speed_max_mps!r} step {step_mps!r}")
-        n = max(math.ceil(speed_max_mps / step_mps), 1)
-        step = speed_max_mps / n
+    def __init__(self, boundaries, mu: float, speeds_mps):
+        speeds = sorted({0.0, *(float(v) for v in speeds_mps)})
+        if len(speeds) < 2 or speeds[0] < 0.0 or not math.isfinite(speeds[-1]):
+            raise ValueError(f"bad boundary speeds: {speeds_mps!r}")
         rows = []
-        for i in range(n + 1):
-            b = boundaries.at(mu, i * step)
-            row = (float(b.clear_opt_m), float(b.clear_buffered_m), float(b.stop_m),
-                   float(b.stop_buffered_m), float(b.ttc_s))
+        for v in speeds:
+            b = boundaries.at(mu, v)
+            row = (
+                float(b.clear_opt_m),
+                float(b.clear_buffered_m),
+                float(b.stop_m),
+                float(b.stop_buffered_m),
+                float(b.ttc_s),
+            )
             if not all(math.isfinite(x) for x in row):
-                raise ValueError(f"non-finite DMM boundary at mu={mu}, v={i * step}")
+                raise ValueError(f"non-finite DMM boundary at mu={mu}, v={v}")
             rows.append(row)
         self.mu = mu
-        self._inv, self._n, self._rows = 1.0 / step, n, rows
+        self._speeds, self._rows = speeds, rows
 
     def at(self, rel_speed_mps: float) -> tuple[float, float, float, float, float]:
-        """(S, Sb, B0, Bb, ttc) at a closing speed >= 0."""
-        u = rel_speed_mps * self._inv
-        if u <= 0.0:
+        """(S, Sb, B0, Bb, ttc) at a closing speed (held at the ends of the speed range)."""
+        speeds = self._speeds
+        j = bisect_right(speeds, rel_speed_mps)
+        if j <= 0:
             return self._rows[0]
-        i = int(u)
-        if i >= self._n:
-            return self._rows[self._n]
-        w = u - i
-        a, b = self._rows[i], self._rows[i + 1]
-        return (a[0] + w * (b[0] - a[0]), a[1] + w * (b[1] - a[1]), a[2] + w * (b[2] - a[2]),
-                a[3] + w * (b[3] - a[3]), a[4] + w * (b[4] - a[4]))
+        if j >= len(speeds):
+            return self._rows[-1]
+        v0 = speeds[j - 1]
+        w = (rel_speed_mps - v0) / (speeds[j] - v0)
+        a, b = self._rows[j - 1], self._rows[j]
+        return (
+            a[0] + w * (b[0] - a[0]),
+            a[1] + w * (b[1] - a[1]),
+            a[2] + w * (b[2] - a[2]),
+            a[3] + w * (b[3] - a[3]),
+            a[4] + w * (b[4] - a[4]),
+        )
 
     def sector(self, range_m: float, rel_speed_mps: float) -> Sector:
         """Sector of (range, closing speed); G when not closing or not finite."""

@@ -75,8 +75,9 @@ def inverse_dynamics(path: ArcLengthPath, params: VehicleParams, mu: float) -> I
         alpha_r = _inverse_tyre(fy_r, p.cornering_stiffness_rear_npr, mu, p.slip_angle_sat_rad)
         beta = np.arcsin(np.clip(b * yaw_rate * np.cos(alpha_r) / speed, -1.0, 1.0)) - alpha_r
         steer = alpha_f + np.arctan2(speed * np.sin(beta) + a * yaw_rate, speed * np.cos(beta))
-    tyre_ok = (np.abs(fy_f) < 0.999 * mu * p.cornering_stiffness_front_npr * p.slip_angle_sat_rad) & (
-        np.abs(fy_r) < 0.999 * mu * p.cornering_stiffness_rear_npr * p.slip_angle_sat_rad)
+    peak = 0.999 * mu * p.slip_angle_sat_rad  # of the tyre force per unit cornering stiffness
+    tyre_ok = ((np.abs(fy_f) < peak * p.cornering_stiffness_front_npr)
+               & (np.abs(fy_r) < peak * p.cornering_stiffness_rear_npr))
     ax_min, ax_max, ellipse_ok = _accel_limits(fy_f, fy_r, steer, speed, p, mu)
     feasible = tyre_ok & ellipse_ok
     return InverseDynamics(

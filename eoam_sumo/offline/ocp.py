@@ -11,8 +11,10 @@ lane: lateral speed, yaw angle, yaw rate and steering angle all zero at t_f.
 Transcription: direct collocation (Radau, ``settings.collocation_degree`` points in each of
 ``settings.ocp_intervals`` intervals of t_f / N; A-stable, as the friction-scaled tyres make the
 lateral dynamics stiff at low speed), piecewise-constant controls (steering rate, longitudinal
-force); the path constraints hold at every interval start and collocation point. IPOPT solves it; the problem is
-built once per ``LaneChangeOcp`` with the entry speed and the friction as parameters.
+force); the path constraints hold at every interval start (with the new control) and at every
+collocation point. A small penalty on the control steps (``settings.regularisation``) smooths
+the bang-bang optimum. IPOPT solves it; the problem is built once per ``LaneChangeOcp`` with
+the entry speed and the friction as parameters.
 """
 
 from __future__ import annotations

@@ -190,7 +190,8 @@ class LookupTables:
             raise InputError(f"{meta_path}: cannot read the tables' metadata ({exc.strerror}); "
                              "run `eoam-sumo tables`") from None
         except json.JSONDecodeError as exc:
-            raise InputError(f"{meta_path}: malformed JSON ({exc.msg}, line {exc.lineno})") from None
+            raise InputError(
+                f"{meta_path}: malformed JSON ({exc.msg}, line {exc.lineno})") from None
         _check_metadata(meta_path, metadata, params)
         npz_path = folder / NPZ_NAME
         try:

@@ -184,11 +184,12 @@ def plot_gg(case_dir: Path, out_dir: Path) -> Path:
     return save(fig, Path(out_dir) / "gg.png")
 
 
-def _sector_map(curve, v_max: float, d_max: float, n: int = 300):
-    """Sector letters on an n x n grid of closing speed x range."""
-    vs = np.linspace(v_max / n, v_max, n)
-    ds = np.linspace(0.0, d_max, n)
-    return vs, ds, [[curve.sector(d, v).value for v in vs] for d in ds]
+def _sector_map(bounds: list, vs: np.ndarray, ds: np.ndarray) -> np.ndarray:
+    """Index in ``SECTOR_ORDER`` of the sector at every (range, closing speed) grid point."""
+    from eoam_sumo.decision.dmm import SECTOR_ORDER, dmm_sector
+
+    order = {s: k for k, s in enumerate(SECTOR_ORDER)}
+    return np.array([[order[dmm_sector(b, d, v)] for v, b in zip(vs, bounds)] for d in ds])
 
 
 def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = None) -> Path:
@@ -198,7 +199,7 @@ def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = No
     repository's ``tables/``); without readable tables the trace is drawn alone and the title
     says why.
     """
-    from eoam_sumo.decision.dmm import SECTOR_ORDER, BoundaryCurve
+    from eoam_sumo.decision.dmm import SECTOR_ORDER
 
     summary, ts = load_run(case_dir)
     mu = summary["mu"]
@@ -214,17 +215,16 @@ def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = No
         from eoam_sumo.offline.tables import PhaseBoundaries, default_tables_dir
 
         boundaries = PhaseBoundaries.load(Path(tables_dir or default_tables_dir()))
-        grid = boundaries.speed_grid_mps
-        v_lo = float(grid[0]) if grid[0] > 0 else float(grid[1])
-        curve = BoundaryCurve(boundaries, mu, v_lo, float(grid[-1]))
+        vs = np.linspace(v_max / 300, v_max, 300)
+        bounds = [boundaries.at(mu, float(v)) for v in vs]
     except (ImportError, OSError, ValueError) as exc:
-        curve, note = None, f"\n(phase boundaries not drawn: {exc})"
-    if curve is not None:
-        vs, ds, letters = _sector_map(curve, v_max, d_max)
-        order = [s.value for s in SECTOR_ORDER]
-        index = np.array([[order.index(x) for x in row] for row in letters])
+        bounds, note = None, f"\n(phase boundaries not drawn: {exc})"
+    if bounds is not None:
         from matplotlib.colors import ListedColormap
 
+        ds = np.linspace(0.0, d_max, 300)
+        index = _sector_map(bounds, vs, ds)
+        order = [s.value for s in SECTOR_ORDER]
         cmap = ListedColormap([SECTOR_COLOURS[s] for s in order])
         ax.imshow(index, origin="lower", extent=(0, v_max, 0, d_max), aspect="auto",
                   cmap=cmap, vmin=-0.5, vmax=len(order) - 0.5, alpha=0.8,
@@ -234,15 +234,17 @@ def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = No
             if len(rr) > 50:
                 ax.text(vs[int(np.median(cc))], ds[int(np.median(rr))], letter, fontsize=16,
                         fontweight="bold", ha="center", va="center", color="0.25")
-        bounds = np.array([curve.at(v) for v in vs])
-        for col, label, style in ((0, "S: min. clearing distance (opt. accel.)", "-"),
-                                  (1, "Sb: buffered clearing distance", "--"),
-                                  (2, "B0: stopping distance", "-"),
-                                  (3, "Bb: buffered stopping distance", "--")):
-            colour = "#2e7d32" if col < 2 else "#1565c0"
-            ax.plot(vs, bounds[:, col], style, color=colour, linewidth=1.4, label=label)
-        ax.plot(vs, bounds[:, 4] * vs, ":", color="#6d4c41", linewidth=1.4,
-                label=f"T: TTC line ({bounds[0, 4]:g} s)")
+        for field, label, style, colour in (
+                ("clear_opt_m", "S: min. clearing distance (opt. accel.)", "-", "#2e7d32"),
+                ("clear_buffered_m", "Sb: buffered clearing distance", "--", "#2e7d32"),
+                ("clear_const_m", "min. clearing distance at constant speed", ":", "#2e7d32"),
+                ("stop_m", "B0: stopping distance", "-", "#1565c0"),
+                ("stop_buffered_m", "Bb: buffered stopping distance", "--", "#1565c0")):
+            ax.plot(vs, [getattr(b, field) for b in bounds], linestyle=style, color=colour,
+                    linewidth=1.4, label=label)
+        ttc = np.array([b.ttc_s for b in bounds])
+        ax.plot(vs, ttc * vs, ":", color="#6d4c41", linewidth=1.4,
+                label=f"T: TTC line ({ttc[-1]:g} s)")
     for mode in sorted(_modes_in(seen)):
         sel = seen[seen["mode"] == mode]
         ax.scatter(-sel["aro_range_rate_mps"], sel["aro_range_m"], s=9,

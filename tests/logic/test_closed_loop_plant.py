@@ -12,7 +12,7 @@ import pytest
 
 from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, Perception
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
-from eoam_sumo.params import AIR_DENSITY_KGPM3, G_MPS2, aro_d_class_minivan, ego_e_class_sedan
+from eoam_sumo.params import AIR_DENSITY_KGPM3, aro_d_class_minivan, ego_e_class_sedan
 from eoam_sumo.plant import OUTPUT_NAMES, Plant, initial_state
 
 P = ego_e_class_sedan()
@@ -34,9 +34,15 @@ def plant():
 
 def corners(x, y, yaw, length, width):
     c, s = math.cos(yaw), math.sin(yaw)
-    return [(x + c * u - s * w, y + s * u + c * w)
-            for u, w in ((length / 2, width / 2), (length / 2, -width / 2),
-                         (-length / 2, -width / 2), (-length / 2, width / 2))]
+    return [
+        (x + c * u - s * w, y + s * u + c * w)
+        for u, w in (
+            (length / 2, width / 2),
+            (length / 2, -width / 2),
+            (-length / 2, -width / 2),
+            (-length / 2, width / 2),
+        )
+    ]
 
 
 def overlap(a, b):
@@ -61,7 +67,7 @@ def simulate(tables, plant, speed_mps, mu, obstacle_rear_m, detect_m, seconds):
     half_widths = 0.5 * (P.width_m + ARO.width_m)
     ax = ay = 0.0
     log = []
-    for k in range(int(round(seconds / DT))):
+    for k in range(round(seconds / DT)):
         t = k * DT
         X, Y, yaw, vx, vy, r = (float(x[i]) for i in range(6))
         rng = obstacle_rear_m - (X + P.cg_to_front_bumper_m * math.cos(yaw))
@@ -69,18 +75,29 @@ def simulate(tables, plant, speed_mps, mu, obstacle_rear_m, detect_m, seconds):
         perception = Perception(rng if seen else None, -vx if seen else None, False)
         meas = EgoMeasurement(t, vx, vy, r, ax, ay, X, Y, yaw, 0.0, mu, LANE)
         cmd = ctrl.step(meas, perception, DT)
-        x, y = plant.step(x, (cmd.steer_cmd_rad, cmd.drive_force_cmd_n, cmd.brake_force_cmd_n),
-                          mu)
+        x, y = plant.step(x, (cmd.steer_cmd_rad, cmd.drive_force_cmd_n, cmd.brake_force_cmd_n), mu)
         ax, ay = float(y[0]), float(y[1])
         X, Y, yaw, vx = float(x[0]), float(x[1]), float(x[2]), float(x[3])
         drag = 0.5 * AIR_DENSITY_KGPM3 * P.drag_area_m2 * vx * abs(vx) / P.mass_kg
         off = P.cg_to_front_bumper_m - P.length_m / 2  # CG to the footprint centre
-        ego = corners(X + off * math.cos(yaw), Y + off * math.sin(yaw), yaw, P.length_m,
-                      P.width_m)
+        ego = corners(X + off * math.cos(yaw), Y + off * math.sin(yaw), yaw, P.length_m, P.width_m)
         hit = overlap(ego, obstacle)
-        log.append(dict(t=t + DT, x=X, y=Y, yaw=yaw, vx=vx, ax=ax, ay=ay, mode=cmd.mode,
-                        tyre_accel=math.hypot(ax + drag, ay), locked=y[LOCK[0]] + y[LOCK[1]],
-                        hit=hit, cmd=cmd))
+        log.append(
+            {
+                "t": t + DT,
+                "x": X,
+                "y": Y,
+                "yaw": yaw,
+                "vx": vx,
+                "ax": ax,
+                "ay": ay,
+                "mode": cmd.mode,
+                "tyre_accel": math.hypot(ax + drag, ay),
+                "locked": y[LOCK[0]] + y[LOCK[1]],
+                "hit": hit,
+                "cmd": cmd,
+            }
+        )
         if hit:
             break
     return log, ctrl
@@ -96,8 +113,9 @@ def steer_detection_range(tables, mu, speed_mps):
 
 def lane_change_case(tables, plant, speed_mps, mu):
     detect = steer_detection_range(tables, mu, speed_mps)
-    log, ctrl = simulate(tables, plant, speed_mps, mu, P.cg_to_front_bumper_m + detect + 0.3,
-                         detect, seconds=30.0)
+    log, ctrl = simulate(
+        tables, plant, speed_mps, mu, P.cg_to_front_bumper_m + detect + 0.3, detect, seconds=30.0
+    )
     return log, ctrl
 
 
@@ -120,15 +138,17 @@ def check_lane_change(log, ctrl, mu, *, lane_tol_m, overshoot_m, ellipse, return
 def test_lane_change_120kmh_dry(tables, plant):
     """120 km/h, mu 1.0: 3.5 +/- 0.3 m, overshoot < 0.5 m, |a| <= 1.05 mu g, back within 0.2 m."""
     log, ctrl = lane_change_case(tables, plant, 120 / 3.6, 1.0)
-    check_lane_change(log, ctrl, 1.0, lane_tol_m=0.3, overshoot_m=0.5, ellipse=1.05,
-                      return_tol_m=0.2)
+    check_lane_change(
+        log, ctrl, 1.0, lane_tol_m=0.3, overshoot_m=0.5, ellipse=1.05, return_tol_m=0.2
+    )
 
 
 def test_lane_change_120kmh_snow(tables, plant):
     """120 km/h, mu 0.3: the same bounds (the slower, longer manoeuvre still fits the timer)."""
     log, ctrl = lane_change_case(tables, plant, 120 / 3.6, 0.3)
-    check_lane_change(log, ctrl, 0.3, lane_tol_m=0.3, overshoot_m=0.5, ellipse=1.05,
-                      return_tol_m=0.2)
+    check_lane_change(
+        log, ctrl, 0.3, lane_tol_m=0.3, overshoot_m=0.5, ellipse=1.05, return_tol_m=0.2
+    )
 
 
 def test_braking_stops_behind_the_obstacle(tables, plant):

@@ -1,17 +1,30 @@
 """DMM sector rules (paper sec. 5-6, Figure 14) on hand-made boundaries."""
 
 import math
+from types import SimpleNamespace
 
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from eoam_sumo.decision import SECTOR_ORDER, Action, BoundaryCurve, Sector, classify, dmm_sector
 
 # S, Sb, B0, Bb, ttc at some closing speed: steering needs less than braking (high speed)
-HIGH = dict(clear_m=30.0, clear_buffered_m=38.0, stop_m=60.0, stop_buffered_m=70.0, ttc_s=2.5)
+HIGH = {
+    "clear_m": 30.0,
+    "clear_buffered_m": 38.0,
+    "stop_m": 60.0,
+    "stop_buffered_m": 70.0,
+    "ttc_s": 2.5,
+}
 # braking needs less than steering (low speed)
-LOW = dict(clear_m=20.0, clear_buffered_m=25.0, stop_m=8.0, stop_buffered_m=12.0, ttc_s=2.5)
+LOW = {
+    "clear_m": 20.0,
+    "clear_buffered_m": 25.0,
+    "stop_m": 8.0,
+    "stop_buffered_m": 12.0,
+    "ttc_s": 2.5,
+}
 
 
 @pytest.mark.parametrize(
@@ -59,52 +72,64 @@ def test_invalid_range_is_g():
 
 
 bounds_st = st.tuples(
-    st.floats(0.0, 200.0), st.floats(0.0, 50.0), st.floats(0.0, 400.0), st.floats(0.0, 50.0),
+    st.floats(0.0, 200.0),
+    st.floats(0.0, 50.0),
+    st.floats(0.0, 400.0),
+    st.floats(0.0, 50.0),
     st.floats(0.5, 30.0),
 )
 
 
+@settings(database=None)
 @given(bounds_st, st.floats(0.1, 60.0), st.lists(st.floats(0.0, 600.0), min_size=2))
 def test_urgency_never_increases_with_distance(b, speed, ranges):
     s, ds, b0, db, ttc = b
     order = [
-        SECTOR_ORDER.index(classify(r, speed, s, s + ds, b0, b0 + db, ttc))
-        for r in sorted(ranges)
+        SECTOR_ORDER.index(classify(r, speed, s, s + ds, b0, b0 + db, ttc)) for r in sorted(ranges)
     ]
     assert order == sorted(order)
 
 
 class AnalyticBoundaries:
-    """Boundaries of the form the tables approximate: linear clearing, quadratic stopping."""
+    """Boundaries piecewise linear in v between the grid speeds (as the tables' ``at``)."""
 
-    class B:
-        def __init__(self, v):
-            self.clear_opt_m = 0.55 * v + 3.0
-            self.clear_buffered_m = self.clear_opt_m + 0.3 * v + 2.0
-            self.stop_m = v * v / 16.0
-            self.stop_buffered_m = self.stop_m + 0.3 * v + 2.0
-            self.ttc_s = 2.5
+    speed_grid_mps = tuple(v / 3.6 for v in range(20, 180, 5))
+
+    @staticmethod
+    def exact(v):
+        return (0.55 * v + 3.0, 0.85 * v + 5.0, v * v / 16.0, v * v / 16.0 + 0.3 * v + 2.0, 2.5)
 
     def at(self, mu, v):
-        assert 0.0 <= v <= 175 / 3.6 + 1e-9, "queried outside the speed range"
-        return self.B(v)
+        grid = self.speed_grid_mps
+        if v <= grid[0]:  # scaled to 0 below the grid
+            row = [x * max(v, 0.0) / grid[0] for x in self.exact(grid[0])]
+            row[4] = 2.5
+        elif v >= grid[-1]:
+            row = self.exact(grid[-1])
+        else:
+            j = next(i for i, g in enumerate(grid) if g > v)
+            w = (v - grid[j - 1]) / (grid[j] - grid[j - 1])
+            a, b = self.exact(grid[j - 1]), self.exact(grid[j])
+            row = [x + w * (y - x) for x, y in zip(a, b, strict=True)]
+        names = ("clear_opt_m", "clear_buffered_m", "stop_m", "stop_buffered_m", "ttc_s")
+        return SimpleNamespace(**dict(zip(names, row, strict=True)))
 
 
-@pytest.mark.parametrize("v", [0.0, 0.3, 1.0, 3.0, 5.5, 10.0, 33.3, 48.6, 60.0])
+@pytest.mark.parametrize("v", [0.0, 0.3, 1.0, 3.0, 5.5, 5.6, 10.0, 33.3, 48.6, 60.0])
 def test_boundary_curve_reproduces_the_boundaries(v):
-    curve = BoundaryCurve(AnalyticBoundaries(), 1.0, 175 / 3.6)
-    truth = AnalyticBoundaries.B(min(v, 175 / 3.6))
-    expected = (truth.clear_opt_m, truth.clear_buffered_m, truth.stop_m, truth.stop_buffered_m,
-                2.5)
-    # linear between 0.25 m/s samples: exact for the linear ones, v^2 within 0.25^2 / 64
-    assert curve.at(v) == pytest.approx(expected, abs=1e-3)
+    fake = AnalyticBoundaries()
+    curve = BoundaryCurve(fake, 1.0, fake.speed_grid_mps)
+    b = fake.at(1.0, v)
+    expected = (b.clear_opt_m, b.clear_buffered_m, b.stop_m, b.stop_buffered_m, b.ttc_s)
+    assert curve.at(v) == pytest.approx(expected, rel=1e-12, abs=1e-12)
 
 
-def test_boundary_curve_sector_agrees_with_classify():
-    curve = BoundaryCurve(AnalyticBoundaries(), 1.0, 175 / 3.6)
-    for v in (0.25, 2.0, 12.0, 30.0, 45.0):  # on the sample grid: the same numbers
-        b = AnalyticBoundaries.B(v)
+def test_boundary_curve_sector_agrees_with_dmm_sector():
+    fake = AnalyticBoundaries()
+    curve = BoundaryCurve(fake, 1.0, fake.speed_grid_mps)
+    for v in (0.25, 2.0, 7.7, 12.0, 30.0, 45.0):
         for d in (1.0, 5.0, 8.0, 10.0, 25.0, 40.0, 70.0, 120.0):
-            assert curve.sector(d, v) is dmm_sector(b, d, v)
-    assert curve.sector(5.0, 0.0) is Sector.G
-    assert curve.sector(5.0, math.nan) is Sector.G
+            assert curve.sector(d, v) is dmm_sector(fake.at(1.0, v), d, v)
+    for bad in (0.0, -1.0, math.nan, math.inf, 1e308 * 10):
+        assert curve.sector(5.0, bad) is Sector.G
+    assert curve.at(1e300) == curve.at(60.0)

@@ -14,7 +14,7 @@ def point_mass(ctrl_fn, v0, seconds, dt=0.01, sub=10):
     """m v' = F_drive - F_brake - F_res with first-order actuator lags (the plant's actuators)."""
     v, fd, fb, ax = v0, 0.0, 0.0, 0.0
     trace = []
-    for k in range(int(round(seconds / dt))):
+    for k in range(round(seconds / dt)):
         drive, brake = ctrl_fn(k * dt, v, ax)
         assert drive >= 0.0 and brake >= 0.0 and drive * brake == 0.0
         h = dt / sub
@@ -69,7 +69,8 @@ def test_speed_pid_reaches_the_set_speed(v0, v_ref, mu):
     brake_limit = 0.8 * mu * P.mass_kg * 9.81
     trace = point_mass(
         lambda t, v, ax: c.track_speed(v_ref, v, mu, *c.limits(v, mu, 0.0, brake_limit), 0.01)[:2],
-        v0, 40.0,
+        v0,
+        40.0,
     )
     final = [v for t, v, _ in trace if t > 35.0]
     assert max(abs(v - v_ref) for v in final) < 0.05
@@ -90,7 +91,8 @@ def test_acceleration_pid_tracks_a_profile(mu):
 
     trace = point_mass(
         lambda t, v, ax: c.track_accel(ref(t), ax, v, *c.limits(v, mu, 0.0, brake_limit), 0.01),
-        30.0, 6.0,
+        30.0,
+        6.0,
     )
     for t_lo, t_hi in ((1.5, 3.0), (4.5, 6.0)):
         errs = [abs(ax - ref(t)) for t, _, ax in trace if t_lo <= t < t_hi]

@@ -1,0 +1,67 @@
+"""Manoeuvre reference sampled from a table trajectory: scaling and the planned speed."""
+
+import math
+
+import pytest
+
+from eoam_sumo.control import PathReference
+
+H_TABLE = 3.5  # lane change of the tables [m]
+LENGTH = 60.0  # [m]
+AX = -3.0  # constant deceleration of the synthetic profile [m/s^2]
+
+
+class QuinticTrajectory:
+    """Closed-form trajectory in the tables' format: (y, ax, yaw, curvature, steer) at dx."""
+
+    length_m = LENGTH
+
+    def at(self, dx):
+        u = min(max(dx / LENGTH, 0.0), 1.0)
+        y = H_TABLE * (10 * u**3 - 15 * u**4 + 6 * u**5)
+        dy = H_TABLE * (30 * u**2 - 60 * u**3 + 30 * u**4) / LENGTH
+        ddy = H_TABLE * (60 * u - 180 * u**2 + 120 * u**3) / LENGTH**2
+        return y, AX, math.atan(dy), ddy / (1 + dy * dy) ** 1.5, 0.0
+
+
+@pytest.mark.parametrize(("start", "height"), [(0.0, 3.5), (0.1, 3.0), (3.4, -3.4)])
+def test_scaled_path_and_planned_speed(start, height):
+    ref = PathReference(
+        QuinticTrajectory(), start_offset_m=start, height_m=height, speed_mps=25.0, step_m=0.25
+    )
+    k = height / H_TABLE
+    assert ref.length_m == LENGTH and ref.start_offset_m == start
+    for dx in (0.0, 7.3, 30.0, 44.4, 59.9):
+        y, yaw, curv, ax, v = ref.at(dx)
+        y_t, _, yaw_t, curv_t, _ = QuinticTrajectory().at(dx)
+        assert y == pytest.approx(start + k * y_t, abs=2e-4)
+        assert yaw == pytest.approx(k * yaw_t, abs=1e-5)
+        assert curv == pytest.approx(k * curv_t, abs=1e-5)
+        assert ax == AX
+        # v^2 = v0^2 + 2 a dx for a constant acceleration (exact at the samples, linear between)
+        assert v == pytest.approx(math.sqrt(25.0**2 + 2 * AX * dx), rel=1e-6)
+    # held at both ends
+    assert ref.at(-5.0)[0] == pytest.approx(start)
+    assert ref.at(LENGTH + 50.0)[0] == pytest.approx(start + height, abs=1e-12)
+    assert ref.at(LENGTH + 50.0)[4] == pytest.approx(math.sqrt(25.0**2 + 2 * AX * LENGTH))
+
+
+def test_speed_profile_stops_at_zero():
+    ref = PathReference(
+        QuinticTrajectory(), start_offset_m=0.0, height_m=3.5, speed_mps=10.0, step_m=0.5
+    )
+    # 10^2 / (2 * 3) = 16.7 m to standstill: the planned speed stays 0 afterwards
+    assert ref.at(16.0)[4] > 0.0 and ref.at(20.0)[4] == 0.0
+
+
+def test_rejects_unusable_trajectories():
+    class Flat(QuinticTrajectory):
+        def at(self, dx):
+            return 0.0, 0.0, 0.0, 0.0, 0.0
+
+    with pytest.raises(ValueError, match="lateral travel"):
+        PathReference(Flat(), start_offset_m=0.0, height_m=3.5, speed_mps=20.0, step_m=0.5)
+    with pytest.raises(ValueError, match="step_m"):
+        PathReference(
+            QuinticTrajectory(), start_offset_m=0.0, height_m=3.5, speed_mps=20.0, step_m=0.0
+        )
