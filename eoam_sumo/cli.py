@@ -192,8 +192,11 @@ def main(argv: list[str] | None = None) -> int:
         args = build_parser().parse_args(argv)
         return _COMMANDS[args.command](args)
     except InputError as exc:
-        print(f"eoam-sumo: error: {exc}", file=sys.stderr)
+        print(f"eoam-sumo: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except RuntimeError as exc:  # a SUMO failure, an optimiser that did not converge
+        print(f"eoam-sumo: failed: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("eoam-sumo: interrupted", file=sys.stderr)
         return 130

@@ -17,8 +17,11 @@ References per mode (road frame of the ego's original lane, d left positive):
 * 3 ONCOMING BRAKE: limit braking to standstill in the original lane: lane keeping to d = 0
   (the lane change is abandoned), the brake force shrunk by the friction ellipse while the
   ego still turns so that no wheel locks.
-* 5 RETURN: the same table shape, at the current speed and friction, scaled from the current
-  offset back to d = 0, at the speed held when the return began.
+* 5 RETURN: a quintic (sec. 4.2) from the current offset back to d = 0 at the speed held
+  when the return began, long enough for its peak lateral acceleration to be
+  ``return_lateral_g`` mu g (``evasive_return_lateral_g`` when oncoming traffic ended the lane
+  change, mode 4). The table's minimum-distance path is not reused: it is that short only
+  with its braking profile, which a return does not need.
 """
 
 from __future__ import annotations
@@ -34,11 +37,6 @@ from eoam_sumo.decision.modes import Mode, next_mode
 from eoam_sumo.params import G_MPS2, VehicleParams
 
 _TWO_PI = 2.0 * math.pi
-import os
-YD_PV = float(os.environ.get('YD_PV', '0'))
-PV = os.environ.get('PV')
-KR = os.environ.get('KR')
-W = os.environ.get('W')
 
 
 @dataclass(frozen=True, slots=True)
@@ -96,16 +94,17 @@ class EoamSettings:
     ponr_fraction: float = 0.3  # point of no return / lane-change height (sec. 8.1)
     manoeuvre_time_s: float = 8.0  # steering manoeuvre timer before RETURN (sec. 3.1 step 5)
     arrive_tolerance_m: float = 0.25  # mode 4: next lane reached within this of its target
-    settle_offset_m: float = 0.2  # mode 5 -> 0: |d| below this ...
+    settle_offset_m: float = 0.1  # mode 5 -> 0: |d| below this ...
     settle_heading_rad: float = 0.02  # ... and |e_yaw| below this ...
     settle_dwell_s: float = 0.5  # ... for this long after the return path ended
     release_opening_speed_mps: float = 0.5  # mode 1 -> 0: obstacle pulls away faster than this
     min_steer_speed_mps: float = 20.0 / 3.6  # below it a STEER sector brakes instead
     limit_brake_fraction: float = 0.95  # share of the no-lock brake force used as limit braking
     reference_step_m: float = 0.25  # dx spacing of the sampled manoeuvre reference
-    return_lateral_g: float = float(__import__('os').environ.get('RG', '0.5'))  # mode 5: peak lateral acceleration of the return / mu g
+    return_lateral_g: float = 0.3  # mode 5 after 2: return's peak lateral acceleration / (mu g)
+    evasive_return_lateral_g: float = 0.6  # mode 5 after 4 (oncoming traffic): the same
     return_min_length_m: float = 10.0  # mode 5: shortest return path
-    preview_time_s: float = float(PV) if PV else 0.3  # feedforward curvature taken this far ahead on the path
+    preview_time_s: float = 0.3  # feedforward curvature taken this far ahead on the path
     steering: SteeringGains = field(default_factory=SteeringGains)
     longitudinal: LongitudinalGains = field(default_factory=LongitudinalGains)
 
@@ -121,6 +120,9 @@ class EoamSettings:
         for name in (
             "manoeuvre_time_s",
             "reference_step_m",
+            "return_lateral_g",
+            "evasive_return_lateral_g",
+            "return_min_length_m",
             "settle_offset_m",
             "settle_heading_rad",
             "arrive_tolerance_m",
@@ -197,7 +199,7 @@ class EoamController:
         self._settle_since = None
         self._long.reset()
 
-    def _enter(self, mode: Mode, meas: EgoMeasurement) -> None:
+    def _enter(self, mode: Mode, previous: Mode, meas: EgoMeasurement) -> None:
         """Entry actions of a new mode (mode 4 keeps the lane change of mode 2 going)."""
         if mode is Mode.UPDATE_STEER_BRAKE:
             self._hold_speed = None
@@ -208,9 +210,10 @@ class EoamController:
         elif mode is Mode.RETURN:
             self._hold_speed = meas.vx_mps
             st = self.settings
+            urgent = previous is Mode.ONCOMING_STEER_BRAKE
+            lateral_g = st.evasive_return_lateral_g if urgent else st.return_lateral_g
             traj = QuinticLaneChange.for_lateral_accel(
-                meas.d_m, meas.vx_mps, st.return_lateral_g * meas.mu * G_MPS2,
-                st.return_min_length_m,
+                meas.d_m, meas.vx_mps, lateral_g * meas.mu * G_MPS2, st.return_min_length_m
             )
             self._start_path(meas, traj, meas.d_m, -meas.d_m)
         elif mode is not Mode.ONCOMING_STEER_BRAKE:
@@ -278,8 +281,8 @@ class EoamController:
             threat_gone=threat_gone,
         )
         if new is not mode:
+            self._enter(new, mode, meas)
             self.mode = mode = new
-            self._enter(new, meas)
             path = self._path
             dx = meas.s_m - self._s0 if path is not None else 0.0
 
@@ -291,8 +294,6 @@ class EoamController:
             in_path = dx < path.length_m
             if in_path:
                 kappa_ff = path.at(dx + v * st.preview_time_s)[2]
-                if YD_PV > 0:
-                    kappa_ref = path.at(dx + v * YD_PV)[2]
             else:
                 yaw_ref = kappa_ref = 0.0
         e_lat = d - y_ref

@@ -6,7 +6,7 @@ from eoam_sumo.control.longitudinal import (
     Pid,
     resistance_force_n,
 )
-from eoam_sumo.control.reference import PathReference
+from eoam_sumo.control.reference import PathReference, QuinticLaneChange
 from eoam_sumo.control.steering import SteeringController, SteeringGains, understeer_gradient
 
 __all__ = [
@@ -14,6 +14,7 @@ __all__ = [
     "LongitudinalGains",
     "PathReference",
     "Pid",
+    "QuinticLaneChange",
     "SteeringController",
     "SteeringGains",
     "resistance_force_n",

@@ -30,21 +30,25 @@ from eoam_sumo.params import VehicleParams
 class SteeringGains:
     """Design values of the steering schedule."""
 
-    natural_freq_radps: float = float(__import__('os').environ.get('W', '2.2'))  # omega_0 [rad/s]
-    damping_ratio: float = float(__import__('os').environ.get('Z', '1.5'))  # zeta [-]
+    natural_freq_radps: float = 2.2  # omega_0, at mu = 1 and v >= v_full [rad/s]
+    damping_ratio: float = 1.5  # zeta [-]
     min_lookahead_m: float = 4.0  # floor of x_la [m]
     schedule_min_speed_mps: float = 5.0  # speed floor used in the schedule [m/s]
-    full_bandwidth_speed_mps: float = float(__import__('os').environ.get('VF', '15.0'))  # v_full [m/s]
-    yaw_damping_s: float = float(__import__('os').environ.get('KR', '0.22'))  # k_r [rad per rad/s]
-    friction_exponent: float = float(__import__('os').environ.get('FE', '0.25'))  # p [-]
+    full_bandwidth_speed_mps: float = 15.0  # v_full: omega falls linearly below it [m/s]
+    yaw_damping_s: float = 0.22  # k_r [rad per rad/s]
+    friction_exponent: float = 0.25  # p: omega scales with mu^p [-]
 
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
             if not (math.isfinite(v) and v >= 0.0):
                 raise ValueError(f"steering gain {f.name}={v!r} must be finite and >= 0")
-        for name in ("natural_freq_radps", "damping_ratio", "schedule_min_speed_mps",
-                     "full_bandwidth_speed_mps"):
+        for name in (
+            "natural_freq_radps",
+            "damping_ratio",
+            "schedule_min_speed_mps",
+            "full_bandwidth_speed_mps",
+        ):
             if getattr(self, name) <= 0.0:
                 raise ValueError(f"steering gain {name} must be > 0")
 

@@ -469,8 +469,15 @@ class SumoSession:
                 f"before the simulation begins ({self._time_s:g} s)"
             )
         if self._overrides.mu is not None:
+            settable = True
             for lane_id in self._lane.getIDList():
-                self._lane.setFriction(lane_id, self._overrides.mu)
+                self._mu_cache[lane_id] = self._overrides.mu
+                if settable:
+                    try:
+                        self._lane.setFriction(lane_id, self._overrides.mu)
+                    except Exception:  # noqa: BLE001 - TraCI's class may come from SUMO_HOME/tools
+                        # TraCI of SUMO 1.28 cannot set friction: the override lives here only
+                        settable = False
         while self._time_s < depart - 0.5 * self._dt:
             self._sumo_step()
         self.ego_depart_time_s = self._time_s

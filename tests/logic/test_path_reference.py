@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from eoam_sumo.control import PathReference
+from eoam_sumo.control import PathReference, QuinticLaneChange
 
 H_TABLE = 3.5  # lane change of the tables [m]
 LENGTH = 60.0  # [m]
@@ -65,3 +65,17 @@ def test_rejects_unusable_trajectories():
         PathReference(
             QuinticTrajectory(), start_offset_m=0.0, height_m=3.5, speed_mps=20.0, step_m=0.0
         )
+
+
+@pytest.mark.parametrize(("height", "speed", "accel"), [(3.5, 33.3, 2.94), (-2.0, 15.0, 0.9)])
+def test_quintic_lane_change_peaks_at_the_asked_lateral_acceleration(height, speed, accel):
+    traj = QuinticLaneChange.for_lateral_accel(height, speed, accel, min_length_m=1.0)
+    ref = PathReference(traj, start_offset_m=0.0, height_m=height, speed_mps=speed, step_m=0.1)
+    n = 400
+    peak = max(abs(ref.at(traj.length_m * i / n)[2]) for i in range(n + 1)) * speed**2
+    assert peak == pytest.approx(accel, rel=2e-3)
+    assert ref.at(traj.length_m)[0] == pytest.approx(height, abs=1e-12)
+    assert ref.at(traj.length_m / 2)[0] == pytest.approx(height / 2, abs=1e-12)
+    assert ref.at(traj.length_m)[4] == speed  # constant speed
+    # never shorter than asked
+    assert QuinticLaneChange.for_lateral_accel(0.01, 5.0, 9.0, 12.0).length_m == 12.0

@@ -67,17 +67,19 @@ def test_clipped_to_the_steering_lock():
     assert delta == -P.max_steer_rad
 
 
-@pytest.mark.parametrize("v", [8.0, 20.0, 33.3, 45.8])
+@pytest.mark.parametrize("v", [3.0, 8.0, 20.0, 33.3, 45.8])
 @pytest.mark.parametrize("mu", [1.0, 0.3, 0.1])
 def test_schedule_places_the_kinematic_error_poles(v, mu):
-    """e' = v psi, psi' = v delta / (L + K v^2): the same omega(mu), zeta at every speed."""
+    """e' = v psi, psi' = v delta / (L + K v^2): s^2 + 2 zeta omega s + omega^2 at any speed."""
     g = SteeringGains()
     ctrl = SteeringController(P, g)
     k, x = ctrl.schedule(v, mu)
-    l_eff = P.wheelbase_m + understeer_gradient(P) * v * v
-    a = np.array([[0.0, v], [-v * k / l_eff, -v * k * x / l_eff]])
+    v_s = max(v, g.schedule_min_speed_mps)  # the schedule's speed floor
+    l_eff = P.wheelbase_m + understeer_gradient(P) * v_s * v_s
+    a = np.array([[0.0, v_s], [-v_s * k / l_eff, -v_s * k * x / l_eff]])
     omega = g.natural_freq_radps * mu**g.friction_exponent
-    # characteristic polynomial s^2 + 2 zeta omega s + omega^2
+    omega *= min(1.0, v_s / g.full_bandwidth_speed_mps)
+    assert ctrl.natural_freq(v, mu) == pytest.approx(omega, rel=1e-12)
     assert np.poly(a) == pytest.approx([1.0, 2.0 * g.damping_ratio * omega, omega**2], rel=1e-6)
 
 

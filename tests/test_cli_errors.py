@@ -1,0 +1,119 @@
+"""Bad input on every CLI path: exit status 2, one line on stderr naming the culprit."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from eoam_sumo.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+SCEN = ROOT / "scenarios"
+
+
+def _copy_scenario(tmp_path: Path) -> Path:
+    """A private copy of the baseline scenario (sumocfg, routes, vTypes, net, parking)."""
+    dst = tmp_path / "scen"
+    shutil.copytree(SCEN, dst)
+    shutil.copytree(ROOT / "networks", tmp_path / "networks")
+    return dst / "baseline.sumocfg"
+
+
+def _check(capsys, argv, needle):
+    status = main(argv)
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if ln.startswith("eoam-sumo")]
+    assert status == 2, err
+    assert len(lines) == 1 and needle in lines[0], err
+    assert "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    "argv, needle",
+    [
+        (["run", "nope.sumocfg"], "nope.sumocfg"),
+        (["run", str(SCEN / "baseline.sumocfg"), "--mu", "0"], "mu 0"),
+        (["run", str(SCEN / "baseline.sumocfg"), "--mu", "1.3"], "1.3"),
+        (["run", str(SCEN / "baseline.sumocfg"), "--speed-kmh", "abc"], "abc"),
+        (["run", str(SCEN / "baseline.sumocfg"), "--oncoming-m", "-10"], "-10"),
+        (["run", str(SCEN / "baseline.sumocfg"), "--oncoming-m", "far"], "far"),
+        (["run", str(SCEN / "baseline.sumocfg"), "--speed-kmh", "300"], "300"),
+        (["run", str(SCEN / "baseline.sumocfg"), "--frobnicate"], "--frobnicate"),
+        (["tables", "--jobs", "0"], "0"),
+        (["batch", "missing.toml"], "missing.toml"),
+        (["plot", "no_such_folder"], "no_such_folder"),
+        (["launch"], "launch"),
+    ],
+)
+def test_bad_arguments(capsys, tmp_path, argv, needle):
+    _check(capsys, argv + (["--out", str(tmp_path / "o")] if argv[0] in ("run",) else []), needle)
+
+
+def test_malformed_sumocfg(capsys, tmp_path):
+    cfg = tmp_path / "broken.sumocfg"
+    cfg.write_text("<configuration><input><net-file value='x.net.xml'/>")
+    _check(capsys, ["run", str(cfg), "--out", str(tmp_path / "o")], "broken.sumocfg")
+
+
+@pytest.mark.parametrize("victim", ["baseline.rou.xml", "../networks/highway.net.xml"])
+def test_malformed_route_or_net_file(capsys, tmp_path, victim):
+    cfg = _copy_scenario(tmp_path)
+    target = (cfg.parent / victim).resolve()
+    target.write_text(target.read_text()[:200])  # cut off mid-element
+    _check(capsys, ["run", str(cfg), "--out", str(tmp_path / "o")], target.name)
+
+
+def test_sumocfg_without_ego(capsys, tmp_path):
+    cfg = _copy_scenario(tmp_path)
+    _check(capsys, ["run", str(cfg), "--ego", "hero", "--out", str(tmp_path / "o")], "hero")
+
+
+def test_unwritable_output_folder(capsys, tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    _check(
+        capsys, ["run", str(SCEN / "baseline.sumocfg"), "--out", str(blocker / "sub")],
+        str(blocker),
+    )
+
+
+@pytest.mark.parametrize(
+    "text, needle",
+    [
+        ("[scenario\nsumocfg = 1", "m.toml"),
+        ('[scenario]\nsumocfg = "baseline.sumocfg"\n[sweep]\nego_sped_kmh = [120]\n',
+         "ego_sped_kmh"),
+        ('[scenario]\nsumocfg = "baseline.sumocfg"\n[sweep]\nego_speed_kmh = [120]\nmu = [2.0]\n',
+         "mu"),
+        ('[scenario]\nsumocfg = "baseline.sumocfg"\n[sweep]\nego_speed_kmh = [120]\nmu = [1.0]\n'
+         'oncoming_start_m = [-3]\n', "oncoming_start_m"),
+        ('[scenario]\nsumocfg = "baseline.sumocfg"\n[weather]\nrain = true\n', "weather"),
+    ],
+)
+def test_bad_matrix(capsys, tmp_path, text, needle):
+    matrix = tmp_path / "m.toml"
+    shutil.copy(SCEN / "baseline.sumocfg", tmp_path / "baseline.sumocfg")
+    matrix.write_text(text)
+    _check(capsys, ["batch", str(matrix), "--out", str(tmp_path / "o")], needle)
+
+
+def test_results_already_written_survive_a_bad_resume(capsys, tmp_path):
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "results.csv").write_text("case_id,outcome\nx,green\n")
+    _check(capsys, ["batch", str(tmp_path / "missing.toml"), "--out", str(out), "--resume"],
+           "missing.toml")
+    assert (out / "results.csv").read_text() == "case_id,outcome\nx,green\n"
+
+
+def test_python_dash_m_behaves_the_same(tmp_path):
+    proc = subprocess.run(
+        [sys.executable, "-m", "eoam_sumo", "run", str(SCEN / "baseline.sumocfg"), "--mu", "9"],
+        capture_output=True, text=True, timeout=120, cwd=tmp_path,
+    )
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "9" in proc.stderr
