@@ -1,11 +1,6 @@
 """Online controllers: steering (paper eq. 38), longitudinal PIDs (sec. 9), path references."""
 
-from eoam_sumo.control.longitudinal import (
-    LongitudinalController,
-    LongitudinalGains,
-    Pid,
-    resistance_force_n,
-)
+from eoam_sumo.control.longitudinal import LongitudinalController, LongitudinalGains, Pid
 from eoam_sumo.control.reference import PathReference, QuinticLaneChange
 from eoam_sumo.control.steering import SteeringController, SteeringGains, understeer_gradient
 
@@ -17,6 +12,5 @@ __all__ = [
     "QuinticLaneChange",
     "SteeringController",
     "SteeringGains",
-    "resistance_force_n",
     "understeer_gradient",
 ]

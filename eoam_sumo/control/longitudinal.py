@@ -49,15 +49,6 @@ class LongitudinalGains:
                 raise ValueError(f"longitudinal gain {name} must be > 0")
 
 
-def resistance_force_n(params: VehicleParams, speed_mps: float) -> float:
-    """Rolling resistance plus aerodynamic drag at a forward speed [N]."""
-    if speed_mps <= 0.0:
-        return 0.0
-    return params.mass_kg * G_MPS2 * params.rolling_resistance_coeff + (
-        0.5 * AIR_DENSITY_KGPM3 * params.drag_area_m2 * speed_mps * speed_mps
-    )
-
-
 class Pid:
     """Discrete PID on an error, derivative on the error, clamped conditional integration."""
 
@@ -132,7 +123,9 @@ class LongitudinalController:
         self._accel.reset()
         self._speed.reset()
 
-    def _resistance(self, v: float) -> float:
+    def resistance_n(self, speed_mps: float) -> float:
+        """Rolling resistance plus aerodynamic drag at a forward speed [N] (feedforward)."""
+        v = speed_mps
         return self._res0 + self._drag * v * v if v > 0.0 else 0.0
 
     def limits(
@@ -165,7 +158,7 @@ class LongitudinalController:
     ):
         """Acceleration PID with feedforward m*ax_ref + F_res: (drive, brake)."""
         m = self._m
-        res = self._resistance(speed_mps)
+        res = self.resistance_n(speed_mps)
         lo = -(brake_limit_n + res) / m - ax_ref
         hi = (drive_limit_n - res) / m - ax_ref
         corr = self._accel.update(ax_ref - ax_mps2, dt_s, lo, max(hi, lo))
@@ -184,6 +177,6 @@ class LongitudinalController:
         lim = self._alim_g * mu
         a = self._speed.update(speed_ref_mps - speed_mps, dt_s, -lim, lim)
         drive, brake = self.split(
-            self._m * a + self._resistance(speed_mps), drive_limit_n, brake_limit_n
+            self._m * a + self.resistance_n(speed_mps), drive_limit_n, brake_limit_n
         )
         return drive, brake, a

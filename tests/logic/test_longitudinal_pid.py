@@ -4,10 +4,19 @@ import math
 
 import pytest
 
-from eoam_sumo.control import LongitudinalController, LongitudinalGains, Pid, resistance_force_n
+from eoam_sumo.control import LongitudinalController, LongitudinalGains, Pid
 from eoam_sumo.params import ego_e_class_sedan
 
 P = ego_e_class_sedan()
+
+
+def resistance_n(v):
+    """Rolling resistance and drag, written out independently of the controller."""
+    return (
+        P.mass_kg * 9.81 * P.rolling_resistance_coeff + 0.5 * 1.2 * P.drag_area_m2 * v * v
+        if v > 0.0
+        else 0.0
+    )
 
 
 def point_mass(ctrl_fn, v0, seconds, dt=0.01, sub=10):
@@ -21,7 +30,7 @@ def point_mass(ctrl_fn, v0, seconds, dt=0.01, sub=10):
         for _ in range(sub):
             fd += (drive - fd) * h / P.drive_lag_s
             fb += (brake - fb) * h / P.brake_lag_s
-            ax = (fd - fb - resistance_force_n(P, v)) / P.mass_kg
+            ax = (fd - fb - resistance_n(v)) / P.mass_kg
             v += ax * h
         trace.append((k * dt, v, ax))
     return trace
@@ -56,11 +65,10 @@ def test_force_limits_engine_traction_and_friction_ellipse():
     assert c.limits(10.0, 0.3, 0.3 * 9.81, 12000.0) == (0.0, 0.0)
 
 
-def test_resistance_closed_form():
-    v = 30.0
-    expected = P.mass_kg * 9.81 * P.rolling_resistance_coeff + 0.5 * 1.2 * P.drag_area_m2 * v * v
-    assert resistance_force_n(P, v) == pytest.approx(expected)
-    assert resistance_force_n(P, 0.0) == 0.0
+def test_resistance_feedforward_matches_the_closed_form():
+    c = LongitudinalController(P)
+    for v in (0.0, 5.0, 30.0, 45.8):
+        assert c.resistance_n(v) == pytest.approx(resistance_n(v), rel=1e-12)
 
 
 @pytest.mark.parametrize(("v0", "v_ref", "mu"), [(30.0, 33.3, 1.0), (25.0, 20.0, 0.3)])
