@@ -74,7 +74,8 @@ class DesignSettings:
     verify_ellipse_tol: float = _p(
         0.03, "-", DESIGN + ": allowed excess of the friction-ellipse use between the nodes")
     steer_buffer_time_s: float = _p(
-        0.3, "s", DESIGN + ": DMM step 10 ms + steering lag 0.05 s + tracking transient ~0.2 s")
+        0.6, "s", DESIGN + ": DMM step 10 ms + steering lag 0.05 s + closed-loop lateral lag "
+        "~0.25 s (measured) + the ARO still braking during the steer (~0.5 a t_c^2)")
     steer_buffer_m: float = _p(2.0, "m", DESIGN + ": visual-comfort margin (sec. 6.2)")
     brake_buffer_time_s: float = _p(
         0.3, "s", DESIGN + ": DMM step + brake build-up (lag 0.1 s, about 3 time constants)")

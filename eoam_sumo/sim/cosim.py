@@ -57,6 +57,18 @@ class RunSettings:
         return round(self.step_s / self.plant_dt_s)
 
 
+SENSE_MARGIN_M = 10.0  # SUMO reports front bumpers: a body reaching into range is this close [m]
+GAP_WATCH_M = 20.0  # centre distance under which box gaps are measured and contact checked [m]
+
+
+def _target(body, parked: dict) -> Target:
+    """Radar target of a SUMO body; parked ones are remembered in ``parked`` by id."""
+    tgt = Target(body.x_m, body.y_m, body.yaw_rad, body.speed_mps, body.length_m, body.width_m)
+    if body.parked:
+        parked[body.vid] = tgt
+    return tgt
+
+
 def _nav_deg(yaw_rad: float) -> float:
     """SUMO navigation angle (degrees clockwise from north) of a math yaw."""
     return (90.0 - math.degrees(yaw_rad)) % 360.0
@@ -115,12 +127,12 @@ class CoSimulation:
         ctrl = EoamController(p, self.tables, st.eoam)
         ctrl.reset(ego.speed_mps)
         mu0 = session.friction_at_ego()
-        sense_radius = st.radar.range_m + 20.0
+        sense_radius = st.radar.range_m + SENSE_MARGIN_M
         steps = int(round(st.max_time_s / st.step_s))
         log = RunLog(steps + 1)
         prof = self.profile = dict.fromkeys(("sense", "control", "plant", "sumo", "contact"), 0.0)
         front = p.cg_to_front_bumper_m
-        ego_radius = 0.5 * math.hypot(p.length_m, p.width_m)
+        ego_radius = 0.5 * math.hypot(p.length_m, p.width_m) + front - 0.5 * p.length_m
         ax = ay = 0.0
         first_contact = None
         min_gap_aro = math.inf
@@ -128,6 +140,7 @@ class CoSimulation:
         stop_at = None
         t = t_start = session.time_s
         bodies = session.nearby(sense_radius)
+        parked_targets: dict[str, Target] = {}  # parked cars do not move: build their box once
         loop0 = clock()
         n_steps = 0
         for n_steps in range(1, steps + 1):
@@ -139,8 +152,7 @@ class CoSimulation:
             cy, sy = math.cos(yaw), math.sin(yaw)
             report = self.radar.scan(
                 (X + front * cy, Y + front * sy), yaw, vx, road,
-                [Target(b.x_m, b.y_m, b.yaw_rad, b.speed_mps, b.length_m, b.width_m)
-                 for b in bodies],
+                [parked_targets.get(b.vid) or _target(b, parked_targets) for b in bodies],
                 lane_width,
             )
             perception = Perception(
@@ -173,23 +185,30 @@ class CoSimulation:
             bodies_next = session.nearby(sense_radius)
             # --- ground truth: oriented-box contact at every plant sub-step ---------------------
             c5 = clock()
-            before = {b.vid: b for b in bodies}
+            ego_box = OrientedBox.from_axis_point(Xn, Yn, yawn, p.length_m, p.width_m, front)
+            # farthest any point of the ego box moved during the step (translation + rotation)
+            ego_move = math.hypot(Xn - x_prev[0], Yn - x_prev[1]) + ego_radius * abs(
+                yawn - x_prev[2])
             for b in bodies_next:
-                dist = math.hypot(b.x_m - Xn, b.y_m - Yn)
-                if dist > 40.0:
+                centres_m = math.hypot(b.x_m - ego_box.x_m, b.y_m - ego_box.y_m)
+                if centres_m > GAP_WATCH_M:
                     continue
-                role = role_of(b, road, lane_width)
+                reach_m = ego_move + b.speed_mps * st.step_s + 0.05
+                if b.parked and centres_m - ego_box.radius_m - 0.5 * math.hypot(
+                        b.length_m, b.width_m) > reach_m:
+                    continue  # bounding circles apart by more than anything moved
+                gap = box_distance(ego_box, OrientedBox(b.x_m, b.y_m, b.yaw_rad, b.length_m,
+                                                        b.width_m))
+                # a parked car cannot be the ARO: its role is worked out only if it is hit
+                role = None if b.parked else role_of(b, road, lane_width)
                 if role == "aro":
-                    box = OrientedBox(b.x_m, b.y_m, b.yaw_rad, b.length_m, b.width_m)
-                    ego_box = OrientedBox.from_axis_point(
-                        Xn, Yn, yawn, p.length_m, p.width_m, front
-                    )
-                    min_gap_aro = min(min_gap_aro, box_distance(ego_box, box))
-                sweep = 2.0 + 0.5 * math.hypot(b.length_m, b.width_m)
-                if first_contact is None and dist < ego_radius + sweep:
-                    hit = self._substep_contact(x_prev, x, b, before.get(b.vid))
+                    min_gap_aro = min(min_gap_aro, gap)
+                # contact during the step is possible only if the gap is within both moves
+                if first_contact is None and gap <= reach_m:
+                    before = next((o for o in bodies if o.vid == b.vid), b)
+                    hit = self._substep_contact(x_prev, x, b, before)
                     if hit is not None:
-                        first_contact = (hit, role, t)
+                        first_contact = (hit, role or role_of(b, road, lane_width), t)
             bodies = bodies_next
             max_lat_offset = max(max_lat_offset, abs(d))
             c6 = clock()
@@ -253,11 +272,11 @@ class CoSimulation:
             return True
         return ctrl.mode in (1, 3) and float(x[3]) < 0.05
 
-    def _substep_contact(self, x_prev, x_next, body, body_prev):
-        """First contact at any plant sub-step between ego and body, poses interpolated."""
+    def _substep_contact(self, x_prev, x_next, body, b0):
+        """First contact at any plant sub-step between ego and body (``b0`` its pose at the
+        start of the step), both poses interpolated linearly over the step."""
         p = self.params
         n = self.settings.substeps
-        b0 = body_prev or body
         for k in range(1, n + 1):
             w = k / n
             ex = x_prev[0] + w * (x_next[0] - x_prev[0])

@@ -167,7 +167,11 @@ def classify_outcome(
             raise ValueError(f"{name}={v!r} must be finite")
     if not lane_width_m > 0.0:
         raise ValueError(f"lane_width_m={lane_width_m} must be > 0")
-    lane_change = abs(max_lateral_offset_m) >= settings.point_of_no_return_fraction * lane_width_m
+    # mode 3 is entered only before the point of no return: limit braking was chosen, whatever
+    # lateral drift the aborted steer leaves (paper sec. 8.1, design.md 3.4 yellow)
+    lane_change = 3 not in modes and (
+        abs(max_lateral_offset_m) >= settings.point_of_no_return_fraction * lane_width_m
+    )
     if contact is None:
         return _no_contact(modes, lane_change, final_offset_m, final_speed_mps, settings)
     if role not in ROLES:

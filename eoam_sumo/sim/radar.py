@@ -163,6 +163,7 @@ class Radar:
         self.settings = settings
         self._half_fov_rad = math.radians(0.5 * settings.fov_deg)
         self._cos_half_fov = math.cos(self._half_fov_rad)
+        self._sin_half_fov = math.sin(self._half_fov_rad)
 
     def visible_range_m(
         self, origin_xy: tuple[float, float], yaw_rad: float, box: OrientedBox
@@ -215,6 +216,10 @@ class Radar:
             dx, dy = box.x_m - ox, box.y_m - oy
             reach = st.range_m + box.radius_m
             if dx * dx + dy * dy > reach * reach:
+                continue
+            # cheap rejection: the box's bounding circle lies wholly outside the cone
+            along, across = dx * bx + dy * by, abs(dy * bx - dx * by)
+            if along * self._sin_half_fov - across * self._cos_half_fov < -box.radius_m:
                 continue
             rng, px, py = self._visible_point(ox, oy, ego_yaw_rad, box)
             if rng > st.range_m:

@@ -250,5 +250,13 @@ def test_invariants(modes, max_offset, hit, role, final_offset, final_speed):
         assert out.collision_with == ("aro" if role == "other" else role)
         assert out.impact_speed_mps == hit.impact_speed_mps
         assert (out.colour == "red") == (role == "oncoming" and hit.kind in ("head_on", "oblique"))
-        if abs(max_offset) >= PONR_M:
+        if abs(max_offset) >= PONR_M and 3 not in modes:
             assert out.colour != "yellow"
+
+
+def test_aborted_steer_that_drifts_past_the_ponr_is_still_limit_braking():
+    """Mode 3 (oncoming seen before the PONR) then a front hit on the ARO: yellow."""
+    hit = Contact("rear_end", "front", "rear", 9.0, (0.0, 0.0))
+    out = classify_outcome([0, 1, 2, 3], 1.6, 3.5, hit, "aro")
+    assert out.colour == "yellow" and "limit braking" in out.reason
+
