@@ -246,6 +246,9 @@ class EoamController:
             action = sector.action
             if action is Action.STEER and v < st.min_steer_speed_mps:
                 action = Action.BRAKE  # too slow for a lane change: braking needs less room
+            elif (action is Action.STEER and self.mode is Mode.UPDATE_BRAKE
+                  and rng > self._curve.at(closing)[2]):
+                action = Action.BRAKE  # braking already stops short of it: no lane change
             threat_gone = closing < -st.release_opening_speed_mps
         else:
             sector = None

@@ -152,14 +152,14 @@ def test_lane_change_120kmh_snow(tables, plant):
 
 
 def test_braking_stops_behind_the_obstacle(tables, plant):
-    """80 km/h on snow (mu 0.3), seen at 100 m: sector D brakes, and braking at the no-lock
-    limit leaves the phase point outside the steering sectors: a stop behind the obstacle."""
+    """80 km/h on snow (mu 0.3), seen at 100 m: sector D brakes; steering sectors met later
+    while braking still stops short (d > B0) do not start a lane change: a stop behind it."""
     speed, mu, rear = 80 / 3.6, 0.3, 140.0
     log, ctrl = simulate(tables, plant, speed, mu, rear, 100.0, seconds=15.0)
     assert not any(r["hit"] for r in log), "the ego hit the obstacle"
     assert ctrl.modes_visited == [0, 1] and ctrl.fcw_raised
     sectors = {r["cmd"].sector for r in log}
-    assert "D" in sectors and not sectors & {"A", "B", "C", "F"}
+    assert "D" in sectors and "A" not in sectors
     assert log[-1]["vx"] < 0.05
     gap = rear - (log[-1]["x"] + P.cg_to_front_bumper_m)
     assert 0.0 < gap < 15.0

@@ -1,0 +1,24 @@
+"""The benchmark runs on tiny settings and writes every key (no timing is asserted)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+from eoam_sumo.bench import TARGETS, run_bench
+
+KEYS = (
+    "realtime_factor", "sumo_only_realtime_factor", "tables_wall_s", "batch_wall_s",
+    "batch_cases", "jobs", "control_us_per_step", "plant_substeps_per_s", "peak_rss_mb",
+    "cosim_over_sumo_cost",
+)
+
+
+def test_quick_bench_writes_every_key(tmp_path):
+    result = run_bench(tmp_path, quick=True)
+    saved = json.loads((tmp_path / "bench.json").read_text())
+    assert saved == json.loads(json.dumps(result))
+    for key in KEYS:
+        assert key in saved and math.isfinite(saved[key]) and saved[key] > 0, key
+    assert saved["batch_cases"] == 2 and saved["jobs"] == 2
+    assert set(saved["targets"]) == set(TARGETS)
