@@ -68,7 +68,7 @@ def _cosim(repeats: int) -> dict:
 def _sumo_only(sim_time_s: float, repeats: int) -> float:
     from eoam_sumo.sim.sumo_adapter import ScenarioOverrides, SumoSession
 
-    steps = max(1, int(round(sim_time_s / 0.01)))
+    steps = max(1, round(sim_time_s / 0.01))
     rates = []
     for _ in range(repeats):
         session = SumoSession.start(BASELINE, ScenarioOverrides(ego_speed_mps=SPEED_MPS, mu=1.0))

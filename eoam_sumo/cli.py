@@ -20,7 +20,7 @@ EXIT_BAD_INPUT = 2
 class _Parser(argparse.ArgumentParser):
     """argparse that reports a usage error as one line (no usage block) with status 2."""
 
-    def error(self, message: str):  # noqa: D102 - argparse API
+    def error(self, message: str):
         raise InputError(f"{self.prog}: {message}")
 
 

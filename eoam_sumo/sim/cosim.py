@@ -80,13 +80,13 @@ class CoSimulation:
     def __init__(
         self,
         cfg: Path,
-        overrides: ScenarioOverrides = ScenarioOverrides(),
-        settings: RunSettings = RunSettings(),
+        overrides: ScenarioOverrides | None = None,
+        settings: RunSettings | None = None,
         params: VehicleParams | None = None,
     ):
         self.cfg = Path(cfg)
-        self.overrides = overrides
-        self.settings = settings
+        self.overrides = overrides = overrides or ScenarioOverrides()
+        self.settings = settings = settings or RunSettings()
         self.params = params or ego_e_class_sedan()
         tables_dir = settings.tables_dir or default_tables_dir()
         self.tables = LookupTables.load(tables_dir, params=self.params)
@@ -105,7 +105,6 @@ class CoSimulation:
 
     def run(self) -> tuple[dict, RunLog]:
         st = self.settings
-        p = self.params
         wall0 = time.perf_counter()
         session = SumoSession.start(
             self.cfg, self.overrides, ego_id=st.ego_id, step_length_s=st.step_s,
@@ -128,7 +127,7 @@ class CoSimulation:
         ctrl.reset(ego.speed_mps)
         mu0 = session.friction_at_ego()
         sense_radius = st.radar.range_m + SENSE_MARGIN_M
-        steps = int(round(st.max_time_s / st.step_s))
+        steps = round(st.max_time_s / st.step_s)
         log = RunLog(steps + 1)
         prof = self.profile = dict.fromkeys(("sense", "control", "plant", "sumo", "contact"), 0.0)
         front = p.cg_to_front_bumper_m
@@ -302,9 +301,9 @@ class CoSimulation:
 
 def run_case(
     cfg: Path,
-    overrides: ScenarioOverrides = ScenarioOverrides(),
+    overrides: ScenarioOverrides | None = None,
     out_dir: Path | None = None,
-    settings: RunSettings = RunSettings(),
+    settings: RunSettings | None = None,
     extra: dict | None = None,
 ) -> dict:
     """Run one case; write ``timeseries.csv`` and ``summary.json`` to ``out_dir`` if given."""
