@@ -55,6 +55,7 @@ class EgoMeasurement:
     road_curvature_1pm: float
     mu: float
     lane_width_m: float
+    left_lane_available: bool = True  # map: a lane (either direction) left of the ego's lane
 
 
 @dataclass(frozen=True, slots=True)
@@ -249,6 +250,8 @@ class EoamController:
             elif (action is Action.STEER and self.mode is Mode.UPDATE_BRAKE
                   and rng > self._curve.at(closing)[2]):
                 action = Action.BRAKE  # braking already stops short of it: no lane change
+            elif action is Action.STEER and not meas.left_lane_available:
+                action = Action.LIMIT_BRAKE  # no lane to change into: brake in lane
             threat_gone = closing < -st.release_opening_speed_mps
         else:
             sector = None

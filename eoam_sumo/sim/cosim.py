@@ -15,7 +15,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, Perception
-from eoam_sumo.errors import InputError
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.plant import Plant, initial_state
@@ -90,18 +89,14 @@ class CoSimulation:
         self.params = params or ego_e_class_sedan()
         tables_dir = settings.tables_dir or default_tables_dir()
         self.tables = LookupTables.load(tables_dir, params=self.params)
-        if overrides.ego_speed_mps is not None:
-            self._check_speed(overrides.ego_speed_mps)
+        # refuse what the tables do not cover before starting SUMO (checked again at the start)
+        self.tables.check_run(
+            overrides.mu if overrides.mu is not None else self.tables.mu_grid[-1],
+            overrides.ego_speed_mps if overrides.ego_speed_mps is not None
+            else self.tables.speed_grid_mps[0],
+        )
         self.plant = Plant(self.params, dt_s=settings.plant_dt_s, substeps=settings.substeps)
         self.radar = Radar(settings.radar)
-
-    def _check_speed(self, speed_mps: float) -> None:
-        top = self.tables.speed_grid_mps[-1]
-        if not 0.0 < speed_mps <= top + 1e-9:
-            raise InputError(
-                f"ego speed {speed_mps * 3.6:.1f} km/h is outside the tables' range "
-                f"(0, {top * 3.6:.0f}] km/h"
-            )
 
     def run(self) -> tuple[dict, RunLog]:
         st = self.settings
@@ -119,13 +114,14 @@ class CoSimulation:
         st, p = self.settings, self.params
         clock = time.perf_counter
         ego = session.ego_body()
-        self._check_speed(ego.speed_mps)
+        mu0 = session.friction_at_ego()
+        self.tables.check_run(mu0, ego.speed_mps)
         road = RoadFrame(session.ego_lane_centreline())
         lane_width = session.lane_width_m
         x = initial_state(ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps)
         ctrl = EoamController(p, self.tables, st.eoam)
         ctrl.reset(ego.speed_mps)
-        mu0 = session.friction_at_ego()
+        left_lane = session.left_lane_exists
         sense_radius = st.radar.range_m + SENSE_MARGIN_M
         steps = round(st.max_time_s / st.step_s)
         log = RunLog(steps + 1)
@@ -158,7 +154,8 @@ class CoSimulation:
                 report.in_path_range_m, report.in_path_range_rate_mps, report.oncoming_detected
             )
             meas = EgoMeasurement(
-                t, vx, vy, r, ax, ay, s, d, yaw - road_yaw, road.curvature_at(s), mu, lane_width
+                t, vx, vy, r, ax, ay, s, d, yaw - road_yaw, road.curvature_at(s), mu, lane_width,
+                left_lane,
             )
             # --- decide and control -------------------------------------------------------------
             c1 = clock()

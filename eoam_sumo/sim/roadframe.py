@@ -36,47 +36,33 @@ class RoadFrame:
             self._hy.append(dy / seg)
             self._len.append(seg)
             self._s.append(self._s[-1] + seg)
+        self._yaw = [math.atan2(hy, hx) for hx, hy in zip(self._hx, self._hy)]
         self._hint = 0
 
     @property
     def length_m(self) -> float:
         return self._s[-1]
 
-    def _project_segment(self, i: int, x: float, y: float) -> tuple[float, float, float]:
-        """(squared distance, along, signed lateral) of (x, y) against segment i, clamped."""
-        rx, ry = x - self._x[i], y - self._y[i]
-        along = rx * self._hx[i] + ry * self._hy[i]
-        lat = -rx * self._hy[i] + ry * self._hx[i]
-        if along < 0.0 and i > 0:
-            along = 0.0
-        elif along > self._len[i] and i < len(self._len) - 1:
-            along = self._len[i]
-        px = self._x[i] + along * self._hx[i]
-        py = self._y[i] + along * self._hy[i]
-        return (x - px) ** 2 + (y - py) ** 2, along, lat
-
     def project(self, x: float, y: float) -> tuple[float, float, float]:
-        """(s_m, d_m, road_yaw_rad) of a point: walks the polyline from the last answer, then
-        keeps the nearer of the final segment and its neighbours (corners of the polyline)."""
+        """(s_m, d_m, road_yaw_rad) of a point. Walks the polyline from the last answer: forward
+        while the point lies past a segment's end, else backward while it lies before its start
+        (beyond the ends, the first and last segments extend)."""
         last = len(self._len) - 1
         i = self._hint
-        step = 0
-        for _ in range(last + 1):
-            _, along, _ = self._project_segment(i, x, y)
-            if along >= self._len[i] and i < last and step >= 0:
-                i, step = i + 1, 1
-            elif along <= 0.0 and i > 0 and step <= 0:
-                i, step = i - 1, -1
-            else:
-                break
-        best = None
-        for j in range(max(0, i - 1), min(last, i + 1) + 1):
-            cand = self._project_segment(j, x, y) + (j,)
-            if best is None or cand[0] < best[0]:
-                best = cand
-        _, along, lat, i = best
+        hx, hy, xs, ys, seg = self._hx, self._hy, self._x, self._y, self._len
+        rx, ry = x - xs[i], y - ys[i]
+        along = rx * hx[i] + ry * hy[i]
+        while along > seg[i] and i < last:
+            i += 1
+            rx, ry = x - xs[i], y - ys[i]
+            along = rx * hx[i] + ry * hy[i]
+        if i == self._hint:
+            while along < 0.0 and i > 0:
+                i -= 1
+                rx, ry = x - xs[i], y - ys[i]
+                along = rx * hx[i] + ry * hy[i]
         self._hint = i
-        return self._s[i] + along, lat, math.atan2(self._hy[i], self._hx[i])
+        return self._s[i] + along, ry * hx[i] - rx * hy[i], self._yaw[i]
 
     def point_at(self, s_m: float, d_m: float = 0.0) -> tuple[float, float, float]:
         """(x, y, road_yaw) of the point at station s and offset d (extrapolated at the ends)."""

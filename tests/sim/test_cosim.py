@@ -197,3 +197,73 @@ def test_traci_path_gives_the_libsumo_result(tmp_path):
     for key in ("outcome", "collision_with", "modes_visited", "fcw_raised", "sim_time_s"):
         assert fast[key] == slow[key]
     assert fast["max_abs_lat_accel_mps2"] == pytest.approx(slow["max_abs_lat_accel_mps2"], 1e-6)
+
+
+def _scenario(folder: Path, edges_xml: str, nodes_xml: str, obstacle_pos_m: float,
+              extra_net_args=()) -> Path:
+    """A small user scenario: the given road, a halted car on the first edge, the ego."""
+    (folder / "n.nod.xml").write_text(nodes_xml)
+    (folder / "n.edg.xml").write_text(edges_xml)
+    import sumolib
+
+    subprocess.run(
+        [sumolib.checkBinary("netconvert"), "-n", str(folder / "n.nod.xml"),
+         "-e", str(folder / "n.edg.xml"), "--no-turnarounds", "true", *extra_net_args,
+         "-o", str(folder / "n.net.xml")],
+        check=True, capture_output=True,
+    )
+    (folder / "r.rou.xml").write_text(textwrap.dedent(f"""\
+        <routes>
+          <vType id="car" length="4.6" width="1.8" decel="9" sigma="0"/>
+          <route id="r" edges="fwd"/>
+          <vehicle id="stalled" type="car" route="r" depart="0" departPos="{obstacle_pos_m}"
+                   departSpeed="0">
+            <stop lane="fwd_0" endPos="{obstacle_pos_m + 5}" duration="1000"/>
+          </vehicle>
+          <vehicle id="ego" type="car" route="r" depart="0" departPos="20" departSpeed="27"/>
+        </routes>"""))
+    cfg = folder / "s.sumocfg"
+    cfg.write_text(
+        '<configuration><input><net-file value="n.net.xml"/><route-files value="r.rou.xml"/>'
+        "</input></configuration>"
+    )
+    return cfg
+
+
+def test_no_lane_to_the_left_means_braking_in_lane(tmp_path):
+    cfg = _scenario(
+        tmp_path,
+        '<edges><edge id="fwd" from="a" to="b" numLanes="1" speed="40"/></edges>',
+        '<nodes><node id="a" x="0" y="0"/><node id="b" x="1500" y="0"/></nodes>',
+        obstacle_pos_m=220.0,
+    )
+    summary, _ = _run(cfg, tmp_path, mu=1.0, max_time_s=25.0)
+    assert summary["fcw_raised"] is True
+    assert not {2, 4, 5} & set(summary["modes_visited"]), summary["modes_visited"]
+    assert summary["max_lateral_offset_m"] < 0.5
+    assert summary["outcome"] in {"green", "yellow"}, summary["reason"]
+
+
+def test_curved_two_way_road(tmp_path):
+    """A 400 m radius left-hand curve: the road frame follows it; a halted car is avoided."""
+    shape = " ".join(
+        f"{400 * math.sin(a):.3f},{400 * (1 - math.cos(a)):.3f}"
+        for a in [i * 0.02 for i in range(101)]
+    )
+    end = f'x="{400 * math.sin(2.0):.3f}" y="{400 * (1 - math.cos(2.0)):.3f}"'
+    cfg = _scenario(
+        tmp_path,
+        f'<edges><edge id="fwd" from="a" to="b" numLanes="1" speed="40" spreadType="right" '
+        f'shape="{shape}"/><edge id="back" from="b" to="a" numLanes="1" speed="40" '
+        f'spreadType="right" shape="{" ".join(reversed(shape.split()))}"/></edges>',
+        f'<nodes><node id="a" x="0" y="0"/><node id="b" {end}/></nodes>',
+        obstacle_pos_m=250.0,
+        extra_net_args=("--opposites.guess", "true"),
+    )
+    summary, out = _run(cfg, tmp_path, mu=1.0, max_time_s=25.0)
+    assert summary["fcw_raised"] is True
+    assert summary["outcome"] in {"green", "yellow"}, summary["reason"]
+    ts = pd.read_csv(out / "timeseries.csv")
+    # before anything is seen, the ego keeps its lane on the curve
+    calm = ts[ts["mode"] == 0].head(50)
+    assert calm["lateral_offset_m"].abs().max() < 0.2

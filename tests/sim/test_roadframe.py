@@ -1,0 +1,43 @@
+"""Road frame: projection onto the lane centre line inverts point_at (closed-form checks)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from eoam_sumo.sim.roadframe import RoadFrame
+
+ARC = RoadFrame([(200 * math.sin(a), 200 * (1 - math.cos(a))) for a in
+                 [i * 0.01 for i in range(101)]])  # left-hand arc, radius 200 m, ~200 m long
+
+
+def test_straight_road_is_plain_coordinates():
+    road = RoadFrame([(0.0, -1.75), (4000.0, -1.75)])
+    assert road.project(120.0, 0.5) == pytest.approx((120.0, 2.25, 0.0))
+    assert road.point_at(120.0, 2.25) == pytest.approx((120.0, 0.5, 0.0))
+    assert road.curvature_at(100.0) == 0.0
+    assert road.length_m == pytest.approx(4000.0)
+
+
+@settings(max_examples=200, deadline=None, database=None)
+@given(st.floats(1.0, 195.0), st.floats(-6.0, 6.0), st.sampled_from([0, 50, 99]))
+def test_project_inverts_point_at_from_any_starting_hint(s_m, d_m, hint):
+    ARC._hint = hint
+    x, y, yaw = ARC.point_at(s_m, d_m)
+    s2, d2, yaw2 = ARC.project(x, y)
+    # chords of a 200 m arc every 2 m: the polyline differs from the circle by < 3 mm
+    assert s2 == pytest.approx(s_m, abs=0.05)
+    assert d2 == pytest.approx(d_m, abs=0.01)
+    assert yaw2 == pytest.approx(yaw, abs=0.011)
+
+
+def test_curvature_of_the_arc():
+    assert ARC.curvature_at(100.0) == pytest.approx(1 / 200.0, rel=0.01)
+
+
+def test_needs_two_distinct_points():
+    with pytest.raises(ValueError, match="two distinct points"):
+        RoadFrame([(1.0, 1.0), (1.0, 1.0)])
