@@ -1,7 +1,7 @@
 """Preallocated per-step log of a co-simulation run and its files (timeseries.csv, summary.json).
 
-One row per SUMO step, written into a preallocated float array (no pandas in the loop);
-pandas is imported only when the run is written out.
+One row per SUMO step, stored as a tuple in a preallocated list (no numpy or pandas work in
+the loop); the float array is built once at the end, pandas only when the run is written.
 """
 
 from __future__ import annotations
@@ -28,16 +28,17 @@ _NAN = math.nan
 
 
 class RunLog:
-    """Fixed-size float log; ``add`` writes one row, ``frame()`` gives a pandas DataFrame."""
+    """Fixed-size log; ``add`` stores one row, ``array()`` / ``frame()`` give the table."""
 
     def __init__(self, rows: int):
-        self.buf = np.full((rows, len(COLUMNS)), _NAN)
+        self._rows: list = [None] * rows
         self.n = 0
         self._col = {c: i for i, c in enumerate(COLUMNS)}
+        self._array = None
 
     def add(self, t, x, ax, ay, s, d, e_yaw, mu, cmd, perception) -> None:
         """Log the state ``x`` at time ``t`` with the command decided from it (None at the end)."""
-        if self.n >= len(self.buf):
+        if self.n >= len(self._rows):
             return
         nan = _NAN
         if perception is not None and perception.aro_range_m is not None:
@@ -53,15 +54,22 @@ class RunLog:
                  float(ord(cmd.sector)) if cmd.sector else nan)
         else:
             c = (nan,) * 15
-        self.buf[self.n] = (
+        self._rows[self.n] = (
             t, c[0], c[1], x[0], x[1], x[2], x[3], x[4], x[5], ax, ay, x[6], c[2], c[3], rng,
             rate, s, d, e_yaw, c[4], c[5], c[6], c[7], c[8], c[9], c[10], x[7], x[8], c[11],
             c[12], c[13], mu, onc, c[14],
         )
         self.n += 1
+        self._array = None
+
+    def array(self) -> np.ndarray:
+        """(n, len(COLUMNS)) float array of the rows logged so far."""
+        if self._array is None:
+            self._array = np.array(self._rows[: self.n], dtype=float).reshape(-1, len(COLUMNS))
+        return self._array
 
     def column(self, name: str) -> np.ndarray:
-        return self.buf[: self.n, self._col[name]]
+        return self.array()[:, self._col[name]]
 
     def max_abs(self, name: str) -> float:
         col = self.column(name)
@@ -71,7 +79,7 @@ class RunLog:
     def frame(self):
         import pandas as pd
 
-        df = pd.DataFrame(self.buf[: self.n], columns=COLUMNS)
+        df = pd.DataFrame(self.array(), columns=COLUMNS)
         for c in _INT_COLUMNS:
             df[c] = df[c].astype("Int64")
         df["sector"] = [chr(int(v)) if np.isfinite(v) else "" for v in df["sector"]]
