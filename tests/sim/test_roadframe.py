@@ -28,8 +28,10 @@ def test_project_inverts_point_at_from_any_starting_hint(s_m, d_m, hint):
     ARC._hint = hint
     x, y, yaw = ARC.point_at(s_m, d_m)
     s2, d2, yaw2 = ARC.project(x, y)
-    # chords of a 200 m arc every 2 m: the polyline differs from the circle by < 3 mm
-    assert s2 == pytest.approx(s_m, abs=0.05)
+    # chords of a 200 m arc every 2 m: the polyline differs from the circle by < 3 mm; next to
+    # a vertex (heading change 0.01 rad) an offset point may project onto either neighbouring
+    # segment, which moves s by at most |d| x 0.01
+    assert s2 == pytest.approx(s_m, abs=0.01 + abs(d_m) * 0.011)
     assert d2 == pytest.approx(d_m, abs=0.01)
     assert yaw2 == pytest.approx(yaw, abs=0.011)
 
