@@ -86,11 +86,13 @@ def _peak_rss_mb(out_dir: Path) -> float:
     """Peak resident memory of one ``eoam-sumo run`` (its own process, from wait4)."""
     cmd = [sys.executable, "-m", "eoam_sumo", "run", str(BASELINE), "--speed-kmh", "120",
            "--mu", "1.0", "--out", str(out_dir)]
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _pid, status, usage = os.wait4(proc.pid, 0)
+    err = out_dir.with_suffix(".stderr")
+    with open(err, "wb") as sink:  # a file, not a pipe: a full pipe would block the child
+        proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=sink)
+        _pid, status, usage = os.wait4(proc.pid, 0)
     proc.returncode = os.waitstatus_to_exitcode(status)
     if proc.returncode != 0:
-        raise RuntimeError(f"benchmark run failed: {proc.stderr.read().decode().strip()}")
+        raise RuntimeError(f"benchmark run failed: {err.read_text().strip()}")
     return usage.ru_maxrss / 1024.0  # kB on Linux
 
 

@@ -502,25 +502,8 @@ class SumoSession:
         pos = self._ego_depart_pos(spec, lane_len)
         speed = self._ego_speed(spec, lane_id)
         veh.remove(ego)
-        route_id = f"eoam.route.{ego}.{uuid.uuid4().hex[:8]}"
-        self._api.route.add(route_id, edges)
-        veh.add(
-            ego,
-            route_id,
-            self._ego_type,
-            depart="now",
-            departLane=str(lane_index),
-            departPos=repr(float(pos)),
-            departSpeed=repr(float(speed)),
-        )
-        for key, value in spec.params.items():
-            veh.setParameter(ego, key, value)
-        veh.setSpeedMode(ego, EGO_SPEED_MODE)
-        veh.setLaneChangeMode(ego, NO_LANE_CHANGES)
-        x, y, heading = self._lane_point(lane_id, pos)
-        veh.moveToXY(ego, edges[0], lane_index, x, y, nav_angle_deg(heading), keepRoute=1)
-        veh.setPreviousSpeed(ego, speed)
-        veh.setSpeed(ego, speed)
+        self._insert(ego, self._ego_type, edges, lane_index, pos, speed, EGO_SPEED_MODE,
+                     spec.params)
         self._route_edges = edges
         self._lane_index = lane_index
         self._start_lane_id = lane_id
@@ -530,7 +513,7 @@ class SumoSession:
             or lane_id in self._files.opposite_lanes
         )
         self._ego_mu = self._friction(lane_id)
-        self._ego_front_start = (x, y)
+        self._ego_front_start = self._lane_point(lane_id, pos)[:2]
         self._centreline = self._build_centreline()
 
     def _ego_lane_index(self, spec: VehicleSpec, edge: str) -> int:
@@ -635,28 +618,29 @@ class SumoSession:
         while vid in self._files.vehicles:
             n += 1
             vid = f"oncoming.{n}"
+        index = int(lane_id.rsplit("_", 1)[1])  # SUMO lane ids are <edge>_<index>
+        self._insert(vid, "oncoming", edges, index, pos, speed, ONCOMING_SPEED_MODE,
+                     {ROLE_KEY: "oncoming"})
+        self.oncoming_id = vid
+        self.roles[vid] = "oncoming"
+
+    def _insert(self, vid: str, type_id: str, edges: list, lane_index: int, pos: float,
+                speed: float, speed_mode: int, params: dict) -> None:
+        """Add ``vid`` on a fresh route over ``edges`` at ``pos`` of its first lane, placed there
+        exactly with ``moveToXY`` and moving at ``speed`` from the insertion step on."""
         veh = self._veh
         route_id = f"eoam.route.{vid}.{uuid.uuid4().hex[:8]}"
         self._api.route.add(route_id, edges)
-        index = int(lane_id.rsplit("_", 1)[1])  # SUMO lane ids are <edge>_<index>
-        veh.add(
-            vid,
-            route_id,
-            "oncoming",
-            depart="now",
-            departLane=str(index),
-            departPos=repr(float(pos)),
-            departSpeed=repr(float(speed)),
-        )
-        veh.setParameter(vid, ROLE_KEY, "oncoming")
-        veh.setSpeedMode(vid, ONCOMING_SPEED_MODE)
+        veh.add(vid, route_id, type_id, depart="now", departLane=str(lane_index),
+                departPos=repr(float(pos)), departSpeed=repr(float(speed)))
+        for key, value in params.items():
+            veh.setParameter(vid, key, value)
+        veh.setSpeedMode(vid, speed_mode)
         veh.setLaneChangeMode(vid, NO_LANE_CHANGES)
-        x, y, heading = self._lane_point(lane_id, pos)
-        veh.moveToXY(vid, edges[0], index, x, y, nav_angle_deg(heading), keepRoute=1)
+        x, y, heading = self._lane_point(f"{edges[0]}_{lane_index}", pos)
+        veh.moveToXY(vid, edges[0], lane_index, x, y, nav_angle_deg(heading), keepRoute=1)
         veh.setPreviousSpeed(vid, speed)
         veh.setSpeed(vid, speed)
-        self.oncoming_id = vid
-        self.roles[vid] = "oncoming"
 
     # ----------------------------------------------------------------------------- stepping
     def _sumo_step(self) -> None:
