@@ -30,7 +30,7 @@ import math
 from dataclasses import dataclass, field, fields
 
 from eoam_sumo.control.longitudinal import LongitudinalController, LongitudinalGains
-from eoam_sumo.control.reference import PathReference, QuinticLaneChange
+from eoam_sumo.control.reference import PathReference, QuinticShift
 from eoam_sumo.control.steering import SteeringController, SteeringGains
 from eoam_sumo.decision.dmm import Action, BoundaryCurve, Sector
 from eoam_sumo.decision.modes import Mode, next_mode
@@ -59,12 +59,24 @@ class EgoMeasurement:
 
 
 @dataclass(frozen=True, slots=True)
+class ObjectState:
+    """A tracked object in the road frame of the ego's original lane (a sensor's object list)."""
+
+    s_m: float  # station of its centre
+    d_m: float  # lateral offset of its centre, left positive
+    speed_mps: float  # along the road
+    length_m: float
+    width_m: float
+
+
+@dataclass(frozen=True, slots=True)
 class Perception:
     """Radar-derived view: the in-path obstacle (None when nothing) and oncoming traffic."""
 
     aro_range_m: float | None = None
     aro_range_rate_mps: float | None = None
     oncoming_detected: bool = False
+    aro_object: ObjectState | None = None  # the in-path obstacle as an object, when tracked
 
 
 @dataclass(frozen=True, slots=True)
@@ -94,7 +106,11 @@ class EoamSettings:
 
     ponr_fraction: float = 0.3  # point of no return / lane-change height (sec. 8.1)
     manoeuvre_time_s: float = 8.0  # steering manoeuvre timer before RETURN (sec. 3.1 step 5)
-    arrive_tolerance_m: float = 0.25  # mode 4: next lane reached within this of its target
+    arrive_tolerance_m: float = 0.3  # 2 -> 5 early: within this of the next lane's centre ...
+    pass_margin_m: float = 1.0  # mode 4 -> 5: ego rear this far past the obstacle's front
+    side_clearance_m: float = 0.5  # mode 4: lateral gap kept to the obstacle's side
+    unknown_obstacle_length_m: float = 12.0  # assumed without an object track (a truck)
+    track_gate_m: float = 5.0  # modes 2, 4: a sensed object further off the track is another
     settle_offset_m: float = 0.1  # mode 5 -> 0: |d| below this ...
     settle_heading_rad: float = 0.02  # ... and |e_yaw| below this ...
     settle_dwell_s: float = 0.5  # ... for this long after the return path ended
@@ -102,8 +118,10 @@ class EoamSettings:
     min_steer_speed_mps: float = 20.0 / 3.6  # below it a STEER sector brakes instead
     limit_brake_fraction: float = 0.95  # share of the no-lock brake force used as limit braking
     reference_step_m: float = 0.25  # dx spacing of the sampled manoeuvre reference
+    return_when_stable: bool = True  # ... heading within settle_heading_rad and clear of the
+    # obstacle: 2 -> 5 before the timer (False: the timer alone, as in the paper's runs)
     return_lateral_g: float = 0.3  # mode 5 after 2: return's peak lateral acceleration / (mu g)
-    evasive_return_lateral_g: float = 0.6  # mode 5 after 4 (oncoming traffic): the same
+    evasive_lateral_g: float = 0.8  # mode 4 and the return after it (oncoming traffic): the same
     return_min_length_m: float = 10.0  # mode 5: shortest return path
     preview_time_s: float = 0.3  # feedforward curvature taken this far ahead on the path
     steering: SteeringGains = field(default_factory=SteeringGains)
@@ -122,10 +140,11 @@ class EoamSettings:
             "manoeuvre_time_s",
             "reference_step_m",
             "return_lateral_g",
-            "evasive_return_lateral_g",
+            "evasive_lateral_g",
             "return_min_length_m",
             "settle_offset_m",
             "settle_heading_rad",
+            "unknown_obstacle_length_m",
             "arrive_tolerance_m",
         ):
             if getattr(self, name) <= 0.0:
@@ -133,6 +152,7 @@ class EoamSettings:
 
 
 _MEAS_FIELDS = tuple(f.name for f in fields(EgoMeasurement))
+_STEERING = (Mode.UPDATE_STEER_BRAKE, Mode.ONCOMING_STEER_BRAKE)
 
 
 class EoamController:
@@ -164,6 +184,8 @@ class EoamController:
         self._height = 0.0
         self._settle_since: float | None = None
         self._hold_speed: float | None = None
+        self._urgent_return = False
+        self._obstacle: tuple[float, float, float, float] | None = None  # t, front s, v, left
         self._long.reset()
 
     def reset(self, initial_speed_mps: float) -> None:
@@ -187,7 +209,37 @@ class EoamController:
         bounds = self.tables.boundaries
         self._curve = BoundaryCurve(bounds, mu, bounds.speed_grid_mps)
 
-    def _start_path(self, meas: EgoMeasurement, traj, start: float, height: float) -> None:
+    def _start_return(self, meas: EgoMeasurement, *, urgent: bool) -> None:
+        """Mode 5's path back to the lane centre; urgent (oncoming traffic) at the evasive
+        lateral acceleration, else at the comfortable one."""
+        self._urgent_return = urgent
+        self._shift_to(0.0, meas, "evasive_lateral_g" if urgent else "return_lateral_g")
+
+    def _shift_to(self, target_m: float, meas: EgoMeasurement, lateral_g_setting: str) -> None:
+        """A quintic (``QuinticShift``) from the ego's offset and heading to ``target_m``, with
+        its peak lateral acceleration the named setting's share of mu g."""
+        st = self.settings
+        traj = QuinticShift.for_lateral_accel(
+            meas.d_m,
+            math.tan(_wrap(meas.e_yaw_rad)),
+            target_m,
+            meas.vx_mps,
+            getattr(st, lateral_g_setting) * meas.mu * G_MPS2,
+            st.return_min_length_m,
+        )
+        self._start_path(meas, traj, meas.d_m, None)
+
+    def _passing_offset_m(self, meas: EgoMeasurement) -> float:
+        """Mode 4's target: just far enough left to pass the obstacle with ``side_clearance_m``
+        (less exposure to the oncoming vehicle than a whole lane), at most a lane width, and
+        never back towards the obstacle from where the ego already is."""
+        left_edge = self._obstacle[3] if self._obstacle is not None else 0.5 * meas.lane_width_m
+        need = left_edge + 0.5 * self.params.width_m + self.settings.side_clearance_m
+        return max(min(need, meas.lane_width_m), meas.d_m)
+
+    def _start_path(
+        self, meas: EgoMeasurement, traj, start: float, height: float | None
+    ) -> None:
         v = meas.vx_mps
         self._path = PathReference(
             traj,
@@ -210,18 +262,49 @@ class EoamController:
             self._start_path(meas, traj, meas.d_m, meas.lane_width_m)
         elif mode is Mode.RETURN:
             self._hold_speed = meas.vx_mps
-            st = self.settings
-            urgent = previous is Mode.ONCOMING_STEER_BRAKE
-            lateral_g = st.evasive_return_lateral_g if urgent else st.return_lateral_g
-            traj = QuinticLaneChange.for_lateral_accel(
-                meas.d_m, meas.vx_mps, lateral_g * meas.mu * G_MPS2, st.return_min_length_m
-            )
-            self._start_path(meas, traj, meas.d_m, -meas.d_m)
-        elif mode is not Mode.ONCOMING_STEER_BRAKE:
+            self._start_return(meas, urgent=previous is Mode.ONCOMING_STEER_BRAKE)
+        elif mode is Mode.ONCOMING_STEER_BRAKE:
+            self._shift_to(self._passing_offset_m(meas), meas, "evasive_lateral_g")
+        else:
             self._path = None
             self._long.reset()
         if int(mode) not in self.modes_visited:
             self.modes_visited.append(int(mode))
+
+    def _track_obstacle(
+        self, meas: EgoMeasurement, range_m: float, closing_mps: float, obj: ObjectState | None
+    ) -> None:
+        """Remember the in-path obstacle's front station, speed and left edge (offset).
+
+        From its object track when the sensor gives one; else from the range, an assumed
+        length (``unknown_obstacle_length_m``) and a width filling its lane. During a lane
+        change (modes 2, 4) only the obstacle being avoided is followed: one whose front is
+        more than ``track_gate_m`` off the prediction is another object."""
+        if obj is not None:
+            front_s = obj.s_m + 0.5 * obj.length_m
+            speed = max(obj.speed_mps, 0.0)
+            left_edge = obj.d_m + 0.5 * obj.width_m
+        else:
+            front_s = (meas.s_m + self.params.cg_to_front_bumper_m + range_m
+                       + self.settings.unknown_obstacle_length_m)
+            speed = max(meas.vx_mps - closing_mps, 0.0)
+            left_edge = 0.5 * meas.lane_width_m
+        if self._obstacle is not None and self.mode in _STEERING:
+            t0, front0, speed0, _ = self._obstacle
+            if abs(front_s - front0 - speed0 * (meas.time_s - t0)) > self.settings.track_gate_m:
+                return
+        self._obstacle = (meas.time_s, front_s, speed, left_edge)
+
+    def _clear_of_obstacle(self, meas: EgoMeasurement, path, dx_m: float) -> bool:
+        """Mode 4's "desired position": the ego's rear is ``pass_margin_m`` past the obstacle's
+        front, predicted at its last sensed speed (a braking obstacle is further back, so the
+        prediction errs on the late side). Without a track, the end of the lane change."""
+        if self._obstacle is None:
+            return path is not None and dx_m >= path.length_m
+        t0, front_s, speed, _ = self._obstacle
+        front_s += speed * (meas.time_s - t0)
+        ego_rear_s = meas.s_m - self.params.cg_to_rear_bumper_m
+        return ego_rear_s - front_s >= self.settings.pass_margin_m
 
     # ----------------------------------------------------------------------------- the step
     def step(self, meas: EgoMeasurement, perception: Perception, dt_s: float) -> Command:
@@ -253,6 +336,7 @@ class EoamController:
             elif action is Action.STEER and not meas.left_lane_available:
                 action = Action.LIMIT_BRAKE  # no lane to change into: brake in lane
             threat_gone = closing < -st.release_opening_speed_mps
+            self._track_obstacle(meas, rng, closing, perception.aro_object)
         else:
             sector = None
             action = Action.NONE
@@ -273,24 +357,33 @@ class EoamController:
                 settled = t - self._settle_since >= st.settle_dwell_s - 1e-9
             else:
                 self._settle_since = None
+        stable = (
+            st.return_when_stable
+            and mode is Mode.UPDATE_STEER_BRAKE
+            and path is not None
+            and dx >= path.length_m
+            and abs(d - path.start_offset_m - height) <= st.arrive_tolerance_m
+            and abs(_wrap(meas.e_yaw_rad)) <= st.settle_heading_rad
+            and self._clear_of_obstacle(meas, path, dx)
+        )
         new = next_mode(
             mode,
             action,
             oncoming=oncoming,
             past_ponr=travel >= st.ponr_fraction * height,
             timer_expired=t - self._t_steer >= st.manoeuvre_time_s - 1e-9,
-            reached_next_lane=(
-                travel >= height - st.arrive_tolerance_m
-                or (path is not None and dx >= path.length_m)
-            ),
+            stable_in_next_lane=stable,
+            clear_of_obstacle=self._clear_of_obstacle(meas, path, dx),
             settled=settled,
             threat_gone=threat_gone,
         )
         if new is not mode:
             self._enter(new, mode, meas)
             self.mode = mode = new
-            path = self._path
-            dx = meas.s_m - self._s0 if path is not None else 0.0
+        elif mode is Mode.RETURN and oncoming and not self._urgent_return:
+            self._start_return(meas, urgent=True)  # oncoming traffic seen during the return
+        path = self._path
+        dx = meas.s_m - self._s0 if path is not None else 0.0
 
         # ---- lateral reference (lane centre unless a path is active) and steering, eq. 38 ----
         y_ref = yaw_ref = kappa_ref = kappa_ff = ax_ref = v_plan = 0.0

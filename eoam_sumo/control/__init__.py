@@ -1,7 +1,7 @@
 """Online controllers: steering (paper eq. 38), longitudinal PIDs (sec. 9), path references."""
 
 from eoam_sumo.control.longitudinal import LongitudinalController, LongitudinalGains, Pid
-from eoam_sumo.control.reference import PathReference, QuinticLaneChange
+from eoam_sumo.control.reference import PathReference, QuinticShift
 from eoam_sumo.control.steering import SteeringController, SteeringGains, understeer_gradient
 
 __all__ = [
@@ -9,7 +9,7 @@ __all__ = [
     "LongitudinalGains",
     "PathReference",
     "Pid",
-    "QuinticLaneChange",
+    "QuinticShift",
     "SteeringController",
     "SteeringGains",
     "understeer_gradient",

@@ -29,9 +29,16 @@ class PathReference:
     )
 
     def __init__(
-        self, traj, *, start_offset_m: float, height_m: float, speed_mps: float, step_m: float
+        self,
+        traj,
+        *,
+        start_offset_m: float,
+        height_m: float | None,
+        speed_mps: float,
+        step_m: float,
     ):
-        """Sample ``traj`` (``.at(dx)``, ``.length_m``) to go from start_offset by height."""
+        """Sample ``traj`` (``.at(dx)``, ``.length_m``) to go from start_offset by height;
+        ``height_m=None`` takes the trajectory's own lateral positions as they are."""
         if not step_m > 0.0:
             raise ValueError(f"reference step_m={step_m!r} must be > 0")
         length = float(traj.length_m)
@@ -40,11 +47,14 @@ class PathReference:
         n = max(math.ceil(length / step_m), 1)
         step = length / n
         samples = [traj.at(i * step) for i in range(n + 1)]
-        y_end = float(samples[-1][0]) - float(samples[0][0])
-        if not (math.isfinite(y_end) and abs(y_end) > 1e-6):
-            raise ValueError(f"trajectory lateral travel {y_end!r} m is not usable")
-        scale = height_m / y_end
-        y_first = float(samples[0][0])
+        if height_m is None:
+            scale, y_first, start_offset_m = 1.0, 0.0, 0.0
+        else:
+            y_end = float(samples[-1][0]) - float(samples[0][0])
+            if not (math.isfinite(y_end) and abs(y_end) > 1e-6):
+                raise ValueError(f"trajectory lateral travel {y_end!r} m is not usable")
+            scale = height_m / y_end
+            y_first = float(samples[0][0])
         self._y = [start_offset_m + scale * (float(s[0]) - y_first) for s in samples]
         self._ax = [float(s[1]) for s in samples]
         self._yaw = [scale * float(s[2]) for s in samples]
@@ -55,7 +65,7 @@ class PathReference:
             v2 += (self._ax[i] + self._ax[i + 1]) * step
             self._v.append(math.sqrt(v2) if v2 > 0.0 else 0.0)
         self.length_m = length
-        self.start_offset_m = start_offset_m
+        self.start_offset_m = self._y[0]
         self._inv, self._n = 1.0 / step, n
 
     def at(self, dx_m: float) -> tuple[float, float, float, float, float]:
@@ -79,35 +89,65 @@ class PathReference:
         )
 
 
-class QuinticLaneChange:
-    """Unit-height quintic lane change over ``length_m`` (paper sec. 4.2), trajectory-like.
+class QuinticShift:
+    """Quintic from offset ``y0`` with slope ``slope0`` to offset ``y1`` (paper sec. 4.2).
 
-    y(u) = 10u^3 - 15u^4 + 6u^5 with u = dx / X, at constant speed (ax = 0), in the tables'
-    ``at(dx) -> (y, ax, yaw, curvature, steer)`` form so that ``PathReference`` can scale it.
-    ``for_lateral_accel`` picks X so that the peak lateral acceleration 5.77 h v^2 / X^2 of a
-    lane change of height h at speed v equals the given value.
+    y(u) = y0 + P u + c3 u^3 + c4 u^4 + c5 u^5 with u = dx / X and P = slope0 X: the start
+    keeps the ego's heading relative to the road (zero curvature), the end is y = y1 with
+    y' = y'' = 0. With slope0 = 0 it is the paper's lane change
+    y0 + (y1 - y0) (10u^3 - 15u^4 + 6u^5). Given at constant speed (ax = 0) in the tables'
+    ``at(dx) -> (y, ax, yaw, curvature, steer)`` form, in absolute lateral positions
+    (``PathReference(..., height_m=None)``).
     """
 
-    __slots__ = ("length_m",)
+    __slots__ = ("_c", "length_m")
 
-    def __init__(self, length_m: float):
+    def __init__(self, y0_m: float, slope0: float, y1_m: float, length_m: float):
         if not (math.isfinite(length_m) and length_m > 0.0):
             raise ValueError(f"quintic length_m={length_m!r} must be finite and > 0")
+        if not (math.isfinite(y0_m) and math.isfinite(slope0) and math.isfinite(y1_m)):
+            raise ValueError(f"quintic y0={y0_m!r}, slope0={slope0!r}, y1={y1_m!r} not finite")
+        p = slope0 * length_m
+        e, f = y1_m - y0_m - p, -p  # what the u^3..u^5 terms must add to y and dy/du at u = 1
+        self._c = (y0_m, p, 10.0 * e - 4.0 * f, -15.0 * e + 7.0 * f, 6.0 * e - 3.0 * f)
         self.length_m = float(length_m)
+
+    def peak_curvature_1pm(self, samples: int = 200) -> float:
+        """Largest |y''| along the path (sampled), the lateral acceleration per v^2."""
+        _, _, c3, c4, c5 = self._c
+        big2 = self.length_m * self.length_m
+        return max(
+            abs(6.0 * c3 * u + 12.0 * c4 * u * u + 20.0 * c5 * u * u * u)
+            for u in (i / samples for i in range(samples + 1))
+        ) / big2
 
     @classmethod
     def for_lateral_accel(
-        cls, height_m: float, speed_mps: float, lateral_accel_mps2: float, min_length_m: float
-    ) -> QuinticLaneChange:
-        peak = 10.0 * math.sqrt(3.0) / 3.0  # max |d2y/du2| of the quintic: 5.77
-        length = speed_mps * math.sqrt(peak * abs(height_m) / lateral_accel_mps2)
-        return cls(max(length, min_length_m))
+        cls,
+        y0_m: float,
+        slope0: float,
+        y1_m: float,
+        speed_mps: float,
+        lateral_accel_mps2: float,
+        min_length_m: float,
+    ) -> QuinticShift:
+        """The shortest shift (on a 2 % length grid, not below ``min_length_m``) whose peak
+        lateral acceleration v^2 |y''| is within ``lateral_accel_mps2``."""
+        if not (lateral_accel_mps2 > 0.0 and min_length_m > 0.0):
+            raise ValueError("lateral_accel_mps2 and min_length_m must be > 0")
+        limit = lateral_accel_mps2 / max(speed_mps * speed_mps, 1e-9)
+        level = math.sqrt(10.0 * math.sqrt(3.0) / 3.0 * abs(y1_m - y0_m) / limit)  # slope0 = 0
+        length = max(min_length_m, 0.5 * level)
+        while (traj := cls(y0_m, slope0, y1_m, length)).peak_curvature_1pm() > limit:
+            length *= 1.02
+        return traj
 
     def at(self, dx_m: float) -> tuple[float, float, float, float, float]:
         big = self.length_m
         u = min(max(dx_m / big, 0.0), 1.0)
+        y0, p, c3, c4, c5 = self._c
         u2 = u * u
-        y = u2 * u * (10.0 - 15.0 * u + 6.0 * u2)
-        dy = 30.0 * u2 * (1.0 - u) * (1.0 - u) / big
-        ddy = 60.0 * u * (1.0 - u) * (1.0 - 2.0 * u) / (big * big)
+        y = y0 + u * (p + u2 * (c3 + u * (c4 + u * c5)))
+        dy = (p + u2 * (3.0 * c3 + u * (4.0 * c4 + 5.0 * u * c5))) / big
+        ddy = u * (6.0 * c3 + u * (12.0 * c4 + 20.0 * u * c5)) / (big * big)
         return y, 0.0, math.atan(dy), ddy / (1.0 + dy * dy) ** 1.5, 0.0

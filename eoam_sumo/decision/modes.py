@@ -8,9 +8,11 @@ the controller derives from perception and ego motion in one step:
 * 1 UPDATE BRAKE -> 3 when an oncoming vehicle is seen; -> 2 on a STEER sector; -> 0 when the
   threat is gone (no obstacle in the path, or it clearly pulls away).
 * 2 UPDATE STEER+BRAKE -> 3 (oncoming before the point of no return, sec. 8.1) or 4 (after
-  it); -> 5 when the manoeuvre timer expires.
+  it); -> 5 when the manoeuvre timer expires, or earlier once the ego is stable in the next
+  lane and clear of the obstacle (the timer's purpose, sec. 3.1 step 5).
 * 3 ONCOMING BRAKE: terminal (limit braking in lane to standstill).
-* 4 ONCOMING STEER+BRAKE -> 5 once the desired position in the next lane is reached.
+* 4 ONCOMING STEER+BRAKE -> 5 once the desired position in the next lane is reached: the ego
+  is clear of the obstacle it steers around, so that the return cannot meet it.
 * 5 RETURN -> 0 once settled in the original lane (hand-back to the high-level system).
 """
 
@@ -42,7 +44,8 @@ def next_mode(
     oncoming: bool,
     past_ponr: bool,
     timer_expired: bool,
-    reached_next_lane: bool,
+    stable_in_next_lane: bool,
+    clear_of_obstacle: bool,
     settled: bool,
     threat_gone: bool,
 ) -> Mode:
@@ -64,11 +67,11 @@ def next_mode(
     if mode is Mode.UPDATE_STEER_BRAKE:
         if oncoming:
             return Mode.ONCOMING_STEER_BRAKE if past_ponr else Mode.ONCOMING_BRAKE
-        if timer_expired:
+        if timer_expired or stable_in_next_lane:
             return Mode.RETURN
         return mode
     if mode is Mode.ONCOMING_STEER_BRAKE:
-        return Mode.RETURN if reached_next_lane else mode
+        return Mode.RETURN if clear_of_obstacle else mode
     if mode is Mode.RETURN:
         return Mode.NORMAL if settled else mode
     return mode

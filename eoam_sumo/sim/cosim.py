@@ -14,13 +14,13 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, Perception
+from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, ObjectState, Perception
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.plant import Plant, initial_state
 from eoam_sumo.sim.geometry import OrientedBox, box_distance, contact
 from eoam_sumo.sim.outcome import classify_outcome, role_of
-from eoam_sumo.sim.radar import Radar, RadarSettings, Target
+from eoam_sumo.sim.radar import Radar, RadarReport, RadarSettings, Target
 from eoam_sumo.sim.roadframe import RoadFrame
 from eoam_sumo.sim.runlog import RunLog
 from eoam_sumo.sim.sumo_adapter import ScenarioOverrides, SumoSession
@@ -150,9 +150,7 @@ class CoSimulation:
                 [parked_targets.get(b.vid) or _target(b, parked_targets) for b in bodies],
                 lane_width,
             )
-            perception = Perception(
-                report.in_path_range_m, report.in_path_range_rate_mps, report.oncoming_detected
-            )
+            perception = _perception(report)
             meas = EgoMeasurement(
                 t, vx, vy, r, ax, ay, s, d, yaw - road_yaw, road.curvature_at(s), mu, lane_width,
                 left_lane,
@@ -313,3 +311,11 @@ def run_case(
         write_run(Path(out_dir), summary, log)
     return summary
 
+
+def _perception(report: RadarReport) -> Perception:
+    """The EOAM's view of a radar report: the in-path obstacle as an object and the oncoming flag."""
+    det = report.in_path
+    if det is None:
+        return Perception(None, None, report.oncoming_detected)
+    obstacle = ObjectState(det.s_m, det.d_m, det.road_speed_mps, det.length_m, det.width_m)
+    return Perception(det.range_m, det.range_rate_mps, report.oncoming_detected, obstacle)

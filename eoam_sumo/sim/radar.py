@@ -123,6 +123,8 @@ class Detection:
     d_m: float  # road-frame lateral offset of the target's centre, left positive
     road_speed_mps: float  # target speed along the road direction, negative against it
     category: str
+    length_m: float  # object size, as a tracking sensor reports it
+    width_m: float
 
 
 @dataclass(frozen=True, slots=True)
@@ -134,6 +136,7 @@ class RadarReport:
     oncoming_detected: bool
     detections: tuple[Detection, ...]  # sorted by range
     in_path_index: int | None = None  # target-list index of the nearest in-path target
+    in_path: Detection | None = None  # the nearest in-path detection itself
 
 
 def _ray_entry_m(box: OrientedBox, ox: float, oy: float, ux: float, uy: float) -> float:
@@ -236,7 +239,8 @@ class Radar:
             road_speed = tgt.speed_mps * math.cos(box.yaw_rad - road_yaw)
             category = self._classify(s > ego_s, d, tgt.speed_mps, road_speed, band_m)
             detections.append(
-                Detection(index, rng, range_rate, bearing, s, d, road_speed, category)
+                Detection(index, rng, range_rate, bearing, s, d, road_speed, category,
+                          tgt.length_m, tgt.width_m)
             )
         detections.sort(key=lambda det: det.range_m)
         in_path = next((det for det in detections if det.category == "in_path"), None)
@@ -246,6 +250,7 @@ class Radar:
             oncoming_detected=any(det.category == "oncoming" for det in detections),
             detections=tuple(detections),
             in_path_index=None if in_path is None else in_path.index,
+            in_path=in_path,
         )
 
     def _classify(

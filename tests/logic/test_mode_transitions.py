@@ -9,7 +9,7 @@ import math
 import pytest
 
 from eoam_sumo.decision import Mode
-from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, Perception
+from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, ObjectState, Perception
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import ego_e_class_sedan
 
@@ -26,13 +26,15 @@ def tables():
 class Drive:
     """Synthetic ego: straight road, kinematic progress at the given speed and lateral offset."""
 
-    def __init__(self, tables, speed_mps, mu=1.0, lane_m=LANE):
-        self.ctrl = EoamController(P, tables)
+    def __init__(self, tables, speed_mps, mu=1.0, lane_m=LANE, settings=None):
+        self.ctrl = EoamController(P, tables, settings or EoamSettings())
         self.ctrl.reset(speed_mps)
         self.t, self.s, self.v, self.d, self.mu, self.lane = 0.0, 0.0, speed_mps, 0.0, mu, lane_m
         self.cmd = None
 
-    def step(self, range_m=None, rate_mps=None, oncoming=False, d_m=None, e_yaw=0.0, n=1):
+    def step(
+        self, range_m=None, rate_mps=None, oncoming=False, d_m=None, e_yaw=0.0, n=1, obj=None
+    ):
         if d_m is not None:
             self.d = d_m
         for _ in range(n):
@@ -40,7 +42,7 @@ class Drive:
                 self.t, self.v, 0.0, 0.0, 0.0, 0.0, self.s, self.d, e_yaw, 0.0, self.mu, self.lane
             )
             rate = -self.v if (range_m is not None and rate_mps is None) else rate_mps
-            self.cmd = self.ctrl.step(meas, Perception(range_m, rate, oncoming), DT)
+            self.cmd = self.ctrl.step(meas, Perception(range_m, rate, oncoming, obj), DT)
             self.t += DT
             self.s += self.v * DT
         return self.cmd
@@ -147,7 +149,7 @@ def test_0_to_3_steer_asked_with_oncoming(tables):
 
 def test_1_to_2_then_timer_expiry_2_to_5(tables):
     v = speed_with(tables, 1.0, "D", "F")
-    drive = Drive(tables, v)
+    drive = Drive(tables, v, settings=EoamSettings(return_when_stable=False))
     drive.step(range_m=range_in(tables, 1.0, v, "D"), n=5)
     assert drive.mode is Mode.UPDATE_BRAKE
     drive.step(range_m=range_in(tables, 1.0, v, "F"))
@@ -160,6 +162,30 @@ def test_1_to_2_then_timer_expiry_2_to_5(tables):
     drive.step(n=3)
     assert drive.mode is Mode.RETURN
     assert drive.ctrl.modes_visited == [0, 1, 2, 5]
+
+
+def test_2_to_5_early_once_stable_in_the_next_lane_and_past_the_obstacle(tables):
+    v = speed_with(tables, 1.0, "F")
+    drive = Drive(tables, v)
+    rng = range_in(tables, 1.0, v, "F")
+    obj = ObjectState(drive.s + P.cg_to_front_bumper_m + rng + 2.5, 0.0, 0.0, 5.0, 1.9)
+    drive.step(range_m=rng, obj=obj)
+    assert drive.mode is Mode.UPDATE_STEER_BRAKE
+    length = drive.ctrl._path.length_m
+    # in the next lane and straight, but the obstacle (front at obj.s + 2.5) not yet passed
+    front = obj.s_m + 2.5
+    while drive.s - P.cg_to_rear_bumper_m < front + 0.9:
+        drive.step(d_m=LANE)
+        assert drive.mode is Mode.UPDATE_STEER_BRAKE or drive.cmd.dx_m < length
+    drive.step(d_m=LANE, n=max(1, math.ceil((length - drive.cmd.dx_m) / (v * DT))) + 15)
+    assert drive.mode is Mode.RETURN and drive.t < 8.0  # well before the timer
+    assert drive.ctrl.modes_visited == [0, 2, 5]
+    # not stable: heading still turning or off the lane centre keeps the lane change going
+    for kwargs in ({"d_m": LANE, "e_yaw": 0.05}, {"d_m": LANE - 0.5}):
+        other = Drive(tables, v)
+        other.step(range_m=rng, obj=obj)
+        other.step(n=int(4.0 / DT), **kwargs)
+        assert other.mode is Mode.UPDATE_STEER_BRAKE
 
 
 def test_1_to_3_on_oncoming(tables):
@@ -212,18 +238,53 @@ def test_2_to_3_or_4_around_the_point_of_no_return(tables, lane_m, travel_m, exp
     assert drive.mode is expected
 
 
-def test_4_to_5_on_reaching_the_next_lane(tables):
-    drive = start_steer(tables)
+@pytest.mark.parametrize(
+    ("width_m", "target_m"),
+    [(1.9, 0.95 + 0.5 * P.width_m + 0.5), (2.6, 1.3 + 0.5 * P.width_m + 0.5), (4.4, LANE)],
+)
+def test_4_aims_just_past_the_obstacle_side_then_5_once_past_it(tables, width_m, target_m):
+    v = speed_with(tables, 1.0, "F")
+    drive = Drive(tables, v)
+    rng = range_in(tables, 1.0, v, "F")
+    length, speed = 25.0, 5.0  # a slow long truck ahead: the shift ends before it is passed
+    centre = drive.s + P.cg_to_front_bumper_m + rng + 0.5 * length
+    drive.step(range_m=rng, obj=ObjectState(centre, 0.0, speed, length, width_m))
     drive.step(d_m=1.5, oncoming=True)
     assert drive.mode is Mode.ONCOMING_STEER_BRAKE
-    drive.step(d_m=2.8, oncoming=True, n=3)
-    assert drive.mode is Mode.ONCOMING_STEER_BRAKE  # not there yet, keeps changing lane
-    assert drive.cmd.y_target_m > 0.0
-    drive.step(d_m=LANE - 0.1, oncoming=True)
-    assert drive.mode is Mode.RETURN
-    assert drive.ctrl.modes_visited == [0, 2, 4, 5]
-    # the return path starts where the ego is and ends on the original lane centre
-    assert drive.cmd.y_target_m == pytest.approx(LANE - 0.1, abs=0.05)
+    # the target of mode 4: the obstacle's side plus half the ego and the side clearance
+    margin = EoamSettings().pass_margin_m
+    for _ in range(2000):
+        ahead = drive.s - P.cg_to_rear_bumper_m - (centre + 0.5 * length + speed * drive.t)
+        peak = drive.d
+        drive.step(d_m=drive.cmd.y_target_m, oncoming=True)
+        if drive.mode is not Mode.ONCOMING_STEER_BRAKE:
+            break
+        assert ahead < margin
+    assert drive.mode is Mode.RETURN and drive.ctrl.modes_visited == [0, 2, 4, 5]
+    assert ahead >= margin
+    assert peak == pytest.approx(target_m, abs=0.02)
+    # the return starts where the ego is and ends on the original lane centre
+    assert drive.cmd.y_target_m == pytest.approx(peak, abs=0.05)
+    follow_return_to_its_end(drive)
+
+
+def test_return_turns_urgent_when_oncoming_traffic_appears(tables):
+    """An oncoming vehicle seen during a comfortable return re-plans it at the evasive
+    lateral acceleration: it reaches the lane centre sooner."""
+    ends = {}
+    for seen in (False, True):
+        drive = start_steer(tables)
+        while drive.mode is not Mode.RETURN:
+            drive.step(d_m=LANE)
+        t0 = drive.t
+        for _ in range(5000):
+            cmd = drive.step(d_m=drive.cmd.y_target_m, oncoming=seen)
+            if cmd.dx_m > 0.0 and abs(cmd.y_target_m) < 1e-9:
+                break
+        ends[seen] = drive.t - t0
+    st = EoamSettings()
+    ratio = math.sqrt(st.return_lateral_g / st.evasive_lateral_g)  # quintic time ~ 1/sqrt(a)
+    assert ends[True] == pytest.approx(ends[False] * ratio, rel=0.06)
 
 
 def follow_return_to_its_end(drive):
