@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 from eoam_sumo import __version__
@@ -89,6 +90,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, default=Path("out/run"), help="output folder")
     p.add_argument("--max-time-s", type=_finite, default=40.0, help="simulated time limit")
     p.add_argument("--tables", type=Path, help="lookup tables folder (default: tables/)")
+    p.add_argument("--radar-range-m", type=_finite, help="ego radar range (default 100 m)")
     p.add_argument("--gui", action="store_true", help="run in sumo-gui through TraCI")
 
     p = sub.add_parser("batch", help="run every case of an experiment matrix")
@@ -133,12 +135,15 @@ def _cmd_tables(args) -> int:
 
 def _cmd_run(args) -> int:
     from eoam_sumo.sim.cosim import RunSettings, run_case
+    from eoam_sumo.sim.radar import RadarSettings
     from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
 
     if not args.cfg.is_file():
         raise InputError(f"{args.cfg}: no such scenario file")
     if args.max_time_s <= 0:
         raise InputError(f"--max-time-s {args.max_time_s} must be > 0")
+    if args.radar_range_m is not None and args.radar_range_m <= 0:
+        raise InputError(f"--radar-range-m {args.radar_range_m} must be > 0")
     out = _writable_dir(args.out)
     overrides = ScenarioOverrides(
         ego_speed_mps=None if args.speed_kmh is None else args.speed_kmh / 3.6,
@@ -149,6 +154,8 @@ def _cmd_run(args) -> int:
         max_time_s=args.max_time_s, ego_id=args.ego, gui=args.gui, use_traci=args.gui,
         tables_dir=args.tables,
     )
+    if args.radar_range_m is not None:
+        settings = replace(settings, radar=RadarSettings(range_m=args.radar_range_m))
     s = run_case(args.cfg, overrides, out, settings)
     print(
         f"{s['outcome']}: collision_with={s['collision_with']} "

@@ -21,7 +21,7 @@ from eoam_sumo.sim.sumo_adapter import MU_MAX, ScenarioOverrides
 DEFAULT_MAX_TIME_S = 40.0
 NO_ONCOMING = "none"
 SCHEMA = {
-    "scenario": ("sumocfg", "max_time_s"),
+    "scenario": ("sumocfg", "max_time_s", "radar_range_m"),
     "sweep": ("ego_speed_kmh", "mu", "oncoming_start_m", "aro_hold_s", "aro_decel_mps2"),
     "paper": ("table",),
 }
@@ -51,6 +51,7 @@ class Case:
     aro_hold_s: float | None
     aro_decel_mps2: float | None
     max_time_s: float
+    radar_range_m: float | None = None  # None: the radar's default range
 
     def overrides(self) -> ScenarioOverrides:
         return ScenarioOverrides(
@@ -75,6 +76,7 @@ class Matrix:
     aro_holds_s: tuple[float, ...]
     aro_decels_mps2: tuple[float, ...]
     paper_table: Path | None = None
+    radar_range_m: float | None = None
 
     def cases(self) -> list[Case]:
         """Every case, in the paper's Table 2 order (traffic, speed, friction, ARO stop)."""
@@ -106,6 +108,7 @@ class Matrix:
                                     hold,
                                     decel,
                                     self.max_time_s,
+                                    self.radar_range_m,
                                 )
                             )
         return cases
@@ -229,6 +232,9 @@ def load_matrix(path: Path) -> Matrix:
     max_time = scenario.get("max_time_s", DEFAULT_MAX_TIME_S)
     if not _is_number(max_time) or max_time <= 0:
         raise InputError(f"{path}: [scenario] max_time_s = {max_time!r} must be a number > 0")
+    radar_range = scenario.get("radar_range_m")
+    if radar_range is not None and (not _is_number(radar_range) or radar_range <= 0):
+        raise InputError(f"{path}: [scenario] radar_range_m = {radar_range!r} must be a number > 0")
     paper = None
     if "table" in doc.get("paper", {}):
         paper = _existing_file(path, "[paper] table", doc["paper"]["table"])
@@ -236,6 +242,7 @@ def load_matrix(path: Path) -> Matrix:
         path=path,
         sumocfg=sumocfg,
         max_time_s=float(max_time),
+        radar_range_m=None if radar_range is None else float(radar_range),
         ego_speeds_kmh=_number_list(
             path, "ego_speed_kmh", sweep["ego_speed_kmh"], minimum=0.0, inclusive=False
         ),

@@ -90,6 +90,12 @@ def test_optional_aro_keys_extend_the_sweep_and_the_ids(tmp_path):
     assert cases[1].overrides().aro_hold_s == 0.5
     assert cases[1].overrides().aro_decel_mps2 == 8.0
     assert cases[0].max_time_s == 40.0  # documented default
+    assert cases[0].radar_range_m is None  # the radar's own default
+
+
+def test_scenario_radar_range_reaches_every_case(tmp_path):
+    path = _write(tmp_path, GOOD_SCENARIO + "radar_range_m = 200\n" + GOOD_SWEEP)
+    assert {c.radar_range_m for c in load_matrix(path).cases()} == {200.0}
 
 
 BAD = [
@@ -169,6 +175,12 @@ BAD = [
         "bad max time",
         '[scenario]\nsumocfg = "s.sumocfg"\nmax_time_s = -1.0\n' + GOOD_SWEEP,
         "max_time_s",
+        None,
+    ),
+    (
+        "bad radar range",
+        '[scenario]\nsumocfg = "s.sumocfg"\nradar_range_m = 0\n' + GOOD_SWEEP,
+        "radar_range_m",
         None,
     ),
     (

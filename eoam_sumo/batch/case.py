@@ -6,7 +6,7 @@ Kept apart from the runner so a worker process imports only what a case needs.
 from __future__ import annotations
 
 import tempfile
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from eoam_sumo.matrix import Case
@@ -37,6 +37,7 @@ def case_parameters(case: Case) -> dict:
         "aro_hold_s": case.aro_hold_s,
         "aro_decel_mps2": case.aro_decel_mps2,
         "max_time_s": case.max_time_s,
+        "radar_range_m": case.radar_range_m,
         "sumocfg": str(case.sumocfg),
     }
 
@@ -47,9 +48,12 @@ def run_matrix_case(task: CaseTask) -> dict:
     Old output files of the case are removed first, so a folder never mixes runs.
     """
     from eoam_sumo.sim.cosim import RunSettings, run_case
+    from eoam_sumo.sim.radar import RadarSettings
 
     case = task.case
     settings = RunSettings(max_time_s=case.max_time_s, tables_dir=task.tables_dir)
+    if case.radar_range_m is not None:
+        settings = replace(settings, radar=RadarSettings(range_m=case.radar_range_m))
     extra = {"case": case_parameters(case)}
     if task.case_dir is not None:
         case_dir = Path(task.case_dir)

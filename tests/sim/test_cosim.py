@@ -139,6 +139,38 @@ def test_user_scenario_with_halted_car_gets_a_sensible_outcome(tmp_path):
     assert summary["mu"] == pytest.approx(0.7)
 
 
+def test_oncoming_seen_past_the_point_of_no_return_passes_the_aro_and_returns(tmp_path):
+    """120 km/h, mu 0.7, oncoming car 400 m away: seen after the point of no return (mode 4);
+    the ego returns as soon as it is past the ARO, long before the manoeuvre timer, and
+    is back in its lane before the oncoming car arrives."""
+    summary, out = _run(BASELINE, tmp_path, ego_speed_mps=120 / 3.6, mu=0.7,
+                        oncoming_start_m=400.0)
+    assert summary["modes_visited"] == [0, 1, 2, 4, 5], summary["reason"]
+    assert summary["outcome"] == "green", summary["reason"]
+    ts = pd.read_csv(out / "timeseries.csv")
+    t2, t4, t5 = (ts.loc[ts["mode"] == m, "time_s"].iloc[0] for m in (2, 4, 5))
+    assert t4 - t2 > 0.5 and t5 - t4 < 0.5 and t5 - t2 < 0.6 * 8.0
+    assert ts["lateral_offset_m"].max() < 3.5 + 0.3
+
+
+def test_radar_range_option_limits_what_is_sensed(tmp_path):
+    """``--radar-range-m`` reaches the radar: the ARO is first reported near that range."""
+    firsts = {}
+    for rng in (60.0, 100.0):
+        out = tmp_path / f"r{rng:.0f}"
+        proc = subprocess.run(
+            [sys.executable, "-m", "eoam_sumo", "run", str(BASELINE), "--speed-kmh", "90",
+             "--mu", "1.0", "--out", str(out), "--max-time-s", "6", "--radar-range-m",
+             str(rng)],
+            check=False, capture_output=True, text=True, timeout=300,
+        )
+        assert proc.returncode == 0, proc.stderr
+        ts = pd.read_csv(out / "timeseries.csv")
+        firsts[rng] = ts["aro_range_m"].dropna().iloc[0]
+    assert 60.0 - 1.0 < firsts[60.0] <= 60.0
+    assert 100.0 - 1.0 < firsts[100.0] <= 100.0
+
+
 def test_cli_run_prints_one_line_and_writes_files(tmp_path):
     out = tmp_path / "cli"
     proc = subprocess.run(
@@ -162,6 +194,7 @@ def test_cli_run_prints_one_line_and_writes_files(tmp_path):
         (["run", str(BASELINE), "--speed-kmh", "400"], "400"),
         (["run", str(BASELINE), "--oncoming-m", "-5"], "-5"),
         (["run", str(BASELINE), "--bogus"], "--bogus"),
+        (["run", str(BASELINE), "--radar-range-m", "-5"], "--radar-range-m"),
     ],
 )
 def test_cli_bad_input_is_one_line_and_status_2(tmp_path, args, needle):
