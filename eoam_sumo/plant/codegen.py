@@ -27,8 +27,15 @@ from eoam_sumo.plant.model import INPUT_NAMES, STATE_NAMES, outputs
 from eoam_sumo.plant.ops import CASADI_OPS
 
 FUNCTION_NAME = "eoam_plant_step"
-C_FLAGS = ("-O2", "-shared", "-fPIC", "-ffp-contract=off")
-"""``-ffp-contract=off``: no fused multiply-adds, so the C code rounds like the reference."""
+C_FLAGS = (
+    "-O2", "-shared", "-fPIC", "-ffp-contract=off", "-fno-semantic-interposition",
+    "-fno-math-errno",
+)
+"""``-ffp-contract=off``: no fused multiply-adds, so the C code rounds like the reference.
+``-fno-semantic-interposition`` lets the compiler inline CasADi's helpers (``casadi_fmax``,
+``casadi_fmin``, ...), which ``-fPIC`` otherwise calls through the PLT, and ``-fno-math-errno``
+turns ``sqrt`` into one instruction; neither changes a result (IEEE arithmetic is kept), both
+together take a 10-sub-step call from ~10 to ~5.5 us."""
 
 CACHE_ENV = "EOAM_SUMO_CACHE_DIR"
 

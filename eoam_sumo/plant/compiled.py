@@ -1,7 +1,7 @@
 """The fast online plant: all sub-steps of a co-simulation step in one compiled C call.
 
-The compiled library (``codegen.py``) is called through ``ctypes`` with pre-allocated numpy
-buffers: about 1-2 us of Python overhead per call, against ~45 us for calling the same
+The compiled library (``codegen.py``) is called through ``ctypes`` with pre-allocated ctypes
+buffers: about 1 us of Python overhead per call, against ~45 us for calling the same
 library through ``casadi.external``. Without a working C compiler the same SX function runs
 on CasADi's virtual machine (identical arithmetic, slower) and a ``RuntimeWarning`` says so.
 """
@@ -74,7 +74,8 @@ class Plant:
     """Ego plant: ``step(x, u, mu) -> (x_next, y)`` advances ``substeps * dt_s`` seconds.
 
     ``x`` (``STATE_NAMES``), ``u`` (``INPUT_NAMES``) and the returned ``x_next``, ``y``
-    (``OUTPUT_NAMES``, evaluated at ``x_next``) are 1-D float arrays; ``mu`` is the peak surface
+    (``OUTPUT_NAMES``, evaluated at ``x_next``) are 1-D float arrays (``advance``: lists of
+    floats, for loops that keep the state in plain floats); ``mu`` is the peak surface
     friction under the vehicle for this step. The model is ``model.rhs`` integrated by RK4
     (``integrator.py``). The C library is built on first construction (a few seconds) and
     cached in ``cache_dir`` (default ``codegen.default_cache_dir()``). Instances hold their
@@ -101,26 +102,21 @@ class Plant:
             if use_compiler
             else None
         )
-        self._x = np.zeros(_NX)
-        self._u = np.zeros(_NU)
-        self._mu = np.zeros(1)
-        self._x_next = np.zeros(_NX)
-        self._y = np.zeros(_NY)
+        self._x = (ctypes.c_double * _NX)()
+        self._u = (ctypes.c_double * _NU)()
+        self._mu = (ctypes.c_double * 1)()
+        self._x_next = (ctypes.c_double * _NX)()
+        self._y = (ctypes.c_double * _NY)()
         if self.library_path is None:
             self._vm = step_function(params, self.dt_s, substeps)
             return
         self._lib, self._fn, (n_arg, n_res, n_iw, n_w) = _load_library(self.library_path)
-        self._iw = np.zeros(max(n_iw, 1), dtype=np.int64)
-        self._w = np.zeros(max(n_w, 1))
-        self._arg = (ctypes.c_void_p * n_arg)(
-            self._x.ctypes.data, self._u.ctypes.data, self._mu.ctypes.data
-        )
-        self._res = (ctypes.c_void_p * n_res)(self._x_next.ctypes.data, self._y.ctypes.data)
+        self._iw = (ctypes.c_longlong * max(n_iw, 1))()
+        self._w = (ctypes.c_double * max(n_w, 1))()
+        self._arg = (ctypes.c_void_p * n_arg)(*map(ctypes.addressof, (self._x, self._u, self._mu)))
+        self._res = (ctypes.c_void_p * n_res)(*map(ctypes.addressof, (self._x_next, self._y)))
         self._call_args = (
-            ctypes.addressof(self._arg),
-            ctypes.addressof(self._res),
-            self._iw.ctypes.data,
-            self._w.ctypes.data,
+            *map(ctypes.addressof, (self._arg, self._res, self._iw, self._w)),
             0,
         )
 
@@ -136,17 +132,22 @@ class Plant:
 
     def step(self, x, u, mu: float) -> tuple[np.ndarray, np.ndarray]:
         """Advance ``substeps`` RK4 steps with ``u`` and ``mu`` held; return new arrays."""
+        x_next, y = self.advance(x, u, mu)
+        return np.array(x_next), np.array(y)
+
+    def advance(self, x, u, mu: float) -> tuple[list[float], list[float]]:
+        """``step`` on and to lists of floats (no numpy on the way)."""
         if len(x) != _NX or len(u) != _NU:
             raise ValueError(f"x needs {_NX} and u {_NU} values, got {len(x)} and {len(u)}")
         self._x[:] = x
         self._u[:] = u
         self._mu[0] = check_mu(mu)
         if self.library_path is None:
-            x_next, y = self._vm(self._x, self._u, self._mu[0])
-            return x_next.full().ravel(), y.full().ravel()
+            x_next, y = self._vm(self._x[:], self._u[:], self._mu[0])
+            return x_next.full().ravel().tolist(), y.full().ravel().tolist()
         if self._fn(*self._call_args) != 0:
             raise RuntimeError(f"{FUNCTION_NAME} returned an error")
-        return self._x_next.copy(), self._y.copy()
+        return self._x_next[:], self._y[:]
 
     def __reduce__(self):
         return (

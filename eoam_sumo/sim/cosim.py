@@ -60,12 +60,22 @@ SENSE_MARGIN_M = 10.0  # SUMO reports front bumpers: a body reaching into range 
 GAP_WATCH_M = 20.0  # centre distance under which box gaps are measured and contact checked [m]
 
 
-def _target(body, parked: dict) -> Target:
-    """Radar target of a SUMO body; parked ones are remembered in ``parked`` by id."""
-    tgt = Target(body.x_m, body.y_m, body.yaw_rad, body.speed_mps, body.length_m, body.width_m)
-    if body.parked:
-        parked[body.vid] = tgt
-    return tgt
+class _Targets:
+    """Radar targets (with their boxes) of SUMO bodies, built only for bodies that changed: the
+    adapter hands back the same ``Body`` object for a vehicle whose values did not change."""
+
+    def __init__(self) -> None:
+        self._known: dict[str, tuple] = {}  # vid -> (body, its target)
+
+    def of(self, bodies: list) -> list[Target]:
+        known, seen = self._known, {}
+        for b in bodies:
+            pair = known.get(b.vid)
+            if pair is None or pair[0] is not b:
+                pair = b, Target(b.x_m, b.y_m, b.yaw_rad, b.speed_mps, b.length_m, b.width_m)
+            seen[b.vid] = pair
+        self._known = seen
+        return [tgt for _, tgt in seen.values()]
 
 
 def _nav_deg(yaw_rad: float) -> float:
@@ -118,15 +128,16 @@ class CoSimulation:
         self.tables.check_run(mu0, ego.speed_mps)
         road = RoadFrame(session.ego_lane_centreline())
         lane_width = session.lane_width_m
-        x = initial_state(ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps)
+        x = initial_state(ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps).tolist()  # plain floats
         ctrl = EoamController(p, self.tables, st.eoam)
         ctrl.reset(ego.speed_mps)
         left_lane = session.left_lane_exists
         sense_radius = st.radar.range_m + SENSE_MARGIN_M
         steps = round(st.max_time_s / st.step_s)
         log = RunLog(steps + 1)
-        prof = self.profile = dict.fromkeys(("sense", "control", "plant", "sumo", "contact"), 0.0)
         front = p.cg_to_front_bumper_m
+        back = front - 0.5 * p.length_m  # CG to the ego box's centre, as in OrientedBox
+        ego_box_radius = math.hypot(0.5 * p.length_m, 0.5 * p.width_m)
         ego_radius = 0.5 * math.hypot(p.length_m, p.width_m) + front - 0.5 * p.length_m
         ax = ay = 0.0
         first_contact = None
@@ -135,20 +146,20 @@ class CoSimulation:
         stop_at = None
         t = t_start = session.time_s
         bodies = session.nearby(sense_radius)
-        parked_targets: dict[str, Target] = {}  # parked cars do not move: build their box once
+        targets_of = _Targets()
+        targets = targets_of.of(bodies)
+        cy, sy = math.cos(x[2]), math.sin(x[2])
+        t_sense = t_control = t_plant = t_sumo = t_contact = 0.0
         loop0 = clock()
         n_steps = 0
         for n_steps in range(1, steps + 1):
             # --- sense: the world at time t ---------------------------------------------------
             c0 = clock()
-            X, Y, yaw, vx, vy, r = x[:6].tolist()
+            X, Y, yaw, vx, vy, r = x[:6]
             s, d, road_yaw = road.project(X, Y)
             mu = session.friction_at_ego()
-            cy, sy = math.cos(yaw), math.sin(yaw)
             report = self.radar.scan(
-                (X + front * cy, Y + front * sy), yaw, vx, road,
-                [parked_targets.get(b.vid) or _target(b, parked_targets) for b in bodies],
-                lane_width,
+                (X + front * cy, Y + front * sy), yaw, vx, road, targets, lane_width
             )
             perception = _perception(report)
             meas = EgoMeasurement(
@@ -163,36 +174,38 @@ class CoSimulation:
             # --- plant: all sub-steps of this SUMO step in one call -----------------------------
             c3 = clock()
             x_prev = x
-            x, y_out = self.plant.step(
+            x, y_out = self.plant.advance(
                 x, (cmd.steer_cmd_rad, cmd.drive_force_cmd_n, cmd.brake_force_cmd_n), mu
             )
-            ax, ay = float(y_out[0]), float(y_out[1])
+            ax, ay = y_out[0], y_out[1]
             # --- write back and step SUMO -------------------------------------------------------
             c4 = clock()
-            Xn, Yn, yawn, vxn = x[:4].tolist()
-            session.move_ego(
-                Xn + front * math.cos(yawn), Yn + front * math.sin(yawn),
-                _nav_deg(yawn), max(vxn, 0.0),
-            )
+            Xn, Yn, yawn, vxn = x[:4]
+            cy, sy = math.cos(yawn), math.sin(yawn)
+            session.move_ego(Xn + front * cy, Yn + front * sy, _nav_deg(yawn), max(vxn, 0.0))
             session.step()
             t = session.time_s
             bodies_next = session.nearby(sense_radius)
             # --- ground truth: oriented-box contact at every plant sub-step ---------------------
             c5 = clock()
-            ego_box = OrientedBox.from_axis_point(Xn, Yn, yawn, p.length_m, p.width_m, front)
+            targets_next = targets_of.of(bodies_next)
+            ego_cx, ego_cy = Xn + back * cy, Yn + back * sy
+            ego_box = None  # built when a body comes close
             # farthest any point of the ego box moved during the step (translation + rotation)
             ego_move = math.hypot(Xn - x_prev[0], Yn - x_prev[1]) + ego_radius * abs(
                 yawn - x_prev[2])
-            for b in bodies_next:
-                centres_m = math.hypot(b.x_m - ego_box.x_m, b.y_m - ego_box.y_m)
+            for b, tgt in zip(bodies_next, targets_next):
+                centres_m = math.hypot(b.x_m - ego_cx, b.y_m - ego_cy)
                 if centres_m > GAP_WATCH_M:
                     continue
                 reach_m = ego_move + b.speed_mps * st.step_s + 0.05
-                if b.parked and centres_m - ego_box.radius_m - 0.5 * math.hypot(
+                if b.parked and centres_m - ego_box_radius - 0.5 * math.hypot(
                         b.length_m, b.width_m) > reach_m:
                     continue  # bounding circles apart by more than anything moved
-                gap = box_distance(ego_box, OrientedBox(b.x_m, b.y_m, b.yaw_rad, b.length_m,
-                                                        b.width_m))
+                if ego_box is None:
+                    ego_box = OrientedBox.from_axis_point(Xn, Yn, yawn, p.length_m, p.width_m,
+                                                          front)
+                gap = box_distance(ego_box, tgt.box)
                 # a parked car cannot be the ARO: its role is worked out only if it is hit
                 role = None if b.parked else role_of(b, road, lane_width)
                 if role == "aro":
@@ -203,14 +216,14 @@ class CoSimulation:
                     hit = self._substep_contact(x_prev, x, b, before)
                     if hit is not None:
                         first_contact = (hit, role or role_of(b, road, lane_width), t)
-            bodies = bodies_next
+            bodies, targets = bodies_next, targets_next
             max_lat_offset = max(max_lat_offset, abs(d))
             c6 = clock()
-            prof["sense"] += c1 - c0
-            prof["control"] += c2 - c1
-            prof["plant"] += c4 - c3
-            prof["sumo"] += c5 - c4
-            prof["contact"] += c6 - c5
+            t_sense += c1 - c0
+            t_control += c2 - c1
+            t_plant += c4 - c3
+            t_sumo += c5 - c4
+            t_contact += c6 - c5
             # --- end of run ---------------------------------------------------------------------
             if first_contact is not None:
                 break
@@ -220,9 +233,11 @@ class CoSimulation:
                 break
             if s > road.length_m - 50.0:
                 break
-        prof["loop_wall_s"] = clock() - loop0
-        prof["steps"] = n_steps
-        X, Y, yaw = float(x[0]), float(x[1]), float(x[2])
+        self.profile = {
+            "sense": t_sense, "control": t_control, "plant": t_plant, "sumo": t_sumo,
+            "contact": t_contact, "loop_wall_s": clock() - loop0, "steps": n_steps,
+        }
+        X, Y, yaw = x[:3]
         s, d, road_yaw = road.project(X, Y)
         log.add(t, x, ax, ay, s, d, yaw - road_yaw, session.friction_at_ego(), None, None)
         contact_info, role, t_contact = first_contact or (None, "none", None)
@@ -233,7 +248,7 @@ class CoSimulation:
             contact=contact_info,
             role=role,
             final_offset_m=d,
-            final_speed_mps=max(float(x[3]), 0.0),
+            final_speed_mps=max(x[3], 0.0),
         )
         wall = time.perf_counter() - wall0
         sim_time = t - t_start
@@ -251,11 +266,11 @@ class CoSimulation:
             "max_abs_lat_accel_mps2": round(log.max_abs("ay_mps2"), 6),
             "max_lateral_offset_m": round(max_lat_offset, 6),
             "final_lateral_offset_m": round(d, 6),
-            "final_speed_mps": round(max(float(x[3]), 0.0), 6),
+            "final_speed_mps": round(max(x[3], 0.0), 6),
             "ego_initial_speed_mps": round(ego.speed_mps, 6),
             "sim_time_s": round(sim_time, 6),
             "wall_time_s": wall,
-            "realtime_factor": sim_time / prof["loop_wall_s"],
+            "realtime_factor": sim_time / self.profile["loop_wall_s"],
         }
         return summary, log
 
@@ -264,7 +279,7 @@ class CoSimulation:
         modes = ctrl.modes_visited
         if len(modes) > 1 and ctrl.mode == 0:
             return True
-        return ctrl.mode in (1, 3) and float(x[3]) < 0.05
+        return ctrl.mode in (1, 3) and x[3] < 0.05
 
     def _substep_contact(self, x_prev, x_next, body, b0):
         """First contact at any plant sub-step between ego and body (``b0`` its pose at the
@@ -280,11 +295,11 @@ class CoSimulation:
             by = b0.y_m + w * (body.y_m - b0.y_m)
             byaw = body.yaw_rad
             ebox = OrientedBox.from_axis_point(
-                float(ex), float(ey), float(eyaw), p.length_m, p.width_m, p.cg_to_front_bumper_m
+                ex, ey, eyaw, p.length_m, p.width_m, p.cg_to_front_bumper_m
             )
             obox = OrientedBox(bx, by, byaw, body.length_m, body.width_m)
-            vx = float(x_prev[3] + w * (x_next[3] - x_prev[3]))
-            vy = float(x_prev[4] + w * (x_next[4] - x_prev[4]))
+            vx = x_prev[3] + w * (x_next[3] - x_prev[3])
+            vy = x_prev[4] + w * (x_next[4] - x_prev[4])
             ce, se = math.cos(eyaw), math.sin(eyaw)
             ve = (vx * ce - vy * se, vx * se + vy * ce)
             vb = (body.speed_mps * math.cos(byaw), body.speed_mps * math.sin(byaw))

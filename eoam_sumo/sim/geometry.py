@@ -60,21 +60,25 @@ class OrientedBox:
     radius_m: float = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        for name in ("x_m", "y_m", "yaw_rad", "length_m", "width_m"):
-            v = getattr(self, name)
-            if not math.isfinite(v):
-                raise ValueError(f"OrientedBox.{name}={v!r} must be finite")
+        isfinite = math.isfinite
+        if not (isfinite(self.x_m) and isfinite(self.y_m) and isfinite(self.yaw_rad)
+                and isfinite(self.length_m) and isfinite(self.width_m)):
+            for name in ("x_m", "y_m", "yaw_rad", "length_m", "width_m"):
+                v = getattr(self, name)
+                if not isfinite(v):
+                    raise ValueError(f"OrientedBox.{name}={v!r} must be finite")
         if self.length_m <= 0.0 or self.width_m <= 0.0:
             raise ValueError(
                 f"OrientedBox needs length_m > 0 and width_m > 0, got {self.length_m}, "
                 f"{self.width_m}"
             )
         hl, hw = 0.5 * self.length_m, 0.5 * self.width_m
-        object.__setattr__(self, "cos_yaw", math.cos(self.yaw_rad))
-        object.__setattr__(self, "sin_yaw", math.sin(self.yaw_rad))
-        object.__setattr__(self, "half_length_m", hl)
-        object.__setattr__(self, "half_width_m", hw)
-        object.__setattr__(self, "radius_m", math.hypot(hl, hw))
+        set_field = object.__setattr__
+        set_field(self, "cos_yaw", math.cos(self.yaw_rad))
+        set_field(self, "sin_yaw", math.sin(self.yaw_rad))
+        set_field(self, "half_length_m", hl)
+        set_field(self, "half_width_m", hw)
+        set_field(self, "radius_m", math.hypot(hl, hw))
 
     @classmethod
     def from_axis_point(

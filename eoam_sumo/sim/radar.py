@@ -37,6 +37,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from operator import attrgetter
 from typing import Protocol
 
 from eoam_sumo.sim.geometry import OrientedBox
@@ -139,6 +140,9 @@ class RadarReport:
     in_path: Detection | None = None  # the nearest in-path detection itself
 
 
+_range_of = attrgetter("range_m")
+
+
 def _ray_entry_m(box: OrientedBox, ox: float, oy: float, ux: float, uy: float) -> float:
     """Distance along the ray (origin o, unit direction u) to where it enters the box, or inf."""
     lox, loy = box.to_local(ox, oy)
@@ -173,18 +177,19 @@ class Radar:
     ) -> float:
         """Distance from the radar to the part of ``box`` inside the field-of-view cone (inf if
         none); the box is detected when this is within ``range_m``."""
-        return self._visible_point(origin_xy[0], origin_xy[1], yaw_rad, box)[0]
+        return self._visible_point(
+            origin_xy[0], origin_xy[1], yaw_rad, math.cos(yaw_rad), math.sin(yaw_rad), box
+        )[0]
 
     def _visible_point(
-        self, ox: float, oy: float, yaw_rad: float, box: OrientedBox
+        self, ox: float, oy: float, yaw_rad: float, cos_yaw: float, sin_yaw: float,
+        box: OrientedBox,
     ) -> tuple[float, float, float]:
         """(distance, x, y) of the point of ``box`` inside the cone nearest to the radar."""
         px, py = box.nearest_point(ox, oy)
         rx, ry = px - ox, py - oy
         r = math.hypot(rx, ry)
-        if r <= 1e-9 or rx * math.cos(yaw_rad) + ry * math.sin(yaw_rad) >= (
-            r * self._cos_half_fov - 1e-12
-        ):
+        if r <= 1e-9 or rx * cos_yaw + ry * sin_yaw >= r * self._cos_half_fov - 1e-12:
             return r, px, py
         best = (math.inf, ox, oy)
         for side in (1.0, -1.0):
@@ -207,25 +212,26 @@ class Radar:
         """Detect and classify ``targets`` seen from the ego's front bumper (rules: module doc)."""
         if not lane_width_m > 0.0:
             raise ValueError(f"lane_width_m={lane_width_m} must be > 0")
-        st = self.settings
+        range_m = self.settings.range_m
+        cos_half_fov, sin_half_fov = self._cos_half_fov, self._sin_half_fov
         ox, oy = ego_front_xy
         bx, by = math.cos(ego_yaw_rad), math.sin(ego_yaw_rad)
         evx, evy = ego_speed_mps * bx, ego_speed_mps * by
         ego_s = road_frame.project(ox, oy)[0]
-        band_m = 0.5 * lane_width_m + st.lane_margin_m
+        band_m = 0.5 * lane_width_m + self.settings.lane_margin_m
         detections = []
         for index, tgt in enumerate(targets):
             box = tgt.box
             dx, dy = box.x_m - ox, box.y_m - oy
-            reach = st.range_m + box.radius_m
+            reach = range_m + box.radius_m
             if dx * dx + dy * dy > reach * reach:
                 continue
             # cheap rejection: the box's bounding circle lies wholly outside the cone
             along, across = dx * bx + dy * by, abs(dy * bx - dx * by)
-            if along * self._sin_half_fov - across * self._cos_half_fov < -box.radius_m:
+            if along * sin_half_fov - across * cos_half_fov < -box.radius_m:
                 continue
-            rng, px, py = self._visible_point(ox, oy, ego_yaw_rad, box)
-            if rng > st.range_m:
+            rng, px, py = self._visible_point(ox, oy, ego_yaw_rad, bx, by, box)
+            if rng > range_m:
                 continue
             if rng > 1e-9:
                 lx, ly = (px - ox) / rng, (py - oy) / rng
@@ -242,16 +248,17 @@ class Radar:
                 Detection(index, rng, range_rate, bearing, s, d, road_speed, category,
                           tgt.length_m, tgt.width_m)
             )
-        detections.sort(key=lambda det: det.range_m)
-        in_path = next((det for det in detections if det.category == "in_path"), None)
-        return RadarReport(
-            in_path_range_m=None if in_path is None else in_path.range_m,
-            in_path_range_rate_mps=None if in_path is None else in_path.range_rate_mps,
-            oncoming_detected=any(det.category == "oncoming" for det in detections),
-            detections=tuple(detections),
-            in_path_index=None if in_path is None else in_path.index,
-            in_path=in_path,
-        )
+        detections.sort(key=_range_of)
+        in_path, oncoming = None, False
+        for det in detections:
+            if det.category == "in_path" and in_path is None:
+                in_path = det
+            elif det.category == "oncoming":
+                oncoming = True
+        if in_path is None:
+            return RadarReport(None, None, oncoming, tuple(detections))
+        return RadarReport(in_path.range_m, in_path.range_rate_mps, oncoming, tuple(detections),
+                           in_path.index, in_path)
 
     def _classify(
         self, ahead: bool, d_m: float, speed_mps: float, road_speed_mps: float, band_m: float

@@ -37,6 +37,7 @@ class RoadFrame:
             self._len.append(seg)
             self._s.append(self._s[-1] + seg)
         self._yaw = [math.atan2(hy, hx) for hx, hy in zip(self._hx, self._hy)]
+        self._kappa = [self._vertex_curvature(i) for i in range(len(self._len))]
         self._hint = 0
 
     @property
@@ -77,7 +78,10 @@ class RoadFrame:
 
     def curvature_at(self, s_m: float) -> float:
         """Signed curvature (1/m) from the heading change at the nearest polyline vertex."""
-        i = min(max(bisect_right(self._s, s_m) - 1, 0), len(self._len) - 1)
+        return self._kappa[min(max(bisect_right(self._s, s_m) - 1, 0), len(self._len) - 1)]
+
+    def _vertex_curvature(self, i: int) -> float:
+        """Curvature at the end of segment ``i`` (0 for the last segment)."""
         if i + 1 >= len(self._len):
             return 0.0
         dyaw = math.atan2(self._hy[i + 1], self._hx[i + 1]) - math.atan2(self._hy[i], self._hx[i])

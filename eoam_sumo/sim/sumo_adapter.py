@@ -341,6 +341,7 @@ class SumoSession:
         self._time_s = self._sim.getTime()
         self._mu_cache: dict[str, float] = {}
         self._dims_cache: dict[str, tuple[float, float]] = {}
+        self._bodies: dict[str, tuple[dict, Body]] = {}  # vid -> (last context result, its Body)
         self._stops = _scripted_stops(files, overrides)
         self._pending_stops = set(self._stops)
         self._scripts: dict[str, _Script] = {}
@@ -352,12 +353,7 @@ class SumoSession:
             self._tc.VAR_TYPE,
             self._tc.VAR_STOPSTATE,
         ]
-        self._ego_vars = [
-            self._tc.VAR_POSITION,
-            self._tc.VAR_ANGLE,
-            self._tc.VAR_SPEED,
-            self._tc.VAR_LANE_ID,
-        ]
+        self._ego_vars = [self._tc.VAR_LANE_ID]  # read every step; the pose only at the start
         self._ego_mu = 1.0
         self.ego_depart_time_s = self._time_s
         self.oncoming_id: str | None = None
@@ -681,6 +677,10 @@ class SumoSession:
             if cmd != script.last_cmd_mps:
                 self._veh.setSpeed(vid, cmd)
                 script.last_cmd_mps = cmd
+            elif cmd == 0.0 and res[self._tc.VAR_SPEED] == 0.0:
+                # stopped under a standing zero command: every later command is zero too
+                del self._scripts[vid]
+                self._veh.unsubscribe(vid)
 
     def step(self) -> None:
         """Advance SUMO by one step."""
@@ -728,7 +728,7 @@ class SumoSession:
     ) -> None:
         """Place the ego's front bumper for the next step (keepRoute=2: any lane, even opposite)."""
         self._check_open()
-        self._veh.moveToXY(self.ego_id, "", -1, x_front_m, y_front_m, angle_nav_deg, keepRoute=2)
+        self._veh.moveToXY(self.ego_id, "", -1, x_front_m, y_front_m, angle_nav_deg, 2)
         self._veh.setSpeed(self.ego_id, speed_mps)
 
     def _dims(self, type_id: str) -> tuple[float, float]:
@@ -757,7 +757,9 @@ class SumoSession:
 
     def nearby(self, radius_m: float) -> list[Body]:
         """Every other vehicle whose SUMO position (front bumper) is within ``radius_m`` of the
-        ego's, from one context subscription (renewed only when the radius changes)."""
+        ego's, sorted by id, from one context subscription (renewed only when the radius
+        changes). A vehicle whose SUMO values did not change since the last call (a parked
+        car) is the same ``Body`` object as then."""
         self._check_open()
         if radius_m != self._ctx_radius_m:
             _number("radius_m", radius_m, minimum=0.0, inclusive=False)
@@ -765,19 +767,18 @@ class SumoSession:
                 self.ego_id, self._tc.CMD_GET_VEHICLE_VARIABLE, radius_m, self._ctx_vars
             )
             self._ctx_radius_m = radius_m
-        tc = self._tc
-        return [
-            self._body(
-                vid,
-                r[tc.VAR_POSITION],
-                r[tc.VAR_ANGLE],
-                r[tc.VAR_SPEED],
-                r[tc.VAR_TYPE],
-                r[tc.VAR_STOPSTATE],
-            )
-            for vid, r in sorted(self._veh.getContextSubscriptionResults(self.ego_id).items())
-            if vid != self.ego_id
-        ]
+        tc, ego, last = self._tc, self.ego_id, self._bodies
+        seen: dict[str, tuple[dict, Body]] = {}
+        for vid, r in sorted(self._veh.getContextSubscriptionResults(ego).items()):
+            if vid == ego:
+                continue
+            known = last.get(vid)
+            if known is None or known[0] != r:
+                known = r, self._body(vid, r[tc.VAR_POSITION], r[tc.VAR_ANGLE], r[tc.VAR_SPEED],
+                                      r[tc.VAR_TYPE], r[tc.VAR_STOPSTATE])
+            seen[vid] = known
+        self._bodies = seen
+        return [body for _, body in seen.values()]
 
     def _ego_results(self) -> dict:
         self._check_open()
@@ -788,10 +789,10 @@ class SumoSession:
 
     def ego_body(self) -> Body:
         """The ego as SUMO sees it."""
-        r = self._ego_results()
-        tc = self._tc
+        self._ego_results()  # fails when the ego has left
+        veh, ego = self._veh, self.ego_id
         return self._body(
-            self.ego_id, r[tc.VAR_POSITION], r[tc.VAR_ANGLE], r[tc.VAR_SPEED], self._ego_type, 0
+            ego, veh.getPosition(ego), veh.getAngle(ego), veh.getSpeed(ego), self._ego_type, 0
         )
 
     def body(self, vid: str) -> Body:
