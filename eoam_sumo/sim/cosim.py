@@ -2,7 +2,7 @@
 
 Two rates: SUMO and the EOAM decision/control run every ``step_s`` (10 ms by default); the
 plant integrates at ``plant_dt_s`` (1 ms) inside each SUMO step, all sub-steps in one compiled
-call. Per SUMO step: sense (radar on SUMO's context subscription), decide and control, advance
+call. Per SUMO step: sense (radar on the vehicles SUMO reports near the ego), decide and control, advance
 the plant, write the ego pose back with ``moveToXY``, step SUMO, check contact with every
 other vehicle on oriented boxes at each plant sub-step, log.
 """
@@ -65,17 +65,18 @@ class _Targets:
     adapter hands back the same ``Body`` object for a vehicle whose values did not change."""
 
     def __init__(self) -> None:
-        self._known: dict[str, tuple] = {}  # vid -> (body, its target)
+        self._known: dict[str, tuple] = {}  # vid -> (last body seen, its target)
 
     def of(self, bodies: list) -> list[Target]:
-        known, seen = self._known, {}
+        known, targets = self._known, []
         for b in bodies:
             pair = known.get(b.vid)
             if pair is None or pair[0] is not b:
-                pair = b, Target(b.x_m, b.y_m, b.yaw_rad, b.speed_mps, b.length_m, b.width_m)
-            seen[b.vid] = pair
-        self._known = seen
-        return [tgt for _, tgt in seen.values()]
+                pair = known[b.vid] = (
+                    b, Target(b.x_m, b.y_m, b.yaw_rad, b.speed_mps, b.length_m, b.width_m)
+                )
+            targets.append(pair[1])
+        return targets
 
 
 def _nav_deg(yaw_rad: float) -> float:
