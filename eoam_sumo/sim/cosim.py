@@ -58,6 +58,7 @@ class RunSettings:
 
 SENSE_MARGIN_M = 10.0  # SUMO reports front bumpers: a body reaching into range is this close [m]
 GAP_WATCH_M = 20.0  # centre distance under which box gaps are measured and contact checked [m]
+ROUNDING_M = 1e-6  # margin for rounding when a lower bound of a gap rules the gap out [m]
 
 
 class _Targets:
@@ -150,6 +151,7 @@ class CoSimulation:
         targets_of = _Targets()
         targets = targets_of.of(bodies)
         cy, sy = math.cos(x[2]), math.sin(x[2])
+        radar, plant, step_s = self.radar, self.plant, st.step_s
         t_sense = t_control = t_plant = t_sumo = t_contact = 0.0
         loop0 = clock()
         n_steps = 0
@@ -159,7 +161,7 @@ class CoSimulation:
             X, Y, yaw, vx, vy, r = x[:6]
             s, d, road_yaw = road.project(X, Y)
             mu = session.friction_at_ego()
-            report = self.radar.scan(
+            report = radar.scan(
                 (X + front * cy, Y + front * sy), yaw, vx, road, targets, lane_width
             )
             perception = Perception(
@@ -171,13 +173,13 @@ class CoSimulation:
             )
             # --- decide and control -------------------------------------------------------------
             c1 = clock()
-            cmd = ctrl.step(meas, perception, st.step_s)
+            cmd = ctrl.step(meas, perception, step_s)
             c2 = clock()
             log.add(t, x, ax, ay, s, d, meas.e_yaw_rad, mu, cmd, perception)
             # --- plant: all sub-steps of this SUMO step in one call -----------------------------
             c3 = clock()
             x_prev = x
-            x, y_out = self.plant.advance(
+            x, y_out = plant.advance(
                 x, (cmd.steer_cmd_rad, cmd.drive_force_cmd_n, cmd.brake_force_cmd_n), mu
             )
             ax, ay = y_out[0], y_out[1]
@@ -201,16 +203,17 @@ class CoSimulation:
                 centres_m = math.hypot(b.x_m - ego_cx, b.y_m - ego_cy)
                 if centres_m > GAP_WATCH_M:
                     continue
-                reach_m = ego_move + b.speed_mps * st.step_s + 0.05
-                if b.parked and centres_m - ego_box_radius - 0.5 * math.hypot(
-                        b.length_m, b.width_m) > reach_m:
-                    continue  # bounding circles apart by more than anything moved
+                reach_m = ego_move + b.speed_mps * step_s + 0.05
+                # a parked car cannot be the ARO: its role is worked out only if it is hit
+                role = None if b.parked else role_of(b, road, lane_width)
+                # the bounding circles' gap is a lower bound of the boxes' gap
+                circles_m = centres_m - ego_box_radius - tgt.box.radius_m - ROUNDING_M
+                if circles_m > reach_m and (role != "aro" or circles_m >= min_gap_aro):
+                    continue  # the box gap can be neither the ARO's least nor a contact
                 if ego_box is None:
                     ego_box = OrientedBox.from_axis_point(Xn, Yn, yawn, p.length_m, p.width_m,
                                                           front)
                 gap = box_distance(ego_box, tgt.box)
-                # a parked car cannot be the ARO: its role is worked out only if it is hit
-                role = None if b.parked else role_of(b, road, lane_width)
                 if role == "aro":
                     min_gap_aro = min(min_gap_aro, gap)
                 # contact during the step is possible only if the gap is within both moves
