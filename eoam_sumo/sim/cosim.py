@@ -20,7 +20,7 @@ from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.plant import Plant, initial_state
 from eoam_sumo.sim.geometry import OrientedBox, box_distance, contact
 from eoam_sumo.sim.outcome import classify_outcome, role_of
-from eoam_sumo.sim.radar import Radar, RadarSettings, Target
+from eoam_sumo.sim.radar import Radar, RadarSettings
 from eoam_sumo.sim.roadframe import RoadFrame
 from eoam_sumo.sim.runlog import RunLog
 from eoam_sumo.sim.sumo_adapter import ScenarioOverrides, SumoSession
@@ -59,25 +59,6 @@ class RunSettings:
 SENSE_MARGIN_M = 10.0  # SUMO reports front bumpers: a body reaching into range is this close [m]
 GAP_WATCH_M = 20.0  # centre distance under which box gaps are measured and contact checked [m]
 ROUNDING_M = 1e-6  # margin for rounding when a lower bound of a gap rules the gap out [m]
-
-
-class _Targets:
-    """Radar targets (with their boxes) of SUMO bodies, built only for bodies that changed: the
-    adapter hands back the same ``Body`` object for a vehicle whose values did not change."""
-
-    def __init__(self) -> None:
-        self._known: dict[str, tuple] = {}  # vid -> (last body seen, its target)
-
-    def of(self, bodies: list) -> list[Target]:
-        known, targets = self._known, []
-        for b in bodies:
-            pair = known.get(b.vid)
-            if pair is None or pair[0] is not b:
-                pair = known[b.vid] = (
-                    b, Target(b.x_m, b.y_m, b.yaw_rad, b.speed_mps, b.length_m, b.width_m)
-                )
-            targets.append(pair[1])
-        return targets
 
 
 def _nav_deg(yaw_rad: float) -> float:
@@ -147,9 +128,7 @@ class CoSimulation:
         max_lat_offset = 0.0
         stop_at = None
         t = t_start = session.time_s
-        bodies = session.nearby(sense_radius)
-        targets_of = _Targets()
-        targets = targets_of.of(bodies)
+        bodies = session.nearby(sense_radius)  # with their boxes: the radar's targets
         cy, sy = math.cos(x[2]), math.sin(x[2])
         radar, plant, step_s = self.radar, self.plant, st.step_s
         t_sense = t_control = t_plant = t_sumo = t_contact = 0.0
@@ -162,7 +141,7 @@ class CoSimulation:
             s, d, road_yaw = road.project(X, Y)
             mu = session.friction_at_ego()
             report = radar.scan(
-                (X + front * cy, Y + front * sy), yaw, vx, road, targets, lane_width
+                (X + front * cy, Y + front * sy), yaw, vx, road, bodies, lane_width
             )
             perception = Perception(
                 report.in_path_range_m, report.in_path_range_rate_mps, report.oncoming_detected
@@ -193,13 +172,12 @@ class CoSimulation:
             bodies_next = session.nearby(sense_radius)
             # --- ground truth: oriented-box contact at every plant sub-step ---------------------
             c5 = clock()
-            targets_next = targets_of.of(bodies_next)
             ego_cx, ego_cy = Xn + back * cy, Yn + back * sy
             ego_box = None  # built when a body comes close
             # farthest any point of the ego box moved during the step (translation + rotation)
             ego_move = math.hypot(Xn - x_prev[0], Yn - x_prev[1]) + ego_radius * abs(
                 yawn - x_prev[2])
-            for b, tgt in zip(bodies_next, targets_next):
+            for b in bodies_next:
                 centres_m = math.hypot(b.x_m - ego_cx, b.y_m - ego_cy)
                 if centres_m > GAP_WATCH_M:
                     continue
@@ -207,13 +185,13 @@ class CoSimulation:
                 # a parked car cannot be the ARO: its role is worked out only if it is hit
                 role = None if b.parked else role_of(b, road, lane_width)
                 # the bounding circles' gap is a lower bound of the boxes' gap
-                circles_m = centres_m - ego_box_radius - tgt.box.radius_m - ROUNDING_M
+                circles_m = centres_m - ego_box_radius - b.box.radius_m - ROUNDING_M
                 if circles_m > reach_m and (role != "aro" or circles_m >= min_gap_aro):
                     continue  # the box gap can be neither the ARO's least nor a contact
                 if ego_box is None:
                     ego_box = OrientedBox.from_axis_point(Xn, Yn, yawn, p.length_m, p.width_m,
                                                           front)
-                gap = box_distance(ego_box, tgt.box)
+                gap = box_distance(ego_box, b.box)
                 if role == "aro":
                     min_gap_aro = min(min_gap_aro, gap)
                 # contact during the step is possible only if the gap is within both moves
@@ -222,7 +200,7 @@ class CoSimulation:
                     hit = self._substep_contact(x_prev, x, b, before)
                     if hit is not None:
                         first_contact = (hit, role or role_of(b, road, lane_width), t)
-            bodies, targets = bodies_next, targets_next
+            bodies = bodies_next
             max_lat_offset = max(max_lat_offset, abs(d))
             c6 = clock()
             t_sense += c1 - c0

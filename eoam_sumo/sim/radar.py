@@ -57,6 +57,13 @@ LANE_MARGIN_M = 0.5
 CATEGORIES = ("in_path", "oncoming", "stationary_side", "other")
 
 
+class Sensed(Protocol):
+    """What the radar reads of a road user (a ``Target``, a SUMO ``Body``)."""
+
+    box: OrientedBox
+    speed_mps: float
+
+
 class RoadProjection(Protocol):
     """Road frame of the ego's original lane (``eoam_sumo.sim.roadframe.RoadFrame``)."""
 
@@ -203,7 +210,7 @@ class Radar:
         ego_yaw_rad: float,
         ego_speed_mps: float,
         road_frame: RoadProjection,
-        targets: Sequence[Target],
+        targets: Sequence[Sensed],
         lane_width_m: float,
     ) -> RadarReport:
         """Detect and classify ``targets`` seen from the ego's front bumper (rules: module doc)."""

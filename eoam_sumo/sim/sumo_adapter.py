@@ -29,7 +29,7 @@ import subprocess
 import tempfile
 import uuid
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from operator import itemgetter
 from pathlib import Path
 from typing import Self
@@ -38,6 +38,7 @@ import numpy as np
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import G_MPS2, oncoming_sedan
+from eoam_sumo.sim.geometry import OrientedBox
 
 ROLE_KEY = "eoam.role"
 HOLD_KEY = "eoam.aro_hold_s"
@@ -111,7 +112,8 @@ class ScenarioOverrides:
 
 @dataclass(frozen=True)
 class Body:
-    """A road user as SUMO sees it: centre (x_m, y_m), yaw CCW from +x, footprint."""
+    """A road user as SUMO sees it: centre (x_m, y_m), yaw CCW from +x, footprint, and its
+    oriented box (for the radar and the contact test)."""
 
     vid: str
     x_m: float
@@ -121,6 +123,11 @@ class Body:
     length_m: float
     width_m: float
     parked: bool
+    box: OrientedBox = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        box = OrientedBox(self.x_m, self.y_m, self.yaw_rad, self.length_m, self.width_m)
+        object.__setattr__(self, "box", box)
 
 
 @dataclass(frozen=True)
@@ -645,7 +652,8 @@ class SumoSession:
 
     # ----------------------------------------------------------------------------- stepping
     def _sumo_step(self) -> None:
-        self._apply_stops()
+        if self._scripts:
+            self._apply_stops()
         self._api.simulationStep()
         self._results = None
         self._time_s = self._sim.getTime()
