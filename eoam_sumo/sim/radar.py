@@ -251,6 +251,8 @@ class Radar:
             detections.append(
                 Detection(index, rng, range_rate, bearing, s, d, road_speed, category)
             )
+        if not detections:
+            return RadarReport(None, None, False, ())
         detections.sort(key=_range_of)
         in_path, oncoming = None, False
         for det in detections:
