@@ -38,7 +38,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from operator import attrgetter
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 from eoam_sumo.sim.geometry import OrientedBox
 
@@ -119,9 +119,9 @@ class Target:
         )
 
 
-@dataclass(frozen=True, slots=True)
-class Detection:
-    """One detected target: measurements, road-frame position and class."""
+class Detection(NamedTuple):
+    """One detected target: measurements, road-frame position and class (a named tuple: built
+    at every scan, three times faster than a frozen dataclass)."""
 
     index: int  # position in the scanned target list (for logging only)
     range_m: float
@@ -133,8 +133,7 @@ class Detection:
     category: str
 
 
-@dataclass(frozen=True, slots=True)
-class RadarReport:
+class RadarReport(NamedTuple):
     """What the EOAM logic uses (nearest in-path target, oncoming flag) plus all detections."""
 
     in_path_range_m: float | None
