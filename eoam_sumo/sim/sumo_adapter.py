@@ -357,6 +357,7 @@ class SumoSession:
         self._tracking = False  # the other vehicles are followed (from the first ``nearby``)
         self._moving: dict[str, tuple | None] = {}  # vid -> (results, front, Body) once read
         self._parked: dict[str, tuple] = {}  # vid -> (front, Body), fixed while it stays parked
+        self._parked_cache: tuple | None = None  # the last answer of _parked_near, see there
         self._sense_vars = [
             self._tc.VAR_POSITION,
             self._tc.VAR_ANGLE,
@@ -688,9 +689,11 @@ class SumoSession:
         arrived."""
         for vid in self._sim.getArrivedIDList():
             self._moving.pop(vid, None)
-            self._parked.pop(vid, None)
+            if self._parked.pop(vid, None) is not None:
+                self._parked_cache = None
         for vid in self._sim.getParkingEndingVehiclesIDList():
             if self._parked.pop(vid, None) is not None:
+                self._parked_cache = None
                 self._moving[vid] = None
                 self._watch(vid)
         for vid in departed:
@@ -834,28 +837,52 @@ class SumoSession:
         if not ego:
             raise RuntimeError(f"the ego '{self.ego_id}' is no longer in the simulation")
         ex, ey = ego[self._tc.VAR_POSITION]
-        r2 = radius_m * radius_m
-        near = []
-        for vid, known in list(self._moving.items()):
+        near = self._moving_near(results, ex, ey, radius_m) + self._parked_near(ex, ey, radius_m)
+        near.sort(key=_first)
+        return [body for _, body in near]
+
+    def _moving_near(self, results: dict, ex: float, ey: float, radius_m: float) -> list:
+        """(vid, Body) of the followed moving vehicles within ``radius_m`` of (ex, ey), from
+        this step's ``results``; a vehicle found parked with settled values becomes fixed."""
+        r2, near, settled = radius_m * radius_m, [], []
+        for vid, known in self._moving.items():
             r = results.get(vid)
             if not r:  # left without arriving (removed)
-                del self._moving[vid]
+                settled.append((vid, None))
                 continue
             if known is None or known[0] != r:
                 known = self._moving[vid] = (r, r[self._tc.VAR_POSITION], self._sumo_body(vid, r))
             elif known[2].parked:  # parked, values settled: fixed until its parking ends
-                del self._moving[vid]
-                self._parked[vid] = known[1:]
-                self._watch(vid)
+                settled.append((vid, known[1:]))
                 continue
             (fx, fy), body = known[1], known[2]
             if (fx - ex) * (fx - ex) + (fy - ey) * (fy - ey) <= r2:
                 near.append((vid, body))
+        for vid, fixed in settled:
+            del self._moving[vid]
+            if fixed is not None:
+                self._parked[vid] = fixed
+                self._parked_cache = None
+                self._watch(vid)
+        return near
+
+    def _parked_near(self, ex: float, ey: float, radius_m: float) -> list:
+        """(vid, Body) of the parked vehicles within ``radius_m`` of (ex, ey). The answer is
+        kept while the ego stays closer to where it was worked out than any parked front is
+        to the radius (less 1e-6 m for rounding): no front can have crossed it."""
+        cache = self._parked_cache
+        if cache is not None:
+            ax, ay, radius, slack_m, near = cache
+            if radius == radius_m and slack_m > 0.0 and (
+                    (ex - ax) * (ex - ax) + (ey - ay) * (ey - ay) < slack_m * slack_m):
+                return near
+        r2, near, slack_m = radius_m * radius_m, [], math.inf
         for vid, ((fx, fy), body) in self._parked.items():
             if (fx - ex) * (fx - ex) + (fy - ey) * (fy - ey) <= r2:
                 near.append((vid, body))
-        near.sort(key=_first)
-        return [body for _, body in near]
+            slack_m = min(slack_m, abs(math.hypot(fx - ex, fy - ey) - radius_m))
+        self._parked_cache = (ex, ey, radius_m, slack_m - 1e-6, near)
+        return near
 
     def _sumo_body(self, vid: str, r: dict) -> Body:
         """Body of a vehicle from its subscription results."""
