@@ -2,7 +2,7 @@
 
 Two rates: SUMO and the EOAM decision/control run every ``step_s`` (10 ms by default); the
 plant integrates at ``plant_dt_s`` (1 ms) inside each SUMO step, all sub-steps in one compiled
-call. Per SUMO step: sense (radar on SUMO's context subscription), decide and control, advance
+call. Per SUMO step: sense (radar on the vehicles SUMO reports near the ego), decide and control, advance
 the plant, write the ego pose back with ``moveToXY``, step SUMO, check contact with every
 other vehicle on oriented boxes at each plant sub-step, log.
 """
@@ -20,7 +20,7 @@ from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.plant import Plant, initial_state
 from eoam_sumo.sim.geometry import OrientedBox, box_distance, contact
 from eoam_sumo.sim.outcome import classify_outcome, role_of
-from eoam_sumo.sim.radar import Radar, RadarReport, RadarSettings, Target
+from eoam_sumo.sim.radar import Radar, RadarReport, RadarSettings
 from eoam_sumo.sim.roadframe import RoadFrame
 from eoam_sumo.sim.runlog import RunLog
 from eoam_sumo.sim.sumo_adapter import ScenarioOverrides, SumoSession
@@ -58,24 +58,7 @@ class RunSettings:
 
 SENSE_MARGIN_M = 10.0  # SUMO reports front bumpers: a body reaching into range is this close [m]
 GAP_WATCH_M = 20.0  # centre distance under which box gaps are measured and contact checked [m]
-
-
-class _Targets:
-    """Radar targets (with their boxes) of SUMO bodies, built only for bodies that changed: the
-    adapter hands back the same ``Body`` object for a vehicle whose values did not change."""
-
-    def __init__(self) -> None:
-        self._known: dict[str, tuple] = {}  # vid -> (body, its target)
-
-    def of(self, bodies: list) -> list[Target]:
-        known, seen = self._known, {}
-        for b in bodies:
-            pair = known.get(b.vid)
-            if pair is None or pair[0] is not b:
-                pair = b, Target(b.x_m, b.y_m, b.yaw_rad, b.speed_mps, b.length_m, b.width_m)
-            seen[b.vid] = pair
-        self._known = seen
-        return [tgt for _, tgt in seen.values()]
+ROUNDING_M = 1e-6  # margin for rounding when a lower bound of a gap rules the gap out [m]
 
 
 def _nav_deg(yaw_rad: float) -> float:
@@ -145,10 +128,9 @@ class CoSimulation:
         max_lat_offset = 0.0
         stop_at = None
         t = t_start = session.time_s
-        bodies = session.nearby(sense_radius)
-        targets_of = _Targets()
-        targets = targets_of.of(bodies)
+        bodies = session.nearby(sense_radius)  # with their boxes: the radar's targets
         cy, sy = math.cos(x[2]), math.sin(x[2])
+        radar, plant, step_s = self.radar, self.plant, st.step_s
         t_sense = t_control = t_plant = t_sumo = t_contact = 0.0
         loop0 = clock()
         n_steps = 0
@@ -158,8 +140,8 @@ class CoSimulation:
             X, Y, yaw, vx, vy, r = x[:6]
             s, d, road_yaw = road.project(X, Y)
             mu = session.friction_at_ego()
-            report = self.radar.scan(
-                (X + front * cy, Y + front * sy), yaw, vx, road, targets, lane_width
+            report = radar.scan(
+                (X + front * cy, Y + front * sy), yaw, vx, road, bodies, lane_width
             )
             perception = _perception(report)
             meas = EgoMeasurement(
@@ -168,13 +150,13 @@ class CoSimulation:
             )
             # --- decide and control -------------------------------------------------------------
             c1 = clock()
-            cmd = ctrl.step(meas, perception, st.step_s)
+            cmd = ctrl.step(meas, perception, step_s)
             c2 = clock()
             log.add(t, x, ax, ay, s, d, meas.e_yaw_rad, mu, cmd, perception)
             # --- plant: all sub-steps of this SUMO step in one call -----------------------------
             c3 = clock()
             x_prev = x
-            x, y_out = self.plant.advance(
+            x, y_out = plant.advance(
                 x, (cmd.steer_cmd_rad, cmd.drive_force_cmd_n, cmd.brake_force_cmd_n), mu
             )
             ax, ay = y_out[0], y_out[1]
@@ -188,26 +170,26 @@ class CoSimulation:
             bodies_next = session.nearby(sense_radius)
             # --- ground truth: oriented-box contact at every plant sub-step ---------------------
             c5 = clock()
-            targets_next = targets_of.of(bodies_next)
             ego_cx, ego_cy = Xn + back * cy, Yn + back * sy
             ego_box = None  # built when a body comes close
             # farthest any point of the ego box moved during the step (translation + rotation)
             ego_move = math.hypot(Xn - x_prev[0], Yn - x_prev[1]) + ego_radius * abs(
                 yawn - x_prev[2])
-            for b, tgt in zip(bodies_next, targets_next):
+            for b in bodies_next:
                 centres_m = math.hypot(b.x_m - ego_cx, b.y_m - ego_cy)
                 if centres_m > GAP_WATCH_M:
                     continue
-                reach_m = ego_move + b.speed_mps * st.step_s + 0.05
-                if b.parked and centres_m - ego_box_radius - 0.5 * math.hypot(
-                        b.length_m, b.width_m) > reach_m:
-                    continue  # bounding circles apart by more than anything moved
+                reach_m = ego_move + b.speed_mps * step_s + 0.05
+                # a parked car cannot be the ARO: its role is worked out only if it is hit
+                role = None if b.parked else role_of(b, road, lane_width)
+                # the bounding circles' gap is a lower bound of the boxes' gap
+                circles_m = centres_m - ego_box_radius - b.box.radius_m - ROUNDING_M
+                if circles_m > reach_m and (role != "aro" or circles_m >= min_gap_aro):
+                    continue  # the box gap can be neither the ARO's least nor a contact
                 if ego_box is None:
                     ego_box = OrientedBox.from_axis_point(Xn, Yn, yawn, p.length_m, p.width_m,
                                                           front)
-                gap = box_distance(ego_box, tgt.box)
-                # a parked car cannot be the ARO: its role is worked out only if it is hit
-                role = None if b.parked else role_of(b, road, lane_width)
+                gap = box_distance(ego_box, b.box)
                 if role == "aro":
                     min_gap_aro = min(min_gap_aro, gap)
                 # contact during the step is possible only if the gap is within both moves
@@ -216,7 +198,7 @@ class CoSimulation:
                     hit = self._substep_contact(x_prev, x, b, before)
                     if hit is not None:
                         first_contact = (hit, role or role_of(b, road, lane_width), t)
-            bodies, targets = bodies_next, targets_next
+            bodies = bodies_next
             max_lat_offset = max(max_lat_offset, abs(d))
             c6 = clock()
             t_sense += c1 - c0

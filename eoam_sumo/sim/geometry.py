@@ -123,9 +123,12 @@ class OrientedBox:
 
     def nearest_point(self, x_m: float, y_m: float) -> tuple[float, float]:
         """The point of the box (boundary or inside) closest to a world point."""
-        lx, ly = self.to_local(x_m, y_m)
+        c, s = self.cos_yaw, self.sin_yaw
+        dx, dy = x_m - self.x_m, y_m - self.y_m
+        lx, ly = c * dx + s * dy, -s * dx + c * dy  # to_local, to_world inlined (hot path)
         hl, hw = self.half_length_m, self.half_width_m
-        return self.to_world(min(max(lx, -hl), hl), min(max(ly, -hw), hw))
+        lx, ly = min(max(lx, -hl), hl), min(max(ly, -hw), hw)
+        return self.x_m + c * lx - s * ly, self.y_m + s * lx + c * ly
 
     def distance_to_point(self, x_m: float, y_m: float) -> float:
         """Euclidean distance from a world point to the box (0 inside)."""

@@ -38,7 +38,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from operator import attrgetter
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 from eoam_sumo.sim.geometry import OrientedBox
 
@@ -55,6 +55,13 @@ ONCOMING_SPEED_MPS = 2.0
 LANE_MARGIN_M = 0.5
 
 CATEGORIES = ("in_path", "oncoming", "stationary_side", "other")
+
+
+class Sensed(Protocol):
+    """What the radar reads of a road user (a ``Target``, a SUMO ``Body``)."""
+
+    box: OrientedBox
+    speed_mps: float
 
 
 class RoadProjection(Protocol):
@@ -112,9 +119,9 @@ class Target:
         )
 
 
-@dataclass(frozen=True, slots=True)
-class Detection:
-    """One detected target: measurements, road-frame position and class."""
+class Detection(NamedTuple):
+    """One detected target: measurements, road-frame position and class (a named tuple: built
+    at every scan, three times faster than a frozen dataclass)."""
 
     index: int  # position in the scanned target list (for logging only)
     range_m: float
@@ -128,8 +135,7 @@ class Detection:
     width_m: float
 
 
-@dataclass(frozen=True, slots=True)
-class RadarReport:
+class RadarReport(NamedTuple):
     """What the EOAM logic uses (nearest in-path target, oncoming flag) plus all detections."""
 
     in_path_range_m: float | None
@@ -206,7 +212,7 @@ class Radar:
         ego_yaw_rad: float,
         ego_speed_mps: float,
         road_frame: RoadProjection,
-        targets: Sequence[Target],
+        targets: Sequence[Sensed],
         lane_width_m: float,
     ) -> RadarReport:
         """Detect and classify ``targets`` seen from the ego's front bumper (rules: module doc)."""
@@ -248,6 +254,8 @@ class Radar:
                 Detection(index, rng, range_rate, bearing, s, d, road_speed, category,
                           tgt.length_m, tgt.width_m)
             )
+        if not detections:
+            return RadarReport(None, None, False, ())
         detections.sort(key=_range_of)
         in_path, oncoming = None, False
         for det in detections:

@@ -46,19 +46,19 @@ class RunLog:
         else:
             rng = rate = nan
         onc = float(perception.oncoming_detected) if perception is not None else nan
-        if cmd is not None:
-            c = (cmd.mode, float(cmd.fcw), cmd.ax_target_mps2, cmd.y_target_m, cmd.dx_m,
-                 cmd.lateral_error_m, cmd.lookahead_error_m, cmd.steer_cmd_rad, cmd.steer_ff_rad,
-                 cmd.steer_fb_rad, cmd.steer_yd_rad, cmd.drive_force_cmd_n,
-                 cmd.brake_force_cmd_n, cmd.speed_target_mps,
-                 float(ord(cmd.sector)) if cmd.sector else nan)
+        if cmd is None:
+            row = (t, nan, nan, *x[:6], ax, ay, x[6], nan, nan, rng, rate, s, d, e_yaw,
+                   *(nan,) * 7, x[7], x[8], nan, nan, nan, mu, onc, nan)
         else:
-            c = (nan,) * 15
-        self._rows[self.n] = (
-            t, c[0], c[1], x[0], x[1], x[2], x[3], x[4], x[5], ax, ay, x[6], c[2], c[3], rng,
-            rate, s, d, e_yaw, c[4], c[5], c[6], c[7], c[8], c[9], c[10], x[7], x[8], c[11],
-            c[12], c[13], mu, onc, c[14],
-        )
+            row = (
+                t, cmd.mode, float(cmd.fcw), x[0], x[1], x[2], x[3], x[4], x[5], ax, ay, x[6],
+                cmd.ax_target_mps2, cmd.y_target_m, rng, rate, s, d, e_yaw, cmd.dx_m,
+                cmd.lateral_error_m, cmd.lookahead_error_m, cmd.steer_cmd_rad, cmd.steer_ff_rad,
+                cmd.steer_fb_rad, cmd.steer_yd_rad, x[7], x[8], cmd.drive_force_cmd_n,
+                cmd.brake_force_cmd_n, cmd.speed_target_mps, mu, onc,
+                float(ord(cmd.sector)) if cmd.sector else nan,
+            )
+        self._rows[self.n] = row
         self.n += 1
         self._array = None
 

@@ -4,7 +4,7 @@ A :class:`SumoSession` loads a ``.sumocfg`` after checking its files, applies th
 :class:`ScenarioOverrides` (surface friction, an added oncoming car, the ARO's emergency stop),
 advances SUMO to the ego's departure and makes the step that inserts the ego at the requested
 speed (moveToXY before the insertion step, design sec. 6). It then answers the co-simulation's
-queries: the ego's reference line, the bodies around the ego (one context subscription) and
+queries: the ego's reference line, the bodies around the ego (variable subscriptions) and
 the friction under the ego. The ego is re-inserted as a copy of its route-file vehicle (route,
 type, departLane/departPos and ``<param>``s kept; other attributes and its stops dropped).
 
@@ -29,7 +29,8 @@ import subprocess
 import tempfile
 import uuid
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from operator import itemgetter
 from pathlib import Path
 from typing import Self
 
@@ -37,6 +38,7 @@ import numpy as np
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import G_MPS2, oncoming_sedan
+from eoam_sumo.sim.geometry import OrientedBox
 
 ROLE_KEY = "eoam.role"
 HOLD_KEY = "eoam.aro_hold_s"
@@ -59,6 +61,7 @@ TRACI_RETRIES = 600  # x 50 ms: time SUMO may take to load before TraCI gives up
 PROCESS_EXIT_S = 10.0  # time a closed SUMO server process gets to exit
 
 _open_libsumo: list[SumoSession] = []  # libsumo runs one simulation per process
+_first = itemgetter(0)
 
 
 def _number(
@@ -109,7 +112,8 @@ class ScenarioOverrides:
 
 @dataclass(frozen=True)
 class Body:
-    """A road user as SUMO sees it: centre (x_m, y_m), yaw CCW from +x, footprint."""
+    """A road user as SUMO sees it: centre (x_m, y_m), yaw CCW from +x, footprint, and its
+    oriented box (for the radar and the contact test)."""
 
     vid: str
     x_m: float
@@ -119,6 +123,11 @@ class Body:
     length_m: float
     width_m: float
     parked: bool
+    box: OrientedBox = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        box = OrientedBox(self.x_m, self.y_m, self.yaw_rad, self.length_m, self.width_m)
+        object.__setattr__(self, "box", box)
 
 
 @dataclass(frozen=True)
@@ -341,19 +350,23 @@ class SumoSession:
         self._time_s = self._sim.getTime()
         self._mu_cache: dict[str, float] = {}
         self._dims_cache: dict[str, tuple[float, float]] = {}
-        self._bodies: dict[str, tuple[dict, Body]] = {}  # vid -> (last context result, its Body)
         self._stops = _scripted_stops(files, overrides)
         self._pending_stops = set(self._stops)
         self._scripts: dict[str, _Script] = {}
-        self._ctx_radius_m: float | None = None
-        self._ctx_vars = [
+        self._radius_m: float | None = None
+        self._tracking = False  # the other vehicles are followed (from the first ``nearby``)
+        self._moving: dict[str, tuple | None] = {}  # vid -> (results, front, Body) once read
+        self._parked: dict[str, tuple] = {}  # vid -> (front, Body), fixed while it stays parked
+        self._parked_cache: tuple | None = None  # the last answer of _parked_near, see there
+        self._sense_vars = [
             self._tc.VAR_POSITION,
             self._tc.VAR_ANGLE,
             self._tc.VAR_SPEED,
             self._tc.VAR_TYPE,
             self._tc.VAR_STOPSTATE,
         ]
-        self._ego_vars = [self._tc.VAR_LANE_ID]  # read every step; the pose only at the start
+        self._ego_vars = [self._tc.VAR_LANE_ID]  # every step (friction); the pose at the start
+        self._results: dict | None = None  # variable-subscription results of this step, once read
         self._ego_mu = 1.0
         self.ego_depart_time_s = self._time_s
         self.oncoming_id: str | None = None
@@ -640,13 +653,61 @@ class SumoSession:
 
     # ----------------------------------------------------------------------------- stepping
     def _sumo_step(self) -> None:
-        self._apply_stops()
+        if self._scripts:
+            self._apply_stops()
         self._api.simulationStep()
+        self._results = None
         self._time_s = self._sim.getTime()
-        if self._pending_stops:
-            for vid in self._sim.getDepartedIDList():
+        if self._tracking or self._pending_stops:
+            departed = self._sim.getDepartedIDList()
+            if self._tracking:
+                self._track(departed)
+            for vid in departed:
                 if vid in self._pending_stops:
                     self._start_stop(vid)
+
+    def _watch(self, vid: str) -> None:
+        """Subscribe to what the adapter reads of ``vid`` (its body, its scripted stop), or
+        unsubscribe when that is nothing."""
+        wanted = list(self._sense_vars) if vid in self._moving else []
+        if vid in self._scripts:
+            wanted += [v for v in (self._tc.VAR_SPEED, self._tc.VAR_LANE_ID) if v not in wanted]
+        if wanted:
+            self._veh.subscribe(vid, wanted)
+        else:
+            self._veh.unsubscribe(vid)
+        self._results = None
+
+    def _step_results(self) -> dict:
+        """Vehicle id -> its variable-subscription results at this step (one read a step)."""
+        if self._results is None:
+            self._results = self._veh.getAllSubscriptionResults()
+        return self._results
+
+    def _track(self, departed) -> None:
+        """Follow the vehicles that departed or ended parking in this step, drop those that
+        arrived."""
+        for vid in self._sim.getArrivedIDList():
+            self._moving.pop(vid, None)
+            if self._parked.pop(vid, None) is not None:
+                self._parked_cache = None
+        for vid in self._sim.getParkingEndingVehiclesIDList():
+            if self._parked.pop(vid, None) is not None:
+                self._parked_cache = None
+                self._moving[vid] = None
+                self._watch(vid)
+        for vid in departed:
+            if vid != self.ego_id:
+                self._moving[vid] = None
+                self._watch(vid)
+
+    def _start_tracking(self) -> None:
+        self._tracking = True
+        self._veh.subscribe(self.ego_id, [*self._ego_vars, self._tc.VAR_POSITION])
+        for vid in self._veh.getIDList():
+            if vid != self.ego_id:
+                self._moving[vid] = None
+                self._watch(vid)
 
     def _start_stop(self, vid: str) -> None:
         hold, decel = self._stops[vid]
@@ -655,13 +716,13 @@ class SumoSession:
             self._veh.getDeparture(vid) + hold, decel, self._veh.getSpeed(vid)
         )
         self._veh.setSpeedMode(vid, SCRIPTED_SPEED_MODE)
-        self._veh.subscribe(vid, [self._tc.VAR_SPEED, self._tc.VAR_LANE_ID])
+        self._watch(vid)
 
     def _apply_stops(self) -> None:
         """Command each scripted vehicle's speed at the end of the coming step (Figure 19)."""
         t_next = self._time_s + self._dt
         for vid, script in list(self._scripts.items()):
-            res = self._veh.getSubscriptionResults(vid)
+            res = self._step_results().get(vid)
             if not res:
                 del self._scripts[vid]
                 continue
@@ -680,7 +741,7 @@ class SumoSession:
             elif cmd == 0.0 and res[self._tc.VAR_SPEED] == 0.0:
                 # stopped under a standing zero command: every later command is zero too
                 del self._scripts[vid]
-                self._veh.unsubscribe(vid)
+                self._watch(vid)
 
     def step(self) -> None:
         """Advance SUMO by one step."""
@@ -757,32 +818,81 @@ class SumoSession:
 
     def nearby(self, radius_m: float) -> list[Body]:
         """Every other vehicle whose SUMO position (front bumper) is within ``radius_m`` of the
-        ego's, sorted by id, from one context subscription (renewed only when the radius
-        changes). A vehicle whose SUMO values did not change since the last call (a parked
-        car) is the same ``Body`` object as then."""
+        ego's, sorted by id.
+
+        From the first call on the session follows all vehicles: a moving one through a
+        variable subscription, a parked one as a fixed body once it was read parked twice
+        with the same values, until SUMO reports its parking ended (a context subscription
+        would read every parked car at every step). A vehicle whose values did not change
+        since the last call is the same ``Body`` object as then.
+        """
         self._check_open()
-        if radius_m != self._ctx_radius_m:
+        if radius_m != self._radius_m:
             _number("radius_m", radius_m, minimum=0.0, inclusive=False)
-            self._veh.subscribeContext(
-                self.ego_id, self._tc.CMD_GET_VEHICLE_VARIABLE, radius_m, self._ctx_vars
-            )
-            self._ctx_radius_m = radius_m
-        tc, ego, last = self._tc, self.ego_id, self._bodies
-        seen: dict[str, tuple[dict, Body]] = {}
-        for vid, r in sorted(self._veh.getContextSubscriptionResults(ego).items()):
-            if vid == ego:
+            self._radius_m = radius_m
+        if not self._tracking:
+            self._start_tracking()
+        results = self._step_results()
+        ego = results.get(self.ego_id)
+        if not ego:
+            raise RuntimeError(f"the ego '{self.ego_id}' is no longer in the simulation")
+        ex, ey = ego[self._tc.VAR_POSITION]
+        near = self._moving_near(results, ex, ey, radius_m) + self._parked_near(ex, ey, radius_m)
+        near.sort(key=_first)
+        return [body for _, body in near]
+
+    def _moving_near(self, results: dict, ex: float, ey: float, radius_m: float) -> list:
+        """(vid, Body) of the followed moving vehicles within ``radius_m`` of (ex, ey), from
+        this step's ``results``; a vehicle found parked with settled values becomes fixed."""
+        r2, near, settled = radius_m * radius_m, [], []
+        for vid, known in self._moving.items():
+            r = results.get(vid)
+            if not r:  # left without arriving (removed)
+                settled.append((vid, None))
                 continue
-            known = last.get(vid)
             if known is None or known[0] != r:
-                known = r, self._body(vid, r[tc.VAR_POSITION], r[tc.VAR_ANGLE], r[tc.VAR_SPEED],
-                                      r[tc.VAR_TYPE], r[tc.VAR_STOPSTATE])
-            seen[vid] = known
-        self._bodies = seen
-        return [body for _, body in seen.values()]
+                known = self._moving[vid] = (r, r[self._tc.VAR_POSITION], self._sumo_body(vid, r))
+            elif known[2].parked:  # parked, values settled: fixed until its parking ends
+                settled.append((vid, known[1:]))
+                continue
+            (fx, fy), body = known[1], known[2]
+            if (fx - ex) * (fx - ex) + (fy - ey) * (fy - ey) <= r2:
+                near.append((vid, body))
+        for vid, fixed in settled:
+            del self._moving[vid]
+            if fixed is not None:
+                self._parked[vid] = fixed
+                self._parked_cache = None
+                self._watch(vid)
+        return near
+
+    def _parked_near(self, ex: float, ey: float, radius_m: float) -> list:
+        """(vid, Body) of the parked vehicles within ``radius_m`` of (ex, ey). The answer is
+        kept while the ego stays closer to where it was worked out than any parked front is
+        to the radius (less 1e-6 m for rounding): no front can have crossed it."""
+        cache = self._parked_cache
+        if cache is not None:
+            ax, ay, radius, slack_m, near = cache
+            if radius == radius_m and slack_m > 0.0 and (
+                    (ex - ax) * (ex - ax) + (ey - ay) * (ey - ay) < slack_m * slack_m):
+                return near
+        r2, near, slack_m = radius_m * radius_m, [], math.inf
+        for vid, ((fx, fy), body) in self._parked.items():
+            if (fx - ex) * (fx - ex) + (fy - ey) * (fy - ey) <= r2:
+                near.append((vid, body))
+            slack_m = min(slack_m, abs(math.hypot(fx - ex, fy - ey) - radius_m))
+        self._parked_cache = (ex, ey, radius_m, slack_m - 1e-6, near)
+        return near
+
+    def _sumo_body(self, vid: str, r: dict) -> Body:
+        """Body of a vehicle from its subscription results."""
+        tc = self._tc
+        return self._body(vid, r[tc.VAR_POSITION], r[tc.VAR_ANGLE], r[tc.VAR_SPEED],
+                          r[tc.VAR_TYPE], r[tc.VAR_STOPSTATE])
 
     def _ego_results(self) -> dict:
         self._check_open()
-        res = self._veh.getSubscriptionResults(self.ego_id)
+        res = self._step_results().get(self.ego_id)
         if not res:
             raise RuntimeError(f"the ego '{self.ego_id}' is no longer in the simulation")
         return res

@@ -249,6 +249,33 @@ def test_parked_cars_sit_beside_the_ego_lane_and_never_in_it(open_session):
     assert "aro" not in s.vehicle_ids()
 
 
+def test_nearby_agrees_with_sumo_at_every_step(open_session):
+    """nearby() follows the vehicles without a context subscription: at every step it equals
+    SUMO's getters for every vehicle within the radius, through the ARO's stop, the oncoming
+    car's insertion and a parked car that drives off (its parking ended by libsumo)."""
+    import libsumo
+
+    s = open_session(BASELINE, ScenarioOverrides(oncoming_start_m=300.0))
+    radius = 250.0
+    leaving = None
+    for k in range(600):
+        ego_front = libsumo.vehicle.getPosition(s.ego_id)
+        want = sorted(
+            vid for vid in s.vehicle_ids()
+            if vid != s.ego_id
+            and math.dist(libsumo.vehicle.getPosition(vid), ego_front) <= radius
+        )
+        got = s.nearby(radius)
+        assert [b.vid for b in got] == want
+        assert got == [s.body(vid) for vid in want]
+        if k == 50:  # right before a step, as SUMO would end a parking within one
+            leaving = next(b.vid for b in got if b.parked)
+            libsumo.vehicle.resume(leaving)
+        s.step()
+    assert leaving is not None and not s.body(leaving).parked
+    assert s.vehicle_speed(leaving) > 1.0
+
+
 # --------------------------------------------------------------------------- friction
 def test_friction_override_sets_every_lane(open_session):
     s = open_session(BASELINE, ScenarioOverrides(mu=0.3))
