@@ -213,19 +213,19 @@ class EoamController:
         """Mode 5's path back to the lane centre; urgent (oncoming traffic) at the evasive
         lateral acceleration, else at the comfortable one."""
         self._urgent_return = urgent
-        self._shift_to(0.0, meas, "evasive_lateral_g" if urgent else "return_lateral_g")
-
-    def _shift_to(self, target_m: float, meas: EgoMeasurement, lateral_g_setting: str) -> None:
-        """A quintic (``QuinticShift``) from the ego's offset and heading to ``target_m``, with
-        its peak lateral acceleration the named setting's share of mu g."""
         st = self.settings
+        self._shift_to(0.0, meas, st.evasive_lateral_g if urgent else st.return_lateral_g)
+
+    def _shift_to(self, target_m: float, meas: EgoMeasurement, lateral_g: float) -> None:
+        """A quintic (``QuinticShift``) from the ego's offset and heading to ``target_m``, with
+        its peak lateral acceleration ``lateral_g`` mu g."""
         traj = QuinticShift.for_lateral_accel(
             meas.d_m,
             math.tan(_wrap(meas.e_yaw_rad)),
             target_m,
             meas.vx_mps,
-            getattr(st, lateral_g_setting) * meas.mu * G_MPS2,
-            st.return_min_length_m,
+            lateral_g * meas.mu * G_MPS2,
+            self.settings.return_min_length_m,
         )
         self._start_path(meas, traj, meas.d_m, None)
 
@@ -264,7 +264,7 @@ class EoamController:
             self._hold_speed = meas.vx_mps
             self._start_return(meas, urgent=previous is Mode.ONCOMING_STEER_BRAKE)
         elif mode is Mode.ONCOMING_STEER_BRAKE:
-            self._shift_to(self._passing_offset_m(meas), meas, "evasive_lateral_g")
+            self._shift_to(self._passing_offset_m(meas), meas, self.settings.evasive_lateral_g)
         else:
             self._path = None
             self._long.reset()
@@ -357,14 +357,14 @@ class EoamController:
                 settled = t - self._settle_since >= st.settle_dwell_s - 1e-9
             else:
                 self._settle_since = None
+        clear = mode in _STEERING and self._clear_of_obstacle(meas, path, dx)  # 2 and 4 only
         stable = (
-            st.return_when_stable
+            clear
+            and st.return_when_stable
             and mode is Mode.UPDATE_STEER_BRAKE
-            and path is not None
             and dx >= path.length_m
             and abs(d - path.start_offset_m - height) <= st.arrive_tolerance_m
             and abs(_wrap(meas.e_yaw_rad)) <= st.settle_heading_rad
-            and self._clear_of_obstacle(meas, path, dx)
         )
         new = next_mode(
             mode,
@@ -373,7 +373,7 @@ class EoamController:
             past_ponr=travel >= st.ponr_fraction * height,
             timer_expired=t - self._t_steer >= st.manoeuvre_time_s - 1e-9,
             stable_in_next_lane=stable,
-            clear_of_obstacle=self._clear_of_obstacle(meas, path, dx),
+            clear_of_obstacle=clear,
             settled=settled,
             threat_gone=threat_gone,
         )
