@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields
+from typing import NamedTuple
 
 from eoam_sumo.control.longitudinal import LongitudinalController, LongitudinalGains
 from eoam_sumo.control.reference import PathReference, QuinticShift
@@ -39,9 +40,11 @@ from eoam_sumo.params import G_MPS2, VehicleParams
 _TWO_PI = 2.0 * math.pi
 
 
-@dataclass(frozen=True, slots=True)
-class EgoMeasurement:
-    """Ego state in the road frame of its original lane (s along, d left of its centre)."""
+class EgoMeasurement(NamedTuple):
+    """Ego state in the road frame of its original lane (s along, d left of its centre).
+
+    The per-step messages (this, ``ObjectState``, ``Perception``, ``Command``) are named
+    tuples: as immutable as frozen dataclasses and built in a quarter of the time."""
 
     time_s: float
     vx_mps: float
@@ -58,8 +61,7 @@ class EgoMeasurement:
     left_lane_available: bool = True  # map: a lane (either direction) left of the ego's lane
 
 
-@dataclass(frozen=True, slots=True)
-class ObjectState:
+class ObjectState(NamedTuple):
     """A tracked object in the road frame of the ego's original lane (a sensor's object list)."""
 
     s_m: float  # station of its centre
@@ -69,8 +71,7 @@ class ObjectState:
     width_m: float
 
 
-@dataclass(frozen=True, slots=True)
-class Perception:
+class Perception(NamedTuple):
     """Radar-derived view: the in-path obstacle (None when nothing) and oncoming traffic."""
 
     aro_range_m: float | None = None
@@ -79,8 +80,7 @@ class Perception:
     aro_object: ObjectState | None = None  # the in-path obstacle as an object, when tracked
 
 
-@dataclass(frozen=True, slots=True)
-class Command:
+class Command(NamedTuple):
     """Actuator commands for the next step plus what the controller decided, for logging."""
 
     steer_cmd_rad: float
@@ -151,7 +151,6 @@ class EoamSettings:
                 raise ValueError(f"EOAM setting {name} must be > 0")
 
 
-_MEAS_FIELDS = tuple(f.name for f in fields(EgoMeasurement))
 _STEERING = (Mode.UPDATE_STEER_BRAKE, Mode.ONCOMING_STEER_BRAKE)
 
 
@@ -311,9 +310,10 @@ class EoamController:
         """One decision + control step; commands hold until the next call."""
         if self._initial_speed is None:
             raise ValueError("EoamController.reset(initial_speed_mps) must be called first")
-        for name in _MEAS_FIELDS:
-            if not math.isfinite(getattr(meas, name)):
-                raise ValueError(f"ego measurement {name}={getattr(meas, name)!r} is not finite")
+        if not math.isfinite(sum(meas)):  # a NaN or inf field (or finite fields overflowing)
+            for name, value in zip(EgoMeasurement._fields, meas):
+                if not math.isfinite(value):
+                    raise ValueError(f"ego measurement {name}={value!r} is not finite")
         if not meas.lane_width_m > 0.0:
             raise ValueError(f"lane_width_m={meas.lane_width_m!r} must be > 0")
         mu = meas.mu

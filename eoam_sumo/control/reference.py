@@ -89,6 +89,10 @@ class PathReference:
         )
 
 
+PEAK_SAMPLES = 200  # intervals over which a shift's peak curvature is sampled
+_PEAK_U = [i / PEAK_SAMPLES for i in range(PEAK_SAMPLES + 1)]
+
+
 class QuinticShift:
     """Quintic from offset ``y0`` with slope ``slope0`` to offset ``y1`` (paper sec. 4.2).
 
@@ -112,14 +116,23 @@ class QuinticShift:
         self._c = (y0_m, p, 10.0 * e - 4.0 * f, -15.0 * e + 7.0 * f, 6.0 * e - 3.0 * f)
         self.length_m = float(length_m)
 
-    def peak_curvature_1pm(self, samples: int = 200) -> float:
+    def peak_curvature_1pm(self, samples: int = PEAK_SAMPLES) -> float:
         """Largest |y''| along the path (sampled), the lateral acceleration per v^2."""
         _, _, c3, c4, c5 = self._c
-        big2 = self.length_m * self.length_m
+        us = _PEAK_U if samples == PEAK_SAMPLES else [i / samples for i in range(samples + 1)]
         return max(
-            abs(6.0 * c3 * u + 12.0 * c4 * u * u + 20.0 * c5 * u * u * u)
-            for u in (i / samples for i in range(samples + 1))
-        ) / big2
+            abs(6.0 * c3 * u + 12.0 * c4 * u * u + 20.0 * c5 * u * u * u) for u in us
+        ) / (self.length_m * self.length_m)
+
+    def _peak_exceeds(self, limit_1pm: float) -> bool:
+        """``peak_curvature_1pm() > limit_1pm``, stopping at the first sample over the limit
+        (division by L^2 is monotone, so testing each sample is the same as testing the max)."""
+        _, _, c3, c4, c5 = self._c
+        big2 = self.length_m * self.length_m
+        return any(
+            abs(6.0 * c3 * u + 12.0 * c4 * u * u + 20.0 * c5 * u * u * u) / big2 > limit_1pm
+            for u in _PEAK_U
+        )
 
     @classmethod
     def for_lateral_accel(
@@ -138,7 +151,7 @@ class QuinticShift:
         limit = lateral_accel_mps2 / max(speed_mps * speed_mps, 1e-9)
         level = math.sqrt(10.0 * math.sqrt(3.0) / 3.0 * abs(y1_m - y0_m) / limit)  # slope0 = 0
         length = max(min_length_m, 0.5 * level)
-        while (traj := cls(y0_m, slope0, y1_m, length)).peak_curvature_1pm() > limit:
+        while (traj := cls(y0_m, slope0, y1_m, length))._peak_exceeds(limit):
             length *= 1.02
         return traj
 

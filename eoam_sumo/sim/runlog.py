@@ -1,7 +1,8 @@
 """Preallocated per-step log of a co-simulation run and its files (timeseries.csv, summary.json).
 
-One row per SUMO step, stored as a tuple in a preallocated list (no numpy or pandas work in
-the loop); the float array is built once at the end, pandas only when the run is written.
+One entry per SUMO step, the step's values kept as a tuple in a preallocated list (no row
+layout, numpy or pandas work in the loop); the rows and the float array are built once at the
+end, pandas only when the run is written.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ _NAN = math.nan
 
 
 class RunLog:
-    """Fixed-size log; ``add`` stores one row, ``array()`` / ``frame()`` give the table."""
+    """Fixed-size log; ``add`` keeps one step, ``array()`` / ``frame()`` give the table."""
 
     def __init__(self, rows: int):
         self._rows: list = [None] * rows
@@ -37,35 +38,21 @@ class RunLog:
         self._array = None
 
     def add(self, t, x, ax, ay, s, d, e_yaw, mu, cmd, perception) -> None:
-        """Log the state ``x`` at time ``t`` with the command decided from it (None at the end)."""
+        """Log the state ``x`` at time ``t`` with the command decided from it (None at the end).
+
+        The arguments are kept as given (``x`` copied) and laid out as a row by ``array``: the
+        step loop pays for one tuple. ``cmd`` and ``perception`` are immutable named tuples."""
         if self.n >= len(self._rows):
             return
-        nan = _NAN
-        if perception is not None and perception.aro_range_m is not None:
-            rng, rate = perception.aro_range_m, perception.aro_range_rate_mps
-        else:
-            rng = rate = nan
-        onc = float(perception.oncoming_detected) if perception is not None else nan
-        if cmd is None:
-            row = (t, nan, nan, *x[:6], ax, ay, x[6], nan, nan, rng, rate, s, d, e_yaw,
-                   *(nan,) * 7, x[7], x[8], nan, nan, nan, mu, onc, nan)
-        else:
-            row = (
-                t, cmd.mode, float(cmd.fcw), x[0], x[1], x[2], x[3], x[4], x[5], ax, ay, x[6],
-                cmd.ax_target_mps2, cmd.y_target_m, rng, rate, s, d, e_yaw, cmd.dx_m,
-                cmd.lateral_error_m, cmd.lookahead_error_m, cmd.steer_cmd_rad, cmd.steer_ff_rad,
-                cmd.steer_fb_rad, cmd.steer_yd_rad, x[7], x[8], cmd.drive_force_cmd_n,
-                cmd.brake_force_cmd_n, cmd.speed_target_mps, mu, onc,
-                float(ord(cmd.sector)) if cmd.sector else nan,
-            )
-        self._rows[self.n] = row
+        self._rows[self.n] = (t, tuple(x), ax, ay, s, d, e_yaw, mu, cmd, perception)
         self.n += 1
         self._array = None
 
     def array(self) -> np.ndarray:
         """(n, len(COLUMNS)) float array of the rows logged so far."""
         if self._array is None:
-            self._array = np.array(self._rows[: self.n], dtype=float).reshape(-1, len(COLUMNS))
+            rows = [_row(*args) for args in self._rows[: self.n]]
+            self._array = np.array(rows, dtype=float).reshape(-1, len(COLUMNS))
         return self._array
 
     def column(self, name: str) -> np.ndarray:
@@ -84,6 +71,27 @@ class RunLog:
             df[c] = df[c].astype("Int64")
         df["sector"] = [chr(int(v)) if np.isfinite(v) else "" for v in df["sector"]]
         return df
+
+
+def _row(t, x, ax, ay, s, d, e_yaw, mu, cmd, perception) -> tuple:
+    """One timeseries row (COLUMNS order) from what ``RunLog.add`` kept."""
+    nan = _NAN
+    if perception is not None and perception.aro_range_m is not None:
+        rng, rate = perception.aro_range_m, perception.aro_range_rate_mps
+    else:
+        rng = rate = nan
+    onc = float(perception.oncoming_detected) if perception is not None else nan
+    if cmd is None:
+        return (t, nan, nan, *x[:6], ax, ay, x[6], nan, nan, rng, rate, s, d, e_yaw,
+                *(nan,) * 7, x[7], x[8], nan, nan, nan, mu, onc, nan)
+    return (
+        t, cmd.mode, float(cmd.fcw), x[0], x[1], x[2], x[3], x[4], x[5], ax, ay, x[6],
+        cmd.ax_target_mps2, cmd.y_target_m, rng, rate, s, d, e_yaw, cmd.dx_m,
+        cmd.lateral_error_m, cmd.lookahead_error_m, cmd.steer_cmd_rad, cmd.steer_ff_rad,
+        cmd.steer_fb_rad, cmd.steer_yd_rad, x[7], x[8], cmd.drive_force_cmd_n,
+        cmd.brake_force_cmd_n, cmd.speed_target_mps, mu, onc,
+        float(ord(cmd.sector)) if cmd.sector else nan,
+    )
 
 
 def _atomic_write_text(path: Path, text: str) -> None:
