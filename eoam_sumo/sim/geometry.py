@@ -28,7 +28,8 @@ Contact rules (the paper's colours, sec. 11, need the faces and the kind of the 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from collections import namedtuple
+from dataclasses import dataclass
 
 #: Boxes closer than this count as touching [m]: far below the 1 mm that tests resolve and far
 #: above the rounding error of a rotation of road-scale coordinates (~1e-12 m).
@@ -44,41 +45,45 @@ FACES = ("front", "rear", "left", "right")
 CONTACT_KINDS = ("head_on", "rear_end", "side", "oblique")
 
 
-@dataclass(frozen=True, slots=True)
-class OrientedBox:
-    """Rectangle footprint of a body: centre, heading and size (validated)."""
+# untyped on purpose: introspection (help, hypothesis' builds) then sees OrientedBox's own
+# five-argument constructor rather than ten tuple fields
+_BoxFields = namedtuple(
+    "_BoxFields",
+    "x_m y_m yaw_rad length_m width_m cos_yaw sin_yaw half_length_m half_width_m radius_m",
+)
 
-    x_m: float
-    y_m: float
-    yaw_rad: float
-    length_m: float
-    width_m: float
-    cos_yaw: float = field(init=False, repr=False, compare=False)
-    sin_yaw: float = field(init=False, repr=False, compare=False)
-    half_length_m: float = field(init=False, repr=False, compare=False)
-    half_width_m: float = field(init=False, repr=False, compare=False)
-    radius_m: float = field(init=False, repr=False, compare=False)
 
-    def __post_init__(self) -> None:
+class OrientedBox(_BoxFields):
+    """Rectangle footprint of a body: centre, heading and size (validated), with the cosine,
+    sine, half sizes and bounding radius worked out once.
+
+    ``OrientedBox(x_m, y_m, yaw_rad, length_m, width_m)``. An immutable tuple subclass: boxes
+    are built for every moving body at every step, and this builds in a third of the time of
+    a frozen dataclass with ``__post_init__``."""
+
+    __slots__ = ()
+
+    def __new__(cls, x_m: float, y_m: float, yaw_rad: float, length_m: float, width_m: float):
         isfinite = math.isfinite
-        if not (isfinite(self.x_m) and isfinite(self.y_m) and isfinite(self.yaw_rad)
-                and isfinite(self.length_m) and isfinite(self.width_m)):
-            for name in ("x_m", "y_m", "yaw_rad", "length_m", "width_m"):
-                v = getattr(self, name)
+        if not (isfinite(x_m) and isfinite(y_m) and isfinite(yaw_rad) and isfinite(length_m)
+                and isfinite(width_m)):
+            for name, v in zip(_BoxFields._fields, (x_m, y_m, yaw_rad, length_m, width_m)):
                 if not isfinite(v):
                     raise ValueError(f"OrientedBox.{name}={v!r} must be finite")
-        if self.length_m <= 0.0 or self.width_m <= 0.0:
+        if length_m <= 0.0 or width_m <= 0.0:
             raise ValueError(
-                f"OrientedBox needs length_m > 0 and width_m > 0, got {self.length_m}, "
-                f"{self.width_m}"
+                f"OrientedBox needs length_m > 0 and width_m > 0, got {length_m}, {width_m}"
             )
-        hl, hw = 0.5 * self.length_m, 0.5 * self.width_m
-        set_field = object.__setattr__
-        set_field(self, "cos_yaw", math.cos(self.yaw_rad))
-        set_field(self, "sin_yaw", math.sin(self.yaw_rad))
-        set_field(self, "half_length_m", hl)
-        set_field(self, "half_width_m", hw)
-        set_field(self, "radius_m", math.hypot(hl, hw))
+        hl, hw = 0.5 * length_m, 0.5 * width_m
+        return tuple.__new__(cls, (x_m, y_m, yaw_rad, length_m, width_m, math.cos(yaw_rad),
+                                   math.sin(yaw_rad), hl, hw, math.hypot(hl, hw)))
+
+    def __getnewargs__(self):
+        return self[:5]
+
+    def __repr__(self) -> str:
+        return (f"OrientedBox(x_m={self.x_m!r}, y_m={self.y_m!r}, yaw_rad={self.yaw_rad!r}, "
+                f"length_m={self.length_m!r}, width_m={self.width_m!r})")
 
     @classmethod
     def from_axis_point(

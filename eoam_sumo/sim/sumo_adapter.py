@@ -29,8 +29,8 @@ import subprocess
 import tempfile
 import uuid
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass, field
-from operator import itemgetter
+from collections import namedtuple
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Self
 
@@ -61,7 +61,6 @@ TRACI_RETRIES = 600  # x 50 ms: time SUMO may take to load before TraCI gives up
 PROCESS_EXIT_S = 10.0  # time a closed SUMO server process gets to exit
 
 _open_libsumo: list[SumoSession] = []  # libsumo runs one simulation per process
-_first = itemgetter(0)
 
 
 def _number(
@@ -110,24 +109,33 @@ class ScenarioOverrides:
             _number("aro_decel_mps2", self.aro_decel_mps2, minimum=0.0, inclusive=False)
 
 
-@dataclass(frozen=True)
-class Body:
+_BodyFields = namedtuple(
+    "_BodyFields", "vid x_m y_m yaw_rad speed_mps length_m width_m parked box"
+)  # untyped: introspection sees Body's own constructor, without ``box``
+
+
+class Body(_BodyFields):
     """A road user as SUMO sees it: centre (x_m, y_m), yaw CCW from +x, footprint, and its
-    oriented box (for the radar and the contact test)."""
+    oriented box (for the radar and the contact test).
 
-    vid: str
-    x_m: float
-    y_m: float
-    yaw_rad: float
-    speed_mps: float
-    length_m: float
-    width_m: float
-    parked: bool
-    box: OrientedBox = field(init=False, repr=False, compare=False)
+    ``Body(vid, x_m, y_m, yaw_rad, speed_mps, length_m, width_m, parked)``; an immutable
+    tuple subclass, built for every moving vehicle at every step."""
 
-    def __post_init__(self) -> None:
-        box = OrientedBox(self.x_m, self.y_m, self.yaw_rad, self.length_m, self.width_m)
-        object.__setattr__(self, "box", box)
+    __slots__ = ()
+
+    def __new__(cls, vid: str, x_m: float, y_m: float, yaw_rad: float, speed_mps: float,
+                length_m: float, width_m: float, parked: bool):
+        box = OrientedBox(x_m, y_m, yaw_rad, length_m, width_m)
+        return tuple.__new__(cls, (vid, x_m, y_m, yaw_rad, speed_mps, length_m, width_m,
+                                   parked, box))
+
+    def __getnewargs__(self):
+        return self[:8]
+
+    def __repr__(self) -> str:
+        return (f"Body(vid={self.vid!r}, x_m={self.x_m!r}, y_m={self.y_m!r}, "
+                f"yaw_rad={self.yaw_rad!r}, speed_mps={self.speed_mps!r}, "
+                f"length_m={self.length_m!r}, width_m={self.width_m!r}, parked={self.parked!r})")
 
 
 @dataclass(frozen=True)
@@ -838,12 +846,12 @@ class SumoSession:
             raise RuntimeError(f"the ego '{self.ego_id}' is no longer in the simulation")
         ex, ey = ego[self._tc.VAR_POSITION]
         near = self._moving_near(results, ex, ey, radius_m) + self._parked_near(ex, ey, radius_m)
-        near.sort(key=_first)
-        return [body for _, body in near]
+        near.sort()  # Body tuples start with their (unique) id
+        return near
 
     def _moving_near(self, results: dict, ex: float, ey: float, radius_m: float) -> list:
-        """(vid, Body) of the followed moving vehicles within ``radius_m`` of (ex, ey), from
-        this step's ``results``; a vehicle found parked with settled values becomes fixed."""
+        """Bodies of the followed moving vehicles within ``radius_m`` of (ex, ey), from this
+        step's ``results``; a vehicle found parked with settled values becomes fixed."""
         r2, near, settled = radius_m * radius_m, [], []
         for vid, known in self._moving.items():
             r = results.get(vid)
@@ -857,7 +865,7 @@ class SumoSession:
                 continue
             (fx, fy), body = known[1], known[2]
             if (fx - ex) * (fx - ex) + (fy - ey) * (fy - ey) <= r2:
-                near.append((vid, body))
+                near.append(body)
         for vid, fixed in settled:
             del self._moving[vid]
             if fixed is not None:
@@ -867,7 +875,7 @@ class SumoSession:
         return near
 
     def _parked_near(self, ex: float, ey: float, radius_m: float) -> list:
-        """(vid, Body) of the parked vehicles within ``radius_m`` of (ex, ey). The answer is
+        """Bodies of the parked vehicles within ``radius_m`` of (ex, ey). The answer is
         kept while the ego stays closer to where it was worked out than any parked front is
         to the radius (less 1e-6 m for rounding): no front can have crossed it."""
         cache = self._parked_cache
@@ -877,9 +885,9 @@ class SumoSession:
                     (ex - ax) * (ex - ax) + (ey - ay) * (ey - ay) < slack_m * slack_m):
                 return near
         r2, near, slack_m = radius_m * radius_m, [], math.inf
-        for vid, ((fx, fy), body) in self._parked.items():
+        for (fx, fy), body in self._parked.values():
             if (fx - ex) * (fx - ex) + (fy - ey) * (fy - ey) <= r2:
-                near.append((vid, body))
+                near.append(body)
             slack_m = min(slack_m, abs(math.hypot(fx - ex, fy - ey) - radius_m))
         self._parked_cache = (ex, ey, radius_m, slack_m - 1e-6, near)
         return near
