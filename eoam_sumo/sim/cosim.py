@@ -9,6 +9,8 @@ other vehicle on oriented boxes at each plant sub-step, log.
 
 from __future__ import annotations
 
+import contextlib
+import gc
 import math
 import time
 from dataclasses import dataclass, field
@@ -58,7 +60,22 @@ class RunSettings:
 
 SENSE_MARGIN_M = 10.0  # SUMO reports front bumpers: a body reaching into range is this close [m]
 GAP_WATCH_M = 20.0  # centre distance under which box gaps are measured and contact checked [m]
+ROAD_END_MARGIN_M = 50.0  # a run ends when the ego is this close to the end of its road [m]
 ROUNDING_M = 1e-6  # margin for rounding when a lower bound of a gap rules the gap out [m]
+
+
+@contextlib.contextmanager
+def _collector_paused():
+    """Pause Python's cyclic garbage collector (restored after): the step loop makes no
+    reference cycles, reference counting frees all it allocates, and the collector's passes
+    over the young tuples cost ~2 us per step on average."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
 
 
 def _nav_deg(yaw_rad: float) -> float:
@@ -99,7 +116,8 @@ class CoSimulation:
             gui=st.gui, use_traci=st.use_traci,
         )
         try:
-            return self._loop(session, wall0)
+            with _collector_paused():
+                return self._loop(session, wall0)
         finally:
             session.close()
 
@@ -117,6 +135,7 @@ class CoSimulation:
         left_lane = session.left_lane_exists
         sense_radius = st.radar.range_m + SENSE_MARGIN_M
         steps = round(st.max_time_s / st.step_s)
+        end_s_m = road.length_m - ROAD_END_MARGIN_M  # the run ends this close to the road end
         log = RunLog(steps + 1)
         front = p.cg_to_front_bumper_m
         back = front - 0.5 * p.length_m  # CG to the ego box's centre, as in OrientedBox
@@ -213,7 +232,7 @@ class CoSimulation:
                 stop_at = t + st.settle_s
             if stop_at is not None and t >= stop_at - 1e-9:
                 break
-            if s > road.length_m - 50.0:
+            if s > end_s_m:
                 break
         self.profile = {
             "sense": t_sense, "control": t_control, "plant": t_plant, "sumo": t_sumo,

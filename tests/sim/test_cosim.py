@@ -300,3 +300,24 @@ def test_curved_two_way_road(tmp_path):
     # before anything is seen, the ego keeps its lane on the curve
     calm = ts[ts["mode"] == 0].head(50)
     assert calm["lateral_offset_m"].abs().max() < 0.2
+
+
+@pytest.mark.parametrize("enabled", [True, False])
+def test_collector_pause_restores_the_collector_state(enabled):
+    """The step loop pauses Python's cyclic collector and leaves it as it found it, also when
+    the loop raises."""
+    import gc
+
+    from eoam_sumo.sim.cosim import _collector_paused
+
+    was = gc.isenabled()
+    try:
+        (gc.enable if enabled else gc.disable)()
+        with _collector_paused():
+            assert not gc.isenabled()
+        assert gc.isenabled() is enabled
+        with pytest.raises(RuntimeError), _collector_paused():
+            raise RuntimeError("loop failed")
+        assert gc.isenabled() is enabled
+    finally:
+        (gc.enable if was else gc.disable)()
