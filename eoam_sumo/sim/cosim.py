@@ -328,10 +328,14 @@ def run_case(
     return summary
 
 
+_NOTHING = Perception(None, None, False)  # immutable, so shared by all steps that see nothing
+_ONCOMING_ONLY = Perception(None, None, True)
+
+
 def _perception(report: RadarReport) -> Perception:
     """The EOAM's view of a radar report: the in-path obstacle as an object and the oncoming flag."""
     det = report.in_path
     if det is None:
-        return Perception(None, None, report.oncoming_detected)
+        return _ONCOMING_ONLY if report.oncoming_detected else _NOTHING
     obstacle = ObjectState(det.s_m, det.d_m, det.road_speed_mps, det.length_m, det.width_m)
     return Perception(det.range_m, det.range_rate_mps, report.oncoming_detected, obstacle)

@@ -147,6 +147,7 @@ class RadarReport(NamedTuple):
 
 
 _range_of = attrgetter("range_m")
+_EMPTY_REPORT = RadarReport(None, None, False, ())  # immutable: one for every empty scan
 
 
 def _ray_entry_m(box: OrientedBox, ox: float, oy: float, ux: float, uy: float) -> float:
@@ -255,7 +256,7 @@ class Radar:
                           tgt.length_m, tgt.width_m)
             )
         if not detections:
-            return RadarReport(None, None, False, ())
+            return _EMPTY_REPORT
         detections.sort(key=_range_of)
         in_path, oncoming = None, False
         for det in detections:
