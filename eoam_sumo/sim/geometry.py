@@ -132,7 +132,14 @@ class OrientedBox(_BoxFields):
         dx, dy = x_m - self.x_m, y_m - self.y_m
         lx, ly = c * dx + s * dy, -s * dx + c * dy  # to_local, to_world inlined (hot path)
         hl, hw = self.half_length_m, self.half_width_m
-        lx, ly = min(max(lx, -hl), hl), min(max(ly, -hw), hw)
+        if lx > hl:  # clamp to the box (comparisons: min/max calls cost more here)
+            lx = hl
+        elif lx < -hl:
+            lx = -hl
+        if ly > hw:
+            ly = hw
+        elif ly < -hw:
+            ly = -hw
         return self.x_m + c * lx - s * ly, self.y_m + s * lx + c * ly
 
     def distance_to_point(self, x_m: float, y_m: float) -> float:

@@ -78,6 +78,9 @@ class RoadFrame:
 
     def curvature_at(self, s_m: float) -> float:
         """Signed curvature (1/m) from the heading change at the nearest polyline vertex."""
+        i = self._hint  # the segment of the last projection: usually the one asked for
+        if self._s[i] <= s_m < self._s[i + 1]:
+            return self._kappa[i]
         return self._kappa[min(max(bisect_right(self._s, s_m) - 1, 0), len(self._len) - 1)]
 
     def _vertex_curvature(self, i: int) -> float:

@@ -43,3 +43,14 @@ def test_curvature_of_the_arc():
 def test_needs_two_distinct_points():
     with pytest.raises(ValueError, match="two distinct points"):
         RoadFrame([(1.0, 1.0), (1.0, 1.0)])
+
+
+@settings(max_examples=200, deadline=None, database=None)
+@given(st.floats(-20.0, 220.0), st.sampled_from([0, 37, 99]))
+def test_curvature_is_the_nearest_vertex_value_whatever_the_last_projection(s_m, hint):
+    """The last projection's segment is only a shortcut: the curvature at s is that of the
+    segment holding s (first or last beyond the ends), wherever the hint points."""
+    ARC._hint = hint
+    k = ARC.curvature_at(s_m)
+    seg = min(max(sum(1 for s0 in ARC._s if s0 <= s_m) - 1, 0), len(ARC._len) - 1)
+    assert k == ARC._kappa[seg]
