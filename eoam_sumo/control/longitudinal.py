@@ -67,7 +67,10 @@ class Pid:
         deriv = 0.0 if self.prev_error is None or dt_s <= 0.0 else (error - self.prev_error) / dt_s
         self.prev_error = error
         trial = self.integral + self.ki * error * dt_s
-        trial = max(-self.i_limit, min(trial, self.i_limit))
+        if trial > self.i_limit:  # clamp (comparisons: min/max calls cost more per step)
+            trial = self.i_limit
+        elif trial < -self.i_limit:
+            trial = -self.i_limit
         out = self.kp * error + trial + self.kd * deriv
         if out > hi:
             if error < 0.0:
@@ -137,15 +140,15 @@ class LongitudinalController:
         drive = self._fmax
         if speed_mps > 1.0 and self._pmax / speed_mps < drive:
             drive = self._pmax / speed_mps
-        drive = mu * min(drive, self._rear_n)
+        drive = mu * (self._rear_n if self._rear_n < drive else drive)
         return drive * ellipse, no_lock_brake_n * ellipse
 
     @staticmethod
     def split(net_force_n: float, drive_limit_n: float, brake_limit_n: float):
         """(drive, brake) realising a net force within the limits; never both."""
         if net_force_n > 0.0:
-            return min(net_force_n, drive_limit_n), 0.0
-        return 0.0, min(-net_force_n, brake_limit_n)
+            return (drive_limit_n if drive_limit_n < net_force_n else net_force_n), 0.0
+        return 0.0, (brake_limit_n if brake_limit_n < -net_force_n else -net_force_n)
 
     def track_accel(
         self,

@@ -102,14 +102,16 @@ class SteeringController:
         if mu != self._mu:
             self._mu = mu
             self._wmu = self._w * mu**self._fexp
-        v = max(self._vmin, speed_mps)
+        v = speed_mps if speed_mps > self._vmin else self._vmin
         return self._wmu * v / self._vfull if v < self._vfull else self._wmu
 
     def schedule(self, speed_mps: float, mu: float) -> tuple[float, float]:
         """(k_la [rad/m], x_la [m]) at this speed and friction."""
         w = self.natural_freq(speed_mps, mu)
-        v = max(self._vmin, speed_mps)
-        x_la = max(2.0 * self._z * v / w, self._xmin)
+        v = speed_mps if speed_mps > self._vmin else self._vmin
+        x_la = 2.0 * self._z * v / w
+        if x_la < self._xmin:
+            x_la = self._xmin
         return w * w * (self._L + self._kus * v * v) / (v * v), x_la
 
     def lateral_accel(self, speed_mps: float, steer_rad: float) -> float:
@@ -133,7 +135,7 @@ class SteeringController:
         yaw-rate reference; ``preview_curvature_1pm`` the one a preview distance ahead, used by
         the feedforward to make up for the steering and tyre lags.
         """
-        v = max(0.0, speed_mps)
+        v = speed_mps if speed_mps > 0.0 else 0.0
         k_la, x_la = self.schedule(v, mu)
         e_la = lateral_error_m + x_la * math.sin(heading_error_rad)
         ff = (self._L + self._kus * v * v) * preview_curvature_1pm

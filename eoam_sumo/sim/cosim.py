@@ -183,7 +183,8 @@ class CoSimulation:
             c4 = clock()
             Xn, Yn, yawn, vxn = x[:4]
             cy, sy = math.cos(yawn), math.sin(yawn)
-            session.move_ego(Xn + front * cy, Yn + front * sy, _nav_deg(yawn), max(vxn, 0.0))
+            ego_speed = 0.0 if vxn < 0.0 else vxn
+            session.move_ego(Xn + front * cy, Yn + front * sy, _nav_deg(yawn), ego_speed)
             session.step()
             t = session.time_s
             bodies_next = session.nearby(sense_radius)
@@ -218,7 +219,8 @@ class CoSimulation:
                     if hit is not None:
                         first_contact = (hit, role or role_of(b, road, lane_width), t)
             bodies = bodies_next
-            max_lat_offset = max(max_lat_offset, abs(d))
+            if abs(d) > max_lat_offset:
+                max_lat_offset = abs(d)
             c6 = clock()
             t_sense += c1 - c0
             t_control += c2 - c1
