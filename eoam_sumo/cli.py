@@ -93,7 +93,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--radar-range-m", type=_finite, help="ego radar range (default 100 m)")
     p.add_argument("--gui", action="store_true", help="run in sumo-gui through TraCI")
 
-    p = sub.add_parser("batch", help="run every case of an experiment matrix")
+    p = sub.add_parser(
+        "batch", help="run every case of an experiment matrix",
+        description="Run every case of an experiment matrix. Exit status: 0 every case ran; "
+        "1 at least one case failed (results.csv and the report are still written, the "
+        "failed count is the last line on stderr); 2 bad input, found before any case runs "
+        "(the matrix, its scenario files, a speed or friction outside the lookup tables).")
     p.add_argument("matrix", type=Path, help="experiment matrix (.toml)")
     p.add_argument("--out", type=Path, default=Path("out/batch"), help="output folder")
     p.add_argument("--jobs", type=_positive_int, default=1, help="parallel processes")

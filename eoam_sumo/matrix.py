@@ -4,6 +4,12 @@ The format is documented in ``scenarios/table2.toml`` (the paper's Table 2, 4 x 
 Cases come in the paper's Table 2 order: traffic outermost (no oncoming car first, then the
 oncoming start distances in file order), then ego speed, then friction, then the optional ARO
 stop parameters, each in file order.
+
+Two levels of checks, both raising ``InputError`` naming the matrix file and the key:
+:func:`load_matrix` checks the TOML on its own (keys, types, ranges, files exist);
+:func:`check_matrix` then checks it against what a run will use (the scenario's files parse
+and hold the ego; every speed and friction is covered by the lookup tables), so a batch
+refuses bad input before any case runs.
 """
 
 from __future__ import annotations
@@ -269,6 +275,50 @@ def load_matrix(path: Path) -> Matrix:
         ),
         paper_table=paper,
     )
+
+
+def check_matrix(matrix: Matrix, tables_dir: Path | None = None, ego_id: str = "ego") -> None:
+    """Check the matrix against what its runs will use, before any of them starts.
+
+    The scenario's ``.sumocfg``, network, route and additional files must parse and hold the
+    vehicle ``ego_id`` (``sim.sumo_adapter.check_scenario``, no SUMO started); every swept
+    speed and friction must be one the lookup tables in ``tables_dir`` (default: the folder
+    the co-simulation uses, ``$EOAM_TABLES_DIR`` or the repository's ``tables/``) cover, by
+    the same ``LookupTables.check_run`` each run applies. InputError names the matrix file,
+    the key and the value.
+    """
+    from eoam_sumo.offline.tables import LookupTables, default_tables_dir
+    from eoam_sumo.sim.sumo_adapter import check_scenario
+
+    try:
+        check_scenario(matrix.sumocfg, ego_id)
+    except InputError as exc:
+        raise InputError(f"{matrix.path}: [scenario] sumocfg: {exc}") from exc
+    folder = Path(tables_dir) if tables_dir is not None else default_tables_dir()
+    check_within_tables(matrix, LookupTables.load(folder), folder)
+
+
+def check_within_tables(matrix: Matrix, tables, folder: Path | str | None = None) -> None:
+    """InputError for the first swept speed or friction ``tables.check_run`` refuses.
+
+    Speeds are checked at the tables' highest friction and frictions at their lowest speed,
+    so the error names the key at fault (``check_run`` refuses speeds above the grid and
+    frictions below it).
+    """
+    for key, values, check in (
+        ("ego_speed_kmh", matrix.ego_speeds_kmh,
+         lambda v: tables.check_run(tables.mu_grid[-1], v / 3.6)),
+        ("mu", matrix.mus, lambda m: tables.check_run(m, tables.speed_grid_mps[0])),
+    ):
+        for value in values:
+            try:
+                check(value)
+            except InputError as exc:
+                where = "" if folder is None else f" in {folder}"
+                raise InputError(
+                    f"{matrix.path}: [sweep] {key} value {value:g} is outside the lookup "
+                    f"tables{where}: {exc}"
+                ) from exc
 
 
 def _existing_file(path: Path, where: str, value) -> Path:

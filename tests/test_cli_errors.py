@@ -117,3 +117,67 @@ def test_python_dash_m_behaves_the_same(tmp_path):
     )
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "9" in proc.stderr
+
+
+def _matrix(folder: Path, cfg: Path, sweep: str, name: str = "m.toml") -> Path:
+    path = folder / name
+    path.write_text(f'[scenario]\nsumocfg = "{cfg.as_posix()}"\nmax_time_s = 5.0\n[sweep]\n{sweep}')
+    return path
+
+
+@pytest.mark.parametrize(
+    "sweep, key, value",
+    [
+        ("ego_speed_kmh = [120, 250]\nmu = [1.0]\n", "ego_speed_kmh", "value 250 "),
+        ("ego_speed_kmh = [120]\nmu = [1.0, 0.05]\n", "mu", "value 0.05 "),
+    ],
+)
+def test_batch_outside_the_tables_is_refused_before_any_case_runs(
+    capsys, tmp_path, monkeypatch, sweep, key, value
+):
+    monkeypatch.delenv("EOAM_TABLES_DIR", raising=False)  # the repository's tables (20-175 km/h)
+    matrix = _matrix(tmp_path, SCEN / "baseline.sumocfg", sweep)
+    out = tmp_path / "o"
+    status = main(["batch", str(matrix), "--out", str(out), "--no-progress"])
+    err = capsys.readouterr().err
+    assert status == 2, err
+    lines = err.splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
+    assert str(matrix) in lines[0] and f"[sweep] {key} {value}" in lines[0], err
+    assert not out.exists()  # nothing ran, nothing written
+
+
+def test_batch_bad_input_leaves_an_earlier_results_file_alone(capsys, tmp_path, monkeypatch):
+    monkeypatch.delenv("EOAM_TABLES_DIR", raising=False)
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "results.csv").write_text("case_id,outcome\nx,green\n")
+    matrix = _matrix(tmp_path, SCEN / "baseline.sumocfg", "ego_speed_kmh = [300]\nmu = [1.0]\n")
+    _check(capsys, ["batch", str(matrix), "--out", str(out), "--resume"], "300")
+    assert (out / "results.csv").read_text() == "case_id,outcome\nx,green\n"
+
+
+def test_batch_tables_folder_that_cannot_be_read(capsys, tmp_path, monkeypatch):
+    monkeypatch.setenv("EOAM_TABLES_DIR", str(tmp_path / "no_tables"))
+    matrix = _matrix(tmp_path, SCEN / "baseline.sumocfg", "ego_speed_kmh = [120]\nmu = [1.0]\n")
+    _check(capsys, ["batch", str(matrix), "--out", str(tmp_path / "o")], "no_tables")
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("breakage", ["no ego", "malformed sumocfg", "malformed route file"])
+def test_batch_scenario_is_checked_before_any_case_runs(capsys, tmp_path, breakage):
+    cfg = _copy_scenario(tmp_path)
+    routes = cfg.parent / "baseline.rou.xml"
+    if breakage == "no ego":
+        routes.write_text(routes.read_text().replace('id="ego"', 'id="hero"'))
+        needle = "no vehicle 'ego'"
+    elif breakage == "malformed sumocfg":
+        cfg.write_text(cfg.read_text()[:300])
+        needle = str(cfg)
+    else:
+        routes.write_text(routes.read_text()[:200])
+        needle = "baseline.rou.xml"
+    matrix = _matrix(tmp_path, cfg, "ego_speed_kmh = [120]\nmu = [1.0]\n")
+    _check(capsys, ["batch", str(matrix), "--out", str(tmp_path / "o")], needle)
+    _check(capsys, ["batch", str(matrix), "--out", str(tmp_path / "o")], f"{matrix}: [scenario]")
+    assert not (tmp_path / "o").exists()

@@ -260,3 +260,58 @@ def test_any_valid_sweep_gives_one_uniquely_named_case_per_combination(
     expected = [(d, float(v), float(m)) for d in traffic for v in speeds for m in mus]
     assert [(c.oncoming_start_m, c.ego_speed_kmh, c.mu) for c in cases] == expected
     assert all(math.isclose(c.overrides().ego_speed_mps * 3.6, c.ego_speed_kmh) for c in cases)
+
+
+class _Tables:
+    """The part of LookupTables that check_within_tables uses: 20-175 km/h, mu 0.1-1.0."""
+
+    mu_grid = (0.1, 0.3, 0.7, 1.0)
+    speed_grid_mps = (20 / 3.6, 175 / 3.6)
+
+    def __init__(self):
+        from eoam_sumo.offline.tables import LookupTables
+
+        self.calls = []
+        self._check = LookupTables.check_run
+
+    def check_run(self, mu, speed_mps):
+        self.calls.append((mu, speed_mps))
+        self._check(self, mu, speed_mps)
+
+
+@pytest.mark.parametrize(
+    "sweep, message",
+    [
+        ("ego_speed_kmh = [120, 175]\nmu = [1.2, 0.1]\n", None),
+        ("ego_speed_kmh = [120, 250]\nmu = [1.0]\n", "[sweep] ego_speed_kmh value 250 is outside"),
+        ("ego_speed_kmh = [175.5]\nmu = [1.0]\n", "[sweep] ego_speed_kmh value 175.5 is outside"),
+        ("ego_speed_kmh = [120]\nmu = [1.0, 0.05]\n", "[sweep] mu value 0.05 is outside"),
+    ],
+)
+def test_every_swept_speed_and_friction_is_checked_against_the_tables(tmp_path, sweep, message):
+    from eoam_sumo.matrix import check_within_tables
+
+    matrix = load_matrix(_write(tmp_path, GOOD_SCENARIO + "[sweep]\n" + sweep))
+    tables = _Tables()
+    if message is None:
+        check_within_tables(matrix, tables, "T")
+        assert len(tables.calls) == len(matrix.ego_speeds_kmh) + len(matrix.mus)
+        return
+    with pytest.raises(InputError) as err:
+        check_within_tables(matrix, tables, "T")
+    assert str(err.value).startswith(f"{matrix.path}: {message} the lookup tables in T: ")
+
+
+def test_check_matrix_uses_the_real_tables_and_scenario(monkeypatch):
+    from eoam_sumo.matrix import check_matrix
+
+    monkeypatch.delenv("EOAM_TABLES_DIR", raising=False)
+    check_matrix(load_matrix(TABLE2))  # the paper's matrix is within the repository's tables
+
+
+def test_check_matrix_parses_the_scenario(tmp_path):
+    from eoam_sumo.matrix import check_matrix
+
+    path = _write(tmp_path, GOOD_SCENARIO + GOOD_SWEEP)  # s.sumocfg has no net-file
+    with pytest.raises(InputError, match=r"m\.toml: \[scenario\] sumocfg: .*s\.sumocfg.*net-file"):
+        check_matrix(load_matrix(path))

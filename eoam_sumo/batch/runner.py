@@ -27,8 +27,10 @@ import pandas as pd
 from eoam_sumo.batch.case import CASE_FILES, PRELOAD, CaseTask, run_matrix_case
 from eoam_sumo.batch.pool import TaskResult, run_dask, run_local
 from eoam_sumo.errors import InputError
-from eoam_sumo.matrix import Case, Matrix, load_matrix
+from eoam_sumo.matrix import Case, Matrix, check_matrix, load_matrix
 
+#: Exit status of ``eoam-sumo batch`` when at least one case failed (bad input is 2).
+EXIT_CASES_FAILED = 1
 RESULTS_FILE = "results.csv"
 CASES_DIR = "cases"
 #: results.csv columns: the case's parameters, its status, the summary fields, where it lives.
@@ -246,6 +248,11 @@ def run_batch(
     ``"local"`` for a Dask LocalCluster of ``jobs`` workers, else a Dask scheduler address.
     ``case_func`` runs one :class:`CaseTask` and returns ``{"summary", "files"}`` like
     :func:`run_matrix_case` (the default); it must be a module-level function.
+
+    Bad input raises InputError before anything is written or run: the matrix itself
+    (:func:`~eoam_sumo.matrix.load_matrix`), its scenario files and every swept speed and
+    friction against the lookup tables in ``tables_dir`` (default: the co-simulation's,
+    :func:`~eoam_sumo.matrix.check_matrix`). A case that fails is a ``failed`` row.
     """
     from tqdm import tqdm
 
@@ -256,6 +263,7 @@ def run_batch(
     if not timeout_s > 0:
         raise InputError(f"--timeout-s {timeout_s!r} must be > 0")
     matrix: Matrix = load_matrix(Path(matrix_path))
+    check_matrix(matrix, tables_dir)
     cases = matrix.cases()
     paper = matrix.paper_outcomes()
     out_dir = Path(out_dir)
@@ -294,7 +302,12 @@ def _raise_interrupt(signum, frame):
 
 
 def run_batch_cli(args) -> int:
-    """``eoam-sumo batch``: run the batch; SIGTERM stops it like Ctrl-C (rows kept)."""
+    """``eoam-sumo batch``: run the batch; SIGTERM stops it like Ctrl-C (rows kept).
+
+    Returns 0 when every case ran, :data:`EXIT_CASES_FAILED` when at least one failed (after
+    results.csv and the report are written; each failed case and then the count on stderr).
+    Bad input raises InputError before any case runs (exit status 2 in ``cli.main``).
+    """
     previous = None
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGTERM, _raise_interrupt)
@@ -306,8 +319,13 @@ def run_batch_cli(args) -> int:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
     failed = results[results["status"] != "ok"]
+    results_path = Path(args.out) / RESULTS_FILE
     print(f"{len(results)} cases, {len(results) - len(failed)} ok, {len(failed)} failed; "
-          f"results in {Path(args.out) / RESULTS_FILE}, Table 2 in {Path(args.out) / 'table2.md'}")
+          f"results in {results_path}, Table 2 in {Path(args.out) / 'table2.md'}")
+    if failed.empty:
+        return 0
     for _, row in failed.iterrows():
         print(f"failed: {row['case_id']}: {row['error']}", file=sys.stderr)
-    return 0
+    print(f"eoam-sumo: {len(failed)} of {len(results)} cases failed; their errors are in the "
+          f"'error' column of {results_path}", file=sys.stderr)
+    return EXIT_CASES_FAILED
