@@ -26,6 +26,7 @@ import math
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 import uuid
 import xml.etree.ElementTree as ET
@@ -55,8 +56,12 @@ ENFORCED_OPTIONS = (
     ("--time-to-teleport", "-1"),
     ("--no-warnings", "true"),
     ("--no-step-log", "true"),
+    # load every route at the start: by default SUMO may read a vehicle listed after another
+    # with the same departure only in its departure step, too late to re-insert it as the ego
+    ("--route-steps", "0"),
 )
 SPEED_LIMIT_WORDS = ("max", "desired", "speedLimit")
+ERROR_LOG_STDERR = "sumo-stderr.log"  # SUMO's standard error while libsumo starts (workdir)
 TRACI_RETRIES = 600  # x 50 ms: time SUMO may take to load before TraCI gives up
 PROCESS_EXIT_S = 10.0  # time a closed SUMO server process gets to exit
 
@@ -146,6 +151,7 @@ class VehicleSpec:
     source: Path
     attrs: dict
     params: dict
+    routed: bool = True  # False for a trip (from/to, no route): SUMO routes it at insertion
 
 
 @dataclass(frozen=True)
@@ -187,6 +193,7 @@ def _read_net(path: Path) -> dict:
                 first = False
             if event == "start" and elem.tag == "lane":
                 lane_id = elem.get("id")
+                _check_friction(path, lane_id, elem.get("friction"))
             elif event == "start" and elem.tag == "neigh" and lane_id is not None:
                 opposite[lane_id] = elem.get("lane")
             elif event == "end" and elem.tag in ("edge", "junction", "connection", "tlLogic"):
@@ -194,6 +201,21 @@ def _read_net(path: Path) -> dict:
     except (ET.ParseError, OSError) as exc:
         raise InputError(f"{path}: malformed XML: {exc}") from exc
     return opposite
+
+
+def _check_friction(path: Path, lane_id: str | None, text: str | None) -> None:
+    """A lane's ``friction`` attribute (absent: SUMO's 1.0) must be a number in (0, MU_MAX];
+    SUMO itself crashes on a non-number."""
+    if text is None:
+        return
+    try:
+        mu = float(text)
+    except ValueError:
+        mu = math.nan
+    if not 0.0 < mu <= MU_MAX:
+        raise InputError(
+            f"{path}: lane '{lane_id}' friction={text!r} must be a number in (0, {MU_MAX:g}]"
+        )
 
 
 def _option_files(root: ET.Element, cfg: Path, option: str) -> tuple[Path, ...]:
@@ -225,8 +247,11 @@ def check_scenario(cfg: Path, ego_id: str = "ego") -> ScenarioFiles:
         for elem in _parse_xml(path, what).iter():
             if elem.tag in ("vehicle", "trip") and elem.get("id") is not None:
                 params = {p.get("key"): p.get("value") for p in elem.findall("param")}
+                routed = elem.tag == "vehicle" and (
+                    "route" in elem.attrib or elem.find("route") is not None
+                )
                 vehicles[elem.get("id")] = VehicleSpec(
-                    elem.get("id"), path, dict(elem.attrib), params
+                    elem.get("id"), path, dict(elem.attrib), params, routed
                 )
     if ego_id not in vehicles:
         searched = ", ".join(p.name for p in routes + additionals) or "no route files"
@@ -234,6 +259,15 @@ def check_scenario(cfg: Path, ego_id: str = "ego") -> ScenarioFiles:
             f"{cfg}: no vehicle '{ego_id}' in its route or additional files ({searched})"
         )
     return ScenarioFiles(cfg, nets[0], routes, additionals, vehicles, opposite)
+
+
+def _without_repeats(edges) -> list[str]:
+    """Route edges with consecutive repeats dropped (a trip from an edge to itself)."""
+    out: list[str] = []
+    for edge in edges:
+        if not out or edge != out[-1]:
+            out.append(edge)
+    return out
 
 
 def _float_attr(spec: VehicleSpec, key: str, text: str) -> float:
@@ -376,6 +410,7 @@ class SumoSession:
         self._ego_vars = [self._tc.VAR_LANE_ID]  # every step (friction); the pose at the start
         self._results: dict | None = None  # variable-subscription results of this step, once read
         self._ego_mu = 1.0
+        self._over_limit: dict[str, float] = {}  # vid -> speed of a departure above the limit
         self.ego_depart_time_s = self._time_s
         self.oncoming_id: str | None = None
         self.roles = {
@@ -452,7 +487,8 @@ class SumoSession:
 
                 errors = (libsumo.TraCIException, libsumo.FatalTraCIError)
                 try:
-                    libsumo.start(cmd)
+                    with _stderr_into(workdir / ERROR_LOG_STDERR):
+                        libsumo.start(cmd)
                 except errors as exc:
                     raise InputError(_start_error(files.cfg, error_log, exc)) from exc
                 api, constants, process = libsumo, libsumo.constants, None
@@ -505,11 +541,15 @@ class SumoSession:
         self._sumo_step()
         if self.ego_id not in self._veh.getIDList():
             raise InputError(f"{spec.source}: SUMO did not insert vehicle '{self.ego_id}'")
+        for vid, speed in self._over_limit.items():  # departed at rest (see _insert)
+            self._veh.setPreviousSpeed(vid, speed)
 
     def _place_ego(self, spec: VehicleSpec) -> None:
         veh, ego = self._veh, self.ego_id
         try:
-            edges = list(veh.getRoute(ego))
+            if not spec.routed:  # a trip holds only its end points until SUMO routes it
+                veh.rerouteTraveltime(ego)
+            edges = _without_repeats(veh.getRoute(ego))
             self._ego_type = veh.getTypeID(ego)
         except self._errors as exc:
             raise InputError(f"{spec.source}: SUMO did not load vehicle '{ego}': {exc}") from exc
@@ -648,8 +688,16 @@ class SumoSession:
         veh = self._veh
         route_id = f"eoam.route.{vid}.{uuid.uuid4().hex[:8]}"
         self._api.route.add(route_id, edges)
+        limit = self._lane.getMaxSpeed(f"{edges[0]}_{lane_index}")
+        # SUMO refuses a departure above the lane's speed limit (times the speed factor): above
+        # it, depart at rest; the speed set below applies from the insertion step on anyway
+        # (speed modes without limits), and a wider speed factor keeps SUMO from capping it
+        depart_speed = speed if speed <= limit else 0.0
         veh.add(vid, route_id, type_id, depart="now", departLane=str(lane_index),
-                departPos=repr(float(pos)), departSpeed=repr(float(speed)))
+                departPos=repr(float(pos)), departSpeed=repr(float(depart_speed)))
+        if speed > limit:
+            veh.setSpeedFactor(vid, speed / limit * (1.0 + 1e-6))
+            self._over_limit[vid] = speed
         for key, value in params.items():
             veh.setParameter(vid, key, value)
         veh.setSpeedMode(vid, speed_mode)
@@ -712,6 +760,7 @@ class SumoSession:
     def _start_tracking(self) -> None:
         self._tracking = True
         self._veh.subscribe(self.ego_id, [*self._ego_vars, self._tc.VAR_POSITION])
+        self._results = None  # re-read: this step's cached results lack the ego's position
         for vid in self._veh.getIDList():
             if vid != self.ego_id:
                 self._moving[vid] = None
@@ -998,12 +1047,30 @@ def _traci_connect(cmd: list[str]):
     return conn, proc
 
 
-def _start_error(cfg: Path, error_log: Path, exc: BaseException) -> str:
-    """One line with SUMO's own error messages (its error log, else the exception's text)."""
+@contextlib.contextmanager
+def _stderr_into(path: Path):
+    """Send this process's standard error (file descriptor 2) to ``path`` meanwhile: in-process
+    SUMO reports errors met while loading the routes at start there, not to its error log."""
+    sys.stderr.flush()
+    saved = os.dup(2)
     try:
-        text = error_log.read_text(errors="replace")
-    except OSError:
-        text = ""
+        with open(path, "ab") as sink:
+            os.dup2(sink.fileno(), 2)
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
+def _start_error(cfg: Path, error_log: Path, exc: BaseException) -> str:
+    """One line with SUMO's own error messages (its error log and what it wrote to standard
+    error while starting, else the exception's text)."""
+    text = ""
+    for log in (error_log, error_log.with_name(ERROR_LOG_STDERR)):
+        try:
+            text += log.read_text(errors="replace")
+        except OSError:
+            pass
     lines = [ln.strip().removeprefix("Error: ") for ln in (text or str(exc)).splitlines()]
     detail = " ".join(ln for ln in lines if ln and ln != "Quitting (on error).")
     return f"{cfg}: SUMO could not load the scenario: {detail or type(exc).__name__}"

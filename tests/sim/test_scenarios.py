@@ -451,3 +451,70 @@ def test_angle_conversions_round_trip():
     for yaw in np.linspace(-math.pi + 1e-9, math.pi, 13):
         assert yaw_rad(nav_angle_deg(yaw)) == pytest.approx(yaw, abs=1e-12)
     assert nav_angle_deg(0.0) == 90.0 and yaw_rad(0.0) == pytest.approx(math.pi / 2)
+
+
+# --------------------------------------------------------------------------- scenario variety
+def _routes_cfg(tmp_path, routes_xml: str, net: Path = NETWORKS / "highway.net.xml") -> Path:
+    (tmp_path / "v.rou.xml").write_text(routes_xml)
+    cfg = tmp_path / "v.sumocfg"
+    cfg.write_text(
+        f'<configuration><input><net-file value="{net}"/><route-files value="v.rou.xml"/>'
+        f'<additional-files value="{SCENARIOS / "vtypes.add.xml"}"/></input></configuration>'
+    )
+    return cfg
+
+
+def test_an_ego_alone_in_the_simulation_is_sensed_and_stepped(tmp_path, open_session):
+    s = open_session(_routes_cfg(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text()))
+    assert s.nearby(150.0) == []  # no other vehicle: nothing near, no error
+    for _ in range(10):
+        s.step()
+    assert s.nearby(150.0) == []
+
+
+@pytest.mark.parametrize("ego_first", [True, False])
+def test_the_ego_may_be_listed_after_a_vehicle_departing_with_it(tmp_path, open_session,
+                                                                 ego_first):
+    ego = ('<vehicle id="ego" type="ego" route="r" depart="1.00" departPos="100" '
+           'departSpeed="30" insertionChecks="none"/>')
+    aro = ('<vehicle id="aro" type="aro" route="r" depart="1.00" departPos="225" '
+           'departSpeed="16" insertionChecks="none"/>')
+    pair = ego + aro if ego_first else aro + ego
+    s = open_session(_routes_cfg(tmp_path, f'<routes><route id="r" edges="E0"/>{pair}</routes>'))
+    assert s.time_s == pytest.approx(1.01)
+    assert s.ego_body().speed_mps == pytest.approx(30.0)
+    assert {b.vid for b in s.nearby(300.0)} == {"aro"}
+
+
+def test_a_trip_ego_gets_the_route_sumo_finds(open_session, user_scenario):
+    routes = USER_ROUTES.replace(
+        '<vehicle id="ego" type="car" depart="0" departSpeed="12"><route edges="road1 road2"/>'
+        "</vehicle>",
+        '<trip id="ego" type="car" depart="0" departSpeed="12" from="road1" to="road2"/>',
+    )
+    assert routes != USER_ROUTES
+    (user_scenario / "user.rou.xml.gz").write_bytes(gzip.compress(routes.encode()))
+    net = sumolib.net.readNet(str(user_scenario / "user.net.xml"))
+    s = open_session(user_scenario / "user.sumocfg")
+    line = s.ego_lane_centreline()  # over both edges, as routed (the trip names only the ends)
+    assert line[-1] == pytest.approx(net.getLane("road2_0").getShape()[-1])
+
+
+def test_an_ego_faster_than_the_lane_limit_starts_at_its_speed(open_session):
+    limit = EGO_LANE.getSpeed()
+    s = open_session(BASELINE, ScenarioOverrides(ego_speed_mps=limit + 10.0,
+                                                 oncoming_start_m=500.0,
+                                                 oncoming_speed_mps=limit + 5.0))
+    assert s.ego_body().speed_mps == pytest.approx(limit + 10.0)
+    s.step()
+    assert s.vehicle_speed(s.oncoming_id) == pytest.approx(limit + 5.0)
+
+
+@pytest.mark.parametrize("friction", ["2.00", "abc", "0.00"])
+def test_lane_friction_outside_the_range_names_the_network(tmp_path, friction):
+    net = tmp_path / "fric.net.xml"
+    text = (NETWORKS / "highway.net.xml").read_text()
+    net.write_text(text.replace('friction="1.00"', f'friction="{friction}"', 1))
+    cfg = _routes_cfg(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(), net)
+    with pytest.raises(InputError, match=rf"fric.net.xml: lane .* friction='{friction}'"):
+        SumoSession.start(cfg)
