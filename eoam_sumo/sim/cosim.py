@@ -21,7 +21,7 @@ from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.plant import Plant, initial_state
 from eoam_sumo.sim.geometry import OrientedBox, box_distance, contact
-from eoam_sumo.sim.outcome import classify_outcome, role_of
+from eoam_sumo.sim.outcome import classify_outcome, left_road, role_of
 from eoam_sumo.sim.radar import Radar, RadarReport, RadarSettings
 from eoam_sumo.sim.roadframe import RoadFrame
 from eoam_sumo.sim.runlog import RunLog
@@ -144,7 +144,12 @@ class CoSimulation:
         ax = ay = 0.0
         first_contact = None
         min_gap_aro = math.inf
-        max_lat_offset = 0.0
+        # loss of control and road departure (outcome rule 1), plain floats: the extremes of the
+        # ego's lateral offset d (signed), of its heading error (wrapped) and of its vx
+        min_d = max_d = 0.0
+        max_e_yaw = 0.0
+        min_vx = x[3]
+        pi, tau = math.pi, math.tau
         stop_at = None
         t = t_start = session.time_s
         bodies = session.nearby(sense_radius)  # with their boxes: the radar's targets
@@ -163,8 +168,9 @@ class CoSimulation:
                 (X + front * cy, Y + front * sy), yaw, vx, road, bodies, lane_width
             )
             perception = _perception(report)
+            e_yaw = yaw - road_yaw  # not wrapped: the plant's yaw is continuous
             meas = EgoMeasurement(
-                t, vx, vy, r, ax, ay, s, d, yaw - road_yaw, road.curvature_at(s), mu, lane_width,
+                t, vx, vy, r, ax, ay, s, d, e_yaw, road.curvature_at(s), mu, lane_width,
                 left_lane,
             )
             # --- decide and control -------------------------------------------------------------
@@ -219,8 +225,18 @@ class CoSimulation:
                     if hit is not None:
                         first_contact = (hit, role or role_of(b, road, lane_width), t)
             bodies = bodies_next
-            if abs(d) > max_lat_offset:
-                max_lat_offset = abs(d)
+            if d > max_d:
+                max_d = d
+            elif d < min_d:
+                min_d = d
+            if vx < min_vx:
+                min_vx = vx
+            if e_yaw > max_e_yaw or e_yaw < -max_e_yaw:  # wrapped only when it may be a new max
+                e_yaw = (e_yaw + pi) % tau - pi
+                if e_yaw < 0.0:
+                    e_yaw = -e_yaw
+                if e_yaw > max_e_yaw:
+                    max_e_yaw = e_yaw
             c6 = clock()
             t_sense += c1 - c0
             t_control += c2 - c1
@@ -240,9 +256,14 @@ class CoSimulation:
             "sense": t_sense, "control": t_control, "plant": t_plant, "sumo": t_sumo,
             "contact": t_contact, "loop_wall_s": clock() - loop0, "steps": n_steps,
         }
-        X, Y, yaw = x[:3]
+        max_lat_offset = max_d if max_d >= -min_d else -min_d  # of the steps' starts, as logged
+        X, Y, yaw, vx = x[:4]
         s, d, road_yaw = road.project(X, Y)
         log.add(t, x, ax, ay, s, d, yaw - road_yaw, session.friction_at_ego(), None, None)
+        # the end state counts for loss of control and road departure too
+        min_d, max_d, min_vx = min(min_d, d), max(max_d, d), min(min_vx, vx)
+        max_e_yaw = max(max_e_yaw, abs((yaw - road_yaw + pi) % tau - pi))
+        left_width = lane_width if left_lane else 0.0
         contact_info, role, t_contact = first_contact or (None, "none", None)
         outcome = classify_outcome(
             modes_visited=ctrl.modes_visited,
@@ -251,7 +272,12 @@ class CoSimulation:
             contact=contact_info,
             role=role,
             final_offset_m=d,
-            final_speed_mps=max(x[3], 0.0),
+            final_speed_mps=vx,
+            max_abs_heading_error_rad=max_e_yaw,
+            min_speed_mps=min_vx,
+            min_offset_m=min_d,
+            max_offset_m=max_d,
+            left_width_m=left_width,
         )
         wall = time.perf_counter() - wall0
         sim_time = t - t_start
@@ -269,7 +295,10 @@ class CoSimulation:
             "max_abs_lat_accel_mps2": round(log.max_abs("ay_mps2"), 6),
             "max_lateral_offset_m": round(max_lat_offset, 6),
             "final_lateral_offset_m": round(d, 6),
-            "final_speed_mps": round(max(x[3], 0.0), 6),
+            "final_speed_mps": round(vx, 6) + 0.0,  # signed; + 0.0 turns -0.0 into 0.0
+            "min_speed_mps": round(min_vx, 6) + 0.0,  # lowest forward speed vx, signed
+            "max_abs_heading_error_rad": round(max_e_yaw, 6),  # |heading - road heading|
+            "left_road": left_road(min_d, max_d, lane_width, left_width),  # CG off the road
             "ego_initial_speed_mps": round(ego.speed_mps, 6),
             "sim_time_s": round(sim_time, 6),
             "wall_time_s": wall,

@@ -12,22 +12,36 @@ Definitions:
   it the EOAM logic is committed to the lane change, before it an oncoming vehicle still turns
   the manoeuvre into straight-line limit braking (yellow, not orange or red);
 * back in lane: |final lateral offset| <= ``in_lane_tolerance_m``;
-* stopped: final speed <= ``stopped_speed_mps``.
+* stopped: final speed <= ``stopped_speed_mps``;
+* lost control: at some time of the run the ego's heading was more than
+  ``lost_control_heading_rad`` (1.0 rad) off the road direction, or its forward speed vx was
+  below ``reversing_speed_mps`` (-0.5 m/s: going backwards);
+* left the road: the ego's centre of gravity went more than ``road_edge_margin_m`` (0.5 m)
+  beyond a road edge; in the road frame of its original lane the road spans
+  d in [-lane_width/2, lane_width/2 + left_width], left_width the width to the left of that
+  lane (one lane width when a lane to the left exists, own direction or opposite, else 0).
+  Lanes right of the original lane and a second lane to the left are not counted (the SUMO
+  session reports neither): an ego that starts in a middle lane and moves a whole lane to the
+  right is reported as having left the road.
 
 Rules, in order:
 
-1. no contact and no mode other than 0 (NORMAL): ``none``;
-2. no contact otherwise: ``green``; the reason says whether the lane change was completed and
+1. no contact, and the ego lost control or left the road: ``orange`` (a spin or a road
+   departure ends in lateral or roadside contact, the paper's orange; the run stops before
+   it), ``collision_with`` ``none``, the reason saying what happened;
+2. no contact and no mode other than 0 (NORMAL): ``none``;
+3. no contact otherwise: ``green``; the reason says whether the lane change was completed and
    the ego returned, or it stopped behind the obstacle; a run that ended before the ego was
    back in lane or stopped is still green (nothing was hit) and the reason says so;
-3. front against front (``head_on`` or ``oblique``) with the oncoming vehicle: ``red``, with or
+4. front against front (``head_on`` or ``oblique``) with the oncoming vehicle: ``red``, with or
    without a lane change (a frontal hit on oncoming traffic is the most severe outcome);
-4. no lane change and the ego's front hit a body that is not oncoming (front-to-rear or
+5. no lane change and the ego's front hit a body that is not oncoming (front-to-rear or
    frontal, not a side contact): ``yellow`` (direct hit at reduced speed, paper sec. 8.1);
-5. every other contact: ``orange`` (lateral or offset contact: side contact with the oncoming
+6. every other contact: ``orange`` (lateral or offset contact: side contact with the oncoming
    vehicle, any contact after a lane change with the ARO or a parked car, any side contact,
    the ego hit from behind).
 
+Runs with contact are classified by rules 4-6 whatever the ego's motion before the contact.
 ``collision_with`` is the role of the body hit; a body of role ``other`` (moving with the
 traffic outside the ego lane band, e.g. a car overtaking in the next lane) is reported as
 ``aro``, the class of in-lane obstacles, because the summary contract has no ``other``.
@@ -49,6 +63,26 @@ from eoam_sumo.sim.radar import (
 )
 
 COLOURS = ("none", "green", "yellow", "orange", "red")
+
+# Loss of control: |heading error| (heading relative to the road) above this [rad]. A lane
+# change turns the ego from the road by about atan(1.875 h / (T v)) (quintic of height h = the
+# lane width over T seconds at speed v), and by more at low speed, where the ego also brakes
+# to about half its entry speed during the steer. Measured: 0.03-0.18 rad at 90-165 km/h and
+# 0.33 rad at 55 km/h in the Table 2 batch; 0.53 rad at the tables' 20 km/h floor on 3.5 m
+# lanes, 0.60 rad on 4 m and 0.70 rad on 5 m lanes (a halted car ahead, mu 0.3-1.0). 1.0 rad
+# (57 deg) keeps 0.3 rad above every lane change and a spin passes it early (the tester's
+# ice-patch spin reached 2.2 rad).
+LOST_CONTROL_HEADING_RAD = 1.0
+# Going backwards: forward speed vx below this [m/s]. The plant's vx is not clamped at 0; a
+# stop by braking ends at vx = 0 to 6 decimals (Table 2, low-speed runs), so -0.5 m/s is no
+# rounding or creep but the car sliding backwards, as after a spin.
+REVERSING_SPEED_MPS = -0.5
+# Road departure: the centre of gravity this far beyond a road edge [m], i.e. about 1.4 m of
+# a 1.85 m wide car off the road. A lane change ends with the CG half a lane inside the left
+# edge (overshoot 0.3 m at most measured) and a return overshoots the own lane centre by
+# 0.33 m at most (Table 2), half a lane inside the right edge.
+ROAD_EDGE_MARGIN_M = 0.5
+
 ROLES = ("aro", "oncoming", "parked", "other")
 _COLLISION_WITH = {"aro": "aro", "oncoming": "oncoming", "parked": "parked", "other": "aro"}
 _ROLE_NAMES = {
@@ -107,16 +141,29 @@ class OutcomeSettings:
     # markers of a 3.5 m lane
     in_lane_tolerance_m: float = 0.5
     stopped_speed_mps: float = 0.1  # "stopped" at the end of the run
+    lost_control_heading_rad: float = LOST_CONTROL_HEADING_RAD  # |heading error| above: lost
+    reversing_speed_mps: float = REVERSING_SPEED_MPS  # vx below: going backwards, lost control
+    road_edge_margin_m: float = ROAD_EDGE_MARGIN_M  # CG beyond a road edge by more: left road
 
     def __post_init__(self) -> None:
         if not 0.0 < self.point_of_no_return_fraction <= 1.0:
             raise ValueError(
                 f"point_of_no_return_fraction={self.point_of_no_return_fraction} must be in (0, 1]"
             )
-        for name in ("in_lane_tolerance_m", "stopped_speed_mps"):
+        for name in ("in_lane_tolerance_m", "stopped_speed_mps", "lost_control_heading_rad"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v > 0.0):
                 raise ValueError(f"OutcomeSettings.{name}={v!r} must be finite and > 0")
+        if not (math.isfinite(self.reversing_speed_mps) and self.reversing_speed_mps < 0.0):
+            raise ValueError(
+                f"OutcomeSettings.reversing_speed_mps={self.reversing_speed_mps!r} must be "
+                "finite and < 0"
+            )
+        if not (math.isfinite(self.road_edge_margin_m) and self.road_edge_margin_m >= 0.0):
+            raise ValueError(
+                f"OutcomeSettings.road_edge_margin_m={self.road_edge_margin_m!r} must be "
+                "finite and >= 0"
+            )
 
 
 @dataclass(frozen=True)
@@ -141,6 +188,36 @@ def _manoeuvre_phrase(modes: set[int], lane_change: bool) -> str:
     return "no EOAM intervention"
 
 
+def road_departure(
+    min_offset_m: float,
+    max_offset_m: float,
+    lane_width_m: float,
+    left_width_m: float = 0.0,
+) -> tuple[str, float]:
+    """The side and distance [m] by which the ego's centre went farthest beyond a road edge.
+
+    ``min_offset_m``/``max_offset_m``: the smallest and largest signed lateral offset d of the
+    ego's centre in the road frame of its original lane (left positive); the road spans
+    d in [-lane_width_m / 2, lane_width_m / 2 + left_width_m]. The distance is <= 0 while the
+    centre stayed on the road (then it is minus the least clearance to an edge).
+    """
+    right = -0.5 * lane_width_m - min_offset_m
+    left = max_offset_m - 0.5 * lane_width_m - left_width_m
+    return ("left", left) if left > right else ("right", right)
+
+
+def left_road(
+    min_offset_m: float,
+    max_offset_m: float,
+    lane_width_m: float,
+    left_width_m: float = 0.0,
+    settings: OutcomeSettings = OutcomeSettings(),
+) -> bool:
+    """Whether the ego's centre went more than ``settings.road_edge_margin_m`` off the road."""
+    _, beyond_m = road_departure(min_offset_m, max_offset_m, lane_width_m, left_width_m)
+    return beyond_m > settings.road_edge_margin_m
+
+
 def classify_outcome(
     modes_visited: Sequence[int],
     max_lateral_offset_m: float,
@@ -150,6 +227,12 @@ def classify_outcome(
     final_offset_m: float = 0.0,
     final_speed_mps: float = 0.0,
     settings: OutcomeSettings = OutcomeSettings(),
+    *,
+    max_abs_heading_error_rad: float = 0.0,
+    min_speed_mps: float = 0.0,
+    min_offset_m: float = 0.0,
+    max_offset_m: float = 0.0,
+    left_width_m: float = 0.0,
 ) -> Outcome:
     """Colour of a run by the rules of the module docstring.
 
@@ -157,22 +240,41 @@ def classify_outcome(
     largest |d| of the ego during the run; ``contact``: the first contact with the ego as box
     ``a`` (None if nothing was hit) and ``role`` the role of the other body (``role_of``);
     ``final_offset_m`` and ``final_speed_mps``: the ego's d and speed when the run ended.
+
+    Loss of control and road departure (keyword-only; the defaults detect neither):
+    ``max_abs_heading_error_rad`` the largest |heading - road heading| (wrapped to [-pi, pi))
+    and ``min_speed_mps`` the lowest forward speed vx (signed) during the run;
+    ``min_offset_m``/``max_offset_m`` the signed extremes of d and ``left_width_m`` the road
+    width to the left of the original lane (``road_departure``).
     """
     modes = set(modes_visited)
     if not modes <= {0, 1, 2, 3, 4, 5}:
         raise ValueError(f"modes_visited={list(modes_visited)} must hold mode numbers 0-5")
     for name, v in (("max_lateral_offset_m", max_lateral_offset_m),
-                    ("final_offset_m", final_offset_m), ("final_speed_mps", final_speed_mps)):
+                    ("final_offset_m", final_offset_m), ("final_speed_mps", final_speed_mps),
+                    ("max_abs_heading_error_rad", max_abs_heading_error_rad),
+                    ("min_speed_mps", min_speed_mps), ("min_offset_m", min_offset_m),
+                    ("max_offset_m", max_offset_m), ("left_width_m", left_width_m)):
         if not math.isfinite(v):
             raise ValueError(f"{name}={v!r} must be finite")
     if not lane_width_m > 0.0:
         raise ValueError(f"lane_width_m={lane_width_m} must be > 0")
+    if left_width_m < 0.0:
+        raise ValueError(f"left_width_m={left_width_m} must be >= 0")
     # mode 3 is entered only before the point of no return: limit braking was chosen, whatever
     # lateral drift the aborted steer leaves (paper sec. 8.1, design.md 3.4 yellow)
     lane_change = 3 not in modes and (
         abs(max_lateral_offset_m) >= settings.point_of_no_return_fraction * lane_width_m
     )
     if contact is None:
+        lost = _loss_of_control(
+            max_abs_heading_error_rad, min_speed_mps,
+            road_departure(min_offset_m, max_offset_m, lane_width_m, left_width_m), settings,
+        )
+        if lost:
+            # an offset past the point of no return is a lane change only if the EOAM steered
+            done = _manoeuvre_phrase(modes, lane_change and bool(modes & {2, 4, 5}))
+            return Outcome("orange", "none", 0.0, f"{done}, no contact; {'; '.join(lost)}")
         return _no_contact(modes, lane_change, final_offset_m, final_speed_mps, settings)
     if role not in ROLES:
         raise ValueError(f"role={role!r} of the body hit must be one of {ROLES}")
@@ -193,6 +295,25 @@ def classify_outcome(
         part = f"ego {contact.face_a} against its {contact.face_b}"
         colour, reason = "orange", f"{done}, {how} contact with {what} ({part}) at {v:.1f} m/s"
     return Outcome(colour, _COLLISION_WITH[role], v, reason)
+
+
+def _loss_of_control(
+    max_abs_heading_error_rad: float, min_speed_mps: float, departure: tuple[str, float],
+    settings: OutcomeSettings,
+) -> list[str]:
+    """What went wrong, one phrase per trigger (empty when the ego stayed in control)."""
+    what = []
+    heading = abs(max_abs_heading_error_rad)
+    if heading > settings.lost_control_heading_rad:
+        what.append(
+            f"lost control: heading {heading:.2f} rad ({math.degrees(heading):.0f} deg) off the road"
+        )
+    if min_speed_mps < settings.reversing_speed_mps:
+        what.append(f"went backwards (vx down to {min_speed_mps:.1f} m/s)")
+    side, beyond_m = departure
+    if beyond_m > settings.road_edge_margin_m:
+        what.append(f"left the road: centre {beyond_m:.1f} m beyond its {side} edge")
+    return what
 
 
 def _no_contact(

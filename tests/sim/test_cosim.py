@@ -70,6 +70,10 @@ def test_120_kmh_dry_no_oncoming_is_green_with_return_and_hand_back(tmp_path):
         assert key in saved
     assert saved["mu"] == pytest.approx(1.0)
     assert saved["min_gap_aro_m"] > 0.0
+    # loss-of-control measures of a normal lane change
+    assert saved["left_road"] is False
+    assert 0.05 < saved["max_abs_heading_error_rad"] < 0.3
+    assert 15.0 < saved["min_speed_mps"] <= saved["final_speed_mps"]
     # one row per SUMO step of 10 ms
     assert ts["time_s"].diff().dropna().round(6).eq(0.01).all()
 
@@ -300,6 +304,60 @@ def test_curved_two_way_road(tmp_path):
     # before anything is seen, the ego keeps its lane on the curve
     calm = ts[ts["mode"] == 0].head(50)
     assert calm["lateral_offset_m"].abs().max() < 0.2
+
+
+def test_ice_patch_road_departure_is_orange_not_green(tmp_path):
+    """Dry road, then mu 0.05 from x = 200 m: the ego steers round a halted car on the ice
+    and slides off the road to the right (was reported green, "returned to lane")."""
+    (tmp_path / "n.nod.xml").write_text(
+        '<nodes><node id="a" x="0" y="0"/><node id="b" x="200" y="0"/>'
+        '<node id="c" x="600" y="0"/><node id="d" x="2000" y="0"/></nodes>'
+    )
+    (tmp_path / "n.edg.xml").write_text(
+        '<edges><edge id="dry" from="a" to="b" numLanes="2" speed="40"/>'
+        '<edge id="ice" from="b" to="c" numLanes="2" speed="40" friction="0.05"/>'
+        '<edge id="end" from="c" to="d" numLanes="2" speed="40"/></edges>'
+    )
+    import sumolib
+
+    subprocess.run(
+        [sumolib.checkBinary("netconvert"), "-n", str(tmp_path / "n.nod.xml"),
+         "-e", str(tmp_path / "n.edg.xml"), "--no-turnarounds", "true",
+         "-o", str(tmp_path / "n.net.xml")],
+        check=True, capture_output=True,
+    )
+    (tmp_path / "r.rou.xml").write_text(textwrap.dedent("""\
+        <routes>
+          <vType id="car" length="4.6" width="1.8" decel="9" sigma="0"/>
+          <route id="r" edges="dry ice end"/>
+          <route id="on_ice" edges="ice end"/>
+          <vehicle id="stalled" type="car" route="on_ice" depart="0" departPos="95"
+                   departSpeed="0">
+            <stop lane="ice_0" endPos="100" duration="1000"/>
+          </vehicle>
+          <vehicle id="ego" type="car" route="r" depart="0" departPos="20" departSpeed="30"/>
+        </routes>"""))
+    cfg = tmp_path / "s.sumocfg"
+    cfg.write_text(
+        '<configuration><input><net-file value="n.net.xml"/><route-files value="r.rou.xml"/>'
+        "</input></configuration>"
+    )
+    summary, out = _run(cfg, tmp_path, max_time_s=20.0)
+    assert summary["mu"] == pytest.approx(1.0)  # dry where the ego starts
+    assert 2 in summary["modes_visited"], summary["reason"]
+    assert (summary["outcome"], summary["collision_with"]) == ("orange", "none"), summary
+    assert summary["left_road"] is True
+    assert "left the road" in summary["reason"] and "right edge" in summary["reason"]
+    ts = pd.read_csv(out / "timeseries.csv")
+    lane_width = 3.2  # netconvert's default
+    assert ts["lateral_offset_m"].min() < -0.5 * lane_width - 0.5
+    assert ts["mu"].min() == pytest.approx(0.05)
+    # the summary's extremes agree with the logged steps
+    e = (ts["heading_error_rad"] + math.pi) % math.tau - math.pi
+    assert summary["max_abs_heading_error_rad"] == pytest.approx(e.abs().max(), abs=1e-6)
+    assert summary["min_speed_mps"] == pytest.approx(ts["vx_mps"].min(), abs=1e-6)
+    assert summary["max_lateral_offset_m"] == pytest.approx(
+        ts["lateral_offset_m"].iloc[:-1].abs().max(), abs=1e-6)
 
 
 @pytest.mark.parametrize("enabled", [True, False])

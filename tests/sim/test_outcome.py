@@ -11,9 +11,14 @@ from hypothesis import strategies as st
 from eoam_sumo.sim.geometry import Contact, OrientedBox, contact
 from eoam_sumo.sim.outcome import (
     COLOURS,
+    LOST_CONTROL_HEADING_RAD,
+    REVERSING_SPEED_MPS,
+    ROAD_EDGE_MARGIN_M,
     Outcome,
     OutcomeSettings,
     classify_outcome,
+    left_road,
+    road_departure,
     role_of,
 )
 from eoam_sumo.sim.radar import Target
@@ -260,3 +265,195 @@ def test_aborted_steer_that_drifts_past_the_ponr_is_still_limit_braking():
     out = classify_outcome([0, 1, 2, 3], 1.6, 3.5, hit, "aro")
     assert out.colour == "yellow" and "limit braking" in out.reason
 
+
+
+# --- loss of control and road departure without contact (rule 1) ---------------------------
+
+RIGHT_EDGE_M = -0.5 * LANE_M  # road frame of the ego lane: its right marker
+LEFT_EDGE_M = 1.5 * LANE_M  # with one lane to the left
+DEFAULTS = OutcomeSettings()
+
+
+def _motion(modes=LANE_CHANGE, max_offset=3.6, hit=None, role="none", final_offset=0.0,
+            final_speed=25.0, heading=0.1, min_speed=20.0, min_offset=-0.2, max_offset_d=None,
+            left_width=LANE_M, lane_width=LANE_M, settings=DEFAULTS):
+    return classify_outcome(
+        modes, max_offset, lane_width, hit, role, final_offset, final_speed, settings,
+        max_abs_heading_error_rad=heading, min_speed_mps=min_speed, min_offset_m=min_offset,
+        max_offset_m=max_offset if max_offset_d is None else max_offset_d,
+        left_width_m=left_width,
+    )
+
+
+def test_thresholds_are_far_from_normal_manoeuvres():
+    # heading: >= 0.3 rad above the largest lane-change heading measured (0.70 rad, 5 m lanes,
+    # 20-25 km/h) and below a spin; speed: a real backwards slide; edge: 1.4 m of the car off
+    assert LOST_CONTROL_HEADING_RAD == 1.0
+    assert REVERSING_SPEED_MPS == -0.5
+    assert ROAD_EDGE_MARGIN_M == 0.5
+    assert OutcomeSettings().lost_control_heading_rad == LOST_CONTROL_HEADING_RAD
+
+
+def test_orange_spin_on_ice_without_contact():
+    """The tester's run: a 0.05 ice patch, heading 2.2 rad off, vx -8 m/s, d 6.4 m on a
+    two-lane road: was green "lane change completed, returned to lane"."""
+    out = _motion(max_offset=6.4, final_offset=0.2, final_speed=-8.0, heading=2.2,
+                  min_speed=-8.0, min_offset=-0.3)
+    assert (out.colour, out.collision_with, out.impact_speed_mps) == ("orange", "none", 0.0)
+    assert out.reason == (
+        "lane change, no contact; lost control: heading 2.20 rad (126 deg) off the road; "
+        "went backwards (vx down to -8.0 m/s); left the road: centre 1.2 m beyond its left edge"
+    )
+
+
+def test_orange_heading_alone():
+    out = _motion(heading=1.3)
+    assert (out.colour, out.collision_with) == ("orange", "none")
+    assert out.reason == "lane change, no contact; lost control: heading 1.30 rad (74 deg) off the road"
+    assert _motion(heading=-1.3) == out  # |heading| counts
+    assert _motion(heading=LOST_CONTROL_HEADING_RAD).colour == "green"
+    assert _motion(heading=LOST_CONTROL_HEADING_RAD + 1e-9).colour == "orange"
+
+
+def test_orange_going_backwards_alone():
+    out = _classify(BRAKE_ONLY, 0.0, final_speed=-1.0)  # the old inputs: still green
+    assert out.colour == "green" and "stopped" in out.reason
+    out = _motion(BRAKE_ONLY, 0.0, final_speed=-1.0, heading=0.0, min_speed=-1.0, min_offset=0.0)
+    assert (out.colour, out.collision_with) == ("orange", "none")
+    assert out.reason == (
+        "limit braking chosen by the DMM, no contact; went backwards (vx down to -1.0 m/s)"
+    )
+    assert _motion(min_speed=REVERSING_SPEED_MPS).colour == "green"
+    assert _motion(min_speed=REVERSING_SPEED_MPS - 1e-9).colour == "orange"
+
+
+def test_orange_left_the_road_to_the_right():
+    out = _motion(min_offset=RIGHT_EDGE_M - 4.1)
+    assert (out.colour, out.collision_with) == ("orange", "none")
+    assert out.reason == "lane change, no contact; left the road: centre 4.1 m beyond its right edge"
+    assert _motion(min_offset=RIGHT_EDGE_M - ROAD_EDGE_MARGIN_M).colour == "green"
+    assert _motion(min_offset=RIGHT_EDGE_M - ROAD_EDGE_MARGIN_M - 1e-9).colour == "orange"
+
+
+def test_orange_not_none_for_a_car_that_left_the_road_without_any_manoeuvre():
+    """The tester's second run: 43 m off the road with the EOAM never triggered was ``none``."""
+    out = _motion([0], 44.75, final_offset=-44.75, heading=0.4, min_speed=25.0,
+                  min_offset=RIGHT_EDGE_M - 43.0, max_offset_d=0.0)
+    assert (out.colour, out.collision_with) == ("orange", "none")
+    assert out.reason == (
+        "no EOAM intervention, no contact; left the road: centre 43.0 m beyond its right edge"
+    )
+
+
+def test_orange_left_the_road_to_the_left_depends_on_the_lane_there():
+    beyond = LEFT_EDGE_M + ROAD_EDGE_MARGIN_M
+    assert _motion(max_offset=beyond).colour == "green"
+    out = _motion(max_offset=beyond + 0.3)
+    assert out.colour == "orange"
+    assert out.reason.endswith("left the road: centre 0.8 m beyond its left edge")
+    # no lane to the left: the road ends at the ego lane's left marker
+    lone = _motion([0, 1], 0.5 * LANE_M + 0.6, left_width=0.0, min_offset=0.0)
+    assert lone.colour == "orange" and "0.6 m beyond its left edge" in lone.reason
+
+
+@pytest.mark.parametrize(
+    ("lane_width", "modes", "max_offset", "min_offset", "heading", "min_speed", "final_speed"),
+    [
+        # Table 2 extremes (no contact): largest heading 0.33 rad (55 km/h, mu 1.0), largest
+        # d 3.76 m (165 km/h, mu 0.1), return overshoot -0.33 m, stops at vx 0
+        (3.5, LANE_CHANGE, 3.21, 0.0, 0.333, 8.4, 12.9),
+        (3.5, LANE_CHANGE, 3.755, -0.128, 0.033, 39.96, 39.96),
+        (3.5, LANE_CHANGE, 3.567, -0.328, 0.118, 35.4, 39.7),
+        (3.5, PONR_PASSED, 3.62, -0.26, 0.11, 33.3, 36.5),
+        (3.5, BRAKE_ONLY, 0.0, 0.0, 0.0, 0.0, 0.0),
+        (3.5, ONCOMING_ABORT, 0.9, 0.0, 0.05, 0.0, 0.0),
+        # low-speed lane changes at the tables' 20 km/h floor (halted car, mu 1.0)
+        (3.5, LANE_CHANGE, 3.3, -0.1, 0.53, 3.1, 5.5),
+        (5.0, LANE_CHANGE, 5.0, -0.1, 0.70, 3.1, 5.5),
+    ],
+)
+def test_normal_runs_stay_green(lane_width, modes, max_offset, min_offset, heading, min_speed,
+                                final_speed):
+    final_offset = 0.05
+    old = classify_outcome(modes, max_offset, lane_width, None, "none", final_offset,
+                           final_speed)
+    new = _motion(modes, max_offset, final_offset=final_offset, final_speed=final_speed,
+                  heading=heading, min_speed=min_speed, min_offset=min_offset,
+                  left_width=lane_width, lane_width=lane_width)
+    assert new == old and new.colour == "green"
+
+
+def test_contact_keeps_the_contact_rules_after_a_loss_of_control():
+    spin = {"heading": 2.5, "min_speed": -3.0, "min_offset": RIGHT_EDGE_M - 2.0}
+    hit = _hit("rear_end", speed=9.0)
+    assert _motion(BRAKE_ONLY, 0.0, hit, "aro", **spin) == _classify(BRAKE_ONLY, 0.0, hit, "aro")
+    side = _hit("side", "left", "right", 12.0)
+    out = _motion(LANE_CHANGE, 3.4, side, "parked", **spin)
+    assert out == _classify(LANE_CHANGE, 3.4, side, "parked")
+    assert (out.colour, out.collision_with) == ("orange", "parked")
+
+
+def test_settings_move_the_thresholds():
+    loose = OutcomeSettings(lost_control_heading_rad=3.0, reversing_speed_mps=-10.0,
+                            road_edge_margin_m=50.0)
+    out = _motion(heading=2.2, min_speed=-8.0, min_offset=RIGHT_EDGE_M - 43.0, settings=loose)
+    assert out.colour == "green"
+    for bad in ({"lost_control_heading_rad": 0.0}, {"reversing_speed_mps": 0.0},
+                {"road_edge_margin_m": -0.1}, {"lost_control_heading_rad": math.inf}):
+        with pytest.raises(ValueError, match=next(iter(bad))):
+            OutcomeSettings(**bad)
+
+
+def test_motion_inputs_are_checked():
+    for kwargs in ({"heading": math.nan}, {"min_speed": -math.inf}, {"min_offset": math.nan},
+                   {"max_offset_d": math.inf}):
+        with pytest.raises(ValueError, match="must be finite"):
+            _motion(**kwargs)
+    with pytest.raises(ValueError, match="left_width_m"):
+        _motion(left_width=-1.0)
+
+
+def test_road_departure_and_left_road():
+    assert road_departure(0.0, 0.0, LANE_M) == ("right", pytest.approx(-1.75))
+    assert road_departure(-0.2, 3.6, LANE_M, LANE_M) == ("right", pytest.approx(-1.55))
+    assert road_departure(-0.2, 5.5, LANE_M, LANE_M) == ("left", pytest.approx(0.25))
+    assert road_departure(-6.0, 5.5, LANE_M, LANE_M) == ("right", pytest.approx(4.25))
+    assert road_departure(0.0, 2.0, LANE_M) == ("left", pytest.approx(0.25))
+    assert not left_road(-2.25, 5.75, LANE_M, LANE_M)  # exactly the margin on both sides
+    assert left_road(-2.26, 0.0, LANE_M, LANE_M)
+    assert left_road(0.0, 2.26, LANE_M)  # no lane to the left
+    assert not left_road(-40.0, 0.0, LANE_M, settings=OutcomeSettings(road_edge_margin_m=40.0))
+
+
+@settings(max_examples=300, deadline=None, database=None)
+@given(
+    st.lists(st.integers(0, 5), min_size=1, max_size=6, unique=True),
+    contacts,
+    st.sampled_from(("aro", "oncoming", "parked", "other")),
+    st.floats(-10.0, 0.0),
+    st.floats(0.0, 10.0),
+    st.floats(-4.0, 4.0),
+    st.floats(-10.0, 50.0),
+    st.sampled_from((0.0, LANE_M)),
+)
+def test_motion_rule_invariants(modes, hit, role, min_offset, max_offset, heading, min_speed,
+                                left_width):
+    role = role if hit else "none"
+    max_abs = max(max_offset, -min_offset)
+    old = classify_outcome(modes, max_abs, LANE_M, hit, role, 0.0, max(min_speed, 0.0))
+    new = classify_outcome(
+        modes, max_abs, LANE_M, hit, role, 0.0, max(min_speed, 0.0),
+        max_abs_heading_error_rad=heading, min_speed_mps=min_speed, min_offset_m=min_offset,
+        max_offset_m=max_offset, left_width_m=left_width,
+    )
+    off_road = (min_offset < RIGHT_EDGE_M - ROAD_EDGE_MARGIN_M
+                or max_offset > 0.5 * LANE_M + left_width + ROAD_EDGE_MARGIN_M)
+    lost = abs(heading) > LOST_CONTROL_HEADING_RAD or min_speed < REVERSING_SPEED_MPS
+    assert off_road == left_road(min_offset, max_offset, LANE_M, left_width)
+    if hit is not None or not (off_road or lost):
+        assert new == old
+    else:
+        assert (new.colour, new.collision_with, new.impact_speed_mps) == ("orange", "none", 0.0)
+        assert ("lost control" in new.reason) == (abs(heading) > LOST_CONTROL_HEADING_RAD)
+        assert ("went backwards" in new.reason) == (min_speed < REVERSING_SPEED_MPS)
+        assert ("left the road" in new.reason) == off_road
