@@ -406,11 +406,16 @@ class EoamController:
                 yaw_ref = kappa_ref = 0.0
         e_lat = d - y_ref
         road_kappa = meas.road_curvature_1pm
+        e_head = meas.e_yaw_rad - yaw_ref
+        if road_kappa:
+            # following a curved road the body points off it by the steady-state sideslip,
+            # which the look-ahead would turn into a steady offset (Kapania and Gerdes 2015)
+            e_head += self._steer.steady_sideslip(v, road_kappa)
         delta, ff, fb, yd, e_la = self._steer.command(
             v,
             meas.yaw_rate_radps,
             e_lat,
-            _wrap(meas.e_yaw_rad - yaw_ref),
+            _wrap(e_head),
             kappa_ref + road_kappa,
             kappa_ff + road_kappa,
             mu,

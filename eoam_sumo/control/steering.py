@@ -70,11 +70,13 @@ class SteeringController:
 
     __slots__ = (
         "_L",
+        "_b",
         "_fexp",
         "_kr",
         "_kus",
         "_max",
         "_mu",
+        "_slip_k",
         "_vfull",
         "_vmin",
         "_w",
@@ -86,6 +88,10 @@ class SteeringController:
     def __init__(self, params: VehicleParams, gains: SteeringGains = SteeringGains()):
         self._L = params.wheelbase_m
         self._kus = understeer_gradient(params)
+        self._b = params.cg_to_rear_m
+        self._slip_k = params.mass_kg * params.cg_to_front_m / (
+            params.wheelbase_m * params.cornering_stiffness_rear_npr
+        )
         self._max = params.max_steer_rad
         self._w = gains.natural_freq_radps
         self._z = gains.damping_ratio
@@ -113,6 +119,12 @@ class SteeringController:
         if x_la < self._xmin:
             x_la = self._xmin
         return w * w * (self._L + self._kus * v * v) / (v * v), x_la
+
+    def steady_sideslip(self, speed_mps: float, curvature_1pm: float) -> float:
+        """Body sideslip angle [rad] of steady cornering on a curvature (linear bicycle model):
+        kappa (b - m a v^2 / (L C_r)), a and b the CG's distances to the axles; its negative is
+        the heading the body keeps off the path tangent."""
+        return curvature_1pm * (self._b - self._slip_k * speed_mps * speed_mps)
 
     def lateral_accel(self, speed_mps: float, steer_rad: float) -> float:
         """Steady-state lateral acceleration v^2 delta / (L + K_us v^2) a steer angle asks for."""

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from bisect import bisect_right
 from collections.abc import Sequence
+from itertools import pairwise
 
 
 class RoadFrame:
@@ -36,8 +37,11 @@ class RoadFrame:
             self._hy.append(dy / seg)
             self._len.append(seg)
             self._s.append(self._s[-1] + seg)
-        self._yaw = [math.atan2(hy, hx) for hx, hy in zip(self._hx, self._hy)]
-        self._kappa = [self._vertex_curvature(i) for i in range(len(self._len))]
+        heading, slope = _smooth_heading(clean, self._s)
+        self._yaw0 = [heading(s_m) for s_m in self._s[:-1]]  # road heading at each segment start
+        self._yaw_rate = [(heading(self._s[i + 1]) - self._yaw0[i]) / self._len[i]
+                          for i in range(len(self._len))]  # its change per metre along it
+        self._kappa = [slope(s_m) for s_m in self._s[1:]]  # at each segment's end vertex
         self._hint = 0
 
     @property
@@ -47,7 +51,10 @@ class RoadFrame:
     def project(self, x: float, y: float) -> tuple[float, float, float]:
         """(s_m, d_m, road_yaw_rad) of a point. Walks the polyline from the last answer: forward
         while the point lies past a segment's end, else backward while it lies before its start
-        (beyond the ends, the first and last segments extend)."""
+        (beyond the ends, the first and last segments extend). The heading is the smooth road
+        heading of ``_smooth_heading`` (continuous, not wrapped), not the segment's own: that
+        jumps at every vertex (0.017 rad for 25 m chords of a 1500 m curve), which a look-ahead
+        steering feedback 30 m ahead would turn into half-metre steps."""
         last = len(self._len) - 1
         i = self._hint
         hx, hy, xs, ys, seg = self._hx, self._hy, self._x, self._y, self._len
@@ -63,7 +70,10 @@ class RoadFrame:
                 rx, ry = x - xs[i], y - ys[i]
                 along = rx * hx[i] + ry * hy[i]
         self._hint = i
-        return self._s[i] + along, ry * hx[i] - rx * hy[i], self._yaw[i]
+        a = along if along > 0.0 else 0.0
+        if a > seg[i]:
+            a = seg[i]
+        return self._s[i] + along, ry * hx[i] - rx * hy[i], self._yaw0[i] + self._yaw_rate[i] * a
 
     def point_at(self, s_m: float, d_m: float = 0.0) -> tuple[float, float, float]:
         """(x, y, road_yaw) of the point at station s and offset d (extrapolated at the ends)."""
@@ -83,10 +93,47 @@ class RoadFrame:
             return self._kappa[i]
         return self._kappa[min(max(bisect_right(self._s, s_m) - 1, 0), len(self._len) - 1)]
 
-    def _vertex_curvature(self, i: int) -> float:
-        """Curvature at the end of segment ``i`` (0 for the last segment)."""
-        if i + 1 >= len(self._len):
+
+CURVATURE_MIN_SEGMENT_M = 2.0
+"""Heading and curvature are measured on the centre line with points closer than this to the
+last kept one dropped: SUMO joins the lanes of consecutive edges by chords of a few
+decimetres across the junction, whose heading change over so short a length would spike the
+curvature (and the steering feedforward) by several times the road's."""
+
+
+def _smooth_heading(points: list, stations: list):
+    """(heading(s), curvature(s)) of the road: the heading of each segment of the thinned
+    polyline (see ``CURVATURE_MIN_SEGMENT_M``) held at its midpoint, unwrapped, and
+    interpolated linearly between midpoints (constant beyond the first and last); the
+    curvature is its slope (the heading change at a vertex over the distance between the
+    neighbouring midpoints; 0 beyond the end midpoints, and on a straight line)."""
+    kept, kept_s = [points[0]], [0.0]
+    for p, s_m in zip(points[1:-1], stations[1:-1]):
+        if s_m - kept_s[-1] >= CURVATURE_MIN_SEGMENT_M:
+            kept.append(p)
+            kept_s.append(s_m)
+    kept.append(points[-1])
+    kept_s.append(stations[-1])
+    mids, yaws = [], []
+    for (p, q), (s0, s1) in zip(pairwise(kept), pairwise(kept_s)):
+        yaw = math.atan2(q[1] - p[1], q[0] - p[0])
+        if yaws:  # unwrapped: continuous along the road
+            yaw = yaws[-1] + (yaw - yaws[-1] + math.pi) % (2.0 * math.pi) - math.pi
+        mids.append(0.5 * (s0 + s1))
+        yaws.append(yaw)
+
+    def slope(s_m: float) -> float:
+        j = bisect_right(mids, s_m) - 1
+        if j < 0 or j >= len(mids) - 1:
             return 0.0
-        dyaw = math.atan2(self._hy[i + 1], self._hx[i + 1]) - math.atan2(self._hy[i], self._hx[i])
-        dyaw = (dyaw + math.pi) % (2.0 * math.pi) - math.pi
-        return dyaw / (0.5 * (self._len[i] + self._len[i + 1]))
+        return (yaws[j + 1] - yaws[j]) / (mids[j + 1] - mids[j])
+
+    def heading(s_m: float) -> float:
+        j = bisect_right(mids, s_m) - 1
+        if j < 0:
+            return yaws[0]
+        if j >= len(mids) - 1:
+            return yaws[-1]
+        return yaws[j] + (s_m - mids[j]) * slope(s_m)
+
+    return heading, slope

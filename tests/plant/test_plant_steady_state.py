@@ -42,3 +42,23 @@ def test_steady_state_yaw_rate_matches_linear_bicycle_gain(plant, params, steer_
     gain = x[R] / x[STEER]
     assert gain == pytest.approx(linear_yaw_gain(params, x[VX]), rel=0.05)
     assert abs(x[VX] - speed) < 0.05 * speed
+
+
+@pytest.mark.parametrize("speed_kmh,steer_deg", [(80.0, 0.5), (120.0, 0.3), (165.0, 0.15)])
+def test_steady_state_sideslip_is_the_steering_controllers(plant, params, speed_kmh, steer_deg):
+    """The plant's body sideslip in steady cornering is what the steering controller expects
+    on a road of that curvature (linear bicycle, kappa (b - m a v^2 / (L C_r)))."""
+    from eoam_sumo.control import SteeringController
+
+    speed = speed_kmh / 3.6
+    drive = cruise_drive_force_n(params, speed)
+    x = initial_state(0.0, 0.0, 0.0, speed, drive_force_n=drive)
+    u = np.array([math.radians(steer_deg), drive, 0.0])
+    for _ in range(400):
+        x, _ = plant.step(x, u, 1.0)
+    vy = x[STATE_NAMES.index("vy_mps")]
+    beta = math.atan(vy / x[VX])
+    curvature = x[R] / x[VX]
+    expected = SteeringController(params).steady_sideslip(x[VX], curvature)
+    assert abs(beta) > 1e-3  # a real sideslip, not zero against zero
+    assert beta == pytest.approx(expected, rel=0.1)

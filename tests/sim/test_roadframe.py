@@ -54,3 +54,31 @@ def test_curvature_is_the_nearest_vertex_value_whatever_the_last_projection(s_m,
     k = ARC.curvature_at(s_m)
     seg = min(max(sum(1 for s0 in ARC._s if s0 <= s_m) - 1, 0), len(ARC._len) - 1)
     assert k == ARC._kappa[seg]
+
+
+def _arc_with_junction_chords(radius=1500.0, chord_m=25.0, edge_m=1000.0, gap_m=0.3):
+    """Points of a left arc as SUMO gives consecutive edges' lane shapes: 25 m chords, and at
+    every edge end a short chord across the junction."""
+    pts, s_m = [], 0.0
+    while s_m <= 3 * edge_m:
+        pts.append((radius * math.sin(s_m / radius), radius * (1 - math.cos(s_m / radius))))
+        nxt = s_m + chord_m
+        if int(nxt // edge_m) > int(s_m // edge_m):  # an edge ends: stop short, then the gap
+            end = (int(nxt // edge_m)) * edge_m
+            pts.append((radius * math.sin(end / radius), radius * (1 - math.cos(end / radius))))
+            nxt = end + gap_m
+        s_m = nxt
+    return pts
+
+
+def test_heading_and_curvature_of_a_curve_ignore_junction_chords():
+    """Heading follows the true tangent within a fraction of a chord's turn (no steps at the
+    vertices) and the curvature stays the road's at the short chords between edges."""
+    radius = 1500.0
+    road = RoadFrame(_arc_with_junction_chords(radius))
+    for s_m in [30.0 + 7.3 * k for k in range(400)]:  # from past the first chord
+        x, y = radius * math.sin(s_m / radius), radius * (1 - math.cos(s_m / radius))
+        s2, _, yaw = road.project(x, y)
+        assert yaw == pytest.approx(s2 / radius, abs=0.1 * 25.0 / radius)
+        if 30.0 < s2 < road.length_m - 30.0:
+            assert road.curvature_at(s2) == pytest.approx(1.0 / radius, rel=0.1)
