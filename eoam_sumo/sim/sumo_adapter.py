@@ -181,28 +181,66 @@ def _parse_xml(path: Path, what: str) -> ET.Element:
 
 
 def _read_net(path: Path) -> dict:
-    """Lane id -> opposite lane id, streaming through the network file."""
+    """Lane id -> opposite lane id, streaming through the network file: each ``<neigh>``, and
+    for a two-way road built without them the leftmost lanes of an edge and its reverse edge
+    (swapped junctions) when they lie side by side (``_side_by_side``)."""
     if not path.is_file():
         raise InputError(f"net-file {path} not found")
     opposite, lane_id, first = {}, None, True
+    edges = {}  # normal edge id -> (from, to, leftmost lane (index, id, width, shape))
+    edge_id = None
     try:
         for event, elem in ET.iterparse(_xml_source(path), events=("start", "end")):
             if first:
                 if elem.tag != "net":
                     raise InputError(f"{path}: not a SUMO network (root element <{elem.tag}>)")
                 first = False
-            if event == "start" and elem.tag == "lane":
+            if event == "start" and elem.tag == "edge":
+                edge_id = elem.get("id") if elem.get("function") in (None, "normal") else None
+                if edge_id is not None:
+                    edges[edge_id] = (elem.get("from"), elem.get("to"), None)
+            elif event == "start" and elem.tag == "lane":
                 lane_id = elem.get("id")
                 _check_friction(path, lane_id, elem.get("friction"))
+                if edge_id is not None:
+                    frm, to, left = edges[edge_id]
+                    index = int(elem.get("index", "0"))
+                    if left is None or index > left[0]:
+                        edges[edge_id] = (frm, to, (index, lane_id, elem.get("width", "3.2"),
+                                                    elem.get("shape", "")))
             elif event == "start" and elem.tag == "neigh" and lane_id is not None:
                 opposite[lane_id] = elem.get("lane")
             elif event == "end" and elem.tag in ("edge", "junction", "connection", "tlLogic"):
                 elem.clear()
     except (ET.ParseError, OSError) as exc:
         raise InputError(f"{path}: malformed XML: {exc}") from exc
+    by_ends = {(frm, to): left for frm, to, left in edges.values() if left is not None}
+    for (frm, to), left in by_ends.items():
+        back = by_ends.get((to, frm))
+        if back is None or left[1] in opposite or back[1] in opposite:
+            continue
+        if _side_by_side(left, back):
+            opposite[left[1]] = back[1]
+            opposite[back[1]] = left[1]
     return opposite
 
 
+def _side_by_side(lane: tuple, other: tuple) -> bool:
+    """The two lanes ((index, id, width, shape) as in the net file) lie next to each other: the
+    other lane's centre line passes the middle of this one on its left at half the sum of their
+    widths (within 0.3 m)."""
+    try:
+        a = np.array([[float(v) for v in p.split(",")[:2]] for p in lane[3].split()])
+        b = np.array([[float(v) for v in p.split(",")[:2]] for p in other[3].split()])
+        width = 0.5 * (float(lane[2]) + float(other[2]))
+    except ValueError:
+        return False
+    if len(a) < 2 or len(b) < 2:
+        return False
+    mx, my, heading = point_at(a, 0.5 * _arclength(a)[-1])
+    bx, by, _ = point_at(b, project(b, mx, my)[0])  # the nearest point of the other lane
+    left = -math.sin(heading) * (bx - mx) + math.cos(heading) * (by - my)
+    return abs(left - width) <= 0.3
 def _check_friction(path: Path, lane_id: str | None, text: str | None) -> None:
     """A lane's ``friction`` attribute (absent: SUMO's 1.0) must be a number in (0, MU_MAX];
     SUMO itself crashes on a non-number."""

@@ -518,3 +518,37 @@ def test_lane_friction_outside_the_range_names_the_network(tmp_path, friction):
     cfg = _routes_cfg(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(), net)
     with pytest.raises(InputError, match=rf"fric.net.xml: lane .* friction='{friction}'"):
         SumoSession.start(cfg)
+
+
+def test_a_two_way_road_without_neigh_elements_has_its_opposite_lane(tmp_path, open_session):
+    """netconvert's default two-way road (no <neigh>): the reverse edge's lane beside the ego's
+    is its opposite lane, for the lane change and for the oncoming car."""
+    (tmp_path / "plain.nod.xml").write_text(
+        '<nodes><node id="w" x="0" y="0"/><node id="e" x="3000" y="0"/></nodes>')
+    (tmp_path / "plain.edg.xml").write_text(
+        '<edges><edge id="E0" from="w" to="e" numLanes="1" speed="50" width="3.5"/>'
+        '<edge id="-E0" from="e" to="w" numLanes="1" speed="50" width="3.5"/></edges>')
+    netbuild.build_all(tmp_path)
+    assert "<neigh" not in (tmp_path / "plain.net.xml").read_text()
+    cfg = _routes_cfg(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(),
+                      tmp_path / "plain.net.xml")
+    s = open_session(cfg, ScenarioOverrides(oncoming_start_m=400.0))
+    assert s.left_lane_exists
+    assert s.vehicle_lane(s.oncoming_id) == "-E0_0"
+    ego, onc = s.ego_body(), s.body(s.oncoming_id)
+    assert onc.x_m - ego.x_m == pytest.approx(400.0, abs=6.0)
+
+
+def test_a_one_way_road_has_no_opposite_lane(tmp_path, open_session):
+    (tmp_path / "oneway.nod.xml").write_text(
+        '<nodes><node id="w" x="0" y="0"/><node id="e" x="3000" y="0"/>'
+        '<node id="far" x="3000" y="500"/></nodes>')
+    (tmp_path / "oneway.edg.xml").write_text(  # a reverse edge elsewhere is not beside it
+        '<edges><edge id="E0" from="w" to="e" numLanes="1" speed="50" width="3.5"/>'
+        '<edge id="back" from="e" to="w" numLanes="1" speed="50" width="3.5" '
+        'shape="3000,500 0,500"/></edges>')
+    netbuild.build_all(tmp_path)
+    cfg = _routes_cfg(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(),
+                      tmp_path / "oneway.net.xml")
+    s = open_session(cfg)
+    assert not s.left_lane_exists
