@@ -40,7 +40,8 @@ SUMMARY_COLUMNS = (
     "outcome", "collision_with", "impact_speed_mps", "contact_kind", "contact_time_s",
     "reason", "modes_visited", "fcw_raised", "mu_at_start", "min_gap_aro_m",
     "max_abs_lat_accel_mps2", "max_lateral_offset_m", "final_lateral_offset_m",
-    "final_speed_mps", "ego_initial_speed_mps", "sim_time_s", "wall_time_s", "realtime_factor",
+    "final_speed_mps", "max_abs_heading_error_rad", "min_speed_mps", "left_road",
+    "ego_initial_speed_mps", "sim_time_s", "wall_time_s", "realtime_factor",
 )
 COLUMNS = (*PARAM_COLUMNS, "status", "paper_outcome", *SUMMARY_COLUMNS, "error", "case_dir",
            "sumocfg")
@@ -50,7 +51,8 @@ NUMERIC_COLUMNS = (
     "ego_speed_kmh", "mu", "oncoming_start_m", "aro_hold_s", "aro_decel_mps2",
     "impact_speed_mps", "contact_time_s", "mu_at_start", "min_gap_aro_m",
     "max_abs_lat_accel_mps2", "max_lateral_offset_m", "final_lateral_offset_m",
-    "final_speed_mps", "ego_initial_speed_mps", "sim_time_s", "wall_time_s", "realtime_factor",
+    "final_speed_mps", "max_abs_heading_error_rad", "min_speed_mps", "ego_initial_speed_mps",
+    "sim_time_s", "wall_time_s", "realtime_factor",
 )
 #: How long to keep trying to reach a Dask scheduler [s].
 DASK_CONNECT_TIMEOUT_S = 20.0
