@@ -37,11 +37,10 @@ class RoadFrame:
             self._hy.append(dy / seg)
             self._len.append(seg)
             self._s.append(self._s[-1] + seg)
-        heading, slope = _smooth_heading(clean, self._s)
-        self._yaw0 = [heading(s_m) for s_m in self._s[:-1]]  # road heading at each segment start
-        self._yaw_rate = [(heading(self._s[i + 1]) - self._yaw0[i]) / self._len[i]
-                          for i in range(len(self._len))]  # its change per metre along it
-        self._kappa = [slope(s_m) for s_m in self._s[1:]]  # at each segment's end vertex
+        # smooth heading: value at the thinned segments' midpoints and slope (the curvature)
+        # to the next one; ``_mid_hint`` the interval of the last lookup
+        self._mids, self._mid_yaw, self._mid_slope = _smooth_heading(clean, self._s)
+        self._mid_hint = 0
         self._hint = 0
 
     @property
@@ -70,10 +69,24 @@ class RoadFrame:
                 rx, ry = x - xs[i], y - ys[i]
                 along = rx * hx[i] + ry * hy[i]
         self._hint = i
-        a = along if along > 0.0 else 0.0
-        if a > seg[i]:
-            a = seg[i]
-        return self._s[i] + along, ry * hx[i] - rx * hy[i], self._yaw0[i] + self._yaw_rate[i] * a
+        s_m = self._s[i] + along
+        j = self._mid_interval(s_m)
+        h = s_m if s_m > 0.0 else 0.0  # beyond its ends the road runs straight on
+        if h > self._s[-1]:
+            h = self._s[-1]
+        yaw = self._mid_yaw[j] + (h - self._mids[j]) * self._mid_slope[j]
+        return s_m, ry * hx[i] - rx * hy[i], yaw
+
+    def _mid_interval(self, s_m: float) -> int:
+        """Index j of the midpoint interval [mids[j], mids[j + 1]) holding s (0 before the
+        first, the last beyond it), walked from the last answer."""
+        mids, j, last = self._mids, self._mid_hint, len(self._mids) - 1
+        while j < last and s_m >= mids[j + 1]:
+            j += 1
+        while j > 0 and s_m < mids[j]:
+            j -= 1
+        self._mid_hint = j
+        return j
 
     def point_at(self, s_m: float, d_m: float = 0.0) -> tuple[float, float, float]:
         """(x, y, road_yaw) of the point at station s and offset d (extrapolated at the ends)."""
@@ -87,29 +100,32 @@ class RoadFrame:
         )
 
     def curvature_at(self, s_m: float) -> float:
-        """Signed curvature (1/m) from the heading change at the nearest polyline vertex."""
-        i = self._hint  # the segment of the last projection: usually the one asked for
-        if self._s[i] <= s_m < self._s[i + 1]:
-            return self._kappa[i]
-        return self._kappa[min(max(bisect_right(self._s, s_m) - 1, 0), len(self._len) - 1)]
+        """Signed curvature (1/m) at station s: the slope of the smooth heading (0 beyond the
+        ends of the road)."""
+        j = self._mid_interval(s_m)
+        return self._mid_slope[j] if 0.0 <= s_m <= self._s[-1] else 0.0
 
 
-CURVATURE_MIN_SEGMENT_M = 2.0
+HEADING_MIN_SEGMENT_M = 10.0
 """Heading and curvature are measured on the centre line with points closer than this to the
-last kept one dropped: SUMO joins the lanes of consecutive edges by chords of a few
-decimetres across the junction, whose heading change over so short a length would spike the
-curvature (and the steering feedforward) by several times the road's."""
+last kept one dropped. SUMO joins the lanes of consecutive edges by chords of a few
+decimetres to a few metres across each junction, which turn sharply when the lane centre
+shifts there (a width change moves it by a quarter of a metre in 3 m); over so short a length
+that would spike the curvature, and the look-ahead 30 m ahead would turn the heading step into
+metres of error. 10 m keeps the 25 m chords of netconvert's curves and arcs as they are."""
 
 
-def _smooth_heading(points: list, stations: list):
-    """(heading(s), curvature(s)) of the road: the heading of each segment of the thinned
-    polyline (see ``CURVATURE_MIN_SEGMENT_M``) held at its midpoint, unwrapped, and
-    interpolated linearly between midpoints (constant beyond the first and last); the
-    curvature is its slope (the heading change at a vertex over the distance between the
-    neighbouring midpoints; 0 beyond the end midpoints, and on a straight line)."""
+def _smooth_heading(points: list, stations: list) -> tuple[list, list, list]:
+    """(midpoint stations, heading there, slope to the next midpoint) of the road's smooth
+    heading: each segment of the polyline thinned to ``HEADING_MIN_SEGMENT_M`` gives its
+    heading (unwrapped: continuous along the road) at its midpoint, interpolated linearly in
+    between and extrapolated from the first and last midpoints to the road's ends; the slope
+    is the curvature (the heading change at a vertex over the distance between the
+    neighbouring midpoints; 0 on a straight line)."""
     kept, kept_s = [points[0]], [0.0]
     for p, s_m in zip(points[1:-1], stations[1:-1]):
-        if s_m - kept_s[-1] >= CURVATURE_MIN_SEGMENT_M:
+        if s_m - kept_s[-1] >= HEADING_MIN_SEGMENT_M and stations[-1] - s_m >= \
+                HEADING_MIN_SEGMENT_M:
             kept.append(p)
             kept_s.append(s_m)
     kept.append(points[-1])
@@ -121,19 +137,6 @@ def _smooth_heading(points: list, stations: list):
             yaw = yaws[-1] + (yaw - yaws[-1] + math.pi) % (2.0 * math.pi) - math.pi
         mids.append(0.5 * (s0 + s1))
         yaws.append(yaw)
-
-    def slope(s_m: float) -> float:
-        j = bisect_right(mids, s_m) - 1
-        if j < 0 or j >= len(mids) - 1:
-            return 0.0
-        return (yaws[j + 1] - yaws[j]) / (mids[j + 1] - mids[j])
-
-    def heading(s_m: float) -> float:
-        j = bisect_right(mids, s_m) - 1
-        if j < 0:
-            return yaws[0]
-        if j >= len(mids) - 1:
-            return yaws[-1]
-        return yaws[j] + (s_m - mids[j]) * slope(s_m)
-
-    return heading, slope
+    slopes = [(y1 - y0) / (m1 - m0) for (y0, y1), (m0, m1) in zip(pairwise(yaws),
+                                                                   pairwise(mids))]
+    return mids, yaws, [*slopes, slopes[-1] if slopes else 0.0]

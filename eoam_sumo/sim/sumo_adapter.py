@@ -660,10 +660,30 @@ class SumoSession:
         return point_at(shape, pos_m * scale)
 
     def _build_centreline(self) -> np.ndarray:
-        points = []
-        for edge in self._route_edges:
-            index = min(self._lane_index, self._api.edge.getLaneNumber(edge) - 1)
-            points += [tuple(p) for p in self._lane.getShape(f"{edge}_{index}")]
+        """Centre line of the ego's start lane followed along its route: from each lane over its
+        connection (and the junction's internal lanes) to the lane it leads to on the next
+        route edge, the one with the same index when there are several."""
+        lane = self._start_lane_id
+        points = [tuple(p) for p in self._lane.getShape(lane)]
+        for edge in self._route_edges[1:]:
+            links = [link for link in self._lane.getLinks(lane)
+                     if self._lane.getEdgeID(link[0]) == edge]
+            if not links:
+                raise InputError(
+                    f"{self._files.net_file}: the ego's lane {lane} does not continue onto "
+                    f"edge '{edge}' of its route (no connection: the lane ends); start the ego "
+                    "in a lane that continues"
+                )
+            link = min(links, key=lambda k: abs(int(k[0].rsplit("_", 1)[1]) - self._lane_index))
+            via = link[4]
+            for _ in range(8):  # a junction's internal lanes, until the next normal lane
+                if not via or not via.startswith(":"):
+                    break
+                points += [tuple(p) for p in self._lane.getShape(via)]
+                onward = self._lane.getLinks(via)
+                via = onward[0][0] if onward else None
+            lane = link[0]
+            points += [tuple(p) for p in self._lane.getShape(lane)]
         line = [points[0]]
         for p in points[1:]:
             if math.hypot(p[0] - line[-1][0], p[1] - line[-1][1]) > 1e-6:

@@ -70,3 +70,45 @@ def test_the_ego_keeps_the_lane_centre_on_a_curve_across_edges(curve_scenario, t
     ts = pd.read_csv(out / "timeseries.csv")
     assert ts["s_m"].iloc[-1] > 1.5 * EDGE_M  # through at least one junction
     assert ts["lateral_offset_m"].abs().max() < 0.2
+
+
+def _straight_edges(tmp_path, name: str, widths: list[float], lanes: list[int]) -> None:
+    """A straight one-way road of 500 m edges with these lane widths and lane counts."""
+    nodes = "".join(f'<node id="n{k}" x="{500.0 * k}" y="0"/>' for k in range(len(widths) + 1))
+    edges = "".join(
+        f'<edge id="e{k}" from="n{k}" to="n{k + 1}" numLanes="{n}" speed="50" width="{w}"/>'
+        for k, (w, n) in enumerate(zip(widths, lanes)))
+    (tmp_path / f"{name}.nod.xml").write_text(f"<nodes>{nodes}</nodes>")
+    (tmp_path / f"{name}.edg.xml").write_text(f"<edges>{edges}</edges>")
+    netbuild.build_all(tmp_path)
+    route = " ".join(f"e{k}" for k in range(len(widths)))
+    (tmp_path / f"{name}.rou.xml").write_text(
+        '<routes><vType id="car" length="4.9" width="1.85" sigma="0"/>'
+        '<vehicle id="ego" type="car" depart="0" departPos="50" departLane="0" '
+        f'departSpeed="30"><route edges="{route}"/></vehicle></routes>')
+    (tmp_path / f"{name}.sumocfg").write_text(
+        f'<configuration><input><net-file value="{name}.net.xml"/>'
+        f'<route-files value="{name}.rou.xml"/></input></configuration>')
+
+
+def test_lane_width_changes_along_the_route_do_not_throw_the_ego_off(tmp_path):
+    """The lane centre shifts by up to 0.6 m at each junction: the ego follows it smoothly
+    (it used to swerve into the next lane, the heading step seen 30 m ahead)."""
+    _straight_edges(tmp_path, "widths", [3.5, 3.0, 4.0, 2.8, 3.5], [1] * 5)
+    out = tmp_path / "run"
+    summary = run_case(tmp_path / "widths.sumocfg",
+                       ScenarioOverrides(ego_speed_mps=120 / 3.6, mu=1.0), out,
+                       RunSettings(max_time_s=60.0))
+    assert summary["outcome"] == "none"
+    ts = pd.read_csv(out / "timeseries.csv")
+    assert ts["s_m"].iloc[-1] > 2000.0
+    assert ts["lateral_offset_m"].abs().max() < 0.7
+    assert ts["ay_mps2"].abs().max() < 3.0
+
+
+def test_an_ego_lane_that_ends_is_refused_by_name(tmp_path):
+    from eoam_sumo.errors import InputError
+
+    _straight_edges(tmp_path, "drop", [3.5, 3.5], [2, 1])  # the right lane ends
+    with pytest.raises(InputError, match="lane e0_0 does not continue onto edge 'e1'"):
+        run_case(tmp_path / "drop.sumocfg", ScenarioOverrides(ego_speed_mps=30.0, mu=1.0))

@@ -10,8 +10,9 @@ from hypothesis import strategies as st
 
 from eoam_sumo.sim.roadframe import RoadFrame
 
-ARC = RoadFrame([(200 * math.sin(a), 200 * (1 - math.cos(a))) for a in
-                 [i * 0.01 for i in range(101)]])  # left-hand arc, radius 200 m, ~200 m long
+ARC_POINTS = [(200 * math.sin(a), 200 * (1 - math.cos(a))) for a in
+              [i * 0.01 for i in range(101)]]  # left-hand arc, radius 200 m, ~200 m long
+ARC = RoadFrame(ARC_POINTS)
 
 
 def test_straight_road_is_plain_coordinates():
@@ -46,14 +47,15 @@ def test_needs_two_distinct_points():
 
 
 @settings(max_examples=200, deadline=None, database=None)
-@given(st.floats(-20.0, 220.0), st.sampled_from([0, 37, 99]))
-def test_curvature_is_the_nearest_vertex_value_whatever_the_last_projection(s_m, hint):
-    """The last projection's segment is only a shortcut: the curvature at s is that of the
-    segment holding s (first or last beyond the ends), wherever the hint points."""
-    ARC._hint = hint
+@given(st.floats(-20.0, 220.0), st.floats(-20.0, 220.0))
+def test_curvature_does_not_depend_on_the_last_lookup(s_m, before_m):
+    """The walk from the last answer is only a shortcut: the curvature at s is the same
+    whatever was asked before, and the arc's own between the first and last midpoints."""
+    ARC.curvature_at(before_m)
     k = ARC.curvature_at(s_m)
-    seg = min(max(sum(1 for s0 in ARC._s if s0 <= s_m) - 1, 0), len(ARC._len) - 1)
-    assert k == ARC._kappa[seg]
+    assert k == RoadFrame(ARC_POINTS).curvature_at(s_m)
+    if 10.0 <= s_m <= ARC.length_m - 10.0:
+        assert k == pytest.approx(1 / 200.0, rel=0.02)
 
 
 def _arc_with_junction_chords(radius=1500.0, chord_m=25.0, edge_m=1000.0, gap_m=0.3):
