@@ -42,9 +42,9 @@ Rules, in order:
    the ego hit from behind).
 
 Runs with contact are classified by rules 4-6 whatever the ego's motion before the contact.
-``collision_with`` is the role of the body hit; a body of role ``other`` (moving with the
-traffic outside the ego lane band, e.g. a car overtaking in the next lane) is reported as
-``aro``, the class of in-lane obstacles, because the summary contract has no ``other``.
+``collision_with`` is the role of the body hit: ``aro``, ``oncoming``, ``parked`` or ``other``
+(moving with the traffic outside the ego lane band, e.g. a car overtaking in the next lane;
+an extension of design.md 3.3's values, which would have called it ``aro``).
 """
 
 from __future__ import annotations
@@ -84,12 +84,12 @@ REVERSING_SPEED_MPS = -0.5
 ROAD_EDGE_MARGIN_M = 0.5
 
 ROLES = ("aro", "oncoming", "parked", "other")
-_COLLISION_WITH = {"aro": "aro", "oncoming": "oncoming", "parked": "parked", "other": "aro"}
+_COLLISION_WITH = {"aro": "aro", "oncoming": "oncoming", "parked": "parked", "other": "other"}
 _ROLE_NAMES = {
     "aro": "the ARO",
     "oncoming": "the oncoming vehicle",
     "parked": "a parked car",
-    "other": "another road user (reported as aro)",
+    "other": "another road user",
 }
 
 

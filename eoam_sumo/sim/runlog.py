@@ -28,11 +28,17 @@ _INT_COLUMNS = ("mode", "fcw", "oncoming_detected")
 _NAN = math.nan
 
 
+PREALLOCATED_ROWS = 1 << 14  # 164 s of 10 ms steps; a longer run doubles the list as it goes
+
+
 class RunLog:
-    """Fixed-size log; ``add`` keeps one step, ``array()`` / ``frame()`` give the table."""
+    """Log of at most ``rows`` steps (preallocated up to ``PREALLOCATED_ROWS``, then grown by
+    doubling, so that a huge time limit costs nothing up front); ``add`` keeps one step,
+    ``array()`` / ``frame()`` give the table."""
 
     def __init__(self, rows: int):
-        self._rows: list = [None] * rows
+        self._limit = rows
+        self._rows: list = [None] * min(rows, PREALLOCATED_ROWS)
         self.n = 0
         self._col = {c: i for i, c in enumerate(COLUMNS)}
         self._array = None
@@ -43,7 +49,9 @@ class RunLog:
         The arguments are kept as given (``x`` copied) and laid out as a row by ``array``: the
         step loop pays for one tuple. ``cmd`` and ``perception`` are immutable named tuples."""
         if self.n >= len(self._rows):
-            return
+            if self.n >= self._limit:
+                return
+            self._rows.extend([None] * min(len(self._rows), self._limit - self.n))
         self._rows[self.n] = (t, tuple(x), ax, ay, s, d, e_yaw, mu, cmd, perception)
         self.n += 1
         self._array = None

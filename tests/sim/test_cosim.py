@@ -379,3 +379,19 @@ def test_collector_pause_restores_the_collector_state(enabled):
         assert gc.isenabled() is enabled
     finally:
         (gc.enable if was else gc.disable)()
+
+
+def test_the_run_log_grows_to_its_limit_and_no_further():
+    """A huge time limit costs nothing up front; rows past the limit are not kept."""
+    from eoam_sumo.sim.runlog import PREALLOCATED_ROWS, RunLog
+
+    x = [0.0] * 9
+    big = RunLog(10**12)
+    for k in range(PREALLOCATED_ROWS + 5):
+        big.add(0.01 * k, x, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, None, None)
+    assert big.array().shape == (PREALLOCATED_ROWS + 5, len(COLUMNS))
+    assert big.column("time_s")[-1] == pytest.approx(0.01 * (PREALLOCATED_ROWS + 4))
+    small = RunLog(5)
+    for k in range(8):
+        small.add(float(k), x, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, None, None)
+    assert small.array().shape == (5, len(COLUMNS))

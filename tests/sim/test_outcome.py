@@ -131,9 +131,9 @@ def test_yellow_limit_braking_by_the_dmm_and_without_intervention():
     assert out.colour == "yellow" and "by the DMM" in out.reason
     late = _classify([0], 0.0, _hit("rear_end", speed=25.0), "aro")
     assert late.colour == "yellow" and "no EOAM intervention" in late.reason
-    # a frontal hit on an in-lane obstacle that is not the ARO (role other) counts as aro
+    # a frontal hit on a road user that is not the ARO (role other) is yellow, with "other"
     other = _classify(BRAKE_ONLY, 0.0, _hit("rear_end"), "other")
-    assert (other.colour, other.collision_with) == ("yellow", "aro")
+    assert (other.colour, other.collision_with) == ("yellow", "other")
 
 
 def test_red_head_on_or_oblique_with_oncoming_after_lane_change():
@@ -156,7 +156,7 @@ def test_red_frontal_hit_on_oncoming_without_lane_change():
         (_hit("side", "right", "left", 20.0), "aro", "aro"),  # cut back in too early
         (_hit("rear_end", "front", "rear", 6.0), "aro", "aro"),  # offset rear hit, lane change
         (_hit("side", "right", "left", 30.0), "parked", "parked"),
-        (_hit("rear_end", "rear", "front", 3.0), "other", "aro"),  # hit from behind
+        (_hit("rear_end", "rear", "front", 3.0), "other", "other"),  # hit from behind
     ],
 )
 def test_orange_any_other_contact_after_a_lane_change(hit, role, collision_with):
@@ -252,7 +252,7 @@ def test_invariants(modes, max_offset, hit, role, final_offset, final_speed):
         assert out.colour == ("none" if set(modes) == {0} else "green")
     else:
         assert out.colour in ("yellow", "orange", "red")
-        assert out.collision_with == ("aro" if role == "other" else role)
+        assert out.collision_with == role
         assert out.impact_speed_mps == hit.impact_speed_mps
         assert (out.colour == "red") == (role == "oncoming" and hit.kind in ("head_on", "oblique"))
         if abs(max_offset) >= PONR_M and 3 not in modes:
