@@ -70,11 +70,16 @@ class RoadFrame:
                 along = rx * hx[i] + ry * hy[i]
         self._hint = i
         s_m = self._s[i] + along
-        j = self._mid_interval(s_m)
+        mids, j, top = self._mids, self._mid_hint, len(self._mids) - 1  # _mid_interval inlined
+        while j < top and s_m >= mids[j + 1]:
+            j += 1
+        while j > 0 and s_m < mids[j]:
+            j -= 1
+        self._mid_hint = j
         h = s_m if s_m > 0.0 else 0.0  # beyond its ends the road runs straight on
         if h > self._s[-1]:
             h = self._s[-1]
-        yaw = self._mid_yaw[j] + (h - self._mids[j]) * self._mid_slope[j]
+        yaw = self._mid_yaw[j] + (h - mids[j]) * self._mid_slope[j]
         return s_m, ry * hx[i] - rx * hy[i], yaw
 
     def _mid_interval(self, s_m: float) -> int:
