@@ -33,6 +33,7 @@ from typing import NamedTuple
 from eoam_sumo.control.longitudinal import LongitudinalController, LongitudinalGains
 from eoam_sumo.control.reference import PathReference, QuinticShift
 from eoam_sumo.control.steering import SteeringController, SteeringGains
+from eoam_sumo.decision import modes
 from eoam_sumo.decision.dmm import Action, BoundaryCurve, Sector
 from eoam_sumo.decision.modes import Mode, next_mode
 from eoam_sumo.params import G_MPS2, VehicleParams
@@ -152,13 +153,12 @@ class EoamSettings:
 
 
 _STEERING = (Mode.UPDATE_STEER_BRAKE, Mode.ONCOMING_STEER_BRAKE)
-# Enum members bound once for ``step``: on Python 3.11 each ``Mode.X`` read goes through the
-# enum metaclass (~80 ns), and a step reads about fifteen of them.
-_NORMAL, _UPDATE_BRAKE, _STEER_BRAKE, _ONCOMING_BRAKE, _ONCOMING_STEER, _RETURN = (
-    Mode.NORMAL, Mode.UPDATE_BRAKE, Mode.UPDATE_STEER_BRAKE, Mode.ONCOMING_BRAKE,
-    Mode.ONCOMING_STEER_BRAKE, Mode.RETURN,
-)
-_STEER, _BRAKE, _LIMIT_BRAKE, _NO_ACTION = Action.STEER, Action.BRAKE, Action.LIMIT_BRAKE, Action.NONE
+# Enum members bound once for ``step`` (the modes in decision.modes): on Python 3.11 each
+# ``Mode.X`` read goes through the enum metaclass (~80 ns), and a step reads about fifteen.
+_NORMAL, _UPDATE_BRAKE, _STEER_BRAKE = modes.NORMAL, modes.UPDATE_BRAKE, modes.STEER_BRAKE
+_ONCOMING_BRAKE, _ONCOMING_STEER, _RETURN = modes.ONCOMING_BRAKE, modes.ONCOMING_STEER, modes.RETURN
+_STEER, _BRAKE, _LIMIT_BRAKE = Action.STEER, Action.BRAKE, Action.LIMIT_BRAKE
+_NO_ACTION = Action.NONE
 _SECTOR_G = Sector.G
 _WARNING_MODES = (_UPDATE_BRAKE, _STEER_BRAKE, _ONCOMING_BRAKE, _ONCOMING_STEER)  # FCW stays on
 

@@ -116,23 +116,20 @@ class QuinticShift:
         self._c = (y0_m, p, 10.0 * e - 4.0 * f, -15.0 * e + 7.0 * f, 6.0 * e - 3.0 * f)
         self.length_m = float(length_m)
 
-    def peak_curvature_1pm(self, samples: int = PEAK_SAMPLES) -> float:
-        """Largest |y''| along the path (sampled), the lateral acceleration per v^2."""
-        _, _, c3, c4, c5 = self._c
-        us = _PEAK_U if samples == PEAK_SAMPLES else [i / samples for i in range(samples + 1)]
-        return max(
-            abs(6.0 * c3 * u + 12.0 * c4 * u * u + 20.0 * c5 * u * u * u) for u in us
-        ) / (self.length_m * self.length_m)
-
-    def _peak_exceeds(self, limit_1pm: float) -> bool:
-        """``peak_curvature_1pm() > limit_1pm``, stopping at the first sample over the limit
-        (division by L^2 is monotone, so testing each sample is the same as testing the max)."""
+    def _curvature_samples(self):
+        """|y''| at the ``PEAK_SAMPLES + 1`` sample points, per metre^2 of length."""
         _, _, c3, c4, c5 = self._c
         big2 = self.length_m * self.length_m
-        return any(
-            abs(6.0 * c3 * u + 12.0 * c4 * u * u + 20.0 * c5 * u * u * u) / big2 > limit_1pm
-            for u in _PEAK_U
-        )
+        return (abs(6.0 * c3 * u + 12.0 * c4 * u * u + 20.0 * c5 * u * u * u) / big2
+                for u in _PEAK_U)
+
+    def peak_curvature_1pm(self) -> float:
+        """Largest |y''| along the path (sampled), the lateral acceleration per v^2."""
+        return max(self._curvature_samples())
+
+    def _peak_exceeds(self, limit_1pm: float) -> bool:
+        """``peak_curvature_1pm() > limit_1pm``, stopping at the first sample over the limit."""
+        return any(k > limit_1pm for k in self._curvature_samples())
 
     @classmethod
     def for_lateral_accel(

@@ -37,10 +37,10 @@ class RoadFrame:
             self._hy.append(dy / seg)
             self._len.append(seg)
             self._s.append(self._s[-1] + seg)
-        # smooth heading: value at the thinned segments' midpoints and slope (the curvature)
-        # to the next one; ``_mid_hint`` the interval of the last lookup
-        self._mids, self._mid_yaw, self._mid_slope = _smooth_heading(clean, self._s)
-        self._mid_hint = 0
+        # smooth heading: its values at break stations and the slopes (the curvature) to the
+        # next break; ``_break_hint`` the interval of the last lookup
+        self._breaks, self._break_yaw, self._break_slope = _smooth_heading(clean, self._s)
+        self._break_hint = 0
         self._hint = 0
 
     @property
@@ -70,27 +70,22 @@ class RoadFrame:
                 along = rx * hx[i] + ry * hy[i]
         self._hint = i
         s_m = self._s[i] + along
-        mids, j, top = self._mids, self._mid_hint, len(self._mids) - 1  # _mid_interval inlined
-        while j < top and s_m >= mids[j + 1]:
-            j += 1
-        while j > 0 and s_m < mids[j]:
-            j -= 1
-        self._mid_hint = j
+        j = self._break_interval(s_m)
         h = s_m if s_m > 0.0 else 0.0  # beyond its ends the road runs straight on
         if h > self._s[-1]:
             h = self._s[-1]
-        yaw = self._mid_yaw[j] + (h - mids[j]) * self._mid_slope[j]
+        yaw = self._break_yaw[j] + (h - self._breaks[j]) * self._break_slope[j]
         return s_m, ry * hx[i] - rx * hy[i], yaw
 
-    def _mid_interval(self, s_m: float) -> int:
-        """Index j of the midpoint interval [mids[j], mids[j + 1]) holding s (0 before the
-        first, the last beyond it), walked from the last answer."""
-        mids, j, last = self._mids, self._mid_hint, len(self._mids) - 1
-        while j < last and s_m >= mids[j + 1]:
+    def _break_interval(self, s_m: float) -> int:
+        """Index j of the interval [breaks[j], breaks[j + 1]) of the smooth heading holding s
+        (0 before the first, the last beyond it), walked from the last answer."""
+        breaks, j, last = self._breaks, self._break_hint, len(self._breaks) - 1
+        while j < last and s_m >= breaks[j + 1]:
             j += 1
-        while j > 0 and s_m < mids[j]:
+        while j > 0 and s_m < breaks[j]:
             j -= 1
-        self._mid_hint = j
+        self._break_hint = j
         return j
 
     def point_at(self, s_m: float, d_m: float = 0.0) -> tuple[float, float, float]:
@@ -107,8 +102,8 @@ class RoadFrame:
     def curvature_at(self, s_m: float) -> float:
         """Signed curvature (1/m) at station s: the slope of the smooth heading (0 beyond the
         ends of the road)."""
-        j = self._mid_interval(s_m)
-        return self._mid_slope[j] if 0.0 <= s_m <= self._s[-1] else 0.0
+        j = self._break_interval(s_m)
+        return self._break_slope[j] if 0.0 <= s_m <= self._s[-1] else 0.0
 
 
 HEADING_MIN_SEGMENT_M = 10.0
@@ -120,13 +115,21 @@ that would spike the curvature, and the look-ahead 30 m ahead would turn the hea
 metres of error. 10 m keeps the 25 m chords of netconvert's curves and arcs as they are."""
 
 
+HEADING_BLEND_M = 12.5
+"""At a vertex of the thinned centre line the heading turns from one segment's to the next's
+linearly, from the middle of the segment before (at most this far back) to the middle of the
+one after (at most this far on): chord midpoint to chord midpoint on curves drawn with chords
+of up to 25 m, and straight road right up to the curve where a long straight edge meets one."""
+
+
 def _smooth_heading(points: list, stations: list) -> tuple[list, list, list]:
-    """(midpoint stations, heading there, slope to the next midpoint) of the road's smooth
-    heading: each segment of the polyline thinned to ``HEADING_MIN_SEGMENT_M`` gives its
-    heading (unwrapped: continuous along the road) at its midpoint, interpolated linearly in
-    between and extrapolated from the first and last midpoints to the road's ends; the slope
-    is the curvature (the heading change at a vertex over the distance between the
-    neighbouring midpoints; 0 on a straight line)."""
+    """(break stations, heading there, slope to the next break) of the road's smooth heading:
+    on the polyline thinned to ``HEADING_MIN_SEGMENT_M``, each segment's own heading
+    (unwrapped: continuous along the road), turning linearly to the next segment's around
+    their vertex (``HEADING_BLEND_M``); held from the road's start and to its end. The slope
+    is the curvature: the heading change over the turn's length at a vertex, 0 along each
+    segment's straight part and on a straight road. Breaks start at 0 and end at the road's
+    length."""
     kept, kept_s = [points[0]], [0.0]
     for p, s_m in zip(points[1:-1], stations[1:-1]):
         if s_m - kept_s[-1] >= HEADING_MIN_SEGMENT_M and stations[-1] - s_m >= \
@@ -135,13 +138,25 @@ def _smooth_heading(points: list, stations: list) -> tuple[list, list, list]:
             kept_s.append(s_m)
     kept.append(points[-1])
     kept_s.append(stations[-1])
-    mids, yaws = [], []
-    for (p, q), (s0, s1) in zip(pairwise(kept), pairwise(kept_s)):
+    yaws = []
+    for p, q in pairwise(kept):
         yaw = math.atan2(q[1] - p[1], q[0] - p[0])
         if yaws:  # unwrapped: continuous along the road
             yaw = yaws[-1] + (yaw - yaws[-1] + math.pi) % (2.0 * math.pi) - math.pi
-        mids.append(0.5 * (s0 + s1))
         yaws.append(yaw)
-    slopes = [(y1 - y0) / (m1 - m0) for (y0, y1), (m0, m1) in zip(pairwise(yaws),
-                                                                   pairwise(mids))]
-    return mids, yaws, [*slopes, slopes[-1] if slopes else 0.0]
+    breaks, values = [0.0], [yaws[0]]
+    for k in range(1, len(yaws)):  # the vertex between segments k - 1 and k
+        v = kept_s[k]
+        before = min(HEADING_BLEND_M, 0.5 * (v - kept_s[k - 1]))
+        after = min(HEADING_BLEND_M, 0.5 * (kept_s[k + 1] - v))
+        if v - before > breaks[-1]:
+            breaks.append(v - before)
+            values.append(yaws[k - 1])
+        breaks.append(v + after)
+        values.append(yaws[k])
+    if stations[-1] > breaks[-1]:
+        breaks.append(stations[-1])
+        values.append(yaws[-1])
+    slopes = [(y1 - y0) / (b1 - b0) for (y0, y1), (b0, b1) in zip(pairwise(values),
+                                                                   pairwise(breaks))]
+    return breaks, values, [*slopes, 0.0]

@@ -201,7 +201,7 @@ def _read_net(path: Path) -> dict:
                     edges[edge_id] = (elem.get("from"), elem.get("to"), None)
             elif event == "start" and elem.tag == "lane":
                 lane_id = elem.get("id")
-                _check_friction(path, lane_id, elem.get("friction"))
+                _check_lane_numbers(path, lane_id, elem)
                 if edge_id is not None:
                     frm, to, left = edges[edge_id]
                     index = int(elem.get("index", "0"))
@@ -214,6 +214,7 @@ def _read_net(path: Path) -> dict:
                 elem.clear()
     except (ET.ParseError, OSError) as exc:
         raise InputError(f"{path}: malformed XML: {exc}") from exc
+    # (parallel edges between the same two junctions: the last one read stands for them)
     by_ends = {(frm, to): left for frm, to, left in edges.values() if left is not None}
     for (frm, to), left in by_ends.items():
         back = by_ends.get((to, frm))
@@ -241,19 +242,24 @@ def _side_by_side(lane: tuple, other: tuple) -> bool:
     bx, by, _ = point_at(b, project(b, mx, my)[0])  # the nearest point of the other lane
     left = -math.sin(heading) * (bx - mx) + math.cos(heading) * (by - my)
     return abs(left - width) <= 0.3
-def _check_friction(path: Path, lane_id: str | None, text: str | None) -> None:
-    """A lane's ``friction`` attribute (absent: SUMO's 1.0) must be a number in (0, MU_MAX];
-    SUMO itself crashes on a non-number."""
-    if text is None:
-        return
-    try:
-        mu = float(text)
-    except ValueError:
-        mu = math.nan
-    if not 0.0 < mu <= MU_MAX:
-        raise InputError(
-            f"{path}: lane '{lane_id}' friction={text!r} must be a number in (0, {MU_MAX:g}]"
-        )
+def _check_lane_numbers(path: Path, lane_id: str | None, lane: ET.Element) -> None:
+    """A lane's numbers, where given, must be numbers in range (SUMO itself crashes on some
+    that are not): ``friction`` in (0, MU_MAX], ``width``, ``length`` and ``speed`` > 0,
+    ``index`` a whole number >= 0."""
+    for key, top in (("friction", MU_MAX), ("width", math.inf), ("length", math.inf),
+                     ("speed", math.inf), ("index", math.inf)):
+        text = lane.get(key)
+        if text is None:
+            continue
+        try:
+            value = int(text) if key == "index" else float(text)
+        except ValueError:
+            value = math.nan
+        low_ok = value >= 0 if key == "index" else value > 0.0
+        if not (low_ok and value <= top and math.isfinite(value)):
+            bound = "a whole number >= 0" if key == "index" else (
+                f"a number in (0, {top:g}]" if math.isfinite(top) else "a number > 0")
+            raise InputError(f"{path}: lane '{lane_id}' {key}={text!r} must be {bound}")
 
 
 def _option_files(root: ET.Element, cfg: Path, option: str) -> tuple[Path, ...]:
@@ -746,15 +752,20 @@ class SumoSession:
         veh = self._veh
         route_id = f"eoam.route.{vid}.{uuid.uuid4().hex[:8]}"
         self._api.route.add(route_id, edges)
-        limit = self._lane.getMaxSpeed(f"{edges[0]}_{lane_index}")
-        # SUMO refuses a departure above the lane's speed limit (times the speed factor): above
-        # it, depart at rest; the speed set below applies from the insertion step on anyway
-        # (speed modes without limits), and a wider speed factor keeps SUMO from capping it
-        depart_speed = speed if speed <= limit else 0.0
-        veh.add(vid, route_id, type_id, depart="now", departLane=str(lane_index),
-                departPos=repr(float(pos)), departSpeed=repr(float(depart_speed)))
-        if speed > limit:
-            veh.setSpeedFactor(vid, speed / limit * (1.0 + 1e-6))
+        try:
+            veh.add(vid, route_id, type_id, depart="now", departLane=str(lane_index),
+                    departPos=repr(float(pos)), departSpeed=repr(float(speed)))
+        except self._errors as exc:
+            if "too high" not in str(exc):
+                raise
+            # SUMO refuses a departure above the lane's limit times the vehicle's speed factor,
+            # or above its type's maximum: depart at rest, with room to go faster; the speed
+            # set below applies from the insertion step on (speed modes without limits)
+            veh.add(vid, route_id, type_id, depart="now", departLane=str(lane_index),
+                    departPos=repr(float(pos)), departSpeed="0")
+            limit = self._lane.getMaxSpeed(f"{edges[0]}_{lane_index}")
+            veh.setSpeedFactor(vid, max(veh.getSpeedFactor(vid), speed / limit * (1.0 + 1e-6)))
+            veh.setMaxSpeed(vid, max(veh.getMaxSpeed(vid), speed * (1.0 + 1e-6)))
             self._over_limit[vid] = speed
         for key, value in params.items():
             veh.setParameter(vid, key, value)

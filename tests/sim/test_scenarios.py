@@ -510,14 +510,30 @@ def test_an_ego_faster_than_the_lane_limit_starts_at_its_speed(open_session):
     assert s.vehicle_speed(s.oncoming_id) == pytest.approx(limit + 5.0)
 
 
-@pytest.mark.parametrize("friction", ["2.00", "abc", "0.00"])
-def test_lane_friction_outside_the_range_names_the_network(tmp_path, friction):
-    net = tmp_path / "fric.net.xml"
+@pytest.mark.parametrize("old,new", [
+    ('friction="1.00"', 'friction="2.00"'), ('friction="1.00"', 'friction="abc"'),
+    ('friction="1.00"', 'friction="0.00"'), ('width="3.50"', 'width="abc"'),
+    ('index="0"', 'index="x"'), ('speed="50.00"', 'speed="-1"'),
+])
+def test_bad_lane_numbers_in_the_network_name_the_file(tmp_path, old, new):
+    """SUMO segfaults on some of these (friction or width "abc"), or tracebacks followed."""
+    net = tmp_path / "bad.net.xml"
     text = (NETWORKS / "highway.net.xml").read_text()
-    net.write_text(text.replace('friction="1.00"', f'friction="{friction}"', 1))
+    assert old in text
+    net.write_text(text.replace(old, new, 1))
     cfg = _routes_cfg(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(), net)
-    with pytest.raises(InputError, match=rf"fric.net.xml: lane .* friction='{friction}'"):
+    key, value = new.split("=")
+    with pytest.raises(InputError, match=rf"bad.net.xml: lane .* {key}='{value.strip(chr(34))}'"):
         SumoSession.start(cfg)
+
+
+def test_an_ego_type_slower_than_the_requested_speed_still_starts_at_it(tmp_path,
+                                                                       open_session):
+    routes = ('<routes><vType id="slow" maxSpeed="25" speedDev="0" length="4.9" width="1.85"/>'
+              '<route id="r" edges="E0"/><vehicle id="ego" type="slow" route="r" depart="1.00" '
+              'departPos="100" departSpeed="20" insertionChecks="none"/></routes>')
+    s = open_session(_routes_cfg(tmp_path, routes), ScenarioOverrides(ego_speed_mps=100 / 3.6))
+    assert s.ego_body().speed_mps == pytest.approx(100 / 3.6)
 
 
 def test_a_two_way_road_without_neigh_elements_has_its_opposite_lane(tmp_path, open_session):
