@@ -2,9 +2,9 @@
 
 Two rates: SUMO and the EOAM decision/control run every ``step_s`` (10 ms by default); the
 plant integrates at ``plant_dt_s`` (1 ms) inside each SUMO step, all sub-steps in one compiled
-call. Per SUMO step: sense (radar on the vehicles SUMO reports near the ego), decide and control, advance
-the plant, write the ego pose back with ``moveToXY``, step SUMO, check contact with every
-other vehicle on oriented boxes at each plant sub-step, log.
+call. Per SUMO step: sense (radar on the vehicles SUMO reports near the ego), decide and
+control, advance the plant, write the ego pose back with ``moveToXY``, step SUMO, check contact
+with every other vehicle on oriented boxes at each plant sub-step, log.
 """
 
 from __future__ import annotations
@@ -364,7 +364,8 @@ _ONCOMING_ONLY = Perception(None, None, True)
 
 
 def _perception(report: RadarReport) -> Perception:
-    """The EOAM's view of a radar report: the in-path obstacle as an object and the oncoming flag."""
+    """The EOAM's view of a radar report: the in-path obstacle as an object, the oncoming
+    flag."""
     det = report.in_path
     if det is None:
         return _ONCOMING_ONLY if report.oncoming_detected else _NOTHING

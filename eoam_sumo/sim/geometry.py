@@ -59,7 +59,8 @@ class OrientedBox(_BoxFields):
 
     ``OrientedBox(x_m, y_m, yaw_rad, length_m, width_m)``. An immutable tuple subclass: boxes
     are built for every moving body at every step, and this builds in a third of the time of
-    a frozen dataclass with ``__post_init__``."""
+    a frozen dataclass with ``__post_init__``. Build boxes with the constructor: the tuple's
+    ``_make``/``_replace`` would skip the validation and the derived values."""
 
     __slots__ = ()
 

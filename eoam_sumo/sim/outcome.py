@@ -306,7 +306,8 @@ def _loss_of_control(
     heading = abs(max_abs_heading_error_rad)
     if heading > settings.lost_control_heading_rad:
         what.append(
-            f"lost control: heading {heading:.2f} rad ({math.degrees(heading):.0f} deg) off the road"
+            f"lost control: heading {heading:.2f} rad ({math.degrees(heading):.0f} deg) off "
+            "the road"
         )
     if min_speed_mps < settings.reversing_speed_mps:
         what.append(f"went backwards (vx down to {min_speed_mps:.1f} m/s)")

@@ -111,5 +111,6 @@ def _atomic_write_text(path: Path, text: str) -> None:
 def write_run(out_dir: Path, summary: dict, log: RunLog) -> None:
     """Write ``timeseries.csv`` then ``summary.json`` (each atomically) into ``out_dir``."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    _atomic_write_text(out_dir / "timeseries.csv", log.frame().to_csv(index=False, float_format="%.9g"))
-    _atomic_write_text(out_dir / "summary.json", json.dumps(summary, indent=2, sort_keys=False) + "\n")
+    csv = log.frame().to_csv(index=False, float_format="%.9g")
+    _atomic_write_text(out_dir / "timeseries.csv", csv)
+    _atomic_write_text(out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
