@@ -79,6 +79,7 @@ class Perception(NamedTuple):
     aro_range_rate_mps: float | None = None
     oncoming_detected: bool = False
     aro_object: ObjectState | None = None  # the in-path obstacle as an object, when tracked
+    next_lane_obstacle_range_m: float | None = None  # nearest standing object in the next lane
 
 
 class Command(NamedTuple):
@@ -124,6 +125,9 @@ class EoamSettings:
     return_lateral_g: float = 0.3  # mode 5 after 2: return's peak lateral acceleration / (mu g)
     evasive_lateral_g: float = 0.8  # mode 4 and the return after it (oncoming traffic): the same
     return_min_length_m: float = 10.0  # mode 5: shortest return path
+    next_lane_clear_m: float = 50.0  # a standing object in the next lane closer than the
+    # in-path obstacle's range plus this (room to pass it and return) blocks the lane change
+    # as oncoming traffic does (modes 3, 4); the paper checks the next lane for oncoming only
     preview_time_s: float = 0.3  # feedforward curvature taken this far ahead on the path
     steering: SteeringGains = field(default_factory=SteeringGains)
     longitudinal: LongitudinalGains = field(default_factory=LongitudinalGains)
@@ -351,6 +355,9 @@ class EoamController:
             action = _NO_ACTION
             threat_gone = True
         oncoming = bool(perception.oncoming_detected)
+        block_m = perception.next_lane_obstacle_range_m
+        if block_m is not None and rng is not None and block_m <= rng + st.next_lane_clear_m:
+            oncoming = True  # the lane change would end against a standing car: as deadly
 
         # ---- mode machine --------------------------------------------------------------
         mode = self.mode

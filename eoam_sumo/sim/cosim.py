@@ -370,4 +370,5 @@ def _perception(report: RadarReport) -> Perception:
     if det is None:
         return _ONCOMING_ONLY if report.oncoming_detected else _NOTHING
     obstacle = ObjectState(det.s_m, det.d_m, det.road_speed_mps, det.length_m, det.width_m)
-    return Perception(det.range_m, det.range_rate_mps, report.oncoming_detected, obstacle)
+    return Perception(det.range_m, det.range_rate_mps, report.oncoming_detected, obstacle,
+                      report.next_lane_range_m)

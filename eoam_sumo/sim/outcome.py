@@ -180,7 +180,8 @@ def _manoeuvre_phrase(modes: set[int], lane_change: bool) -> str:
     if lane_change:
         return "lane change"
     if 3 in modes:
-        return "limit braking chosen (oncoming seen before the point of no return)"
+        return ("limit braking chosen (next lane not free before the point of no return: "
+                "oncoming traffic or a standing car)")
     if 1 in modes:
         return "limit braking chosen by the DMM"
     if modes & {2, 4, 5}:

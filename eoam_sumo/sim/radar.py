@@ -27,8 +27,11 @@ road speed = target speed times the cosine of its heading relative to the road):
   band (in the ego lane or any lane to its left; a wrong-way driver in the ego lane counts);
 * ``in_path``: centre ahead of the ego's front bumper along the road, inside the lane band,
   and moving with the road direction or stopped (road speed above -stationary_speed_mps);
+* ``in_next_lane``: stopped (speed below stationary_speed_mps), ahead, and the centre in the
+  band of the next lane to the left (from the lane band's edge to one lane width beyond it):
+  a standing car in the lane an evasive lane change would take;
 * ``stationary_side``: speed below stationary_speed_mps and the centre outside the lane band
-  (parked cars; never in path, never oncoming);
+  otherwise (parked cars; never in path, never oncoming);
 * ``other``: everything else (e.g. traffic in another lane moving with the ego).
 """
 
@@ -54,7 +57,7 @@ ONCOMING_SPEED_MPS = 2.0
 #: (1.75 m beyond) are outside.
 LANE_MARGIN_M = 0.5
 
-CATEGORIES = ("in_path", "oncoming", "stationary_side", "other")
+CATEGORIES = ("in_path", "oncoming", "in_next_lane", "stationary_side", "other")
 
 
 class Sensed(Protocol):
@@ -144,6 +147,7 @@ class RadarReport(NamedTuple):
     detections: tuple[Detection, ...]  # sorted by range
     in_path_index: int | None = None  # target-list index of the nearest in-path target
     in_path: Detection | None = None  # the nearest in-path detection itself
+    next_lane_range_m: float | None = None  # nearest standing object in the next lane
 
 
 _range_of = attrgetter("range_m")
@@ -250,7 +254,8 @@ class Radar:
             bearing = math.atan2(bx * ly - by * lx, bx * lx + by * ly)
             s, d, road_yaw = road_frame.project(box.x_m, box.y_m)
             road_speed = tgt.speed_mps * math.cos(box.yaw_rad - road_yaw)
-            category = self._classify(s > ego_s, d, tgt.speed_mps, road_speed, band_m)
+            category = self._classify(s > ego_s, d, tgt.speed_mps, road_speed, band_m,
+                                      lane_width_m)
             detections.append(
                 Detection(index, rng, range_rate, bearing, s, d, road_speed, category,
                           tgt.length_m, tgt.width_m)
@@ -258,19 +263,23 @@ class Radar:
         if not detections:
             return _EMPTY_REPORT
         detections.sort(key=_range_of)
-        in_path, oncoming = None, False
+        in_path, oncoming, next_lane = None, False, None
         for det in detections:
             if det.category == "in_path" and in_path is None:
                 in_path = det
             elif det.category == "oncoming":
                 oncoming = True
+            elif det.category == "in_next_lane" and next_lane is None:
+                next_lane = det.range_m
         if in_path is None:
-            return RadarReport(None, None, oncoming, tuple(detections))
+            return RadarReport(None, None, oncoming, tuple(detections),
+                               next_lane_range_m=next_lane)
         return RadarReport(in_path.range_m, in_path.range_rate_mps, oncoming, tuple(detections),
-                           in_path.index, in_path)
+                           in_path.index, in_path, next_lane)
 
     def _classify(
-        self, ahead: bool, d_m: float, speed_mps: float, road_speed_mps: float, band_m: float
+        self, ahead: bool, d_m: float, speed_mps: float, road_speed_mps: float, band_m: float,
+        lane_width_m: float,
     ) -> str:
         st = self.settings
         if road_speed_mps < -st.oncoming_speed_mps and d_m > -band_m:
@@ -280,5 +289,7 @@ class Radar:
                 return "in_path"
             return "other"
         if abs(speed_mps) < st.stationary_speed_mps:
+            if ahead and d_m < band_m + lane_width_m and d_m > 0.0:
+                return "in_next_lane"
             return "stationary_side"
         return "other"

@@ -341,3 +341,19 @@ def test_step_needs_reset_and_finite_measurements(tables):
     bad = EgoMeasurement(0.0, math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, LANE)
     with pytest.raises(ValueError, match="vx_mps"):
         ctrl.step(bad, Perception(), DT)
+
+
+@pytest.mark.parametrize("beyond_m,mode", [(20.0, Mode.ONCOMING_BRAKE),
+                                           (80.0, Mode.UPDATE_STEER_BRAKE)])
+def test_a_standing_car_in_the_next_lane_blocks_the_steer_like_oncoming_traffic(
+        tables, beyond_m, mode):
+    """A standing object in the next lane within the in-path obstacle's range plus
+    ``next_lane_clear_m`` (50 m) turns the steer into limit braking in lane (mode 3); one
+    further on leaves room to pass and return."""
+    v = speed_with(tables, 1.0, "F")
+    rng = range_in(tables, 1.0, v, "F")
+    drive = Drive(tables, v)
+    drive.ctrl.step(
+        EgoMeasurement(0.0, v, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, LANE),
+        Perception(rng, -v, False, None, rng + beyond_m), DT)
+    assert drive.mode is mode

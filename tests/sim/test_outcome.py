@@ -121,8 +121,8 @@ def test_yellow_oncoming_seen_before_the_point_of_no_return():
     out = _classify(ONCOMING_ABORT, 0.6, _hit("rear_end", speed=7.2), "aro")
     assert (out.colour, out.collision_with, out.impact_speed_mps) == ("yellow", "aro", 7.2)
     assert out.reason == (
-        "limit braking chosen (oncoming seen before the point of no return), "
-        "front hit the ARO at 7.2 m/s"
+        "limit braking chosen (next lane not free before the point of no return: oncoming "
+        "traffic or a standing car), front hit the ARO at 7.2 m/s"
     )
 
 

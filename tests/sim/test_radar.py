@@ -139,7 +139,9 @@ def test_oncoming_at_80_m_in_the_left_lane():
         (_ahead(40.0, 0.0, CAR, 15.0, reverse=True), "oncoming"),  # wrong-way in the ego lane
         (_ahead(40.0, LANE_M, CAR, 25.0), "other"),  # overtaking in the left lane
         (_ahead(40.0, LANE_M, CAR, 1.0, reverse=True), "other"),  # creeping, not oncoming
-        (_ahead(40.0, LANE_M, CAR, 0.0), "stationary_side"),  # stopped in the left lane
+        (_ahead(40.0, LANE_M, CAR, 0.0), "in_next_lane"),  # stopped in the left lane
+        (_ahead(40.0, 2.2 * LANE_M, CAR, 0.0), "stationary_side"),  # beyond the next lane
+        (_ahead(40.0, -LANE_M, CAR, 0.0), "stationary_side"),  # parked on the right
         (_ahead(40.0, 0.5 * LANE_M + 0.4, CAR, 0.0), "in_path"),  # half on the marker
     ],
 )
@@ -351,3 +353,13 @@ def test_bad_inputs():
         Target(0.0, 0.0, 0.0, 1.0, 0.0, 2.0)
     with pytest.raises(ValueError, match="lane_width_m"):
         Radar().scan((0.0, 0.0), 0.0, 10.0, ROAD, [], 0.0)
+
+
+def test_the_nearest_standing_car_in_the_next_lane_is_reported():
+    near, far = _ahead(50.0, LANE_M, CAR, 0.0), _ahead(70.0, LANE_M, CAR, 0.0)
+    rep = _scan([far, _ahead(30.0, 0.0, ARO, 0.0), near], speed=30.0)
+    assert rep.in_path_range_m == pytest.approx(30.0)
+    assert rep.next_lane_range_m == min(d.range_m for d in rep.detections
+                                        if d.category == "in_next_lane")
+    assert 50.0 <= rep.next_lane_range_m < 51.0
+    assert _scan([_ahead(40.0, LANE_M, CAR, 25.0)]).next_lane_range_m is None  # moving
