@@ -288,10 +288,14 @@ def check_matrix(matrix: Matrix, tables_dir: Path | None = None, ego_id: str = "
     the key and the value.
     """
     from eoam_sumo.offline.tables import LookupTables, default_tables_dir
-    from eoam_sumo.sim.sumo_adapter import check_scenario
+    from eoam_sumo.sim.sumo_adapter import ScenarioOverrides, check_scenario, scripted_stops
 
     try:
-        check_scenario(matrix.sumocfg, ego_id)
+        files = check_scenario(matrix.sumocfg, ego_id)
+        for hold in matrix.aro_holds_s or (None,):  # the ARO's stop profile fits the scenario
+            for decel in matrix.aro_decels_mps2 or (None,):
+                over = ScenarioOverrides(aro_hold_s=hold, aro_decel_mps2=decel)
+                scripted_stops(files, over, ego_id)
     except InputError as exc:
         raise InputError(f"{matrix.path}: [scenario] sumocfg: {exc}") from exc
     folder = Path(tables_dir) if tables_dir is not None else default_tables_dir()

@@ -315,3 +315,21 @@ def test_check_matrix_parses_the_scenario(tmp_path):
     path = _write(tmp_path, GOOD_SCENARIO + GOOD_SWEEP)  # s.sumocfg has no net-file
     with pytest.raises(InputError, match=r"m\.toml: \[scenario\] sumocfg: .*s\.sumocfg.*net-file"):
         check_matrix(load_matrix(path))
+
+
+def test_check_matrix_refuses_a_stop_profile_for_a_scenario_without_an_aro(tmp_path):
+    from eoam_sumo.matrix import check_matrix
+
+    cfg = ROOT / "scenarios" / "parked_only.sumocfg"  # the ego and parked cars: no ARO
+    path = tmp_path / "m.toml"
+    path.write_text(f'[scenario]\nsumocfg = "{cfg.as_posix()}"\n'
+                    "[sweep]\nego_speed_kmh = [120]\nmu = [1.0]\naro_hold_s = [1.0]\n")
+    with pytest.raises(InputError, match=r"m\.toml: \[scenario\] sumocfg: .*eoam.role"):
+        check_matrix(load_matrix(path))
+
+
+def test_speeds_below_the_tables_lowest_are_refused():
+    tables = _Tables()
+    with pytest.raises(InputError, match=r"15.0 km/h is outside the tables' range \[20, 175\]"):
+        tables.check_run(1.0, 15.0 / 3.6)
+    tables.check_run(1.0, 20.0 / 3.6)  # the lowest itself is covered

@@ -209,13 +209,14 @@ class LookupTables:
         return cls(arrays, boundaries, metadata, params)
 
     def check_run(self, mu: float, speed_mps: float) -> None:
-        """Refuse (``InputError``) a run the tables do not cover: entry speed above the grid or
-        friction below it."""
-        top = self.speed_grid_mps[-1]
-        if not 0.0 < speed_mps <= top + 1e-9:
+        """Refuse (``InputError``) a run the tables do not cover: entry speed outside the grid
+        or friction below it (above it the highest friction's tables are used: they ask for
+        less than the road gives)."""
+        low, top = self.speed_grid_mps[0], self.speed_grid_mps[-1]
+        if not low - 1e-9 <= speed_mps <= top + 1e-9:
             raise InputError(f"ego speed {speed_mps * 3.6:.1f} km/h is outside the tables' "
-                             f"range (0, {top * 3.6:.0f}] km/h; rebuild with `eoam-sumo tables "
-                             "--speeds-kmh ...`")
+                             f"range [{low * 3.6:.0f}, {top * 3.6:.0f}] km/h; rebuild with "
+                             "`eoam-sumo tables --speeds-kmh ...`")
         if mu < self.mu_grid[0] - 1e-9:
             raise InputError(f"mu {mu:g} is below the tables' lowest friction "
                              f"{self.mu_grid[0]:g}; rebuild with `eoam-sumo tables --mu ...`")

@@ -128,6 +128,7 @@ class CoSimulation:
         mu0 = session.friction_at_ego()
         self.tables.check_run(mu0, ego.speed_mps)
         road = RoadFrame(session.ego_lane_centreline())
+        road.locate(ego.x_m, ego.y_m)
         lane_width = session.lane_width_m
         x = initial_state(ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps).tolist()  # plain floats
         ctrl = EoamController(p, self.tables, st.eoam)

@@ -47,6 +47,19 @@ class RoadFrame:
     def length_m(self) -> float:
         return self._s[-1]
 
+    def locate(self, x: float, y: float) -> None:
+        """Start the projections' walk at the segment nearest to (x, y), searched over the
+        whole line: a road that curves back (a hairpin, a loop) passes a point of its return
+        leg level with its first straight, where a walk from the start would stop."""
+        best, best_i = math.inf, 0
+        for i in range(len(self._len)):
+            rx, ry = x - self._x[i], y - self._y[i]
+            along = min(max(rx * self._hx[i] + ry * self._hy[i], 0.0), self._len[i])
+            dist = math.hypot(rx - along * self._hx[i], ry - along * self._hy[i])
+            if dist < best:
+                best, best_i = dist, i
+        self._hint = best_i
+
     def project(self, x: float, y: float) -> tuple[float, float, float]:
         """(s_m, d_m, road_yaw_rad) of a point. Walks the polyline from the last answer: forward
         while the point lies past a segment's end, else backward while it lies before its start

@@ -194,6 +194,11 @@ def _read_net(path: Path) -> dict:
             if first:
                 if elem.tag != "net":
                     raise InputError(f"{path}: not a SUMO network (root element <{elem.tag}>)")
+                if elem.get("lefthand") in ("true", "1"):
+                    raise InputError(
+                        f"{path}: a left-hand-traffic network: the EOAM changes lanes to the "
+                        "left, where right-hand traffic has the opposite lane; not supported"
+                    )
                 first = False
             if event == "start" and elem.tag == "edge":
                 edge_id = elem.get("id") if elem.get("function") in (None, "normal") else None
@@ -335,10 +340,14 @@ class _Script:
     last_cmd_mps: float = -1.0
 
 
-def _scripted_stops(files: ScenarioFiles, overrides: ScenarioOverrides) -> dict:
-    """Vehicle id -> (hold_s, decel_mps2) for every vehicle whose stop is scripted."""
+def scripted_stops(files: ScenarioFiles, overrides: ScenarioOverrides,
+                    ego_id: str | None = None) -> dict:
+    """Vehicle id -> (hold_s, decel_mps2) for every vehicle whose stop is scripted (not the
+    ego's: the plant drives it, whatever its parameters say)."""
     stops, aro_seen = {}, False
     for spec in files.vehicles.values():
+        if spec.vid == ego_id:
+            continue
         is_aro = spec.params.get(ROLE_KEY) == "aro"
         aro_seen = aro_seen or is_aro
         values = {}
@@ -436,7 +445,7 @@ class SumoSession:
         self._time_s = self._sim.getTime()
         self._mu_cache: dict[str, float] = {}
         self._dims_cache: dict[str, tuple[float, float]] = {}
-        self._stops = _scripted_stops(files, overrides)
+        self._stops = scripted_stops(files, overrides, ego_id)
         self._pending_stops = set(self._stops)
         self._scripts: dict[str, _Script] = {}
         self._radius_m: float | None = None
@@ -489,7 +498,7 @@ class SumoSession:
             )
         extra = tuple(str(a) for a in extra_args)
         files = check_scenario(Path(cfg), ego_id)
-        _scripted_stops(files, overrides)
+        scripted_stops(files, overrides, ego_id)
 
         import sumo
         import sumolib

@@ -422,3 +422,13 @@ def test_a_car_standing_in_the_next_lane_turns_the_steer_into_braking(tmp_path):
     assert 3 in summary["modes_visited"] and 2 not in summary["modes_visited"]
     assert summary["collision_with"] in ("none", "aro")
     assert summary["outcome"] in ("green", "yellow")
+
+
+def test_the_ego_may_be_a_vehicle_with_a_scripted_stop(tmp_path):
+    """`--ego aro`: its stop parameters are ignored (the plant drives it); it used to fail,
+    'the ego is no longer in the simulation'."""
+    out = tmp_path / "aro-ego"
+    summary = run_case(BASELINE, ScenarioOverrides(ego_speed_mps=20.0, mu=1.0), out,
+                       RunSettings(max_time_s=3.0, ego_id="aro"))
+    assert summary["ego_initial_speed_mps"] == pytest.approx(20.0)
+    assert summary["sim_time_s"] > 0.0

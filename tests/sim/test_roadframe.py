@@ -103,3 +103,20 @@ def test_a_straight_edge_stays_straight_up_to_the_curve_it_meets():
         s_m, _, yaw = road.project(1000.0 + radius * math.sin(a), radius * (1 - math.cos(a)))
         assert yaw == pytest.approx(a, abs=1e-3)
         assert road.curvature_at(s_m) == pytest.approx(1.0 / radius, rel=0.02)
+
+
+def test_locate_starts_the_walk_on_the_return_leg_of_a_hairpin():
+    """1000 m east, a 300 m half circle, 1000 m back west 600 m north of the first leg: a
+    point on the return leg lies level with the first straight; ``locate`` finds its own."""
+    radius = 300.0
+    pts = [(0.0, 0.0), (1000.0, 0.0)]
+    pts += [(1000.0 + radius * math.sin(a), radius * (1 - math.cos(a)))
+            for a in [k * math.pi / 60 for k in range(1, 60)]]
+    pts += [(1000.0, 2 * radius), (0.0, 2 * radius)]
+    road = RoadFrame(pts)
+    assert road.project(500.0, 2 * radius)[1] == pytest.approx(2 * radius)  # the first leg's
+    road.locate(500.0, 2 * radius)
+    s_m, d_m, yaw = road.project(500.0, 2 * radius)
+    assert d_m == pytest.approx(0.0, abs=1e-9)
+    assert s_m == pytest.approx(1000.0 + math.pi * radius + 500.0, abs=1.0)
+    assert math.cos(yaw) == pytest.approx(-1.0, abs=1e-6)  # heading west

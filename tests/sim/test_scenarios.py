@@ -568,3 +568,12 @@ def test_a_one_way_road_has_no_opposite_lane(tmp_path, open_session):
                       tmp_path / "oneway.net.xml")
     s = open_session(cfg)
     assert not s.left_lane_exists
+
+
+def test_a_left_hand_traffic_network_is_refused_by_name(tmp_path):
+    net = tmp_path / "lh.net.xml"
+    text = (NETWORKS / "highway.net.xml").read_text()
+    net.write_text(text.replace("<net ", '<net lefthand="true" ', 1))
+    cfg = _routes_cfg(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(), net)
+    with pytest.raises(InputError, match=r"lh.net.xml: a left-hand-traffic network"):
+        SumoSession.start(cfg)
