@@ -341,7 +341,7 @@ class _Script:
 
 
 def scripted_stops(files: ScenarioFiles, overrides: ScenarioOverrides,
-                    ego_id: str | None = None) -> dict:
+                   ego_id: str | None = None) -> dict:
     """Vehicle id -> (hold_s, decel_mps2) for every vehicle whose stop is scripted (not the
     ego's: the plant drives it, whatever its parameters say)."""
     stops, aro_seen = {}, False
