@@ -35,7 +35,7 @@ RESULTS_FILE = "results.csv"
 CASES_DIR = "cases"
 #: results.csv columns: the case's parameters, its status, the summary fields, where it lives.
 PARAM_COLUMNS = ("case_id", "ego_speed_kmh", "mu", "oncoming_start_m", "aro_hold_s",
-                 "aro_decel_mps2")
+                 "aro_decel_mps2", "max_time_s", "radar_range_m")
 SUMMARY_COLUMNS = (
     "outcome", "collision_with", "impact_speed_mps", "contact_kind", "contact_time_s",
     "reason", "modes_visited", "fcw_raised", "mu_at_start", "min_gap_aro_m",
@@ -48,8 +48,8 @@ COLUMNS = (*PARAM_COLUMNS, "status", "paper_outcome", *SUMMARY_COLUMNS, "error",
 #: Columns that measure the machine, not the physics: they differ between runs.
 TIMING_COLUMNS = ("wall_time_s", "realtime_factor")
 NUMERIC_COLUMNS = (
-    "ego_speed_kmh", "mu", "oncoming_start_m", "aro_hold_s", "aro_decel_mps2",
-    "impact_speed_mps", "contact_time_s", "mu_at_start", "min_gap_aro_m",
+    "ego_speed_kmh", "mu", "oncoming_start_m", "aro_hold_s", "aro_decel_mps2", "max_time_s",
+    "radar_range_m", "impact_speed_mps", "contact_time_s", "mu_at_start", "min_gap_aro_m",
     "max_abs_lat_accel_mps2", "max_lateral_offset_m", "final_lateral_offset_m",
     "final_speed_mps", "max_abs_heading_error_rad", "min_speed_mps", "ego_initial_speed_mps",
     "sim_time_s", "wall_time_s", "realtime_factor",
@@ -73,7 +73,8 @@ def result_row(case: Case, result: TaskResult, paper_outcome: str | None = None)
     row.update(case_id=case.case_id, paper_outcome=paper_outcome,
                ego_speed_kmh=case.ego_speed_kmh, mu=case.mu,
                oncoming_start_m=case.oncoming_start_m, aro_hold_s=case.aro_hold_s,
-               aro_decel_mps2=case.aro_decel_mps2, case_dir=case_dir_of(case.case_id),
+               aro_decel_mps2=case.aro_decel_mps2, max_time_s=case.max_time_s,
+               radar_range_m=case.radar_range_m, case_dir=case_dir_of(case.case_id),
                sumocfg=str(case.sumocfg))
     summary = result.value.get("summary") if isinstance(result.value, dict) else None
     if not result.ok or not isinstance(summary, dict):
@@ -156,11 +157,22 @@ class _RowLog:
         self.fh.close()
 
 
+def _case_keys(cases: list[Case]) -> dict[str, tuple[str, ...]]:
+    """case_id -> (sumocfg, max_time_s, radar_range_m) as results.csv writes them."""
+    frame = pd.DataFrame([(c.case_id, str(c.sumocfg), c.max_time_s, c.radar_range_m)
+                          for c in cases],
+                         columns=["case_id", "sumocfg", "max_time_s", "radar_range_m"])
+    text = pd.read_csv(io.StringIO(frame.to_csv(index=False)), dtype=str, keep_default_na=False)
+    return {r[0]: tuple(r[1:]) for r in text.itertuples(index=False)}
+
+
 def _kept_rows(path: Path, cases: list[Case]) -> pd.DataFrame:
-    """Rows of an earlier run worth keeping: finished, and still the same case."""
+    """Rows of an earlier run worth keeping: finished, and still the same case (same id, and
+    the same scenario file, time limit and radar range as written in results.csv)."""
     rows = _read_rows(path)
-    want = {c.case_id: str(c.sumocfg) for c in cases}
-    same = [want.get(cid) == cfg for cid, cfg in zip(rows["case_id"], rows["sumocfg"])]
+    want = _case_keys(cases)
+    same = [want.get(cid) == key for cid, key in zip(
+        rows["case_id"], zip(rows["sumocfg"], rows["max_time_s"], rows["radar_range_m"]))]
     keep = (rows["status"] == "ok").to_numpy() & pd.Series(same, dtype=bool).to_numpy()
     return rows[keep].drop_duplicates("case_id", keep="last")
 

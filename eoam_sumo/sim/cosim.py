@@ -17,10 +17,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, ObjectState, Perception
+from eoam_sumo.errors import InputError
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.plant import Plant, initial_state
-from eoam_sumo.sim.geometry import OrientedBox, box_distance, contact
+from eoam_sumo.sim.geometry import OrientedBox, box_distance, boxes_overlap, contact
 from eoam_sumo.sim.outcome import classify_outcome, left_road, role_of
 from eoam_sumo.sim.radar import Radar, RadarReport, RadarSettings
 from eoam_sumo.sim.roadframe import RoadFrame
@@ -154,6 +155,11 @@ class CoSimulation:
         stop_at = None
         t = t_start = session.time_s
         bodies = session.nearby(sense_radius)  # with their boxes: the radar's targets
+        start_box = OrientedBox.from_axis_point(x[0], x[1], x[2], p.length_m, p.width_m, front)
+        for b in bodies:
+            if boxes_overlap(start_box, b.box):
+                raise InputError(f"{self.cfg}: vehicle '{b.vid}' overlaps the ego at its "
+                                 "departure")
         cy, sy = math.cos(x[2]), math.sin(x[2])
         radar, plant, step_s = self.radar, self.plant, st.step_s
         t_sense = t_control = t_plant = t_sumo = t_contact = 0.0
@@ -247,8 +253,11 @@ class CoSimulation:
             # --- end of run ---------------------------------------------------------------------
             if first_contact is not None:
                 break
-            if stop_at is None and self._finished(ctrl, x):
-                stop_at = t + st.settle_s
+            if stop_at is None:
+                if self._finished(ctrl, x):
+                    stop_at = t + st.settle_s
+            elif not self._finished(ctrl, x):
+                stop_at = None  # a new manoeuvre began after the hand-back: run on to its end
             if stop_at is not None and t >= stop_at - 1e-9:
                 break
             if s > end_s_m:

@@ -168,3 +168,21 @@ def test_bad_settings_are_input_errors(tmp_path, matrix, kwargs, message, monkey
     monkeypatch.setattr(runner, "DASK_CONNECT_TIMEOUT_S", 1.0)
     with pytest.raises(InputError, match=message):
         run_batch(matrix, tmp_path / "x", progress=False, case_func=fake_case, **kwargs)
+
+
+@pytest.mark.parametrize("change", ["radar_range_m = 300.0\n", "max_time_s = 60.0\n"])
+def test_resume_reruns_cases_whose_scenario_settings_changed(tmp_path, matrix, change):
+    """Same case ids but another radar range or time limit: the old rows are not kept."""
+    out = tmp_path / "r"
+    run_batch(matrix, out, jobs=1, progress=False, case_func=fake_case)
+    changed = tmp_path / "changed.toml"
+    changed.write_text(matrix.read_text().replace("[sweep]\n", change + "[sweep]\n", 1))
+    run_batch(changed, out, jobs=1, resume=True, progress=False, case_func=fake_case)
+    calls = [len((p / "calls.txt").read_text().splitlines())
+             for p in sorted((out / "cases").iterdir())]
+    assert calls == [2] * 8  # every case ran again
+    key, value = change.strip().split(" = ")
+    assert set(pd.read_csv(out / "results.csv")[key]) == {float(value)}
+    run_batch(changed, out, jobs=1, resume=True, progress=False, case_func=fake_case)
+    assert [len((p / "calls.txt").read_text().splitlines())
+            for p in sorted((out / "cases").iterdir())] == [2] * 8  # now all kept

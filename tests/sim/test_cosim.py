@@ -432,3 +432,36 @@ def test_the_ego_may_be_a_vehicle_with_a_scripted_stop(tmp_path):
                        RunSettings(max_time_s=3.0, ego_id="aro"))
     assert summary["ego_initial_speed_mps"] == pytest.approx(20.0)
     assert summary["sim_time_s"] > 0.0
+
+
+def _baseline_variant(tmp_path, old: str, new: str) -> Path:
+    """The baseline scenario with one edit to its route file."""
+    scenarios = ROOT / "scenarios"
+    routes = (scenarios / "baseline.rou.xml").read_text()
+    assert old in routes
+    (tmp_path / "r.rou.xml").write_text(routes.replace(old, new, 1))
+    cfg = tmp_path / "variant.sumocfg"
+    cfg.write_text(
+        f'<configuration><input><net-file value="{ROOT / "networks" / "highway.net.xml"}"/>'
+        f'<route-files value="r.rou.xml"/><additional-files value="{scenarios / "vtypes.add.xml"}"/>'
+        "</input></configuration>")
+    return cfg
+
+
+def test_a_second_manoeuvre_soon_after_a_hand_back_runs_to_its_end(tmp_path):
+    """An ARO braking gently: the EOAM brakes, hands back, then has to change lanes; the run
+    used to stop 2 s after the first hand-back, in the middle of the lane change."""
+    cfg = _baseline_variant(tmp_path, '<param key="eoam.aro_decel_mps2" value="8.0"/>',
+                            '<param key="eoam.aro_decel_mps2" value="1.0"/>')
+    summary, _ = _run(cfg, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0, max_time_s=40.0)
+    assert summary["modes_visited"][:3] == [0, 1, 2]
+    assert abs(summary["final_lateral_offset_m"]) < 0.5
+    assert "returned to lane" in summary["reason"]
+
+
+def test_a_vehicle_overlapping_the_ego_at_its_departure_is_bad_input(tmp_path):
+    from eoam_sumo.errors import InputError
+
+    cfg = _baseline_variant(tmp_path, 'departPos="225.09"', 'departPos="102.00"')
+    with pytest.raises(InputError, match="vehicle 'aro' overlaps the ego at its departure"):
+        _run(cfg, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0)
