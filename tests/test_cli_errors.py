@@ -181,3 +181,65 @@ def test_batch_scenario_is_checked_before_any_case_runs(capsys, tmp_path, breaka
     _check(capsys, ["batch", str(matrix), "--out", str(tmp_path / "o")], needle)
     _check(capsys, ["batch", str(matrix), "--out", str(tmp_path / "o")], f"{matrix}: [scenario]")
     assert not (tmp_path / "o").exists()
+
+
+def _tables_copy(tmp_path: Path) -> Path:
+    dst = tmp_path / "tables"
+    shutil.copytree(ROOT / "tables", dst)
+    return dst
+
+
+@pytest.mark.parametrize("damage", ["summary", "timeseries-header-only", "timeseries-empty",
+                                    "timeseries-cut", "npz-missing"])
+def test_plot_of_a_damaged_folder_names_the_file(tmp_path, capsys, damage):
+    """A damaged run or tables folder: one line and exit 2, not a traceback."""
+    if damage == "npz-missing":
+        folder = _tables_copy(tmp_path)
+        (folder / "lookup_tables.npz").unlink()
+        _check(capsys, ["plot", str(folder), "--out", str(tmp_path / "png")], "lookup_tables.npz")
+        return
+    folder = tmp_path / "run"
+    folder.mkdir()
+    (folder / "summary.json").write_text('{"outcome": "green", "mu": 1.0, "modes_visited": [0]}')
+    from eoam_sumo.sim.runlog import COLUMNS
+
+    header = ",".join(COLUMNS) + "\n"
+    row = ",".join("" if c == "sector" else "0" for c in COLUMNS) + "\n"
+    (folder / "timeseries.csv").write_text(header + row + row)
+    if damage == "summary":
+        (folder / "summary.json").write_text("{oops")
+    elif damage == "timeseries-header-only":
+        (folder / "timeseries.csv").write_text(header)
+    elif damage == "timeseries-empty":
+        (folder / "timeseries.csv").write_text("")
+    else:
+        (folder / "timeseries.csv").write_text(header + row + "1.2e")  # cut mid-number
+    name = "summary.json" if damage == "summary" else "timeseries.csv"
+    _check(capsys, ["plot", str(folder), "--out", str(tmp_path / "png")], name)
+
+
+@pytest.mark.parametrize("grid,needle", [(["--speeds-kmh", "1"], "speeds_kmh holds 1.0"),
+                                         (["--mu", "0.001"], "mus holds 0.001")])
+def test_tables_grid_values_the_optimisation_cannot_solve_are_refused(tmp_path, capsys, grid,
+                                                                      needle):
+    _check(capsys, ["tables", "--out", str(tmp_path / "t"), *grid], needle)
+
+
+def test_a_tables_folder_mixing_two_builds_is_refused(tmp_path, capsys):
+    import json
+
+    folder = _tables_copy(tmp_path)
+    meta = json.loads((folder / "metadata.json").read_text())
+    meta["grids"]["mu"] = meta["grids"]["mu"][1:]  # as if the metadata came from another build
+    (folder / "metadata.json").write_text(json.dumps(meta))
+    _check(capsys, ["run", str(SCEN / "baseline.sumocfg"), "--tables", str(folder),
+                    "--out", str(tmp_path / "run")], "mixes two builds")
+
+
+def test_gui_without_a_display_fails_at_once(tmp_path, capsys, monkeypatch):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    if not sys.platform.startswith("linux"):
+        pytest.skip("the display check is for Linux")
+    _check(capsys, ["run", str(SCEN / "baseline.sumocfg"), "--gui",
+                    "--out", str(tmp_path / "run")], "DISPLAY is not set")

@@ -110,8 +110,10 @@ class DesignSettings:
             raise ValueError(f"min_speed_fraction={self.min_speed_fraction} must be < 1")
         if self.lat_accel_fraction > 1.0:
             raise ValueError(f"lat_accel_fraction={self.lat_accel_fraction} must be <= 1")
-        _check_grid("speeds_kmh", self.speeds_kmh, 0.0, 400.0)
-        _check_grid("mus", self.mus, 0.0, 1.2)
+        # the lane-change optimisation is posed for highway manoeuvres: below 20 km/h or
+        # mu 0.1 IPOPT finds no solution (measured: 1 km/h, mu 0.001)
+        _check_grid("speeds_kmh", self.speeds_kmh, MIN_SPEED_KMH, 400.0, inclusive=True)
+        _check_grid("mus", self.mus, MIN_MU, 1.2, inclusive=True)
         _check_grid("ttc_mus", self.ttc_mus, 0.0, 1.2)
         if list(self.ttc_mus) != sorted(self.ttc_mus):
             raise ValueError(f"ttc_mus={self.ttc_mus} must be in increasing order")
@@ -156,11 +158,17 @@ class DesignSettings:
 QUINTIC_PEAK_COEFF = 10.0 * math.sqrt(3.0) / 3.0
 
 
-def _check_grid(name: str, values, low: float, high: float) -> None:
+MIN_SPEED_KMH = 20.0  # lowest entry speed of a lookup table the optimisation solves [km/h]
+MIN_MU = 0.1  # lowest friction of a lookup table the optimisation solves [-]
+
+
+def _check_grid(name: str, values, low: float, high: float, inclusive: bool = False) -> None:
     if not isinstance(values, tuple) or len(values) < 1:
-        raise ValueError(f"design setting {name} must be a non-empty tuple")
+        raise ValueError(f"design setting {name} holds no values")
     for v in values:
-        if not (isinstance(v, (int, float)) and math.isfinite(v) and low < v <= high):
-            raise ValueError(f"design setting {name} holds {v!r}: must be in ({low}, {high}]")
+        above = low <= v if inclusive else low < v
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and above and v <= high):
+            bounds = f"[{low:g}, {high:g}]" if inclusive else f"({low:g}, {high:g}]"
+            raise ValueError(f"design setting {name} holds {v!r}: must be in {bounds}")
     if len(set(values)) != len(values):
         raise ValueError(f"design setting {name} holds duplicates: {values}")

@@ -206,6 +206,7 @@ class LookupTables:
             raise InputError(f"{npz_path}: missing arrays {', '.join(missing)}; "
                              "run `eoam-sumo tables`")
         boundaries = PhaseBoundaries.load(folder)
+        _check_same_grids(folder, metadata, arrays, boundaries)
         return cls(arrays, boundaries, metadata, params)
 
     def check_run(self, mu: float, speed_mps: float) -> None:
@@ -238,6 +239,29 @@ class LookupTables:
         length = sum(c * lengths[m, v] for m, v, c in corners)
         final = (self.lane_change_m, 0.0, 0.0, 0.0, 0.0)
         return Trajectory(length, self.dx_step_m, cols, final)
+
+
+def _check_same_grids(folder: Path, metadata: dict, arrays: dict, boundaries) -> None:
+    """The three files of a tables folder were built together: the same friction and speed
+    grids in metadata.json, the lookup tables and the phase boundaries."""
+    grids = metadata.get("grids", {})
+    try:
+        mus = sorted(float(m) for m in grids["mu"])
+        speeds = sorted(float(v) / 3.6 for v in grids["speed_kmh"])
+    except (KeyError, TypeError, ValueError):
+        raise InputError(f"{folder / METADATA_NAME}: no friction and speed grids; run "
+                         "`eoam-sumo tables`") from None
+    for name, mu_grid, speed_grid in (
+            (NPZ_NAME, arrays["mu_grid"], arrays["speed_grid_mps"]),
+            (CSV_NAME, boundaries.mu_grid, boundaries.speed_grid_mps)):
+        if not (_same(mu_grid, mus, 1e-9) and _same(speed_grid, speeds, 1e-6)):
+            raise InputError(f"{folder}: {name} holds other friction or speed grids than "
+                             f"{METADATA_NAME}: the folder mixes two builds; run `eoam-sumo "
+                             "tables`")
+
+
+def _same(grid, values: list[float], tol: float) -> bool:
+    return len(grid) == len(values) and bool(np.allclose(sorted(grid), values, atol=tol))
 
 
 def _check_metadata(path: Path, metadata: dict, params: VehicleParams) -> None:

@@ -14,6 +14,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch, Rectangle
 
+from eoam_sumo.sim.runlog import read_timeseries
+
 #: Outcome colours (paper sec. 11); grey for none, dark grey for a failed case.
 OUTCOME_COLOURS = {
     "green": "#43a047", "yellow": "#fdd835", "orange": "#fb8c00", "red": "#e53935",
@@ -89,8 +91,8 @@ def plot_table2(grid, path: Path) -> Path:
 
 
 def _offsets(batch_dir: Path, case_dir: str) -> pd.DataFrame:
-    return pd.read_csv(Path(batch_dir) / case_dir / "timeseries.csv",
-                       usecols=["time_s", "lateral_offset_m", "mode"])
+    return read_timeseries(Path(batch_dir) / case_dir / "timeseries.csv",
+                           ["time_s", "lateral_offset_m", "mode"])
 
 
 def _panel(ax, batch_dir: Path, rows: pd.DataFrame, label_of, cmap_name: str) -> int:

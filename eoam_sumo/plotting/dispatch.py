@@ -22,7 +22,11 @@ def plot_folder(folder: Path, out_dir: Path) -> list[Path]:
             raise InputError(f"{folder}: has summary.json but no timeseries.csv")
         return plot_run(folder, out_dir)
     if (folder / "phase_boundaries.csv").is_file():
+        from eoam_sumo.offline.tables import NPZ_NAME
         from eoam_sumo.plotting.offline_plots import plot_accel_profiles, plot_phase_diagrams
+
+        if not (folder / NPZ_NAME).is_file():
+            raise InputError(f"{folder}: has phase_boundaries.csv but no {NPZ_NAME}")
 
         return [*_paths(plot_phase_diagrams(folder, out_dir)),
                 *_paths(plot_accel_profiles(folder, out_dir))]

@@ -24,8 +24,10 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from eoam_sumo.batch.report import mu_text
+from eoam_sumo.errors import InputError
 from eoam_sumo.params import G_MPS2, ego_e_class_sedan
 from eoam_sumo.plotting.batch_plots import save
+from eoam_sumo.sim.runlog import COLUMNS, read_timeseries
 
 MODE_NAMES = {0: "0 NORMAL", 1: "1 UPDATE BRAKE", 2: "2 STEER+BRAKE", 3: "3 ONCOMING BRAKE",
               4: "4 ONCOMING STEER+BRAKE", 5: "5 RETURN"}
@@ -38,10 +40,23 @@ _ACTUAL = {"color": "#1e88e5", "linewidth": 1.6}
 
 
 def load_run(case_dir: Path) -> tuple[dict, pd.DataFrame]:
-    """A run folder's summary and time series."""
+    """A run folder's summary and time series (InputError naming the file when either is
+    missing or damaged)."""
     case_dir = Path(case_dir)
-    summary = json.loads((case_dir / "summary.json").read_text(encoding="utf-8"))
-    return summary, pd.read_csv(case_dir / "timeseries.csv")
+    path = case_dir / "summary.json"
+    try:
+        summary = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{path}: cannot be read as a run summary: {exc}") from exc
+    if not isinstance(summary, dict) or not {"outcome", "mu", "modes_visited"} <= summary.keys():
+        raise InputError(f"{path}: cannot be read as a run summary: not a JSON object with "
+                         "outcome, mu and modes_visited")
+    frame = read_timeseries(case_dir / "timeseries.csv")
+    missing = [c for c in COLUMNS if c not in frame.columns]
+    if missing:
+        raise InputError(f"{case_dir / 'timeseries.csv'}: cannot be read as a run's time "
+                         f"series: no column {missing[0]}")
+    return summary, frame
 
 
 def run_title(summary: dict) -> str:

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
+from eoam_sumo.errors import InputError
+
 #: timeseries.csv columns (design.md 3.3 first, then the rest), SI units in the names.
 COLUMNS = (
     "time_s", "mode", "fcw", "x_m", "y_m", "yaw_rad", "vx_mps", "vy_mps", "yaw_rate_radps",
@@ -100,6 +102,22 @@ def _row(t, x, ax, ay, s, d, e_yaw, mu, cmd, perception) -> tuple:
         cmd.brake_force_cmd_n, cmd.speed_target_mps, mu, onc,
         float(ord(cmd.sector)) if cmd.sector else nan,
     )
+
+
+def read_timeseries(path: Path, columns: list[str] | None = None):
+    """A run's timeseries.csv as a DataFrame (``columns`` only, if given): InputError naming
+    the file when it is missing, empty, cut short or not numbers where numbers belong."""
+    import pandas as pd
+
+    try:
+        frame = pd.read_csv(path, usecols=columns)
+    except (OSError, ValueError, pd.errors.EmptyDataError, pd.errors.ParserError) as exc:
+        raise InputError(f"{path}: cannot be read as a run's time series: {exc}") from exc
+    numeric = [c for c in frame.columns if c != "sector"]
+    if frame.empty or not all(pd.api.types.is_numeric_dtype(frame[c]) for c in numeric):
+        raise InputError(f"{path}: cannot be read as a run's time series: no rows, or a row "
+                         "cut short")
+    return frame
 
 
 def _atomic_write_text(path: Path, text: str) -> None:

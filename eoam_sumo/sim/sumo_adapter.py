@@ -505,6 +505,10 @@ class SumoSession:
 
         os.environ.setdefault("SUMO_HOME", sumo.SUMO_HOME)
         via_traci = gui or use_traci
+        if gui and sys.platform.startswith("linux") and not (
+                os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+            raise InputError("--gui needs a display, and DISPLAY is not set (sumo-gui would "
+                             "fail to connect after 30 s)")
         if not via_traci and _open_libsumo:
             raise RuntimeError("a libsumo session is already open in this process; close it first")
         workdir = Path(tempfile.mkdtemp(prefix="eoam-sumo-"))
