@@ -156,7 +156,6 @@ class EoamSettings:
                 raise ValueError(f"EOAM setting {name} must be > 0")
 
 
-_STEERING = (Mode.UPDATE_STEER_BRAKE, Mode.ONCOMING_STEER_BRAKE)
 # Enum members bound once for ``step`` (the modes in decision.modes): on Python 3.11 each
 # ``Mode.X`` read goes through the enum metaclass (~80 ns), and a step reads about fifteen.
 _NORMAL, _UPDATE_BRAKE, _STEER_BRAKE = modes.NORMAL, modes.UPDATE_BRAKE, modes.STEER_BRAKE
@@ -165,6 +164,7 @@ _STEER, _BRAKE, _LIMIT_BRAKE = Action.STEER, Action.BRAKE, Action.LIMIT_BRAKE
 _NO_ACTION = Action.NONE
 _SECTOR_G = Sector.G
 _WARNING_MODES = (_UPDATE_BRAKE, _STEER_BRAKE, _ONCOMING_BRAKE, _ONCOMING_STEER)  # FCW stays on
+_STEERING = (_STEER_BRAKE, _ONCOMING_STEER)
 
 
 class EoamController:

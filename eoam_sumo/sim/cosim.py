@@ -184,7 +184,7 @@ class CoSimulation:
             c1 = clock()
             cmd = ctrl.step(meas, perception, step_s)
             c2 = clock()
-            log.add(t, x, ax, ay, s, d, meas.e_yaw_rad, mu, cmd, perception)
+            log.add(t, x, ax, ay, s, d, e_yaw, mu, cmd, perception)
             # --- plant: all sub-steps of this SUMO step in one call -----------------------------
             c3 = clock()
             x_prev = x
@@ -253,11 +253,10 @@ class CoSimulation:
             # --- end of run ---------------------------------------------------------------------
             if first_contact is not None:
                 break
-            if stop_at is None:
-                if self._finished(ctrl, x):
-                    stop_at = t + st.settle_s
-            elif not self._finished(ctrl, x):
-                stop_at = None  # a new manoeuvre began after the hand-back: run on to its end
+            if not self._finished(ctrl, x):
+                stop_at = None  # (again) a manoeuvre under way: run on to its end
+            elif stop_at is None:
+                stop_at = t + st.settle_s
             if stop_at is not None and t >= stop_at - 1e-9:
                 break
             if s > end_s_m:

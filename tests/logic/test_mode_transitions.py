@@ -57,17 +57,22 @@ def bounds(tables, mu, v):
     return b.clear_opt_m, b.clear_buffered_m, b.stop_m, b.stop_buffered_m, b.ttc_s
 
 
-def range_in(tables, mu, v, sector):
-    """A distance in the given sector at closing speed v (asserts the sector is not empty)."""
+def sector_spans(tables, mu, v) -> dict:
+    """Sector -> (lowest, highest) distance of it at closing speed v (paper Figure 14)."""
     s, sb, b0, bb, ttc = bounds(tables, mu, v)
-    lo, hi = {
+    return {
         "A": (0.0, min(s, b0)),
         "C": (b0, s),
         "F": (s, min(sb, bb)),
         "B": (max(s, bb), sb),
         "D": (sb, bb),
         "E": (max(sb, bb), ttc * v),
-    }[sector]
+    }
+
+
+def range_in(tables, mu, v, sector):
+    """A distance in the given sector at closing speed v (asserts the sector is not empty)."""
+    lo, hi = sector_spans(tables, mu, v)[sector]
     assert hi - lo > 0.2, f"sector {sector} empty at mu={mu}, v={v}: {lo}..{hi}"
     return 0.5 * (lo + hi)
 
@@ -75,15 +80,7 @@ def range_in(tables, mu, v, sector):
 def speed_with(tables, mu, *sectors, speeds=(45.0, 40.0, 33.3, 25.0, 20.0, 15.0, 10.0, 7.0)):
     """A closing speed at which all the given sectors are wide enough to aim at."""
     for v in speeds:
-        s, sb, b0, bb, ttc = bounds(tables, mu, v)
-        widths = {
-            "A": (0.0, min(s, b0)),
-            "C": (b0, s),
-            "F": (s, min(sb, bb)),
-            "B": (max(s, bb), sb),
-            "D": (sb, bb),
-            "E": (max(sb, bb), ttc * v),
-        }
+        widths = sector_spans(tables, mu, v)
         if all(widths[k][1] - widths[k][0] > 1.0 for k in sectors):
             return v
     pytest.fail(f"no speed with usable sectors {sectors} at mu={mu}")

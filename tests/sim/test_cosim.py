@@ -400,7 +400,6 @@ def test_the_run_log_grows_to_its_limit_and_no_further():
 def test_a_car_standing_in_the_next_lane_turns_the_steer_into_braking(tmp_path):
     """Cars parked in the opposite lane just beyond the ARO: the lane change would end against
     them, so the EOAM brakes in lane (mode 3) instead of hitting them (it used to, orange)."""
-    scenarios = ROOT / "scenarios"
     spaces = "".join(f'<space x="{x:.2f}" y="2.60" angle="270.00" length="4.30" width="1.80"/>'
                      for x in (250.0, 262.0, 274.0))
     (tmp_path / "park.add.xml").write_text(
@@ -410,14 +409,8 @@ def test_a_car_standing_in_the_next_lane_turns_the_steer_into_braking(tmp_path):
         f'<vehicle id="p{k}" type="parked" route="w" depart="0" departPos="stop" '
         'insertionChecks="none"><stop parkingArea="pa" parking="true" until="1000000"/>'
         "</vehicle>" for k in range(3))
-    routes = (scenarios / "baseline.rou.xml").read_text().replace(
-        "<routes>", f'<routes><route id="w" edges="-E0"/>{parked}', 1)
-    (tmp_path / "r.rou.xml").write_text(routes)
-    cfg = tmp_path / "blocked.sumocfg"
-    cfg.write_text(
-        f'<configuration><input><net-file value="{ROOT / "networks" / "highway.net.xml"}"/>'
-        '<route-files value="r.rou.xml"/><additional-files value='
-        f'"{scenarios / "vtypes.add.xml"},park.add.xml"/></input></configuration>')
+    cfg = _baseline_variant(tmp_path, "<routes>", f'<routes><route id="w" edges="-E0"/>{parked}',
+                            extra_additional="park.add.xml")
     summary, _ = _run(cfg, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0)
     assert 3 in summary["modes_visited"] and 2 not in summary["modes_visited"]
     assert summary["collision_with"] in ("none", "aro")
@@ -434,8 +427,9 @@ def test_the_ego_may_be_a_vehicle_with_a_scripted_stop(tmp_path):
     assert summary["sim_time_s"] > 0.0
 
 
-def _baseline_variant(tmp_path, old: str, new: str) -> Path:
-    """The baseline scenario with one edit to its route file."""
+def _baseline_variant(tmp_path, old: str, new: str, extra_additional: str = "") -> Path:
+    """The baseline scenario with one edit to its route file (and an additional file of
+    ``tmp_path`` besides the vehicle types, if given)."""
     scenarios = ROOT / "scenarios"
     routes = (scenarios / "baseline.rou.xml").read_text()
     assert old in routes
@@ -443,7 +437,8 @@ def _baseline_variant(tmp_path, old: str, new: str) -> Path:
     cfg = tmp_path / "variant.sumocfg"
     cfg.write_text(
         f'<configuration><input><net-file value="{ROOT / "networks" / "highway.net.xml"}"/>'
-        f'<route-files value="r.rou.xml"/><additional-files value="{scenarios / "vtypes.add.xml"}"/>'
+        f'<route-files value="r.rou.xml"/><additional-files value="'
+        f'{",".join(filter(None, [str(scenarios / "vtypes.add.xml"), extra_additional]))}"/>'
         "</input></configuration>")
     return cfg
 
