@@ -31,12 +31,12 @@ from dataclasses import dataclass, field, fields
 from typing import NamedTuple
 
 from eoam_sumo.control.longitudinal import LongitudinalController, LongitudinalGains
-from eoam_sumo.control.reference import PathReference, QuinticShift
+from eoam_sumo.control.paths import PathReference, QuinticShift
 from eoam_sumo.control.steering import SteeringController, SteeringGains
 from eoam_sumo.decision import modes
 from eoam_sumo.decision.dmm import Action, BoundaryCurve, Sector
 from eoam_sumo.decision.modes import Mode, next_mode
-from eoam_sumo.params import G_MPS2, VehicleParams
+from eoam_sumo.params import G_MPS2, PONR_FRACTION, VehicleParams
 
 _TWO_PI = 2.0 * math.pi
 
@@ -106,7 +106,7 @@ class Command(NamedTuple):
 class EoamSettings:
     """Tunable values of the EOAM logic (the paper's defaults where it gives them)."""
 
-    ponr_fraction: float = 0.3  # point of no return / lane-change height (sec. 8.1)
+    ponr_fraction: float = PONR_FRACTION  # point of no return / lane-change height
     manoeuvre_time_s: float = 8.0  # steering manoeuvre timer before RETURN (sec. 3.1 step 5)
     arrive_tolerance_m: float = 0.3  # 2 -> 5 early: within this of the next lane's centre ...
     pass_margin_m: float = 1.0  # mode 4 -> 5: ego rear this far past the obstacle's front
@@ -344,7 +344,7 @@ class EoamController:
             if action is _STEER and v < st.min_steer_speed_mps:
                 action = _BRAKE  # too slow for a lane change: braking needs less room
             elif (action is _STEER and self.mode is _UPDATE_BRAKE
-                  and rng > self._curve.at(closing)[2]):
+                  and rng > self._curve.at(closing).stop_m):
                 action = _BRAKE  # braking already stops short of it: no lane change
             elif action is _STEER and not meas.left_lane_available:
                 action = _LIMIT_BRAKE  # no lane to change into: brake in lane
@@ -408,7 +408,7 @@ class EoamController:
             y_ref, yaw_ref, kappa_ref, ax_ref, v_plan = path.at(dx)
             in_path = dx < path.length_m
             if in_path:
-                kappa_ff = path.at(dx + v * st.preview_time_s)[2]
+                kappa_ff = path.at(dx + v * st.preview_time_s).curvature_1pm
             else:
                 yaw_ref = kappa_ref = 0.0
         e_lat = d - y_ref

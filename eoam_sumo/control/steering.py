@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
+from typing import NamedTuple
 
 from eoam_sumo.params import VehicleParams
 
@@ -51,6 +52,19 @@ class SteeringGains:
         ):
             if getattr(self, name) <= 0.0:
                 raise ValueError(f"steering gain {name} must be > 0")
+
+
+class SteeringCommand(NamedTuple):
+    """The road-wheel angle of eq. 38 and its parts (left positive)."""
+
+    steer_rad: float  # feedforward + feedback + yaw damping, clipped to the lock
+    feedforward_rad: float
+    feedback_rad: float
+    yaw_damping_rad: float
+    lookahead_error_m: float  # the feedback's error e_la
+
+
+_new = tuple.__new__  # builds the per-step SteeringCommand in half its constructor's time
 
 
 def understeer_gradient(params: VehicleParams) -> float:
@@ -139,8 +153,8 @@ class SteeringController:
         curvature_1pm: float,
         preview_curvature_1pm: float,
         mu: float,
-    ) -> tuple[float, float, float, float, float]:
-        """(delta, delta_ff, delta_fb, delta_yd, lookahead_error_m), delta clipped to the lock.
+    ) -> SteeringCommand:
+        """The steering command; delta clipped to the lock.
 
         ``lateral_error_m`` and ``heading_error_rad`` are ego minus reference (left positive);
         ``curvature_1pm`` is the reference curvature here (path plus road, left positive), the
@@ -159,4 +173,4 @@ class SteeringController:
             delta = lim
         elif delta < -lim:
             delta = -lim
-        return delta, ff, fb, yd, e_la
+        return _new(SteeringCommand, (delta, ff, fb, yd, e_la))

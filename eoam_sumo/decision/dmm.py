@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 from bisect import bisect_right
 from enum import Enum
+from typing import NamedTuple
 
 
 class Action(Enum):
@@ -109,6 +110,16 @@ def dmm_sector(boundary, range_m: float, rel_speed_mps: float) -> Sector:
     )
 
 
+class BoundaryRow(NamedTuple):
+    """The DMM boundaries at one friction and closing speed (m; the TTC in s)."""
+
+    clear_m: float  # S, minimum clearing distance with the optimised profile (eq. 32)
+    clear_buffered_m: float  # Sb
+    stop_m: float  # B0, stopping distance (eq. 33)
+    stop_buffered_m: float  # Bb
+    ttc_s: float  # T / v (eq. 34)
+
+
 class BoundaryCurve:
     """The DMM boundaries at one friction as plain floats at fixed closing speeds.
 
@@ -127,7 +138,7 @@ class BoundaryCurve:
         rows = []
         for v in speeds:
             b = boundaries.at(mu, v)
-            row = (
+            row = (  # plain tuples: indexing a tuple subclass is slower
                 float(b.clear_opt_m),
                 float(b.clear_buffered_m),
                 float(b.stop_m),
@@ -140,8 +151,12 @@ class BoundaryCurve:
         self.mu = mu
         self._speeds, self._rows = speeds, rows
 
-    def at(self, rel_speed_mps: float) -> tuple[float, float, float, float, float]:
-        """(S, Sb, B0, Bb, ttc) at a closing speed (held at the ends of the speed range)."""
+    def at(self, rel_speed_mps: float) -> BoundaryRow:
+        """The boundaries at a closing speed (held at the ends of the speed range)."""
+        return BoundaryRow._make(self._blend(rel_speed_mps))
+
+    def _blend(self, rel_speed_mps: float) -> tuple[float, float, float, float, float]:
+        """``at`` as a plain tuple (for ``sector``, at every step with an obstacle in range)."""
         speeds = self._speeds
         j = bisect_right(speeds, rel_speed_mps)
         if j <= 0:
@@ -163,5 +178,5 @@ class BoundaryCurve:
         """Sector of (range, closing speed); G when not closing or not finite."""
         if not (rel_speed_mps > 0.0 and math.isfinite(rel_speed_mps)):
             return _G
-        s, sb, b0, bb, ttc = self.at(rel_speed_mps)
+        s, sb, b0, bb, ttc = self._blend(rel_speed_mps)
         return classify(range_m, rel_speed_mps, s, sb, b0, bb, ttc)

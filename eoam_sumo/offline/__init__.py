@@ -12,6 +12,7 @@ from eoam_sumo.offline.tables import (
     LookupTables,
     PhaseBoundaries,
     Trajectory,
+    TrajectoryPoint,
     default_tables_dir,
 )
 
@@ -21,6 +22,7 @@ __all__ = [
     "LookupTables",
     "PhaseBoundaries",
     "Trajectory",
+    "TrajectoryPoint",
     "build_tables",
     "default_tables_dir",
     "max_decel_no_lock_mps2",

@@ -74,6 +74,16 @@ def _bracket(grid: list, value: float) -> tuple[int, int, float]:
     return j - 1, j, (value - grid[j - 1]) / (grid[j] - grid[j - 1])
 
 
+class TrajectoryPoint(NamedTuple):
+    """A manoeuvre trajectory at one differential x-position (the tables' columns)."""
+
+    y_m: float  # lateral position of the path
+    ax_mps2: float  # body longitudinal acceleration (the optimised profile)
+    yaw_rad: float  # path direction of travel (course)
+    curvature_1pm: float  # signed path curvature, left positive
+    steer_rad: float  # road-wheel steering angle
+
+
 class PhaseBoundaries:
     """The DMM boundaries of ``phase_boundaries.csv`` with bilinear interpolation."""
 
@@ -138,27 +148,28 @@ class Trajectory:
 
     __slots__ = ("_cols", "_final", "_inv_step", "_last", "length_m")
 
-    def __init__(self, length_m: float, step_m: float, columns: np.ndarray, final: tuple):
+    def __init__(self, length_m: float, step_m: float, columns: np.ndarray,
+                 final: TrajectoryPoint):
         self.length_m = float(length_m)
         self._inv_step = 1.0 / step_m
         self._last = columns.shape[1] - 1
         self._cols = tuple(c.tolist() for c in columns)
         self._final = final
 
-    def at(self, dx_m: float) -> tuple[float, float, float, float, float]:
-        """(y_m, ax_mps2, yaw_rad, curvature_1pm, steer_rad) at differential x ``dx_m``."""
+    def at(self, dx_m: float) -> TrajectoryPoint:
+        """The trajectory at differential x ``dx_m``."""
         f = dx_m * self._inv_step
         if f <= 0.0:
             y, ax, yaw, k, st = self._cols
-            return y[0], ax[0], yaw[0], k[0], st[0]
+            return TrajectoryPoint(y[0], ax[0], yaw[0], k[0], st[0])
         i = int(f)
         if i >= self._last:
             return self._final
         w = f - i
         y, ax, yaw, k, st = self._cols
-        return (y[i] + w * (y[i + 1] - y[i]), ax[i] + w * (ax[i + 1] - ax[i]),
-                yaw[i] + w * (yaw[i + 1] - yaw[i]), k[i] + w * (k[i + 1] - k[i]),
-                st[i] + w * (st[i + 1] - st[i]))
+        return TrajectoryPoint(y[i] + w * (y[i + 1] - y[i]), ax[i] + w * (ax[i + 1] - ax[i]),
+                               yaw[i] + w * (yaw[i + 1] - yaw[i]), k[i] + w * (k[i + 1] - k[i]),
+                               st[i] + w * (st[i + 1] - st[i]))
 
 
 class LookupTables:
@@ -237,7 +248,7 @@ class LookupTables:
         rows = min(rows, self._tables.shape[-1])
         cols = sum(c * self._tables[:, m, v, :rows] for m, v, c in corners)
         length = sum(c * lengths[m, v] for m, v, c in corners)
-        final = (self.lane_change_m, 0.0, 0.0, 0.0, 0.0)
+        final = TrajectoryPoint(self.lane_change_m, 0.0, 0.0, 0.0, 0.0)
         return Trajectory(length, self.dx_step_m, cols, final)
 
 

@@ -14,6 +14,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch, Rectangle
 
+from eoam_sumo.params import LANE_CHANGE_HEIGHT_M, PONR_FRACTION
 from eoam_sumo.sim.runlog import read_timeseries
 
 #: Outcome colours (paper sec. 11); grey for none, dark grey for a failed case.
@@ -23,8 +24,8 @@ OUTCOME_COLOURS = {
 }
 _MISSING = "#ffffff"
 _STYLES = ("-", "--", "-.", ":")
-LANE_WIDTH_M = 3.5  # paper sec. 10.1 (lane change height)
-PONR_M = 0.3 * LANE_WIDTH_M  # point of no return (paper sec. 8.1)
+LANE_WIDTH_M = LANE_CHANGE_HEIGHT_M  # the lane change's height (paper sec. 4.2)
+PONR_M = PONR_FRACTION * LANE_WIDTH_M  # point of no return (paper sec. 8.1)
 
 
 def save(fig: Figure, path: Path, dpi: int = 120) -> Path:

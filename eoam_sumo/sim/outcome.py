@@ -54,6 +54,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
+from eoam_sumo.params import PONR_FRACTION
 from eoam_sumo.sim.geometry import Contact
 from eoam_sumo.sim.radar import (
     LANE_MARGIN_M,
@@ -136,7 +137,7 @@ def role_of(
 class OutcomeSettings:
     """Thresholds that turn the end state of a run into the facts the colours need."""
 
-    point_of_no_return_fraction: float = 0.3  # of the lane width (paper sec. 8.1: 0.3 x 3.5 m)
+    point_of_no_return_fraction: float = PONR_FRACTION  # of the lane width (paper sec. 8.1)
     # ego centre within 0.5 m of the lane centre: a 1.85 m wide car keeps >= 0.3 m to the
     # markers of a 3.5 m lane
     in_lane_tolerance_m: float = 0.5

@@ -7,6 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from eoam_sumo.control import PathReference, QuinticShift
+from eoam_sumo.offline import TrajectoryPoint
 
 H_TABLE = 3.5  # lane change of the tables [m]
 LENGTH = 60.0  # [m]
@@ -23,7 +24,7 @@ class QuinticTrajectory:
         y = H_TABLE * (10 * u**3 - 15 * u**4 + 6 * u**5)
         dy = H_TABLE * (30 * u**2 - 60 * u**3 + 30 * u**4) / LENGTH
         ddy = H_TABLE * (60 * u - 180 * u**2 + 120 * u**3) / LENGTH**2
-        return y, AX, math.atan(dy), ddy / (1 + dy * dy) ** 1.5, 0.0
+        return TrajectoryPoint(y, AX, math.atan(dy), ddy / (1 + dy * dy) ** 1.5, 0.0)
 
 
 @pytest.mark.parametrize(("start", "height"), [(0.0, 3.5), (0.1, 3.0), (3.4, -3.4)])
@@ -59,7 +60,7 @@ def test_speed_profile_stops_at_zero():
 def test_rejects_unusable_trajectories():
     class Flat(QuinticTrajectory):
         def at(self, dx):
-            return 0.0, 0.0, 0.0, 0.0, 0.0
+            return TrajectoryPoint(0.0, 0.0, 0.0, 0.0, 0.0)
 
     with pytest.raises(ValueError, match="lateral travel"):
         PathReference(Flat(), start_offset_m=0.0, height_m=3.5, speed_mps=20.0, step_m=0.5)

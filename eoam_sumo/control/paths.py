@@ -11,6 +11,24 @@ planned speed follows from the acceleration profile: v(dx)^2 = v0^2 + 2 int_0^dx
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
+
+from eoam_sumo.offline.tables import TrajectoryPoint
+
+
+class PathPoint(NamedTuple):
+    """A sampled manoeuvre reference at one differential x-position."""
+
+    y_m: float  # lateral position (road frame, left positive)
+    yaw_rad: float  # path direction of travel relative to the road
+    curvature_1pm: float  # signed path curvature, left positive
+    ax_mps2: float  # planned longitudinal acceleration
+    speed_mps: float  # planned speed
+
+
+# ``tuple.__new__(NamedTuple, values)`` builds a named tuple in ~70 ns, its constructor in
+# ~160 ns: used where a result is built at every step
+_new = tuple.__new__
 
 
 class PathReference:
@@ -50,15 +68,15 @@ class PathReference:
         if height_m is None:
             scale, y_first, start_offset_m = 1.0, 0.0, 0.0
         else:
-            y_end = float(samples[-1][0]) - float(samples[0][0])
+            y_end = float(samples[-1].y_m) - float(samples[0].y_m)
             if not (math.isfinite(y_end) and abs(y_end) > 1e-6):
                 raise ValueError(f"trajectory lateral travel {y_end!r} m is not usable")
             scale = height_m / y_end
-            y_first = float(samples[0][0])
-        self._y = [start_offset_m + scale * (float(s[0]) - y_first) for s in samples]
-        self._ax = [float(s[1]) for s in samples]
-        self._yaw = [scale * float(s[2]) for s in samples]
-        self._k = [scale * float(s[3]) for s in samples]
+            y_first = float(samples[0].y_m)
+        self._y = [start_offset_m + scale * (float(s.y_m) - y_first) for s in samples]
+        self._ax = [float(s.ax_mps2) for s in samples]
+        self._yaw = [scale * float(s.yaw_rad) for s in samples]
+        self._k = [scale * float(s.curvature_1pm) for s in samples]
         v2 = speed_mps * speed_mps
         self._v = [speed_mps]
         for i in range(n):
@@ -68,25 +86,25 @@ class PathReference:
         self.start_offset_m = self._y[0]
         self._inv, self._n = 1.0 / step, n
 
-    def at(self, dx_m: float) -> tuple[float, float, float, float, float]:
-        """(y_m, yaw_rad, curvature_1pm, ax_mps2, speed_mps), held at the ends of the path."""
+    def at(self, dx_m: float) -> PathPoint:
+        """The reference at ``dx_m``, held at the ends of the path."""
         u = dx_m * self._inv
         if u <= 0.0:
-            return self._y[0], self._yaw[0], self._k[0], self._ax[0], self._v[0]
+            return PathPoint(self._y[0], self._yaw[0], self._k[0], self._ax[0], self._v[0])
         i = int(u)
         if i >= self._n:
             n = self._n
-            return self._y[n], self._yaw[n], self._k[n], self._ax[n], self._v[n]
+            return PathPoint(self._y[n], self._yaw[n], self._k[n], self._ax[n], self._v[n])
         w = u - i
         j = i + 1
         y, yaw, k, ax, v = self._y, self._yaw, self._k, self._ax, self._v
-        return (
+        return _new(PathPoint, (
             y[i] + w * (y[j] - y[i]),
             yaw[i] + w * (yaw[j] - yaw[i]),
             k[i] + w * (k[j] - k[i]),
             ax[i] + w * (ax[j] - ax[i]),
             v[i] + w * (v[j] - v[i]),
-        )
+        ))
 
 
 PEAK_SAMPLES = 200  # intervals over which a shift's peak curvature is sampled
@@ -100,7 +118,7 @@ class QuinticShift:
     keeps the ego's heading relative to the road (zero curvature), the end is y = y1 with
     y' = y'' = 0. With slope0 = 0 it is the paper's lane change
     y0 + (y1 - y0) (10u^3 - 15u^4 + 6u^5). Given at constant speed (ax = 0) in the tables'
-    ``at(dx) -> (y, ax, yaw, curvature, steer)`` form, in absolute lateral positions
+    ``at(dx) -> TrajectoryPoint`` form, in absolute lateral positions
     (``PathReference(..., height_m=None)``).
     """
 
@@ -152,7 +170,7 @@ class QuinticShift:
             length *= 1.02
         return traj
 
-    def at(self, dx_m: float) -> tuple[float, float, float, float, float]:
+    def at(self, dx_m: float) -> TrajectoryPoint:
         big = self.length_m
         u = min(max(dx_m / big, 0.0), 1.0)
         y0, p, c3, c4, c5 = self._c
@@ -160,4 +178,4 @@ class QuinticShift:
         y = y0 + u * (p + u2 * (c3 + u * (c4 + u * c5)))
         dy = (p + u2 * (3.0 * c3 + u * (4.0 * c4 + 5.0 * u * c5))) / big
         ddy = u * (6.0 * c3 + u * (12.0 * c4 + 20.0 * u * c5)) / (big * big)
-        return y, 0.0, math.atan(dy), ddy / (1.0 + dy * dy) ** 1.5, 0.0
+        return TrajectoryPoint(y, 0.0, math.atan(dy), ddy / (1.0 + dy * dy) ** 1.5, 0.0)
