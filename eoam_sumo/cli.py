@@ -59,6 +59,16 @@ def _speed_kmh(text: str) -> float:
     return value
 
 
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"seed {text!r} is not an integer") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"seed {text} must be >= 0")
+    return value
+
+
 def _distance_or_none(text: str) -> float | None:
     if text.lower() == "none":
         return None
@@ -91,6 +101,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-time-s", type=_finite, default=40.0, help="simulated time limit")
     p.add_argument("--tables", type=Path, help="lookup tables folder (default: tables/)")
     p.add_argument("--radar-range-m", type=_finite, help="ego radar range (default 100 m)")
+    p.add_argument("--mu-belief", default="known",
+                   help="friction the EOAM decides with: known (the road's), estimate (a "
+                   "friction estimator's output) or a number (default: known)")
+    p.add_argument("--seed", type=_seed, default=0, help="seed of every random model (0)")
     p.add_argument("--gui", action="store_true", help="run in sumo-gui through TraCI")
 
     p = sub.add_parser(
@@ -139,6 +153,7 @@ def _cmd_tables(args) -> int:
 
 
 def _cmd_run(args) -> int:
+    from eoam_sumo.sensing.friction import parse_mu_belief
     from eoam_sumo.sim.cosim import RunSettings, run_case
     from eoam_sumo.sim.radar import RadarSettings
     from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
@@ -157,7 +172,7 @@ def _cmd_run(args) -> int:
     )
     settings = RunSettings(
         max_time_s=args.max_time_s, ego_id=args.ego, gui=args.gui, use_traci=args.gui,
-        tables_dir=args.tables,
+        tables_dir=args.tables, mu_belief=parse_mu_belief(args.mu_belief), seed=args.seed,
     )
     if args.radar_range_m is not None:
         settings = replace(settings, radar=RadarSettings(range_m=args.radar_range_m))

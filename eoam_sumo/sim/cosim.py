@@ -16,11 +16,14 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, ObjectState, Perception
 from eoam_sumo.errors import InputError
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.plant import Plant, initial_state
+from eoam_sumo.sensing.friction import FrictionBelief
 from eoam_sumo.sim.geometry import OrientedBox, box_distance, boxes_overlap, contact
 from eoam_sumo.sim.outcome import classify_outcome, left_road, role_of
 from eoam_sumo.sim.radar import Radar, RadarReport, RadarSettings
@@ -43,6 +46,8 @@ class RunSettings:
     tables_dir: Path | None = None
     radar: RadarSettings = field(default_factory=RadarSettings)
     eoam: EoamSettings = field(default_factory=EoamSettings)
+    mu_belief: str | float = "known"  # sensing.friction: known, estimate or a number
+    seed: int = 0  # seeds every random model of the run (friction estimator, radar)
 
     def __post_init__(self) -> None:
         ms = self.step_s * 1000.0
@@ -59,7 +64,6 @@ class RunSettings:
         return round(self.step_s / self.plant_dt_s)
 
 
-SENSE_MARGIN_M = 10.0  # SUMO reports front bumpers: a body reaching into range is this close [m]
 GAP_WATCH_M = 20.0  # centre distance under which box gaps are measured and contact checked [m]
 ROAD_END_MARGIN_M = 50.0  # a run ends when the ego is this close to the end of its road [m]
 ROUNDING_M = 1e-6  # margin for rounding when a lower bound of a gap rules the gap out [m]
@@ -108,6 +112,13 @@ class CoSimulation:
         )
         self.plant = Plant(self.params, dt_s=settings.plant_dt_s, substeps=settings.substeps)
         self.radar = Radar(settings.radar)
+        self.belief = self._new_belief()
+        if isinstance(self.belief.belief, float):
+            self.tables.check_run(self.belief.belief, self.tables.speed_grid_mps[0])
+
+    def _new_belief(self) -> FrictionBelief:
+        st = self.settings
+        return FrictionBelief(st.mu_belief, seed=st.seed, mu_min=self.tables.mu_grid[0])
 
     def run(self) -> tuple[dict, RunLog]:
         st = self.settings
@@ -135,7 +146,7 @@ class CoSimulation:
         ctrl = EoamController(p, self.tables, st.eoam)
         ctrl.reset(ego.speed_mps)
         left_lane = session.left_lane_exists
-        sense_radius = st.radar.range_m + SENSE_MARGIN_M
+        sense_radius = st.radar.range_m  # from the front bumper, where the radar is
         steps = round(st.max_time_s / st.step_s)
         end_s_m = road.length_m - ROAD_END_MARGIN_M  # the run ends this close to the road end
         log = RunLog(steps + 1)
@@ -161,6 +172,7 @@ class CoSimulation:
                 raise InputError(f"{self.cfg}: vehicle '{b.vid}' overlaps the ego at its "
                                  "departure")
         cy, sy = math.cos(x[2]), math.sin(x[2])
+        self.belief = belief = self._new_belief()
         radar, plant, step_s = self.radar, self.plant, st.step_s
         t_sense = t_control = t_plant = t_sumo = t_contact = 0.0
         loop0 = clock()
@@ -170,7 +182,8 @@ class CoSimulation:
             c0 = clock()
             X, Y, yaw, vx, vy, r = x[:6]
             s, d, road_yaw = road.project(X, Y)
-            mu = session.friction_at_ego()
+            mu_true = session.friction_at_ego()
+            mu = belief.mu(mu_true, t, ax, ay)
             report = radar.scan(
                 (X + front * cy, Y + front * sy), yaw, vx, road, bodies, lane_width
             )
@@ -184,12 +197,12 @@ class CoSimulation:
             c1 = clock()
             cmd = ctrl.step(meas, perception, step_s)
             c2 = clock()
-            log.add(t, x, ax, ay, s, d, e_yaw, mu, cmd, perception)
+            log.add(t, x, ax, ay, s, d, e_yaw, mu_true, cmd, perception)
             # --- plant: all sub-steps of this SUMO step in one call -----------------------------
             c3 = clock()
             x_prev = x
             x, y_out = plant.advance(
-                x, (cmd.steer_cmd_rad, cmd.drive_force_cmd_n, cmd.brake_force_cmd_n), mu
+                x, (cmd.steer_cmd_rad, cmd.drive_force_cmd_n, cmd.brake_force_cmd_n), mu_true
             )
             ax, ay = y_out[0], y_out[1]
             # --- write back and step SUMO -------------------------------------------------------
@@ -300,6 +313,8 @@ class CoSimulation:
             "modes_visited": list(ctrl.modes_visited),
             "fcw_raised": bool(ctrl.fcw_raised),
             "mu": mu0,
+            "mu_belief": self.belief.label,
+            **_trigger(log, self.belief),
             "min_gap_aro_m": None if math.isinf(min_gap_aro) else round(min_gap_aro, 6),
             "max_abs_lat_accel_mps2": round(log.max_abs("ay_mps2"), 6),
             "max_lateral_offset_m": round(max_lat_offset, 6),
@@ -366,6 +381,21 @@ def run_case(
 
         write_run(Path(out_dir), summary, log)
     return summary
+
+
+def _trigger(log: RunLog, belief: FrictionBelief) -> dict:
+    """When the EOAM first left NORMAL (mode 0): SUMO time, the obstacle's range then and the
+    friction it believed (all None when it never did)."""
+    modes = log.column("mode")
+    acting = np.flatnonzero(np.isfinite(modes) & (modes != 0))
+    if acting.size == 0:
+        return {"trigger_time_s": None, "trigger_range_m": None, "mu_believed_at_trigger": None}
+    k = int(acting[0])
+    t = float(log.column("time_s")[k])
+    rng = float(log.column("aro_range_m")[k])
+    return {"trigger_time_s": round(t, 6),
+            "trigger_range_m": round(rng, 6) if math.isfinite(rng) else None,
+            "mu_believed_at_trigger": belief.at(t)}
 
 
 _NOTHING = Perception(None, None, False)  # immutable, so shared by all steps that see nothing

@@ -26,7 +26,8 @@ road speed = target speed times the cosine of its heading relative to the road):
 * ``oncoming``: road speed below -oncoming_speed_mps and the centre not right of the lane
   band (in the ego lane or any lane to its left; a wrong-way driver in the ego lane counts);
 * ``in_path``: centre ahead of the ego's front bumper along the road, inside the lane band,
-  and moving with the road direction or stopped (road speed above -stationary_speed_mps);
+  and not oncoming (road speed above -oncoming_speed_mps): stopped, moving with the road, or
+  slowly towards the ego (a person walking towards it in its lane, a car backing up);
 * ``in_next_lane``: stopped (speed below stationary_speed_mps), ahead, and the centre in the
   band of the next lane to the left (from the lane band's edge to one lane width beyond it):
   a standing car in the lane an evasive lane change would take;
@@ -285,7 +286,7 @@ class Radar:
         if road_speed_mps < -st.oncoming_speed_mps and d_m > -band_m:
             return "oncoming"
         if abs(d_m) < band_m:
-            if ahead and road_speed_mps > -st.stationary_speed_mps:
+            if ahead:  # not oncoming (tested above)
                 return "in_path"
             return "other"
         if abs(speed_mps) < st.stationary_speed_mps:

@@ -119,6 +119,13 @@ _BodyFields = namedtuple(
 )  # untyped: introspection sees Body's own constructor, without ``box``
 
 
+def _reach2(radius_m: float, body: Body) -> float:
+    """Square of the largest front-bumper distance at which some point of ``body`` can be
+    within ``radius_m``: radius plus the box's diagonal (twice its bounding radius)."""
+    reach_m = radius_m + 2.0 * body.box.radius_m
+    return reach_m * reach_m
+
+
 class Body(_BodyFields):
     """A road user as SUMO sees it: centre (x_m, y_m), yaw CCW from +x, footprint, and its
     oriented box (for the radar and the contact test).
@@ -956,8 +963,10 @@ class SumoSession:
         )
 
     def nearby(self, radius_m: float) -> list[Body]:
-        """Every other vehicle whose SUMO position (front bumper) is within ``radius_m`` of the
-        ego's, sorted by id.
+        """Every other vehicle some part of which may be within ``radius_m`` of the ego's SUMO
+        position (its front bumper), sorted by id: one whose front bumper is within
+        ``radius_m`` plus its diagonal (no point of its box is farther from its front), so
+        that a long vehicle is found as soon as its nearest point can be in reach.
 
         From the first call on the session follows all vehicles: a moving one through a
         variable subscription, a parked one as a fixed body once it was read parked twice
@@ -983,7 +992,7 @@ class SumoSession:
     def _moving_near(self, results: dict, ex: float, ey: float, radius_m: float) -> list:
         """Bodies of the followed moving vehicles within ``radius_m`` of (ex, ey), from this
         step's ``results``; a vehicle found parked with settled values becomes fixed."""
-        r2, near, settled = radius_m * radius_m, [], []
+        near, settled = [], []
         for vid, known in self._moving.items():
             r = results.get(vid)
             if not r:  # left without arriving (removed)
@@ -995,7 +1004,8 @@ class SumoSession:
                 settled.append((vid, known[1:]))
                 continue
             (fx, fy), body = known[1], known[2]
-            if (fx - ex) * (fx - ex) + (fy - ey) * (fy - ey) <= r2:
+            dist2 = (fx - ex) * (fx - ex) + (fy - ey) * (fy - ey)
+            if dist2 <= _reach2(radius_m, body):
                 near.append(body)
         for vid, fixed in settled:
             del self._moving[vid]
@@ -1008,18 +1018,20 @@ class SumoSession:
     def _parked_near(self, ex: float, ey: float, radius_m: float) -> list:
         """Bodies of the parked vehicles within ``radius_m`` of (ex, ey). The answer is
         kept while the ego stays closer to where it was worked out than any parked front is
-        to the radius (less 1e-6 m for rounding): no front can have crossed it."""
+        to its reach (less 1e-6 m for rounding): no front can have crossed it."""
         cache = self._parked_cache
         if cache is not None:
             ax, ay, radius, slack_m, near = cache
             if radius == radius_m and slack_m > 0.0 and (
                     (ex - ax) * (ex - ax) + (ey - ay) * (ey - ay) < slack_m * slack_m):
                 return near
-        r2, near, slack_m = radius_m * radius_m, [], math.inf
+        near, slack_m = [], math.inf
         for (fx, fy), body in self._parked.values():
-            if (fx - ex) * (fx - ex) + (fy - ey) * (fy - ey) <= r2:
+            reach_m = radius_m + 2.0 * body.box.radius_m
+            dist_m = math.hypot(fx - ex, fy - ey)
+            if dist_m <= reach_m:
                 near.append(body)
-            slack_m = min(slack_m, abs(math.hypot(fx - ex, fy - ey) - radius_m))
+            slack_m = min(slack_m, abs(dist_m - reach_m))
         self._parked_cache = (ex, ey, radius_m, slack_m - 1e-6, near)
         return near
 

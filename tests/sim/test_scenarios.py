@@ -251,19 +251,26 @@ def test_parked_cars_sit_beside_the_ego_lane_and_never_in_it(open_session):
 
 def test_nearby_agrees_with_sumo_at_every_step(open_session):
     """nearby() follows the vehicles without a context subscription: at every step it equals
-    SUMO's getters for every vehicle within the radius, through the ARO's stop, the oncoming
+    SUMO's getters for every vehicle some part of which may be within the radius (front
+    bumper within the radius plus the box's diagonal), through the ARO's stop, the oncoming
     car's insertion and a parked car that drives off (its parking ended by libsumo)."""
     import libsumo
 
     s = open_session(BASELINE, ScenarioOverrides(oncoming_start_m=300.0))
     radius = 250.0
     leaving = None
+
+    def reach(vid):
+        t = libsumo.vehicle.getTypeID(vid)
+        return radius + math.hypot(libsumo.vehicletype.getLength(t),
+                                   libsumo.vehicletype.getWidth(t))
+
     for k in range(600):
         ego_front = libsumo.vehicle.getPosition(s.ego_id)
         want = sorted(
             vid for vid in s.vehicle_ids()
             if vid != s.ego_id
-            and math.dist(libsumo.vehicle.getPosition(vid), ego_front) <= radius
+            and math.dist(libsumo.vehicle.getPosition(vid), ego_front) <= reach(vid)
         )
         got = s.nearby(radius)
         assert [b.vid for b in got] == want

@@ -1,0 +1,1 @@
+"""Sensing and perception models: friction belief, automotive radar, tracker."""

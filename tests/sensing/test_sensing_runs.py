@@ -1,0 +1,80 @@
+"""Real SUMO runs of the sensing models: friction belief, full-range sensing."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from eoam_sumo.sim.cosim import RunSettings, run_case
+from eoam_sumo.sim.radar import RadarSettings
+from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
+
+pytestmark = pytest.mark.sumo
+
+ROOT = Path(__file__).resolve().parents[2]
+BASELINE = ROOT / "scenarios" / "baseline.sumocfg"
+
+
+def variant(tmp_path: Path, edits: dict[str, str], vtypes: str = "") -> Path:
+    """The baseline scenario (no parked cars) with its route file edited (old -> new) and
+    extra vTypes in an additional file."""
+    routes = (ROOT / "scenarios" / "baseline.rou.xml").read_text()
+    for old, new in edits.items():
+        assert old in routes
+        routes = routes.replace(old, new, 1)
+    (tmp_path / "r.rou.xml").write_text(routes)
+    extra = ""
+    if vtypes:
+        (tmp_path / "extra.add.xml").write_text(f"<additional>{vtypes}</additional>")
+        extra = "," + str(tmp_path / "extra.add.xml")
+    cfg = tmp_path / "variant.sumocfg"
+    cfg.write_text(
+        f'<configuration><input><net-file value="{ROOT / "networks" / "highway.net.xml"}"/>'
+        f'<route-files value="r.rou.xml"/><additional-files value="'
+        f'{ROOT / "scenarios" / "vtypes.add.xml"}{extra}"/></input></configuration>')
+    return cfg
+
+
+def test_believing_a_dry_road_on_snow_acts_later_than_knowing(tmp_path):
+    """mu 0.3 road, 90 km/h: believing 1.0 the DMM's boundaries are those of a dry road, so
+    the EOAM acts later (closer to the ARO) than with the true friction; summary.json says so."""
+    over = ScenarioOverrides(ego_speed_mps=90 / 3.6, mu=0.3)
+    runs = {}
+    for belief in ("known", 1.0):
+        out = tmp_path / str(belief)
+        run_case(BASELINE, over, out, RunSettings(max_time_s=20.0, mu_belief=belief))
+        runs[belief] = json.loads((out / "summary.json").read_text())
+    known, dry = runs["known"], runs[1.0]
+    assert known["mu_belief"] == "known" and dry["mu_belief"] == 1.0
+    assert known["mu"] == dry["mu"] == pytest.approx(0.3)  # the road is the same
+    assert known["mu_believed_at_trigger"] == pytest.approx(0.3)
+    assert dry["mu_believed_at_trigger"] == 1.0
+    assert dry["trigger_time_s"] > known["trigger_time_s"] + 0.5
+    assert dry["trigger_range_m"] < known["trigger_range_m"] - 10.0
+
+
+TRUCK = ('<vType id="truck" vClass="truck" length="16.50" width="2.55" minGap="2.50" '
+         'maxSpeed="30.00" accel="1.00" decel="6.00" emergencyDecel="9.00" sigma="0" '
+         'speedDev="0"/>')
+
+
+@pytest.mark.parametrize("range_m", [100.0, 150.0])
+def test_a_long_truck_is_first_seen_at_the_radars_range(tmp_path, range_m):
+    """A 16.5 m truck 300 m ahead (rear bumper), driving at 60 km/h; the ego closes at
+    16.7 m/s, 0.17 m per step: its rear is first reported within 1 m of the radar's range
+    (it was 93.5 m for 100 m when sensing looked for front bumpers within range + 10 m)."""
+    cfg = variant(tmp_path, {
+        'type="aro" route="eastbound" depart="1.00" departLane="0" departPos="225.09"':
+        'type="truck" route="eastbound" depart="1.00" departLane="0" departPos="416.50"',
+        '<param key="eoam.aro_hold_s" value="2.0"/>': '<param key="eoam.aro_hold_s" '
+        'value="100.0"/>'}, TRUCK)
+    settings = RunSettings(max_time_s=14.0, radar=RadarSettings(range_m=range_m))
+    out = tmp_path / "run"
+    run_case(cfg, ScenarioOverrides(ego_speed_mps=120 / 3.6), out, settings)
+    ts = pd.read_csv(out / "timeseries.csv")
+    seen = ts["aro_range_m"].dropna()
+    assert not seen.empty
+    assert range_m - 1.0 <= seen.iloc[0] <= range_m
