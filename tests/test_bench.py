@@ -5,7 +5,11 @@ from __future__ import annotations
 import json
 import math
 
+import pytest
+
 from eoam_sumo.bench import TARGETS, run_bench
+
+pytestmark = pytest.mark.sumo
 
 KEYS = (
     "realtime_factor", "sumo_only_realtime_factor", "tables_wall_s", "batch_wall_s",

@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from eoam_sumo.cli import main
+from tests.builders import write_matrix
 
 ROOT = Path(__file__).resolve().parents[1]
 SCEN = ROOT / "scenarios"
@@ -120,9 +121,7 @@ def test_python_dash_m_behaves_the_same(tmp_path):
 
 
 def _matrix(folder: Path, cfg: Path, sweep: str, name: str = "m.toml") -> Path:
-    path = folder / name
-    path.write_text(f'[scenario]\nsumocfg = "{cfg.as_posix()}"\nmax_time_s = 5.0\n[sweep]\n{sweep}')
-    return path
+    return write_matrix(folder / name, sweep, cfg, scenario="max_time_s = 5.0\n")
 
 
 @pytest.mark.parametrize(
@@ -236,6 +235,7 @@ def test_a_tables_folder_mixing_two_builds_is_refused(tmp_path, capsys):
                     "--out", str(tmp_path / "run")], "mixes two builds")
 
 
+@pytest.mark.sumo
 def test_gui_without_a_display_fails_at_once(tmp_path, capsys, monkeypatch):
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)

@@ -7,15 +7,14 @@ ego's road (4 km): a per-case error the matrix check cannot see without starting
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pandas as pd
 import pytest
 
 from eoam_sumo.batch.runner import EXIT_CASES_FAILED, RESULTS_FILE
 from eoam_sumo.cli import main
+from tests.builders import write_matrix
 
-REPO = Path(__file__).resolve().parents[2]
+pytestmark = pytest.mark.sumo
 
 
 @pytest.mark.parametrize(
@@ -29,11 +28,9 @@ REPO = Path(__file__).resolve().parents[2]
 def test_exit_status_counts_failed_cases(capsys, tmp_path, monkeypatch, oncoming, status,
                                          failed):
     monkeypatch.delenv("EOAM_TABLES_DIR", raising=False)  # the repository's tables
-    matrix = tmp_path / "m.toml"
-    matrix.write_text(
-        f'[scenario]\nsumocfg = "{(REPO / "scenarios" / "baseline.sumocfg").as_posix()}"\n'
-        f"max_time_s = 5.0\n[sweep]\nego_speed_kmh = [90]\nmu = [1.0]\n"
-        f"oncoming_start_m = {oncoming}\n")
+    matrix = write_matrix(tmp_path / "m.toml",
+                          f"ego_speed_kmh = [90]\nmu = [1.0]\noncoming_start_m = {oncoming}\n",
+                          scenario="max_time_s = 5.0\n")
     out = tmp_path / "out"
     got = main(["batch", str(matrix), "--out", str(out), "--no-progress"])
     captured = capsys.readouterr()

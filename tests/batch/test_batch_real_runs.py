@@ -26,8 +26,9 @@ from eoam_sumo.batch.runner import TIMING_COLUMNS, run_batch
 from eoam_sumo.errors import InputError
 from eoam_sumo.offline.build import build_tables
 from eoam_sumo.plotting.dispatch import plot_folder
+from tests.builders import write_matrix
 
-REPO = Path(__file__).resolve().parents[2]
+pytestmark = pytest.mark.sumo
 CASES = 4
 POLL_LIMIT_S = 600.0  # give up waiting for the first row (a broken build, not a timing check)
 
@@ -45,13 +46,8 @@ def corrupt_one(task):
 
 
 def _write_matrix(folder: Path) -> Path:
-    folder.mkdir(parents=True, exist_ok=True)
-    path = folder / "small.toml"
-    path.write_text(
-        f'[scenario]\nsumocfg = "{REPO / "scenarios" / "baseline.sumocfg"}"\nmax_time_s = 25.0\n'
-        "[sweep]\nego_speed_kmh = [120, 90]\nmu = [1.0, 0.3]\n"
-        f'[paper]\ntable = "{REPO / "scenarios" / "paper_table2.csv"}"\n')
-    return path
+    return write_matrix(folder / "small.toml", "ego_speed_kmh = [120, 90]\nmu = [1.0, 0.3]\n",
+                        scenario="max_time_s = 25.0\n", paper_table=True)
 
 
 def _stable(results_csv: Path) -> pd.DataFrame:

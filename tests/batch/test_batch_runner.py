@@ -15,8 +15,7 @@ import pytest
 from eoam_sumo.batch import runner
 from eoam_sumo.batch.runner import COLUMNS, TIMING_COLUMNS, run_batch
 from eoam_sumo.errors import InputError
-
-REPO = Path(__file__).resolve().parents[2]
+from tests.builders import write_matrix
 
 
 def _fake_summary(case) -> dict:
@@ -67,13 +66,8 @@ def raise_one(task):
 
 @pytest.fixture
 def matrix(tmp_path):
-    path = tmp_path / "m.toml"
-    path.write_text(
-        f'[scenario]\nsumocfg = "{REPO / "scenarios" / "baseline.sumocfg"}"\n'
-        "[sweep]\nego_speed_kmh = [120, 90]\nmu = [1.0, 0.3]\n"
-        'oncoming_start_m = ["none", 400]\n'
-        f'[paper]\ntable = "{REPO / "scenarios" / "paper_table2.csv"}"\n')
-    return path
+    return write_matrix(tmp_path / "m.toml", "ego_speed_kmh = [120, 90]\nmu = [1.0, 0.3]\n"
+                        'oncoming_start_m = ["none", 400]\n', paper_table=True)
 
 
 def _stable(path: Path) -> pd.DataFrame:

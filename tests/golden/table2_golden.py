@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
+import math
 import sys
 import tempfile
 from pathlib import Path
@@ -27,7 +28,7 @@ COLUMNS = ("case_id", "outcome", "collision_with", *FIGURES, "modes_visited",
 
 
 def _figure(value) -> str:
-    if value is None or value == "" or (isinstance(value, float) and value != value):
+    if value is None or value == "" or (isinstance(value, float) and math.isnan(value)):
         return ""
     return f"{float(value):.3f}"
 

@@ -1,4 +1,4 @@
-"""Real SUMO co-simulation runs of small scenarios (issue 6 must-shows)."""
+"""Real SUMO co-simulation runs of small scenarios."""
 
 from __future__ import annotations
 
@@ -16,10 +16,15 @@ from eoam_sumo.params import G_MPS2
 from eoam_sumo.sim.cosim import RunSettings, run_case
 from eoam_sumo.sim.runlog import COLUMNS
 from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
+from tests.builders import (
+    BASELINE,
+    PARKED_ONLY,
+    baseline_variant,
+    halted_car_scenario,
+    netconvert,
+    write_sumocfg,
+)
 
-ROOT = Path(__file__).resolve().parents[2]
-BASELINE = ROOT / "scenarios" / "baseline.sumocfg"
-PARKED = ROOT / "scenarios" / "parked_only.sumocfg"
 CONTRACT_COLUMNS = [
     "time_s", "mode", "fcw", "x_m", "y_m", "yaw_rad", "vx_mps", "vy_mps", "yaw_rate_radps",
     "ax_mps2", "ay_mps2", "steer_rad", "ax_target_mps2", "y_target_m", "aro_range_m",
@@ -38,8 +43,9 @@ def _run(cfg, tmp_path, **over):
     return summary, out
 
 
+@pytest.mark.sumo
 def test_parked_cars_only_trigger_nothing(tmp_path):
-    summary, out = _run(PARKED, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0, max_time_s=12.0)
+    summary, out = _run(PARKED_ONLY, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0, max_time_s=12.0)
     assert summary["outcome"] == "none"
     assert summary["collision_with"] == "none"
     assert summary["modes_visited"] == [0]
@@ -49,6 +55,7 @@ def test_parked_cars_only_trigger_nothing(tmp_path):
     assert ts["mode"].dropna().eq(0).all()
 
 
+@pytest.mark.sumo
 def test_120_kmh_dry_no_oncoming_is_green_with_return_and_hand_back(tmp_path):
     summary, out = _run(BASELINE, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0)
     assert summary["outcome"] == "green", summary["reason"]
@@ -78,6 +85,7 @@ def test_120_kmh_dry_no_oncoming_is_green_with_return_and_hand_back(tmp_path):
     assert ts["time_s"].diff().dropna().round(6).eq(0.01).all()
 
 
+@pytest.mark.sumo
 def test_120_kmh_dry_oncoming_300_m_is_not_red(tmp_path):
     summary, _ = _run(BASELINE, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0, oncoming_start_m=300.0)
     assert summary["outcome"] in {"green", "yellow", "orange"}, summary["reason"]
@@ -86,26 +94,21 @@ def test_120_kmh_dry_oncoming_300_m_is_not_red(tmp_path):
 
 def _write_user_scenario(folder: Path) -> Path:
     """A scenario unlike ours: other ids, 3.2 m lanes, friction in the net, a halted car."""
-    (folder / "road.nod.xml").write_text(textwrap.dedent("""\
-        <nodes>
-          <node id="west" x="0" y="50"/>
-          <node id="east" x="2500" y="50"/>
-        </nodes>"""))
-    (folder / "road.edg.xml").write_text(textwrap.dedent("""\
-        <edges>
-          <edge id="main_fwd" from="west" to="east" numLanes="1" speed="40" width="3.2"
-                spreadType="right"/>
-          <edge id="main_back" from="east" to="west" numLanes="1" speed="40" width="3.2"
-                spreadType="right"/>
-        </edges>"""))
-    import sumolib
-
-    netconvert = sumolib.checkBinary("netconvert")
-    subprocess.run(
-        [netconvert, "-n", str(folder / "road.nod.xml"), "-e", str(folder / "road.edg.xml"),
-         "--opposites.guess", "true", "--no-turnarounds", "true",
-         "-o", str(folder / "road.net.xml")],
-        check=True, capture_output=True,
+    netconvert(
+        folder, "road",
+        textwrap.dedent("""\
+            <nodes>
+              <node id="west" x="0" y="50"/>
+              <node id="east" x="2500" y="50"/>
+            </nodes>"""),
+        textwrap.dedent("""\
+            <edges>
+              <edge id="main_fwd" from="west" to="east" numLanes="1" speed="40" width="3.2"
+                    spreadType="right"/>
+              <edge id="main_back" from="east" to="west" numLanes="1" speed="40" width="3.2"
+                    spreadType="right"/>
+            </edges>"""),
+        "--opposites.guess", "true", "--no-turnarounds", "true",
     )
     (folder / "cars.rou.xml").write_text(textwrap.dedent("""\
         <routes>
@@ -119,18 +122,11 @@ def _write_user_scenario(folder: Path) -> Path:
           <vehicle id="ego" type="sedan" route="r" depart="0" departPos="150"
                    departSpeed="25"/>
         </routes>"""))
-    cfg = folder / "user.sumocfg"
-    cfg.write_text(textwrap.dedent("""\
-        <configuration>
-          <input>
-            <net-file value="road.net.xml"/>
-            <route-files value="cars.rou.xml"/>
-          </input>
-          <time><step-length value="0.01"/></time>
-        </configuration>"""))
-    return cfg
+    return write_sumocfg(folder / "user.sumocfg", "road.net.xml", "cars.rou.xml",
+                         step_length_s=0.01)
 
 
+@pytest.mark.sumo
 def test_user_scenario_with_halted_car_gets_a_sensible_outcome(tmp_path):
     cfg = _write_user_scenario(tmp_path)
     summary, out = _run(cfg, tmp_path, mu=0.7, max_time_s=30.0)
@@ -143,6 +139,7 @@ def test_user_scenario_with_halted_car_gets_a_sensible_outcome(tmp_path):
     assert summary["mu"] == pytest.approx(0.7)
 
 
+@pytest.mark.sumo
 def test_oncoming_seen_past_the_point_of_no_return_passes_the_aro_and_returns(tmp_path):
     """120 km/h, mu 0.7, oncoming car 400 m away: seen after the point of no return (mode 4);
     the ego returns as soon as it is past the ARO, long before the manoeuvre timer, and
@@ -157,6 +154,7 @@ def test_oncoming_seen_past_the_point_of_no_return_passes_the_aro_and_returns(tm
     assert ts["lateral_offset_m"].max() < 3.5 + 0.3
 
 
+@pytest.mark.sumo
 def test_radar_range_option_limits_what_is_sensed(tmp_path):
     """``--radar-range-m`` reaches the radar: the ARO is first reported near that range."""
     firsts = {}
@@ -175,6 +173,7 @@ def test_radar_range_option_limits_what_is_sensed(tmp_path):
     assert 100.0 - 1.0 < firsts[100.0] <= 100.0
 
 
+@pytest.mark.sumo
 def test_cli_run_prints_one_line_and_writes_files(tmp_path):
     out = tmp_path / "cli"
     proc = subprocess.run(
@@ -212,6 +211,7 @@ def test_cli_bad_input_is_one_line_and_status_2(tmp_path, args, needle):
     assert "Traceback" not in proc.stderr
 
 
+@pytest.mark.sumo
 def test_same_input_gives_identical_files(tmp_path):
     over = {"ego_speed_mps": 90 / 3.6, "mu": 0.7, "oncoming_start_m": 400.0}
     runs = []
@@ -226,6 +226,7 @@ def test_same_input_gives_identical_files(tmp_path):
     assert runs[0][1] == runs[1][1]
 
 
+@pytest.mark.sumo
 def test_traci_path_gives_the_libsumo_result(tmp_path):
     """The --gui loop runs through TraCI; checked here with the plain sumo binary."""
     over = ScenarioOverrides(ego_speed_mps=120 / 3.6, mu=1.0)
@@ -236,43 +237,13 @@ def test_traci_path_gives_the_libsumo_result(tmp_path):
     assert fast["max_abs_lat_accel_mps2"] == pytest.approx(slow["max_abs_lat_accel_mps2"], 1e-6)
 
 
-def _scenario(folder: Path, edges_xml: str, nodes_xml: str, obstacle_pos_m: float,
-              extra_net_args=()) -> Path:
-    """A small user scenario: the given road, a halted car on the first edge, the ego."""
-    (folder / "n.nod.xml").write_text(nodes_xml)
-    (folder / "n.edg.xml").write_text(edges_xml)
-    import sumolib
-
-    subprocess.run(
-        [sumolib.checkBinary("netconvert"), "-n", str(folder / "n.nod.xml"),
-         "-e", str(folder / "n.edg.xml"), "--no-turnarounds", "true", *extra_net_args,
-         "-o", str(folder / "n.net.xml")],
-        check=True, capture_output=True,
-    )
-    (folder / "r.rou.xml").write_text(textwrap.dedent(f"""\
-        <routes>
-          <vType id="car" length="4.6" width="1.8" decel="9" sigma="0"/>
-          <route id="r" edges="fwd"/>
-          <vehicle id="stalled" type="car" route="r" depart="0" departPos="{obstacle_pos_m}"
-                   departSpeed="0">
-            <stop lane="fwd_0" endPos="{obstacle_pos_m + 5}" duration="1000"/>
-          </vehicle>
-          <vehicle id="ego" type="car" route="r" depart="0" departPos="20" departSpeed="27"/>
-        </routes>"""))
-    cfg = folder / "s.sumocfg"
-    cfg.write_text(
-        '<configuration><input><net-file value="n.net.xml"/><route-files value="r.rou.xml"/>'
-        "</input></configuration>"
-    )
-    return cfg
-
-
+@pytest.mark.sumo
 def test_no_lane_to_the_left_means_braking_in_lane(tmp_path):
-    cfg = _scenario(
+    cfg = halted_car_scenario(
         tmp_path,
-        '<edges><edge id="fwd" from="a" to="b" numLanes="1" speed="40"/></edges>',
         '<nodes><node id="a" x="0" y="0"/><node id="b" x="1500" y="0"/></nodes>',
-        obstacle_pos_m=220.0,
+        '<edges><edge id="fwd" from="a" to="b" numLanes="1" speed="40"/></edges>',
+        220.0,
     )
     summary, _ = _run(cfg, tmp_path, mu=1.0, max_time_s=25.0)
     assert summary["fcw_raised"] is True
@@ -281,6 +252,7 @@ def test_no_lane_to_the_left_means_braking_in_lane(tmp_path):
     assert summary["outcome"] in {"green", "yellow"}, summary["reason"]
 
 
+@pytest.mark.sumo
 def test_curved_two_way_road(tmp_path):
     """A 400 m radius left-hand curve: the road frame follows it; a halted car is avoided."""
     shape = " ".join(
@@ -288,14 +260,13 @@ def test_curved_two_way_road(tmp_path):
         for a in [i * 0.02 for i in range(101)]
     )
     end = f'x="{400 * math.sin(2.0):.3f}" y="{400 * (1 - math.cos(2.0)):.3f}"'
-    cfg = _scenario(
+    cfg = halted_car_scenario(
         tmp_path,
+        f'<nodes><node id="a" x="0" y="0"/><node id="b" {end}/></nodes>',
         f'<edges><edge id="fwd" from="a" to="b" numLanes="1" speed="40" spreadType="right" '
         f'shape="{shape}"/><edge id="back" from="b" to="a" numLanes="1" speed="40" '
         f'spreadType="right" shape="{" ".join(reversed(shape.split()))}"/></edges>',
-        f'<nodes><node id="a" x="0" y="0"/><node id="b" {end}/></nodes>',
-        obstacle_pos_m=250.0,
-        extra_net_args=("--opposites.guess", "true"),
+        250.0, "--opposites.guess", "true",
     )
     summary, out = _run(cfg, tmp_path, mu=1.0, max_time_s=25.0)
     assert summary["fcw_raised"] is True
@@ -306,25 +277,18 @@ def test_curved_two_way_road(tmp_path):
     assert calm["lateral_offset_m"].abs().max() < 0.2
 
 
+@pytest.mark.sumo
 def test_ice_patch_road_departure_is_orange_not_green(tmp_path):
     """Dry road, then mu 0.05 from x = 200 m: the ego steers round a halted car on the ice
-    and slides off the road to the right (was reported green, "returned to lane")."""
-    (tmp_path / "n.nod.xml").write_text(
+    and slides off the road to the right: orange, not a green "returned to lane"."""
+    netconvert(
+        tmp_path, "n",
         '<nodes><node id="a" x="0" y="0"/><node id="b" x="200" y="0"/>'
-        '<node id="c" x="600" y="0"/><node id="d" x="2000" y="0"/></nodes>'
-    )
-    (tmp_path / "n.edg.xml").write_text(
+        '<node id="c" x="600" y="0"/><node id="d" x="2000" y="0"/></nodes>',
         '<edges><edge id="dry" from="a" to="b" numLanes="2" speed="40"/>'
         '<edge id="ice" from="b" to="c" numLanes="2" speed="40" friction="0.05"/>'
-        '<edge id="end" from="c" to="d" numLanes="2" speed="40"/></edges>'
-    )
-    import sumolib
-
-    subprocess.run(
-        [sumolib.checkBinary("netconvert"), "-n", str(tmp_path / "n.nod.xml"),
-         "-e", str(tmp_path / "n.edg.xml"), "--no-turnarounds", "true",
-         "-o", str(tmp_path / "n.net.xml")],
-        check=True, capture_output=True,
+        '<edge id="end" from="c" to="d" numLanes="2" speed="40"/></edges>',
+        "--no-turnarounds", "true",
     )
     (tmp_path / "r.rou.xml").write_text(textwrap.dedent("""\
         <routes>
@@ -337,11 +301,7 @@ def test_ice_patch_road_departure_is_orange_not_green(tmp_path):
           </vehicle>
           <vehicle id="ego" type="car" route="r" depart="0" departPos="20" departSpeed="30"/>
         </routes>"""))
-    cfg = tmp_path / "s.sumocfg"
-    cfg.write_text(
-        '<configuration><input><net-file value="n.net.xml"/><route-files value="r.rou.xml"/>'
-        "</input></configuration>"
-    )
+    cfg = write_sumocfg(tmp_path / "s.sumocfg", "n.net.xml", "r.rou.xml")
     summary, out = _run(cfg, tmp_path, max_time_s=20.0)
     assert summary["mu"] == pytest.approx(1.0)  # dry where the ego starts
     assert 2 in summary["modes_visited"], summary["reason"]
@@ -397,9 +357,10 @@ def test_the_run_log_grows_to_its_limit_and_no_further():
     assert small.array().shape == (5, len(COLUMNS))
 
 
+@pytest.mark.sumo
 def test_a_car_standing_in_the_next_lane_turns_the_steer_into_braking(tmp_path):
     """Cars parked in the opposite lane just beyond the ARO: the lane change would end against
-    them, so the EOAM brakes in lane (mode 3) instead of hitting them (it used to, orange)."""
+    them, so the EOAM brakes in lane (mode 3) instead of hitting them (orange)."""
     spaces = "".join(f'<space x="{x:.2f}" y="2.60" angle="270.00" length="4.30" width="1.80"/>'
                      for x in (250.0, 262.0, 274.0))
     (tmp_path / "park.add.xml").write_text(
@@ -409,17 +370,18 @@ def test_a_car_standing_in_the_next_lane_turns_the_steer_into_braking(tmp_path):
         f'<vehicle id="p{k}" type="parked" route="w" depart="0" departPos="stop" '
         'insertionChecks="none"><stop parkingArea="pa" parking="true" until="1000000"/>'
         "</vehicle>" for k in range(3))
-    cfg = _baseline_variant(tmp_path, "<routes>", f'<routes><route id="w" edges="-E0"/>{parked}',
-                            extra_additional="park.add.xml")
+    cfg = baseline_variant(tmp_path, "<routes>", f'<routes><route id="w" edges="-E0"/>{parked}',
+                           extra_additional="park.add.xml")
     summary, _ = _run(cfg, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0)
     assert 3 in summary["modes_visited"] and 2 not in summary["modes_visited"]
     assert summary["collision_with"] in ("none", "aro")
     assert summary["outcome"] in ("green", "yellow")
 
 
+@pytest.mark.sumo
 def test_the_ego_may_be_a_vehicle_with_a_scripted_stop(tmp_path):
-    """`--ego aro`: its stop parameters are ignored (the plant drives it); it used to fail,
-    'the ego is no longer in the simulation'."""
+    """`--ego aro`: its stop parameters are ignored (the plant drives it), so it stays in the
+    simulation."""
     out = tmp_path / "aro-ego"
     summary = run_case(BASELINE, ScenarioOverrides(ego_speed_mps=20.0, mu=1.0), out,
                        RunSettings(max_time_s=3.0, ego_id="aro"))
@@ -427,36 +389,22 @@ def test_the_ego_may_be_a_vehicle_with_a_scripted_stop(tmp_path):
     assert summary["sim_time_s"] > 0.0
 
 
-def _baseline_variant(tmp_path, old: str, new: str, extra_additional: str = "") -> Path:
-    """The baseline scenario with one edit to its route file (and an additional file of
-    ``tmp_path`` besides the vehicle types, if given)."""
-    scenarios = ROOT / "scenarios"
-    routes = (scenarios / "baseline.rou.xml").read_text()
-    assert old in routes
-    (tmp_path / "r.rou.xml").write_text(routes.replace(old, new, 1))
-    cfg = tmp_path / "variant.sumocfg"
-    cfg.write_text(
-        f'<configuration><input><net-file value="{ROOT / "networks" / "highway.net.xml"}"/>'
-        f'<route-files value="r.rou.xml"/><additional-files value="'
-        f'{",".join(filter(None, [str(scenarios / "vtypes.add.xml"), extra_additional]))}"/>'
-        "</input></configuration>")
-    return cfg
-
-
+@pytest.mark.sumo
 def test_a_second_manoeuvre_soon_after_a_hand_back_runs_to_its_end(tmp_path):
     """An ARO braking gently: the EOAM brakes, hands back, then has to change lanes; the run
-    used to stop 2 s after the first hand-back, in the middle of the lane change."""
-    cfg = _baseline_variant(tmp_path, '<param key="eoam.aro_decel_mps2" value="8.0"/>',
-                            '<param key="eoam.aro_decel_mps2" value="1.0"/>')
+    must not stop 2 s after the first hand-back, in the middle of the lane change."""
+    cfg = baseline_variant(tmp_path, '<param key="eoam.aro_decel_mps2" value="8.0"/>',
+                           '<param key="eoam.aro_decel_mps2" value="1.0"/>')
     summary, _ = _run(cfg, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0, max_time_s=40.0)
     assert summary["modes_visited"][:3] == [0, 1, 2]
     assert abs(summary["final_lateral_offset_m"]) < 0.5
     assert "returned to lane" in summary["reason"]
 
 
+@pytest.mark.sumo
 def test_a_vehicle_overlapping_the_ego_at_its_departure_is_bad_input(tmp_path):
     from eoam_sumo.errors import InputError
 
-    cfg = _baseline_variant(tmp_path, 'departPos="225.09"', 'departPos="102.00"')
+    cfg = baseline_variant(tmp_path, 'departPos="225.09"', 'departPos="102.00"')
     with pytest.raises(InputError, match="vehicle 'aro' overlaps the ego at its departure"):
         _run(cfg, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0)

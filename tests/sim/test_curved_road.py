@@ -7,9 +7,11 @@ import math
 import pandas as pd
 import pytest
 
-from eoam_sumo import netbuild
 from eoam_sumo.sim.cosim import RunSettings, run_case
 from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
+from tests.builders import network, write_sumocfg
+
+pytestmark = pytest.mark.sumo
 
 RADIUS_M = 1500.0
 EDGE_M = 700.0
@@ -44,18 +46,14 @@ def curve_scenario(tmp_path):
             f'shape="{_shape(s0, s1, True)}"><lane index="0"><neigh lane="c{k}_0"/></lane>'
             "</edge>"
         )
-    (tmp_path / "curve.nod.xml").write_text(f"<nodes>{''.join(nodes)}</nodes>")
-    (tmp_path / "curve.edg.xml").write_text(f"<edges>{''.join(edges)}</edges>")
-    netbuild.build_all(tmp_path)
+    network(tmp_path, "curve", f"<nodes>{''.join(nodes)}</nodes>",
+            f"<edges>{''.join(edges)}</edges>")
     (tmp_path / "curve.rou.xml").write_text(
         '<routes><vType id="car" length="4.9" width="1.85" sigma="0"/>'
         '<vehicle id="ego" type="car" depart="0" departPos="50" departSpeed="30">'
         '<route edges="c0 c1 c2"/></vehicle></routes>'
     )
-    cfg = tmp_path / "curve.sumocfg"
-    cfg.write_text('<configuration><input><net-file value="curve.net.xml"/>'
-                   '<route-files value="curve.rou.xml"/></input></configuration>')
-    return cfg
+    return write_sumocfg(tmp_path / "curve.sumocfg", "curve.net.xml", "curve.rou.xml")
 
 
 @pytest.mark.parametrize("speed_kmh", [120.0, 165.0])
@@ -78,22 +76,18 @@ def _straight_edges(tmp_path, name: str, widths: list[float], lanes: list[int]) 
     edges = "".join(
         f'<edge id="e{k}" from="n{k}" to="n{k + 1}" numLanes="{n}" speed="50" width="{w}"/>'
         for k, (w, n) in enumerate(zip(widths, lanes)))
-    (tmp_path / f"{name}.nod.xml").write_text(f"<nodes>{nodes}</nodes>")
-    (tmp_path / f"{name}.edg.xml").write_text(f"<edges>{edges}</edges>")
-    netbuild.build_all(tmp_path)
+    network(tmp_path, name, f"<nodes>{nodes}</nodes>", f"<edges>{edges}</edges>")
     route = " ".join(f"e{k}" for k in range(len(widths)))
     (tmp_path / f"{name}.rou.xml").write_text(
         '<routes><vType id="car" length="4.9" width="1.85" sigma="0"/>'
         '<vehicle id="ego" type="car" depart="0" departPos="50" departLane="0" '
         f'departSpeed="30"><route edges="{route}"/></vehicle></routes>')
-    (tmp_path / f"{name}.sumocfg").write_text(
-        f'<configuration><input><net-file value="{name}.net.xml"/>'
-        f'<route-files value="{name}.rou.xml"/></input></configuration>')
+    write_sumocfg(tmp_path / f"{name}.sumocfg", f"{name}.net.xml", f"{name}.rou.xml")
 
 
 def test_lane_width_changes_along_the_route_do_not_throw_the_ego_off(tmp_path):
     """The lane centre shifts by up to 0.6 m at each junction: the ego follows it smoothly
-    (it used to swerve into the next lane, the heading step seen 30 m ahead)."""
+    (not swerving into the next lane at the heading step seen 30 m ahead)."""
     _straight_edges(tmp_path, "widths", [3.5, 3.0, 4.0, 2.8, 3.5], [1] * 5)
     out = tmp_path / "run"
     summary = run_case(tmp_path / "widths.sumocfg",
@@ -116,17 +110,17 @@ def test_an_ego_lane_that_ends_is_refused_by_name(tmp_path):
 
 def test_a_straight_edge_then_a_curve_keeps_the_lane_centre(tmp_path):
     """A 1000 m straight edge, then a 500 m curve of 25 m chords (the heading of a straight
-    edge must not lean towards the curve it meets; it once drifted 0.9 m on the straight)."""
+    edge must not lean towards the curve it meets, or the ego drifts 0.9 m on the straight)."""
     radius = 500.0
     curve = [(1000.0 + radius * math.sin(k * CHORD_M / radius),
               radius * (1 - math.cos(k * CHORD_M / radius))) for k in range(33)]
     end = curve[-1]
     shape = " ".join(f"{x:.3f},{y:.3f}" for x, y in curve)
     back = " ".join(f"{x:.3f},{y:.3f}" for x, y in reversed(curve))
-    (tmp_path / "bend.nod.xml").write_text(
+    network(
+        tmp_path, "bend",
         '<nodes><node id="a" x="0" y="0"/><node id="b" x="1000" y="0"/>'
-        f'<node id="c" x="{end[0]:.3f}" y="{end[1]:.3f}"/></nodes>')
-    (tmp_path / "bend.edg.xml").write_text(
+        f'<node id="c" x="{end[0]:.3f}" y="{end[1]:.3f}"/></nodes>',
         '<edges><edge id="s" from="a" to="b" numLanes="1" speed="50" width="3.5">'
         '<lane index="0"><neigh lane="-s_0"/></lane></edge>'
         '<edge id="-s" from="b" to="a" numLanes="1" speed="50" width="3.5">'
@@ -135,14 +129,11 @@ def test_a_straight_edge_then_a_curve_keeps_the_lane_centre(tmp_path):
         '<lane index="0"><neigh lane="-c_0"/></lane></edge>'
         f'<edge id="-c" from="c" to="b" numLanes="1" speed="50" width="3.5" shape="{back}">'
         '<lane index="0"><neigh lane="c_0"/></lane></edge></edges>')
-    netbuild.build_all(tmp_path)
     (tmp_path / "bend.rou.xml").write_text(
         '<routes><vType id="car" length="4.9" width="1.85" sigma="0"/>'
         '<vehicle id="ego" type="car" depart="0" departPos="50" departSpeed="30">'
         '<route edges="s c"/></vehicle></routes>')
-    cfg = tmp_path / "bend.sumocfg"
-    cfg.write_text('<configuration><input><net-file value="bend.net.xml"/>'
-                   '<route-files value="bend.rou.xml"/></input></configuration>')
+    cfg = write_sumocfg(tmp_path / "bend.sumocfg", "bend.net.xml", "bend.rou.xml")
     out = tmp_path / "run"
     summary = run_case(cfg, ScenarioOverrides(ego_speed_mps=100 / 3.6, mu=1.0), out,
                        RunSettings(max_time_s=60.0))

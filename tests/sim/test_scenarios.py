@@ -21,13 +21,18 @@ from eoam_sumo.params import (
     parked_car,
 )
 from eoam_sumo.sim.sumo_adapter import ScenarioOverrides, SumoSession, nav_angle_deg, yaw_rad
+from tests.builders import (
+    BASELINE,
+    HIGHWAY_NET,
+    NETWORKS,
+    PARKED_ONLY,
+    SCENARIOS,
+    network,
+    on_highway,
+    write_sumocfg,
+)
 
-ROOT = Path(__file__).resolve().parents[2]
-NETWORKS = ROOT / "networks"
-SCENARIOS = ROOT / "scenarios"
-BASELINE = SCENARIOS / "baseline.sumocfg"
-PARKED_ONLY = SCENARIOS / "parked_only.sumocfg"
-NET = sumolib.net.readNet(str(NETWORKS / "highway.net.xml"), withInternal=True)
+NET = sumolib.net.readNet(str(HIGHWAY_NET), withInternal=True)
 EGO_LANE = NET.getLane("E0_0")
 RIGHT_MARKER_Y = EGO_LANE.getShape()[0][1] - EGO_LANE.getWidth() / 2.0  # from the network file
 
@@ -78,6 +83,7 @@ def _front(body):
 
 
 # --------------------------------------------------------------------------- network
+@pytest.mark.sumo
 def test_committed_network_is_what_netconvert_builds_from_the_sources(tmp_path):
     for name in ("highway.nod.xml", "highway.edg.xml"):
         shutil.copy(NETWORKS / name, tmp_path / name)
@@ -90,7 +96,7 @@ def test_committed_network_is_what_netconvert_builds_from_the_sources(tmp_path):
             for lane in root.iter("lane")
         }
 
-    assert lanes(built) == lanes(NETWORKS / "highway.net.xml")
+    assert lanes(built) == lanes(HIGHWAY_NET)
 
 
 def test_highway_geometry_and_surface():
@@ -100,7 +106,7 @@ def test_highway_geometry_and_surface():
         assert lane.getWidth() == 3.5
         assert lane.getLength() == pytest.approx(4000.0)
         assert lane.getSpeed() * 3.6 >= 165.0
-    root = ET.parse(NETWORKS / "highway.net.xml").getroot()
+    root = ET.parse(HIGHWAY_NET).getroot()
     assert {ln.get("id"): ln.get("friction") for ln in root.iter("lane")} == {
         "E0_0": "1.00",
         "-E0_0": "1.00",
@@ -117,6 +123,7 @@ def test_netbuild_command_needs_a_directory(tmp_path, capsys):
 
 
 # --------------------------------------------------------------------------- ego and vTypes
+@pytest.mark.sumo
 @pytest.mark.parametrize("speed_kmh", [55.0, 165.0])
 def test_ego_is_present_at_the_requested_speed_from_the_first_step(open_session, speed_kmh):
     speed = speed_kmh / 3.6
@@ -137,6 +144,7 @@ def test_ego_is_present_at_the_requested_speed_from_the_first_step(open_session,
         assert s.vehicle_speed("ego") == pytest.approx(speed, abs=1e-9)
 
 
+@pytest.mark.sumo
 def test_vehicle_types_have_the_preset_footprints(open_session):
     s = open_session(BASELINE, ScenarioOverrides(oncoming_start_m=300.0))
     ego, aro, onc = s.ego_body(), s.body("aro"), s.body(s.oncoming_id)
@@ -151,6 +159,7 @@ def test_vehicle_types_have_the_preset_footprints(open_session):
 
 
 # --------------------------------------------------------------------------- ARO stop
+@pytest.mark.sumo
 @pytest.mark.parametrize("mu,decel_override", [(1.0, None), (0.3, None), (1.0, 3.0)])
 def test_aro_holds_then_stops_no_harder_than_the_surface_allows(open_session, mu, decel_override):
     s = open_session(
@@ -186,6 +195,7 @@ def test_aro_holds_then_stops_no_harder_than_the_surface_allows(open_session, mu
 
 
 # --------------------------------------------------------------------------- oncoming
+@pytest.mark.sumo
 def test_oncoming_car_starts_at_the_distance_and_keeps_20_mps(open_session):
     s = open_session(BASELINE, ScenarioOverrides(ego_speed_mps=10.0, oncoming_start_m=300.0))
     onc_lane = NET.getLane("-E0_0")
@@ -209,6 +219,7 @@ def test_oncoming_car_starts_at_the_distance_and_keeps_20_mps(open_session):
     assert x0 - _front(s.body(s.oncoming_id))[0] == pytest.approx(20.0 * (s.time_s - t0), abs=1e-6)
 
 
+@pytest.mark.sumo
 def test_move_ego_into_the_opposite_lane_and_back(open_session):
     s = open_session(BASELINE, ScenarioOverrides(ego_speed_mps=20.0))
     length = s.ego_body().length_m
@@ -230,6 +241,7 @@ def test_move_ego_into_the_opposite_lane_and_back(open_session):
 
 
 # --------------------------------------------------------------------------- parked cars
+@pytest.mark.sumo
 def test_parked_cars_sit_beside_the_ego_lane_and_never_in_it(open_session):
     s = open_session(PARKED_ONLY)
     ego_front_x = _front(s.ego_body())[0]
@@ -249,6 +261,7 @@ def test_parked_cars_sit_beside_the_ego_lane_and_never_in_it(open_session):
     assert "aro" not in s.vehicle_ids()
 
 
+@pytest.mark.sumo
 def test_nearby_agrees_with_sumo_at_every_step(open_session):
     """nearby() follows the vehicles without a context subscription: at every step it equals
     SUMO's getters for every vehicle some part of which may be within the radius (front
@@ -284,6 +297,7 @@ def test_nearby_agrees_with_sumo_at_every_step(open_session):
 
 
 # --------------------------------------------------------------------------- friction
+@pytest.mark.sumo
 def test_friction_override_sets_every_lane(open_session):
     s = open_session(BASELINE, ScenarioOverrides(mu=0.3))
     assert s.lane_ids() and all(
@@ -300,6 +314,7 @@ def test_friction_override_sets_every_lane(open_session):
 
 
 # --------------------------------------------------------------------------- TraCI path
+@pytest.mark.sumo
 def test_traci_path_with_plain_sumo(open_session):
     s = open_session(
         BASELINE,
@@ -345,14 +360,13 @@ USER_CFG = """<configuration><input><net-file value="user.net.xml"/>
 
 @pytest.fixture
 def user_scenario(tmp_path):
-    (tmp_path / "user.nod.xml").write_text(USER_NODES)
-    (tmp_path / "user.edg.xml").write_text(USER_EDGES)
-    netbuild.build_all(tmp_path)
+    network(tmp_path, "user", USER_NODES, USER_EDGES)
     (tmp_path / "user.rou.xml.gz").write_bytes(gzip.compress(USER_ROUTES.encode()))
     (tmp_path / "user.sumocfg").write_text(USER_CFG)
     return tmp_path
 
 
+@pytest.mark.sumo
 def test_a_users_scenario_with_its_own_network_and_a_plain_stop(open_session, user_scenario):
     net = sumolib.net.readNet(str(user_scenario / "user.net.xml"))
     shape1 = np.array(net.getLane("road1_0").getShape())
@@ -385,13 +399,7 @@ def test_a_users_scenario_with_its_own_network_and_a_plain_stop(open_session, us
 
 # --------------------------------------------------------------------------- bad input
 def _cfg(tmp_path, routes: str) -> Path:
-    net = NETWORKS / "highway.net.xml"
-    cfg = tmp_path / "bad.sumocfg"
-    cfg.write_text(
-        f'<configuration><input><net-file value="{net}"/>'
-        f'<route-files value="{routes}"/></input></configuration>'
-    )
-    return cfg
+    return write_sumocfg(tmp_path / "bad.sumocfg", HIGHWAY_NET, routes)
 
 
 def test_bad_scenarios_are_input_errors_naming_the_file(tmp_path):
@@ -413,6 +421,7 @@ def test_bad_scenarios_are_input_errors_naming_the_file(tmp_path):
         SumoSession.start(BASELINE, step_length_s=0.0105)
 
 
+@pytest.mark.sumo
 @pytest.mark.parametrize("use_traci", [False, True])
 def test_sumos_own_load_errors_become_input_errors(tmp_path, use_traci):
     bad_route = tmp_path / "bad.rou.xml"
@@ -441,6 +450,7 @@ def test_overrides_validate_themselves(kwargs, name):
         ScenarioOverrides(**kwargs)
 
 
+@pytest.mark.sumo
 def test_one_libsumo_session_at_a_time_and_close_is_final(open_session):
     s = open_session(PARKED_ONLY)
     with pytest.raises(RuntimeError, match="already open"):
@@ -461,24 +471,16 @@ def test_angle_conversions_round_trip():
 
 
 # --------------------------------------------------------------------------- scenario variety
-def _routes_cfg(tmp_path, routes_xml: str, net: Path = NETWORKS / "highway.net.xml") -> Path:
-    (tmp_path / "v.rou.xml").write_text(routes_xml)
-    cfg = tmp_path / "v.sumocfg"
-    cfg.write_text(
-        f'<configuration><input><net-file value="{net}"/><route-files value="v.rou.xml"/>'
-        f'<additional-files value="{SCENARIOS / "vtypes.add.xml"}"/></input></configuration>'
-    )
-    return cfg
-
-
+@pytest.mark.sumo
 def test_an_ego_alone_in_the_simulation_is_sensed_and_stepped(tmp_path, open_session):
-    s = open_session(_routes_cfg(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text()))
+    s = open_session(on_highway(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text()))
     assert s.nearby(150.0) == []  # no other vehicle: nothing near, no error
     for _ in range(10):
         s.step()
     assert s.nearby(150.0) == []
 
 
+@pytest.mark.sumo
 @pytest.mark.parametrize("ego_first", [True, False])
 def test_the_ego_may_be_listed_after_a_vehicle_departing_with_it(tmp_path, open_session,
                                                                  ego_first):
@@ -487,12 +489,13 @@ def test_the_ego_may_be_listed_after_a_vehicle_departing_with_it(tmp_path, open_
     aro = ('<vehicle id="aro" type="aro" route="r" depart="1.00" departPos="225" '
            'departSpeed="16" insertionChecks="none"/>')
     pair = ego + aro if ego_first else aro + ego
-    s = open_session(_routes_cfg(tmp_path, f'<routes><route id="r" edges="E0"/>{pair}</routes>'))
+    s = open_session(on_highway(tmp_path, f'<routes><route id="r" edges="E0"/>{pair}</routes>'))
     assert s.time_s == pytest.approx(1.01)
     assert s.ego_body().speed_mps == pytest.approx(30.0)
     assert {b.vid for b in s.nearby(300.0)} == {"aro"}
 
 
+@pytest.mark.sumo
 def test_a_trip_ego_gets_the_route_sumo_finds(open_session, user_scenario):
     routes = USER_ROUTES.replace(
         '<vehicle id="ego" type="car" depart="0" departSpeed="12"><route edges="road1 road2"/>'
@@ -507,6 +510,7 @@ def test_a_trip_ego_gets_the_route_sumo_finds(open_session, user_scenario):
     assert line[-1] == pytest.approx(net.getLane("road2_0").getShape()[-1])
 
 
+@pytest.mark.sumo
 def test_an_ego_faster_than_the_lane_limit_starts_at_its_speed(open_session):
     limit = EGO_LANE.getSpeed()
     s = open_session(BASELINE, ScenarioOverrides(ego_speed_mps=limit + 10.0,
@@ -525,36 +529,36 @@ def test_an_ego_faster_than_the_lane_limit_starts_at_its_speed(open_session):
 def test_bad_lane_numbers_in_the_network_name_the_file(tmp_path, old, new):
     """SUMO segfaults on some of these (friction or width "abc"), or tracebacks followed."""
     net = tmp_path / "bad.net.xml"
-    text = (NETWORKS / "highway.net.xml").read_text()
+    text = HIGHWAY_NET.read_text()
     assert old in text
     net.write_text(text.replace(old, new, 1))
-    cfg = _routes_cfg(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(), net)
+    cfg = on_highway(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(), net)
     key, value = new.split("=")
     with pytest.raises(InputError, match=rf"bad.net.xml: lane .* {key}='{value.strip(chr(34))}'"):
         SumoSession.start(cfg)
 
 
+@pytest.mark.sumo
 def test_an_ego_type_slower_than_the_requested_speed_still_starts_at_it(tmp_path,
                                                                        open_session):
     routes = ('<routes><vType id="slow" maxSpeed="25" speedDev="0" length="4.9" width="1.85"/>'
               '<route id="r" edges="E0"/><vehicle id="ego" type="slow" route="r" depart="1.00" '
               'departPos="100" departSpeed="20" insertionChecks="none"/></routes>')
-    s = open_session(_routes_cfg(tmp_path, routes), ScenarioOverrides(ego_speed_mps=100 / 3.6))
+    s = open_session(on_highway(tmp_path, routes), ScenarioOverrides(ego_speed_mps=100 / 3.6))
     assert s.ego_body().speed_mps == pytest.approx(100 / 3.6)
 
 
+@pytest.mark.sumo
 def test_a_two_way_road_without_neigh_elements_has_its_opposite_lane(tmp_path, open_session):
     """netconvert's default two-way road (no <neigh>): the reverse edge's lane beside the ego's
     is its opposite lane, for the lane change and for the oncoming car."""
-    (tmp_path / "plain.nod.xml").write_text(
-        '<nodes><node id="w" x="0" y="0"/><node id="e" x="3000" y="0"/></nodes>')
-    (tmp_path / "plain.edg.xml").write_text(
+    net = network(
+        tmp_path, "plain",
+        '<nodes><node id="w" x="0" y="0"/><node id="e" x="3000" y="0"/></nodes>',
         '<edges><edge id="E0" from="w" to="e" numLanes="1" speed="50" width="3.5"/>'
         '<edge id="-E0" from="e" to="w" numLanes="1" speed="50" width="3.5"/></edges>')
-    netbuild.build_all(tmp_path)
-    assert "<neigh" not in (tmp_path / "plain.net.xml").read_text()
-    cfg = _routes_cfg(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(),
-                      tmp_path / "plain.net.xml")
+    assert "<neigh" not in net.read_text()
+    cfg = on_highway(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(), net)
     s = open_session(cfg, ScenarioOverrides(oncoming_start_m=400.0))
     assert s.left_lane_exists
     assert s.vehicle_lane(s.oncoming_id) == "-E0_0"
@@ -562,25 +566,24 @@ def test_a_two_way_road_without_neigh_elements_has_its_opposite_lane(tmp_path, o
     assert onc.x_m - ego.x_m == pytest.approx(400.0, abs=6.0)
 
 
+@pytest.mark.sumo
 def test_a_one_way_road_has_no_opposite_lane(tmp_path, open_session):
-    (tmp_path / "oneway.nod.xml").write_text(
+    net = network(  # a reverse edge elsewhere is not beside it
+        tmp_path, "oneway",
         '<nodes><node id="w" x="0" y="0"/><node id="e" x="3000" y="0"/>'
-        '<node id="far" x="3000" y="500"/></nodes>')
-    (tmp_path / "oneway.edg.xml").write_text(  # a reverse edge elsewhere is not beside it
+        '<node id="far" x="3000" y="500"/></nodes>',
         '<edges><edge id="E0" from="w" to="e" numLanes="1" speed="50" width="3.5"/>'
         '<edge id="back" from="e" to="w" numLanes="1" speed="50" width="3.5" '
         'shape="3000,500 0,500"/></edges>')
-    netbuild.build_all(tmp_path)
-    cfg = _routes_cfg(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(),
-                      tmp_path / "oneway.net.xml")
+    cfg = on_highway(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(), net)
     s = open_session(cfg)
     assert not s.left_lane_exists
 
 
 def test_a_left_hand_traffic_network_is_refused_by_name(tmp_path):
     net = tmp_path / "lh.net.xml"
-    text = (NETWORKS / "highway.net.xml").read_text()
+    text = HIGHWAY_NET.read_text()
     net.write_text(text.replace("<net ", '<net lefthand="true" ', 1))
-    cfg = _routes_cfg(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(), net)
+    cfg = on_highway(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(), net)
     with pytest.raises(InputError, match=r"lh.net.xml: a left-hand-traffic network"):
         SumoSession.start(cfg)

@@ -1,0 +1,110 @@
+"""Scenario builders shared by the tests: small SUMO networks, route files and sumocfg files,
+written under a test's temporary folder. Building a network runs netconvert, so a test that
+calls ``network`` or ``netconvert`` is marked ``sumo``."""
+
+from __future__ import annotations
+
+import subprocess
+import textwrap
+from collections.abc import Iterable
+from pathlib import Path
+
+from eoam_sumo import netbuild
+
+ROOT = Path(__file__).resolve().parents[1]
+NETWORKS = ROOT / "networks"
+SCENARIOS = ROOT / "scenarios"
+HIGHWAY_NET = NETWORKS / "highway.net.xml"
+VTYPES = SCENARIOS / "vtypes.add.xml"
+BASELINE = SCENARIOS / "baseline.sumocfg"
+PARKED_ONLY = SCENARIOS / "parked_only.sumocfg"
+
+
+def write_sumocfg(path: Path, net: Path | str, routes: Path | str,
+                  additional: Iterable[Path | str] = (),
+                  step_length_s: float | None = None) -> Path:
+    """A sumocfg at ``path`` naming these files (relative names are relative to its folder)."""
+    files = ",".join(str(a) for a in additional)
+    text = (f'<configuration><input><net-file value="{net}"/>'
+            f'<route-files value="{routes}"/>')
+    if files:
+        text += f'<additional-files value="{files}"/>'
+    text += "</input>"
+    if step_length_s is not None:
+        text += f'<time><step-length value="{step_length_s}"/></time>'
+    path.write_text(text + "</configuration>")
+    return path
+
+
+def network(folder: Path, stem: str, nodes_xml: str, edges_xml: str) -> Path:
+    """``STEM.net.xml`` built from these plain nodes and edges by ``eoam_sumo.netbuild`` (the
+    project's netconvert options, lane frictions written out)."""
+    (folder / f"{stem}.nod.xml").write_text(nodes_xml)
+    (folder / f"{stem}.edg.xml").write_text(edges_xml)
+    return netbuild.build_network(folder / f"{stem}.nod.xml")
+
+
+def netconvert(folder: Path, stem: str, nodes_xml: str, edges_xml: str,
+               *options: str) -> Path:
+    """``STEM.net.xml`` built by plain netconvert with these options, as a user would build it
+    (netconvert's defaults otherwise)."""
+    import sumolib
+
+    (folder / f"{stem}.nod.xml").write_text(nodes_xml)
+    (folder / f"{stem}.edg.xml").write_text(edges_xml)
+    net = folder / f"{stem}.net.xml"
+    subprocess.run(
+        [sumolib.checkBinary("netconvert"), "-n", str(folder / f"{stem}.nod.xml"),
+         "-e", str(folder / f"{stem}.edg.xml"), *options, "-o", str(net)],
+        check=True, capture_output=True,
+    )
+    return net
+
+
+def on_highway(folder: Path, routes_xml: str, net: Path = HIGHWAY_NET) -> Path:
+    """These routes (vehicle types of ``scenarios/vtypes.add.xml`` available) on the project's
+    highway, or on another network: ``v.sumocfg``."""
+    (folder / "v.rou.xml").write_text(routes_xml)
+    return write_sumocfg(folder / "v.sumocfg", net, "v.rou.xml", [VTYPES])
+
+
+def baseline_variant(folder: Path, old: str, new: str, extra_additional: str = "") -> Path:
+    """The baseline scenario with one edit to its route file (and an additional file of
+    ``folder`` besides the vehicle types, if given): ``variant.sumocfg``."""
+    routes = (SCENARIOS / "baseline.rou.xml").read_text()
+    assert old in routes
+    (folder / "r.rou.xml").write_text(routes.replace(old, new, 1))
+    return write_sumocfg(folder / "variant.sumocfg", HIGHWAY_NET, "r.rou.xml",
+                         filter(None, [str(VTYPES), extra_additional]))
+
+
+def halted_car_scenario(folder: Path, nodes_xml: str, edges_xml: str, obstacle_pos_m: float,
+                        *netconvert_options: str) -> Path:
+    """A small user scenario: the given road (edge ``fwd`` first), a car halted on it at
+    ``obstacle_pos_m`` by a plain ``<stop>``, the ego 20 m from the start at 27 m/s."""
+    netconvert(folder, "n", nodes_xml, edges_xml, "--no-turnarounds", "true",
+               *netconvert_options)
+    (folder / "r.rou.xml").write_text(textwrap.dedent(f"""\
+        <routes>
+          <vType id="car" length="4.6" width="1.8" decel="9" sigma="0"/>
+          <route id="r" edges="fwd"/>
+          <vehicle id="stalled" type="car" route="r" depart="0" departPos="{obstacle_pos_m}"
+                   departSpeed="0">
+            <stop lane="fwd_0" endPos="{obstacle_pos_m + 5}" duration="1000"/>
+          </vehicle>
+          <vehicle id="ego" type="car" route="r" depart="0" departPos="20" departSpeed="27"/>
+        </routes>"""))
+    return write_sumocfg(folder / "s.sumocfg", "n.net.xml", "r.rou.xml")
+
+
+def write_matrix(path: Path, sweep: str, sumocfg: Path = BASELINE, scenario: str = "",
+                 paper_table: bool = False) -> Path:
+    """An experiment matrix at ``path``: ``[scenario]`` with ``sumocfg`` and the extra
+    ``scenario`` lines, ``[sweep]`` with the ``sweep`` lines, and the paper's Table 2 to
+    compare with if ``paper_table``."""
+    text = f'[scenario]\nsumocfg = "{sumocfg.as_posix()}"\n{scenario}[sweep]\n{sweep}'
+    if paper_table:
+        text += f'[paper]\ntable = "{(SCENARIOS / "paper_table2.csv").as_posix()}"\n'
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
+    return path
