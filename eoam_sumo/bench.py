@@ -1,6 +1,6 @@
 """The performance benchmark (``eoam-sumo bench``): what users wait for, measured in one run.
 
-Figures (design.md 3.3 keys first):
+Figures:
 - ``realtime_factor``: simulated seconds per wall second of the co-simulation step loop for
   the 120 km/h, mu 1.0, no-oncoming case (plant at 1 ms, logging on), median of repeats;
 - ``sumo_only_realtime_factor``: the same scenario stepped by SUMO alone, SUMO driving the ego;

@@ -23,7 +23,7 @@ def _p(default, unit: str, source: str):
     return field(default=default, metadata={"unit": unit, "source": source})
 
 
-JING = "CarSim E-class sedan table, Jing et al., IEEE T-ITS 2022 (via design.md sec. 4)"
+JING = "CarSim E-class sedan table, Jing et al., IEEE T-ITS 2022"
 JI = "CarSim E-class sedan, Ji et al., IEEE T-VT 66(2) 2017, Table I"
 W213 = "Mercedes-Benz E-Class (W213) sedan dimensions, manufacturer data sheet"
 GILLESPIE = "Gillespie, Fundamentals of Vehicle Dynamics (1992), typical passenger-car value"

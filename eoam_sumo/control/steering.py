@@ -13,7 +13,7 @@ feedback alone gives e'' + (v k_la x_la / L_eff) e' + (v^2 k_la / L_eff) e = 0; 
 k_la = omega^2 L_eff / v^2 and x_la = 2 zeta v / omega makes the error dynamics a second-order
 system of natural frequency omega and damping ratio zeta. omega is scheduled on friction and
 speed: omega = omega_0 mu^p min(1, v / v_full). The friction factor keeps the loop inside what
-the tyres give (the friction-limited path is itself slower, design.md sec. 5); the speed factor
+the tyres give (the friction-limited path is itself slower); the speed factor
 keeps the spatial bandwidth omega / v bounded at low speed, where a fixed omega would ask for
 heading angles of tens of degrees. The schedule speed is floored to keep the gains finite.
 """

@@ -51,7 +51,7 @@ class DesignSettings:
         "friction is left for the tracking controller and the longitudinal profile")
     max_quintic_time_s: float = _p(
         6.0, "s", DESIGN + ": upper bound of T; binds only below mu 0.07 and keeps the lane "
-        "change well inside the 8 s manoeuvre timer (design.md sec. 4)")
+        "change well inside the 8 s manoeuvre timer")
     ocp_intervals: int = _p(40, "-", DESIGN + ": collocation intervals (speed vs. accuracy)")
     collocation_degree: int = _p(3, "-", DESIGN + ": Radau collocation points per interval")
     min_speed_fraction: float = _p(

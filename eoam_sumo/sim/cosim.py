@@ -1,4 +1,4 @@
-"""The co-simulation step loop (design card: SUMO + radar + EOAM logic + plant + write-back).
+"""The co-simulation step loop: SUMO, radar, EOAM logic, plant and write-back, step by step.
 
 Two rates: SUMO and the EOAM decision/control run every ``step_s`` (10 ms by default); the
 plant integrates at ``plant_dt_s`` (1 ms) inside each SUMO step, all sub-steps in one compiled

@@ -1,11 +1,11 @@
 """Oriented boxes of road users: overlap, distance and contact classification (ground truth).
 
-SUMO does not report the remote-controlled ego's collisions reliably (design.md sec. 6), so
+SUMO does not report the remote-controlled ego's collisions reliably, so
 the co-simulation tests the ego against every other body with these functions at every plant
 step. They run in that loop, hence plain floats and the math module, and far pairs are
 rejected by their bounding circles before the separating-axis test.
 
-Frame: network coordinates, x east, y north, yaw counter-clockwise from +x (docs/interfaces.md).
+Frame: network coordinates, x east, y north, yaw counter-clockwise from +x (docs/architecture.md).
 A box's own frame has x forward (towards its ``front`` face) and y to its ``left``.
 
 Contact rules (the paper's colours, sec. 11, need the faces and the kind of the first contact):

@@ -1,4 +1,4 @@
-"""Outcome colour of a run (paper sec. 11, design.md sec. 3.4) from ground truth.
+"""Outcome colour of a run (paper sec. 11) from ground truth (docs/outcomes.md).
 
 Inputs are the first contact found on the oriented boxes (``geometry.contact`` with the ego as
 box ``a``), the ground-truth role of the body hit (``role_of``, from its position and motion,
@@ -43,8 +43,8 @@ Rules, in order:
 
 Runs with contact are classified by rules 4-6 whatever the ego's motion before the contact.
 ``collision_with`` is the role of the body hit: ``aro``, ``oncoming``, ``parked`` or ``other``
-(moving with the traffic outside the ego lane band, e.g. a car overtaking in the next lane;
-an extension of design.md 3.3's values, which would have called it ``aro``).
+(moving with the traffic outside the ego lane band, e.g. a car overtaking in the next
+lane).
 """
 
 from __future__ import annotations
@@ -71,8 +71,8 @@ COLOURS = ("none", "green", "yellow", "orange", "red")
 # to about half its entry speed during the steer. Measured: 0.03-0.18 rad at 90-165 km/h and
 # 0.33 rad at 55 km/h in the Table 2 batch; 0.53 rad at the tables' 20 km/h floor on 3.5 m
 # lanes, 0.60 rad on 4 m and 0.70 rad on 5 m lanes (a halted car ahead, mu 0.3-1.0). 1.0 rad
-# (57 deg) keeps 0.3 rad above every lane change and a spin passes it early (the tester's
-# ice-patch spin reached 2.2 rad).
+# (57 deg) keeps 0.3 rad above every lane change and a spin passes it early (a spin on an
+# ice patch reaches 2.2 rad).
 LOST_CONTROL_HEADING_RAD = 1.0
 # Going backwards: forward speed vx below this [m/s]. The plant's vx is not clamped at 0; a
 # stop by braking ends at vx = 0 to 6 decimals (Table 2, low-speed runs), so -0.5 m/s is no
@@ -264,7 +264,7 @@ def classify_outcome(
     if left_width_m < 0.0:
         raise ValueError(f"left_width_m={left_width_m} must be >= 0")
     # mode 3 is entered only before the point of no return: limit braking was chosen, whatever
-    # lateral drift the aborted steer leaves (paper sec. 8.1, design.md 3.4 yellow)
+    # lateral drift the aborted steer leaves (paper sec. 8.1)
     lane_change = 3 not in modes and (
         abs(max_lateral_offset_m) >= settings.point_of_no_return_fraction * lane_width_m
     )

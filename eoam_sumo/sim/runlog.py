@@ -16,7 +16,7 @@ import numpy as np
 
 from eoam_sumo.errors import InputError
 
-#: timeseries.csv columns (design.md 3.3 first, then the rest), SI units in the names.
+#: timeseries.csv columns (the paper's signals first, then the rest), SI units in the names.
 COLUMNS = (
     "time_s", "mode", "fcw", "x_m", "y_m", "yaw_rad", "vx_mps", "vy_mps", "yaw_rate_radps",
     "ax_mps2", "ay_mps2", "steer_rad", "ax_target_mps2", "y_target_m", "aro_range_m",

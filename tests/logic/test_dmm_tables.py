@@ -53,7 +53,7 @@ def test_boundaries_monotone_in_speed_and_friction(tables):
 
 
 def test_stopping_boundary_respects_the_physics_floor(tables):
-    # v^2 / (2 mu g) is a floor no braking can beat (design.md sec. 5)
+    # v^2 / (2 mu g) is a floor no braking can beat
     lo, hi = speed_range(tables)
     for mu in (0.1, 0.3, 0.7, 1.0):
         for v in (lo, 0.5 * (lo + hi), hi):

@@ -1,4 +1,4 @@
-"""Outcome colours (design.md sec. 3.4) and ground-truth roles, one test per rule."""
+"""Outcome colours (docs/outcomes.md) and ground-truth roles, one test per rule."""
 
 from __future__ import annotations
 
@@ -286,8 +286,8 @@ def _motion(modes=LANE_CHANGE, max_offset=3.6, hit=None, role="none", final_offs
 
 
 def test_orange_spin_on_ice_without_contact():
-    """The tester's run: a 0.05 ice patch, heading 2.2 rad off, vx -8 m/s, d 6.4 m on a
-    two-lane road: was green "lane change completed, returned to lane"."""
+    """A spin on a 0.05 ice patch, heading 2.2 rad off, vx -8 m/s, d 6.4 m on a two-lane
+    road: orange, not green "lane change completed, returned to lane"."""
     out = _motion(max_offset=6.4, final_offset=0.2, final_speed=-8.0, heading=2.2,
                   min_speed=-8.0, min_offset=-0.3)
     assert (out.colour, out.collision_with, out.impact_speed_mps) == ("orange", "none", 0.0)
@@ -307,7 +307,7 @@ def test_orange_heading_alone():
 
 
 def test_orange_going_backwards_alone():
-    out = _classify(BRAKE_ONLY, 0.0, final_speed=-1.0)  # the old inputs: still green
+    out = _classify(BRAKE_ONLY, 0.0, final_speed=-1.0)  # without the motion measures: green
     assert out.colour == "green" and "stopped" in out.reason
     out = _motion(BRAKE_ONLY, 0.0, final_speed=-1.0, heading=0.0, min_speed=-1.0, min_offset=0.0)
     assert (out.colour, out.collision_with) == ("orange", "none")
@@ -327,7 +327,7 @@ def test_orange_left_the_road_to_the_right():
 
 
 def test_orange_not_none_for_a_car_that_left_the_road_without_any_manoeuvre():
-    """The tester's second run: 43 m off the road with the EOAM never triggered was ``none``."""
+    """43 m off the road with the EOAM never triggered: orange, not ``none``."""
     out = _motion([0], 44.75, final_offset=-44.75, heading=0.4, min_speed=25.0,
                   min_offset=RIGHT_EDGE_M - 43.0, max_offset_d=0.0)
     assert (out.colour, out.collision_with) == ("orange", "none")
