@@ -42,7 +42,7 @@ def _cosim_and_sumo_only(repeats: int) -> dict:
     pairs (one co-simulation run, then SUMO alone for as many steps) so that both see the same
     machine load; medians over the repeats, the cost ratio the median of the pairs' ratios."""
     from eoam_sumo.sim.cosim import CoSimulation, RunSettings
-    from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
+    from eoam_sumo.sim.scenario import ScenarioOverrides
 
     over = ScenarioOverrides(ego_speed_mps=SPEED_MPS, mu=1.0)
     sim = CoSimulation(BASELINE, over, RunSettings())
@@ -77,7 +77,8 @@ def _cosim_and_sumo_only(repeats: int) -> dict:
 def _sumo_only_rate(sim_time_s: float, step_s: float) -> float:
     """Simulated seconds per wall second of SUMO alone stepping the scenario for
     ``sim_time_s`` at ``step_s`` (the ego driven by SUMO, no co-simulation work)."""
-    from eoam_sumo.sim.sumo_adapter import ScenarioOverrides, SumoSession
+    from eoam_sumo.sim.scenario import ScenarioOverrides
+    from eoam_sumo.sim.session import SumoSession
 
     steps = max(1, round(sim_time_s / step_s))
     session = SumoSession.start(

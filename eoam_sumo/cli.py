@@ -14,6 +14,7 @@ from pathlib import Path
 
 from eoam_sumo import __version__
 from eoam_sumo.errors import InputError
+from eoam_sumo.params import MU_MAX
 
 EXIT_BAD_INPUT = 2
 
@@ -47,8 +48,8 @@ def _finite(text: str) -> float:
 
 def _mu(text: str) -> float:
     value = _finite(text)
-    if not 0.0 < value <= 1.2:
-        raise argparse.ArgumentTypeError(f"mu {text} is outside (0, 1.2]")
+    if not 0.0 < value <= MU_MAX:
+        raise argparse.ArgumentTypeError(f"mu {text} is outside (0, {MU_MAX:g}]")
     return value
 
 
@@ -156,7 +157,7 @@ def _cmd_run(args) -> int:
     from eoam_sumo.sensing.friction import parse_mu_belief
     from eoam_sumo.sim.cosim import RunSettings, run_case
     from eoam_sumo.sim.radar import RadarSettings
-    from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
+    from eoam_sumo.sim.scenario import ScenarioOverrides
 
     if not args.cfg.is_file():
         raise InputError(f"{args.cfg}: no such scenario file")

@@ -22,7 +22,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from eoam_sumo.errors import InputError
-from eoam_sumo.sim.sumo_adapter import MU_MAX, ScenarioOverrides
+from eoam_sumo.params import MU_MAX
+from eoam_sumo.sim.scenario import ScenarioOverrides, check_scenario, scripted_stops
 
 DEFAULT_MAX_TIME_S = 40.0
 NO_ONCOMING = "none"
@@ -281,14 +282,13 @@ def check_matrix(matrix: Matrix, tables_dir: Path | None = None, ego_id: str = "
     """Check the matrix against what its runs will use, before any of them starts.
 
     The scenario's ``.sumocfg``, network, route and additional files must parse and hold the
-    vehicle ``ego_id`` (``sim.sumo_adapter.check_scenario``, no SUMO started); every swept
+    vehicle ``ego_id`` (``sim.scenario.check_scenario``, no SUMO started); every swept
     speed and friction must be one the lookup tables in ``tables_dir`` (default: the folder
     the co-simulation uses, ``$EOAM_TABLES_DIR`` or the repository's ``tables/``) cover, by
     the same ``LookupTables.check_run`` each run applies. InputError names the matrix file,
     the key and the value.
     """
     from eoam_sumo.offline.tables import LookupTables, default_tables_dir
-    from eoam_sumo.sim.sumo_adapter import ScenarioOverrides, check_scenario, scripted_stops
 
     try:
         files = check_scenario(matrix.sumocfg, ego_id)

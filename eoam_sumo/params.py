@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 G_MPS2 = 9.81  # standard gravity [m/s^2]
 AIR_DENSITY_KGPM3 = 1.2  # sea level, 20 C [kg/m^3]
+MU_MAX = 1.2  # highest tyre-road friction accepted (lanes, runs, tables): dry asphalt [-]
 #: Lateral travel of the lane change, one lane (paper sec. 4.2: y_f = 3.5 m) [m].
 LANE_CHANGE_HEIGHT_M = 3.5
 #: Point of no return as a fraction of the lane change's lateral travel (paper sec. 8.1) [-].

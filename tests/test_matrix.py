@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.matrix import load_matrix, load_paper_table
-from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
+from eoam_sumo.sim.scenario import ScenarioOverrides
 
 ROOT = Path(__file__).resolve().parents[1]
 TABLE2 = ROOT / "scenarios" / "table2.toml"

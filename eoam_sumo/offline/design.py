@@ -24,7 +24,7 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 
-from eoam_sumo.params import G_MPS2, LANE_CHANGE_HEIGHT_M, aro_d_class_minivan
+from eoam_sumo.params import G_MPS2, LANE_CHANGE_HEIGHT_M, MU_MAX, aro_d_class_minivan
 
 PAPER = "Lowe & Guvenc 2022 (the paper)"
 DESIGN = "design choice"
@@ -113,8 +113,8 @@ class DesignSettings:
         # the lane-change optimisation is posed for highway manoeuvres: below 20 km/h or
         # mu 0.1 IPOPT finds no solution (measured: 1 km/h, mu 0.001)
         _check_grid("speeds_kmh", self.speeds_kmh, MIN_SPEED_KMH, 400.0, inclusive=True)
-        _check_grid("mus", self.mus, MIN_MU, 1.2, inclusive=True)
-        _check_grid("ttc_mus", self.ttc_mus, 0.0, 1.2)
+        _check_grid("mus", self.mus, MIN_MU, MU_MAX, inclusive=True)
+        _check_grid("ttc_mus", self.ttc_mus, 0.0, MU_MAX)
         if list(self.ttc_mus) != sorted(self.ttc_mus):
             raise ValueError(f"ttc_mus={self.ttc_mus} must be in increasing order")
         if len(self.ttc_values_s) != len(self.ttc_mus) or not all(

@@ -31,9 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from eoam_sumo.errors import InputError
-from eoam_sumo.params import G_MPS2
+from eoam_sumo.params import G_MPS2, MU_MAX
 
-MU_LIMIT = 1.2  # highest friction a run accepts (the lane friction's upper bound) [-]
 KINDS = ("known", "estimate")
 
 
@@ -70,11 +69,11 @@ def parse_mu_belief(value) -> str | float:
             value = float(text)
         except ValueError:
             raise InputError(f"mu_belief {value!r} is not 'known', 'estimate' or a number "
-                             "in (0, 1.2]") from None
+                             f"in (0, {MU_MAX:g}]") from None
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise InputError(f"mu_belief {value!r} is not 'known', 'estimate' or a number")
-    if not (math.isfinite(value) and 0.0 < value <= MU_LIMIT):
-        raise InputError(f"mu_belief {value!r} is outside (0, {MU_LIMIT:g}]")
+    if not (math.isfinite(value) and 0.0 < value <= MU_MAX):
+        raise InputError(f"mu_belief {value!r} is outside (0, {MU_MAX:g}]")
     return float(value)
 
 
@@ -104,7 +103,7 @@ class FrictionBelief:
         return self.belief
 
     def _clip(self, mu: float) -> float:
-        return min(max(mu, self.mu_min), MU_LIMIT)
+        return min(max(mu, self.mu_min), MU_MAX)
 
     def mu(self, true_mu: float, t_s: float, ax_mps2: float, ay_mps2: float) -> float:
         """The believed friction at time ``t_s``, given the road's ``true_mu`` under the ego

@@ -24,12 +24,14 @@ from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.plant import Plant, initial_state
 from eoam_sumo.sensing.friction import FrictionBelief
+from eoam_sumo.sim.bodies import nav_angle_deg
 from eoam_sumo.sim.geometry import OrientedBox, box_distance, boxes_overlap, contact
 from eoam_sumo.sim.outcome import classify_outcome, left_road, role_of
 from eoam_sumo.sim.radar import Radar, RadarReport, RadarSettings
 from eoam_sumo.sim.roadframe import RoadFrame
 from eoam_sumo.sim.runlog import RunLog
-from eoam_sumo.sim.sumo_adapter import ScenarioOverrides, SumoSession
+from eoam_sumo.sim.scenario import ScenarioOverrides
+from eoam_sumo.sim.session import SumoSession
 
 
 @dataclass(frozen=True)
@@ -81,11 +83,6 @@ def _collector_paused():
     finally:
         if was_enabled:
             gc.enable()
-
-
-def _nav_deg(yaw_rad: float) -> float:
-    """SUMO navigation angle (degrees clockwise from north) of a math yaw."""
-    return (90.0 - math.degrees(yaw_rad)) % 360.0
 
 
 class CoSimulation:
@@ -210,7 +207,7 @@ class CoSimulation:
             Xn, Yn, yawn, vxn = x[:4]
             cy, sy = math.cos(yawn), math.sin(yawn)
             ego_speed = 0.0 if vxn < 0.0 else vxn
-            session.move_ego(Xn + front * cy, Yn + front * sy, _nav_deg(yawn), ego_speed)
+            session.move_ego(Xn + front * cy, Yn + front * sy, nav_angle_deg(yawn), ego_speed)
             session.step()
             t = session.time_s
             bodies_next = session.nearby(sense_radius)

@@ -52,9 +52,9 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Protocol
 
 from eoam_sumo.params import PONR_FRACTION
+from eoam_sumo.sim.bodies import Body
 from eoam_sumo.sim.geometry import Contact
 from eoam_sumo.sim.radar import (
     LANE_MARGIN_M,
@@ -92,15 +92,6 @@ _ROLE_NAMES = {
     "parked": "a parked car",
     "other": "another road user",
 }
-
-
-class Body(Protocol):
-    """Anything with a ground-truth centre, heading and speed (a ``radar.Target``, a SUMO body)."""
-
-    x_m: float
-    y_m: float
-    yaw_rad: float
-    speed_mps: float
 
 
 def role_of(

@@ -1,4 +1,4 @@
-"""Forward radar model on plain target lists: detection, range, range rate, classification.
+"""Forward radar model on road users: detection, range, range rate, classification.
 
 The radar sits at the centre of the ego's front bumper and looks along the ego's heading
 (paper sec. 10.1, Figures 16 and 18: a long-range radar with a narrow field of view that
@@ -40,10 +40,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from operator import attrgetter
 from typing import NamedTuple, Protocol
 
+from eoam_sumo.sim.bodies import Body
 from eoam_sumo.sim.geometry import OrientedBox
 
 #: Below this speed a target counts as stopped [m/s]: SUMO reports exactly 0 for parked and
@@ -59,13 +60,6 @@ ONCOMING_SPEED_MPS = 2.0
 LANE_MARGIN_M = 0.5
 
 CATEGORIES = ("in_path", "oncoming", "in_next_lane", "stationary_side", "other")
-
-
-class Sensed(Protocol):
-    """What the radar reads of a road user (a ``Target``, a SUMO ``Body``)."""
-
-    box: OrientedBox
-    speed_mps: float
 
 
 class RoadProjection(Protocol):
@@ -101,26 +95,6 @@ class RadarSettings:
                 f"RadarSettings.oncoming_speed_mps={self.oncoming_speed_mps} must be >= "
                 f"stationary_speed_mps={self.stationary_speed_mps}"
             )
-
-
-@dataclass(frozen=True, slots=True)
-class Target:
-    """Ground truth of another road user: box centre, heading, speed along it, size."""
-
-    x_m: float
-    y_m: float
-    yaw_rad: float
-    speed_mps: float
-    length_m: float
-    width_m: float
-    box: OrientedBox = field(init=False, repr=False, compare=False)
-
-    def __post_init__(self) -> None:
-        if not math.isfinite(self.speed_mps):
-            raise ValueError(f"Target.speed_mps={self.speed_mps!r} must be finite")
-        object.__setattr__(
-            self, "box", OrientedBox(self.x_m, self.y_m, self.yaw_rad, self.length_m, self.width_m)
-        )
 
 
 class Detection(NamedTuple):
@@ -218,7 +192,7 @@ class Radar:
         ego_yaw_rad: float,
         ego_speed_mps: float,
         road_frame: RoadProjection,
-        targets: Sequence[Sensed],
+        targets: Sequence[Body],
         lane_width_m: float,
     ) -> RadarReport:
         """Detect and classify ``targets`` seen from the ego's front bumper (rules: module doc)."""

@@ -4,6 +4,10 @@ The EOAM geometry (paper sec. 4.2-4.3) is written in a frame attached to the lan
 starts in: ``s_m`` along its centre line, ``d_m`` the lateral offset (left positive, towards
 the oncoming lane), and the road heading. The centre line is a polyline taken from the SUMO
 network, so curved and user-made roads work as well as the paper's straight one.
+
+:class:`RoadFrame` answers the step loop's many projections in plain floats, walking from the
+last answer; the numpy functions :func:`arclength`, :func:`point_at` and :func:`project`
+answer one-off questions about a whole polyline (a SUMO lane shape, the ego's centre line).
 """
 
 from __future__ import annotations
@@ -12,6 +16,8 @@ import math
 from bisect import bisect_right
 from collections.abc import Sequence
 from itertools import pairwise
+
+import numpy as np
 
 
 class RoadFrame:
@@ -173,3 +179,30 @@ def _smooth_heading(points: list, stations: list) -> tuple[list, list, list]:
     slopes = [(y1 - y0) / (b1 - b0) for (y0, y1), (b0, b1) in zip(pairwise(values),
                                                                    pairwise(breaks))]
     return breaks, values, [*slopes, 0.0]
+
+
+def arclength(poly: np.ndarray) -> np.ndarray:
+    """Arc length at each vertex of an (N, 2) polyline, from 0."""
+    return np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(poly, axis=0).T))))
+
+
+def point_at(poly: np.ndarray, s_m: float) -> tuple[float, float, float]:
+    """(x, y, heading_rad) at arc length ``s_m`` along a polyline (clamped to its ends)."""
+    s = arclength(poly)
+    i = int(np.clip(np.searchsorted(s, s_m, side="right") - 1, 0, len(poly) - 2))
+    seg = poly[i + 1] - poly[i]
+    u = (min(max(s_m, 0.0), s[-1]) - s[i]) / max(s[i + 1] - s[i], 1e-12)
+    p = poly[i] + u * seg
+    return float(p[0]), float(p[1]), math.atan2(seg[1], seg[0])
+
+
+def project(poly: np.ndarray, x_m: float, y_m: float) -> tuple[float, float]:
+    """(arc length, distance) of the point of a polyline nearest to (x_m, y_m)."""
+    a, b = poly[:-1], poly[1:]
+    seg = b - a
+    seg_len2 = np.maximum(np.einsum("ij,ij->i", seg, seg), 1e-24)
+    u = np.clip(np.einsum("ij,ij->i", np.array([x_m, y_m]) - a, seg) / seg_len2, 0.0, 1.0)
+    foot = a + u[:, None] * seg
+    dist = np.hypot(foot[:, 0] - x_m, foot[:, 1] - y_m)
+    i = int(np.argmin(dist))
+    return float(arclength(poly)[i] + u[i] * math.sqrt(seg_len2[i])), float(dist[i])

@@ -10,7 +10,7 @@ import pytest
 
 from eoam_sumo.sim.cosim import RunSettings, run_case
 from eoam_sumo.sim.radar import RadarSettings
-from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
+from eoam_sumo.sim.scenario import ScenarioOverrides
 
 pytestmark = pytest.mark.sumo
 

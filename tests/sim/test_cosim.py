@@ -15,7 +15,7 @@ import pytest
 from eoam_sumo.params import G_MPS2
 from eoam_sumo.sim.cosim import RunSettings, run_case
 from eoam_sumo.sim.runlog import COLUMNS
-from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
+from eoam_sumo.sim.scenario import ScenarioOverrides
 from tests.builders import (
     BASELINE,
     PARKED_ONLY,

@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 from eoam_sumo.sim.cosim import RunSettings, run_case
-from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
+from eoam_sumo.sim.scenario import ScenarioOverrides
 from tests.builders import network, write_sumocfg
 
 pytestmark = pytest.mark.sumo

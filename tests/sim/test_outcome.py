@@ -8,6 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from eoam_sumo.sim.bodies import Body
 from eoam_sumo.sim.geometry import Contact, OrientedBox, contact
 from eoam_sumo.sim.outcome import (
     COLOURS,
@@ -21,7 +22,6 @@ from eoam_sumo.sim.outcome import (
     road_departure,
     role_of,
 )
-from eoam_sumo.sim.radar import Target
 from eoam_sumo.sim.roadframe import RoadFrame
 
 LANE_M = 3.5
@@ -52,7 +52,7 @@ def _classify(modes, max_offset, contact_=None, role="none", final_offset=0.0, f
 
 
 def _body(s_m, d_m, yaw_rad, speed_mps, dims=CAR):
-    return Target(s_m, d_m, yaw_rad, speed_mps, *dims)
+    return Body("t", "passenger", s_m, d_m, yaw_rad, speed_mps, *dims)
 
 
 @pytest.mark.parametrize(

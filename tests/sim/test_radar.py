@@ -8,8 +8,9 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
+from eoam_sumo.sim.bodies import Body
 from eoam_sumo.sim.geometry import OrientedBox
-from eoam_sumo.sim.radar import Radar, RadarSettings, Target
+from eoam_sumo.sim.radar import Radar, RadarSettings
 from eoam_sumo.sim.roadframe import RoadFrame
 
 LANE_M = 3.5
@@ -25,7 +26,7 @@ ROAD = RoadFrame([(-1000.0, 0.0), (5000.0, 0.0)])  # ego lane centre line, eastb
 def _ahead(rear_s_m, d_m, dims, speed_mps=0.0, reverse=False):
     """A target in the straight road frame, its rear (or front if ``reverse``) face at rear_s."""
     centre = rear_s_m + 0.5 * dims[0]
-    return Target(centre, d_m, math.pi if reverse else 0.0, speed_mps, *dims)
+    return Body("t", "passenger", centre, d_m, math.pi if reverse else 0.0, speed_mps, *dims)
 
 
 def _scan(targets, front=(0.0, 0.0), yaw=0.0, speed=30.0, radar=None, road=ROAD):
@@ -181,7 +182,7 @@ def test_field_of_view_edges(side, fov_deg):
     edge_y = 50.0 * math.tan(half)
     for shift, seen in ((0.01, False), (-0.01, True)):
         near_y = edge_y + shift  # |y| of the square's face nearest the boresight
-        target = Target(49.5, side * (near_y + 0.5), 0.0, 0.0, 1.0, 1.0)
+        target = Body("t", "passenger", 49.5, side * (near_y + 0.5), 0.0, 0.0, 1.0, 1.0)
         rep = _scan([target], radar=radar)
         assert (len(rep.detections) == 1) is seen
         if seen:
@@ -192,7 +193,7 @@ def test_field_of_view_edges(side, fov_deg):
 
 
 def test_box_spanning_the_field_of_view_with_all_corners_outside():
-    truck = Target(30.0, 0.0, math.pi / 2, 5.0, 12.0, 2.0)  # crossing ahead, 12 m long
+    truck = Body("t", "truck", 30.0, 0.0, math.pi / 2, 5.0, 12.0, 2.0)  # crossing ahead, 12 m
     radar = Radar()
     assert all(
         abs(math.atan2(y, x)) > HALF_FOV for x, y in truck.box.corners()
@@ -212,7 +213,7 @@ def test_box_seen_only_where_the_edge_ray_crosses_it():
     cx, cy = 0.5 * (p_in[0] + p_out[0]), 0.5 * (p_in[1] + p_out[1])
     length = math.hypot(p_in[0] - p_out[0], p_in[1] - p_out[1])
     yaw = math.atan2(p_in[1] - p_out[1], p_in[0] - p_out[0])
-    target = Target(cx, cy, yaw, 0.0, length, 0.05)
+    target = Body("t", "passenger", cx, cy, yaw, 0.0, length, 0.05)
     box = target.box
 
     def sector(x, y):
@@ -281,7 +282,7 @@ def _reference_range(box: OrientedBox, origin, yaw, half_fov) -> float:
     st.floats(10.0, 60.0),
 )
 def test_detection_and_range_are_exact(x, y, yaw, length, width, ego_yaw, fov_deg):
-    target = Target(x, y, yaw, 0.0, length, width)
+    target = Body("t", "passenger", x, y, yaw, 0.0, length, width)
     radar = Radar(RadarSettings(fov_deg=fov_deg))
     ref = _reference_range(target.box, (0.0, 0.0), ego_yaw, math.radians(0.5 * fov_deg))
     assume(abs(ref - 100.0) > 1e-6)
@@ -304,8 +305,9 @@ def test_scene_rotated_and_moved_gives_the_same_report():
     def move(x, y):
         return c * x - s * y + tx, s * x + c * y + ty
 
-    def moved(t: Target) -> Target:
-        return Target(*move(t.x_m, t.y_m), t.yaw_rad + rot, t.speed_mps, t.length_m, t.width_m)
+    def moved(t: Body) -> Body:
+        return Body(t.vid, t.vclass, *move(t.x_m, t.y_m), t.yaw_rad + rot, t.speed_mps,
+                    t.length_m, t.width_m)
 
     scene = [
         _ahead(70.0, 0.2, ARO, 9.0),
@@ -350,9 +352,9 @@ def test_settings_validate(kwargs):
 
 def test_bad_inputs():
     with pytest.raises(ValueError, match="speed_mps"):
-        Target(0.0, 0.0, 0.0, math.nan, 4.0, 2.0)
+        Body("t", "passenger", 0.0, 0.0, 0.0, math.nan, 4.0, 2.0)
     with pytest.raises(ValueError, match="length_m"):
-        Target(0.0, 0.0, 0.0, 1.0, 0.0, 2.0)
+        Body("t", "passenger", 0.0, 0.0, 0.0, 1.0, 0.0, 2.0)
     with pytest.raises(ValueError, match="lane_width_m"):
         Radar().scan((0.0, 0.0), 0.0, 10.0, ROAD, [], 0.0)
 

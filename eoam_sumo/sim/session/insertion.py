@@ -1,0 +1,250 @@
+"""Putting vehicles into a running SUMO: the ego re-inserted at the requested speed, the added
+oncoming car, and the ego's centre line along its route.
+
+The ego is re-inserted as a copy of its route-file vehicle (route, type, departLane/departPos
+and ``<param>``s kept; other attributes and its stops dropped), placed exactly with moveToXY
+in the insertion step.
+"""
+
+from __future__ import annotations
+
+import math
+import uuid
+from dataclasses import dataclass
+
+import numpy as np
+
+from eoam_sumo.errors import InputError
+from eoam_sumo.params import oncoming_sedan
+from eoam_sumo.sim.bodies import nav_angle_deg
+from eoam_sumo.sim.roadframe import arclength, point_at, project
+from eoam_sumo.sim.scenario import ROLE_KEY, ScenarioFiles, ScenarioOverrides, VehicleSpec
+from eoam_sumo.sim.scenario.files import float_attr
+from eoam_sumo.sim.scenario.values import number
+
+EGO_SPEED_MODE = 32  # SUMO applies setSpeed and moveToXY without checks
+ONCOMING_SPEED_MODE = 0  # constant speed even when the ego is mapped onto its lane
+NO_LANE_CHANGES = 0
+SPEED_LIMIT_WORDS = ("max", "desired", "speedLimit")
+
+
+@dataclass(frozen=True)
+class EgoStart:
+    """Where and how the ego was inserted."""
+
+    type_id: str
+    route_edges: list
+    lane_index: int
+    lane_id: str
+    lane_width_m: float
+    left_lane_exists: bool  # a lane of its own direction or the opposite one to its left
+    front_xy: tuple[float, float]  # front bumper at insertion
+    centreline: np.ndarray  # (N, 2) of its start lane followed along its route
+
+
+def without_repeats(edges) -> list[str]:
+    """Route edges with consecutive repeats dropped (a trip from an edge to itself)."""
+    out: list[str] = []
+    for edge in edges:
+        if not out or edge != out[-1]:
+            out.append(edge)
+    return out
+
+
+def lane_point(lane_api, lane_id: str, pos_m: float) -> tuple[float, float, float]:
+    """(x, y, heading) of the point ``pos_m`` along a lane (SUMO's length, scaled to its
+    shape)."""
+    shape = np.asarray(lane_api.getShape(lane_id), dtype=float)
+    scale = arclength(shape)[-1] / max(lane_api.getLength(lane_id), 1e-9)
+    return point_at(shape, pos_m * scale)
+
+
+def place_ego(api, errors: tuple, files: ScenarioFiles, overrides: ScenarioOverrides,
+              ego_id: str, over_limit: dict) -> EgoStart:
+    """Remove the ego SUMO loaded and insert it anew at its route file's lane and position
+    with the requested speed (``over_limit`` as for :func:`insert`)."""
+    veh, lanes = api.vehicle, api.lane
+    spec = files.vehicles[ego_id]
+    try:
+        if not spec.routed:  # a trip holds only its end points until SUMO routes it
+            veh.rerouteTraveltime(ego_id)
+        edges = without_repeats(veh.getRoute(ego_id))
+        type_id = veh.getTypeID(ego_id)
+    except errors as exc:
+        raise InputError(f"{spec.source}: SUMO did not load vehicle '{ego_id}': {exc}") from exc
+    lane_index = _ego_lane_index(api, spec, edges[0], type_id)
+    lane_id = f"{edges[0]}_{lane_index}"
+    lane_len = lanes.getLength(lane_id)
+    pos = _ego_depart_pos(api, spec, lane_len, type_id)
+    speed = _ego_speed(api, spec, lane_id, type_id, overrides)
+    veh.remove(ego_id)
+    insert(api, errors, ego_id, type_id, edges, lane_index, pos, speed, EGO_SPEED_MODE,
+           spec.params, over_limit)
+    left_lane = (lane_index < api.edge.getLaneNumber(edges[0]) - 1
+                 or lane_id in files.opposite_lanes)
+    return EgoStart(type_id, edges, lane_index, lane_id, float(lanes.getWidth(lane_id)),
+                    left_lane, lane_point(lanes, lane_id, pos)[:2],
+                    route_centreline(lanes, files, lane_id, edges, lane_index))
+
+
+def _ego_lane_index(api, spec: VehicleSpec, edge: str, type_id: str) -> int:
+    text = spec.attrs.get("departLane", "first")
+    n_lanes = api.edge.getLaneNumber(edge)
+    if text == "first":
+        vclass = api.vehicletype.getVehicleClass(type_id)
+        for i in range(n_lanes):
+            allowed = api.lane.getAllowed(f"{edge}_{i}")
+            if (not allowed or vclass in allowed) and vclass not in api.lane.getDisallowed(
+                f"{edge}_{i}"
+            ):
+                return i
+        raise InputError(f"{spec.source}: no lane of edge '{edge}' allows vehicle '{spec.vid}'")
+    if not text.isdigit() or int(text) >= n_lanes:
+        raise InputError(
+            f"{spec.source}: vehicle '{spec.vid}' departLane={text!r}: the ego needs "
+            f"a lane index below {n_lanes} (or 'first')"
+        )
+    return int(text)
+
+
+def _ego_depart_pos(api, spec: VehicleSpec, lane_len: float, type_id: str) -> float:
+    text = spec.attrs.get("departPos", "base")
+    if text == "base":
+        return min(api.vehicletype.getLength(type_id), lane_len)
+    pos = float_attr(spec, "departPos", text)
+    pos = pos + lane_len if pos < 0 else pos
+    if not 0.0 <= pos <= lane_len:
+        raise InputError(
+            f"{spec.source}: vehicle '{spec.vid}' departPos={text!r} is off its "
+            f"{lane_len:.2f} m start lane"
+        )
+    return pos
+
+
+def _ego_speed(api, spec: VehicleSpec, lane_id: str, type_id: str,
+               overrides: ScenarioOverrides) -> float:
+    if overrides.ego_speed_mps is not None:
+        return overrides.ego_speed_mps
+    text = spec.attrs.get("departSpeed", "0")
+    if text in SPEED_LIMIT_WORDS:
+        return min(api.lane.getMaxSpeed(lane_id), api.vehicletype.getMaxSpeed(type_id))
+    speed = float_attr(spec, "departSpeed", text)
+    return number(f"{spec.source}: vehicle '{spec.vid}' departSpeed", speed, minimum=0.0)
+
+
+def route_centreline(lanes, files: ScenarioFiles, start_lane_id: str, route_edges: list,
+                     lane_index: int) -> np.ndarray:
+    """Centre line of the ego's start lane followed along its route: from each lane over its
+    connection (and the junction's internal lanes) to the lane it leads to on the next
+    route edge, the one with the same index when there are several."""
+    lane = start_lane_id
+    points = [tuple(p) for p in lanes.getShape(lane)]
+    for edge in route_edges[1:]:
+        links = [link for link in lanes.getLinks(lane) if lanes.getEdgeID(link[0]) == edge]
+        if not links:
+            raise InputError(
+                f"{files.net_file}: the ego's lane {lane} does not continue onto "
+                f"edge '{edge}' of its route (no connection: the lane ends); start the ego "
+                "in a lane that continues"
+            )
+        link = min(links, key=lambda k: abs(int(k[0].rsplit("_", 1)[1]) - lane_index))
+        via = link[4]
+        for _ in range(8):  # a junction's internal lanes, until the next normal lane
+            if not via or not via.startswith(":"):
+                break
+            points += [tuple(p) for p in lanes.getShape(via)]
+            onward = lanes.getLinks(via)
+            via = onward[0][0] if onward else None
+        lane = link[0]
+        points += [tuple(p) for p in lanes.getShape(lane)]
+    line = [points[0]]
+    for p in points[1:]:
+        if math.hypot(p[0] - line[-1][0], p[1] - line[-1][1]) > 1e-6:
+            line.append(p)
+    return np.array(line, dtype=float)
+
+
+def add_oncoming(api, errors: tuple, files: ScenarioFiles, overrides: ScenarioOverrides,
+                 ego: EgoStart, over_limit: dict) -> str:
+    """Insert the oncoming car of ``overrides.oncoming_start_m`` in the lane opposite the
+    ego's, its front bumper that far ahead of the ego's along the road; its id."""
+    lanes = api.lane
+    distance = overrides.oncoming_start_m
+    s_ego, _ = project(ego.centreline, *ego.front_xy)
+    total = arclength(ego.centreline)[-1]
+    if s_ego + distance > total:
+        raise InputError(
+            f"oncoming_start_m={distance:g}: the ego's route ends "
+            f"{total - s_ego:.1f} m ahead of the ego"
+        )
+    px, py, _ = point_at(ego.centreline, s_ego + distance)
+    opposite = []  # per route edge: the opposite lane of its leftmost lane, or None
+    for edge in ego.route_edges:
+        leftmost = f"{edge}_{api.edge.getLaneNumber(edge) - 1}"
+        opposite.append(files.opposite_lanes.get(leftmost))
+    candidates = [
+        (project(np.asarray(lanes.getShape(o), float), px, py), k, o)
+        for k, o in enumerate(opposite)
+        if o is not None
+    ]
+    if not candidates:
+        raise InputError(
+            f"{files.net_file}: the ego's lane {ego.lane_id} has no "
+            "opposite lane (<neigh lane=...>) for the oncoming car"
+        )
+    (s_opp, _), k, lane_id = min(candidates, key=lambda c: c[0][1])
+    edges = []
+    for o in reversed(opposite[: k + 1]):
+        if o is None:
+            break
+        edges.append(lanes.getEdgeID(o))
+    shape = np.asarray(lanes.getShape(lane_id), dtype=float)
+    pos = s_opp * lanes.getLength(lane_id) / arclength(shape)[-1]
+    types = api.vehicletype
+    if "oncoming" not in types.getIDList():
+        dims = oncoming_sedan()
+        types.copy("DEFAULT_VEHTYPE", "oncoming")
+        types.setLength("oncoming", dims.length_m)
+        types.setWidth("oncoming", dims.width_m)
+    vid, n = "oncoming", 0
+    while vid in files.vehicles:
+        n += 1
+        vid = f"oncoming.{n}"
+    index = int(lane_id.rsplit("_", 1)[1])  # SUMO lane ids are <edge>_<index>
+    insert(api, errors, vid, "oncoming", edges, index, pos, overrides.oncoming_speed_mps,
+           ONCOMING_SPEED_MODE, {ROLE_KEY: "oncoming"}, over_limit)
+    return vid
+
+
+def insert(api, errors: tuple, vid: str, type_id: str, edges: list, lane_index: int,
+           pos: float, speed: float, speed_mode: int, params: dict, over_limit: dict) -> None:
+    """Add ``vid`` on a fresh route over ``edges`` at ``pos`` of its first lane, placed there
+    exactly with ``moveToXY`` and moving at ``speed`` from the insertion step on. A vehicle
+    SUMO lets depart only at rest (above its lane's or type's limit) is entered in
+    ``over_limit`` (id -> speed), to be given its speed after the insertion step."""
+    veh = api.vehicle
+    route_id = f"eoam.route.{vid}.{uuid.uuid4().hex[:8]}"
+    api.route.add(route_id, edges)
+    try:
+        veh.add(vid, route_id, type_id, depart="now", departLane=str(lane_index),
+                departPos=repr(float(pos)), departSpeed=repr(float(speed)))
+    except errors as exc:
+        if "too high" not in str(exc):
+            raise
+        # SUMO refuses a departure above the lane's limit times the vehicle's speed factor,
+        # or above its type's maximum: depart at rest, with room to go faster; the speed
+        # set below applies from the insertion step on (speed modes without limits)
+        veh.add(vid, route_id, type_id, depart="now", departLane=str(lane_index),
+                departPos=repr(float(pos)), departSpeed="0")
+        limit = api.lane.getMaxSpeed(f"{edges[0]}_{lane_index}")
+        veh.setSpeedFactor(vid, max(veh.getSpeedFactor(vid), speed / limit * (1.0 + 1e-6)))
+        veh.setMaxSpeed(vid, max(veh.getMaxSpeed(vid), speed * (1.0 + 1e-6)))
+        over_limit[vid] = speed
+    for key, value in params.items():
+        veh.setParameter(vid, key, value)
+    veh.setSpeedMode(vid, speed_mode)
+    veh.setLaneChangeMode(vid, NO_LANE_CHANGES)
+    x, y, heading = lane_point(api.lane, f"{edges[0]}_{lane_index}", pos)
+    veh.moveToXY(vid, edges[0], lane_index, x, y, nav_angle_deg(heading), keepRoute=1)
+    veh.setPreviousSpeed(vid, speed)
+    veh.setSpeed(vid, speed)

@@ -1,0 +1,361 @@
+"""A running SUMO scenario with the ego under external control: :class:`SumoSession`.
+
+:meth:`SumoSession.start` loads a ``.sumocfg`` after checking its files, applies the
+:class:`~eoam_sumo.sim.scenario.ScenarioOverrides` (surface friction, an added oncoming car,
+the ARO's emergency stop), advances SUMO to the ego's departure and makes the step that
+inserts the ego at the requested speed (moveToXY before the insertion step). The session then
+answers the co-simulation's queries: the ego's reference line, the road users around the ego
+(vehicles of every class and persons, as :class:`~eoam_sumo.sim.bodies.Body`), the friction
+under the ego; :meth:`move_ego` writes the ego's pose back and :meth:`step` advances SUMO.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+from typing import Self
+
+import numpy as np
+
+from eoam_sumo.errors import InputError
+from eoam_sumo.sim.bodies import Body
+from eoam_sumo.sim.scenario import (
+    ROLE_KEY,
+    ScenarioFiles,
+    ScenarioOverrides,
+    check_scenario,
+    scripted_stops,
+)
+from eoam_sumo.sim.scenario.files import float_attr
+from eoam_sumo.sim.scenario.values import number
+from eoam_sumo.sim.session.insertion import EgoStart, add_oncoming, place_ego
+from eoam_sumo.sim.session.launch import (
+    ERROR_LOG_STDERR,
+    shut_down,
+    start_error,
+    stderr_into,
+    sumo_command,
+    traci_connect,
+)
+from eoam_sumo.sim.session.scripts import StopScripts
+from eoam_sumo.sim.session.tracking import RoadUsers
+
+_open_libsumo: list[SumoSession] = []  # libsumo runs one simulation per process
+_NO_OVERRIDES = ScenarioOverrides()
+
+
+class SumoSession:
+    """One running SUMO scenario with the ego under external control. Use :meth:`start`.
+
+    ``sumo_overrides``: option -> value of the SUMO options the session set over what the
+    sumocfg (or SUMO's default) gives."""
+
+    def __init__(self, api, constants, errors: tuple, files: ScenarioFiles,
+                 overrides: ScenarioOverrides, ego_id: str, step_length_s: float,
+                 workdir: Path, process=None, sumo_overrides: dict | None = None) -> None:
+        self._api, self._tc, self._errors, self._files = api, constants, errors, files
+        self._overrides, self.ego_id, self._dt = overrides, ego_id, step_length_s
+        self._workdir, self._process = workdir, process
+        self.sumo_overrides = dict(sumo_overrides or {})
+        self._veh, self._lane, self._sim = api.vehicle, api.lane, api.simulation
+        self._closed = False
+        self._time_s = self._sim.getTime()
+        self._mu_cache: dict[str, float] = {}
+        self._scripts = StopScripts(api, constants, scripted_stops(files, overrides, ego_id))
+        self._users = RoadUsers(api, constants, ego_id, self._scripts.running)
+        self._radius_m: float | None = None
+        self._ego_mu = 1.0
+        self._over_limit: dict[str, float] = {}  # vid -> speed of a departure above the limit
+        self._ego: EgoStart | None = None
+        self.ego_depart_time_s = self._time_s
+        self.oncoming_id: str | None = None
+        self.roles = {
+            vid: s.params[ROLE_KEY] for vid, s in files.vehicles.items() if ROLE_KEY in s.params
+        }
+
+    # ----------------------------------------------------------------------------- start
+    @classmethod
+    def start(
+        cls,
+        cfg: Path,
+        overrides: ScenarioOverrides = _NO_OVERRIDES,
+        *,
+        ego_id: str = "ego",
+        step_length_s: float = 0.01,
+        gui: bool = False,
+        use_traci: bool = False,
+        extra_args: tuple[str, ...] = (),
+    ) -> SumoSession:
+        """Check the files, start SUMO, advance it to the ego's departure and make the step
+        that inserts the ego at the requested speed; on return the ego is in SUMO and every
+        query answers. ``gui`` runs ``sumo-gui`` through TraCI, ``use_traci`` plain ``sumo``
+        through TraCI; otherwise libsumo (in-process, one session per process)."""
+        if not isinstance(overrides, ScenarioOverrides):
+            raise TypeError(
+                f"overrides must be a ScenarioOverrides, not {type(overrides).__name__}"
+            )
+        step = number("step_length_s", step_length_s, minimum=0.0, inclusive=False)
+        if abs(step * 1000.0 - round(step * 1000.0)) > 1e-9:
+            raise InputError(
+                f"step_length_s={step_length_s!r} must be a whole number of milliseconds"
+            )
+        extra = tuple(str(a) for a in extra_args)
+        files = check_scenario(Path(cfg), ego_id)
+        scripted_stops(files, overrides, ego_id)
+
+        import sumo
+        import sumolib
+
+        os.environ.setdefault("SUMO_HOME", sumo.SUMO_HOME)
+        via_traci = gui or use_traci
+        if gui and sys.platform.startswith("linux") and not (
+                os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+            raise InputError("--gui needs a display, and DISPLAY is not set (sumo-gui would "
+                             "fail to connect after 30 s)")
+        if not via_traci and _open_libsumo:
+            raise RuntimeError("a libsumo session is already open in this process; close it first")
+        workdir = Path(tempfile.mkdtemp(prefix="eoam-sumo-"))
+        error_log = workdir / "sumo-errors.log"
+        cmd, sumo_overrides = sumo_command(
+            sumolib.checkBinary("sumo-gui" if gui else "sumo"), files.cfg, files.options, step,
+            error_log, extra, gui)
+        try:
+            if via_traci:
+                import traci
+
+                errors = (traci.exceptions.TraCIException, traci.exceptions.FatalTraCIError)
+                try:
+                    api, process = traci_connect(cmd)
+                except (*errors, OSError) as exc:
+                    raise InputError(start_error(files.cfg, error_log, exc)) from exc
+                constants = traci.constants
+            else:
+                import libsumo
+
+                errors = (libsumo.TraCIException, libsumo.FatalTraCIError)
+                try:
+                    with stderr_into(workdir / ERROR_LOG_STDERR):
+                        libsumo.start(cmd)
+                except errors as exc:
+                    raise InputError(start_error(files.cfg, error_log, exc)) from exc
+                api, constants, process = libsumo, libsumo.constants, None
+        except BaseException:
+            shutil.rmtree(workdir, ignore_errors=True)
+            raise
+        session = None
+        try:
+            session = cls(api, constants, errors, files, overrides, ego_id, step, workdir,
+                          process, sumo_overrides)
+            if not via_traci:
+                _open_libsumo.append(session)
+            session._set_up()
+        except BaseException as exc:
+            if session is not None:
+                session._release()
+            else:
+                shut_down(api, process)
+            detail = start_error(files.cfg, error_log, exc) if isinstance(exc, errors) else None
+            shutil.rmtree(workdir, ignore_errors=True)
+            if detail is None:
+                raise
+            raise InputError(detail) from exc
+        return session
+
+    def _set_up(self) -> None:
+        spec = self._files.vehicles[self.ego_id]
+        depart = float_attr(spec, "depart", spec.attrs.get("depart", "0"))
+        if depart < self._time_s - 1e-9:
+            raise InputError(
+                f"{spec.source}: vehicle '{self.ego_id}' departs at {depart:g} s, "
+                f"before the simulation begins ({self._time_s:g} s)"
+            )
+        if self._overrides.mu is not None:
+            settable = True
+            for lane_id in self._lane.getIDList():
+                self._mu_cache[lane_id] = self._overrides.mu
+                if settable:
+                    try:
+                        self._lane.setFriction(lane_id, self._overrides.mu)
+                    except Exception:  # noqa: BLE001 - TraCI's class may come from SUMO_HOME/tools
+                        # TraCI of SUMO 1.28 cannot set friction: the override lives here only
+                        settable = False
+        while self._time_s < depart - 0.5 * self._dt:
+            self._sumo_step()
+        self.ego_depart_time_s = self._time_s
+        ego = self._ego = place_ego(self._api, self._errors, self._files, self._overrides,
+                                    self.ego_id, self._over_limit)
+        self.lane_width_m = ego.lane_width_m
+        self.left_lane_exists = ego.left_lane_exists
+        self._ego_mu = self._friction(ego.lane_id)
+        if self._overrides.oncoming_start_m is not None:
+            self.oncoming_id = add_oncoming(self._api, self._errors, self._files,
+                                            self._overrides, ego, self._over_limit)
+            self.roles[self.oncoming_id] = "oncoming"
+        self._veh.subscribe(self.ego_id, self._users.ego_vars)
+        self._sumo_step()
+        if self.ego_id not in self._veh.getIDList():
+            raise InputError(f"{spec.source}: SUMO did not insert vehicle '{self.ego_id}'")
+        for vid, speed in self._over_limit.items():  # departed at rest (see insert)
+            self._veh.setPreviousSpeed(vid, speed)
+
+    # ----------------------------------------------------------------------------- stepping
+    def _sumo_step(self) -> None:
+        scripts, users = self._scripts, self._users
+        if scripts.running:
+            scripts.apply(self._time_s + self._dt, self._dt, users.step_results(),
+                          self._friction, users.watch)
+        self._api.simulationStep()
+        users.new_step()
+        self._time_s = self._sim.getTime()
+        if users.tracking or scripts.pending:
+            departed = self._sim.getDepartedIDList()
+            if users.tracking:
+                users.track(departed)
+            for vid in departed:
+                if vid in scripts.pending:
+                    scripts.start(vid, users.watch)
+
+    def step(self) -> None:
+        """Advance SUMO by one step."""
+        self._check_open()
+        try:
+            self._sumo_step()
+        except self._errors as exc:
+            raise RuntimeError(f"SUMO failed at t={self._time_s:.3f} s: {exc}") from exc
+
+    @property
+    def time_s(self) -> float:
+        """SUMO's simulation time."""
+        return self._time_s
+
+    @property
+    def step_length_s(self) -> float:
+        return self._dt
+
+    # ----------------------------------------------------------------------------- queries
+    def ego_lane_centreline(self) -> np.ndarray:
+        """(N, 2) centre line of the ego's start lane followed along its route (lane index kept)."""
+        return self._ego.centreline.copy()
+
+    def _friction(self, lane_id: str) -> float:
+        mu = self._mu_cache.get(lane_id)
+        if mu is None:
+            mu = self._mu_cache[lane_id] = float(self._lane.getFriction(lane_id))
+        return mu
+
+    def friction_at_ego(self) -> float:
+        """Friction of the lane under the ego now (the last known one while it is off all lanes)."""
+        lane_id = self._ego_results()[self._tc.VAR_LANE_ID]
+        if lane_id:
+            self._ego_mu = self._friction(lane_id)
+        return self._ego_mu
+
+    def lane_friction(self, lane_id: str) -> float:
+        return float(self._lane.getFriction(lane_id))
+
+    def lane_ids(self) -> list[str]:
+        return list(self._lane.getIDList())
+
+    def move_ego(
+        self, x_front_m: float, y_front_m: float, angle_nav_deg: float, speed_mps: float
+    ) -> None:
+        """Place the ego's front bumper for the next step (keepRoute=2: any lane, even opposite)."""
+        self._check_open()
+        self._veh.moveToXY(self.ego_id, "", -1, x_front_m, y_front_m, angle_nav_deg, 2)
+        self._veh.setSpeed(self.ego_id, speed_mps)
+
+    def nearby(self, radius_m: float) -> list[Body]:
+        """Every other road user (vehicles of every class, persons on foot) some part of which
+        may be within ``radius_m`` of the ego's SUMO position (its front bumper), sorted by id
+        (``RoadUsers.near``). From the first call on the session follows all road users
+        (``session.tracking``)."""
+        self._check_open()
+        if radius_m != self._radius_m:
+            number("radius_m", radius_m, minimum=0.0, inclusive=False)
+            self._radius_m = radius_m
+        ex, ey = self._ego_position()
+        near = self._users.near(ex, ey, radius_m)
+        near.sort()  # Body tuples start with their (unique) id
+        return near
+
+    def road_users(self) -> list[Body]:
+        """Every road user but the ego, wherever it is, sorted by id."""
+        self._check_open()
+        self._ego_position()
+        bodies = self._users.everyone()
+        bodies.sort()
+        return bodies
+
+    def _ego_position(self) -> tuple[float, float]:
+        """The ego's SUMO position (front bumper) from the subscription (following starts)."""
+        users = self._users
+        if not users.tracking:
+            users.start()
+        ego = users.step_results().get(self.ego_id)
+        if not ego:
+            raise RuntimeError(f"the ego '{self.ego_id}' is no longer in the simulation")
+        return ego[self._tc.VAR_POSITION]
+
+    def _ego_results(self) -> dict:
+        self._check_open()
+        res = self._users.step_results().get(self.ego_id)
+        if not res:
+            raise RuntimeError(f"the ego '{self.ego_id}' is no longer in the simulation")
+        return res
+
+    def ego_body(self) -> Body:
+        """The ego as SUMO sees it."""
+        self._ego_results()  # fails when the ego has left
+        veh, ego = self._veh, self.ego_id
+        return self._users.vehicle_body(ego, veh.getPosition(ego), veh.getAngle(ego),
+                                        veh.getSpeed(ego), self._ego.type_id, 0)
+
+    def body(self, vid: str) -> Body:
+        """Any road user by id, a vehicle or a person (getters; for checks, not for the step
+        loop)."""
+        self._check_open()
+        if vid not in self._veh.getIDList() and vid in self._api.person.getIDList():
+            person = self._api.person
+            return self._users.person_body(vid, person.getPosition(vid), person.getAngle(vid),
+                                           person.getSpeed(vid), person.getTypeID(vid))
+        veh = self._veh
+        return self._users.vehicle_body(vid, veh.getPosition(vid), veh.getAngle(vid),
+                                        veh.getSpeed(vid), veh.getTypeID(vid),
+                                        veh.getStopState(vid))
+
+    def vehicle_ids(self) -> list[str]:
+        return list(self._veh.getIDList())
+
+    def vehicle_speed(self, vid: str) -> float:
+        return float(self._veh.getSpeed(vid))
+
+    def vehicle_lane(self, vid: str) -> str:
+        return self._veh.getLaneID(vid)
+
+    # ----------------------------------------------------------------------------- life cycle
+    def _check_open(self) -> None:
+        if self._closed:
+            raise RuntimeError("the SUMO session is closed")
+
+    def _release(self) -> None:
+        """End SUMO, keeping the session's working directory."""
+        if self._closed:
+            return
+        self._closed = True
+        if self in _open_libsumo:
+            _open_libsumo.remove(self)
+        shut_down(self._api, self._process)
+
+    def close(self) -> None:
+        """End SUMO (idempotent)."""
+        self._release()
+        shutil.rmtree(self._workdir, ignore_errors=True)
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
