@@ -13,10 +13,13 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
-## The main job: the paper's Table 2 (64 co-simulations), printed beside the paper's.
+## The main job: the paper's Table 2 (64 co-simulations), printed beside the paper's; then
+## the same 64 cases under the safe policy with V2X, also beside the paper's.
 run: $(STAMP)
 	$(BIN)/eoam-sumo batch scenarios/table2.toml --out $(OUT)/table2 --jobs 2
 	cat $(OUT)/table2/table2.md
+	$(BIN)/eoam-sumo batch scenarios/table2_safe_v2x.toml --out $(OUT)/table2_safe_v2x --jobs 2
+	cat $(OUT)/table2_safe_v2x/table2.md
 
 ## Every test, the SUMO co-simulations included (what CI runs).
 test: $(STAMP)

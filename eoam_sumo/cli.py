@@ -107,6 +107,15 @@ def build_parser() -> argparse.ArgumentParser:
                    "friction estimator's output) or a number (default: known)")
     p.add_argument("--seed", type=_seed, default=0, help="seed of every random model (0)")
     p.add_argument("--gui", action="store_true", help="run in sumo-gui through TraCI")
+    p.add_argument("--policy", choices=("paper", "safe"), default="paper",
+                   help="decision policy: the paper's (default) or safe (sight-distance gate)")
+    p.add_argument("--v2x-range-m", type=_finite, default=0.0,
+                   help="V2X reception range (m), 0 = no V2X (safe policy only)")
+    p.add_argument("--v2x-latency-s", type=_finite, default=0.1, help="V2X latency (s)")
+    p.add_argument("--v2x-loss", type=_finite, default=0.0,
+                   help="V2X packet-loss probability, in [0, 1)")
+    p.add_argument("--v2x-penetration", type=_finite, default=1.0,
+                   help="share of road users equipped with V2X, in [0, 1]")
 
     p = sub.add_parser(
         "batch", help="run every case of an experiment matrix",
@@ -155,7 +164,7 @@ def _cmd_tables(args) -> int:
 
 def _cmd_run(args) -> int:
     from eoam_sumo.sensing.friction import parse_mu_belief
-    from eoam_sumo.sim.cosim import RunSettings, run_case
+    from eoam_sumo.sim.cosim import RunSettings, policy_settings, run_case
     from eoam_sumo.sim.radar import RadarSettings
     from eoam_sumo.sim.scenario import ScenarioOverrides
 
@@ -165,6 +174,7 @@ def _cmd_run(args) -> int:
         raise InputError(f"--max-time-s {args.max_time_s} must be > 0")
     if args.radar_range_m is not None and args.radar_range_m <= 0:
         raise InputError(f"--radar-range-m {args.radar_range_m} must be > 0")
+    _check_v2x(args)
     out = _writable_dir(args.out)
     overrides = ScenarioOverrides(
         ego_speed_mps=None if args.speed_kmh is None else args.speed_kmh / 3.6,
@@ -177,14 +187,41 @@ def _cmd_run(args) -> int:
     )
     if args.radar_range_m is not None:
         settings = replace(settings, radar=RadarSettings(range_m=args.radar_range_m))
+    settings = policy_settings(settings, args.policy, args.v2x_range_m, args.v2x_latency_s,
+                               args.v2x_loss, args.v2x_penetration)
     s = run_case(args.cfg, overrides, out, settings)
     print(
         f"{s['outcome']}: collision_with={s['collision_with']} "
         f"impact={s['impact_speed_mps']:.1f} m/s modes={s['modes_visited']} "
-        f"fcw={s['fcw_raised']} mu={s['mu']:.2f} sim={s['sim_time_s']:.2f} s "
+        f"fcw={s['fcw_raised']} mu={s['mu']:.2f} policy={s['policy']} "
+        f"{_sight_text(s)}sim={s['sim_time_s']:.2f} s "
         f"rtf={s['realtime_factor']:.0f} -> {out}"
     )
     return 0
+
+
+def _check_v2x(args) -> None:
+    """InputError for a V2X option out of its range, or V2X without the safe policy."""
+    if args.v2x_range_m < 0.0:
+        raise InputError(f"--v2x-range-m {args.v2x_range_m:g} must be >= 0")
+    if args.v2x_latency_s < 0.0:
+        raise InputError(f"--v2x-latency-s {args.v2x_latency_s:g} must be >= 0")
+    if not 0.0 <= args.v2x_loss < 1.0:
+        raise InputError(f"--v2x-loss {args.v2x_loss:g} must be in [0, 1)")
+    if not 0.0 <= args.v2x_penetration <= 1.0:
+        raise InputError(f"--v2x-penetration {args.v2x_penetration:g} must be in [0, 1]")
+    if args.v2x_range_m > 0.0 and args.policy != "safe":
+        raise InputError("--v2x-range-m needs --policy safe (V2X informs the safe policy only)")
+
+
+def _sight_text(summary: dict) -> str:
+    """The sight-distance gate's record for the run's line (empty when it was not asked)."""
+    if not summary.get("sight_gate"):
+        return ""
+    need = summary["sight_needed_m"]
+    need_text = "never passes" if need is None else f"{need:.0f} m"
+    return (f"gate={summary['sight_gate']} (needed {need_text}, known free "
+            f"{summary['sight_known_free_m']:.0f} m) ")
 
 
 def _cmd_batch(args) -> int:

@@ -36,6 +36,7 @@ from eoam_sumo.control.steering import SteeringController, SteeringGains
 from eoam_sumo.decision import modes
 from eoam_sumo.decision.dmm import Action, BoundaryCurve, Sector
 from eoam_sumo.decision.modes import Mode, next_mode
+from eoam_sumo.decision.policy import NextLaneView, PolicySettings, SafePolicy
 from eoam_sumo.params import G_MPS2, PONR_FRACTION, VehicleParams
 
 _TWO_PI = 2.0 * math.pi
@@ -80,6 +81,7 @@ class Perception(NamedTuple):
     oncoming_detected: bool = False
     aro_object: ObjectState | None = None  # the in-path obstacle as an object, when tracked
     next_lane_obstacle_range_m: float | None = None  # nearest standing object in the next lane
+    next_lane: NextLaneView | None = None  # what is known of the next lane (safe policy)
 
 
 class Command(NamedTuple):
@@ -131,6 +133,7 @@ class EoamSettings:
     preview_time_s: float = 0.3  # feedforward curvature taken this far ahead on the path
     steering: SteeringGains = field(default_factory=SteeringGains)
     longitudinal: LongitudinalGains = field(default_factory=LongitudinalGains)
+    policy: PolicySettings = field(default_factory=PolicySettings)  # paper or safe
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -165,6 +168,8 @@ _NO_ACTION = Action.NONE
 _SECTOR_G = Sector.G
 _WARNING_MODES = (_UPDATE_BRAKE, _STEER_BRAKE, _ONCOMING_BRAKE, _ONCOMING_STEER)  # FCW stays on
 _STEERING = (_STEER_BRAKE, _ONCOMING_STEER)
+_COMMITTING = (_NORMAL, _UPDATE_BRAKE)  # a STEER here begins a lane change (safe policy gate)
+_WATCHING = (_STEER_BRAKE, _RETURN)  # the safe policy watches the next lane in these modes
 
 
 class EoamController:
@@ -181,6 +186,8 @@ class EoamController:
         self._brake_mu = math.nan
         self._brake_limit = 0.0
         self._initial_speed: float | None = None
+        self.policy = (SafePolicy(params, tables, settings, settings.policy)
+                       if settings.policy.name == "safe" else None)
         self._reset_state()
 
     # ----------------------------------------------------------------------------- lifecycle
@@ -199,6 +206,8 @@ class EoamController:
         self._urgent_return = False
         self._obstacle: tuple[float, float, float, float] | None = None  # t, front s, v, left
         self._long.reset()
+        if self.policy is not None:
+            self.policy.reset()
 
     def reset(self, initial_speed_mps: float) -> None:
         """Start a run: NORMAL, holding ``initial_speed_mps`` with the speed PID."""
@@ -358,6 +367,11 @@ class EoamController:
         block_m = perception.next_lane_obstacle_range_m
         if block_m is not None and rng is not None and block_m <= rng + st.next_lane_clear_m:
             oncoming = True  # the lane change would end against a standing car: as deadly
+        policy = self.policy
+        if policy is not None and policy.blocks(
+                meas, perception, action is _STEER and self.mode in _COMMITTING,
+                self.mode in _WATCHING):
+            oncoming = True  # the next lane is not known free (safe policy): as oncoming
 
         # ---- mode machine --------------------------------------------------------------
         mode = self.mode
@@ -382,11 +396,15 @@ class EoamController:
             and abs(d - path.start_offset_m - height) <= st.arrive_tolerance_m
             and abs(_wrap(meas.e_yaw_rad)) <= st.settle_heading_rad
         )
+        past_ponr = travel >= st.ponr_fraction * height
+        if (past_ponr and oncoming and mode is _STEER_BRAKE and policy is not None
+                and policy.prefer_braking(meas, perception)):
+            past_ponr = False  # severity tie-breaker: braking in lane ends softer
         new = next_mode(
             mode,
             action,
             oncoming=oncoming,
-            past_ponr=travel >= st.ponr_fraction * height,
+            past_ponr=past_ponr,
             timer_expired=t - self._t_steer >= st.manoeuvre_time_s - 1e-9,
             stable_in_next_lane=stable,
             clear_of_obstacle=clear,

@@ -28,13 +28,22 @@ from eoam_sumo.sim.scenario import ScenarioOverrides, check_scenario, scripted_s
 DEFAULT_MAX_TIME_S = 40.0
 NO_ONCOMING = "none"
 SCHEMA = {
-    "scenario": ("sumocfg", "max_time_s", "radar_range_m"),
+    "scenario": ("sumocfg", "max_time_s", "radar_range_m", "policy", "v2x_range_m",
+                 "v2x_latency_s", "v2x_loss", "v2x_penetration"),
     "sweep": ("ego_speed_kmh", "mu", "oncoming_start_m", "aro_hold_s", "aro_decel_mps2"),
     "paper": ("table",),
 }
 REQUIRED = {"scenario": ("sumocfg",), "sweep": ("ego_speed_kmh", "mu")}
 PAPER_COLUMNS = ("oncoming_start_m", "ego_speed_kmh", "mu", "outcome")
 OUTCOMES = ("none", "green", "yellow", "orange", "red")
+POLICIES = ("paper", "safe")
+#: [scenario] V2X keys: (default, lowest, highest or None, highest included)
+V2X_KEYS = {
+    "v2x_range_m": (0.0, 0.0, None, True),
+    "v2x_latency_s": (0.1, 0.0, None, True),
+    "v2x_loss": (0.0, 0.0, 1.0, False),
+    "v2x_penetration": (1.0, 0.0, 1.0, True),
+}
 
 
 def _id_number(value: float) -> str:
@@ -59,6 +68,11 @@ class Case:
     aro_decel_mps2: float | None
     max_time_s: float
     radar_range_m: float | None = None  # None: the radar's default range
+    policy: str = "paper"
+    v2x_range_m: float = 0.0  # 0: no V2X
+    v2x_latency_s: float = 0.1
+    v2x_loss: float = 0.0
+    v2x_penetration: float = 1.0
 
     def overrides(self) -> ScenarioOverrides:
         return ScenarioOverrides(
@@ -84,6 +98,8 @@ class Matrix:
     aro_decels_mps2: tuple[float, ...]
     paper_table: Path | None = None
     radar_range_m: float | None = None
+    policy: str = "paper"
+    v2x: tuple[float, float, float, float] = (0.0, 0.1, 0.0, 1.0)  # range, latency, loss, share
 
     def cases(self) -> list[Case]:
         """Every case, in the paper's Table 2 order (traffic, speed, friction, ARO stop)."""
@@ -116,6 +132,8 @@ class Matrix:
                                     decel,
                                     self.max_time_s,
                                     self.radar_range_m,
+                                    self.policy,
+                                    *self.v2x,
                                 )
                             )
         return cases
@@ -242,6 +260,22 @@ def load_matrix(path: Path) -> Matrix:
     radar_range = scenario.get("radar_range_m")
     if radar_range is not None and (not _is_number(radar_range) or radar_range <= 0):
         raise InputError(f"{path}: [scenario] radar_range_m = {radar_range!r} must be a number > 0")
+    policy = scenario.get("policy", "paper")
+    if policy not in POLICIES:
+        raise InputError(f"{path}: [scenario] policy = {policy!r} must be one of "
+                         f"{', '.join(repr(p) for p in POLICIES)}")
+    v2x = []
+    for key, (default, low, high, high_in) in V2X_KEYS.items():
+        value = scenario.get(key, default)
+        if (not _is_number(value) or value < low
+                or (high is not None and (value > high or (value == high and not high_in)))):
+            bound = f">= {low:g}" + ("" if high is None else
+                                     f" and {'<=' if high_in else '<'} {high:g}")
+            raise InputError(f"{path}: [scenario] {key} = {value!r} must be a number {bound}")
+        v2x.append(float(value))
+    if v2x[0] > 0.0 and policy != "safe":
+        raise InputError(f"{path}: [scenario] v2x_range_m = {v2x[0]:g} needs policy = "
+                         "\"safe\" (V2X informs the safe policy only)")
     paper = None
     if "table" in doc.get("paper", {}):
         paper = _existing_file(path, "[paper] table", doc["paper"]["table"])
@@ -275,6 +309,8 @@ def load_matrix(path: Path) -> Matrix:
             else ()
         ),
         paper_table=paper,
+        policy=policy,
+        v2x=tuple(v2x),
     )
 
 

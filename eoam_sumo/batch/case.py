@@ -38,6 +38,11 @@ def case_parameters(case: Case) -> dict:
         "aro_decel_mps2": case.aro_decel_mps2,
         "max_time_s": case.max_time_s,
         "radar_range_m": case.radar_range_m,
+        "policy": case.policy,
+        "v2x_range_m": case.v2x_range_m,
+        "v2x_latency_s": case.v2x_latency_s,
+        "v2x_loss": case.v2x_loss,
+        "v2x_penetration": case.v2x_penetration,
         "sumocfg": str(case.sumocfg),
     }
 
@@ -47,11 +52,13 @@ def run_matrix_case(task: CaseTask) -> dict:
 
     Old output files of the case are removed first, so a folder never mixes runs.
     """
-    from eoam_sumo.sim.cosim import RunSettings, run_case
+    from eoam_sumo.sim.cosim import RunSettings, policy_settings, run_case
     from eoam_sumo.sim.radar import RadarSettings
 
     case = task.case
-    settings = RunSettings(max_time_s=case.max_time_s, tables_dir=task.tables_dir)
+    settings = policy_settings(
+        RunSettings(max_time_s=case.max_time_s, tables_dir=task.tables_dir), case.policy,
+        case.v2x_range_m, case.v2x_latency_s, case.v2x_loss, case.v2x_penetration)
     if case.radar_range_m is not None:
         settings = replace(settings, radar=RadarSettings(range_m=case.radar_range_m))
     extra = {"case": case_parameters(case)}

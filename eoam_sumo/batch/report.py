@@ -202,12 +202,17 @@ def table2_markdown(grid: OutcomeGrid, title: str = "Table 2") -> str:
 
 def write_report(out_dir: Path, results: pd.DataFrame) -> list[Path]:
     """Write ``table2.md`` and ``table2.png`` of a results frame into ``out_dir``."""
+    from eoam_sumo.batch.policy_report import policy_line, policy_title, sight_markdown
     from eoam_sumo.plotting.batch_plots import plot_table2
 
     out_dir = Path(out_dir)
     grid = outcome_grid(results)
     md = out_dir / TABLE_MD
     tmp = md.with_name(md.name + ".tmp")
-    tmp.write_text(table2_markdown(grid), encoding="utf-8")
+    text = table2_markdown(grid, policy_title(results))
+    head, _, rest = text.partition("\n\n")
+    sight = sight_markdown(results)
+    text = f"{head}\n\n{policy_line(results)}\n\n{rest}" + (f"\n{sight}" if sight else "")
+    tmp.write_text(text, encoding="utf-8")
     os.replace(tmp, md)
     return [md, plot_table2(grid, out_dir / TABLE_PNG)]

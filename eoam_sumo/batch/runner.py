@@ -35,13 +35,15 @@ RESULTS_FILE = "results.csv"
 CASES_DIR = "cases"
 #: results.csv columns: the case's parameters, its status, the summary fields, where it lives.
 PARAM_COLUMNS = ("case_id", "ego_speed_kmh", "mu", "oncoming_start_m", "aro_hold_s",
-                 "aro_decel_mps2", "max_time_s", "radar_range_m")
+                 "aro_decel_mps2", "max_time_s", "radar_range_m", "policy", "v2x_range_m",
+                 "v2x_latency_s", "v2x_loss", "v2x_penetration")
 SUMMARY_COLUMNS = (
     "outcome", "collision_with", "impact_speed_mps", "contact_kind", "contact_time_s",
     "reason", "modes_visited", "fcw_raised", "mu_at_start", "min_gap_aro_m",
     "max_abs_lat_accel_mps2", "max_lateral_offset_m", "final_lateral_offset_m",
     "final_speed_mps", "max_abs_heading_error_rad", "min_speed_mps", "left_road",
-    "ego_initial_speed_mps", "sim_time_s", "wall_time_s", "realtime_factor",
+    "ego_initial_speed_mps", "sim_time_s", "wall_time_s", "realtime_factor", "sight_gate",
+    "sight_needed_m", "sight_known_free_m", "sight_time_s", "tie_break",
 )
 COLUMNS = (*PARAM_COLUMNS, "status", "paper_outcome", *SUMMARY_COLUMNS, "error", "case_dir",
            "sumocfg")
@@ -52,7 +54,8 @@ NUMERIC_COLUMNS = (
     "radar_range_m", "impact_speed_mps", "contact_time_s", "mu_at_start", "min_gap_aro_m",
     "max_abs_lat_accel_mps2", "max_lateral_offset_m", "final_lateral_offset_m",
     "final_speed_mps", "max_abs_heading_error_rad", "min_speed_mps", "ego_initial_speed_mps",
-    "sim_time_s", "wall_time_s", "realtime_factor",
+    "sim_time_s", "wall_time_s", "realtime_factor", "v2x_range_m", "v2x_latency_s", "v2x_loss",
+    "v2x_penetration", "sight_needed_m", "sight_known_free_m", "sight_time_s",
 )
 #: How long to keep trying to reach a Dask scheduler [s].
 DASK_CONNECT_TIMEOUT_S = 20.0
@@ -74,7 +77,9 @@ def result_row(case: Case, result: TaskResult, paper_outcome: str | None = None)
                ego_speed_kmh=case.ego_speed_kmh, mu=case.mu,
                oncoming_start_m=case.oncoming_start_m, aro_hold_s=case.aro_hold_s,
                aro_decel_mps2=case.aro_decel_mps2, max_time_s=case.max_time_s,
-               radar_range_m=case.radar_range_m, case_dir=case_dir_of(case.case_id),
+               radar_range_m=case.radar_range_m, policy=case.policy,
+               v2x_range_m=case.v2x_range_m, v2x_latency_s=case.v2x_latency_s,
+               v2x_loss=case.v2x_loss, v2x_penetration=case.v2x_penetration, case_dir=case_dir_of(case.case_id),
                sumocfg=str(case.sumocfg))
     summary = result.value.get("summary") if isinstance(result.value, dict) else None
     if not result.ok or not isinstance(summary, dict):
@@ -157,22 +162,28 @@ class _RowLog:
         self.fh.close()
 
 
+#: The settings of a case besides its id that a resumed row must share with it.
+_SAME_CASE = ("sumocfg", "max_time_s", "radar_range_m", "policy", "v2x_range_m",
+              "v2x_latency_s", "v2x_loss", "v2x_penetration")
+
+
 def _case_keys(cases: list[Case]) -> dict[str, tuple[str, ...]]:
-    """case_id -> (sumocfg, max_time_s, radar_range_m) as results.csv writes them."""
-    frame = pd.DataFrame([(c.case_id, str(c.sumocfg), c.max_time_s, c.radar_range_m)
-                          for c in cases],
-                         columns=["case_id", "sumocfg", "max_time_s", "radar_range_m"])
+    """case_id -> its ``_SAME_CASE`` settings as results.csv writes them."""
+    frame = pd.DataFrame([(c.case_id, *(str(c.sumocfg) if k == "sumocfg" else getattr(c, k)
+                                        for k in _SAME_CASE)) for c in cases],
+                         columns=["case_id", *_SAME_CASE])
     text = pd.read_csv(io.StringIO(frame.to_csv(index=False)), dtype=str, keep_default_na=False)
     return {r[0]: tuple(r[1:]) for r in text.itertuples(index=False)}
 
 
 def _kept_rows(path: Path, cases: list[Case]) -> pd.DataFrame:
     """Rows of an earlier run worth keeping: finished, and still the same case (same id, and
-    the same scenario file, time limit and radar range as written in results.csv)."""
+    the same scenario file, time limit, radar range, policy and V2X link as written in
+    results.csv)."""
     rows = _read_rows(path)
     want = _case_keys(cases)
     same = [want.get(cid) == key for cid, key in zip(
-        rows["case_id"], zip(rows["sumocfg"], rows["max_time_s"], rows["radar_range_m"]))]
+        rows["case_id"], zip(*(rows[k] for k in _SAME_CASE)))]
     keep = (rows["status"] == "ok").to_numpy() & pd.Series(same, dtype=bool).to_numpy()
     return rows[keep].drop_duplicates("case_id", keep="last")
 

@@ -13,7 +13,7 @@ import contextlib
 import gc
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +24,8 @@ from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.plant import Plant, initial_state
 from eoam_sumo.sensing.friction import FrictionBelief
+from eoam_sumo.sensing.next_lane import CornerRadarSettings, NextLaneSensing
+from eoam_sumo.sensing.v2x import V2XSettings
 from eoam_sumo.sim.bodies import nav_angle_deg
 from eoam_sumo.sim.geometry import OrientedBox, box_distance, boxes_overlap, contact
 from eoam_sumo.sim.outcome import classify_outcome, left_road, role_of
@@ -50,6 +52,8 @@ class RunSettings:
     eoam: EoamSettings = field(default_factory=EoamSettings)
     mu_belief: str | float = "known"  # sensing.friction: known, estimate or a number
     seed: int = 0  # seeds every random model of the run (friction estimator, radar)
+    v2x: V2XSettings = field(default_factory=V2XSettings)  # used by the safe policy
+    corner_radar: CornerRadarSettings = field(default_factory=CornerRadarSettings)
 
     def __post_init__(self) -> None:
         ms = self.step_s * 1000.0
@@ -60,6 +64,9 @@ class RunSettings:
             raise ValueError(f"plant_dt_s={self.plant_dt_s} must divide step_s={self.step_s}")
         if self.max_time_s <= 0:
             raise ValueError(f"max_time_s={self.max_time_s} must be > 0")
+        if self.v2x.enabled and self.eoam.policy.name != "safe":
+            raise ValueError("V2X informs the safe policy only: set policy 'safe' or V2X "
+                             "range 0")
 
     @property
     def substeps(self) -> int:
@@ -143,7 +150,9 @@ class CoSimulation:
         ctrl = EoamController(p, self.tables, st.eoam)
         ctrl.reset(ego.speed_mps)
         left_lane = session.left_lane_exists
-        sense_radius = st.radar.range_m  # from the front bumper, where the radar is
+        lane_sensing = self._next_lane_sensing(session, lane_width)  # safe policy only
+        # from the front bumper, where the radar is; further for V2X and the corner radars
+        sense_radius = max(st.radar.range_m, lane_sensing.reach_m if lane_sensing else 0.0)
         steps = round(st.max_time_s / st.step_s)
         end_s_m = road.length_m - ROAD_END_MARGIN_M  # the run ends this close to the road end
         log = RunLog(steps + 1)
@@ -185,6 +194,9 @@ class CoSimulation:
                 (X + front * cy, Y + front * sy), yaw, vx, road, bodies, lane_width
             )
             perception = _perception(report)
+            if lane_sensing is not None:
+                perception = perception._replace(next_lane=lane_sensing.update(
+                    t, (X + front * cy, Y + front * sy), yaw, road, report, bodies))
             e_yaw = yaw - road_yaw  # not wrapped: the plant's yaw is continuous
             meas = EgoMeasurement(
                 t, vx, vy, r, ax, ay, s, d, e_yaw, road.curvature_at(s), mu, lane_width,
@@ -324,8 +336,32 @@ class CoSimulation:
             "sim_time_s": round(sim_time, 6),
             "wall_time_s": wall,
             "realtime_factor": sim_time / self.profile["loop_wall_s"],
+            **self._policy_record(ctrl),
         }
         return summary, log
+
+    def _next_lane_sensing(self, session: SumoSession, lane_width: float):
+        """The next lane's sensing for the safe policy (None for the paper's)."""
+        st = self.settings
+        if st.eoam.policy.name != "safe":
+            return None
+        opposing, limit = session.next_lane_traffic()
+        return NextLaneSensing(
+            opposing=opposing, speed_limit_mps=limit, lane_width_m=lane_width,
+            radar_range_m=st.radar.range_m, radar_fov_deg=st.radar.fov_deg,
+            ego_length_m=self.params.length_m, ego_width_m=self.params.width_m, v2x=st.v2x,
+            corner=st.corner_radar, fastest_mps=st.eoam.policy.opposing_speed_mps)
+
+    def _policy_record(self, ctrl: EoamController) -> dict:
+        """The policy, the V2X settings and what the sight-distance gate needed."""
+        st = self.settings
+        record = {"policy": st.eoam.policy.name, "v2x_range_m": st.v2x.range_m,
+                  "v2x_latency_s": st.v2x.latency_s, "v2x_loss": st.v2x.loss,
+                  "v2x_penetration": st.v2x.penetration}
+        if ctrl.policy is not None:
+            return {**record, **ctrl.policy.summary()}
+        return {**record, "sight_gate": "", "sight_needed_m": None, "sight_known_free_m": None,
+                "sight_time_s": None, "tie_break": ""}
 
     def _finished(self, ctrl: EoamController, x) -> bool:
         """The EOAM is over: handed back to NORMAL after a manoeuvre, or stopped."""
@@ -360,6 +396,16 @@ class CoSimulation:
             if hit is not None:
                 return hit
         return None
+
+
+def policy_settings(settings: RunSettings, policy: str, v2x_range_m: float = 0.0,
+                    v2x_latency_s: float = 0.1, v2x_loss: float = 0.0,
+                    v2x_penetration: float = 1.0) -> RunSettings:
+    """``settings`` with the decision policy and the V2X link set."""
+    eoam = replace(settings.eoam, policy=replace(settings.eoam.policy, name=policy))
+    v2x = replace(settings.v2x, range_m=v2x_range_m, latency_s=v2x_latency_s, loss=v2x_loss,
+                  penetration=v2x_penetration)
+    return replace(settings, eoam=eoam, v2x=v2x)
 
 
 def run_case(

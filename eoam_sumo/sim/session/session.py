@@ -256,6 +256,22 @@ class SumoSession:
     def lane_friction(self, lane_id: str) -> float:
         return float(self._lane.getFriction(lane_id))
 
+    def next_lane_traffic(self) -> tuple[bool, float]:
+        """(opposing, speed limit [m/s]) of the lane left of the ego's along its route: opposing
+        when the ego's start edge has no lane of its own direction to the left but an opposite
+        lane; the speed limit is the highest of those lanes along the route (0: none)."""
+        ego, opposing, limit = self._ego, False, 0.0
+        for edge in ego.route_edges:
+            if ego.lane_index < self._api.edge.getLaneNumber(edge) - 1:
+                lane = f"{edge}_{ego.lane_index + 1}"
+            else:
+                lane = self._files.opposite_lanes.get(f"{edge}_{ego.lane_index}")
+                if lane is None:
+                    continue
+                opposing = opposing or edge == ego.route_edges[0]
+            limit = max(limit, float(self._lane.getMaxSpeed(lane)))
+        return opposing, limit
+
     def lane_ids(self) -> list[str]:
         return list(self._lane.getIDList())
 

@@ -1,0 +1,88 @@
+"""The decision policy of a batch in its Table 2 report: title, settings line, sight distances.
+
+Under the safe policy every case records what its sight-distance gate needed (the passing
+sight distance of the lane change when the DMM first asked for one) and the length of the
+next lane known to be free then; ``sight_markdown`` lays them out in the grid of Table 2.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pandas as pd
+
+from eoam_sumo.batch.report import mu_text, traffic_label
+
+
+def _first(results: pd.DataFrame, column: str, default=None):
+    values = results[column].dropna() if column in results else []
+    return values.iloc[0] if len(values) else default
+
+
+def policy_title(results: pd.DataFrame) -> str:
+    """'Table 2, policy safe, V2X 1000 m' (the paper policy without V2X: 'Table 2')."""
+    policy = _first(results, "policy", "paper") or "paper"
+    v2x = _first(results, "v2x_range_m", 0.0)
+    title = "Table 2" if policy == "paper" else f"Table 2, policy {policy}"
+    if v2x and v2x > 0:
+        title += f", V2X {v2x:g} m"
+    return title
+
+
+def policy_line(results: pd.DataFrame) -> str:
+    """One line naming the policy, the radar range and the V2X link."""
+    policy = _first(results, "policy", "paper") or "paper"
+    radar = _first(results, "radar_range_m")
+    radar_text = "100 m (default)" if radar is None or not math.isfinite(radar) else f"{radar:g} m"
+    line = f"Policy **{policy}**; forward radar {radar_text}"
+    v2x = _first(results, "v2x_range_m", 0.0)
+    if v2x and v2x > 0:
+        line += (f"; V2X range {v2x:g} m, latency {_first(results, 'v2x_latency_s'):g} s, "
+                 f"loss {_first(results, 'v2x_loss'):g}, penetration "
+                 f"{_first(results, 'v2x_penetration'):g}")
+    elif policy == "safe":
+        line += "; no V2X"
+    return line + "."
+
+
+def _sight_cell(row) -> str:
+    gate = row.get("sight_gate") or ""
+    if not gate:
+        return "—"
+    need = row.get("sight_needed_m")
+    free = row.get("sight_known_free_m")
+    need_text = "∞" if need is None or not math.isfinite(need) else f"{need:.0f}"
+    free_text = "?" if free is None or not math.isfinite(free) else f"{free:.0f}"
+    return f"{need_text} / {free_text} {'✓' if gate == 'passed' else '✗'}"
+
+
+def sight_markdown(results: pd.DataFrame) -> str:
+    """The sight distance each case needed and knew free at its first lane-change request,
+    in Table 2's grid (empty text when no case asked the gate)."""
+    if "sight_gate" not in results or not (results["sight_gate"].fillna("") != "").any():
+        return ""
+    rows, mus, cells = [], [], {}
+    for _, row in results.iterrows():
+        key = (traffic_label(row["oncoming_start_m"]), f"{row['ego_speed_kmh']:g} km/h")
+        if key not in rows:
+            rows.append(key)
+        if row["mu"] not in mus:
+            mus.append(row["mu"])
+        cells[(rows.index(key), mus.index(row["mu"]))] = _sight_cell(row)
+    lines = [
+        "## Sight distance of each lane change (safe policy)", "",
+        "Each cell: passing sight distance needed [m] / length of the next lane known free "
+        "[m], when the DMM first asked for the lane change; ✓ the gate let it begin, ✗ it "
+        "braked in lane instead; — no lane change was asked for; ∞ the ego would never get "
+        "past the obstacle.", "",
+        "| Traffic | Initial ego speed | "
+        + " | ".join(f"{mu_text(mu)} surface mu" for mu in mus) + " |",
+        "|---|---|" + "---|" * len(mus),
+    ]
+    previous = None
+    for i, (traffic, speed) in enumerate(rows):
+        cols = [cells.get((i, j), "") for j in range(len(mus))]
+        lines.append(f"| {traffic if traffic != previous else ''} | {speed} | "
+                     + " | ".join(cols) + " |")
+        previous = traffic
+    return "\n".join(lines) + "\n"
