@@ -71,10 +71,10 @@ def sight_markdown(results: pd.DataFrame) -> str:
         cells[(rows.index(key), mus.index(row["mu"]))] = _sight_cell(row)
     lines = [
         "## Sight distance of each lane change (safe policy)", "",
-        "Each cell: passing sight distance needed [m] / length of the next lane known free "
+        ("Each cell: passing sight distance needed [m] / length of the next lane known free "
         "[m], when the DMM first asked for the lane change; ✓ the gate let it begin, ✗ it "
         "braked in lane instead; — no lane change was asked for; ∞ the ego would never get "
-        "past the obstacle.", "",
+        "past the obstacle."), "",
         "| Traffic | Initial ego speed | "
         + " | ".join(f"{mu_text(mu)} surface mu" for mu in mus) + " |",
         "|---|---|" + "---|" * len(mus),

@@ -15,7 +15,7 @@ lane's road frame (w the lane width). Three sensors look at it, all on the ego's
   while it may go unheard (``V2XSettings.blind_time_s``).
 
 The strip of lane beside the ego's body, between the corner radars' fields, counts as seen: a
-road user there came through a seen part (a tracker follows it). Coverage is measured on three
+road user there came through a seen part (a tracker follows it), and is reported. Coverage is measured on three
 lines along the lane (0.25 m inside each marker and its centre): the covered length ahead is
 where the first of them stops being covered without a gap. Geometry is that of a straight road
 (stations and offsets in the road frame).
@@ -38,6 +38,7 @@ from eoam_sumo.sensing.v2x import V2XReceiver, V2XSettings
 MIN_OVERLAP_M = 0.1  # a road user reaching this far into the lane is in it [m]
 FUSION_GATE_M = 3.0  # radar and V2X objects closer than this (centre, plus half lengths) [m]
 LINE_INSET_M = 0.25  # coverage lines: this far inside each lane marker [m]
+BESIDE_M = 2.0  # a road user within this of the ego's body along the road is beside it [m]
 
 
 @dataclass(frozen=True)
@@ -129,8 +130,8 @@ class NextLaneSensing:
 
     def __init__(self, *, opposing: bool, speed_limit_mps: float, lane_width_m: float,
                  radar_range_m: float, radar_fov_deg: float, ego_length_m: float,
-                 ego_width_m: float, v2x: V2XSettings = V2XSettings(),
-                 corner: CornerRadarSettings = CornerRadarSettings(),
+                 ego_width_m: float, v2x: V2XSettings | None = None,
+                 corner: CornerRadarSettings | None = None,
                  fastest_mps: float | None = None):
         self.opposing = opposing
         self.speed_limit_mps = speed_limit_mps
@@ -138,7 +139,8 @@ class NextLaneSensing:
         self.radar_range_m = radar_range_m
         self._radar_half_fov = math.radians(0.5 * radar_fov_deg)
         self.ego_length_m, self.ego_width_m = ego_length_m, ego_width_m
-        self.corner = corner
+        v2x = v2x or V2XSettings()
+        self.corner = corner or CornerRadarSettings()
         self.v2x = V2XReceiver(v2x) if v2x.enabled else None
         fastest = speed_limit_mps if fastest_mps is None else fastest_mps
         self._v2x_free_m = (v2x.range_m - fastest * v2x.blind_time_s()
@@ -231,16 +233,21 @@ class NextLaneSensing:
         bore = math.radians(c.boresight_deg)
         sensors = ((fx, fy, yaw_rad + bore), (rx, ry, yaw_rad + math.pi - bore))
         out = []
+        s_front = road.project(*front_xy)[0]
         for b in bodies:
-            for ox, oy, look in sensors:
-                if math.hypot(b.x_m - ox, b.y_m - oy) > c.range_m + b.box.radius_m:
-                    continue
-                px, py = b.box.nearest_point(ox, oy)
-                if math.hypot(px - ox, py - oy) > c.range_m:
-                    continue
-                bearing = math.remainder(math.atan2(py - oy, px - ox) - look, math.tau)
-                if abs(bearing) > half_fov:
-                    continue
+            s_b = road.project(b.x_m, b.y_m)[0]
+            beside = (s_b - 0.5 * b.length_m <= s_front + BESIDE_M
+                      and s_b + 0.5 * b.length_m >= s_front - self.ego_length_m - BESIDE_M)
+            for ox, oy, look in sensors if not beside else ((fx, fy, None),):
+                if look is not None:  # beside the body: tracked (module doc)
+                    if math.hypot(b.x_m - ox, b.y_m - oy) > c.range_m + b.box.radius_m:
+                        continue
+                    px, py = b.box.nearest_point(ox, oy)
+                    if math.hypot(px - ox, py - oy) > c.range_m:
+                        continue
+                    bearing = math.remainder(math.atan2(py - oy, px - ox) - look, math.tau)
+                    if abs(bearing) > half_fov:
+                        continue
                 s, d, ryaw = road.project(b.x_m, b.y_m)
                 if not self._in_lane(d, b.width_m, lane_lo, lane_hi):
                     break
