@@ -108,7 +108,9 @@ def test_write_report_writes_markdown_and_a_png(tmp_path):
     _, results = _results(tmp_path, REPO / "scenarios" / "table2.toml", differ=(5,),
                           failed=(6,))
     md, png = write_report(tmp_path, results)
-    assert md.read_text(encoding="utf-8") == table2_markdown(outcome_grid(results))
+    head, _, rest = table2_markdown(outcome_grid(results)).partition("\n\n")
+    text = md.read_text(encoding="utf-8")  # the grid, with the policy's line below the title
+    assert text.startswith(f"{head}\n\nPolicy **paper**; forward radar") and text.endswith(rest)
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
 
 

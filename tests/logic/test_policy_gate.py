@@ -18,7 +18,7 @@ from eoam_sumo.decision.policy import (
     sight_needed,
 )
 from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, ObjectState, Perception
-from eoam_sumo.offline.tables import LookupTables, default_tables_dir
+from eoam_sumo.offline.tables import LookupTables, TrajectoryPoint, default_tables_dir
 from eoam_sumo.params import G_MPS2, ego_e_class_sedan
 
 P = ego_e_class_sedan()
@@ -36,7 +36,7 @@ class _Flat:
     length_m = 80.0
 
     def at(self, dx_m):
-        return (0.0, 0.0, 0.0, 0.0, 0.0)
+        return TrajectoryPoint(0.0, 0.0, 0.0, 0.0, 0.0)
 
 
 def _need(tables, **kw):

@@ -8,6 +8,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from eoam_sumo.params import LANE_CHANGE_HEIGHT_M, PONR_FRACTION
 from eoam_sumo.sim.cosim import RunSettings, policy_settings, run_case
 from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
 
@@ -16,7 +17,7 @@ pytestmark = pytest.mark.sumo
 ROOT = Path(__file__).resolve().parents[2]
 SCENARIOS = ROOT / "scenarios"
 BASELINE = SCENARIOS / "baseline.sumocfg"
-PONR_M = 0.3 * 3.5  # the point of no return: 30 % of the lane width of lateral travel
+PONR_M = PONR_FRACTION * LANE_CHANGE_HEIGHT_M  # the point of no return on 3.5 m lanes
 SAFE_OUTCOMES = ("green", "yellow")
 #: A van creeping west at 1.5 m/s in the opposite lane beside where the ARO stops.
 VAN = ('<vType id="van" vClass="delivery" length="5.50" width="2.00" maxSpeed="1.50" '
