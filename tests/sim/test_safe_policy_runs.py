@@ -10,7 +10,7 @@ import pytest
 
 from eoam_sumo.params import LANE_CHANGE_HEIGHT_M, PONR_FRACTION
 from eoam_sumo.sim.cosim import RunSettings, policy_settings, run_case
-from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
+from eoam_sumo.sim.scenario import ScenarioOverrides
 
 pytestmark = pytest.mark.sumo
 
