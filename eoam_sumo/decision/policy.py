@@ -25,8 +25,10 @@ distance)::
 If the gate fails the lane change is not begun: the EOAM brakes in lane (mode 3). Any road user
 in the next lane (vehicle, bicycle or person, whatever its speed or direction) closer than the
 distance still needed blocks the lane change as an oncoming vehicle does in the paper (mode 3
-before the point of no return, 4 after it); on a lane of the ego's own direction so does one
-closing from behind. When every option past the point of no return ends in contact, the one
+before the point of no return, 4 after it). A lane of the ego's own direction needs no sight
+distance against opposing traffic; there a road user ahead that the ego would catch up during
+the manoeuvre, or one closing from behind that would catch the ego up, blocks, and the lane
+must be seen as far as the ego drives in it until it is past the obstacle. When every option past the point of no return ends in contact, the one
 with the lower predicted delta-v of the ego (equal masses, plastic impact) is taken.
 """
 
@@ -222,7 +224,9 @@ class SafePolicy:
 
     def _lane_free(self, view: NextLaneView, speed_mps: float, t_left_s: float,
                    need_m: float, committing: bool) -> bool:
-        """The next lane is free for ``t_left_s`` more seconds of manoeuvre."""
+        """The next lane is free for ``t_left_s`` more seconds of manoeuvre; at a commit it
+        must be seen ``need_m`` ahead (free of road users too, if it carries opposing
+        traffic)."""
         st = self.settings
         if view.opposing:
             if committing:
@@ -233,8 +237,8 @@ class SafePolicy:
             ahead_speed = view.nearest_ahead_speed_mps or 0.0
             if view.nearest_ahead_m <= max(speed_mps - ahead_speed, 0.0) * t + st.margin_m:
                 return False
-        if committing and view.coverage_ahead_m < speed_mps * t + st.margin_m:
-            return False  # the lane ahead is not seen far enough
+        if committing and view.coverage_ahead_m < need_m:
+            return False  # the lane is not seen as far as the ego goes in it before it is past
         if view.nearest_behind_m is not None:  # it must not catch the ego up
             behind_speed = view.nearest_behind_speed_mps or 0.0
             if view.nearest_behind_m <= max(behind_speed - speed_mps, 0.0) * t + st.rear_gap_m:
@@ -249,6 +253,9 @@ class SafePolicy:
         view = perception.next_lane
         if committing:
             need = self.sight_need(meas, perception, view)
+            if view is not None and not view.opposing:  # seen as far as it drives in it
+                need = need._replace(needed_m=meas.vx_mps * (
+                    need.t_lane_change_s + need.t_beside_s) + need.margin_m)
             free = (view is not None and math.isfinite(need.needed_m)
                     and self._lane_free(view, meas.vx_mps, need.t_total_s, need.needed_m, True))
             if not self.gate:

@@ -11,6 +11,7 @@ import pytest
 from eoam_sumo.params import LANE_CHANGE_HEIGHT_M, PONR_FRACTION
 from eoam_sumo.sim.cosim import RunSettings, policy_settings, run_case
 from eoam_sumo.sim.scenario import ScenarioOverrides
+from tests.builders import netconvert, write_sumocfg
 
 pytestmark = pytest.mark.sumo
 
@@ -19,17 +20,26 @@ SCENARIOS = ROOT / "scenarios"
 BASELINE = SCENARIOS / "baseline.sumocfg"
 PONR_M = PONR_FRACTION * LANE_CHANGE_HEIGHT_M  # the point of no return on 3.5 m lanes
 SAFE_OUTCOMES = ("green", "yellow")
-#: A van creeping west at 1.5 m/s in the opposite lane beside where the ARO stops.
-VAN = ('<vType id="van" vClass="delivery" length="5.50" width="2.00" maxSpeed="1.50" '
-       'sigma="0" speedDev="0"/><route id="west" edges="-E0"/>'
-       '<vehicle id="van" type="van" route="west" depart="1.00" departPos="{pos}" '
-       'departSpeed="1.50" insertionChecks="none"/>')
+#: Road users in the opposite lane beside where the ARO stops: a van creeping west at
+#: 1.5 m/s, a cyclist riding west at 5 m/s, a person walking west on the carriageway.
+USERS = {
+    "van": ('<vType id="van" vClass="delivery" length="5.50" width="2.00" maxSpeed="1.50" '
+            'sigma="0" speedDev="0"/><route id="west" edges="-E0"/>'
+            '<vehicle id="van" type="van" route="west" depart="1.00" departPos="{pos}" '
+            'departSpeed="1.50" insertionChecks="none"/>'),
+    "bicycle": ('<vType id="bike" vClass="bicycle" length="1.80" width="0.65" maxSpeed="5.00" '
+                'sigma="0" speedDev="0"/><route id="west" edges="-E0"/>'
+                '<vehicle id="bike" type="bike" route="west" depart="1.00" departPos="{pos}" '
+                'departSpeed="5.00" insertionChecks="none"/>'),
+    "person": ('<person id="walker" depart="1.00" departPos="{pos}">'
+               '<walk edges="-E0" arrivalPos="3990"/></person>'),
+}
 
 
 def _scenario(tmp_path: Path, *, van_x_m: float | None = None,
-              speed_limit_mps: float | None = None) -> Path:
-    """The baseline scenario, optionally with the van (front bumper at x = ``van_x_m``) and
-    the road's speed limit changed."""
+              speed_limit_mps: float | None = None, user: str = "van") -> Path:
+    """The baseline scenario, optionally with a road user of ``USERS`` (front at x =
+    ``van_x_m``) and the road's speed limit changed."""
     net = ROOT / "networks" / "highway.net.xml"
     if speed_limit_mps is not None:
         text = net.read_text().replace('speed="50.00"', f'speed="{speed_limit_mps:.2f}"')
@@ -37,7 +47,12 @@ def _scenario(tmp_path: Path, *, van_x_m: float | None = None,
         net.write_text(text)
     routes = (SCENARIOS / "baseline.rou.xml").read_text()
     if van_x_m is not None:
-        routes = routes.replace("<routes>", "<routes>" + VAN.format(pos=4000.0 - van_x_m), 1)
+        routes = routes.replace("<routes>",
+                                "<routes>" + USERS[user].format(pos=4000.0 - van_x_m), 1)
+        if user == "person":  # persons come after the vehicles departing with them
+            routes = routes.replace("<routes>" + USERS[user].format(pos=4000.0 - van_x_m),
+                                    "<routes>", 1).replace(
+                "</routes>", USERS[user].format(pos=4000.0 - van_x_m) + "</routes>")
     (tmp_path / "r.rou.xml").write_text(routes)
     cfg = tmp_path / "s.sumocfg"
     cfg.write_text(
@@ -84,22 +99,59 @@ def test_a_van_creeping_in_the_opposite_lane_beside_the_obstacle_is_not_hit(tmp_
         assert 2 not in safe["modes_visited"]
 
 
-def test_v2x_opens_the_gate_on_a_free_road_and_a_slow_van_closes_it(tmp_path):
+def test_v2x_opens_the_gate_on_a_free_road(tmp_path):
     """A 90 km/h road (25 m/s limit), the ego at 120 km/h: with every road user equipped and
-    a 1000 m range the lane is known free far enough for the lane change; a van at 1.5 m/s
-    in the opposite lane 260 m ahead of the ego blocks it, by the length it leaves free."""
-    over = {"ego_speed_mps": 120 / 3.6, "mu": 1.0}
+    a 1000 m range the lane is known free far enough for the lane change."""
     free, _ = _run(_scenario(tmp_path, speed_limit_mps=25.0), tmp_path, "free", "safe",
-                   1000.0, **over)
+                   1000.0, ego_speed_mps=120 / 3.6, mu=1.0)
     assert free["sight_gate"] == "passed"
     assert free["sight_known_free_m"] >= free["sight_needed_m"]
     assert 2 in free["modes_visited"] and free["outcome"] == "green"
-    van_dir = tmp_path / "van"
-    van_dir.mkdir()
-    cfg = _scenario(van_dir, van_x_m=360.0, speed_limit_mps=25.0)
-    blocked, _ = _run(cfg, tmp_path, "blocked", "safe", 1000.0, **over)
+
+
+@pytest.mark.parametrize("user", ["van", "bicycle", "person"])
+def test_any_road_user_in_the_opposite_lane_closes_the_gate(tmp_path, user):
+    """The same road with a slow road user in the opposite lane 260 m ahead of the ego:
+    the gate refuses by the length it leaves free, whatever its kind."""
+    cfg = _scenario(tmp_path, van_x_m=360.0, speed_limit_mps=25.0, user=user)
+    blocked, _ = _run(cfg, tmp_path, "blocked", "safe", 1000.0, ego_speed_mps=120 / 3.6,
+                      mu=1.0)
     assert blocked["sight_gate"] == "refused"
     assert blocked["sight_known_free_m"] < blocked["sight_needed_m"]
-    assert blocked["sight_known_free_m"] < 260.0  # limited by the van, not by the range
+    assert blocked["sight_known_free_m"] < 260.0  # limited by the road user, not by the range
     assert 2 not in blocked["modes_visited"]
     assert blocked["collision_with"] in ("none", "aro")
+
+
+TWO_LANES_NODES = ('<nodes><node id="a" x="0" y="0"/><node id="b" x="3000" y="0"/></nodes>')
+TWO_LANES_EDGES = ('<edges><edge id="fwd" from="a" to="b" numLanes="2" speed="50.0" '
+                   'width="3.5"/></edges>')
+
+
+def _two_lane_road(tmp_path: Path, fast_car: bool) -> Path:
+    """A one-way road of two lanes with the baseline's ego (120 km/h) and braking ARO in the
+    right lane; optionally a car at 45 m/s in the left lane, 60 m behind the ego."""
+    netconvert(tmp_path, "n", TWO_LANES_NODES, TWO_LANES_EDGES, "--no-turnarounds", "true")
+    fast = ('<vType id="fast" length="4.7" width="1.8" sigma="0" maxSpeed="45" '
+            'lcStrategic="-1" lcKeepRight="0" lcSpeedGain="0" lcCooperative="-1"/>'
+            '<vehicle id="fast" type="fast" route="r" depart="1.00" departLane="1" '
+            'departPos="40" departSpeed="45" insertionChecks="none"/>') if fast_car else ""
+    routes = (SCENARIOS / "baseline.rou.xml").read_text().replace('edges="E0"', 'edges="fwd"')
+    (tmp_path / "r.rou.xml").write_text(routes.replace(
+        '<route id="eastbound" edges="fwd"/>',
+        '<route id="eastbound" edges="fwd"/><route id="r" edges="fwd"/>' + fast))
+    return write_sumocfg(tmp_path / "s.sumocfg", "n.net.xml", "r.rou.xml",
+                         [SCENARIOS / "vtypes.add.xml"])
+
+
+def test_a_car_closing_from_behind_in_the_next_lane_of_the_same_direction_blocks(tmp_path):
+    clear, _ = _run(_two_lane_road(tmp_path, False), tmp_path, "clear", "safe", mu=1.0)
+    assert clear["sight_gate"] == "passed"  # the lane seen as far as the ego drives in it
+    assert clear["sight_needed_m"] <= clear["sight_known_free_m"] <= 100.0
+    assert 2 in clear["modes_visited"] and clear["outcome"] == "green"
+    busy_dir = tmp_path / "busy"
+    busy_dir.mkdir()
+    busy, _ = _run(_two_lane_road(busy_dir, True), tmp_path, "busy", "safe", mu=1.0)
+    assert busy["sight_gate"] == "refused"  # the car behind would catch the ego up
+    assert 2 not in busy["modes_visited"]
+    assert busy["collision_with"] in ("none", "aro")
