@@ -155,3 +155,17 @@ def test_a_car_closing_from_behind_in_the_next_lane_of_the_same_direction_blocks
     assert busy["sight_gate"] == "refused"  # the car behind would catch the ego up
     assert 2 not in busy["modes_visited"]
     assert busy["collision_with"] in ("none", "aro")
+
+
+def test_a_speeder_heard_after_the_commit_is_met_by_the_tie_breaker(tmp_path):
+    """An oncoming car at 70 m/s on a 25 m/s road: the gate (sized for the limit) lets the
+    lane change begin 396 m ahead of it; V2X reports it closing during the lane change, past
+    the point of no return; passing on is predicted to end head-on, braking back into the
+    lane softer: the EOAM brakes in lane and nothing is hit."""
+    cfg = _scenario(tmp_path, speed_limit_mps=25.0)
+    safe, ts = _run(cfg, tmp_path, "speeder", "safe", 1000.0, ego_speed_mps=120 / 3.6, mu=1.0,
+                    oncoming_start_m=800.0, oncoming_speed_mps=70.0)
+    assert safe["sight_gate"] == "passed" and safe["tie_break"] == "brake"
+    assert safe["modes_visited"][-2:] == [2, 3]
+    assert ts[ts["mode"] == 3]["lateral_offset_m"].iloc[0] > PONR_M
+    assert safe["collision_with"] == "none" and safe["outcome"] == "green"
