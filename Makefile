@@ -36,8 +36,10 @@ tables: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/eoam-sumo bench --out $(OUT)/bench
 
+## ruff (rules chosen in pyproject.toml) and mypy over eoam_sumo/.
 lint: $(STAMP)
 	$(BIN)/ruff check eoam_sumo tests
+	$(BIN)/python -m mypy
 
 ## Rebuild networks/*.net.xml from the plain XML sources with netconvert.
 network: $(STAMP)

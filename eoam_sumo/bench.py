@@ -22,6 +22,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 BASELINE = ROOT / "scenarios" / "baseline.sumocfg"
@@ -136,9 +137,9 @@ def _batch(out_dir: Path, quick: bool) -> tuple[float, int]:
 def run_bench(out_dir: Path, quick: bool = False) -> dict:
     """Measure every figure; ``quick`` uses tiny settings (one repeat, 2-case batch)."""
     repeats = 1 if quick else 15  # short runs on a shared machine: a median of many
-    with tempfile.TemporaryDirectory(prefix="eoam-bench-") as tmp:
-        tmp = Path(tmp)
-        result = {"quick": quick, "jobs": 2}
+    with tempfile.TemporaryDirectory(prefix="eoam-bench-") as tmp_dir:
+        tmp = Path(tmp_dir)
+        result: dict[str, Any] = {"quick": quick, "jobs": 2}
         result["peak_rss_mb"] = _peak_rss_mb(tmp / "rss")
         result.update(_cosim_and_sumo_only(repeats))
         result["tables_wall_s"] = _tables(tmp / "tables", quick)

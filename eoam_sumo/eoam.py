@@ -175,6 +175,8 @@ _WATCHING = (_STEER_BRAKE, _RETURN)  # the safe policy watches the next lane in 
 class EoamController:
     """Decision (DMM, modes 0-5) and control (steering, longitudinal) of the ego."""
 
+    _curve: BoundaryCurve  # the DMM boundaries at the sensed friction, set by _friction()
+
     def __init__(self, params: VehicleParams, tables, settings: EoamSettings = EoamSettings()):
         self.params = params
         self.tables = tables
@@ -182,7 +184,6 @@ class EoamController:
         self._steer = SteeringController(params, settings.steering)
         self._long = LongitudinalController(params, settings.longitudinal)
         self._mass = params.mass_kg
-        self._curve: BoundaryCurve | None = None
         self._brake_mu = math.nan
         self._brake_limit = 0.0
         self._initial_speed: float | None = None
@@ -222,7 +223,7 @@ class EoamController:
         """Refresh what depends on the sensed friction: brake limit and DMM boundaries."""
         if mu == self._brake_mu:
             return
-        if not 0.0 < mu:
+        if not mu > 0.0:
             raise ValueError(f"friction mu={mu!r} must be > 0")
         self._brake_mu = mu
         decel = float(self.tables.max_decel_mps2(mu))
@@ -390,6 +391,7 @@ class EoamController:
         clear = mode in _STEERING and self._clear_of_obstacle(meas, path, dx)  # 2 and 4 only
         stable = (
             clear
+            and path is not None
             and st.return_when_stable
             and mode is _STEER_BRAKE
             and dx >= path.length_m

@@ -310,7 +310,7 @@ def load_matrix(path: Path) -> Matrix:
         ),
         paper_table=paper,
         policy=policy,
-        v2x=tuple(v2x),
+        v2x=(v2x[0], v2x[1], v2x[2], v2x[3]),
     )
 
 

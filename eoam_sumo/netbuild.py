@@ -42,7 +42,7 @@ def declared_frictions(edg_file: Path) -> dict[str, float]:
             if "friction" in lane.attrib:
                 lane_id = f"{edge.get('id')}_{lane.get('index')}"
                 try:
-                    frictions[lane_id] = float(lane.get("friction"))
+                    frictions[lane_id] = float(lane.attrib["friction"])
                 except ValueError as exc:
                     raise InputError(
                         f"{edg_file}: lane {lane_id} friction={lane.get('friction')!r} "

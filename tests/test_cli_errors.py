@@ -51,7 +51,7 @@ def _check(capsys, argv, needle):
     ],
 )
 def test_bad_arguments(capsys, tmp_path, argv, needle):
-    _check(capsys, argv + (["--out", str(tmp_path / "o")] if argv[0] in ("run",) else []), needle)
+    _check(capsys, argv + (["--out", str(tmp_path / "o")] if argv[0] == "run" else []), needle)
 
 
 def test_malformed_sumocfg(capsys, tmp_path):

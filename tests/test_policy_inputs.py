@@ -51,7 +51,7 @@ def test_the_shipped_safe_matrices_load():
     ('polcy = "safe"', "did you mean 'policy'"),
 ])
 def test_bad_policy_or_v2x_keys_name_the_key(tmp_path, scenario, needle):
-    with pytest.raises(InputError, match="m.toml") as err:
+    with pytest.raises(InputError, match=r"m\.toml") as err:
         load_matrix(_matrix(tmp_path, scenario))
     assert needle in str(err.value)
 
@@ -74,7 +74,8 @@ def test_bad_run_options_exit_2_with_one_line(capsys, tmp_path, argv, needle):
 def _results(**cols) -> pd.DataFrame:
     base = {"oncoming_start_m": [float("nan"), 300.0], "ego_speed_kmh": [120.0, 120.0],
                 "mu": [1.0, 1.0], "policy": ["safe", "safe"], "radar_range_m": [float("nan")] * 2,
-                "v2x_range_m": [1000.0, 1000.0], "v2x_latency_s": [0.1, 0.1], "v2x_loss": [0.0, 0.0],
+                "v2x_range_m": [1000.0, 1000.0], "v2x_latency_s": [0.1, 0.1],
+                "v2x_loss": [0.0, 0.0],
                 "v2x_penetration": [1.0, 1.0], "sight_gate": ["passed", "refused"],
                 "sight_needed_m": [499.4, 499.4], "sight_known_free_m": [990.0, 192.0]}
     base.update(cols)

@@ -15,7 +15,9 @@ from eoam_sumo.batch.report import mu_text, traffic_label
 
 
 def _first(results: pd.DataFrame, column: str, default=None):
-    values = results[column].dropna() if column in results else []
+    if column not in results:
+        return default
+    values = results[column].dropna()
     return values.iloc[0] if len(values) else default
 
 

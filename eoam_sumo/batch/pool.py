@@ -21,6 +21,7 @@ Two drivers share the worker: :func:`run_local` (N workers on this machine) and
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -30,7 +31,7 @@ import threading
 import time
 import traceback
 from collections import deque
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Generator, Iterable, Sequence
 from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from typing import Any
@@ -91,19 +92,20 @@ class _Worker:
             [sys.executable, "-c", "from eoam_sumo.batch.pool import _child_main; _child_main()"],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.log,
         )
-        self.send_conn = Connection(os.dup(self.proc.stdin.fileno()), readable=False)
-        self.recv_conn = Connection(os.dup(self.proc.stdout.fileno()), writable=False)
-        self.proc.stdin.close()
-        self.proc.stdout.close()
+        stdin, stdout = self.proc.stdin, self.proc.stdout
+        assert stdin is not None and stdout is not None  # both are pipes
+        self.send_conn = Connection(os.dup(stdin.fileno()), readable=False)
+        self.recv_conn = Connection(os.dup(stdout.fileno()), writable=False)
+        stdin.close()
+        stdout.close()
         self.ready = False
         self.dead = False
         self.key: str | None = None
         self.timeout_s = STARTUP_TIMEOUT_S
         self.deadline = time.monotonic() + STARTUP_TIMEOUT_S
-        try:
+        # died at once: end of file on its pipe reports it
+        with contextlib.suppress(OSError):
             self.send_conn.send(("init", list(sys.path), tuple(preload)))
-        except OSError:
-            pass  # died at once: end of file on its pipe reports it
 
     @property
     def busy(self) -> bool:
@@ -113,10 +115,8 @@ class _Worker:
         """Hand the worker a task; a worker that died meanwhile shows it on its next receive."""
         self.key, self.timeout_s = key, timeout_s
         self.deadline = time.monotonic() + timeout_s
-        try:
+        with contextlib.suppress(OSError):
             self.send_conn.send(("task", func, payload))
-        except OSError:
-            pass
 
     def receive(self) -> TaskResult | None:
         """Read the message waiting on the pipe: None for 'ready', else the task's result.
@@ -133,11 +133,13 @@ class _Worker:
                 raise RuntimeError(
                     f"a worker process ended before its first task: {reason}") from None
             key, self.key = self.key, None
+            assert key is not None  # busy
             return TaskResult(key, error=f"worker process died ({reason})")
         if msg[0] == "ready":
             self.ready = True
             return None
         key, self.key = self.key, None
+        assert key is not None  # a task's result comes only from a busy worker
         return TaskResult(key, value=msg[1]) if msg[0] == "ok" else TaskResult(key, error=msg[1])
 
     def expire(self) -> TaskResult:
@@ -146,6 +148,7 @@ class _Worker:
         if not self.busy:
             raise RuntimeError(f"a worker process did not start within {STARTUP_TIMEOUT_S:g} s")
         key, self.key = self.key, None
+        assert key is not None  # busy
         return TaskResult(key, error=f"timed out after {self.timeout_s:g} s (worker killed)")
 
     def run(self, func: Callable, key: str, payload: Any, timeout_s: float) -> TaskResult:
@@ -157,7 +160,9 @@ class _Worker:
         self.dispatch(func, key, payload, timeout_s)
         if not self.recv_conn.poll(timeout_s):
             return self.expire()
-        return self.receive()
+        result = self.receive()
+        assert result is not None  # ready, so this is the task's result
+        return result
 
     @property
     def alive(self) -> bool:
@@ -207,7 +212,7 @@ def run_local(
     jobs: int = 1,
     timeout_s: float = 300.0,
     preload: Sequence[str] = (),
-) -> Iterator[TaskResult]:
+) -> Generator[TaskResult, None, None]:
     """Run ``func(payload)`` for every ``(key, payload)`` in ``jobs`` worker processes.
 
     Yields one :class:`TaskResult` per task as tasks finish (completion order). ``func`` must
@@ -281,7 +286,7 @@ def run_dask(
     client,
     timeout_s: float = 300.0,
     preload: Sequence[str] = (),
-) -> Iterator[TaskResult]:
+) -> Generator[TaskResult, None, None]:
     """Run the tasks on a ``dask.distributed.Client``, one Dask task per task.
 
     Each Dask worker thread keeps one worker process of this module, so crashes and

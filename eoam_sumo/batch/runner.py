@@ -79,8 +79,8 @@ def result_row(case: Case, result: TaskResult, paper_outcome: str | None = None)
                aro_decel_mps2=case.aro_decel_mps2, max_time_s=case.max_time_s,
                radar_range_m=case.radar_range_m, policy=case.policy,
                v2x_range_m=case.v2x_range_m, v2x_latency_s=case.v2x_latency_s,
-               v2x_loss=case.v2x_loss, v2x_penetration=case.v2x_penetration, case_dir=case_dir_of(case.case_id),
-               sumocfg=str(case.sumocfg))
+               v2x_loss=case.v2x_loss, v2x_penetration=case.v2x_penetration,
+               case_dir=case_dir_of(case.case_id), sumocfg=str(case.sumocfg))
     summary = result.value.get("summary") if isinstance(result.value, dict) else None
     if not result.ok or not isinstance(summary, dict):
         row.update(status="failed",

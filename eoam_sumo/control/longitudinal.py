@@ -56,6 +56,7 @@ class Pid:
 
     def __init__(self, kp: float, ki: float, kd: float, i_limit: float):
         self.kp, self.ki, self.kd, self.i_limit = kp, ki, kd, i_limit
+        self.prev_error: float | None = None
         self.reset()
 
     def reset(self) -> None:

@@ -44,6 +44,8 @@ class Sector(Enum):
     """DMM phase-diagram sector (paper Figure 14): value the letter, ``action`` what it asks
     for (a plain attribute: it is read at every step with an obstacle in range)."""
 
+    action: Action
+
     A = ("A", Action.LIMIT_BRAKE)
     B = ("B", Action.STEER)
     C = ("C", Action.BRAKE)

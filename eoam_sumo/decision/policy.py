@@ -306,12 +306,14 @@ class SafePolicy:
     def summary(self) -> dict:
         """The gate's record for summary.json (empty values when it was never asked)."""
         need = self.need
-        finite = need is not None and math.isfinite(need.needed_m)
+        if need is not None and not math.isfinite(need.needed_m):
+            need = None
         return {
             "sight_gate": self.gate,
-            "sight_needed_m": round(need.needed_m, 3) if finite else None,
+            "sight_needed_m": round(need.needed_m, 3) if need is not None else None,
             "sight_known_free_m": (None if self.known_free_m is None
                                    else round(self.known_free_m, 3)),
-            "sight_time_s": round(need.t_total_s + need.t_escape_s, 3) if finite else None,
+            "sight_time_s": (round(need.t_total_s + need.t_escape_s, 3) if need is not None
+                             else None),
             "tie_break": self.tie_break,
         }

@@ -245,7 +245,7 @@ def _write_metadata(path: Path, params: VehicleParams, settings: DesignSettings)
         },
         "solver": {
             "name": "ipopt (CasADi Opti, direct collocation)",
-            "casadi_version": casadi.__version__,
+            "casadi_version": casadi.CasadiMeta.version(),
             "options": solver_options(settings),
         },
         "files": {

@@ -38,7 +38,8 @@ def _p(default, unit: str, source: str):
 class DesignSettings:
     """Settings of the offline design (paths, optimal control, phase boundaries, tables)."""
 
-    lane_change_m: float = _p(LANE_CHANGE_HEIGHT_M, "m", PAPER + ", sec. 4.2 (y_f = 3.5 m, one lane)")
+    lane_change_m: float = _p(
+        LANE_CHANGE_HEIGHT_M, "m", PAPER + ", sec. 4.2 (y_f = 3.5 m, one lane)")
     obstacle_width_m: float = _p(
         aro_d_class_minivan().width_m, "m", "eoam_sumo.params.aro_d_class_minivan (sec. 10.1)")
     speeds_kmh: tuple = _p(

@@ -215,6 +215,7 @@ def rescaled_guess(previous: OcpSolution, speed_mps: float) -> OcpSolution:
     states = previous.states.copy()
     states[:, 0] *= ratio
     states[:, 1] *= ratio
+    assert previous.colloc_states is not None  # every solved chain keeps its collocation states
     colloc = previous.colloc_states.copy()
     colloc[:, :2] *= ratio
     return OcpSolution(float(speed_mps), previous.mu, previous.duration_s, states,
@@ -227,7 +228,7 @@ def solve_chain(ocp: LaneChangeOcp, mu: float, speeds_mps, on_solved=None) -> li
     The highest speed starts from ``quintic_guess`` (fast lane changes converge easily from
     it); ``on_solved(solution)`` is called after each. Returns the solutions, highest first.
     """
-    solutions = []
+    solutions: list[OcpSolution] = []
     for v in sorted(speeds_mps, reverse=True):
         if solutions:
             guess = rescaled_guess(solutions[-1], v)

@@ -27,7 +27,7 @@ import csv
 import json
 import os
 from pathlib import Path
-from typing import NamedTuple
+from typing import NamedTuple, cast
 
 import numpy as np
 
@@ -211,8 +211,8 @@ class LookupTables:
         except (OSError, ValueError) as exc:
             raise InputError(f"{npz_path}: cannot read the lookup tables ({exc}); "
                              "run `eoam-sumo tables`") from None
-        missing = [k for k in TABLE_NAMES + ("mu_grid", "speed_grid_mps", "dx_step_m",
-                                             "length_m", "lane_change_m") if k not in arrays]
+        missing = [k for k in (*TABLE_NAMES, "mu_grid", "speed_grid_mps", "dx_step_m",
+                               "length_m", "lane_change_m") if k not in arrays]
         if missing:
             raise InputError(f"{npz_path}: missing arrays {', '.join(missing)}; "
                              "run `eoam-sumo tables`")
@@ -246,7 +246,7 @@ class LookupTables:
         lengths = self.length_m
         rows = int(max(lengths[m, v] for m, v, _ in corners) / self.dx_step_m) + 3
         rows = min(rows, self._tables.shape[-1])
-        cols = sum(c * self._tables[:, m, v, :rows] for m, v, c in corners)
+        cols = cast(np.ndarray, sum(c * self._tables[:, m, v, :rows] for m, v, c in corners))
         length = sum(c * lengths[m, v] for m, v, c in corners)
         final = TrajectoryPoint(self.lane_change_m, 0.0, 0.0, 0.0, 0.0)
         return Trajectory(length, self.dx_step_m, cols, final)

@@ -28,7 +28,7 @@ tyres handle as a wheel rolling backwards; clamping it would delete momentum mid
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 from eoam_sumo.params import AIR_DENSITY_KGPM3, G_MPS2, VehicleParams
 from eoam_sumo.plant.tyres import CREEP_SPEED_MPS, SLIP_SPEED_FLOOR_MPS, AxleForce, axle_force
@@ -77,10 +77,10 @@ leave a residual below 1 % of the load transfer."""
 class _Forces(NamedTuple):
     front: AxleForce
     rear: AxleForce
-    fz_front_n: object
-    fz_rear_n: object
-    drive_n: object
-    drag_n: object
+    fz_front_n: Any  # a float or a CasADi expression, as the arithmetic in use gives
+    fz_rear_n: Any
+    drive_n: Any
+    drag_n: Any
 
 
 def _forces(x, mu, p: VehicleParams, ops) -> _Forces:

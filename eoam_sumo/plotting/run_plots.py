@@ -274,7 +274,7 @@ def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = No
                     arrowprops={"arrowstyle": "->"})
     ax.set_xlim(0, v_max)
     ax.set_ylim(0, d_max)
-    ax.set_xlabel("closing speed to the ARO (−range rate) [m/s]")
+    ax.set_xlabel("closing speed to the ARO (-range rate) [m/s]")
     ax.set_ylabel("range to the ARO [m]")
     ax.legend(fontsize=8, loc="upper left", framealpha=0.9)
     ax.set_title(f"DMM phase diagram at μ = {mu_text(mu)} with the ARO phase trace "

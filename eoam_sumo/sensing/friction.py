@@ -111,7 +111,7 @@ class FrictionBelief:
         belief = self.belief
         if belief == "known":
             out = true_mu
-        elif belief != "estimate":
+        elif isinstance(belief, float):
             out = belief
         else:
             out = self._estimated(true_mu, t_s, ax_mps2, ay_mps2)

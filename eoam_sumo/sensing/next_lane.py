@@ -15,8 +15,9 @@ lane's road frame (w the lane width). Three sensors look at it, all on the ego's
   while it may go unheard (``V2XSettings.blind_time_s``).
 
 The strip of lane beside the ego's body, between the corner radars' fields, counts as seen: a
-road user there came through a seen part (a tracker follows it), and is reported. Coverage is measured on three
-lines along the lane (0.25 m inside each marker and its centre): the covered length ahead is
+road user there came through a seen part (a tracker follows it), and is reported. Coverage is
+measured on three lines along the lane (0.25 m inside each marker and its centre): the covered
+length ahead is
 where the first of them stops being covered without a gap. Geometry is that of a straight road
 (stations and offsets in the road frame).
 
@@ -101,7 +102,7 @@ def shadow_on_line(dy_m: float, box: tuple[float, float, float, float]) -> tuple
     lo, hi = max(lo, 0.0), min(hi, math.pi)
     if lo >= hi:
         return None
-    a, b = max(dy_m * _cot(hi), max(x0, 0.0)), dy_m * _cot(lo)
+    a, b = max(dy_m * _cot(hi), x0, 0.0), dy_m * _cot(lo)
     if y0 <= dy_m <= y1:
         a = max(x0, 0.0)
     return (a, b) if a < b else None
@@ -193,7 +194,7 @@ class NextLaneSensing:
         coverage = self._coverage(d_f, e_yaw, shadows)
         ahead = behind = None
         s_rear = s_f - self.ego_length_m
-        for s, d, v, length, width in objects:
+        for s, _d, v, length, _width in objects:
             if s - 0.5 * length >= s_f - 1e-9 or s + 0.5 * length >= s_rear:
                 gap = max(s - 0.5 * length - s_f, 0.0)
                 if ahead is None or gap < ahead[0]:
@@ -232,7 +233,7 @@ class NextLaneSensing:
         half_fov = math.radians(0.5 * c.fov_deg)
         bore = math.radians(c.boresight_deg)
         sensors = ((fx, fy, yaw_rad + bore), (rx, ry, yaw_rad + math.pi - bore))
-        out = []
+        out: list[tuple[float, float, float, float, float]] = []
         s_front = road.project(*front_xy)[0]
         for b in bodies:
             s_b = road.project(b.x_m, b.y_m)[0]

@@ -183,7 +183,7 @@ class CoSimulation:
         t_sense = t_control = t_plant = t_sumo = t_contact = 0.0
         loop0 = clock()
         n_steps = 0
-        for n_steps in range(1, steps + 1):
+        for n_steps in range(1, steps + 1):  # noqa: B007 - the count is read after the loop
             # --- sense: the world at time t ---------------------------------------------------
             c0 = clock()
             X, Y, yaw, vx, vy, r = x[:6]
@@ -295,7 +295,7 @@ class CoSimulation:
         min_d, max_d, min_vx = min(min_d, d), max(max_d, d), min(min_vx, vx)
         max_e_yaw = max(max_e_yaw, abs((yaw - road_yaw + pi) % tau - pi))
         left_width = lane_width if left_lane else 0.0
-        contact_info, role, t_contact = first_contact or (None, "none", None)
+        contact_info, role, contact_time_s = first_contact or (None, "none", None)
         outcome = classify_outcome(
             modes_visited=ctrl.modes_visited,
             max_lateral_offset_m=max_lat_offset,
@@ -317,7 +317,7 @@ class CoSimulation:
             "collision_with": outcome.collision_with,
             "impact_speed_mps": round(outcome.impact_speed_mps, 6),
             "contact_kind": contact_info.kind if contact_info else "none",
-            "contact_time_s": t_contact,
+            "contact_time_s": contact_time_s,
             "reason": outcome.reason,
             "modes_visited": list(ctrl.modes_visited),
             "fcw_raised": bool(ctrl.fcw_raised),

@@ -297,10 +297,10 @@ def contact(
     dx, dy = b.x_m - a.x_m, b.y_m - a.y_m
     rvx, rvy = vb[0] - va[0], vb[1] - va[1]
     best_key, normal = None, (1.0, 0.0)
-    for nx, ny in _axes(a, b):
-        proj = dx * nx + dy * ny
+    for ax, ay in _axes(a, b):
+        nx, ny, proj = ax, ay, dx * ax + dy * ay
         if proj < 0.0:
-            nx, ny, proj = -nx, -ny, -proj
+            nx, ny, proj = -ax, -ay, -proj
         depth = _half_extent(a, nx, ny) + _half_extent(b, nx, ny) - proj
         closing_mps = -(rvx * nx + rvy * ny)
         if depth <= tol_m:

@@ -101,7 +101,7 @@ class Detection(NamedTuple):
     """One detected target: measurements, road-frame position and class (a named tuple: built
     at every scan, three times faster than a frozen dataclass)."""
 
-    index: int  # position in the scanned target list (for logging only)
+    target_index: int  # position in the scanned target list (for logging only)
     range_m: float
     range_rate_mps: float  # negative when closing
     bearing_rad: float  # of the measured point from the boresight, left positive
@@ -250,7 +250,7 @@ class Radar:
             return RadarReport(None, None, oncoming, tuple(detections),
                                next_lane_range_m=next_lane)
         return RadarReport(in_path.range_m, in_path.range_rate_mps, oncoming, tuple(detections),
-                           in_path.index, in_path, next_lane)
+                           in_path.target_index, in_path, next_lane)
 
     def _classify(
         self, ahead: bool, d_m: float, speed_mps: float, road_speed_mps: float, band_m: float,

@@ -23,7 +23,7 @@ import numpy as np
 class RoadFrame:
     """Projection of points onto a polyline centre line (station, offset, heading, curvature)."""
 
-    def __init__(self, points: Sequence[Sequence[float]]):
+    def __init__(self, points: Sequence[Sequence[float]] | np.ndarray):
         pts = [(float(p[0]), float(p[1])) for p in points]
         # drop repeated points, which give zero-length segments
         clean = [pts[0]]
@@ -157,7 +157,7 @@ def _smooth_heading(points: list, stations: list) -> tuple[list, list, list]:
             kept_s.append(s_m)
     kept.append(points[-1])
     kept_s.append(stations[-1])
-    yaws = []
+    yaws: list[float] = []
     for p, q in pairwise(kept):
         yaw = math.atan2(q[1] - p[1], q[0] - p[0])
         if yaws:  # unwrapped: continuous along the road

@@ -43,7 +43,7 @@ class RunLog:
         self._rows: list = [None] * min(rows, PREALLOCATED_ROWS)
         self.n = 0
         self._col = {c: i for i, c in enumerate(COLUMNS)}
-        self._array = None
+        self._array: np.ndarray | None = None
 
     def add(self, t, x, ax, ay, s, d, e_yaw, mu, cmd, perception) -> None:
         """Log the state ``x`` at time ``t`` with the command decided from it (None at the end).

@@ -41,7 +41,8 @@ class _Flat:
 
 def _need(tables, **kw):
     args = {"speed_mps": 30.0, "mu": 1.0, "opposing_speed_mps": 20.0,
-                "trajectory": tables.trajectory(1.0, 30.0), "gap_m": 40.0, "obstacle_speed_mps": 0.0,
+                "trajectory": tables.trajectory(1.0, 30.0), "gap_m": 40.0,
+                "obstacle_speed_mps": 0.0,
                 "obstacle_length_m": 5.09, "ego_length_m": P.length_m, "ego_width_m": P.width_m,
                 "lane_width_m": LANE, "pass_margin_m": 1.0, "return_lateral_g": 0.3,
                 "return_min_length_m": 10.0, "margin_s": 0.5, "margin_m": 10.0}

@@ -77,7 +77,7 @@ def test_warm_start_from_a_neighbour_reaches_the_same_optimum(ocp, solution):
 
 def test_chain_runs_from_the_highest_speed(ocp):
     seen = []
-    sols = solve_chain(ocp, 1.0, [90 / 3.6, 100 / 3.6], on_solved=lambda s: seen.append(s))
+    sols = solve_chain(ocp, 1.0, [90 / 3.6, 100 / 3.6], on_solved=seen.append)
     assert [round(s.speed_mps * 3.6) for s in sols] == [100, 90]
     assert seen == sols
     assert sols[1].distance_m < sols[0].distance_m

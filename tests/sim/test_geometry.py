@@ -58,8 +58,8 @@ def _brute_distance(a: OrientedBox, b: OrientedBox) -> float:
     if any(_inside_or_on(p, pb) for p in pa) or any(_inside_or_on(p, pa) for p in pb):
         return 0.0
     return min(
-        min(_point_segment(p, *f) for p in pa for f in eb),
-        min(_point_segment(p, *e) for p in pb for e in ea),
+        *(_point_segment(p, *f) for p in pa for f in eb),
+        *(_point_segment(p, *e) for p in pb for e in ea),
     )
 
 

@@ -300,7 +300,8 @@ def test_orange_spin_on_ice_without_contact():
 def test_orange_heading_alone():
     out = _motion(heading=1.3)
     assert (out.colour, out.collision_with) == ("orange", "none")
-    assert out.reason == "lane change, no contact; lost control: heading 1.30 rad (74 deg) off the road"
+    assert out.reason == ("lane change, no contact; lost control: heading 1.30 rad (74 deg) off "
+                          "the road")
     assert _motion(heading=-1.3) == out  # |heading| counts
     assert _motion(heading=LOST_CONTROL_HEADING_RAD).colour == "green"
     assert _motion(heading=LOST_CONTROL_HEADING_RAD + 1e-9).colour == "orange"
@@ -321,7 +322,8 @@ def test_orange_going_backwards_alone():
 def test_orange_left_the_road_to_the_right():
     out = _motion(min_offset=RIGHT_EDGE_M - 4.1)
     assert (out.colour, out.collision_with) == ("orange", "none")
-    assert out.reason == "lane change, no contact; left the road: centre 4.1 m beyond its right edge"
+    assert out.reason == ("lane change, no contact; left the road: centre 4.1 m beyond its right "
+                          "edge")
     assert _motion(min_offset=RIGHT_EDGE_M - ROAD_EDGE_MARGIN_M).colour == "green"
     assert _motion(min_offset=RIGHT_EDGE_M - ROAD_EDGE_MARGIN_M - 1e-9).colour == "orange"
 

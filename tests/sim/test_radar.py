@@ -321,7 +321,7 @@ def test_scene_rotated_and_moved_gives_the_same_report():
     )
     assert len(base.detections) == len(turned.detections) == 5
     for d0, d1 in zip(base.detections, turned.detections, strict=True):
-        assert d0.index == d1.index and d0.category == d1.category
+        assert d0.target_index == d1.target_index and d0.category == d1.category
         assert (d1.range_m, d1.range_rate_mps, d1.bearing_rad, d1.d_m, d1.road_speed_mps) == (
             pytest.approx((d0.range_m, d0.range_rate_mps, d0.bearing_rad, d0.d_m,
                            d0.road_speed_mps), abs=1e-8)

@@ -248,7 +248,7 @@ def test_parked_cars_sit_beside_the_ego_lane_and_never_in_it(open_session):
     s = open_session(PARKED_ONLY)
     ego_front_x = _front(s.ego_body())[0]
     ahead = sorted(_front(b)[0] - ego_front_x for b in s.nearby(1000.0))
-    assert len(ahead) == 8 and 0.0 < ahead[0] and ahead[-1] <= 850.0  # the first ~800 m
+    assert len(ahead) == 8 and ahead[0] > 0.0 and ahead[-1] <= 850.0  # the first ~800 m
     assert min(np.diff(ahead)) > 50.0
     for _ in range(400):
         parked = s.nearby(1000.0)
@@ -405,19 +405,19 @@ def _cfg(tmp_path, routes: str) -> Path:
 
 
 def test_bad_scenarios_are_input_errors_naming_the_file(tmp_path):
-    with pytest.raises(InputError, match="missing.sumocfg"):
+    with pytest.raises(InputError, match=r"missing\.sumocfg"):
         SumoSession.start(tmp_path / "missing.sumocfg")
     broken = tmp_path / "broken.sumocfg"
     broken.write_text("<configuration><input>")
-    with pytest.raises(InputError, match="broken.sumocfg: malformed XML"):
+    with pytest.raises(InputError, match=r"broken\.sumocfg: malformed XML"):
         SumoSession.start(broken)
-    with pytest.raises(InputError, match="nowhere.rou.xml"):
+    with pytest.raises(InputError, match=r"nowhere\.rou\.xml"):
         SumoSession.start(_cfg(tmp_path, str(tmp_path / "nowhere.rou.xml")))
     with pytest.raises(InputError, match="no vehicle 'ego'"):
         SumoSession.start(_cfg(tmp_path, str(SCENARIOS / "parked.rou.xml")))
     with pytest.raises(InputError, match="no vehicle 'nobody'"):
         SumoSession.start(BASELINE, ego_id="nobody")
-    with pytest.raises(InputError, match="eoam.role"):
+    with pytest.raises(InputError, match=r"eoam\.role"):
         SumoSession.start(PARKED_ONLY, ScenarioOverrides(aro_hold_s=1.0))
     with pytest.raises(InputError, match="step_length_s"):
         SumoSession.start(BASELINE, step_length_s=0.0105)
@@ -430,7 +430,7 @@ def test_sumos_own_load_errors_become_input_errors(tmp_path, use_traci):
     bad_route.write_text(
         '<routes><vehicle id="ego" depart="0"><route edges="nowhere"/></vehicle></routes>'
     )
-    with pytest.raises(InputError, match="bad.sumocfg: SUMO could not load .*'nowhere'"):
+    with pytest.raises(InputError, match=r"bad\.sumocfg: SUMO could not load .*'nowhere'"):
         SumoSession.start(_cfg(tmp_path, str(bad_route)), use_traci=use_traci)
 
 

@@ -68,14 +68,12 @@ def check_scenario(cfg: Path, ego_id: str = "ego") -> ScenarioFiles:
         (p, "additional file") for p in additionals
     ]:
         for elem in parse_xml(path, what).iter():
-            if elem.tag in ("vehicle", "trip") and elem.get("id") is not None:
+            if elem.tag in ("vehicle", "trip") and (vid := elem.get("id")) is not None:
                 params = {p.get("key"): p.get("value") for p in elem.findall("param")}
                 routed = elem.tag == "vehicle" and (
                     "route" in elem.attrib or elem.find("route") is not None
                 )
-                vehicles[elem.get("id")] = VehicleSpec(
-                    elem.get("id"), path, dict(elem.attrib), params, routed
-                )
+                vehicles[vid] = VehicleSpec(vid, path, dict(elem.attrib), params, routed)
     if ego_id not in vehicles:
         searched = ", ".join(p.name for p in routes + additionals) or "no route files"
         raise InputError(

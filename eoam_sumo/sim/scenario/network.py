@@ -31,7 +31,8 @@ def read_net(path: Path) -> dict:
     if not path.is_file():
         raise InputError(f"net-file {path} not found")
     opposite, lane_id, first = {}, None, True
-    edges = {}  # normal edge id -> (from, to, leftmost lane (index, id, width, shape))
+    # normal edge id -> (from, to, leftmost lane (index, id, width, shape))
+    edges: dict[str, tuple[str | None, str | None, tuple | None]] = {}
     edge_id = None
     try:
         for event, elem in ET.iterparse(xml_source(path), events=("start", "end")):

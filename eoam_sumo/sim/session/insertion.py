@@ -170,6 +170,7 @@ def add_oncoming(api, errors: tuple, files: ScenarioFiles, overrides: ScenarioOv
     ego's, its front bumper that far ahead of the ego's along the road; its id."""
     lanes = api.lane
     distance = overrides.oncoming_start_m
+    assert distance is not None  # called only when the overrides ask for an oncoming car
     s_ego, _ = project(ego.centreline, *ego.front_xy)
     total = arclength(ego.centreline)[-1]
     if s_ego + distance > total:

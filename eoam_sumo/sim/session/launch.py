@@ -127,10 +127,8 @@ def start_error(cfg: Path, error_log: Path, exc: BaseException) -> str:
     error while starting, else the exception's text)."""
     text = ""
     for log in (error_log, error_log.with_name(ERROR_LOG_STDERR)):
-        try:
+        with contextlib.suppress(OSError):
             text += log.read_text(errors="replace")
-        except OSError:
-            pass
     lines = [ln.strip().removeprefix("Error: ") for ln in (text or str(exc)).splitlines()]
     detail = " ".join(ln for ln in lines if ln and ln != "Quitting (on error).")
     return f"{cfg}: SUMO could not load the scenario: {detail or type(exc).__name__}"

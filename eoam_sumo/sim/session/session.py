@@ -53,6 +53,8 @@ class SumoSession:
     ``sumo_overrides``: option -> value of the SUMO options the session set over what the
     sumocfg (or SUMO's default) gives."""
 
+    _ego: EgoStart  # the ego's start, placed by start() before any query
+
     def __init__(self, api, constants, errors: tuple, files: ScenarioFiles,
                  overrides: ScenarioOverrides, ego_id: str, step_length_s: float,
                  workdir: Path, process=None, sumo_overrides: dict | None = None) -> None:
@@ -69,7 +71,6 @@ class SumoSession:
         self._radius_m: float | None = None
         self._ego_mu = 1.0
         self._over_limit: dict[str, float] = {}  # vid -> speed of a departure above the limit
-        self._ego: EgoStart | None = None
         self.ego_depart_time_s = self._time_s
         self.oncoming_id: str | None = None
         self.roles = {
@@ -263,7 +264,7 @@ class SumoSession:
         ego, opposing, limit = self._ego, False, 0.0
         for edge in ego.route_edges:
             if ego.lane_index < self._api.edge.getLaneNumber(edge) - 1:
-                lane = f"{edge}_{ego.lane_index + 1}"
+                lane: str | None = f"{edge}_{ego.lane_index + 1}"
             else:
                 lane = self._files.opposite_lanes.get(f"{edge}_{ego.lane_index}")
                 if lane is None:
@@ -325,9 +326,9 @@ class SumoSession:
     def ego_body(self) -> Body:
         """The ego as SUMO sees it."""
         self._ego_results()  # fails when the ego has left
-        veh, ego = self._veh, self.ego_id
+        veh, ego, start = self._veh, self.ego_id, self._ego
         return self._users.vehicle_body(ego, veh.getPosition(ego), veh.getAngle(ego),
-                                        veh.getSpeed(ego), self._ego.type_id, 0)
+                                        veh.getSpeed(ego), start.type_id, 0)
 
     def body(self, vid: str) -> Body:
         """Any road user by id, a vehicle or a person (getters; for checks, not for the step

@@ -154,7 +154,8 @@ class RoadUsers:
     def _moving_near(self, results: dict, ex: float, ey: float, radius_m: float) -> list:
         """Bodies of the followed moving vehicles within ``radius_m`` of (ex, ey), from this
         step's ``results``; a vehicle found parked with settled values becomes fixed."""
-        near, settled = [], []
+        near: list[Body] = []
+        settled: list[tuple[str, tuple | None]] = []
         tc = self._tc
         for vid, known in self._moving.items():
             r = results.get(vid)
@@ -164,7 +165,7 @@ class RoadUsers:
             if known is None or known[0] != r:
                 body = self.vehicle_body(vid, r[tc.VAR_POSITION], r[tc.VAR_ANGLE],
                                          r[tc.VAR_SPEED], r[tc.VAR_TYPE], r[tc.VAR_STOPSTATE])
-                known = self._moving[vid] = (r, r[tc.VAR_POSITION], body)
+                known = self._moving[vid] = (r, r[tc.VAR_POSITION], body)  # noqa: PLW2901
             elif known[2].parked:  # parked, values settled: fixed until its parking ends
                 settled.append((vid, known[1:]))
                 continue
@@ -213,7 +214,7 @@ class RoadUsers:
             if known is None or known[0] != r:
                 body = self.person_body(pid, r[tc.VAR_POSITION], r[tc.VAR_ANGLE],
                                         r[tc.VAR_SPEED], r[tc.VAR_TYPE])
-                known = self._persons[pid] = (r, r[tc.VAR_POSITION], body)
+                known = self._persons[pid] = (r, r[tc.VAR_POSITION], body)  # noqa: PLW2901
             (fx, fy), body = known[1], known[2]
             if (fx - ex) * (fx - ex) + (fy - ey) * (fy - ey) <= _reach2(radius_m, body):
                 near.append(body)
