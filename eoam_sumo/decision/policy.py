@@ -28,8 +28,9 @@ distance still needed blocks the lane change as an oncoming vehicle does in the 
 before the point of no return, 4 after it). A lane of the ego's own direction needs no sight
 distance against opposing traffic; there a road user ahead that the ego would catch up during
 the manoeuvre, or one closing from behind that would catch the ego up, blocks, and the lane
-must be seen as far as the ego drives in it until it is past the obstacle. When every option past the point of no return ends in contact, the one
-with the lower predicted delta-v of the ego (equal masses, plastic impact) is taken.
+must be seen as far as the ego drives in it until it is past the obstacle. When every option
+past the point of no return ends in contact, the one with the lower predicted delta-v of the
+ego (equal masses, plastic impact) is taken.
 """
 
 from __future__ import annotations
