@@ -39,6 +39,7 @@ from eoam_sumo.sensing.v2x import V2XReceiver, V2XSettings
 MIN_OVERLAP_M = 0.1  # a road user reaching this far into the lane is in it [m]
 FUSION_GATE_M = 3.0  # radar and V2X objects closer than this (centre, plus half lengths) [m]
 LINE_INSET_M = 0.25  # coverage lines: this far inside each lane marker [m]
+STANDING_CACHE = 4096  # road-frame positions of standing road users kept at most
 BESIDE_M = 2.0  # a road user within this of the ego's body along the road is beside it [m]
 
 
@@ -148,6 +149,7 @@ class NextLaneSensing:
                             if v2x.covers_all else 0.0)
         w = lane_width_m
         self.lines_m = (0.5 * w + LINE_INSET_M, w, 1.5 * w - LINE_INSET_M)
+        self._standing: dict[tuple[float, float], tuple[float, float, float]] = {}
 
     @property
     def reach_m(self) -> float:
@@ -176,12 +178,12 @@ class NextLaneSensing:
                                 det.width_m))
             else:
                 shadows.append(self._box(det.s_m, det.d_m, det.length_m, det.width_m, s_f, d_f))
-        objects += self._corner_objects(front_xy, yaw_rad, road, bodies, lane_lo, lane_hi,
-                                        objects, in_path)
+        objects += self._corner_objects(front_xy, s_f, yaw_rad, road, bodies, lane_lo,
+                                        lane_hi, objects, in_path)
         if self.v2x is not None:
             self.v2x.update(time_s, front_xy, bodies)
             for o in self.v2x.objects(time_s):
-                s, d, ryaw = road.project(o.x_m, o.y_m)
+                s, d, ryaw = self._project(road, o)
                 if not self._in_lane(d, o.width_m, lane_lo, lane_hi):
                     continue
                 if in_path is not None and _same(s, o.length_m, in_path.s_m, in_path.length_m):
@@ -220,7 +222,7 @@ class NextLaneSensing:
         return (s - 0.5 * length - s_f, s + 0.5 * length - s_f,
                 d - 0.5 * width - d_f, d + 0.5 * width - d_f)
 
-    def _corner_objects(self, front_xy, yaw_rad, road, bodies, lane_lo, lane_hi, known,
+    def _corner_objects(self, front_xy, s_f, yaw_rad, road, bodies, lane_lo, lane_hi, known,
                         in_path) -> list:
         """Road users the corner radars see in the lane, not already known."""
         c = self.corner
@@ -234,33 +236,50 @@ class NextLaneSensing:
         bore = math.radians(c.boresight_deg)
         sensors = ((fx, fy, yaw_rad + bore), (rx, ry, yaw_rad + math.pi - bore))
         out: list[tuple[float, float, float, float, float]] = []
-        s_front = road.project(*front_xy)[0]
+        s_front = s_f
+        reach = c.range_m + self.ego_length_m
         for b in bodies:
-            s_b = road.project(b.x_m, b.y_m)[0]
-            beside = (s_b - 0.5 * b.length_m <= s_front + BESIDE_M
-                      and s_b + 0.5 * b.length_m >= s_front - self.ego_length_m - BESIDE_M)
-            for ox, oy, look in sensors if not beside else ((fx, fy, None),):
-                if look is not None:  # beside the body: tracked (module doc)
-                    if math.hypot(b.x_m - ox, b.y_m - oy) > c.range_m + b.box.radius_m:
-                        continue
-                    px, py = b.box.nearest_point(ox, oy)
-                    if math.hypot(px - ox, py - oy) > c.range_m:
-                        continue
-                    bearing = math.remainder(math.atan2(py - oy, px - ox) - look, math.tau)
-                    if abs(bearing) > half_fov:
-                        continue
-                s, d, ryaw = road.project(b.x_m, b.y_m)
-                if not self._in_lane(d, b.width_m, lane_lo, lane_hi):
-                    break
-                if in_path is not None and _same(s, b.length_m, in_path.s_m, in_path.length_m):
-                    break
-                if any(_same(s, b.length_m, q[0], q[3]) and abs(d - q[1]) < FUSION_GATE_M
-                       for q in (*known, *out)):
-                    break
-                out.append((s, d, b.speed_mps * math.cos(b.yaw_rad - ryaw), b.length_m,
-                            b.width_m))
-                break
+            if math.hypot(b.x_m - fx, b.y_m - fy) > reach + b.box.radius_m:
+                continue  # beyond both corner radars and not beside the body
+            s, d, ryaw = self._project(road, b)
+            beside = (s - 0.5 * b.length_m <= s_front + BESIDE_M
+                      and s + 0.5 * b.length_m >= s_front - self.ego_length_m - BESIDE_M)
+            if not beside and not any(self._corner_sees(b, *sensor, c.range_m, half_fov)
+                                      for sensor in sensors):
+                continue
+            if not self._in_lane(d, b.width_m, lane_lo, lane_hi):
+                continue
+            if in_path is not None and _same(s, b.length_m, in_path.s_m, in_path.length_m):
+                continue
+            if any(_same(s, b.length_m, q[0], q[3]) and abs(d - q[1]) < FUSION_GATE_M
+                   for q in (*known, *out)):
+                continue
+            out.append((s, d, b.speed_mps * math.cos(b.yaw_rad - ryaw), b.length_m, b.width_m))
         return out
+
+    @staticmethod
+    def _corner_sees(b, ox: float, oy: float, look: float, range_m: float,
+                     half_fov: float) -> bool:
+        """Some part of the road user's box lies within the corner radar's range, at a
+        bearing inside its field of view (its nearest point)."""
+        if math.hypot(b.x_m - ox, b.y_m - oy) > range_m + b.box.radius_m:
+            return False
+        px, py = b.box.nearest_point(ox, oy)
+        if math.hypot(px - ox, py - oy) > range_m:
+            return False
+        return abs(math.remainder(math.atan2(py - oy, px - ox) - look, math.tau)) <= half_fov
+
+    def _project(self, road, obj) -> tuple[float, float, float]:
+        """Road-frame (s, d, road yaw) of a road user's centre; kept for standing ones."""
+        if obj.speed_mps != 0.0:
+            return road.project(obj.x_m, obj.y_m)
+        key = (obj.x_m, obj.y_m)
+        hit = self._standing.get(key)
+        if hit is None:
+            if len(self._standing) > STANDING_CACHE:
+                self._standing.clear()
+            hit = self._standing[key] = road.project(obj.x_m, obj.y_m)
+        return hit
 
     def _coverage(self, d_f: float, e_yaw: float, shadows: list) -> float:
         """Length of the lane ahead of the front bumper covered without a gap (module doc)."""
