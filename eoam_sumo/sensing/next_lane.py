@@ -4,8 +4,8 @@ The next lane is the one left of the ego's original lane, between d = w/2 and 3 
 lane's road frame (w the lane width). Three sensors look at it, all on the ego's body:
 
 * the forward radar (``sim.radar``): its range and field of view from the front bumper, with
-  the shadow of every other road user it sees (a ray through a nearer box does not reach the
-  lane; the boxes are taken aligned with the road);
+  the shadow of every other road user it sees (a point whose line of sight crosses a nearer
+  road user's box is hidden);
 * two left corner radars (front-left and rear-left corners), each looking ``boresight_deg``
   outward from the ego's axis (forward and backward), with the range and field of view of a
   24 GHz lane-change-assist radar: Autoliv SRR "NB" sensor, user manual filed with the FCC,
@@ -16,10 +16,10 @@ lane's road frame (w the lane width). Three sensors look at it, all on the ego's
 
 The strip of lane beside the ego's body, between the corner radars' fields, counts as seen: a
 road user there came through a seen part (a tracker follows it), and is reported. Coverage is
-measured on three lines along the lane (0.25 m inside each marker and its centre): the covered
-length ahead is
-where the first of them stops being covered without a gap. Geometry is that of a straight road
-(stations and offsets in the road frame).
+measured on three lines along the lane (0.25 m inside each marker and its centre), at points
+every ``COVERAGE_STEP_M`` placed on the road (curves included) from ``BESIDE_M`` ahead of the
+front bumper: the covered length ahead ends at the last point before the first one that no
+sensor sees on any line. It is worked out only when the policy reads it (at a commit).
 
 Road users in the lane are those whose box overlaps it by at least ``MIN_OVERLAP_M``, from the
 forward radar's detections, the corner radars' and V2X, one object per road user (a V2X object
@@ -41,6 +41,9 @@ FUSION_GATE_M = 3.0  # radar and V2X objects closer than this (centre, plus half
 LINE_INSET_M = 0.25  # coverage lines: this far inside each lane marker [m]
 STANDING_CACHE = 4096  # road-frame positions of standing road users kept at most
 BESIDE_M = 2.0  # a road user within this of the ego's body along the road is beside it [m]
+#: A sensor: position (x, y), look direction, half field of view [rad], range [m].
+Sensor = tuple[float, float, float, float, float]
+COVERAGE_STEP_M = 1.0  # spacing of the points at which coverage is tested [m]
 
 
 @dataclass(frozen=True)
@@ -57,74 +60,35 @@ class CornerRadarSettings:
             raise ValueError(f"corner radar settings out of range: {self}")
 
 
-def _cot(angle_rad: float) -> float:
-    if angle_rad <= 1e-12:
-        return math.inf
-    if angle_rad >= math.pi - 1e-12:
-        return -math.inf
-    return math.cos(angle_rad) / math.sin(angle_rad)
+def sees(ox: float, oy: float, look_rad: float, half_fov_rad: float, range_m: float,
+         px: float, py: float) -> bool:
+    """A sensor at (ox, oy) looking along ``look_rad`` sees the point (px, py): within its
+    range and field of view."""
+    dx, dy = px - ox, py - oy
+    if dx * dx + dy * dy > range_m * range_m:
+        return False
+    return abs(math.remainder(math.atan2(dy, dx) - look_rad, math.tau)) <= half_fov_rad
 
 
-def cone_on_line(dy_m: float, boresight_rad: float, half_fov_rad: float,
-                 range_m: float) -> tuple[float, float] | None:
-    """The x-interval (along the road, from the sensor) of the line at lateral distance
-    ``dy_m`` (left positive) inside the sensor's cone and range; None when none."""
-    if range_m <= abs(dy_m):
-        return None
-    reach = math.sqrt(range_m * range_m - dy_m * dy_m)
-    if abs(dy_m) < 1e-9:
-        lo_ang, hi_ang = boresight_rad - half_fov_rad, boresight_rad + half_fov_rad
-        fwd = lo_ang <= 0.0 <= hi_ang
-        back = lo_ang <= math.pi <= hi_ang or lo_ang <= -math.pi <= hi_ang
-        if fwd and back:
-            return (-reach, reach)
-        return (0.0, reach) if fwd else ((-reach, 0.0) if back else None)
-    if dy_m < 0.0:  # mirror: the line to the right
-        dy_m, boresight_rad = -dy_m, -boresight_rad
-    lo = max(boresight_rad - half_fov_rad, 0.0)
-    hi = min(boresight_rad + half_fov_rad, math.pi)
-    if lo >= hi:
-        return None
-    x0, x1 = dy_m * _cot(hi), dy_m * _cot(lo)  # x = dy cot(angle), falling with the angle
-    x0, x1 = max(x0, -reach), min(x1, reach)
-    return (x0, x1) if x0 < x1 else None
-
-
-def shadow_on_line(dy_m: float, box: tuple[float, float, float, float]) -> tuple | None:
-    """The x-interval of the line at lateral ``dy_m`` hidden from a sensor at the origin by a
-    road-aligned box (x0, x1, y0, y1) relative to it, beyond the box's near face."""
-    x0, x1, y0, y1 = box
-    if x1 <= 0.0 or dy_m == 0.0:
-        return None
-    angles = [math.atan2(y, x) for x in (x0, x1) for y in (y0, y1)]
-    lo, hi = min(angles), max(angles)
-    if dy_m < 0.0:
-        dy_m, lo, hi = -dy_m, -hi, -lo
-    lo, hi = max(lo, 0.0), min(hi, math.pi)
-    if lo >= hi:
-        return None
-    a, b = max(dy_m * _cot(hi), x0, 0.0), dy_m * _cot(lo)
-    if y0 <= dy_m <= y1:
-        a = max(x0, 0.0)
-    return (a, b) if a < b else None
-
-
-def covered_from(intervals: list[tuple[float, float]], start: float) -> float:
-    """How far from ``start`` the union of ``intervals`` covers without a gap (0 if ``start``
-    itself is not covered)."""
-    end = start
-    for a, b in sorted(intervals):
-        if a > end + 1e-9:
-            break
-        end = max(end, b)
-    return end - start
-
-
-def _minus(interval: tuple[float, float], holes: list) -> list[tuple[float, float]]:
-    parts = [interval]
-    for h0, h1 in holes:
-        parts = [p for a, b in parts for p in ((a, min(b, h0)), (max(a, h1), b)) if p[0] < p[1]]
-    return parts
+def hides(box, ox: float, oy: float, px: float, py: float) -> bool:
+    """The segment from (ox, oy) to (px, py) crosses ``box`` (an ``OrientedBox``) before its
+    end: the box hides the point from a sensor at (ox, oy) (slab test in the box's frame)."""
+    ax, ay = box.to_local(ox, oy)
+    bx, by = box.to_local(px, py)
+    t_in, t_out = 0.0, 1.0
+    for a, b, h in ((ax, bx, box.half_length_m), (ay, by, box.half_width_m)):
+        u = b - a
+        if abs(u) < 1e-12:
+            if abs(a) > h:
+                return False
+            continue
+        t1, t2 = (-h - a) / u, (h - a) / u
+        if t1 > t2:
+            t1, t2 = t2, t1
+        t_in, t_out = max(t_in, t1), min(t_out, t2)
+        if t_in > t_out:
+            return False
+    return t_in < 1.0 - 1e-9
 
 
 class NextLaneSensing:
@@ -162,22 +126,18 @@ class NextLaneSensing:
         """The view at ``time_s``: ``report`` the forward radar's (``sim.radar.RadarReport``),
         ``bodies`` the ground truth of the road users around (for the corner radars and V2X),
         ``road`` the original lane's frame (``project(x, y) -> (s, d, road_yaw)``)."""
-        s_f, d_f, road_yaw = road.project(*front_xy)
-        e_yaw = math.remainder(yaw_rad - road_yaw, math.tau)
+        s_f = road.project(*front_xy)[0]
         w = self.lane_width_m
         lane_lo, lane_hi = 0.5 * w, 1.5 * w
         in_path = report.in_path
         objects = []  # (s, d, road speed, length, width) of road users in the lane
-        shadows = []
+        shadows = []  # boxes of the road users the forward radar sees outside the lane
         for det in report.detections:
-            if det is in_path or (in_path is not None and det.index == in_path.index):
-                shadows.append(self._box(det.s_m, det.d_m, det.length_m, det.width_m, s_f, d_f))
-                continue
-            if self._in_lane(det.d_m, det.width_m, lane_lo, lane_hi):
+            if det is not in_path and self._in_lane(det.d_m, det.width_m, lane_lo, lane_hi):
                 objects.append((det.s_m, det.d_m, det.road_speed_mps, det.length_m,
                                 det.width_m))
             else:
-                shadows.append(self._box(det.s_m, det.d_m, det.length_m, det.width_m, s_f, d_f))
+                shadows.append(bodies[det.target_index].box)
         objects += self._corner_objects(front_xy, s_f, yaw_rad, road, bodies, lane_lo,
                                         lane_hi, objects, in_path)
         if self.v2x is not None:
@@ -193,7 +153,6 @@ class NextLaneSensing:
                     continue  # fused with a radar object
                 objects.append((s, d, o.speed_mps * math.cos(o.yaw_rad - ryaw), o.length_m,
                                 o.width_m))
-        coverage = self._coverage(d_f, e_yaw, shadows)
         ahead = behind = None
         s_rear = s_f - self.ego_length_m
         for s, _d, v, length, _width in objects:
@@ -205,11 +164,16 @@ class NextLaneSensing:
                 gap = s_rear - (s + 0.5 * length)
                 if behind is None or gap < behind[0]:
                     behind = (gap, v)
-        free = coverage if ahead is None else min(coverage, ahead[0])
+
+        def coverage() -> float:
+            return self._coverage(road, s_f, front_xy, yaw_rad, shadows)
+
         return NextLaneView(
-            self.opposing, self.speed_limit_mps, coverage, free,
-            None if ahead is None else ahead[0], None if ahead is None else ahead[1],
-            None if behind is None else behind[0], None if behind is None else behind[1])
+            self.opposing, self.speed_limit_mps, coverage=coverage,
+            nearest_ahead_m=None if ahead is None else ahead[0],
+            nearest_ahead_speed_mps=None if ahead is None else ahead[1],
+            nearest_behind_m=None if behind is None else behind[0],
+            nearest_behind_speed_mps=None if behind is None else behind[1])
 
     # ----------------------------------------------------------------------------- parts
     @staticmethod
@@ -217,35 +181,24 @@ class NextLaneSensing:
         return min(d_m + 0.5 * width_m, lane_hi) - max(d_m - 0.5 * width_m, lane_lo) \
             >= MIN_OVERLAP_M
 
-    @staticmethod
-    def _box(s, d, length, width, s_f, d_f) -> tuple[float, float, float, float]:
-        return (s - 0.5 * length - s_f, s + 0.5 * length - s_f,
-                d - 0.5 * width - d_f, d + 0.5 * width - d_f)
-
     def _corner_objects(self, front_xy, s_f, yaw_rad, road, bodies, lane_lo, lane_hi, known,
                         in_path) -> list:
-        """Road users the corner radars see in the lane, not already known."""
+        """Road users the corner radars see in the lane (or beside the body), not already
+        known."""
         c = self.corner
         if c.range_m <= 0.0:
             return []
-        cy, sy = math.cos(yaw_rad), math.sin(yaw_rad)
-        half_w = 0.5 * self.ego_width_m
-        fx, fy = front_xy[0] - half_w * sy, front_xy[1] + half_w * cy  # front-left corner
-        rx, ry = fx - self.ego_length_m * cy, fy - self.ego_length_m * sy  # rear-left corner
-        half_fov = math.radians(0.5 * c.fov_deg)
-        bore = math.radians(c.boresight_deg)
-        sensors = ((fx, fy, yaw_rad + bore), (rx, ry, yaw_rad + math.pi - bore))
+        corners = self._sensors(front_xy, yaw_rad)[1:]
+        fx, fy = corners[0][:2]
         out: list[tuple[float, float, float, float, float]] = []
-        s_front = s_f
         reach = c.range_m + self.ego_length_m
         for b in bodies:
             if math.hypot(b.x_m - fx, b.y_m - fy) > reach + b.box.radius_m:
                 continue  # beyond both corner radars and not beside the body
             s, d, ryaw = self._project(road, b)
-            beside = (s - 0.5 * b.length_m <= s_front + BESIDE_M
-                      and s + 0.5 * b.length_m >= s_front - self.ego_length_m - BESIDE_M)
-            if not beside and not any(self._corner_sees(b, *sensor, c.range_m, half_fov)
-                                      for sensor in sensors):
+            beside = (s - 0.5 * b.length_m <= s_f + BESIDE_M
+                      and s + 0.5 * b.length_m >= s_f - self.ego_length_m - BESIDE_M)
+            if not beside and not any(self._corner_sees(b, *corner) for corner in corners):
                 continue
             if not self._in_lane(d, b.width_m, lane_lo, lane_hi):
                 continue
@@ -258,16 +211,13 @@ class NextLaneSensing:
         return out
 
     @staticmethod
-    def _corner_sees(b, ox: float, oy: float, look: float, range_m: float,
-                     half_fov: float) -> bool:
+    def _corner_sees(b, ox: float, oy: float, look: float, half_fov: float,
+                     range_m: float) -> bool:
         """Some part of the road user's box lies within the corner radar's range, at a
         bearing inside its field of view (its nearest point)."""
         if math.hypot(b.x_m - ox, b.y_m - oy) > range_m + b.box.radius_m:
             return False
-        px, py = b.box.nearest_point(ox, oy)
-        if math.hypot(px - ox, py - oy) > range_m:
-            return False
-        return abs(math.remainder(math.atan2(py - oy, px - ox) - look, math.tau)) <= half_fov
+        return sees(ox, oy, look, half_fov, range_m, *b.box.nearest_point(ox, oy))
 
     def _project(self, road, obj) -> tuple[float, float, float]:
         """Road-frame (s, d, road yaw) of a road user's centre; kept for standing ones."""
@@ -281,33 +231,36 @@ class NextLaneSensing:
             hit = self._standing[key] = road.project(obj.x_m, obj.y_m)
         return hit
 
-    def _coverage(self, d_f: float, e_yaw: float, shadows: list) -> float:
-        """Length of the lane ahead of the front bumper covered without a gap (module doc)."""
+    def _sensors(self, front_xy, yaw_rad: float) -> tuple[Sensor, Sensor, Sensor]:
+        """(x, y, look, half field of view, range) of the forward and the two corner radars."""
         c = self.corner
+        cy, sy = math.cos(yaw_rad), math.sin(yaw_rad)
         half_w = 0.5 * self.ego_width_m
-        c_half = math.radians(0.5 * c.fov_deg)
-        bore = math.radians(c.boresight_deg)
+        fx, fy = front_xy[0] - half_w * sy, front_xy[1] + half_w * cy  # front-left corner
+        rx, ry = fx - self.ego_length_m * cy, fy - self.ego_length_m * sy  # rear-left corner
+        half, bore = math.radians(0.5 * c.fov_deg), math.radians(c.boresight_deg)
+        return ((front_xy[0], front_xy[1], yaw_rad, self._radar_half_fov, self.radar_range_m),
+                (fx, fy, yaw_rad + bore, half, c.range_m),
+                (rx, ry, yaw_rad + math.pi - bore, half, c.range_m))
+
+    def _coverage(self, road, s_f: float, front_xy, yaw_rad: float, shadows: list) -> float:
+        """Length of the lane ahead of the front bumper covered without a gap (module doc)."""
+        radar, front_corner, rear_corner = self._sensors(front_xy, yaw_rad)
+        corners = (front_corner, rear_corner)
+        ox, oy = front_xy
+        reach = max(self.radar_range_m, self.corner.range_m)
         best = math.inf
-        for y in self.lines_m:
-            dy = y - d_f
-            parts = []
-            cone = cone_on_line(dy, e_yaw, self._radar_half_fov, self.radar_range_m)
-            if cone is not None:
-                holes = [h for box in shadows if (h := shadow_on_line(dy, box)) is not None]
-                parts += _minus(cone, holes)
-            if c.range_m > 0.0:
-                front = cone_on_line(dy - half_w, e_yaw + bore, c_half, c.range_m)
-                rear = cone_on_line(dy - half_w, e_yaw + math.pi - bore, c_half, c.range_m)
-                if front is not None:
-                    parts.append(front)
-                if rear is not None:
-                    parts.append((rear[0] - self.ego_length_m, rear[1] - self.ego_length_m))
-                if front is not None and rear is not None:  # beside the body: tracked
-                    parts.append((rear[1] - self.ego_length_m, front[0]))
-            if self._v2x_free_m > 0.0:
-                parts.append((-self._v2x_free_m, self._v2x_free_m))
-            best = min(best, covered_from(parts, 0.0))
-        return best
+        for line in self.lines_m:
+            covered, x = 0.0, BESIDE_M
+            while x <= reach:
+                px, py, _ = road.point_at(s_f + x, line)
+                seen = (sees(*radar, px, py)
+                        and not any(hides(box, ox, oy, px, py) for box in shadows))
+                if not seen and not any(sees(*c, px, py) for c in corners):
+                    break
+                covered, x = x, x + COVERAGE_STEP_M
+            best = min(best, covered)
+        return max(best, self._v2x_free_m)
 
 
 def _same(s_a: float, length_a: float, s_b: float, length_b: float) -> bool:

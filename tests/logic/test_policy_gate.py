@@ -107,8 +107,9 @@ def _meas(v=30.0, d=0.0, t=0.0, mu=1.0):
 
 
 def _view(free, nearest=None, speed=None, opposing=True, behind=None, behind_speed=None):
-    return NextLaneView(opposing, 20.0, max(free, nearest or 0.0), free, nearest, speed,
-                        behind, behind_speed)
+    return NextLaneView(opposing, 20.0, coverage_ahead_m=free, nearest_ahead_m=nearest,
+                        nearest_ahead_speed_mps=speed, nearest_behind_m=behind,
+                        nearest_behind_speed_mps=behind_speed)
 
 
 def _policy(tables):

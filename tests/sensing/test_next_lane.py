@@ -6,12 +6,7 @@ from collections import namedtuple
 
 import pytest
 
-from eoam_sumo.sensing.next_lane import (
-    NextLaneSensing,
-    cone_on_line,
-    covered_from,
-    shadow_on_line,
-)
+from eoam_sumo.sensing.next_lane import COVERAGE_STEP_M, NextLaneSensing, hides, sees
 from eoam_sumo.sensing.v2x import V2XSettings
 from eoam_sumo.sim.geometry import OrientedBox
 from eoam_sumo.sim.radar import Radar, RadarSettings
@@ -26,6 +21,24 @@ class Straight:
     def project(self, x, y):
         return x, y, 0.0
 
+    def point_at(self, s, d=0.0):
+        return s, d, 0.0
+
+
+class LeftCurve:
+    """Road frame of a lane turning left on a circle of ``radius`` m from the origin."""
+
+    def __init__(self, radius):
+        self.r = radius
+
+    def point_at(self, s, d=0.0):
+        a = s / self.r
+        return (self.r - d) * math.sin(a), self.r - (self.r - d) * math.cos(a), a
+
+    def project(self, x, y):
+        a = math.atan2(x, self.r - y)
+        return self.r * a, self.r - math.hypot(x, self.r - y), a
+
 
 class Body(namedtuple("Body", "vid x_m y_m yaw_rad speed_mps length_m width_m")):
     @property
@@ -33,33 +46,19 @@ class Body(namedtuple("Body", "vid x_m y_m yaw_rad speed_mps length_m width_m"))
         return OrientedBox(self.x_m, self.y_m, self.yaw_rad, self.length_m, self.width_m)
 
 
-def test_the_forward_cone_meets_a_side_line_between_its_edge_and_its_range():
-    lo, hi = cone_on_line(3.5, 0.0, HALF_FOV, 100.0)
-    assert lo == pytest.approx(3.5 / math.tan(HALF_FOV))
-    assert hi == pytest.approx(math.sqrt(100.0**2 - 3.5**2))
-    assert cone_on_line(120.0, 0.0, HALF_FOV, 100.0) is None
-    lo, hi = cone_on_line(-3.5, 0.0, HALF_FOV, 100.0)  # mirror image on the right
-    assert lo == pytest.approx(3.5 / math.tan(HALF_FOV))
+def test_a_sensor_sees_within_its_range_and_field_of_view():
+    assert sees(0.0, 0.0, 0.0, HALF_FOV, 100.0, 99.0, 3.5)
+    assert not sees(0.0, 0.0, 0.0, HALF_FOV, 100.0, 20.0, 3.5)  # 9.9 deg off the boresight
+    assert not sees(0.0, 0.0, 0.0, HALF_FOV, 100.0, 100.0, 3.5)  # beyond the range
+    assert sees(0.0, 0.0, math.pi, 0.1, 50.0, -40.0, 0.0)  # looking backward
 
 
-def test_a_rear_looking_corner_cone_covers_behind():
-    lo, hi = cone_on_line(2.0, math.radians(140.0), math.radians(40.0), 80.0)
-    assert lo == pytest.approx(-math.sqrt(80.0**2 - 4.0))
-    assert hi == pytest.approx(2.0 / math.tan(math.radians(100.0)))
-    assert hi < 0.0
-
-
-def test_a_box_ahead_shadows_the_side_line_beyond_the_ray_past_its_corner():
-    box = (40.0, 45.0, -1.0, 1.0)  # 40 m ahead, 2 m wide, centred
-    a, b = shadow_on_line(3.5, box)
-    assert a == pytest.approx(3.5 * 40.0 / 1.0)  # the ray through the near left corner
-    assert math.isinf(b)
-    assert shadow_on_line(3.5, (40.0, 45.0, -4.0, -2.0)) is None  # a box on the right
-
-
-def test_covered_length_stops_at_the_first_gap():
-    assert covered_from([(0.0, 10.0), (9.0, 50.0), (60.0, 90.0)], 0.0) == 50.0
-    assert covered_from([(1.0, 10.0)], 0.0) == 0.0
+def test_a_box_hides_only_what_lies_behind_it():
+    box = OrientedBox(42.5, 0.0, 0.0, 5.0, 2.0)
+    assert hides(box, 0.0, 0.0, 90.0, 1.75)  # line of sight passes through the box
+    assert not hides(box, 0.0, 0.0, 60.0, 1.75)  # at x = 40 the line is at y = 1.17
+    assert not hides(box, 0.0, 0.0, 30.0, 0.0)  # in front of the box
+    assert not hides(box, 0.0, 0.0, 90.0, 5.0)
 
 
 def _sensing(v2x=None, radar_range_m=100.0):
@@ -68,25 +67,35 @@ def _sensing(v2x=None, radar_range_m=100.0):
                            ego_width_m=1.85, v2x=v2x)
 
 
-def _view(sensing, bodies, t=0.0):
+def _view(sensing, bodies, t=0.0, road=None):
+    road = road or Straight()
     radar = Radar(RadarSettings())
-    report = radar.scan((0.0, 0.0), 0.0, 30.0, Straight(), bodies, LANE)
-    return sensing.update(t, (0.0, 0.0), 0.0, Straight(), report, bodies)
+    report = radar.scan((0.0, 0.0), 0.0, 30.0, road, bodies, LANE)
+    return sensing.update(t, (0.0, 0.0), 0.0, road, report, bodies)
 
 
 def test_an_empty_road_is_known_free_to_the_radar_range_on_the_far_line():
     view = _view(_sensing(), [])
     far = 1.5 * LANE - 0.25
-    assert view.coverage_ahead_m == pytest.approx(math.sqrt(100.0**2 - far**2))
+    assert view.coverage_ahead_m == pytest.approx(math.sqrt(100.0**2 - far**2),
+                                                  abs=COVERAGE_STEP_M)
     assert view.known_free_ahead_m == view.coverage_ahead_m
     assert view.nearest_ahead_m is None
+
+
+def test_on_a_left_curve_the_lane_leaves_the_forward_radars_field_sooner():
+    straight = _view(_sensing(), []).coverage_ahead_m
+    curve = _view(_sensing(), [], road=LeftCurve(300.0)).coverage_ahead_m
+    # the lane bends out of the forward radar's 9 deg half field after about 50 m; beyond it
+    # the front corner radar (80 m, 40 deg outward) still sees it, to its range
+    assert curve == pytest.approx(80.0, abs=COVERAGE_STEP_M) and straight > 95.0
 
 
 def test_the_obstacle_ahead_hides_the_lane_beyond_its_shadow():
     aro = Body("aro", 42.5, 0.0, 0.0, 0.0, 5.0, 2.0)
     view = _view(_sensing(), [aro])
     near = 0.5 * LANE + 0.25  # the near line is hidden from x = 2.0 * 40 / 1.0 = 80 m
-    assert view.coverage_ahead_m == pytest.approx(near * 40.0 / 1.0)
+    assert view.coverage_ahead_m == pytest.approx(near * 40.0 / 1.0, abs=COVERAGE_STEP_M)
     assert view.nearest_ahead_m is None  # the in-path obstacle is not in the next lane
 
 
