@@ -25,10 +25,11 @@ distance)::
 If the gate fails the lane change is not begun: the EOAM brakes in lane (mode 3). Any road user
 in the next lane (vehicle, bicycle or person, whatever its speed or direction) closer than the
 distance still needed blocks the lane change as an oncoming vehicle does in the paper (mode 3
-before the point of no return, 4 after it). A lane of the ego's own direction needs no sight
-distance against opposing traffic; there a road user ahead that the ego would catch up during
-the manoeuvre, or one closing from behind that would catch the ego up, blocks, and the lane
-must be seen as far as the ego drives in it until it is past the obstacle. When every option
+before the point of no return, 4 after it), and so does one behind that would catch the ego up
+(a car overtaking in the opposite lane, a faster one in a lane of the own direction). A lane of
+the ego's own direction needs no sight distance against opposing traffic; there a road user
+ahead that the ego would catch up during the manoeuvre blocks, and the lane must be seen as
+far as the ego drives in it until it is past the obstacle. When every option
 past the point of no return ends in contact, the one with the lower predicted delta-v of the
 ego (equal masses, plastic impact) is taken.
 """
@@ -254,24 +255,24 @@ class SafePolicy:
                    need_m: float, committing: bool) -> bool:
         """The next lane is free for ``t_left_s`` more seconds of manoeuvre; at a commit it
         must be seen ``need_m`` ahead (free of road users too, if it carries opposing
-        traffic)."""
+        traffic). In either kind of lane a road user behind must not catch the ego up (one
+        overtaking in the opposite lane, or a faster car of the own direction)."""
         st = self.settings
+        t = t_left_s + st.margin_s
+        if view.nearest_behind_m is not None:
+            behind_speed = view.nearest_behind_speed_mps or 0.0
+            if view.nearest_behind_m <= max(behind_speed - speed_mps, 0.0) * t + st.rear_gap_m:
+                return False
         if view.opposing:
             if committing:
                 return view.known_free_ahead_m >= need_m
             return view.nearest_ahead_m is None or view.nearest_ahead_m > need_m
-        t = t_left_s + st.margin_s
         if view.nearest_ahead_m is not None:  # the ego must not catch it up
             ahead_speed = view.nearest_ahead_speed_mps or 0.0
             if view.nearest_ahead_m <= max(speed_mps - ahead_speed, 0.0) * t + st.margin_m:
                 return False
-        if committing and view.coverage_ahead_m < need_m:
-            return False  # the lane is not seen as far as the ego goes in it before it is past
-        if view.nearest_behind_m is not None:  # it must not catch the ego up
-            behind_speed = view.nearest_behind_speed_mps or 0.0
-            if view.nearest_behind_m <= max(behind_speed - speed_mps, 0.0) * t + st.rear_gap_m:
-                return False
-        return True
+        # the lane must be seen as far as the ego goes in it before it is past the obstacle
+        return not committing or view.coverage_ahead_m >= need_m
 
     # ----------------------------------------------------------------------------- checks
     def blocks(self, meas, perception, committing: bool, manoeuvring: bool) -> bool:

@@ -150,6 +150,15 @@ def test_same_direction_lane_blocks_on_a_faster_car_closing_from_behind(tables):
     assert not _policy(tables).blocks(_meas(), _seen(slow_behind), True, False)
 
 
+def test_a_car_overtaking_in_the_opposite_lane_from_behind_blocks(tables):
+    pol = _policy(tables)
+    need = pol.sight_need(_meas(), _seen(None), _view(0.0)).needed_m
+    overtaker = _view(need + 100.0, behind=20.0, behind_speed=40.0)
+    assert _policy(tables).blocks(_meas(), _seen(overtaker), True, False)
+    falling_back = _view(need + 100.0, behind=20.0, behind_speed=20.0)
+    assert not _policy(tables).blocks(_meas(), _seen(falling_back), True, False)
+
+
 def test_tie_breaker_brakes_in_lane_when_the_head_on_would_be_harder(tables):
     pol = _policy(tables)
     # past the point of no return (d 1.5 m), an oncoming car 40 m ahead at 20 m/s: passing
