@@ -105,6 +105,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--mu-belief", default="known",
                    help="friction the EOAM decides with: known (the road's), estimate (a "
                    "friction estimator's output) or a number (default: known)")
+    p.add_argument("--radar-model", default="ideal",
+                   help="ideal (exact, every step) or automotive (noise, misses, latency, "
+                   "occlusion, tracker; docs/sensing.md)")
     p.add_argument("--seed", type=_seed, default=0, help="seed of every random model (0)")
     p.add_argument("--gui", action="store_true", help="run in sumo-gui through TraCI")
     p.add_argument("--policy", choices=("paper", "safe"), default="paper",
@@ -163,6 +166,7 @@ def _cmd_tables(args) -> int:
 
 
 def _cmd_run(args) -> int:
+    from eoam_sumo.sensing.automotive import parse_radar_model
     from eoam_sumo.sensing.friction import parse_mu_belief
     from eoam_sumo.sim.cosim import RunSettings, policy_settings, run_case
     from eoam_sumo.sim.radar import RadarSettings
@@ -184,6 +188,7 @@ def _cmd_run(args) -> int:
     settings = RunSettings(
         max_time_s=args.max_time_s, ego_id=args.ego, gui=args.gui, use_traci=args.gui,
         tables_dir=args.tables, mu_belief=parse_mu_belief(args.mu_belief), seed=args.seed,
+        radar_model=parse_radar_model(args.radar_model),
     )
     if args.radar_range_m is not None:
         settings = replace(settings, radar=RadarSettings(range_m=args.radar_range_m))

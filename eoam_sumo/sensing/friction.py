@@ -34,6 +34,7 @@ from eoam_sumo.errors import InputError
 from eoam_sumo.params import G_MPS2, MU_MAX
 
 KINDS = ("known", "estimate")
+STREAM = 1  # random stream of the run seed (the radar draws from stream 2)
 
 
 @dataclass(frozen=True)
@@ -89,7 +90,7 @@ class FrictionBelief:
         self.belief = parse_mu_belief(belief)
         self.settings = settings
         self.mu_min = mu_min
-        self._rng = np.random.default_rng(seed)
+        self._rng = np.random.default_rng([seed, STREAM])
         self._estimate = settings.prior_mu
         self._history: deque[tuple[float, float]] = deque()  # (t, true mu) within the delay
         self._next_update_s: float | None = None

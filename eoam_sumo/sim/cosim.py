@@ -23,13 +23,14 @@ from eoam_sumo.errors import InputError
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.plant import Plant, initial_state
+from eoam_sumo.sensing.automotive import make_radar
 from eoam_sumo.sensing.friction import FrictionBelief
 from eoam_sumo.sensing.next_lane import CornerRadarSettings, NextLaneSensing
 from eoam_sumo.sensing.v2x import V2XSettings
 from eoam_sumo.sim.bodies import nav_angle_deg
 from eoam_sumo.sim.geometry import OrientedBox, box_distance, boxes_overlap, contact
 from eoam_sumo.sim.outcome import classify_outcome, left_road, role_of
-from eoam_sumo.sim.radar import Radar, RadarReport, RadarSettings
+from eoam_sumo.sim.radar import RadarReport, RadarSettings
 from eoam_sumo.sim.roadframe import RoadFrame
 from eoam_sumo.sim.runlog import RunLog
 from eoam_sumo.sim.scenario import ScenarioOverrides
@@ -54,6 +55,7 @@ class RunSettings:
     seed: int = 0  # seeds every random model of the run (friction estimator, radar)
     v2x: V2XSettings = field(default_factory=V2XSettings)  # used by the safe policy
     corner_radar: CornerRadarSettings = field(default_factory=CornerRadarSettings)
+    radar_model: str = "ideal"  # sensing.automotive: ideal or automotive
 
     def __post_init__(self) -> None:
         ms = self.step_s * 1000.0
@@ -115,7 +117,7 @@ class CoSimulation:
             else self.tables.speed_grid_mps[0],
         )
         self.plant = Plant(self.params, dt_s=settings.plant_dt_s, substeps=settings.substeps)
-        self.radar = Radar(settings.radar)
+        self.radar = make_radar(settings.radar_model, settings.radar, settings.seed)
         self.belief = self._new_belief()
         if isinstance(self.belief.belief, float):
             self.tables.check_run(self.belief.belief, self.tables.speed_grid_mps[0])
@@ -179,6 +181,7 @@ class CoSimulation:
                                  "departure")
         cy, sy = math.cos(x[2]), math.sin(x[2])
         self.belief = belief = self._new_belief()
+        self.radar = make_radar(st.radar_model, st.radar, st.seed)  # fresh state per run
         radar, plant, step_s = self.radar, self.plant, st.step_s
         t_sense = t_control = t_plant = t_sumo = t_contact = 0.0
         loop0 = clock()
@@ -191,7 +194,7 @@ class CoSimulation:
             mu_true = session.friction_at_ego()
             mu = belief.mu(mu_true, t, ax, ay)
             report = radar.scan(
-                (X + front * cy, Y + front * sy), yaw, vx, road, bodies, lane_width
+                (X + front * cy, Y + front * sy), yaw, vx, road, bodies, lane_width, t
             )
             perception = _perception(report)
             if lane_sensing is not None:
@@ -323,6 +326,8 @@ class CoSimulation:
             "fcw_raised": bool(ctrl.fcw_raised),
             "mu": mu0,
             "mu_belief": self.belief.label,
+            "radar_model": st.radar_model,
+            "seed": st.seed,
             **_trigger(log, self.belief),
             "min_gap_aro_m": None if math.isinf(min_gap_aro) else round(min_gap_aro, 6),
             "max_abs_lat_accel_mps2": round(log.max_abs("ay_mps2"), 6),

@@ -126,10 +126,10 @@ class RadarReport(NamedTuple):
 
 
 _range_of = attrgetter("range_m")
-_EMPTY_REPORT = RadarReport(None, None, False, ())  # immutable: one for every empty scan
+EMPTY_REPORT = RadarReport(None, None, False, ())  # immutable: one for every empty scan
 
 
-def _ray_entry_m(box: OrientedBox, ox: float, oy: float, ux: float, uy: float) -> float:
+def ray_entry_m(box: OrientedBox, ox: float, oy: float, ux: float, uy: float) -> float:
     """Distance along the ray (origin o, unit direction u) to where it enters the box, or inf."""
     lox, loy = box.to_local(ox, oy)
     lux = box.cos_yaw * ux + box.sin_yaw * uy
@@ -149,6 +149,26 @@ def _ray_entry_m(box: OrientedBox, ox: float, oy: float, ux: float, uy: float) -
     return t_in
 
 
+def report_of(detections: list[Detection]) -> RadarReport:
+    """The report of a scan's detections: sorted by range, the nearest in-path one, the
+    oncoming flag and the nearest standing object in the next lane."""
+    if not detections:
+        return EMPTY_REPORT
+    detections.sort(key=_range_of)
+    in_path, oncoming, next_lane = None, False, None
+    for det in detections:
+        if det.category == "in_path" and in_path is None:
+            in_path = det
+        elif det.category == "oncoming":
+            oncoming = True
+        elif det.category == "in_next_lane" and next_lane is None:
+            next_lane = det.range_m
+    if in_path is None:
+        return RadarReport(None, None, oncoming, tuple(detections), next_lane_range_m=next_lane)
+    return RadarReport(in_path.range_m, in_path.range_rate_mps, oncoming, tuple(detections),
+                       in_path.target_index, in_path, next_lane)
+
+
 class Radar:
     """Radar at the ego's front bumper; ``scan`` turns ground truth into a ``RadarReport``."""
 
@@ -163,11 +183,11 @@ class Radar:
     ) -> float:
         """Distance from the radar to the part of ``box`` inside the field-of-view cone (inf if
         none); the box is detected when this is within ``range_m``."""
-        return self._visible_point(
+        return self.visible_point(
             origin_xy[0], origin_xy[1], yaw_rad, math.cos(yaw_rad), math.sin(yaw_rad), box
         )[0]
 
-    def _visible_point(
+    def visible_point(
         self, ox: float, oy: float, yaw_rad: float, cos_yaw: float, sin_yaw: float,
         box: OrientedBox,
     ) -> tuple[float, float, float]:
@@ -181,7 +201,7 @@ class Radar:
         for side in (1.0, -1.0):
             ang = yaw_rad + side * self._half_fov_rad
             ux, uy = math.cos(ang), math.sin(ang)
-            t = _ray_entry_m(box, ox, oy, ux, uy)
+            t = ray_entry_m(box, ox, oy, ux, uy)
             if t < best[0]:
                 best = (t, ox + t * ux, oy + t * uy)
         return best
@@ -194,8 +214,10 @@ class Radar:
         road_frame: RoadProjection,
         targets: Sequence[Body],
         lane_width_m: float,
+        time_s: float | None = None,
     ) -> RadarReport:
-        """Detect and classify ``targets`` seen from the ego's front bumper (rules: module doc)."""
+        """Detect and classify ``targets`` seen from the ego's front bumper (rules: module
+        doc); ``time_s`` is for radars with a cycle (the ideal one sees at every call)."""
         if not lane_width_m > 0.0:
             raise ValueError(f"lane_width_m={lane_width_m} must be > 0")
         range_m = self.settings.range_m
@@ -216,7 +238,7 @@ class Radar:
             along, across = dx * bx + dy * by, abs(dy * bx - dx * by)
             if along * sin_half_fov - across * cos_half_fov < -box.radius_m:
                 continue
-            rng, px, py = self._visible_point(ox, oy, ego_yaw_rad, bx, by, box)
+            rng, px, py = self.visible_point(ox, oy, ego_yaw_rad, bx, by, box)
             if rng > range_m:
                 continue
             if rng > 1e-9:
@@ -229,30 +251,15 @@ class Radar:
             bearing = math.atan2(bx * ly - by * lx, bx * lx + by * ly)
             s, d, road_yaw = road_frame.project(box.x_m, box.y_m)
             road_speed = tgt.speed_mps * math.cos(box.yaw_rad - road_yaw)
-            category = self._classify(s > ego_s, d, tgt.speed_mps, road_speed, band_m,
+            category = self.classify(s > ego_s, d, tgt.speed_mps, road_speed, band_m,
                                       lane_width_m)
             detections.append(
                 Detection(index, rng, range_rate, bearing, s, d, road_speed, category,
                           tgt.length_m, tgt.width_m)
             )
-        if not detections:
-            return _EMPTY_REPORT
-        detections.sort(key=_range_of)
-        in_path, oncoming, next_lane = None, False, None
-        for det in detections:
-            if det.category == "in_path" and in_path is None:
-                in_path = det
-            elif det.category == "oncoming":
-                oncoming = True
-            elif det.category == "in_next_lane" and next_lane is None:
-                next_lane = det.range_m
-        if in_path is None:
-            return RadarReport(None, None, oncoming, tuple(detections),
-                               next_lane_range_m=next_lane)
-        return RadarReport(in_path.range_m, in_path.range_rate_mps, oncoming, tuple(detections),
-                           in_path.target_index, in_path, next_lane)
+        return report_of(detections)
 
-    def _classify(
+    def classify(
         self, ahead: bool, d_m: float, speed_mps: float, road_speed_mps: float, band_m: float,
         lane_width_m: float,
     ) -> str:
