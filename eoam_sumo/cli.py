@@ -132,6 +132,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scheduler", help="Dask scheduler address, or 'local' for a LocalCluster")
     p.add_argument("--resume", action="store_true", help="run only the cases not yet done")
     p.add_argument("--timeout-s", type=_finite, default=300.0, help="per-case time limit")
+    p.add_argument("--timeseries", choices=("csv", "parquet", "none"), default="csv",
+                   help="per-case time series format, or none (summary.json only)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
     p = sub.add_parser("plot", help="plots of a run, a batch or a tables folder")

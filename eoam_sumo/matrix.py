@@ -18,22 +18,27 @@ import csv
 import difflib
 import math
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import MU_MAX
+from eoam_sumo.sampling import Sample, parse_sample
+from eoam_sumo.sensing.automotive import parse_radar_model
+from eoam_sumo.sensing.friction import parse_mu_belief
 from eoam_sumo.sim.scenario import ScenarioOverrides, check_scenario, scripted_stops
 
 DEFAULT_MAX_TIME_S = 40.0
 NO_ONCOMING = "none"
 SCHEMA = {
     "scenario": ("sumocfg", "max_time_s", "radar_range_m", "policy", "v2x_range_m",
-                 "v2x_latency_s", "v2x_loss", "v2x_penetration"),
+                 "v2x_latency_s", "v2x_loss", "v2x_penetration", "mu_belief", "radar_model",
+                 "seed"),
     "sweep": ("ego_speed_kmh", "mu", "oncoming_start_m", "aro_hold_s", "aro_decel_mps2"),
     "paper": ("table",),
+    "sample": (),  # draws, seed and the sampled keys: checked by sampling.parse_sample
 }
-REQUIRED = {"scenario": ("sumocfg",), "sweep": ("ego_speed_kmh", "mu")}
+REQUIRED = {"scenario": ("sumocfg",), "sweep": ("ego_speed_kmh", "mu")}  # unless sampled
 PAPER_COLUMNS = ("oncoming_start_m", "ego_speed_kmh", "mu", "outcome")
 OUTCOMES = ("none", "green", "yellow", "orange", "red")
 POLICIES = ("paper", "safe")
@@ -73,6 +78,11 @@ class Case:
     v2x_latency_s: float = 0.1
     v2x_loss: float = 0.0
     v2x_penetration: float = 1.0
+    mu_belief: str | float = "known"
+    radar_model: str = "ideal"
+    seed: int = 0
+    draw: int | None = None  # the draw's number within its group (sampled matrices)
+    group_id: str | None = None  # the case id of its group of swept values (sampled)
 
     def overrides(self) -> ScenarioOverrides:
         return ScenarioOverrides(
@@ -100,9 +110,15 @@ class Matrix:
     radar_range_m: float | None = None
     policy: str = "paper"
     v2x: tuple[float, float, float, float] = (0.0, 0.1, 0.0, 1.0)  # range, latency, loss, share
+    mu_belief: str | float = "known"
+    radar_model: str = "ideal"
+    seed: int = 0
+    sample: Sample | None = None
 
     def cases(self) -> list[Case]:
-        """Every case, in the paper's Table 2 order (traffic, speed, friction, ARO stop)."""
+        """Every case, in the paper's Table 2 order (traffic, speed, friction, ARO stop); with
+        a ``[sample]`` table, each combination's draws in turn (``<combination id>_dNNNN``)."""
+        sampled = self.sample.keys if self.sample else ()
         traffic = sorted(self.oncoming_starts_m, key=lambda d: d is not None)  # stable: none first
         holds = self.aro_holds_s or (None,)
         decels = self.aro_decels_mps2 or (None,)
@@ -113,29 +129,30 @@ class Matrix:
                     for hold in holds:
                         for decel in decels:
                             parts = [
+                                "" if "oncoming_start_m" in sampled else
                                 f"onc-{NO_ONCOMING if onc is None else _id_number(onc)}",
-                                f"v{_id_number(speed)}",
-                                f"mu{_mu_text(mu)}",
+                                "" if speed is None else f"v{_id_number(speed)}",
+                                "" if mu is None else f"mu{_mu_text(mu)}",
+                                "" if hold is None else f"hold{_id_number(hold)}",
+                                "" if decel is None else f"dec{_id_number(decel)}",
                             ]
-                            if hold is not None:
-                                parts.append(f"hold{_id_number(hold)}")
-                            if decel is not None:
-                                parts.append(f"dec{_id_number(decel)}")
-                            cases.append(
-                                Case(
-                                    "_".join(parts),
-                                    self.sumocfg,
-                                    speed,
-                                    mu,
-                                    onc,
-                                    hold,
-                                    decel,
-                                    self.max_time_s,
-                                    self.radar_range_m,
-                                    self.policy,
-                                    *self.v2x,
-                                )
-                            )
+                            cases.append(Case(
+                                "_".join(p for p in parts if p) or "all", self.sumocfg, speed,
+                                mu, onc, hold, decel, self.max_time_s, self.radar_range_m,
+                                self.policy, *self.v2x, mu_belief=self.mu_belief,
+                                radar_model=self.radar_model, seed=self.seed))
+        return cases if self.sample is None else self._draws(cases)
+
+    def _draws(self, groups: list[Case]) -> list[Case]:
+        sample = self.sample
+        width = len(str(sample.draws - 1))
+        cases = []
+        for group in groups:
+            for k in range(sample.draws):
+                values, seed = sample.values(group.case_id, k)
+                cases.append(replace(group, **values, seed=seed, draw=k,
+                                     group_id=group.case_id,
+                                     case_id=f"{group.case_id}_d{k:0{width}d}"))
         return cases
 
     def paper_outcomes(self) -> dict[str, str]:
@@ -226,6 +243,49 @@ def _number_list(
     return tuple(out)
 
 
+def _checked(minimum: float, inclusive: bool, maximum: float | None = None,
+             allow_none: bool = False, max_inclusive: bool = True):
+    """The check of one value of a numeric key (for sampled values)."""
+
+    def check(value):
+        if allow_none and value == NO_ONCOMING:
+            return None
+        if not _is_number(value):
+            raise InputError("is not a number" + (f' or "{NO_ONCOMING}"' if allow_none else ""))
+        if (value < minimum if inclusive else value <= minimum) or (maximum is not None and (
+                value > maximum if max_inclusive else value >= maximum)):
+            low = "[" if inclusive else "("
+            high = "inf)" if maximum is None else f"{maximum:g}" + ("]" if max_inclusive
+                                                                     else ")")
+            raise InputError(f"is outside {low}{minimum:g}, {high}")
+        return float(value)
+
+    return check
+
+
+def _policy(value) -> str:
+    if value not in POLICIES:
+        raise InputError(f"policy {value!r} is not one of {', '.join(POLICIES)}")
+    return value
+
+
+#: The keys a [sample] table may draw, with the check of one value of each.
+SAMPLED = {
+    "ego_speed_kmh": _checked(0.0, False),
+    "mu": _checked(0.0, False, MU_MAX),
+    "oncoming_start_m": _checked(0.0, True, allow_none=True),
+    "aro_hold_s": _checked(0.0, True),
+    "aro_decel_mps2": _checked(0.0, False),
+    "max_time_s": _checked(0.0, False),
+    "radar_range_m": _checked(0.0, False),
+    "mu_belief": parse_mu_belief,
+    "radar_model": parse_radar_model,
+    "policy": _policy,
+    **{key: _checked(low, True, high, max_inclusive=high_in)
+       for key, (_, low, high, high_in) in V2X_KEYS.items()},
+}
+
+
 def load_matrix(path: Path) -> Matrix:
     """Read and check an experiment-matrix TOML file; InputError names the file and the key."""
     path = Path(path)
@@ -244,15 +304,25 @@ def load_matrix(path: Path) -> Matrix:
         if not isinstance(body, dict):
             raise InputError(f"{path}: '{table}' must be a table ([{table}])")
         for key in body:
-            if key not in SCHEMA[table]:
+            if key not in SCHEMA[table] and table != "sample":
                 raise _unknown(path, f"key in [{table}]", key, SCHEMA[table])
+    sample = parse_sample(path, doc["sample"], SAMPLED) if "sample" in doc else None
+    sampled = sample.keys if sample else ()
     for table, keys in REQUIRED.items():
         if table not in doc:
             raise InputError(f"{path}: missing table [{table}]")
         for key in keys:
-            if key not in doc[table]:
-                raise InputError(f"{path}: [{table}] needs the key '{key}'")
+            if key not in doc[table] and key not in sampled:
+                raise InputError(f"{path}: [{table}] needs the key '{key}' (or sample it)")
     scenario, sweep = doc["scenario"], doc["sweep"]
+    for key in sampled:
+        for table in ("scenario", "sweep"):
+            if key in doc[table]:
+                raise InputError(f"{path}: '{key}' is both in [{table}] and sampled in "
+                                 "[sample]; keep one")
+    if sample is not None and "seed" in scenario:
+        raise InputError(f"{path}: [scenario] seed with a [sample] table: the draws' seeds "
+                         "come from [sample] seed")
     sumocfg = _existing_file(path, "[scenario] sumocfg", scenario["sumocfg"])
     max_time = scenario.get("max_time_s", DEFAULT_MAX_TIME_S)
     if not _is_number(max_time) or max_time <= 0:
@@ -279,16 +349,30 @@ def load_matrix(path: Path) -> Matrix:
     paper = None
     if "table" in doc.get("paper", {}):
         paper = _existing_file(path, "[paper] table", doc["paper"]["table"])
+    settings = {}
+    for key in ("mu_belief", "radar_model"):
+        if key in scenario:
+            try:
+                settings[key] = SAMPLED[key](scenario[key])
+            except InputError as exc:
+                raise InputError(f"{path}: [scenario] {exc}") from None
+    seed = scenario.get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise InputError(f"{path}: [scenario] seed = {seed!r} must be an integer >= 0")
     return Matrix(
         path=path,
         sumocfg=sumocfg,
         max_time_s=float(max_time),
         radar_range_m=None if radar_range is None else float(radar_range),
-        ego_speeds_kmh=_number_list(
+        **settings,
+        seed=seed,
+        sample=sample,
+        ego_speeds_kmh=(None,) if "ego_speed_kmh" in sampled else _number_list(
             path, "ego_speed_kmh", sweep["ego_speed_kmh"], minimum=0.0, inclusive=False
         ),
-        mus=_number_list(path, "mu", sweep["mu"], minimum=0.0, inclusive=False, maximum=MU_MAX),
-        oncoming_starts_m=_number_list(
+        mus=(None,) if "mu" in sampled else _number_list(
+            path, "mu", sweep["mu"], minimum=0.0, inclusive=False, maximum=MU_MAX),
+        oncoming_starts_m=(None,) if "oncoming_start_m" in sampled else _number_list(
             path,
             "oncoming_start_m",
             sweep.get("oncoming_start_m", [NO_ONCOMING]),
@@ -328,8 +412,10 @@ def check_matrix(matrix: Matrix, tables_dir: Path | None = None, ego_id: str = "
 
     try:
         files = check_scenario(matrix.sumocfg, ego_id)
-        for hold in matrix.aro_holds_s or (None,):  # the ARO's stop profile fits the scenario
-            for decel in matrix.aro_decels_mps2 or (None,):
+        holds = matrix.aro_holds_s or _extremes(matrix, "aro_hold_s") or (None,)
+        decels = matrix.aro_decels_mps2 or _extremes(matrix, "aro_decel_mps2") or (None,)
+        for hold in holds:  # the ARO's stop profile fits the scenario
+            for decel in decels:
                 over = ScenarioOverrides(aro_hold_s=hold, aro_decel_mps2=decel)
                 scripted_stops(files, over, ego_id)
     except InputError as exc:
@@ -345,20 +431,35 @@ def check_within_tables(matrix: Matrix, tables, folder: Path | str | None = None
     so the error names the key at fault (``check_run`` refuses speeds above the grid and
     frictions below it).
     """
+    beliefs = (matrix.mu_belief, *_extremes(matrix, "mu_belief"))
     for key, values, check in (
-        ("ego_speed_kmh", matrix.ego_speeds_kmh,
+        ("ego_speed_kmh", (*matrix.ego_speeds_kmh, *_extremes(matrix, "ego_speed_kmh")),
          lambda v: tables.check_run(tables.mu_grid[-1], v / 3.6)),
-        ("mu", matrix.mus, lambda m: tables.check_run(m, tables.speed_grid_mps[0])),
+        ("mu", (*matrix.mus, *_extremes(matrix, "mu")),
+         lambda m: tables.check_run(m, tables.speed_grid_mps[0])),
+        ("mu_belief", tuple(b for b in beliefs if isinstance(b, float)),
+         lambda m: tables.check_run(m, tables.speed_grid_mps[0])),
     ):
         for value in values:
+            if value is None:  # the placeholder of a sampled key
+                continue
             try:
                 check(value)
             except InputError as exc:
                 where = "" if folder is None else f" in {folder}"
+                table = "[scenario]" if key == "mu_belief" else "[sweep]"
+                if matrix.sample and matrix.sample.of(key):
+                    table = "[sample]"
                 raise InputError(
-                    f"{matrix.path}: [sweep] {key} value {value:g} is outside the lookup "
+                    f"{matrix.path}: {table} {key} value {value:g} is outside the lookup "
                     f"tables{where}: {exc}"
                 ) from exc
+
+
+def _extremes(matrix: Matrix, key: str) -> tuple:
+    """The values at the bounds of a sampled key's distribution (none if not sampled)."""
+    dist = matrix.sample.of(key) if matrix.sample else None
+    return dist.extremes() if dist else ()
 
 
 def _existing_file(path: Path, where: str, value) -> Path:

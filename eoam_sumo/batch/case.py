@@ -11,8 +11,13 @@ from pathlib import Path
 
 from eoam_sumo.matrix import Case
 
-#: The files a case writes (``sim.runlog.write_run``), in the order they are written.
-CASE_FILES = ("timeseries.csv", "summary.json")
+#: The files a case writes (``sim.runlog.write_run``), in the order they are written, by
+#: ``--timeseries`` format.
+TIMESERIES_FORMATS = ("csv", "parquet", "none")
+CASE_FILES_OF = {"csv": ("timeseries.csv", "summary.json"),
+                 "parquet": ("timeseries.parquet", "summary.json"),
+                 "none": ("summary.json",)}
+ALL_CASE_FILES = ("timeseries.csv", "timeseries.parquet", "summary.json")
 #: Modules a worker imports before its first case, so start-up is not charged to a case.
 PRELOAD = ("eoam_sumo.sim.cosim",)
 
@@ -25,6 +30,7 @@ class CaseTask:
     case: Case
     case_dir: Path | None
     tables_dir: Path | None = None
+    timeseries: str = "csv"  # csv, parquet or none
 
 
 def case_parameters(case: Case) -> dict:
@@ -43,6 +49,10 @@ def case_parameters(case: Case) -> dict:
         "v2x_latency_s": case.v2x_latency_s,
         "v2x_loss": case.v2x_loss,
         "v2x_penetration": case.v2x_penetration,
+        "mu_belief": case.mu_belief,
+        "radar_model": case.radar_model,
+        "seed": case.seed,
+        "draw": case.draw,
         "sumocfg": str(case.sumocfg),
     }
 
@@ -57,19 +67,23 @@ def run_matrix_case(task: CaseTask) -> dict:
 
     case = task.case
     settings = policy_settings(
-        RunSettings(max_time_s=case.max_time_s, tables_dir=task.tables_dir), case.policy,
-        case.v2x_range_m, case.v2x_latency_s, case.v2x_loss, case.v2x_penetration)
+        RunSettings(max_time_s=case.max_time_s, tables_dir=task.tables_dir,
+                    mu_belief=case.mu_belief, radar_model=case.radar_model, seed=case.seed),
+        case.policy, case.v2x_range_m, case.v2x_latency_s, case.v2x_loss, case.v2x_penetration)
     if case.radar_range_m is not None:
         settings = replace(settings, radar=RadarSettings(range_m=case.radar_range_m))
     extra = {"case": case_parameters(case)}
     if task.case_dir is not None:
         case_dir = Path(task.case_dir)
         case_dir.mkdir(parents=True, exist_ok=True)
-        for name in CASE_FILES:
+        for name in ALL_CASE_FILES:
             (case_dir / name).unlink(missing_ok=True)
-        summary = run_case(case.sumocfg, case.overrides(), case_dir, settings, extra=extra)
+        summary = run_case(case.sumocfg, case.overrides(), case_dir, settings, extra=extra,
+                           timeseries=task.timeseries)
         return {"summary": summary, "files": None}
     with tempfile.TemporaryDirectory(prefix="eoam-case-") as scratch:
-        summary = run_case(case.sumocfg, case.overrides(), Path(scratch), settings, extra=extra)
-        files = {name: (Path(scratch) / name).read_bytes() for name in CASE_FILES}
+        summary = run_case(case.sumocfg, case.overrides(), Path(scratch), settings, extra=extra,
+                           timeseries=task.timeseries)
+        files = {name: (Path(scratch) / name).read_bytes()
+                 for name in CASE_FILES_OF[task.timeseries]}
     return {"summary": summary, "files": files}

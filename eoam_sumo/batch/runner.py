@@ -24,7 +24,13 @@ from pathlib import Path
 
 import pandas as pd
 
-from eoam_sumo.batch.case import CASE_FILES, PRELOAD, CaseTask, run_matrix_case
+from eoam_sumo.batch.case import (
+    ALL_CASE_FILES,
+    PRELOAD,
+    TIMESERIES_FORMATS,
+    CaseTask,
+    run_matrix_case,
+)
 from eoam_sumo.batch.pool import TaskResult, run_dask, run_local
 from eoam_sumo.errors import InputError
 from eoam_sumo.matrix import Case, Matrix, check_matrix, load_matrix
@@ -36,14 +42,16 @@ CASES_DIR = "cases"
 #: results.csv columns: the case's parameters, its status, the summary fields, where it lives.
 PARAM_COLUMNS = ("case_id", "ego_speed_kmh", "mu", "oncoming_start_m", "aro_hold_s",
                  "aro_decel_mps2", "max_time_s", "radar_range_m", "policy", "v2x_range_m",
-                 "v2x_latency_s", "v2x_loss", "v2x_penetration")
+                 "v2x_latency_s", "v2x_loss", "v2x_penetration", "mu_belief", "radar_model",
+                 "seed", "draw")
 SUMMARY_COLUMNS = (
     "outcome", "collision_with", "impact_speed_mps", "contact_kind", "contact_time_s",
     "reason", "modes_visited", "fcw_raised", "mu_at_start", "min_gap_aro_m",
     "max_abs_lat_accel_mps2", "max_lateral_offset_m", "final_lateral_offset_m",
     "final_speed_mps", "max_abs_heading_error_rad", "min_speed_mps", "left_road",
-    "ego_initial_speed_mps", "sim_time_s", "wall_time_s", "realtime_factor", "sight_gate",
-    "sight_needed_m", "sight_known_free_m", "sight_time_s", "tie_break",
+    "ego_initial_speed_mps", "trigger_time_s", "trigger_range_m", "mu_believed_at_trigger",
+    "sim_time_s", "wall_time_s", "realtime_factor", "sight_gate", "sight_needed_m",
+    "sight_known_free_m", "sight_time_s", "tie_break",
 )
 COLUMNS = (*PARAM_COLUMNS, "status", "paper_outcome", *SUMMARY_COLUMNS, "error", "case_dir",
            "sumocfg")
@@ -56,6 +64,7 @@ NUMERIC_COLUMNS = (
     "final_speed_mps", "max_abs_heading_error_rad", "min_speed_mps", "ego_initial_speed_mps",
     "sim_time_s", "wall_time_s", "realtime_factor", "v2x_range_m", "v2x_latency_s", "v2x_loss",
     "v2x_penetration", "sight_needed_m", "sight_known_free_m", "sight_time_s",
+    "seed", "draw", "trigger_time_s", "trigger_range_m", "mu_believed_at_trigger",
 )
 #: How long to keep trying to reach a Dask scheduler [s].
 DASK_CONNECT_TIMEOUT_S = 20.0
@@ -80,7 +89,9 @@ def result_row(case: Case, result: TaskResult, paper_outcome: str | None = None)
                radar_range_m=case.radar_range_m, policy=case.policy,
                v2x_range_m=case.v2x_range_m, v2x_latency_s=case.v2x_latency_s,
                v2x_loss=case.v2x_loss, v2x_penetration=case.v2x_penetration,
-               case_dir=case_dir_of(case.case_id), sumocfg=str(case.sumocfg))
+               mu_belief=case.mu_belief, radar_model=case.radar_model, seed=case.seed,
+               draw=case.draw, case_dir=case_dir_of(case.case_id),
+               sumocfg=str(case.sumocfg))
     summary = result.value.get("summary") if isinstance(result.value, dict) else None
     if not result.ok or not isinstance(summary, dict):
         row.update(status="failed",
@@ -162,28 +173,30 @@ class _RowLog:
         self.fh.close()
 
 
-#: The settings of a case besides its id that a resumed row must share with it.
-_SAME_CASE = ("sumocfg", "max_time_s", "radar_range_m", "policy", "v2x_range_m",
-              "v2x_latency_s", "v2x_loss", "v2x_penetration")
+#: results.csv columns that, besides the case id, make a kept row the same case for --resume
+RESUME_KEYS = ("sumocfg", "ego_speed_kmh", "mu", "oncoming_start_m", "aro_hold_s",
+               "aro_decel_mps2", "max_time_s", "radar_range_m", "policy", "v2x_range_m",
+               "v2x_latency_s", "v2x_loss", "v2x_penetration", "mu_belief", "radar_model",
+               "seed")
 
 
 def _case_keys(cases: list[Case]) -> dict[str, tuple[str, ...]]:
-    """case_id -> its ``_SAME_CASE`` settings as results.csv writes them."""
+    """case_id -> its RESUME_KEYS as results.csv writes them."""
     frame = pd.DataFrame([(c.case_id, *(str(c.sumocfg) if k == "sumocfg" else getattr(c, k)
-                                        for k in _SAME_CASE)) for c in cases],
-                         columns=["case_id", *_SAME_CASE])
+                                        for k in RESUME_KEYS)) for c in cases],
+                         columns=["case_id", *RESUME_KEYS])
     text = pd.read_csv(io.StringIO(frame.to_csv(index=False)), dtype=str, keep_default_na=False)
     return {r[0]: tuple(r[1:]) for r in text.itertuples(index=False)}
 
 
 def _kept_rows(path: Path, cases: list[Case]) -> pd.DataFrame:
     """Rows of an earlier run worth keeping: finished, and still the same case (same id, and
-    the same scenario file, time limit, radar range, policy and V2X link as written in
-    results.csv)."""
+    the same RESUME_KEYS as written in results.csv: policy, V2X link, drawn values and seeds
+    included)."""
     rows = _read_rows(path)
     want = _case_keys(cases)
     same = [want.get(cid) == key for cid, key in zip(
-        rows["case_id"], zip(*(rows[k] for k in _SAME_CASE)))]
+        rows["case_id"], zip(*(rows[k] for k in RESUME_KEYS)))]
     keep = (rows["status"] == "ok").to_numpy() & pd.Series(same, dtype=bool).to_numpy()
     return rows[keep].drop_duplicates("case_id", keep="last")
 
@@ -205,12 +218,15 @@ def _store_case_files(case_dir: Path, result: TaskResult, ok: bool) -> None:
     files = result.value.get("files") if ok else None
     if files:
         case_dir.mkdir(parents=True, exist_ok=True)
-        for name in CASE_FILES:
+        for name in ALL_CASE_FILES:
+            if name not in files:
+                (case_dir / name).unlink(missing_ok=True)
+        for name, data in files.items():
             tmp = case_dir / (name + ".tmp")
-            tmp.write_bytes(files[name])
+            tmp.write_bytes(data)
             os.replace(tmp, case_dir / name)
     elif not ok:
-        for name in CASE_FILES:
+        for name in ALL_CASE_FILES:
             (case_dir / name).unlink(missing_ok=True)
 
 
@@ -237,17 +253,17 @@ def _dask_client(scheduler: str, jobs: int):
 
 def _results(to_run: list[Case], out_dir: Path, jobs: int, scheduler: str | None,
              timeout_s: float, case_func: Callable, tables_dir: Path | None,
-             ) -> Iterator[tuple[Case, TaskResult]]:
+             timeseries: str = "csv") -> Iterator[tuple[Case, TaskResult]]:
     by_id = {c.case_id: c for c in to_run}
     preload = PRELOAD if case_func is run_matrix_case else ()
     if scheduler is None:
-        tasks = [(c.case_id, CaseTask(c, out_dir / case_dir_of(c.case_id), tables_dir))
-                 for c in to_run]
+        tasks = [(c.case_id, CaseTask(c, out_dir / case_dir_of(c.case_id), tables_dir,
+                                      timeseries)) for c in to_run]
         with contextlib.closing(run_local(case_func, tasks, jobs, timeout_s, preload)) as it:
             for result in it:
                 yield by_id[result.key], result
         return
-    tasks = [(c.case_id, CaseTask(c, None, tables_dir)) for c in to_run]
+    tasks = [(c.case_id, CaseTask(c, None, tables_dir, timeseries)) for c in to_run]
     with (_dask_client(scheduler, jobs) as client,
           contextlib.closing(run_dask(case_func, tasks, client, timeout_s, preload)) as it):
         for result in it:
@@ -265,6 +281,7 @@ def run_batch(
     *,
     case_func: Callable[[CaseTask], dict] = run_matrix_case,
     tables_dir: Path | None = None,
+    timeseries: str = "csv",
 ) -> pd.DataFrame:
     """Run every case of the matrix; return the final results (as :func:`read_results`).
 
@@ -281,12 +298,16 @@ def run_batch(
     """
     from tqdm import tqdm
 
+    from eoam_sumo.batch.probabilities import write_probabilities
     from eoam_sumo.batch.report import write_report
 
     if not (isinstance(jobs, int) and jobs >= 1):
         raise InputError(f"--jobs {jobs!r} must be an integer >= 1")
     if not timeout_s > 0:
         raise InputError(f"--timeout-s {timeout_s!r} must be > 0")
+    if timeseries not in TIMESERIES_FORMATS:
+        raise InputError(f"--timeseries {timeseries!r} is not one of "
+                         f"{', '.join(TIMESERIES_FORMATS)}")
     matrix: Matrix = load_matrix(Path(matrix_path))
     check_matrix(matrix, tables_dir)
     cases = matrix.cases()
@@ -307,7 +328,7 @@ def run_batch(
     failed = 0
     try:
         for case, result in _results(to_run, out_dir, jobs, scheduler, timeout_s, case_func,
-                                     tables_dir):
+                                     tables_dir, timeseries):
             row = result_row(case, result, paper.get(case.case_id))
             _store_case_files(out_dir / case_dir_of(case.case_id), result, row["status"] == "ok")
             log.add(row)
@@ -318,7 +339,10 @@ def run_batch(
         bar.close()
         log.close()
     results = _finalise(results_path, cases, paper)
-    write_report(out_dir, results)
+    if matrix.sample is None:
+        write_report(out_dir, results)
+    else:
+        write_probabilities(out_dir, results)
     return results
 
 
@@ -339,7 +363,7 @@ def run_batch_cli(args) -> int:
     try:
         results = run_batch(args.matrix, args.out, jobs=args.jobs, scheduler=args.scheduler,
                             resume=args.resume, timeout_s=args.timeout_s,
-                            progress=not args.no_progress)
+                            progress=not args.no_progress, timeseries=args.timeseries)
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)

@@ -167,6 +167,10 @@ def plot_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
     from eoam_sumo.batch.runner import RESULTS_FILE, read_results
 
     results = read_results(Path(batch_dir) / RESULTS_FILE)
+    if results["draw"].notna().any():  # a sampled batch: its envelopes, no Table 2 grid
+        from eoam_sumo.plotting.envelope_plots import plot_envelopes
+
+        return plot_envelopes(results, out_dir)
     paths = [plot_table2(outcome_grid(results), Path(out_dir) / TABLE_PNG)]
     fig25 = plot_lateral_offsets(batch_dir, results, out_dir)
     if fig25 is not None:

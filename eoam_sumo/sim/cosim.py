@@ -419,15 +419,17 @@ def run_case(
     out_dir: Path | None = None,
     settings: RunSettings | None = None,
     extra: dict | None = None,
+    timeseries: str = "csv",
 ) -> dict:
-    """Run one case; write ``timeseries.csv`` and ``summary.json`` to ``out_dir`` if given."""
+    """Run one case; write the time series (``timeseries``: csv, parquet or none) and
+    ``summary.json`` to ``out_dir`` if given."""
     summary, log = CoSimulation(cfg, overrides, settings).run()
     if extra:
         summary = {**extra, **summary}
     if out_dir is not None:
         from eoam_sumo.sim.runlog import write_run
 
-        write_run(Path(out_dir), summary, log)
+        write_run(Path(out_dir), summary, log, timeseries)
     return summary
 
 

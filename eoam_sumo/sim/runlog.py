@@ -126,9 +126,17 @@ def _atomic_write_text(path: Path, text: str) -> None:
     os.replace(tmp, path)
 
 
-def write_run(out_dir: Path, summary: dict, log: RunLog) -> None:
-    """Write ``timeseries.csv`` then ``summary.json`` (each atomically) into ``out_dir``."""
+def write_run(out_dir: Path, summary: dict, log: RunLog, timeseries: str = "csv") -> None:
+    """Write the time series (``timeseries.csv``, ``timeseries.parquet`` through pyarrow, or
+    none) then ``summary.json`` (each atomically) into ``out_dir``."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    csv = log.frame().to_csv(index=False, float_format="%.9g")
-    _atomic_write_text(out_dir / "timeseries.csv", csv)
+    if timeseries == "csv":
+        csv = log.frame().to_csv(index=False, float_format="%.9g")
+        _atomic_write_text(out_dir / "timeseries.csv", csv)
+    elif timeseries == "parquet":
+        tmp = out_dir / "timeseries.parquet.tmp"
+        log.frame().to_parquet(tmp, index=False, engine="pyarrow")
+        os.replace(tmp, out_dir / "timeseries.parquet")
+    elif timeseries != "none":
+        raise InputError(f"time series format {timeseries!r} is not csv, parquet or none")
     _atomic_write_text(out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")

@@ -1,0 +1,68 @@
+"""Outcome probabilities of a sampled batch: ``outcome_probabilities.csv`` and the envelopes.
+
+One group per combination of swept values (the case id without its ``_dNNN`` draw suffix);
+in each, every outcome colour seen in the batch (and ``failed`` for draws that did not run)
+with its count, the group's number of draws n, p = count / n and the Wilson 95 % interval
+(:func:`eoam_sumo.sampling.wilson_interval`). The probabilities of a group sum to 1.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+import pandas as pd
+
+from eoam_sumo.sampling import wilson_interval
+
+PROBABILITIES_FILE = "outcome_probabilities.csv"
+OUTCOME_ORDER = ("none", "green", "unfinished", "yellow", "orange", "red")
+FAILED = "failed"
+#: Parameter columns that may identify a group (those constant within every group are kept).
+GROUP_COLUMNS = ("ego_speed_kmh", "mu", "oncoming_start_m", "aro_hold_s", "aro_decel_mps2",
+                 "max_time_s", "radar_range_m", "mu_belief", "radar_model")
+_DRAW_SUFFIX = re.compile(r"_d\d+$")
+
+
+def group_of(case_id: str) -> str:
+    """The group (combination of swept values) of a draw's case id."""
+    return _DRAW_SUFFIX.sub("", case_id)
+
+
+def _outcomes(results: pd.DataFrame) -> pd.Series:
+    return results["outcome"].where(results["status"] == "ok", FAILED).fillna(FAILED)
+
+
+def outcome_probabilities(results: pd.DataFrame) -> pd.DataFrame:
+    """The outcome probabilities of a results frame (``runner.read_results``) of draws."""
+    results = results.assign(group=results["case_id"].map(group_of),
+                             _outcome=_outcomes(results))
+    seen = set(results["_outcome"])
+    order = [o for o in OUTCOME_ORDER if o != "unfinished" or o in seen]  # listed at 0 too
+    order += sorted(seen - set(order) - {FAILED}) + ([FAILED] if FAILED in seen else [])
+    keep = [c for c in GROUP_COLUMNS
+            if (results.groupby("group", sort=False)[c].nunique(dropna=False) <= 1).all()]
+    rows = []
+    for group, draws in results.groupby("group", sort=False):
+        n = len(draws)
+        first = draws.iloc[0]
+        for outcome in order:
+            count = int((draws["_outcome"] == outcome).sum())
+            low, high = wilson_interval(count, n)
+            rows.append({"group": group, **{c: first[c] for c in keep}, "outcome": outcome,
+                         "count": count, "n": n, "p": count / n, "ci_low": low,
+                         "ci_high": high})
+    return pd.DataFrame(rows)
+
+
+def write_probabilities(out_dir: Path, results: pd.DataFrame) -> list[Path]:
+    """Write ``outcome_probabilities.csv`` (atomically) and the envelope plots."""
+    from eoam_sumo.plotting.envelope_plots import plot_envelopes
+
+    out_dir = Path(out_dir)
+    path = out_dir / PROBABILITIES_FILE
+    tmp = path.with_name(path.name + ".tmp")
+    outcome_probabilities(results).to_csv(tmp, index=False)
+    os.replace(tmp, path)
+    return [path, *plot_envelopes(results, out_dir)]

@@ -1,0 +1,82 @@
+"""Envelope plots of a sampled batch: probability of contact and of red over speed x friction.
+
+Each cell pools every finished draw at that speed and friction (over the other swept and
+sampled values) and shows p with its Wilson 95 % interval and n. A sampled (continuous)
+speed or friction is binned into ``BINS`` equal-width bins.
+"""
+
+from __future__ import annotations
+
+from itertools import pairwise
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+
+from eoam_sumo.plotting.batch_plots import save
+from eoam_sumo.sampling import wilson_interval
+
+ENVELOPE_PNG = "envelope.png"
+BINS = 6
+MAX_LEVELS = 12  # more distinct values than this: binned
+
+
+def _levels(values: pd.Series) -> tuple[pd.Series, list[str]]:
+    """Each value's level index and the level labels (distinct values, or bins)."""
+    distinct = sorted(values.dropna().unique())
+    if len(distinct) <= MAX_LEVELS:
+        index = values.map({v: i for i, v in enumerate(distinct)})
+        return index, [f"{v:g}" for v in distinct]
+    edges = np.linspace(distinct[0], distinct[-1], BINS + 1)
+    index = pd.Series(np.clip(np.digitize(values, edges[1:-1]), 0, BINS - 1), index=values.index)
+    return index, [f"{a:.3g}-{b:.3g}" for a, b in pairwise(edges)]
+
+
+def envelope_table(results: pd.DataFrame, event: pd.Series) -> tuple:
+    """(count, n, speed labels, friction labels) arrays of ``event`` over the finished draws."""
+    ok = results["status"] == "ok"
+    speed_i, speeds = _levels(results.loc[ok, "ego_speed_kmh"])
+    mu_i, mus = _levels(results.loc[ok, "mu"])
+    count = np.zeros((len(speeds), len(mus)), dtype=int)
+    n = np.zeros_like(count)
+    for i, j, e in zip(speed_i, mu_i, event[ok]):
+        n[i, j] += 1
+        count[i, j] += bool(e)
+    return count, n, speeds, mus
+
+
+def plot_envelopes(results: pd.DataFrame, out_dir: Path) -> list[Path]:
+    """``envelope.png``: P(contact) and P(red) over initial speed x friction."""
+    if not (results["status"] == "ok").any():
+        return []
+    events = {
+        "contact (any road user)": results["collision_with"].fillna("none") != "none",
+        "red (head-on after a lane change)": results["outcome"] == "red",
+    }
+    fig = Figure(figsize=(12, 5.5), layout="constrained")
+    axes = fig.subplots(1, 2)
+    for ax, (title, event) in zip(axes, events.items()):
+        count, n, speeds, mus = envelope_table(results, event)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            p = np.where(n > 0, count / np.maximum(n, 1), np.nan)
+        image = ax.imshow(p, cmap="Reds", vmin=0.0, vmax=1.0, aspect="auto")
+        for i in range(len(speeds)):
+            for j in range(len(mus)):
+                if n[i, j] == 0:
+                    continue
+                low, high = wilson_interval(int(count[i, j]), int(n[i, j]))
+                ax.text(j, i, f"{p[i, j]:.2f}\n[{low:.2f}, {high:.2f}]\nn={n[i, j]}",
+                        ha="center", va="center", fontsize=8,
+                        color="white" if p[i, j] > 0.6 else "black")
+        ax.set_xticks(range(len(mus)), mus)
+        ax.set_yticks(range(len(speeds)), speeds)
+        ax.set_xlabel("surface friction mu")
+        ax.set_ylabel("initial ego speed [km/h]")
+        ax.set_title(f"P({title})")
+        fig.colorbar(image, ax=ax, shrink=0.8, label="probability")
+    failed = int((results["status"] != "ok").sum())
+    fig.suptitle(f"Outcome envelopes: {int((results['status'] == 'ok').sum())} draws"
+                 + (f" ({failed} failed, left out)" if failed else "")
+                 + "; each cell p [Wilson 95 %] and n")
+    return [save(fig, Path(out_dir) / ENVELOPE_PNG)]

@@ -1,0 +1,100 @@
+"""A sampled matrix run for real: same seed, same results.csv; no time series with
+--timeseries none; outcome probabilities inside their intervals, summing to 1 per group;
+parquet time series equal to the csv ones."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from eoam_sumo.batch.runner import TIMING_COLUMNS, run_batch
+
+pytestmark = pytest.mark.sumo
+
+REPO = Path(__file__).resolve().parents[2]
+MATRIX = f"""
+[scenario]
+sumocfg = "{REPO / 'scenarios' / 'baseline.sumocfg'}"
+max_time_s = 20.0
+radar_model = "automotive"
+
+[sweep]
+ego_speed_kmh = [90]
+mu = [0.7, 0.3]
+
+[sample]
+draws = 3
+seed = 5
+oncoming_start_m = {{ uniform = [250, 450] }}
+mu_belief = {{ choice = ["known", 1.0] }}
+"""
+
+
+def _run(tmp_path: Path, name: str, timeseries: str):
+    matrix = tmp_path / "sampled.toml"
+    matrix.write_text(MATRIX)
+    out = tmp_path / name
+    results = run_batch(matrix, out, jobs=2, progress=False, timeseries=timeseries)
+    return results, out
+
+
+def test_sampled_matrix_is_reproducible_and_its_probabilities_are_consistent(tmp_path):
+    first, out1 = _run(tmp_path, "a", "none")
+    second, out2 = _run(tmp_path, "b", "none")
+    assert len(first) == 6 and (first["status"] == "ok").all()
+    assert first["draw"].tolist() == [0, 1, 2, 0, 1, 2]
+    assert first["oncoming_start_m"].between(250, 450).all()
+    assert set(first["mu_belief"]) <= {"known", "1.0"}
+    assert first["seed"].nunique() == 6 and (first["radar_model"] == "automotive").all()
+    a = (out1 / "results.csv").read_text().splitlines()
+    b = (out2 / "results.csv").read_text().splitlines()
+    drop = [list(first.columns).index(c) for c in ("case_dir", *TIMING_COLUMNS)]
+
+    def without_timing(lines):
+        frame = pd.read_csv(pd.io.common.StringIO("\n".join(lines)), dtype=str,
+                            keep_default_na=False)
+        return frame.drop(columns=[first.columns[i] for i in drop])
+
+    pd.testing.assert_frame_equal(without_timing(a), without_timing(b))
+    # --timeseries none: summaries only
+    for case_dir in first["case_dir"]:
+        assert sorted(p.name for p in (out1 / case_dir).iterdir()) == ["summary.json"]
+    assert not list(out1.rglob("timeseries.*"))
+    # outcome probabilities: per group of swept values, within their intervals, sum to 1
+    probs = pd.read_csv(out1 / "outcome_probabilities.csv")
+    assert list(probs.columns[-6:]) == ["outcome", "count", "n", "p", "ci_low", "ci_high"]
+    assert set(probs["group"]) == {"v90_mu0.7", "v90_mu0.3"}
+    assert ((probs["ci_low"] <= probs["p"]) & (probs["p"] <= probs["ci_high"])).all()
+    for _, group in probs.groupby("group"):
+        assert group["p"].sum() == pytest.approx(1.0, abs=1e-12)
+        assert group["count"].sum() == 3 and (group["n"] == 3).all()
+    observed = first.groupby(first["case_id"].str[:-3])["outcome"].value_counts()
+    for (group, outcome), count in observed.items():
+        row = probs[(probs["group"] == group) & (probs["outcome"] == outcome)]
+        assert int(row["count"].iloc[0]) == count
+    assert (out1 / "envelope.png").stat().st_size > 10_000
+    assert not (out1 / "table2.md").exists()
+
+
+def test_parquet_time_series_equal_the_csv_ones(tmp_path):
+    pytest.importorskip("pyarrow")
+    matrix = tmp_path / "one.toml"
+    matrix.write_text(MATRIX.replace("draws = 3", "draws = 1").replace("mu = [0.7, 0.3]",
+                                                                         "mu = [0.3]"))
+    csv_out, pq_out = tmp_path / "csv", tmp_path / "pq"
+    run_batch(matrix, csv_out, progress=False, timeseries="csv")
+    results = run_batch(matrix, pq_out, progress=False, timeseries="parquet")
+    case_dir = results["case_dir"].iloc[0]
+    from_csv = pd.read_csv(csv_out / case_dir / "timeseries.csv")
+    from_pq = pd.read_parquet(pq_out / case_dir / "timeseries.parquet")
+    assert list(from_pq.columns) == list(from_csv.columns)
+    for column in from_csv.columns:
+        if column == "sector":
+            assert from_pq[column].fillna("").tolist() == from_csv[column].fillna("").tolist()
+        else:  # the csv keeps 9 significant digits
+            np.testing.assert_allclose(from_pq[column].astype(float), from_csv[column],
+                                       rtol=1e-8, atol=1e-12)
+    assert not (pq_out / case_dir / "timeseries.csv").exists()
