@@ -369,8 +369,10 @@ def run_batch_cli(args) -> int:
             signal.signal(signal.SIGTERM, previous)
     failed = results[results["status"] != "ok"]
     results_path = Path(args.out) / RESULTS_FILE
+    report = ("outcome probabilities in " + str(Path(args.out) / "outcome_probabilities.csv")
+              if results["draw"].notna().any() else f"Table 2 in {Path(args.out) / 'table2.md'}")
     print(f"{len(results)} cases, {len(results) - len(failed)} ok, {len(failed)} failed; "
-          f"results in {results_path}, Table 2 in {Path(args.out) / 'table2.md'}")
+          f"results in {results_path}, {report}")
     if failed.empty:
         return 0
     for _, row in failed.iterrows():

@@ -135,7 +135,7 @@ def write_run(out_dir: Path, summary: dict, log: RunLog, timeseries: str = "csv"
         _atomic_write_text(out_dir / "timeseries.csv", csv)
     elif timeseries == "parquet":
         tmp = out_dir / "timeseries.parquet.tmp"
-        log.frame().to_parquet(tmp, index=False, engine="pyarrow")
+        log.frame().to_parquet(tmp, index=False, engine="pyarrow", compression="zstd")
         os.replace(tmp, out_dir / "timeseries.parquet")
     elif timeseries != "none":
         raise InputError(f"time series format {timeseries!r} is not csv, parquet or none")
