@@ -33,6 +33,7 @@ import numpy as np
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.sensing.tracker import Measurement, Tracker, TrackerSettings
+from eoam_sumo.sim.bodies import Body
 from eoam_sumo.sim.radar import (
     EMPTY_REPORT,
     Detection,
@@ -40,7 +41,6 @@ from eoam_sumo.sim.radar import (
     RadarReport,
     RadarSettings,
     RoadProjection,
-    Sensed,
     ray_entry_m,
     report_of,
 )
@@ -107,7 +107,7 @@ class AutomotiveRadar:
         self._t_internal = 0.0
 
     def scan(self, ego_front_xy: tuple[float, float], ego_yaw_rad: float, ego_speed_mps: float,
-             road_frame: RoadProjection, targets: Sequence[Sensed], lane_width_m: float,
+             road_frame: RoadProjection, targets: Sequence[Body], lane_width_m: float,
              time_s: float | None = None) -> RadarReport:
         """The report the EOAM reads at ``time_s`` (scans when a cycle is due; without a
         time, calls are taken as 10 ms apart)."""

@@ -17,7 +17,8 @@ from eoam_sumo.sensing.automotive import (
     parse_radar_model,
 )
 from eoam_sumo.sensing.tracker import Measurement, Tracker, TrackerSettings
-from eoam_sumo.sim.radar import Radar, Target
+from eoam_sumo.sim.bodies import Body
+from eoam_sumo.sim.radar import Radar
 from eoam_sumo.sim.roadframe import RoadFrame
 
 LANE_M = 3.5
@@ -27,8 +28,8 @@ EXACT = AutomotiveRadarSettings(range_sd_m=0.0, azimuth_sd_deg=0.0, range_rate_s
                                 detection_probability=1.0)
 
 
-def _car(rear_x_m, y_m=0.0, speed_mps=0.0, dims=CAR):
-    return Target(rear_x_m + 0.5 * dims[0], y_m, 0.0, speed_mps, *dims)
+def _car(rear_x_m, y_m=0.0, speed_mps=0.0, dims=CAR, vid="car"):
+    return Body(vid, "passenger", rear_x_m + 0.5 * dims[0], y_m, 0.0, speed_mps, *dims)
 
 
 def _drive(radar, targets_at, seconds, ego_speed=30.0, dt=0.01):
