@@ -141,10 +141,10 @@ class Matrix:
                                 mu, onc, hold, decel, self.max_time_s, self.radar_range_m,
                                 self.policy, *self.v2x, mu_belief=self.mu_belief,
                                 radar_model=self.radar_model, seed=self.seed))
-        return cases if self.sample is None else self._draws(cases)
+        return cases if self.sample is None else self._draws(cases, self.sample)
 
-    def _draws(self, groups: list[Case]) -> list[Case]:
-        sample = self.sample
+    @staticmethod
+    def _draws(groups: list[Case], sample: Sample) -> list[Case]:
         width = len(str(sample.draws - 1))
         cases = []
         for group in groups:

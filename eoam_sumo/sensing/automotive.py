@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -157,35 +157,25 @@ class AutomotiveRadar:
                      ego_s)
 
     def _visible(self, ox, oy, yaw, bx, by, targets) -> list:
-        """(target, range, x, y) of each target with a part in range and cone and a free line
-        of sight to it, nearest first."""
-        geo, range_m = self._geometry, self.settings.range_m
-        half = math.radians(0.5 * self.settings.fov_deg)
-        cos_half, sin_half = math.cos(half), math.sin(half)
+        """(target, range, x, y) of each target with a part in a beam and a free line of
+        sight to it, nearest first."""
+        geo = self._geometry
+        reach_m = self.settings.range_m
         inside = []
         for tgt in targets:
             box = tgt.box
-            dx, dy = box.x_m - ox, box.y_m - oy
-            if math.hypot(dx, dy) > range_m + box.radius_m:
+            if math.hypot(box.x_m - ox, box.y_m - oy) > reach_m + box.radius_m:
                 continue
-            along, across = dx * bx + dy * by, abs(dy * bx - dx * by)
-            if along * sin_half - across * cos_half < -box.radius_m:
-                continue  # the bounding circle lies wholly outside the cone
-            r, px, py = geo.visible_point(ox, oy, yaw, bx, by, box)
-            if r <= range_m:
+            r, px, py = geo.seen_point(ox, oy, yaw, bx, by, box)
+            if r < math.inf:
                 inside.append((r, tgt, px, py))
         inside.sort(key=lambda item: item[0])
         seen = []
         for k, (r, tgt, px, py) in enumerate(inside):
             nearer = [item[1].box for item in inside[:k]]
-            candidates = [(r, px, py)]
-            for cx, cy in tgt.box.corners():
-                cr = math.hypot(cx - ox, cy - oy)
-                off = abs(math.atan2(math.sin(math.atan2(cy - oy, cx - ox) - yaw),
-                                     math.cos(math.atan2(cy - oy, cx - ox) - yaw)))
-                if cr <= range_m and off <= half:
-                    candidates.append((cr, cx, cy))
-            candidates.sort()
+            candidates = [(r, px, py), *sorted(
+                (math.hypot(cx - ox, cy - oy), cx, cy) for cx, cy in tgt.box.corners()
+                if geo.covers(ox, oy, yaw, cx, cy))]
             for cr, cx, cy in candidates:
                 if not _blocked(nearer, ox, oy, cx, cy, cr):
                     seen.append((tgt, cr, cx, cy))
@@ -226,9 +216,18 @@ def _blocked(nearer, ox, oy, px, py, r) -> bool:
     return any(ray_entry_m(box, ox, oy, ux, uy) < r - _SEEN_EPS_M for box in nearer)
 
 
+#: The ARS 408-21's near-range beam: 0.20-70 m within +-45 deg (data sheet, near range).
+NEAR_RANGE_M = 70.0
+NEAR_FOV_DEG = 90.0
+
+
 def make_radar(model: str, settings: RadarSettings, seed: int = 0):
-    """The radar of a run: :class:`Radar` (ideal) or :class:`AutomotiveRadar`."""
+    """The radar of a run: :class:`Radar` (ideal) or :class:`AutomotiveRadar` (with the data
+    sheet's near-range beam unless ``settings`` has one)."""
     model = parse_radar_model(model)
     if model == "ideal":
         return Radar(settings)
+    if settings.near_range_m == 0.0:
+        settings = replace(settings, near_range_m=min(NEAR_RANGE_M, settings.range_m),
+                           near_fov_deg=NEAR_FOV_DEG)
     return AutomotiveRadar(settings, seed=seed)

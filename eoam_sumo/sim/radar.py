@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from operator import attrgetter
 from typing import NamedTuple, Protocol
 
@@ -79,10 +79,12 @@ class RadarSettings:
     stationary_speed_mps: float = STATIONARY_SPEED_MPS
     oncoming_speed_mps: float = ONCOMING_SPEED_MPS
     lane_margin_m: float = LANE_MARGIN_M
+    near_range_m: float = 0.0  # a second, wide near-range beam this long (0: none) [m]
+    near_fov_deg: float = 90.0  # its full horizontal field of view [deg]
 
     def __post_init__(self) -> None:
         for name in ("range_m", "fov_deg", "stationary_speed_mps", "oncoming_speed_mps",
-                     "lane_margin_m"):
+                     "lane_margin_m", "near_range_m", "near_fov_deg"):
             v = getattr(self, name)
             if not math.isfinite(v) or v < 0.0:
                 raise ValueError(f"RadarSettings.{name}={v!r} must be finite and >= 0")
@@ -90,6 +92,9 @@ class RadarSettings:
             raise ValueError(f"RadarSettings.range_m={self.range_m} must be > 0")
         if not 0.0 < self.fov_deg < 180.0:
             raise ValueError(f"RadarSettings.fov_deg={self.fov_deg} must be in (0, 180)")
+        if self.near_range_m > self.range_m or not 0.0 < self.near_fov_deg < 180.0:
+            raise ValueError(f"RadarSettings.near_range_m={self.near_range_m} must be <= "
+                             f"range_m and near_fov_deg={self.near_fov_deg} in (0, 180)")
         if self.oncoming_speed_mps < self.stationary_speed_mps:
             raise ValueError(
                 f"RadarSettings.oncoming_speed_mps={self.oncoming_speed_mps} must be >= "
@@ -177,6 +182,31 @@ class Radar:
         self._half_fov_rad = math.radians(0.5 * settings.fov_deg)
         self._cos_half_fov = math.cos(self._half_fov_rad)
         self._sin_half_fov = math.sin(self._half_fov_rad)
+        self._near = None  # the near-range beam, as a radar of its own
+        if settings.near_range_m > 0.0:
+            self._near = Radar(replace(settings, range_m=settings.near_range_m,
+                                       fov_deg=settings.near_fov_deg, near_range_m=0.0))
+
+    def seen_point(self, ox: float, oy: float, yaw_rad: float, cos_yaw: float, sin_yaw: float,
+                   box: OrientedBox) -> tuple[float, float, float]:
+        """(distance, x, y) of the nearest point of ``box`` the radar covers (the far beam
+        within ``range_m``, the near beam within ``near_range_m``); distance inf if none."""
+        rng, px, py = self.visible_point(ox, oy, yaw_rad, cos_yaw, sin_yaw, box)
+        if rng > self.settings.range_m:
+            rng = math.inf
+        if self._near is not None:
+            near = self._near.seen_point(ox, oy, yaw_rad, cos_yaw, sin_yaw, box)
+            if near[0] < rng:
+                return near
+        return rng, px, py
+
+    def covers(self, ox: float, oy: float, yaw_rad: float, px: float, py: float) -> bool:
+        """Whether the point (px, py) lies in one of the beams."""
+        r = math.hypot(px - ox, py - oy)
+        off = abs(math.remainder(math.atan2(py - oy, px - ox) - yaw_rad, math.tau))
+        if r <= self.settings.range_m and off <= self._half_fov_rad:
+            return True
+        return self._near is not None and self._near.covers(ox, oy, yaw_rad, px, py)
 
     def visible_range_m(
         self, origin_xy: tuple[float, float], yaw_rad: float, box: OrientedBox
@@ -222,6 +252,7 @@ class Radar:
             raise ValueError(f"lane_width_m={lane_width_m} must be > 0")
         range_m = self.settings.range_m
         cos_half_fov, sin_half_fov = self._cos_half_fov, self._sin_half_fov
+        near = self._near
         ox, oy = ego_front_xy
         bx, by = math.cos(ego_yaw_rad), math.sin(ego_yaw_rad)
         evx, evy = ego_speed_mps * bx, ego_speed_mps * by
@@ -234,13 +265,18 @@ class Radar:
             reach = range_m + box.radius_m
             if dx * dx + dy * dy > reach * reach:
                 continue
-            # cheap rejection: the box's bounding circle lies wholly outside the cone
-            along, across = dx * bx + dy * by, abs(dy * bx - dx * by)
-            if along * sin_half_fov - across * cos_half_fov < -box.radius_m:
-                continue
-            rng, px, py = self.visible_point(ox, oy, ego_yaw_rad, bx, by, box)
-            if rng > range_m:
-                continue
+            if near is not None:
+                rng, px, py = self.seen_point(ox, oy, ego_yaw_rad, bx, by, box)
+                if rng == math.inf:
+                    continue
+            else:
+                # cheap rejection: the box's bounding circle lies wholly outside the cone
+                along, across = dx * bx + dy * by, abs(dy * bx - dx * by)
+                if along * sin_half_fov - across * cos_half_fov < -box.radius_m:
+                    continue
+                rng, px, py = self.visible_point(ox, oy, ego_yaw_rad, bx, by, box)
+                if rng > range_m:
+                    continue
             if rng > 1e-9:
                 lx, ly = (px - ox) / rng, (py - oy) / rng
             else:
