@@ -70,6 +70,16 @@ def _seed(text: str) -> int:
     return value
 
 
+def _seconds_list(text: str) -> tuple[float, ...]:
+    try:
+        values = tuple(float(t) for t in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a list of seconds T[,T...]") from None
+    if not all(math.isfinite(v) and v >= 0.0 for v in values):
+        raise argparse.ArgumentTypeError(f"times {text} s must be numbers >= 0")
+    return values
+
+
 def _distance_or_none(text: str) -> float | None:
     if text.lower() == "none":
         return None
@@ -119,6 +129,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="V2X packet-loss probability, in [0, 1)")
     p.add_argument("--v2x-penetration", type=_finite, default=1.0,
                    help="share of road users equipped with V2X, in [0, 1]")
+    p.add_argument("--gui-delay-ms", type=_finite, metavar="N",
+                   help="with --gui: wall ms per SUMO step (default: real time)")
+    p.add_argument("--gui-screenshot", type=_seconds_list, metavar="T[,T...]", default=(),
+                   help="with --gui: screenshots at these simulation times (s) into --out")
 
     p = sub.add_parser(
         "batch", help="run every case of an experiment matrix",
@@ -173,6 +187,7 @@ def _cmd_run(args) -> int:
     from eoam_sumo.sim.cosim import RunSettings, policy_settings, run_case
     from eoam_sumo.sim.radar import RadarSettings
     from eoam_sumo.sim.scenario import ScenarioOverrides
+    from eoam_sumo.sim.session.gui import GuiSettings
 
     if not args.cfg.is_file():
         raise InputError(f"{args.cfg}: no such scenario file")
@@ -181,7 +196,11 @@ def _cmd_run(args) -> int:
     if args.radar_range_m is not None and args.radar_range_m <= 0:
         raise InputError(f"--radar-range-m {args.radar_range_m} must be > 0")
     _check_v2x(args)
+    if not args.gui and (args.gui_delay_ms is not None or args.gui_screenshot):
+        raise InputError("--gui-delay-ms and --gui-screenshot need --gui")
     out = _writable_dir(args.out)
+    gui = GuiSettings(delay_ms=args.gui_delay_ms, screenshots_s=args.gui_screenshot,
+                      screenshot_dir=out)
     overrides = ScenarioOverrides(
         ego_speed_mps=None if args.speed_kmh is None else args.speed_kmh / 3.6,
         mu=args.mu,
@@ -189,6 +208,7 @@ def _cmd_run(args) -> int:
     )
     settings = RunSettings(
         max_time_s=args.max_time_s, ego_id=args.ego, gui=args.gui, use_traci=args.gui,
+        gui_settings=gui,
         tables_dir=args.tables, mu_belief=parse_mu_belief(args.mu_belief), seed=args.seed,
         radar_model=parse_radar_model(args.radar_model),
     )
@@ -204,6 +224,11 @@ def _cmd_run(args) -> int:
         f"{_sight_text(s)}sim={s['sim_time_s']:.2f} s "
         f"rtf={s['realtime_factor']:.0f} -> {out}"
     )
+    if s.get("sumo_overrides"):
+        options = ", ".join(f"{k}={v}" for k, v in s["sumo_overrides"].items())
+        print(f"eoam-sumo: SUMO options set over the scenario's: {options}", file=sys.stderr)
+    if args.gui:
+        print("eoam-sumo: the sumo-gui window stays open until you close it", file=sys.stderr)
     return 0
 
 

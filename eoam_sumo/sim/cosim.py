@@ -35,6 +35,7 @@ from eoam_sumo.sim.roadframe import RoadFrame
 from eoam_sumo.sim.runlog import RunLog
 from eoam_sumo.sim.scenario import ScenarioOverrides
 from eoam_sumo.sim.session import SumoSession
+from eoam_sumo.sim.session.gui import GuiSettings
 
 
 @dataclass(frozen=True)
@@ -48,6 +49,7 @@ class RunSettings:
     ego_id: str = "ego"
     gui: bool = False
     use_traci: bool = False
+    gui_settings: GuiSettings = field(default_factory=GuiSettings)  # with gui: pacing, view
     tables_dir: Path | None = None
     radar: RadarSettings = field(default_factory=RadarSettings)
     eoam: EoamSettings = field(default_factory=EoamSettings)
@@ -131,11 +133,13 @@ class CoSimulation:
         wall0 = time.perf_counter()
         session = SumoSession.start(
             self.cfg, self.overrides, ego_id=st.ego_id, step_length_s=st.step_s,
-            gui=st.gui, use_traci=st.use_traci,
+            gui=st.gui, use_traci=st.use_traci, gui_settings=st.gui_settings,
         )
         try:
             with _collector_paused():
-                return self._loop(session, wall0)
+                summary, log = self._loop(session, wall0)
+            summary["sumo_overrides"] = dict(session.sumo_overrides)
+            return summary, log
         finally:
             session.close()
 

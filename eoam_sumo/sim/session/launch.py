@@ -24,7 +24,8 @@ ENFORCED_OPTIONS = (
     ("no-step-log", "true"),
     ("route-steps", "0"),
 )
-HONOURED_OPTIONS = ("no-warnings",)  # left as the sumocfg sets them, when it sets them
+HONOURED_OPTIONS = ("no-warnings", "window-size")  # left as the sumocfg sets them, if it does
+GUI_WINDOW_SIZE = "1280,800"  # sumo-gui's window [px] (its default is a small one)
 ERROR_LOG_STDERR = "sumo-stderr.log"  # SUMO's standard error while libsumo starts (workdir)
 TRACI_RETRIES = 600  # x 50 ms: time SUMO may take to load before TraCI gives up
 PROCESS_EXIT_S = 10.0  # time a closed SUMO server process gets to exit
@@ -45,17 +46,23 @@ def _same_value(a: str | None, b: str) -> bool:
 
 
 def sumo_command(binary: str, cfg: Path, cfg_options: dict, step_s: float, error_log: Path,
-                 extra: tuple[str, ...], gui: bool) -> tuple[list[str], dict]:
+                 extra: tuple[str, ...], gui: bool,
+                 keep_gui_open: bool = False) -> tuple[list[str], dict]:
     """(command line, overrides): SUMO started on ``cfg`` with the co-simulation's options,
     and option -> value of every one of them that changes what the sumocfg (``cfg_options``,
-    its option elements) or SUMO's default gives. Options in ``extra`` win over both."""
+    its option elements) or SUMO's default gives. Options in ``extra`` win over both. sumo-gui
+    starts at once, and quits at the end unless ``keep_gui_open``."""
     wanted = [("step-length", f"{step_s:.3f}")]
     for option, value in ENFORCED_OPTIONS:
         if option in HONOURED_OPTIONS and option in cfg_options:
             continue
         wanted.append((option, value))
     if gui:
-        wanted += [("start", "true"), ("quit-on-end", "true")]
+        wanted.append(("start", "true"))
+        if "window-size" not in cfg_options:
+            wanted.append(("window-size", GUI_WINDOW_SIZE))
+        if not keep_gui_open:
+            wanted.append(("quit-on-end", "true"))
     given = {a.split("=", 1)[0].lstrip("-") for a in extra if a.startswith("-")}
     cmd = [binary, "-c", str(cfg)]
     if "error-log" not in cfg_options:

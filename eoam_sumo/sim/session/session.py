@@ -7,10 +7,23 @@ inserts the ego at the requested speed (moveToXY before the insertion step). The
 answers the co-simulation's queries: the ego's reference line, the road users around the ego
 (vehicles of every class and persons, as :class:`~eoam_sumo.sim.bodies.Body`), the friction
 under the ego; :meth:`move_ego` writes the ego's pose back and :meth:`step` advances SUMO.
+
+Time: :attr:`SumoSession.time_s` is SUMO's time at the end of the last step (``getTime``
+after ``simulationStep``), the time the co-simulation logs (timeseries.csv ``time_s``). SUMO
+labels its own outputs (fcd-output, collision-output, ...) with the time at the start of the
+step, so the state logged at t is in SUMO's outputs at t - step length: fcd-output's row at t
+holds the ego of timeseries.csv's row at t + 0.01 s (checked with libsumo 1.28; joined on
+equal times they differ by one step, 0.33 m at 120 km/h).
+
+Options: SUMO runs with the options of ``launch.sumo_command`` over the sumocfg's;
+:attr:`SumoSession.sumo_overrides` names those that change what the sumocfg or SUMO's default
+gives. A collision-output that the sumocfg asks for gets the co-simulation's own contacts
+(:meth:`SumoSession.record_collision`, written at :meth:`SumoSession.close`).
 """
 
 from __future__ import annotations
 
+import math
 import os
 import shutil
 import sys
@@ -21,7 +34,7 @@ from typing import Self
 import numpy as np
 
 from eoam_sumo.errors import InputError
-from eoam_sumo.sim.bodies import Body
+from eoam_sumo.sim.bodies import PEDESTRIAN, Body
 from eoam_sumo.sim.scenario import (
     ROLE_KEY,
     ScenarioFiles,
@@ -31,6 +44,8 @@ from eoam_sumo.sim.scenario import (
 )
 from eoam_sumo.sim.scenario.files import float_attr
 from eoam_sumo.sim.scenario.values import number
+from eoam_sumo.sim.session.collisions import CollisionRecord, write_collision_output
+from eoam_sumo.sim.session.gui import GuiSettings, GuiView
 from eoam_sumo.sim.session.insertion import EgoStart, add_oncoming, place_ego
 from eoam_sumo.sim.session.launch import (
     ERROR_LOG_STDERR,
@@ -45,6 +60,16 @@ from eoam_sumo.sim.session.tracking import RoadUsers
 
 _open_libsumo: list[SumoSession] = []  # libsumo runs one simulation per process
 _NO_OVERRIDES = ScenarioOverrides()
+_GUI_DEFAULTS = GuiSettings()
+
+
+def _delay_ms(text: str | None) -> float | None:
+    """The sumocfg's sumo-gui ``delay`` [ms] when it is a number >= 0, else None."""
+    try:
+        value = float(text) if text is not None else math.nan
+    except ValueError:
+        return None
+    return value if math.isfinite(value) and value >= 0.0 else None
 
 
 class SumoSession:
@@ -57,11 +82,18 @@ class SumoSession:
 
     def __init__(self, api, constants, errors: tuple, files: ScenarioFiles,
                  overrides: ScenarioOverrides, ego_id: str, step_length_s: float,
-                 workdir: Path, process=None, sumo_overrides: dict | None = None) -> None:
+                 workdir: Path, process=None, sumo_overrides: dict | None = None,
+                 gui: GuiSettings | None = None) -> None:
         self._api, self._tc, self._errors, self._files = api, constants, errors, files
         self._overrides, self.ego_id, self._dt = overrides, ego_id, step_length_s
         self._workdir, self._process = workdir, process
         self.sumo_overrides = dict(sumo_overrides or {})
+        self.gui = None if gui is None else GuiView(
+            api, gui, step_length_s, _delay_ms(files.options.get("delay")),
+            "gui-settings-file" in files.options)
+        self._collisions: list[CollisionRecord] = []
+        output = files.options.get("collision-output")
+        self.collision_output = files.cfg.parent / output if output else None
         self._veh, self._lane, self._sim = api.vehicle, api.lane, api.simulation
         self._closed = False
         self._time_s = self._sim.getTime()
@@ -89,11 +121,13 @@ class SumoSession:
         gui: bool = False,
         use_traci: bool = False,
         extra_args: tuple[str, ...] = (),
+        gui_settings: GuiSettings = _GUI_DEFAULTS,
     ) -> SumoSession:
         """Check the files, start SUMO, advance it to the ego's departure and make the step
         that inserts the ego at the requested speed; on return the ego is in SUMO and every
-        query answers. ``gui`` runs ``sumo-gui`` through TraCI, ``use_traci`` plain ``sumo``
-        through TraCI; otherwise libsumo (in-process, one session per process)."""
+        query answers. ``gui`` runs ``sumo-gui`` through TraCI (shown as ``gui_settings``
+        says), ``use_traci`` plain ``sumo`` through TraCI; otherwise libsumo (in-process, one
+        session per process)."""
         if not isinstance(overrides, ScenarioOverrides):
             raise TypeError(
                 f"overrides must be a ScenarioOverrides, not {type(overrides).__name__}"
@@ -122,7 +156,7 @@ class SumoSession:
         error_log = workdir / "sumo-errors.log"
         cmd, sumo_overrides = sumo_command(
             sumolib.checkBinary("sumo-gui" if gui else "sumo"), files.cfg, files.options, step,
-            error_log, extra, gui)
+            error_log, extra, gui, keep_gui_open=gui_settings.keep_open)
         try:
             if via_traci:
                 import traci
@@ -149,7 +183,7 @@ class SumoSession:
         session = None
         try:
             session = cls(api, constants, errors, files, overrides, ego_id, step, workdir,
-                          process, sumo_overrides)
+                          process, sumo_overrides, gui_settings if gui else None)
             if not via_traci:
                 _open_libsumo.append(session)
             session._set_up()
@@ -201,6 +235,8 @@ class SumoSession:
             raise InputError(f"{spec.source}: SUMO did not insert vehicle '{self.ego_id}'")
         for vid, speed in self._over_limit.items():  # departed at rest (see insert)
             self._veh.setPreviousSpeed(vid, speed)
+        if self.gui is not None:
+            self.gui.follow(self.ego_id)
 
     # ----------------------------------------------------------------------------- stepping
     def _sumo_step(self) -> None:
@@ -222,6 +258,8 @@ class SumoSession:
     def step(self) -> None:
         """Advance SUMO by one step."""
         self._check_open()
+        if self.gui is not None:
+            self.gui.before_step(self._time_s + self._dt)
         try:
             self._sumo_step()
         except self._errors as exc:
@@ -352,6 +390,23 @@ class SumoSession:
     def vehicle_lane(self, vid: str) -> str:
         return self._veh.getLaneID(vid)
 
+    def record_collision(self, time_s: float, collider: Body, victim: Body) -> None:
+        """Note a contact the co-simulation found in the step that ended at ``time_s``
+        (``collider`` hit ``victim``, as they were then) for the scenario's collision-output;
+        does nothing when the sumocfg asks for none. Call it before the next step: the
+        collider's lane and position are read from SUMO now."""
+        if self.collision_output is None:
+            return
+        self._check_open()
+        types = []
+        for body in (collider, victim):
+            domain = self._api.person if body.vclass == PEDESTRIAN else self._veh
+            types.append(domain.getTypeID(body.vid))
+        lane = self._veh.getLaneID(collider.vid) if collider.vclass != PEDESTRIAN else ""
+        pos = self._veh.getLanePosition(collider.vid) if lane else 0.0
+        self._collisions.append(CollisionRecord(time_s - self._dt, lane, pos, collider, victim,
+                                                *types))
+
     # ----------------------------------------------------------------------------- life cycle
     def _check_open(self) -> None:
         if self._closed:
@@ -364,12 +419,17 @@ class SumoSession:
         self._closed = True
         if self in _open_libsumo:
             _open_libsumo.remove(self)
-        shut_down(self._api, self._process)
+        keep_open = self.gui is not None and self.gui.settings.keep_open
+        shut_down(self._api, self._process, wait=not keep_open)
 
     def close(self) -> None:
-        """End SUMO (idempotent)."""
+        """End SUMO (idempotent; a sumo-gui window meant to stay open is left to the user),
+        then add the recorded collisions to the scenario's collision-output."""
         self._release()
         shutil.rmtree(self._workdir, ignore_errors=True)
+        if self._collisions and self.collision_output is not None:
+            write_collision_output(self.collision_output, self._collisions)
+            self._collisions = []
 
     def __enter__(self) -> Self:
         return self
