@@ -51,8 +51,8 @@ def plot_envelopes(results: pd.DataFrame, out_dir: Path) -> list[Path]:
     if not (results["status"] == "ok").any():
         return []
     events = {
-        "contact (any road user)": results["collision_with"].fillna("none") != "none",
-        "red (head-on after a lane change)": results["outcome"] == "red",
+        "P(contact with any road user)": results["collision_with"].fillna("none") != "none",
+        "P(red: head-on after a lane change)": results["outcome"] == "red",
     }
     fig = Figure(figsize=(12, 5.5), layout="constrained")
     axes = fig.subplots(1, 2)
@@ -71,9 +71,10 @@ def plot_envelopes(results: pd.DataFrame, out_dir: Path) -> list[Path]:
                         color="white" if p[i, j] > 0.6 else "black")
         ax.set_xticks(range(len(mus)), mus)
         ax.set_yticks(range(len(speeds)), speeds)
+        ax.invert_yaxis()  # the highest speed on top
         ax.set_xlabel("surface friction mu")
         ax.set_ylabel("initial ego speed [km/h]")
-        ax.set_title(f"P({title})")
+        ax.set_title(title)
         fig.colorbar(image, ax=ax, shrink=0.8, label="probability")
     failed = int((results["status"] != "ok").sum())
     fig.suptitle(f"Outcome envelopes: {int((results['status'] == 'ok').sum())} draws"

@@ -164,3 +164,18 @@ def test_make_radar_and_settings_checks():
         replace(EXACT, detection_probability=0.0)
     with pytest.raises(InputError, match="confirm_hits"):
         TrackerSettings(confirm_hits=4, confirm_window=3)
+
+
+@pytest.mark.parametrize(("option", "value", "named"), [
+    ("--radar-model", "sonar", "radar_model 'sonar'"), ("--seed", "-1", "seed -1"),
+    ("--seed", "x", "seed 'x'")])
+def test_run_refuses_a_bad_radar_model_or_seed_with_one_line(option, value, named, capsys,
+                                                              tmp_path):
+    from pathlib import Path
+
+    from eoam_sumo.cli import main
+
+    cfg = Path(__file__).resolve().parents[2] / "scenarios" / "baseline.sumocfg"
+    assert main(["run", str(cfg), option, value, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and named in err[0]
