@@ -33,17 +33,20 @@ mu_belief = {{ choice = ["known", 1.0] }}
 """
 
 
-def _run(tmp_path: Path, name: str, timeseries: str):
+def _run(tmp_path: Path, name: str, timeseries: str, scheduler: str | None = None):
     matrix = tmp_path / "sampled.toml"
     matrix.write_text(MATRIX)
     out = tmp_path / name
-    results = run_batch(matrix, out, jobs=2, progress=False, timeseries=timeseries)
+    results = run_batch(matrix, out, jobs=2, progress=False, timeseries=timeseries,
+                        scheduler=scheduler)
     return results, out
 
 
 def test_sampled_matrix_is_reproducible_and_its_probabilities_are_consistent(tmp_path):
+    """Twice with the same seed, the second time on a Dask cluster (--scheduler local):
+    the same results.csv, timing columns aside."""
     first, out1 = _run(tmp_path, "a", "none")
-    _, out2 = _run(tmp_path, "b", "none")
+    _, out2 = _run(tmp_path, "b", "none", scheduler="local")
     assert len(first) == 6 and (first["status"] == "ok").all()
     assert first["draw"].tolist() == [0, 1, 2, 0, 1, 2]
     assert first["oncoming_start_m"].between(250, 450).all()
@@ -55,7 +58,7 @@ def test_sampled_matrix_is_reproducible_and_its_probabilities_are_consistent(tmp
     # --timeseries none: summaries only
     for case_dir in first["case_dir"]:
         assert sorted(p.name for p in (out1 / case_dir).iterdir()) == ["summary.json"]
-    assert not list(out1.rglob("timeseries.*"))
+    assert not list(out1.rglob("timeseries.*")) and not list(out2.rglob("timeseries.*"))
     # outcome probabilities: per group of swept values, within their intervals, sum to 1
     probs = pd.read_csv(out1 / "outcome_probabilities.csv")
     assert list(probs.columns[-6:]) == ["outcome", "count", "n", "p", "ci_low", "ci_high"]

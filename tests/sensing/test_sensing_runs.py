@@ -44,11 +44,15 @@ def test_believing_a_dry_road_on_snow_acts_later_than_knowing(tmp_path):
     the EOAM acts later (closer to the ARO) than with the true friction; summary.json says so."""
     over = ScenarioOverrides(ego_speed_mps=90 / 3.6, mu=0.3)
     runs = {}
-    for belief in ("known", 1.0):
+    for belief in ("known", 1.0, "estimate"):
         out = tmp_path / str(belief)
         run_case(BASELINE, over, out, RunSettings(max_time_s=20.0, mu_belief=belief))
         runs[belief] = json.loads((out / "summary.json").read_text())
-    known, dry = runs["known"], runs[1.0]
+    known, dry, estimate = runs["known"], runs[1.0], runs["estimate"]
+    # the estimator has learnt nothing while cruising: it triggers as the dry-road belief
+    assert estimate["mu_belief"] == "estimate"
+    assert estimate["mu_believed_at_trigger"] == 1.0
+    assert estimate["trigger_time_s"] == dry["trigger_time_s"]
     assert known["mu_belief"] == "known" and dry["mu_belief"] == 1.0
     assert known["mu"] == dry["mu"] == pytest.approx(0.3)  # the road is the same
     assert known["mu_believed_at_trigger"] == pytest.approx(0.3)
