@@ -105,6 +105,8 @@ def test_sampled_speed_and_friction_leave_the_sweep(tmp_path):
     ("draws = 2\nmu_belief = { uniform = [0.5, 1.5] }", "mu_belief: high 1.5"),
     ("draws = 2\ncolour = { choice = [1] }", "'colour' cannot be sampled"),
     ("draws = 2\nmu = { choice = [0.3] }", "'mu' is both in [sweep] and sampled"),
+    ('draws = 2\npolicy = { choice = ["paper", "careful"] }', "policy: choice 'careful'"),
+    ("draws = 2\nv2x_loss = { uniform = [0, 1] }", "v2x_loss: high 1.0: is outside [0, 1)"),
 ])
 def test_bad_samples_name_key_and_value(tmp_path, sample, message):
     with pytest.raises(InputError, match=None) as err:
@@ -129,3 +131,12 @@ def test_scenario_settings_and_their_errors(tmp_path):
         assert message in str(err.value)
     with pytest.raises(InputError, match=r"\[scenario\] seed with a \[sample\] table"):
         load_matrix(_matrix(tmp_path, "draws = 2", scenario="seed = 1"))
+
+
+def test_policy_and_v2x_settings_can_be_sampled(tmp_path):
+    path = _matrix(tmp_path, 'draws = 20\nseed = 4\npolicy = { choice = ["paper", "safe"] }\n'
+                   "v2x_penetration = { uniform = [0.5, 1.0] }",
+                   "ego_speed_kmh = [120]\nmu = [0.3]")
+    cases = load_matrix(path).cases()
+    assert {c.policy for c in cases} == {"paper", "safe"}
+    assert all(0.5 <= c.v2x_penetration <= 1.0 for c in cases)
