@@ -21,6 +21,7 @@ import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from eoam_sumo.colours import OUTCOMES
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import MU_MAX
 from eoam_sumo.sampling import Sample, parse_sample
@@ -40,7 +41,6 @@ SCHEMA = {
 }
 REQUIRED = {"scenario": ("sumocfg",), "sweep": ("ego_speed_kmh", "mu")}  # unless sampled
 PAPER_COLUMNS = ("oncoming_start_m", "ego_speed_kmh", "mu", "outcome")
-OUTCOMES = ("none", "green", "yellow", "orange", "red")
 POLICIES = ("paper", "safe")
 #: [scenario] V2X keys: (default, lowest, highest or None, highest included)
 V2X_KEYS = {

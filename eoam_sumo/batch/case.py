@@ -6,8 +6,9 @@ Kept apart from the runner so a worker process imports only what a case needs.
 from __future__ import annotations
 
 import tempfile
-from dataclasses import dataclass, replace
+from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
+from typing import get_type_hints
 
 from eoam_sumo.matrix import Case
 
@@ -33,28 +34,47 @@ class CaseTask:
     timeseries: str = "csv"  # csv, parquet or none
 
 
+@dataclass(frozen=True)
+class CaseParameters:
+    """A case's matrix parameters as stored with its summary (summary.json's ``case``) and in
+    results.csv (``sumocfg`` among the last columns there)."""
+
+    case_id: str
+    ego_speed_kmh: float
+    mu: float  # the friction asked for (the summary's ``mu`` is the one under the ego)
+    oncoming_start_m: float | None  # None: no oncoming car added
+    aro_hold_s: float | None  # None: the route file's value
+    aro_decel_mps2: float | None  # None: the route file's value
+    max_time_s: float
+    radar_range_m: float | None  # None: the radar's default range
+    policy: str  # the decision policy: paper or safe
+    v2x_range_m: float  # 0: no V2X
+    v2x_latency_s: float
+    v2x_loss: float
+    v2x_penetration: float
+    mu_belief: str | float  # known, estimate or a number
+    radar_model: str  # ideal or automotive
+    seed: int
+    draw: int | None  # the sample's number in a sampled matrix
+    sumocfg: str
+
+    @classmethod
+    def of(cls, case: Case) -> CaseParameters:
+        return cls(**{f.name: getattr(case, f.name) for f in fields(cls)
+                      if f.name != "sumocfg"}, sumocfg=str(case.sumocfg))
+
+
+#: The parameter names, in order.
+PARAMETERS: tuple[str, ...] = tuple(f.name for f in fields(CaseParameters))
+#: The parameters that are numbers (or empty).
+NUMERIC_PARAMETERS: tuple[str, ...] = tuple(
+    name for name, tp in get_type_hints(CaseParameters).items()
+    if tp in (float, int, float | None, int | None))
+
+
 def case_parameters(case: Case) -> dict:
     """The case's matrix parameters, stored with its summary."""
-    return {
-        "case_id": case.case_id,
-        "ego_speed_kmh": case.ego_speed_kmh,
-        "mu": case.mu,
-        "oncoming_start_m": case.oncoming_start_m,
-        "aro_hold_s": case.aro_hold_s,
-        "aro_decel_mps2": case.aro_decel_mps2,
-        "max_time_s": case.max_time_s,
-        "radar_range_m": case.radar_range_m,
-        "policy": case.policy,
-        "v2x_range_m": case.v2x_range_m,
-        "v2x_latency_s": case.v2x_latency_s,
-        "v2x_loss": case.v2x_loss,
-        "v2x_penetration": case.v2x_penetration,
-        "mu_belief": case.mu_belief,
-        "radar_model": case.radar_model,
-        "seed": case.seed,
-        "draw": case.draw,
-        "sumocfg": str(case.sumocfg),
-    }
+    return asdict(CaseParameters.of(case))
 
 
 def run_matrix_case(task: CaseTask) -> dict:

@@ -8,12 +8,12 @@ with its count, the group's number of draws n, p = count / n and the Wilson 95 %
 
 from __future__ import annotations
 
-import os
 import re
 from pathlib import Path
 
 import pandas as pd
 
+from eoam_sumo.fileio import write_atomic
 from eoam_sumo.sampling import wilson_interval
 
 PROBABILITIES_FILE = "outcome_probabilities.csv"
@@ -62,7 +62,5 @@ def write_probabilities(out_dir: Path, results: pd.DataFrame) -> list[Path]:
 
     out_dir = Path(out_dir)
     path = out_dir / PROBABILITIES_FILE
-    tmp = path.with_name(path.name + ".tmp")
-    outcome_probabilities(results).to_csv(tmp, index=False)
-    os.replace(tmp, path)
+    write_atomic(path, outcome_probabilities(results).to_csv(index=False))
     return [path, *plot_envelopes(results, out_dir)]

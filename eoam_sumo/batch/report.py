@@ -12,25 +12,12 @@ that was not green.
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
-from pathlib import Path
 
 import pandas as pd
 
-COLOURS = ("green", "yellow", "orange", "red", "none")
-FAILED = "failed"
-MARKERS = {"green": "🟩", "yellow": "🟨", "orange": "🟧", "red": "🟥", "none": "⬜",
-           FAILED: "⚠️"}
-#: Paper sec. 11 colour definitions, shortened.
-LEGEND = {
-    "green": "lane change completed without collision and back in lane (or stopped, no contact)",
-    "yellow": "straight-line limit braking chosen, front hit on the ARO at reduced speed",
-    "orange": "lane change made, lateral (side) contact",
-    "red": "lane change made, head-on (direct or offset) hit on the oncoming vehicle",
-    "none": "no manoeuvre needed, nothing hit",
-    FAILED: "the case did not finish (see the error)",
-}
+from eoam_sumo.colours import FAILED, LEGEND, MARKERS, OUTCOMES
+
 TABLE_MD = "table2.md"
 TABLE_PNG = "table2.png"
 _EXTRA_PARAMS = (("aro_hold_s", "ARO hold {:g} s"), ("aro_decel_mps2", "ARO decel {:g} m/s²"))
@@ -138,7 +125,7 @@ def _mark(colour: str | None) -> str:
 
 
 def _counts(colours: list[str]) -> str:
-    return ", ".join(f"{colours.count(c)} {c}" for c in (*COLOURS, FAILED) if colours.count(c))
+    return ", ".join(f"{colours.count(c)} {c}" for c in (*OUTCOMES, FAILED) if colours.count(c))
 
 
 def _ref(cell: Cell, n: int) -> str:
@@ -198,21 +185,3 @@ def table2_markdown(grid: OutcomeGrid, title: str = "Table 2") -> str:
     if not differing:
         lines.append("None.")
     return "\n".join(lines) + "\n"
-
-
-def write_report(out_dir: Path, results: pd.DataFrame) -> list[Path]:
-    """Write ``table2.md`` and ``table2.png`` of a results frame into ``out_dir``."""
-    from eoam_sumo.batch.policy_report import policy_line, policy_title, sight_markdown
-    from eoam_sumo.plotting.batch_plots import plot_table2
-
-    out_dir = Path(out_dir)
-    grid = outcome_grid(results)
-    md = out_dir / TABLE_MD
-    tmp = md.with_name(md.name + ".tmp")
-    text = table2_markdown(grid, policy_title(results))
-    head, _, rest = text.partition("\n\n")
-    sight = sight_markdown(results)
-    text = f"{head}\n\n{policy_line(results)}\n\n{rest}" + (f"\n{sight}" if sight else "")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, md)
-    return [md, plot_table2(grid, out_dir / TABLE_PNG)]

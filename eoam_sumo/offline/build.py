@@ -14,7 +14,6 @@ import io
 import json
 import math
 import multiprocessing
-import os
 import queue as queue_module
 import sys
 import zipfile
@@ -28,6 +27,7 @@ from tqdm import tqdm
 
 import eoam_sumo
 from eoam_sumo.errors import InputError
+from eoam_sumo.fileio import write_atomic
 from eoam_sumo.offline import tables as tb
 from eoam_sumo.offline.boundaries import (
     clearing_distance_m,
@@ -181,12 +181,6 @@ def _drain(q, bar) -> None:
             return
 
 
-def _atomic_write(path: Path, data: bytes) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_bytes(data)
-    os.replace(tmp, path)
-
-
 def _write_csv(path: Path, per_mu: dict, params: VehicleParams) -> None:
     buf = io.StringIO()
     buf.write(f"# eoam-sumo {eoam_sumo.__version__} DMM phase boundaries for {params.name}; "
@@ -196,7 +190,7 @@ def _write_csv(path: Path, per_mu: dict, params: VehicleParams) -> None:
     for results in per_mu.values():
         for r in results:
             writer.writerow([f.format(v) for f, v in zip(_CSV_FORMATS, r.csv_values)])
-    _atomic_write(path, buf.getvalue().encode())
+    write_atomic(path, buf.getvalue().encode())
 
 
 def _write_npz(path: Path, per_mu: dict, settings: DesignSettings) -> None:
@@ -227,7 +221,7 @@ def _write_npz(path: Path, per_mu: dict, settings: DesignSettings) -> None:
             np.lib.format.write_array(item, np.array(arrays[name], order="C"),
                                       allow_pickle=False)
             zf.writestr(info, item.getvalue())
-    _atomic_write(path, buf.getvalue())
+    write_atomic(path, buf.getvalue())
 
 
 def _write_metadata(path: Path, params: VehicleParams, settings: DesignSettings) -> None:
@@ -254,4 +248,4 @@ def _write_metadata(path: Path, params: VehicleParams, settings: DesignSettings)
                          + ", ".join(tb.TABLE_NAMES + EXTRA_TABLES),
         },
     }
-    _atomic_write(path, (json.dumps(meta, indent=2, sort_keys=True) + "\n").encode())
+    write_atomic(path, (json.dumps(meta, indent=2, sort_keys=True) + "\n").encode())

@@ -10,41 +10,29 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch, Rectangle
 
+from eoam_sumo.batch.report import TABLE_PNG, mu_text, outcome_grid
+from eoam_sumo.batch.results import RESULTS_FILE, read_results
+from eoam_sumo.colours import DARK_TEXT
+from eoam_sumo.colours import HEX as OUTCOME_COLOURS
 from eoam_sumo.params import LANE_CHANGE_HEIGHT_M, PONR_FRACTION
+from eoam_sumo.plotting.figures import save
 from eoam_sumo.sim.runlog import read_timeseries
 
-#: Outcome colours (paper sec. 11); grey for none, dark grey for a failed case.
-OUTCOME_COLOURS = {
-    "green": "#43a047", "yellow": "#fdd835", "orange": "#fb8c00", "red": "#e53935",
-    "none": "#bdbdbd", "failed": "#616161",
-}
 _MISSING = "#ffffff"
 _STYLES = ("-", "--", "-.", ":")
 LANE_WIDTH_M = LANE_CHANGE_HEIGHT_M  # the lane change's height (paper sec. 4.2)
 PONR_M = PONR_FRACTION * LANE_WIDTH_M  # point of no return (paper sec. 8.1)
 
 
-def save(fig: Figure, path: Path, dpi: int = 120) -> Path:
-    """Render ``fig`` to a PNG at ``path`` (parents created)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    FigureCanvasAgg(fig)
-    fig.savefig(path, dpi=dpi)
-    return path
-
-
 def _text_colour(colour: str) -> str:
-    return "black" if colour in ("yellow", "none", "orange", None) else "white"
+    return "black" if colour is None or colour in DARK_TEXT else "white"
 
 
 def plot_table2(grid, path: Path) -> Path:
     """The outcome grid (``report.OutcomeGrid``) as an image: each cell split ours | paper."""
-    from eoam_sumo.batch.report import mu_text
-
     n_rows, n_cols = len(grid.rows), len(grid.mus)
     halves = 2 if grid.has_paper else 1
     fig = Figure(figsize=(3.2 + 1.9 * n_cols, 1.6 + 0.42 * n_rows), layout="constrained")
@@ -135,8 +123,6 @@ def plot_lateral_offsets(batch_dir: Path, results: pd.DataFrame, out_dir: Path,
     ``speed_kmh`` defaults to 120 km/h when the batch has it, else its most common speed;
     None is returned when the batch has no finished case at that speed.
     """
-    from eoam_sumo.batch.report import mu_text
-
     ok = results[results["status"] == "ok"]
     if ok.empty:
         return None
@@ -163,9 +149,6 @@ def plot_lateral_offsets(batch_dir: Path, results: pd.DataFrame, out_dir: Path,
 
 def plot_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
     """Every batch plot of a batch folder (has results.csv): Table 2 image and Figure 25."""
-    from eoam_sumo.batch.report import TABLE_PNG, outcome_grid
-    from eoam_sumo.batch.runner import RESULTS_FILE, read_results
-
     results = read_results(Path(batch_dir) / RESULTS_FILE)
     if results["draw"].notna().any():  # a sampled batch: its envelopes, no Table 2 grid
         from eoam_sumo.plotting.envelope_plots import plot_envelopes

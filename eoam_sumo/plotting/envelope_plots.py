@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from eoam_sumo.plotting.batch_plots import save
+from eoam_sumo.plotting.figures import save
 from eoam_sumo.sampling import wilson_interval
 
 ENVELOPE_PNG = "envelope.png"

@@ -26,7 +26,7 @@ from matplotlib.lines import Line2D
 from eoam_sumo.batch.report import mu_text
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import G_MPS2, ego_e_class_sedan
-from eoam_sumo.plotting.batch_plots import save
+from eoam_sumo.plotting.figures import save
 from eoam_sumo.sim.runlog import COLUMNS, read_timeseries
 
 MODE_NAMES = {0: "0 NORMAL", 1: "1 UPDATE BRAKE", 2: "2 STEER+BRAKE", 3: "3 ONCOMING BRAKE",

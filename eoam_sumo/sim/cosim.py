@@ -2,9 +2,11 @@
 
 Two rates: SUMO and the EOAM decision/control run every ``step_s`` (10 ms by default); the
 plant integrates at ``plant_dt_s`` (1 ms) inside each SUMO step, all sub-steps in one compiled
-call. Per SUMO step: sense (radar on the vehicles SUMO reports near the ego), decide and
-control, advance the plant, write the ego pose back with ``moveToXY``, step SUMO, check contact
-with every other vehicle on oriented boxes at each plant sub-step, log.
+call. A step (:meth:`CoSimulation.step`) is a sequence of named phases: ``sense`` (the ego in
+the road frame, the radar on the road users SUMO reports near it), ``decide`` (EOAM decision
+and control), ``actuate`` (the plant), ``write_back`` (the ego's pose to SUMO with
+``moveToXY``, SUMO one step on), ``check_contact`` (oriented boxes at each plant sub-step),
+then the observers (time series, running extremes, anything added) and ``finished``.
 """
 
 from __future__ import annotations
@@ -13,12 +15,20 @@ import contextlib
 import gc
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
-from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, ObjectState, Perception
+from eoam_sumo.eoam import (
+    Command,
+    EgoMeasurement,
+    EoamController,
+    EoamSettings,
+    ObjectState,
+    Perception,
+)
 from eoam_sumo.errors import InputError
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
@@ -29,13 +39,15 @@ from eoam_sumo.sensing.next_lane import CornerRadarSettings, NextLaneSensing
 from eoam_sumo.sensing.v2x import V2XSettings
 from eoam_sumo.sim.bodies import nav_angle_deg
 from eoam_sumo.sim.geometry import OrientedBox, box_distance, boxes_overlap, contact
+from eoam_sumo.sim.observers import Extremes, StepObserver, TimeSeries
 from eoam_sumo.sim.outcome import classify_outcome, left_road, role_of
 from eoam_sumo.sim.radar import RadarReport, RadarSettings
 from eoam_sumo.sim.roadframe import RoadFrame
-from eoam_sumo.sim.runlog import RunLog
+from eoam_sumo.sim.runlog import RunLog, write_run
 from eoam_sumo.sim.scenario import ScenarioOverrides
 from eoam_sumo.sim.session import SumoSession
 from eoam_sumo.sim.session.gui import GuiSettings
+from eoam_sumo.sim.summary import RunSummary, finite_or_none, rounded
 
 
 @dataclass(frozen=True)
@@ -49,7 +61,6 @@ class RunSettings:
     ego_id: str = "ego"
     gui: bool = False
     use_traci: bool = False
-    gui_settings: GuiSettings = field(default_factory=GuiSettings)  # with gui: pacing, view
     tables_dir: Path | None = None
     radar: RadarSettings = field(default_factory=RadarSettings)
     eoam: EoamSettings = field(default_factory=EoamSettings)
@@ -58,6 +69,7 @@ class RunSettings:
     v2x: V2XSettings = field(default_factory=V2XSettings)  # used by the safe policy
     corner_radar: CornerRadarSettings = field(default_factory=CornerRadarSettings)
     radar_model: str = "ideal"  # sensing.automotive: ideal or automotive
+    gui_settings: GuiSettings = field(default_factory=GuiSettings)  # with gui: pacing, view
 
     def __post_init__(self) -> None:
         ms = self.step_s * 1000.0
@@ -97,7 +109,23 @@ def _collector_paused():
 
 
 class CoSimulation:
-    """One run of a SUMO scenario with the ego driven by the plant under the EOAM logic."""
+    """One run of a SUMO scenario with the ego driven by the plant under the EOAM logic.
+
+    ``run()`` does it all. To drive it by hand: ``start()``, then ``step()`` until it returns
+    True, then ``finish()``; between steps the run's state is readable (``t``, ``x`` the plant
+    state, ``meas``, ``perception``, ``cmd``, ``bodies``, ``first_contact``). ``observers``
+    (see :mod:`eoam_sumo.sim.observers`) watch every step.
+    """
+
+    #: The phases of a step, in order (``step``); a PhaseTimer times each.
+    PHASES: tuple[str, ...] = ("sense", "decide", "actuate", "write_back", "check_contact")
+    # the run's state, set by ``start`` and the steps
+    session: SumoSession
+    meas: EgoMeasurement
+    perception: Perception
+    cmd: Command
+    bodies: list
+    bodies_before: list
 
     def __init__(
         self,
@@ -105,6 +133,7 @@ class CoSimulation:
         overrides: ScenarioOverrides | None = None,
         settings: RunSettings | None = None,
         params: VehicleParams | None = None,
+        observers: Sequence[StepObserver] = (),
     ):
         self.cfg = Path(cfg)
         self.overrides = overrides = overrides or ScenarioOverrides()
@@ -123,261 +152,295 @@ class CoSimulation:
         self.belief = self._new_belief()
         if isinstance(self.belief.belief, float):
             self.tables.check_run(self.belief.belief, self.tables.speed_grid_mps[0])
+        self.extra_observers = tuple(observers)
 
     def _new_belief(self) -> FrictionBelief:
         st = self.settings
         return FrictionBelief(st.mu_belief, seed=st.seed, mu_min=self.tables.mu_grid[0])
 
+    # ----------------------------------------------------------------------------- a whole run
     def run(self) -> tuple[dict, RunLog]:
-        st = self.settings
+        """The whole run: (summary as summary.json writes it, the time series)."""
         wall0 = time.perf_counter()
-        session = SumoSession.start(
+        session = self.open_session()
+        try:
+            with _collector_paused():
+                self.start(session, wall0)
+                while not self.step():
+                    pass
+                summary = self.finish()
+        finally:
+            session.close()
+        return summary.as_dict(), self.timeseries.log
+
+    def open_session(self) -> SumoSession:
+        """Start SUMO on the scenario (the caller closes the session)."""
+        st = self.settings
+        return SumoSession.start(
             self.cfg, self.overrides, ego_id=st.ego_id, step_length_s=st.step_s,
             gui=st.gui, use_traci=st.use_traci, gui_settings=st.gui_settings,
         )
-        try:
-            with _collector_paused():
-                summary, log = self._loop(session, wall0)
-            summary["sumo_overrides"] = dict(session.sumo_overrides)
-            return summary, log
-        finally:
-            session.close()
 
-    def _loop(self, session: SumoSession, wall0: float) -> tuple[dict, RunLog]:
+    # ----------------------------------------------------------------------------- set-up
+    def start(self, session: SumoSession, wall0: float | None = None) -> None:
+        """Set the run up on an open session: the ego's plant state, road frame, controller
+        and observers; refuses a road user overlapping the ego at its departure."""
         st, p = self.settings, self.params
-        clock = time.perf_counter
+        self.session = session
+        self._wall0 = time.perf_counter() if wall0 is None else wall0
         ego = session.ego_body()
-        mu0 = session.friction_at_ego()
-        self.tables.check_run(mu0, ego.speed_mps)
-        road = RoadFrame(session.ego_lane_centreline())
+        self.mu_start = session.friction_at_ego()
+        self.tables.check_run(self.mu_start, ego.speed_mps)
+        self.ego_initial_speed_mps = ego.speed_mps
+        self.road = road = RoadFrame(session.ego_lane_centreline())
         road.locate(ego.x_m, ego.y_m)
-        lane_width = session.lane_width_m
-        x = initial_state(ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps).tolist()  # plain floats
-        ctrl = EoamController(p, self.tables, st.eoam)
-        ctrl.reset(ego.speed_mps)
-        left_lane = session.left_lane_exists
-        lane_sensing = self._next_lane_sensing(session, lane_width)  # safe policy only
+        self.lane_width_m = session.lane_width_m
+        self.left_lane = session.left_lane_exists
+        self.x = initial_state(ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps).tolist()
+        self.x_prev = self.x
+        self.ax = self.ay = 0.0
+        self.ctrl = EoamController(p, self.tables, st.eoam)
+        self.ctrl.reset(ego.speed_mps)
+        self.lane_sensing = self._next_lane_sensing(session)  # safe policy only
         # from the front bumper, where the radar is; further for V2X and the corner radars
-        sense_radius = max(st.radar.range_m, lane_sensing.reach_m if lane_sensing else 0.0)
-        steps = round(st.max_time_s / st.step_s)
-        end_s_m = road.length_m - ROAD_END_MARGIN_M  # the run ends this close to the road end
-        log = RunLog(steps + 1)
-        front = p.cg_to_front_bumper_m
-        back = front - 0.5 * p.length_m  # CG to the ego box's centre, as in OrientedBox
-        ego_box_radius = math.hypot(0.5 * p.length_m, 0.5 * p.width_m)
-        ego_radius = 0.5 * math.hypot(p.length_m, p.width_m) + front - 0.5 * p.length_m
-        ax = ay = 0.0
-        first_contact = None
-        min_gap_aro = math.inf
-        # loss of control and road departure (outcome rule 1), plain floats: the extremes of the
-        # ego's lateral offset d (signed), of its heading error (wrapped) and of its vx
-        min_d = max_d = 0.0
-        max_e_yaw = 0.0
-        min_vx = x[3]
-        pi, tau = math.pi, math.tau
-        stop_at = None
-        t = t_start = session.time_s
-        bodies = session.nearby(sense_radius)  # with their boxes: the radar's targets
+        self._sense_radius_m = max(
+            st.radar.range_m, self.lane_sensing.reach_m if self.lane_sensing else 0.0)
+        self.max_steps = round(st.max_time_s / st.step_s)
+        self._end_s_m = road.length_m - ROAD_END_MARGIN_M  # the run ends this close to the end
+        self._front = front = p.cg_to_front_bumper_m
+        self._back = front - 0.5 * p.length_m  # CG to the ego box's centre, as in OrientedBox
+        self._ego_box_radius = math.hypot(0.5 * p.length_m, 0.5 * p.width_m)
+        self._ego_radius = 0.5 * math.hypot(p.length_m, p.width_m) + front - 0.5 * p.length_m
+        self.first_contact: tuple | None = None  # (Contact, role, time)
+        self.min_gap_aro_m = math.inf
+        self.end_cause: str | None = None
+        self.n_steps = 0
+        self._stop_at: float | None = None
+        self.t = self.t_start = session.time_s
+        self.bodies = session.nearby(self._sense_radius_m)  # with their boxes
+        x = self.x
         start_box = OrientedBox.from_axis_point(x[0], x[1], x[2], p.length_m, p.width_m, front)
-        for b in bodies:
+        for b in self.bodies:
             if boxes_overlap(start_box, b.box):
                 raise InputError(f"{self.cfg}: vehicle '{b.vid}' overlaps the ego at its "
                                  "departure")
-        cy, sy = math.cos(x[2]), math.sin(x[2])
-        self.belief = belief = self._new_belief()
+        self._cy, self._sy = math.cos(x[2]), math.sin(x[2])
+        self.belief = self._new_belief()
         self.radar = make_radar(st.radar_model, st.radar, st.seed)  # fresh state per run
-        radar, plant, step_s = self.radar, self.plant, st.step_s
-        t_sense = t_control = t_plant = t_sumo = t_contact = 0.0
-        loop0 = clock()
-        n_steps = 0
-        for n_steps in range(1, steps + 1):  # noqa: B007 - the count is read after the loop
-            # --- sense: the world at time t ---------------------------------------------------
-            c0 = clock()
-            X, Y, yaw, vx, vy, r = x[:6]
-            s, d, road_yaw = road.project(X, Y)
-            mu_true = session.friction_at_ego()
-            mu = belief.mu(mu_true, t, ax, ay)
-            report = radar.scan(
-                (X + front * cy, Y + front * sy), yaw, vx, road, bodies, lane_width, t
-            )
-            perception = _perception(report)
-            if lane_sensing is not None:
-                perception = perception._replace(next_lane=lane_sensing.update(
-                    t, (X + front * cy, Y + front * sy), yaw, road, report, bodies))
-            e_yaw = yaw - road_yaw  # not wrapped: the plant's yaw is continuous
-            meas = EgoMeasurement(
-                t, vx, vy, r, ax, ay, s, d, e_yaw, road.curvature_at(s), mu, lane_width,
-                left_lane,
-            )
-            # --- decide and control -------------------------------------------------------------
-            c1 = clock()
-            cmd = ctrl.step(meas, perception, step_s)
-            c2 = clock()
-            log.add(t, x, ax, ay, s, d, e_yaw, mu_true, cmd, perception)
-            # --- plant: all sub-steps of this SUMO step in one call -----------------------------
-            c3 = clock()
-            x_prev = x
-            x, y_out = plant.advance(
-                x, (cmd.steer_cmd_rad, cmd.drive_force_cmd_n, cmd.brake_force_cmd_n), mu_true
-            )
-            ax, ay = y_out[0], y_out[1]
-            # --- write back and step SUMO -------------------------------------------------------
-            c4 = clock()
-            Xn, Yn, yawn, vxn = x[:4]
-            cy, sy = math.cos(yawn), math.sin(yawn)
-            ego_speed = 0.0 if vxn < 0.0 else vxn
-            session.move_ego(Xn + front * cy, Yn + front * sy, nav_angle_deg(yawn), ego_speed)
-            session.step()
-            t = session.time_s
-            bodies_next = session.nearby(sense_radius)
-            # --- ground truth: oriented-box contact at every plant sub-step ---------------------
-            c5 = clock()
-            ego_cx, ego_cy = Xn + back * cy, Yn + back * sy
-            ego_box = None  # built when a body comes close
-            # farthest any point of the ego box moved during the step (translation + rotation)
-            ego_move = math.hypot(Xn - x_prev[0], Yn - x_prev[1]) + ego_radius * abs(
-                yawn - x_prev[2])
-            for b in bodies_next:
-                centres_m = math.hypot(b.x_m - ego_cx, b.y_m - ego_cy)
-                if centres_m > GAP_WATCH_M:
-                    continue
-                reach_m = ego_move + b.speed_mps * step_s + 0.05
-                # a parked car cannot be the ARO: its role is worked out only if it is hit
-                role = None if b.parked else role_of(b, road, lane_width)
-                # the bounding circles' gap is a lower bound of the boxes' gap
-                circles_m = centres_m - ego_box_radius - b.box.radius_m - ROUNDING_M
-                if circles_m > reach_m and (role != "aro" or circles_m >= min_gap_aro):
-                    continue  # the box gap can be neither the ARO's least nor a contact
-                if ego_box is None:
-                    ego_box = OrientedBox.from_axis_point(Xn, Yn, yawn, p.length_m, p.width_m,
-                                                          front)
-                gap = box_distance(ego_box, b.box)
-                if role == "aro":
-                    min_gap_aro = min(min_gap_aro, gap)
-                # contact during the step is possible only if the gap is within both moves
-                if first_contact is None and gap <= reach_m:
-                    before = next((o for o in bodies if o.vid == b.vid), b)
-                    hit = self._substep_contact(x_prev, x, b, before)
-                    if hit is not None:
-                        first_contact = (hit, role or role_of(b, road, lane_width), t)
-            bodies = bodies_next
-            if d > max_d:
-                max_d = d
-            elif d < min_d:
-                min_d = d
-            if vx < min_vx:
-                min_vx = vx
-            if e_yaw > max_e_yaw or e_yaw < -max_e_yaw:  # wrapped only when it may be a new max
-                e_yaw = (e_yaw + pi) % tau - pi
-                if e_yaw < 0.0:
-                    e_yaw = -e_yaw
-                if e_yaw > max_e_yaw:
-                    max_e_yaw = e_yaw
-            c6 = clock()
-            t_sense += c1 - c0
-            t_control += c2 - c1
-            t_plant += c4 - c3
-            t_sumo += c5 - c4
-            t_contact += c6 - c5
-            # --- end of run ---------------------------------------------------------------------
-            if first_contact is not None:
-                break
-            if not self._finished(ctrl, x):
-                stop_at = None  # (again) a manoeuvre under way: run on to its end
-            elif stop_at is None:
-                stop_at = t + st.settle_s
-            if stop_at is not None and t >= stop_at - 1e-9:
-                break
-            if s > end_s_m:
-                break
-        self.profile = {
-            "sense": t_sense, "control": t_control, "plant": t_plant, "sumo": t_sumo,
-            "contact": t_contact, "loop_wall_s": clock() - loop0, "steps": n_steps,
-        }
-        max_lat_offset = max_d if max_d >= -min_d else -min_d  # of the steps' starts, as logged
-        X, Y, yaw, vx = x[:4]
+        self.mu_true = self.mu_start
+        self.timeseries, self.extremes = TimeSeries(), Extremes()
+        self.observers = (self.timeseries, self.extremes, *self.extra_observers)
+        for obs in self.observers:
+            obs.start(self)
+        self._after_step = tuple(obs.after_step for obs in self.observers)
+        self._loop0 = time.perf_counter()
+
+    # ----------------------------------------------------------------------------- the step
+    def step(self) -> bool:
+        """One co-simulation step (as highway-env's ``AbstractEnv.step``: named phases in
+        order); True when the run is over."""
+        self.meas, self.perception = meas, perception = self.sense()
+        self.cmd = cmd = self.decide(meas, perception)
+        self.actuate(cmd)
+        self.write_back()
+        self.check_contact()
+        self.n_steps += 1
+        for after_step in self._after_step:
+            after_step(self)
+        return self.finished()
+
+    def sense(self) -> tuple[EgoMeasurement, Perception]:
+        """The ego in the road frame and the radar's view of the road users, at time ``t``."""
+        x, road = self.x, self.road
+        X, Y, yaw, vx, vy, r = x[:6]
         s, d, road_yaw = road.project(X, Y)
-        log.add(t, x, ax, ay, s, d, yaw - road_yaw, session.friction_at_ego(), None, None)
-        # the end state counts for loss of control and road departure too
-        min_d, max_d, min_vx = min(min_d, d), max(max_d, d), min(min_vx, vx)
-        max_e_yaw = max(max_e_yaw, abs((yaw - road_yaw + pi) % tau - pi))
-        left_width = lane_width if left_lane else 0.0
-        contact_info, role, contact_time_s = first_contact or (None, "none", None)
+        self.mu_true = mu_true = self.session.friction_at_ego()
+        mu = self.belief.mu(mu_true, self.t, self.ax, self.ay)  # what the EOAM believes
+        front = self._front
+        front_xy = (X + front * self._cy, Y + front * self._sy)
+        report = self.radar.scan(front_xy, yaw, vx, road, self.bodies, self.lane_width_m,
+                                 self.t)
+        perception = _perception(report)
+        if self.lane_sensing is not None:
+            perception = perception._replace(next_lane=self.lane_sensing.update(
+                self.t, front_xy, yaw, road, report, self.bodies))
+        meas = EgoMeasurement(
+            self.t, vx, vy, r, self.ax, self.ay, s, d, yaw - road_yaw,  # e_yaw not wrapped:
+            road.curvature_at(s), mu, self.lane_width_m, self.left_lane,  # yaw is continuous
+        )
+        return meas, perception
+
+    def decide(self, meas: EgoMeasurement, perception: Perception) -> Command:
+        """The EOAM's decision and control for this step."""
+        return self.ctrl.step(meas, perception, self.settings.step_s)
+
+    def actuate(self, cmd: Command) -> None:
+        """The plant over the step, on the road's true friction: all sub-steps in one call."""
+        self.x_prev = x = self.x
+        self.x, y_out = self.plant.advance(
+            x, (cmd.steer_cmd_rad, cmd.drive_force_cmd_n, cmd.brake_force_cmd_n), self.mu_true
+        )
+        self.ax, self.ay = y_out[0], y_out[1]
+
+    def write_back(self) -> None:
+        """The ego's pose to SUMO (front bumper, navigation angle), SUMO one step on, and the
+        road users around the ego then."""
+        X, Y, yaw, vx = self.x[:4]
+        self._cy, self._sy = cy, sy = math.cos(yaw), math.sin(yaw)
+        front = self._front
+        session = self.session
+        session.move_ego(X + front * cy, Y + front * sy, nav_angle_deg(yaw),
+                         0.0 if vx < 0.0 else vx)
+        session.step()
+        self.t = session.time_s
+        self.bodies_before, self.bodies = self.bodies, session.nearby(self._sense_radius_m)
+
+    def check_contact(self) -> None:
+        """Ground truth: oriented-box contact with every road user near the ego at every plant
+        sub-step of the step, and the smallest gap to the in-lane obstacle (ARO)."""
+        x_prev, x = self.x_prev, self.x
+        Xn, Yn, yawn = x[0], x[1], x[2]
+        back, cy, sy = self._back, self._cy, self._sy
+        ego_cx, ego_cy = Xn + back * cy, Yn + back * sy
+        ego_box = None  # built when a body comes close
+        # farthest any point of the ego box moved during the step (translation + rotation)
+        ego_move = math.hypot(Xn - x_prev[0], Yn - x_prev[1]) + self._ego_radius * abs(
+            yawn - x_prev[2])
+        road, lane_width, step_s = self.road, self.lane_width_m, self.settings.step_s
+        ego_box_radius = self._ego_box_radius
+        for b in self.bodies:
+            centres_m = math.hypot(b.x_m - ego_cx, b.y_m - ego_cy)
+            if centres_m > GAP_WATCH_M:
+                continue
+            reach_m = ego_move + b.speed_mps * step_s + 0.05
+            # a parked car cannot be the ARO: its role is worked out only if it is hit
+            role = None if b.parked else role_of(b, road, lane_width)
+            # the bounding circles' gap is a lower bound of the boxes' gap
+            circles_m = centres_m - ego_box_radius - b.box.radius_m - ROUNDING_M
+            if circles_m > reach_m and (role != "aro" or circles_m >= self.min_gap_aro_m):
+                continue  # the box gap can be neither the ARO's least nor a contact
+            if ego_box is None:
+                p = self.params
+                ego_box = OrientedBox.from_axis_point(Xn, Yn, yawn, p.length_m, p.width_m,
+                                                      self._front)
+            gap = box_distance(ego_box, b.box)
+            if role == "aro" and gap < self.min_gap_aro_m:
+                self.min_gap_aro_m = gap
+            # contact during the step is possible only if the gap is within both moves
+            if self.first_contact is None and gap <= reach_m:
+                before = next((o for o in self.bodies_before if o.vid == b.vid), b)
+                hit = self._substep_contact(x_prev, x, b, before)
+                if hit is not None:
+                    self.first_contact = (hit, role or role_of(b, road, lane_width), self.t)
+
+    def finished(self) -> bool:
+        """Whether the run is over: a contact, ``settle_s`` after the EOAM handed back to
+        NORMAL after a manoeuvre or stopped (a manoeuvre begun in that time runs to its end),
+        the end of the road, or the time limit. Sets ``end_cause``."""
+        if self.first_contact is not None:
+            self.end_cause = "contact"
+            return True
+        ctrl = self.ctrl
+        mode = ctrl.mode
+        if not ((mode == 0 and len(ctrl.modes_visited) > 1)
+                or (mode in (1, 3) and self.x[3] < 0.05)):
+            self._stop_at = None  # (again) a manoeuvre under way: run on to its end
+        elif self._stop_at is None:
+            self._stop_at = self.t + self.settings.settle_s
+        if self._stop_at is not None and self.t >= self._stop_at - 1e-9:
+            self.end_cause = "settled"
+        elif self.meas.s_m > self._end_s_m:
+            self.end_cause = "road_end"
+        elif self.n_steps >= self.max_steps:
+            self.end_cause = "time_limit"
+        else:
+            return False
+        return True
+
+    # ----------------------------------------------------------------------------- the end
+    def finish(self) -> RunSummary:
+        """The end state to the observers, the outcome and the run's summary."""
+        loop_wall_s = time.perf_counter() - self._loop0
+        x = self.x
+        X, Y, yaw, vx = x[:4]
+        s, d, road_yaw = self.road.project(X, Y)
+        self.mu_true = self.session.friction_at_ego()
+        self.meas = EgoMeasurement(
+            self.t, vx, x[4], x[5], self.ax, self.ay, s, d, yaw - road_yaw, 0.0,
+            self.mu_true, self.lane_width_m, self.left_lane)
+        for obs in self.observers:
+            obs.end(self)
+        ext = self.extremes
+        left_width = self.lane_width_m if self.left_lane else 0.0
+        contact_info, role, t_contact = self.first_contact or (None, "none", None)
         outcome = classify_outcome(
-            modes_visited=ctrl.modes_visited,
-            max_lateral_offset_m=max_lat_offset,
-            lane_width_m=lane_width,
+            modes_visited=self.ctrl.modes_visited,
+            max_lateral_offset_m=ext.max_abs_offset_m,
+            lane_width_m=self.lane_width_m,
             contact=contact_info,
             role=role,
             final_offset_m=d,
             final_speed_mps=vx,
-            max_abs_heading_error_rad=max_e_yaw,
-            min_speed_mps=min_vx,
-            min_offset_m=min_d,
-            max_offset_m=max_d,
+            max_abs_heading_error_rad=ext.max_abs_heading_error_rad,
+            min_speed_mps=ext.min_vx_mps,
+            min_offset_m=ext.min_d_m,
+            max_offset_m=ext.max_d_m,
             left_width_m=left_width,
         )
-        wall = time.perf_counter() - wall0
-        sim_time = t - t_start
-        summary = {
-            "outcome": outcome.colour,
-            "collision_with": outcome.collision_with,
-            "impact_speed_mps": round(outcome.impact_speed_mps, 6),
-            "contact_kind": contact_info.kind if contact_info else "none",
-            "contact_time_s": contact_time_s,
-            "reason": outcome.reason,
-            "modes_visited": list(ctrl.modes_visited),
-            "fcw_raised": bool(ctrl.fcw_raised),
-            "mu": mu0,
-            "mu_belief": self.belief.label,
-            "radar_model": st.radar_model,
-            "seed": st.seed,
-            **_trigger(log, self.belief),
-            "min_gap_aro_m": None if math.isinf(min_gap_aro) else round(min_gap_aro, 6),
-            "max_abs_lat_accel_mps2": round(log.max_abs("ay_mps2"), 6),
-            "max_lateral_offset_m": round(max_lat_offset, 6),
-            "final_lateral_offset_m": round(d, 6),
-            "final_speed_mps": round(vx, 6) + 0.0,  # signed; + 0.0 turns -0.0 into 0.0
-            "min_speed_mps": round(min_vx, 6) + 0.0,  # lowest forward speed vx, signed
-            "max_abs_heading_error_rad": round(max_e_yaw, 6),  # |heading - road heading|
-            "left_road": left_road(min_d, max_d, lane_width, left_width),  # CG off the road
-            "ego_initial_speed_mps": round(ego.speed_mps, 6),
-            "sim_time_s": round(sim_time, 6),
-            "wall_time_s": wall,
-            "realtime_factor": sim_time / self.profile["loop_wall_s"],
-            **self._policy_record(ctrl),
-        }
-        return summary, log
+        sim_time = self.t - self.t_start
+        self.loop_wall_s = loop_wall_s
+        return RunSummary(
+            outcome=outcome.colour,
+            collision_with=outcome.collision_with,
+            impact_speed_mps=rounded(outcome.impact_speed_mps),
+            contact_kind=contact_info.kind if contact_info else "none",
+            contact_time_s=t_contact,
+            reason=outcome.reason,
+            modes_visited=tuple(self.ctrl.modes_visited),
+            fcw_raised=bool(self.ctrl.fcw_raised),
+            mu=self.mu_start,
+            mu_belief=self.belief.label,
+            radar_model=self.settings.radar_model,
+            seed=self.settings.seed,
+            **_trigger(self.timeseries.log, self.belief),
+            min_gap_aro_m=finite_or_none(self.min_gap_aro_m),
+            max_abs_lat_accel_mps2=rounded(self.timeseries.log.max_abs("ay_mps2")),
+            max_lateral_offset_m=rounded(ext.max_abs_offset_m),
+            final_lateral_offset_m=rounded(d),
+            final_speed_mps=rounded(vx),
+            min_speed_mps=rounded(ext.min_vx_mps),
+            max_abs_heading_error_rad=rounded(ext.max_abs_heading_error_rad),
+            left_road=left_road(ext.min_d_m, ext.max_d_m, self.lane_width_m, left_width),
+            ego_initial_speed_mps=rounded(self.ego_initial_speed_mps),
+            sim_time_s=rounded(sim_time),
+            wall_time_s=time.perf_counter() - self._wall0,
+            realtime_factor=sim_time / loop_wall_s,
+            sumo_overrides=dict(self.session.sumo_overrides),
+            **self._policy_record(),
+        )
 
-    def _next_lane_sensing(self, session: SumoSession, lane_width: float):
+    def _next_lane_sensing(self, session: SumoSession) -> NextLaneSensing | None:
         """The next lane's sensing for the safe policy (None for the paper's)."""
         st = self.settings
         if st.eoam.policy.name != "safe":
             return None
         opposing, limit = session.next_lane_traffic()
         return NextLaneSensing(
-            opposing=opposing, speed_limit_mps=limit, lane_width_m=lane_width,
+            opposing=opposing, speed_limit_mps=limit, lane_width_m=self.lane_width_m,
             radar_range_m=st.radar.range_m, radar_fov_deg=st.radar.fov_deg,
             ego_length_m=self.params.length_m, ego_width_m=self.params.width_m, v2x=st.v2x,
             corner=st.corner_radar, fastest_mps=st.eoam.policy.opposing_speed_mps)
 
-    def _policy_record(self, ctrl: EoamController) -> dict:
+    def _policy_record(self) -> dict:
         """The policy, the V2X settings and what the sight-distance gate needed."""
         st = self.settings
         record = {"policy": st.eoam.policy.name, "v2x_range_m": st.v2x.range_m,
                   "v2x_latency_s": st.v2x.latency_s, "v2x_loss": st.v2x.loss,
                   "v2x_penetration": st.v2x.penetration}
-        if ctrl.policy is not None:
-            return {**record, **ctrl.policy.summary()}
+        if self.ctrl.policy is not None:
+            return {**record, **self.ctrl.policy.summary()}
         return {**record, "sight_gate": "", "sight_needed_m": None, "sight_known_free_m": None,
                 "sight_time_s": None, "tie_break": ""}
-
-    def _finished(self, ctrl: EoamController, x) -> bool:
-        """The EOAM is over: handed back to NORMAL after a manoeuvre, or stopped."""
-        modes = ctrl.modes_visited
-        if len(modes) > 1 and ctrl.mode == 0:
-            return True
-        return ctrl.mode in (1, 3) and x[3] < 0.05
 
     def _substep_contact(self, x_prev, x_next, body, b0):
         """First contact at any plant sub-step between ego and body (``b0`` its pose at the
@@ -431,8 +494,6 @@ def run_case(
     if extra:
         summary = {**extra, **summary}
     if out_dir is not None:
-        from eoam_sumo.sim.runlog import write_run
-
         write_run(Path(out_dir), summary, log, timeseries)
     return summary
 

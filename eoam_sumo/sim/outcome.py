@@ -53,6 +53,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from eoam_sumo.colours import OUTCOMES
 from eoam_sumo.params import PONR_FRACTION
 from eoam_sumo.sim.bodies import Body
 from eoam_sumo.sim.geometry import Contact
@@ -63,7 +64,7 @@ from eoam_sumo.sim.radar import (
     RoadProjection,
 )
 
-COLOURS = ("none", "green", "yellow", "orange", "red")
+COLOURS = OUTCOMES
 
 # Loss of control: |heading error| (heading relative to the road) above this [rad]. A lane
 # change turns the ego from the road by about atan(1.875 h / (T v)) (quintic of height h = the

@@ -9,12 +9,13 @@ from __future__ import annotations
 
 import json
 import math
-import os
+from operator import attrgetter
 from pathlib import Path
 
 import numpy as np
 
 from eoam_sumo.errors import InputError
+from eoam_sumo.fileio import write_atomic
 
 #: timeseries.csv columns (the paper's signals first, then the rest), SI units in the names.
 COLUMNS = (
@@ -45,24 +46,25 @@ class RunLog:
         self._col = {c: i for i, c in enumerate(COLUMNS)}
         self._array: np.ndarray | None = None
 
-    def add(self, t, x, ax, ay, s, d, e_yaw, mu, cmd, perception) -> None:
-        """Log the state ``x`` at time ``t`` with the command decided from it (None at the end).
+    def add(self, meas, x, cmd, perception, mu) -> None:
+        """Log the ego at ``meas`` (an ``EgoMeasurement``) with its plant state ``x`` (copied),
+        the command decided from it (None at the end), the radar's view and the road's
+        friction ``mu`` under the ego (``meas.mu`` is the friction the EOAM believed).
 
-        The arguments are kept as given (``x`` copied) and laid out as a row by ``array``: the
-        step loop pays for one tuple. ``cmd`` and ``perception`` are immutable named tuples."""
+        The arguments are kept as given and laid out as a row by ``array``: the step loop pays
+        for one tuple. ``meas``, ``cmd`` and ``perception`` are immutable named tuples."""
         if self.n >= len(self._rows):
             if self.n >= self._limit:
                 return
             self._rows.extend([None] * min(len(self._rows), self._limit - self.n))
-        self._rows[self.n] = (t, tuple(x), ax, ay, s, d, e_yaw, mu, cmd, perception)
+        self._rows[self.n] = (meas, tuple(x), cmd, perception, mu)
         self.n += 1
         self._array = None
 
     def array(self) -> np.ndarray:
         """(n, len(COLUMNS)) float array of the rows logged so far."""
         if self._array is None:
-            rows = [_row(*args) for args in self._rows[: self.n]]
-            self._array = np.array(rows, dtype=float).reshape(-1, len(COLUMNS))
+            self._array = _table(self._rows[: self.n])
         return self._array
 
     def column(self, name: str) -> np.ndarray:
@@ -83,25 +85,62 @@ class RunLog:
         return df
 
 
-def _row(t, x, ax, ay, s, d, e_yaw, mu, cmd, perception) -> tuple:
-    """One timeseries row (COLUMNS order) from what ``RunLog.add`` kept."""
-    nan = _NAN
-    if perception is not None and perception.aro_range_m is not None:
-        rng, rate = perception.aro_range_m, perception.aro_range_rate_mps
-    else:
-        rng = rate = nan
-    onc = float(perception.oncoming_detected) if perception is not None else nan
-    if cmd is None:
-        return (t, nan, nan, *x[:6], ax, ay, x[6], nan, nan, rng, rate, s, d, e_yaw,
-                *(nan,) * 7, x[7], x[8], nan, nan, nan, mu, onc, nan)
-    return (
-        t, cmd.mode, float(cmd.fcw), x[0], x[1], x[2], x[3], x[4], x[5], ax, ay, x[6],
-        cmd.ax_target_mps2, cmd.y_target_m, rng, rate, s, d, e_yaw, cmd.dx_m,
-        cmd.lateral_error_m, cmd.lookahead_error_m, cmd.steer_cmd_rad, cmd.steer_ff_rad,
-        cmd.steer_fb_rad, cmd.steer_yd_rad, x[7], x[8], cmd.drive_force_cmd_n,
-        cmd.brake_force_cmd_n, cmd.speed_target_mps, mu, onc,
-        float(ord(cmd.sector)) if cmd.sector else nan,
-    )
+#: Where each column comes from, by name: the plant state's index, or a field of the
+#: ``EgoMeasurement``, of the ``Command`` (empty in the end state's row) or of the
+#: ``Perception`` (the radar's view: empty at the end, ranges empty when nothing is in path);
+#: ``mu`` is the road's friction under the ego (the EOAM may believe another).
+_FROM_STATE = {
+    "x_m": 0, "y_m": 1, "yaw_rad": 2, "vx_mps": 3, "vy_mps": 4, "yaw_rate_radps": 5,
+    "steer_rad": 6, "drive_force_n": 7, "brake_force_n": 8,
+}
+_FROM_MEAS = {
+    "time_s": "time_s", "ax_mps2": "ax_mps2", "ay_mps2": "ay_mps2", "s_m": "s_m",
+    "lateral_offset_m": "d_m", "heading_error_rad": "e_yaw_rad",
+}
+_FROM_CMD = {
+    "mode": "mode", "fcw": "fcw", "ax_target_mps2": "ax_target_mps2",
+    "y_target_m": "y_target_m", "dx_m": "dx_m", "lateral_error_m": "lateral_error_m",
+    "lookahead_error_m": "lookahead_error_m", "steer_cmd_rad": "steer_cmd_rad",
+    "steer_ff_rad": "steer_ff_rad", "steer_fb_rad": "steer_fb_rad",
+    "steer_yd_rad": "steer_yd_rad", "drive_force_cmd_n": "drive_force_cmd_n",
+    "brake_force_cmd_n": "brake_force_cmd_n", "speed_target_mps": "speed_target_mps",
+}
+_FROM_PERCEPTION = {
+    "aro_range_m": "aro_range_m", "aro_range_rate_mps": "aro_range_rate_mps",
+    "oncoming_detected": "oncoming_detected",
+}
+_SECTOR = "sector"  # the command's DMM sector letter, stored as its character code
+_ROAD_MU = "mu"  # the road's friction under the ego
+
+
+def _table(rows: list) -> np.ndarray:
+    """The (n, len(COLUMNS)) float array of logged steps, each column filled by name."""
+    n = len(rows)
+    out = np.full((n, len(COLUMNS)), _NAN)
+    if not n:
+        return out
+    col = {c: i for i, c in enumerate(COLUMNS)}
+    states = np.array([r[1] for r in rows], dtype=float)
+    for name, k in _FROM_STATE.items():
+        out[:, col[name]] = states[:, k]
+    get = attrgetter(*_FROM_MEAS.values())
+    meas = np.array([get(r[0]) for r in rows], dtype=float)
+    for k, name in enumerate(_FROM_MEAS):
+        out[:, col[name]] = meas[:, k]
+    with_cmd = [i for i, r in enumerate(rows) if r[2] is not None]
+    if with_cmd:
+        get = attrgetter(*_FROM_CMD.values())
+        cmds = np.array([get(rows[i][2]) for i in with_cmd], dtype=float)
+        for k, name in enumerate(_FROM_CMD):
+            out[with_cmd, col[name]] = cmds[:, k]
+        out[with_cmd, col[_SECTOR]] = [
+            float(ord(rows[i][2].sector)) if rows[i][2].sector else _NAN for i in with_cmd]
+    out[:, col[_ROAD_MU]] = [r[4] for r in rows]
+    for name, field in _FROM_PERCEPTION.items():
+        out[:, col[name]] = [
+            _NAN if r[3] is None or getattr(r[3], field) is None else getattr(r[3], field)
+            for r in rows]
+    return out
 
 
 def read_timeseries(path: Path, columns: list[str] | None = None):
@@ -120,23 +159,16 @@ def read_timeseries(path: Path, columns: list[str] | None = None):
     return frame
 
 
-def _atomic_write_text(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
-
-
 def write_run(out_dir: Path, summary: dict, log: RunLog, timeseries: str = "csv") -> None:
     """Write the time series (``timeseries.csv``, ``timeseries.parquet`` through pyarrow, or
     none) then ``summary.json`` (each atomically) into ``out_dir``."""
     out_dir.mkdir(parents=True, exist_ok=True)
     if timeseries == "csv":
         csv = log.frame().to_csv(index=False, float_format="%.9g")
-        _atomic_write_text(out_dir / "timeseries.csv", csv)
+        write_atomic(out_dir / "timeseries.csv", csv)
     elif timeseries == "parquet":
-        tmp = out_dir / "timeseries.parquet.tmp"
-        log.frame().to_parquet(tmp, index=False, engine="pyarrow", compression="zstd")
-        os.replace(tmp, out_dir / "timeseries.parquet")
+        data = log.frame().to_parquet(None, index=False, engine="pyarrow", compression="zstd")
+        write_atomic(out_dir / "timeseries.parquet", data)
     elif timeseries != "none":
         raise InputError(f"time series format {timeseries!r} is not csv, parquet or none")
-    _atomic_write_text(out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
+    write_atomic(out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")

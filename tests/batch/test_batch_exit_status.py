@@ -10,7 +10,8 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
-from eoam_sumo.batch.runner import EXIT_CASES_FAILED, RESULTS_FILE
+from eoam_sumo.batch.results import RESULTS_FILE
+from eoam_sumo.batch.runner import EXIT_CASES_FAILED
 from eoam_sumo.cli import main
 from tests.builders import write_matrix
 

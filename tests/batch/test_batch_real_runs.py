@@ -22,7 +22,8 @@ import pandas as pd
 import pytest
 
 from eoam_sumo.batch.case import run_matrix_case
-from eoam_sumo.batch.runner import TIMING_COLUMNS, run_batch
+from eoam_sumo.batch.results import TIMING_COLUMNS
+from eoam_sumo.batch.runner import run_batch
 from eoam_sumo.errors import InputError
 from eoam_sumo.offline.build import build_tables
 from eoam_sumo.plotting.dispatch import plot_folder

@@ -9,8 +9,9 @@ import pandas as pd
 import pytest
 
 from eoam_sumo.batch.pool import TaskResult
-from eoam_sumo.batch.report import outcome_grid, table2_markdown, write_report
-from eoam_sumo.batch.runner import COLUMNS, read_results, result_row
+from eoam_sumo.batch.report import outcome_grid, table2_markdown
+from eoam_sumo.batch.results import COLUMNS, read_results, result_row
+from eoam_sumo.batch.runner import write_report
 from eoam_sumo.matrix import load_matrix
 
 REPO = Path(__file__).resolve().parents[2]

@@ -13,7 +13,8 @@ import pandas as pd
 import pytest
 
 from eoam_sumo.batch import runner
-from eoam_sumo.batch.runner import COLUMNS, TIMING_COLUMNS, run_batch
+from eoam_sumo.batch.results import COLUMNS, TIMING_COLUMNS
+from eoam_sumo.batch.runner import run_batch
 from eoam_sumo.errors import InputError
 from tests.builders import write_matrix
 

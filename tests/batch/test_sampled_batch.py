@@ -10,7 +10,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from eoam_sumo.batch.runner import TIMING_COLUMNS, run_batch
+from eoam_sumo.batch.results import TIMING_COLUMNS
+from eoam_sumo.batch.runner import run_batch
 
 pytestmark = pytest.mark.sumo
 

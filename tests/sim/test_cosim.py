@@ -343,17 +343,21 @@ def test_collector_pause_restores_the_collector_state(enabled):
 
 def test_the_run_log_grows_to_its_limit_and_no_further():
     """A huge time limit costs nothing up front; rows past the limit are not kept."""
+    from eoam_sumo.eoam import EgoMeasurement
     from eoam_sumo.sim.runlog import PREALLOCATED_ROWS, RunLog
+
+    def meas(t):
+        return EgoMeasurement(t, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 3.5)
 
     x = [0.0] * 9
     big = RunLog(10**12)
     for k in range(PREALLOCATED_ROWS + 5):
-        big.add(0.01 * k, x, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, None, None)
+        big.add(meas(0.01 * k), x, None, None, 1.0)
     assert big.array().shape == (PREALLOCATED_ROWS + 5, len(COLUMNS))
     assert big.column("time_s")[-1] == pytest.approx(0.01 * (PREALLOCATED_ROWS + 4))
     small = RunLog(5)
     for k in range(8):
-        small.add(float(k), x, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, None, None)
+        small.add(meas(float(k)), x, None, None, 1.0)
     assert small.array().shape == (5, len(COLUMNS))
 
 

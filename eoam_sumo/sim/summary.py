@@ -1,0 +1,101 @@
+"""The summary of one co-simulation run: one typed record, the source of summary.json and of
+the summary columns of a batch's results.csv.
+
+Each field carries its meaning in its metadata (``doc``); units are in the names (SI).
+``docs/verdicts.md`` lists the same fields (a test holds the two together).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import types
+import typing
+from dataclasses import dataclass, field
+
+
+def _doc(text: str):
+    return field(metadata={"doc": text})
+
+
+@dataclass(frozen=True)
+class RunSummary:
+    """What one run came to (summary.json, in this order)."""
+
+    outcome: str = _doc("outcome colour: none, green, yellow, orange or red")
+    collision_with: str = _doc("role of the road user hit: none, aro, oncoming, parked, other")
+    impact_speed_mps: float = _doc("relative speed of the box centres at the first contact")
+    contact_kind: str = _doc("none, head_on, oblique, rear_end or side")
+    contact_time_s: float | None = _doc("SUMO time of the first contact (empty: none)")
+    reason: str = _doc("one sentence on why the run got its colour")
+    modes_visited: tuple[int, ...] = _doc("EOAM modes 0-5 in order of first visit")
+    fcw_raised: bool = _doc("the forward collision warning was raised")
+    mu: float = _doc("friction under the ego at the start (results.csv: mu_at_start)")
+    mu_belief: str | float = _doc("the friction the EOAM decided with: known, estimate or a number")
+    trigger_time_s: float | None = _doc("when the EOAM first left normal driving (empty: never)")
+    trigger_range_m: float | None = _doc("range to the obstacle then (empty: none seen)")
+    mu_believed_at_trigger: float | None = _doc("the friction the EOAM believed then")
+    policy: str = _doc("the decision policy: paper or safe")
+    v2x_range_m: float = _doc("V2X range (0: no V2X)")
+    v2x_latency_s: float = _doc("V2X message latency")
+    v2x_loss: float = _doc("share of V2X messages lost")
+    v2x_penetration: float = _doc("share of road users sending V2X")
+    sight_gate: str = _doc("safe policy: passed or closed at the first lane-change request")
+    sight_needed_m: float | None = _doc("passing sight distance the lane change needed")
+    sight_known_free_m: float | None = _doc("length of the next lane known free then")
+    sight_time_s: float | None = _doc("time the lane change and the escape would take")
+    tie_break: str = _doc("safe policy: what the severity tie-breaker chose")
+    radar_model: str = _doc("the radar model: ideal or automotive")
+    seed: int = _doc("the seed of every random model of the run")
+    min_gap_aro_m: float | None = _doc(
+        "smallest box-to-box gap to the in-lane obstacle within 20 m (empty: never that close)")
+    max_abs_lat_accel_mps2: float = _doc("largest |lateral acceleration| of the ego")
+    max_lateral_offset_m: float = _doc("largest |lateral offset| from the original lane centre")
+    final_lateral_offset_m: float = _doc("lateral offset when the run ended (left +)")
+    final_speed_mps: float = _doc("forward speed when the run ended, signed")
+    min_speed_mps: float = _doc("lowest forward speed, signed (negative: went backwards)")
+    max_abs_heading_error_rad: float = _doc("largest |heading - road heading|")
+    left_road: bool = _doc("the ego's centre went more than 0.5 m beyond a road edge")
+    ego_initial_speed_mps: float = _doc("ego speed at its departure")
+    sim_time_s: float = _doc("simulated time from the ego's departure")
+    wall_time_s: float = _doc("wall time of the whole run, SUMO start-up included")
+    realtime_factor: float = _doc("simulated seconds per wall second of the step loop")
+    sumo_overrides: dict = field(
+        metadata={"doc": "SUMO options the run set over the sumocfg, option -> value"})
+
+    def as_dict(self) -> dict:
+        """The summary as summary.json writes it (lists for tuples)."""
+        out = {}
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            out[f.name] = list(value) if isinstance(value, tuple) else value
+        return out
+
+
+#: summary.json keys in order.
+FIELDS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(RunSummary))
+#: What each field means.
+FIELD_DOCS: dict[str, str] = {f.name: f.metadata["doc"] for f in dataclasses.fields(RunSummary)}
+#: Fields that measure the machine, not the physics: they differ between two runs.
+TIMING_FIELDS = ("wall_time_s", "realtime_factor")
+
+
+def _is_number(tp) -> bool:
+    """A number, or a number or None (``str | float`` is not: text may be in it)."""
+    args = typing.get_args(tp) if isinstance(tp, types.UnionType) else (tp,)
+    return all(a in (float, int, types.NoneType) for a in args) and args != (types.NoneType,)
+
+
+#: Fields that are numbers (or empty).
+NUMERIC_FIELDS: tuple[str, ...] = tuple(
+    name for name, tp in typing.get_type_hints(RunSummary).items() if _is_number(tp))
+
+
+def rounded(value: float, digits: int = 6) -> float:
+    """``value`` to ``digits`` decimals, -0.0 turned into 0.0."""
+    return round(value, digits) + 0.0
+
+
+def finite_or_none(value: float, digits: int = 6) -> float | None:
+    """``rounded(value)``, or None for an infinite value (nothing measured)."""
+    return None if math.isinf(value) else rounded(value, digits)
