@@ -60,7 +60,9 @@ class RunSummary:
     sim_time_s: float = _doc("simulated time from the ego's departure")
     wall_time_s: float = _doc("wall time of the whole run, SUMO start-up included")
     realtime_factor: float = _doc("simulated seconds per wall second of the step loop")
-    sumo_overrides: dict = field(
+    # mypy takes the _doc(...) calls above for defaults, and then this field() without one
+    # for an error; neither has a default at run time
+    sumo_overrides: dict = field(  # type: ignore[misc]
         metadata={"doc": "SUMO options the run set over the sumocfg, option -> value"})
 
     def as_dict(self) -> dict:
