@@ -4,8 +4,8 @@ The next lane is the one left of the ego's original lane, between d = w/2 and 3 
 lane's road frame (w the lane width). Three sensors look at it, all on the ego's body:
 
 * the forward radar (``sim.radar``): its range and field of view from the front bumper, with
-  the shadow of every other road user it sees (a point whose line of sight crosses a nearer
-  road user's box is hidden);
+  the shadow of every other road user it reports (a point whose line of sight crosses the box
+  of a reported object, placed along the road at its station and offset, is hidden);
 * two left corner radars (front-left and rear-left corners), each looking ``boresight_deg``
   outward from the ego's axis (forward and backward), with the range and field of view of a
   24 GHz lane-change-assist radar: Autoliv SRR "NB" sensor, user manual filed with the FCC,
@@ -35,6 +35,7 @@ from dataclasses import dataclass
 
 from eoam_sumo.decision.policy import NextLaneView
 from eoam_sumo.sensing.v2x import V2XReceiver, V2XSettings
+from eoam_sumo.sim.geometry import OrientedBox
 
 MIN_OVERLAP_M = 0.1  # a road user reaching this far into the lane is in it [m]
 FUSION_GATE_M = 3.0  # radar and V2X objects closer than this (centre, plus half lengths) [m]
@@ -131,13 +132,13 @@ class NextLaneSensing:
         lane_lo, lane_hi = 0.5 * w, 1.5 * w
         in_path = report.in_path
         objects = []  # (s, d, road speed, length, width) of road users in the lane
-        shadows = []  # boxes of the road users the forward radar sees outside the lane
+        shadows = []  # detections of road users outside the lane (they hide what is behind)
         for det in report.detections:
             if det is not in_path and self._in_lane(det.d_m, det.width_m, lane_lo, lane_hi):
                 objects.append((det.s_m, det.d_m, det.road_speed_mps, det.length_m,
                                 det.width_m))
             else:
-                shadows.append(bodies[det.target_index].box)
+                shadows.append(det)
         objects += self._corner_objects(front_xy, s_f, yaw_rad, road, bodies, lane_lo,
                                         lane_hi, objects, in_path)
         if self.v2x is not None:
@@ -245,6 +246,10 @@ class NextLaneSensing:
 
     def _coverage(self, road, s_f: float, front_xy, yaw_rad: float, shadows: list) -> float:
         """Length of the lane ahead of the front bumper covered without a gap (module doc)."""
+        boxes = []  # the detected objects as boxes along the road at their place
+        for det in shadows:
+            x, y, road_yaw = road.point_at(det.s_m, det.d_m)
+            boxes.append(OrientedBox(x, y, road_yaw, det.length_m, det.width_m))
         radar, front_corner, rear_corner = self._sensors(front_xy, yaw_rad)
         corners = (front_corner, rear_corner)
         ox, oy = front_xy
@@ -255,7 +260,7 @@ class NextLaneSensing:
             while x <= reach:
                 px, py, _ = road.point_at(s_f + x, line)
                 seen = (sees(*radar, px, py)
-                        and not any(hides(box, ox, oy, px, py) for box in shadows))
+                        and not any(hides(box, ox, oy, px, py) for box in boxes))
                 if not seen and not any(sees(*c, px, py) for c in corners):
                     break
                 covered, x = x, x + COVERAGE_STEP_M

@@ -63,8 +63,9 @@ def _scenario(tmp_path: Path, *, van_x_m: float | None = None,
     return cfg
 
 
-def _run(cfg, tmp_path, name, policy="paper", v2x_range_m=0.0, **over):
-    settings = policy_settings(RunSettings(max_time_s=30.0), policy, v2x_range_m)
+def _run(cfg, tmp_path, name, policy="paper", v2x_range_m=0.0, radar_model="ideal", **over):
+    settings = policy_settings(RunSettings(max_time_s=30.0, radar_model=radar_model), policy,
+                               v2x_range_m)
     out = tmp_path / name
     summary = run_case(cfg, ScenarioOverrides(**over), out, settings)
     return summary, pd.read_csv(out / "timeseries.csv")
@@ -84,6 +85,16 @@ def test_an_oncoming_car_first_seen_past_the_point_of_no_return_on_mu_03(tmp_pat
         assert safe["sight_gate"] == "refused"
         assert safe["sight_needed_m"] > safe["sight_known_free_m"]
         assert ts["lateral_offset_m"].abs().max() < PONR_M  # braked in its lane
+
+
+@pytest.mark.parametrize("v2x", [0.0, 500.0])
+def test_the_safe_policy_with_the_automotive_radar_and_its_tracker(tmp_path, v2x):
+    """The same late oncoming car seen through the noisy, tracked automotive radar: the gate
+    refuses, the EOAM brakes in lane."""
+    safe, _ = _run(BASELINE, tmp_path, "auto", "safe", v2x, radar_model="automotive",
+                   ego_speed_mps=165 / 3.6, mu=0.3, oncoming_start_m=400.0)
+    assert safe["outcome"] in SAFE_OUTCOMES, safe["reason"]
+    assert 2 not in safe["modes_visited"] and safe["sight_gate"] == "refused"
 
 
 @pytest.mark.parametrize("mu", [1.0, 0.3])
