@@ -1,0 +1,194 @@
+"""traffic.csv: every road user near the ego at each logged step (ground truth beside the
+ego's timeseries.csv, and what ``eoam-sumo animate`` draws).
+
+One row per road user per logged step: ``time_s, id, vclass, role, x_m, y_m, heading_rad,
+speed_mps, length_m, width_m``. The time base is timeseries.csv's: the row at ``time_s`` t
+holds the world at SUMO time t, where the timeseries row at t holds the ego state the
+decision of that step started from. Pose is the centre of the body's footprint rectangle
+(for the ego: the centre of its box, not its centre of gravity), heading counter-clockwise
+from +x in (-pi, pi], speed along the heading (the ego's: its forward speed vx, signed).
+
+Logged: the ego and every road user whose footprint centre lies within ``radius_m``
+(``TRAFFIC_RADIUS_M``, 250 m) of the ego's centre of gravity, parked ones included.
+
+Roles (per row, worked out when the log is written, relative to the ego's original lane as
+the radar's classes are, with the radar's thresholds):
+
+* ``ego``;
+* ``parked``: SUMO reports the road user parked;
+* ``oncoming``: moving against the road direction faster than 2 m/s, not right of the
+  ego's lane;
+* ``aro``: ahead of the ego (station beyond the ego's centre) with its centre in the ego
+  lane's band (half the lane width + 0.5 m): the obstacle in the ego's lane, whatever
+  it is (a stopped car, a person walking on the road);
+* ``other``: the rest (traffic in other lanes, behind the ego, people on the pavement).
+
+Cost in the step loop: one radius test per road user and one tuple kept per step; the rows,
+the roles and the columns are laid out once, when the log is written.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from eoam_sumo.sim.radar import LANE_MARGIN_M, ONCOMING_SPEED_MPS
+from eoam_sumo.sim.roadframe import RoadFrame
+
+TRAFFIC_FILE = "traffic.csv"
+#: traffic.csv columns, SI units in the names.
+TRAFFIC_COLUMNS = ("time_s", "id", "vclass", "role", "x_m", "y_m", "heading_rad", "speed_mps",
+                   "length_m", "width_m")
+ROLES = ("ego", "aro", "oncoming", "parked", "other")
+#: Road users whose centre is within this distance of the ego's centre of gravity are logged:
+#: twice the view of ``eoam-sumo animate`` and beyond any radar range used here, so a car
+#: closing at 60 m/s is in the log 4 s before it reaches the ego [m].
+TRAFFIC_RADIUS_M = 250.0
+_DECIMALS = {"time_s": 6, "x_m": 4, "y_m": 4, "heading_rad": 6, "speed_mps": 4,
+             "length_m": 4, "width_m": 4}
+
+
+class TrafficLog:
+    """Observer of the step loop that keeps the road users near the ego at each step.
+
+    ``ego_vclass``, ``ego_length_m`` and ``ego_width_m`` describe the ego's box;
+    ``cg_to_centre_m`` is the distance from its centre of gravity forward to the box's centre;
+    ``centreline`` and ``lane_width_m`` give the ego's original lane for the roles."""
+
+    def __init__(self, ego_id: str, ego_vclass: str, ego_length_m: float, ego_width_m: float,
+                 cg_to_centre_m: float, centreline: Sequence[Sequence[float]],
+                 lane_width_m: float, radius_m: float = TRAFFIC_RADIUS_M):
+        if not (math.isfinite(radius_m) and radius_m > 0.0):
+            raise ValueError(f"radius_m={radius_m!r} must be a finite number > 0")
+        if not lane_width_m > 0.0:
+            raise ValueError(f"lane_width_m={lane_width_m!r} must be > 0")
+        self.ego_id, self.ego_vclass = ego_id, ego_vclass
+        self._ego_size = (float(ego_length_m), float(ego_width_m))
+        self._to_centre = float(cg_to_centre_m)
+        self._centreline = [(float(p[0]), float(p[1])) for p in centreline]
+        self._lane_width = float(lane_width_m)
+        self.radius_m = float(radius_m)
+        self._r2 = self.radius_m * self.radius_m
+        self._steps: list[tuple] = []
+
+    def __len__(self) -> int:
+        return len(self._steps)
+
+    def add(self, t: float, x: Sequence[float], bodies: Sequence) -> None:
+        """Keep the ego state ``x`` (plant state: X, Y at the centre of gravity, yaw, vx, ...)
+        and the ``bodies`` (immutable ``Body`` tuples, not the ego) within the radius at
+        time ``t``."""
+        ex, ey, r2 = x[0], x[1], self._r2
+        near = [b for b in bodies
+                if (b.x_m - ex) * (b.x_m - ex) + (b.y_m - ey) * (b.y_m - ey) <= r2]
+        self._steps.append((t, ex, ey, x[2], x[3], near))
+
+    def columns(self) -> dict:
+        """The log as columns (TRAFFIC_COLUMNS order): numpy arrays, and lists of str for
+        ``id``, ``vclass`` and ``role``. Rows are by time, then the ego, then by id."""
+        steps = self._steps
+        n_rows = sum(1 + len(s[5]) for s in steps)
+        t = np.empty(n_rows)
+        num = np.empty((n_rows, 6))  # x, y, heading, speed, length, width
+        parked = np.zeros(n_rows, dtype=bool)
+        ids: list[str] = []
+        vclasses: list[str] = []
+        ego_rows = np.empty(len(steps), dtype=np.int64)
+        step_of = np.empty(n_rows, dtype=np.int64)
+        length, width = self._ego_size
+        k = 0
+        for i, (ti, ex, ey, yaw, vx, near) in enumerate(steps):
+            ego_rows[i] = k
+            t[k:k + 1 + len(near)] = ti
+            step_of[k:k + 1 + len(near)] = i
+            num[k] = (ex + self._to_centre * math.cos(yaw), ey + self._to_centre * math.sin(yaw),
+                      math.remainder(yaw, math.tau), vx, length, width)
+            ids.append(self.ego_id)
+            vclasses.append(self.ego_vclass)
+            k += 1
+            for b in near:
+                num[k] = (b.x_m, b.y_m, b.yaw_rad, b.speed_mps, b.length_m, b.width_m)
+                parked[k] = b.parked
+                ids.append(b.vid)
+                vclasses.append(b.vclass)
+                k += 1
+        roles = self._roles(ids, num, parked, ego_rows, step_of)
+        return {"time_s": t, "id": ids, "vclass": vclasses, "role": roles,
+                "x_m": num[:, 0], "y_m": num[:, 1], "heading_rad": num[:, 2],
+                "speed_mps": num[:, 3], "length_m": num[:, 4], "width_m": num[:, 5]}
+
+    def _roles(self, ids: list, num: np.ndarray, parked: np.ndarray, ego_rows: np.ndarray,
+               step_of: np.ndarray) -> list[str]:
+        """Role of every row (module doc): the ego's station at each step first, then each
+        road user's rows in time order, so the road frame's walk moves a little at a time."""
+        roles = ["other"] * len(ids)
+        if not ids:
+            return roles
+        road = RoadFrame(self._centreline)
+        ego_s = np.empty(len(ego_rows))
+        road.locate(num[ego_rows[0], 0], num[ego_rows[0], 1])
+        for i, k in enumerate(ego_rows):
+            ego_s[i] = road.project(num[k, 0], num[k, 1])[0]
+            roles[k] = "ego"
+        band = 0.5 * self._lane_width + LANE_MARGIN_M
+        others = np.flatnonzero(~parked)
+        others = others[np.isin(others, ego_rows, invert=True)]
+        for k in np.flatnonzero(parked):
+            roles[k] = "parked"
+        by_id = sorted(others.tolist(), key=lambda k: (ids[k], k))
+        previous = None
+        for k in by_id:
+            x, y, yaw, speed = num[k, :4]
+            if ids[k] != previous:
+                road.locate(x, y)
+                previous = ids[k]
+            s, d, road_yaw = road.project(x, y)
+            if speed * math.cos(yaw - road_yaw) < -ONCOMING_SPEED_MPS and d > -band:
+                roles[k] = "oncoming"
+            elif abs(d) < band and s > ego_s[step_of[k]]:
+                roles[k] = "aro"
+        return roles
+
+    def frame(self):
+        """The log as a pandas DataFrame (TRAFFIC_COLUMNS), numbers rounded for the file."""
+        import pandas as pd
+
+        cols = self.columns()
+        for name, decimals in _DECIMALS.items():
+            cols[name] = np.round(cols[name], decimals) + 0.0  # + 0.0: no -0.0 in the file
+        return pd.DataFrame(cols, columns=list(TRAFFIC_COLUMNS))
+
+    def write(self, path: Path) -> None:
+        """Write the log as CSV to ``path`` (atomically)."""
+        path = Path(path)
+        tmp = path.with_name(path.name + ".tmp")
+        self.frame().to_csv(tmp, index=False)
+        os.replace(tmp, path)
+
+
+def read_traffic(path: Path):
+    """A run's traffic.csv as a DataFrame; InputError naming the file when it cannot be read
+    or lacks a column."""
+    import pandas as pd
+
+    from eoam_sumo.errors import InputError
+
+    try:
+        frame = pd.read_csv(path, dtype={"id": str, "vclass": str, "role": str},
+                            keep_default_na=False, na_values={c: ["", "nan"] for c in
+                                                              _DECIMALS})
+    except (OSError, ValueError, pd.errors.EmptyDataError, pd.errors.ParserError) as exc:
+        raise InputError(f"{path}: cannot be read as a run's traffic log: {exc}") from exc
+    missing = [c for c in TRAFFIC_COLUMNS if c not in frame.columns]
+    if missing:
+        raise InputError(f"{path}: cannot be read as a run's traffic log: no column "
+                         f"{missing[0]}")
+    numeric = list(_DECIMALS)
+    if not all(pd.api.types.is_numeric_dtype(frame[c]) for c in numeric):
+        raise InputError(f"{path}: cannot be read as a run's traffic log: not numbers where "
+                         "numbers belong")
+    return frame
