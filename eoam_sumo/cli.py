@@ -1,4 +1,4 @@
-"""The ``eoam-sumo`` command line: tables, run, batch, plot, bench.
+"""The ``eoam-sumo`` command line: tables, run, batch, plot, animate, bench.
 
 Bad input ends with one line on stderr naming the file or value and exit status 2; the
 library raises, only this module prints and exits.
@@ -154,6 +154,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("folder", type=Path, help="a run, batch or tables output folder")
     p.add_argument("--out", type=Path, help="where to put the PNGs (default: the folder)")
 
+    p = sub.add_parser("animate", help="animated bird's-eye view of a run folder")
+    p.add_argument("run_dir", type=Path, help="a run folder (summary.json, timeseries.csv, "
+                   "traffic.csv)")
+    p.add_argument("--out", type=Path, help="GIF, or MP4 with ffmpeg (default: "
+                   "RUN_DIR/animation.gif)")
+    p.add_argument("--fps", type=_finite, default=10.0, help="frames per second of run time")
+
     p = sub.add_parser("bench", help="the performance benchmark")
     p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder")
     p.add_argument("--quick", action="store_true", help="tiny settings (for tests)")
@@ -272,6 +279,13 @@ def _cmd_plot(args) -> int:
     return 0
 
 
+def _cmd_animate(args) -> int:
+    from eoam_sumo.plotting.animate import animate_cli
+
+    print(animate_cli(args.run_dir, args.out, args.fps))
+    return 0
+
+
 def _cmd_bench(args) -> int:
     from eoam_sumo.bench import run_bench_cli
 
@@ -280,7 +294,7 @@ def _cmd_bench(args) -> int:
 
 _COMMANDS = {
     "tables": _cmd_tables, "run": _cmd_run, "batch": _cmd_batch,
-    "plot": _cmd_plot, "bench": _cmd_bench,
+    "plot": _cmd_plot, "animate": _cmd_animate, "bench": _cmd_bench,
 }
 
 

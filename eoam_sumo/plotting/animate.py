@@ -64,8 +64,10 @@ def animate_run(run_dir: Path, out: Path | None = None, fps: float = DEFAULT_FPS
     run_dir = Path(run_dir)
     if not run_dir.is_dir():
         raise InputError(f"{run_dir}: no such run folder")
+    if not (run_dir / "summary.json").is_file():
+        raise InputError(f"{run_dir}: not a run folder (no summary.json)")
     if not (math.isfinite(fps) and fps > 0.0):
-        raise InputError(f"--fps {fps} must be a number > 0")
+        raise InputError(f"--fps {fps:g} must be a number > 0")
     summary, ts = load_run(run_dir)
     traffic_path = run_dir / TRAFFIC_FILE
     if not traffic_path.is_file():
@@ -78,14 +80,17 @@ def animate_run(run_dir: Path, out: Path | None = None, fps: float = DEFAULT_FPS
         raise InputError(f"{out}: an MP4 needs ffmpeg on PATH; name a .gif instead")
     if not mp4 and out.suffix.lower() != ".gif":
         raise InputError(f"{out}: the animation's file name must end in .gif or .mp4")
-    out.parent.mkdir(parents=True, exist_ok=True)
     scene = _Scene(summary, ts, traffic, size_in, dpi)
     frames = _frame_rows(ts["time_s"].to_numpy(), fps)
     writer = FFMpegWriter(fps=fps) if mp4 else PillowWriter(fps=fps)
-    with writer.saving(scene.fig, str(out), dpi):
-        for row in frames:
-            scene.draw(int(row))
-            writer.grab_frame()
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        with writer.saving(scene.fig, str(out), dpi):
+            for row in frames:
+                scene.draw(int(row))
+                writer.grab_frame()
+    except OSError as exc:
+        raise InputError(f"{out}: cannot be written: {exc.strerror or exc}") from exc
     return out, len(frames)
 
 
@@ -129,8 +134,9 @@ class _Scene:
         (self.plan,) = ax.plot([], [], color="black", linestyle="--", linewidth=1.0, zorder=3)
         self.bodies = PolyCollection([], edgecolors="black", linewidths=0.5, zorder=4)
         ax.add_collection(self.bodies)
-        (self.contact,) = ax.plot([], [], marker="*", markersize=16, color="#d50000",
-                                  markeredgecolor="black", linestyle="", zorder=5)
+        (self.contact,) = ax.plot([], [], marker="o", markersize=18, markerfacecolor="none",
+                                  markeredgecolor="#d50000", markeredgewidth=2.0,
+                                  linestyle="", zorder=5)
         self.text = ax.text(0.01, 0.97, "", transform=ax.transAxes, va="top", fontsize=8,
                             family="monospace", zorder=6,
                             bbox={"facecolor": "white", "alpha": 0.85, "linewidth": 0})

@@ -1,4 +1,5 @@
-"""Plots of a batch: the Table 2 grid (ours | paper) and lateral offsets across cases (Fig. 25).
+"""Plots of a batch: the Table 2 grid (ours | paper) and lateral offsets across cases (Fig. 25,
+one figure per speed swept).
 
 Figures are drawn on matplotlib's Agg canvas through the object interface (no pyplot, no
 global backend change).
@@ -6,6 +7,7 @@ global backend change).
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -13,18 +15,19 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch, Rectangle
 
+from eoam_sumo.batch.case import PARAMETERS
 from eoam_sumo.batch.report import TABLE_PNG, mu_text, outcome_grid
 from eoam_sumo.batch.results import RESULTS_FILE, read_results
 from eoam_sumo.colours import DARK_TEXT
 from eoam_sumo.colours import HEX as OUTCOME_COLOURS
-from eoam_sumo.params import LANE_CHANGE_HEIGHT_M, PONR_FRACTION
+from eoam_sumo.params import PONR_FRACTION
 from eoam_sumo.plotting.figures import save
+from eoam_sumo.plotting.runfacts import (fit, lane_width_m, oncoming_seen, point_of_no_return_m,
+                                         traffic_text)
 from eoam_sumo.sim.runlog import read_timeseries
 
 _MISSING = "#ffffff"
 _STYLES = ("-", "--", "-.", ":")
-LANE_WIDTH_M = LANE_CHANGE_HEIGHT_M  # the lane change's height (paper sec. 4.2)
-PONR_M = PONR_FRACTION * LANE_WIDTH_M  # point of no return (paper sec. 8.1)
 
 
 def _text_colour(colour: str) -> str:
@@ -84,12 +87,74 @@ def _offsets(batch_dir: Path, case_dir: str) -> pd.DataFrame:
                            ["time_s", "lateral_offset_m", "mode"])
 
 
-def _panel(ax, batch_dir: Path, rows: pd.DataFrame, label_of, cmap_name: str) -> int:
-    """Lateral offset against time of each ``rows`` case; returns the number of lines."""
+#: How a swept matrix key is named in a legend (other keys: ``key = value``).
+_SWEEP_FORMATS = {"ego_speed_kmh": "{:g} km/h", "aro_hold_s": "ARO hold {:g} s",
+                  "aro_decel_mps2": "ARO decel {:g} m/s²", "max_time_s": "time limit {:g} s",
+                  "radar_range_m": "radar {:g} m"}
+
+
+def swept_keys(results: pd.DataFrame) -> list[str]:
+    """The matrix keys (results.csv parameter columns, the scenario file too) that take more
+    than one value in ``results``."""
+    keys = [c for c in PARAMETERS if c not in ("case_id", "draw") and c in results]
+    return [c for c in keys if results[c].nunique(dropna=False) > 1]
+
+
+def _key_text(row, key: str) -> str:
+    value = row[key]
+    if key == "mu":
+        return f"μ = {mu_text(value)}"
+    if key == "sumocfg":
+        return Path(str(value)).name
+    if pd.isna(value):
+        return f"{key} default"
+    fmt = _SWEEP_FORMATS.get(key)
+    return fmt.format(value) if fmt else f"{key} = {value:g}" if isinstance(
+        value, float) else f"{key} = {value}"
+
+
+class _CaseFacts:
+    """What each case folder of a batch says: lane width recorded, oncoming traffic seen."""
+
+    def __init__(self, batch_dir: Path):
+        self.batch_dir = Path(batch_dir)
+        self._cache: dict[str, tuple] = {}
+
+    def __call__(self, case_dir: str) -> tuple[float, bool, bool]:
+        """(lane width, recorded, oncoming traffic seen) of a case."""
+        if case_dir not in self._cache:
+            folder = self.batch_dir / case_dir
+            try:
+                summary = json.loads((folder / "summary.json").read_text(encoding="utf-8"))
+            except (OSError, ValueError):
+                summary = {}
+            width, recorded = lane_width_m(summary if isinstance(summary, dict) else {})
+            self._cache[case_dir] = (width, recorded, oncoming_seen(folder))
+        return self._cache[case_dir]
+
+
+def _label(row, keys: list[str], facts: _CaseFacts) -> str:
+    parts = []
+    for key in keys:
+        if key == "oncoming_start_m":
+            parts.append(traffic_text(row[key], facts(row["case_dir"])[2]))
+        else:
+            parts.append(_key_text(row, key))
+    return ", ".join(parts)
+
+
+def _panel(ax, batch_dir: Path, rows: pd.DataFrame, label_of, cmap_name: str,
+           facts: _CaseFacts) -> int:
+    """Lateral offset against time of each ``rows`` case, with the next lane's centre and
+    the point of no return of each lane width the cases ran on; returns the number of
+    lines."""
     rows = rows[rows["status"] == "ok"]
     cmap = _colormap(cmap_name)
+    widths: dict[float, bool] = {}
     for k, (_, row) in enumerate(rows.iterrows()):
         ts = _offsets(batch_dir, row["case_dir"])
+        width, recorded, _ = facts(row["case_dir"])
+        widths[width] = widths.get(width, True) and recorded
         colour = cmap(0.45 + 0.55 * k / max(len(rows) - 1, 1))
         ax.plot(ts["time_s"], ts["lateral_offset_m"], color=colour, linewidth=1.8,
                 linestyle=_STYLES[k % len(_STYLES)],
@@ -97,10 +162,15 @@ def _panel(ax, batch_dir: Path, rows: pd.DataFrame, label_of, cmap_name: str) ->
         ax.plot(ts["time_s"].iloc[-1], ts["lateral_offset_m"].iloc[-1], marker="s",
                 markersize=9, color=OUTCOME_COLOURS.get(row["outcome"], _MISSING),
                 markeredgecolor="black")
-    ax.axhline(LANE_WIDTH_M, color="0.4", linestyle="--", linewidth=0.8)
-    ax.axhline(PONR_M, color="0.4", linestyle=":", linewidth=0.8)
-    ax.text(ax.get_xlim()[0], LANE_WIDTH_M, " next lane centre", va="bottom", fontsize=8)
-    ax.text(ax.get_xlim()[0], PONR_M, " point of no return", va="bottom", fontsize=8)
+    for width, recorded in widths.items():
+        lane = f"{width:.2f} m lane" + ("" if recorded else ", assumed: not recorded")
+        ponr = point_of_no_return_m(width)
+        ax.axhline(width, color="0.4", linestyle="--", linewidth=0.8)
+        ax.axhline(ponr, color="0.4", linestyle=":", linewidth=0.8)
+        ax.text(ax.get_xlim()[0], width, f" next lane centre ({lane})", va="bottom",
+                fontsize=8)
+        ax.text(ax.get_xlim()[0], ponr, f" point of no return ({PONR_FRACTION:g} x {width:.2f}"
+                " m)", va="bottom", fontsize=8)
     ax.set_xlabel("time [s]")
     ax.set_ylabel("lateral offset from the original lane centre [m] (left +)")
     ax.grid(alpha=0.3)
@@ -116,35 +186,45 @@ def _colormap(name: str):
 
 
 def plot_lateral_offsets(batch_dir: Path, results: pd.DataFrame, out_dir: Path,
-                         speed_kmh: float | None = None) -> Path | None:
-    """Figure 25: lateral offset vs time at one speed, across frictions with no oncoming car
-    (left) and across oncoming distances at the highest friction (right).
-
-    ``speed_kmh`` defaults to 120 km/h when the batch has it, else its most common speed;
-    None is returned when the batch has no finished case at that speed.
-    """
+                         speed_kmh: float) -> Path | None:
+    """Figure 25 at one speed: lateral offset vs time of the cases without an added oncoming
+    car (left) and of the cases at the highest friction across the oncoming settings
+    (right). Each line is named by every key the batch sweeps (but the speed); None when the
+    batch has no finished case at that speed."""
     ok = results[results["status"] == "ok"]
-    if ok.empty:
-        return None
-    speeds = ok["ego_speed_kmh"]
-    if speed_kmh is None:
-        speed_kmh = 120.0 if (speeds == 120.0).any() else float(speeds.mode().iloc[0])
     at_speed = ok[ok["ego_speed_kmh"] == speed_kmh]
     if at_speed.empty:
         return None
+    facts = _CaseFacts(batch_dir)
+    keys = [k for k in swept_keys(results) if k != "ego_speed_kmh"]
     top_mu = float(at_speed["mu"].max())
     no_onc = at_speed[at_speed["oncoming_start_m"].isna()].sort_values("mu", ascending=False)
     dry = at_speed[at_speed["mu"] == top_mu].sort_values(
         "oncoming_start_m", ascending=False, na_position="first")
+    left_keys = [k for k in keys if k != "oncoming_start_m"] or ["mu"]
+    if any(facts(c)[2] for c in no_onc["case_dir"]):
+        left_keys.append("oncoming_start_m")  # the scenario's own traffic: say which saw it
+        left_title = "no oncoming car added"
+    else:
+        left_title = "no oncoming traffic"
+    right_keys = ["oncoming_start_m", *(k for k in keys if k not in ("mu",
+                                                                   "oncoming_start_m"))]
     fig = Figure(figsize=(13, 5.2), layout="constrained")
     left, right = fig.subplots(1, 2, sharey=True)
-    _panel(left, batch_dir, no_onc, lambda r: f"μ = {mu_text(r['mu'])}", "Blues")
-    left.set_title(f"{speed_kmh:g} km/h, no oncoming traffic, across frictions")
-    _panel(right, batch_dir, dry, lambda r: "no oncoming" if pd.isna(r["oncoming_start_m"])
-           else f"oncoming from {r['oncoming_start_m']:g} m", "Purples")
-    right.set_title(f"{speed_kmh:g} km/h, μ = {mu_text(top_mu)}, across oncoming start distances")
+    _panel(left, batch_dir, no_onc, lambda r: _label(r, left_keys, facts), "Blues", facts)
+    left.set_title(fit(f"{speed_kmh:g} km/h, {left_title}, across "
+                       f"{', '.join(_KEY_NAMES.get(k, k) for k in left_keys if k != 'oncoming_start_m')}",
+                       6.3, 12))
+    _panel(right, batch_dir, dry, lambda r: _label(r, right_keys, facts), "Purples", facts)
+    right.set_title(fit(f"{speed_kmh:g} km/h, μ = {mu_text(top_mu)}, across oncoming settings",
+                        6.3, 12))
     fig.suptitle("Ego lateral position during the EOAM (cf. paper Figure 25)")
     return save(fig, Path(out_dir) / f"lateral_offsets_{speed_kmh:g}kmh.png")
+
+
+_KEY_NAMES = {"mu": "frictions", "aro_hold_s": "ARO hold times",
+              "aro_decel_mps2": "ARO decelerations", "max_time_s": "time limits",
+              "radar_range_m": "radar ranges", "sumocfg": "scenarios"}
 
 
 def plot_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
@@ -155,7 +235,9 @@ def plot_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
 
         return plot_envelopes(results, out_dir)
     paths = [plot_table2(outcome_grid(results), Path(out_dir) / TABLE_PNG)]
-    fig25 = plot_lateral_offsets(batch_dir, results, out_dir)
-    if fig25 is not None:
-        paths.append(fig25)
+    ok = results[results["status"] == "ok"]
+    for speed_kmh in pd.unique(ok["ego_speed_kmh"]):
+        fig25 = plot_lateral_offsets(batch_dir, results, out_dir, float(speed_kmh))
+        if fig25 is not None:
+            paths.append(fig25)
     return paths

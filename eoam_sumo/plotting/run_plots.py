@@ -3,13 +3,16 @@ paper's Figures 21-24 for its 120 km/h dry case:
 
 * ``phase_trace.png`` (Fig. 21): the ARO's range against the closing speed (-range rate)
   as the radar saw it, on the DMM phase diagram (sectors A-G shaded, boundaries drawn) of
-  the run's friction, coloured by EOAM mode;
+  the friction the manoeuvre ran on (under the ego when it began), coloured by EOAM mode;
 * ``dynamics.png`` (Fig. 22): mode, FCW, speed and acceleration (target vs actual),
   lateral position (target vs actual), lateral and lookahead errors, differential x;
 * ``steering.png`` (Fig. 23): the steering components (feedforward, feedback, yaw damping,
   total command, actual road-wheel angle), hand-wheel angle, lateral acceleration, yaw rate;
 * ``gg.png`` (Fig. 24): longitudinal against lateral acceleration inside the friction
-  circle of radius mu g.
+  circle of radius mu g of the manoeuvre's friction (and of any other friction met).
+
+Titles name the traffic as the run had it (an added oncoming car, or the scenario's own
+oncoming traffic) and are wrapped to the figure's width.
 """
 
 from __future__ import annotations
@@ -27,6 +30,8 @@ from eoam_sumo.batch.report import mu_text
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import G_MPS2, ego_e_class_sedan
 from eoam_sumo.plotting.figures import save
+from eoam_sumo.plotting.runfacts import (fit, frictions_seen, manoeuvre_mu, oncoming_seen,
+                                         traffic_text)
 from eoam_sumo.sim.runlog import COLUMNS, read_timeseries
 
 MODE_NAMES = {0: "0 NORMAL", 1: "1 UPDATE BRAKE", 2: "2 STEER+BRAKE", 3: "3 ONCOMING BRAKE",
@@ -59,13 +64,14 @@ def load_run(case_dir: Path) -> tuple[dict, pd.DataFrame]:
     return summary, frame
 
 
-def run_title(summary: dict) -> str:
-    """'120 km/h, μ = 1.0, no oncoming: green (reason)' from a summary."""
+def run_title(summary: dict, ts: pd.DataFrame, run_dir: Path) -> str:
+    """'120 km/h, μ = 1.0, no oncoming: green (reason)' from a run: the friction is the one
+    the manoeuvre ran on, the traffic the added oncoming car or what the run saw."""
     case = summary.get("case") or {}
     speed_kmh = case.get("ego_speed_kmh") or 3.6 * summary.get("ego_initial_speed_mps", math.nan)
-    onc = case.get("oncoming_start_m")
-    traffic = "no oncoming" if onc is None else f"oncoming from {onc:g} m"
-    return (f"{speed_kmh:.0f} km/h, μ = {mu_text(summary['mu'])}, {traffic}: "
+    traffic = traffic_text(case.get("oncoming_start_m"), oncoming_seen(run_dir))
+    mu, _ = manoeuvre_mu(summary, ts)
+    return (f"{speed_kmh:.0f} km/h, μ = {mu_text(mu)}, {traffic}: "
             f"{summary['outcome']} ({summary.get('reason', '')})")
 
 
@@ -126,7 +132,8 @@ def plot_dynamics(case_dir: Path, out_dir: Path) -> Path:
         ax.set_xlabel("time [s]")
     fig.legend(handles=_mode_legend(_modes_in(ts)), loc="outside lower center",
                ncols=6, fontsize=8, title="background: EOAM mode", title_fontsize=8)
-    fig.suptitle("EOAM dynamics (cf. paper Figure 22) — " + run_title(summary), fontsize=11)
+    fig.suptitle(fit("EOAM dynamics (cf. paper Figure 22) — " + run_title(summary, ts, case_dir),
+                     14, 11), fontsize=11)
     return save(fig, Path(out_dir) / "dynamics.png")
 
 
@@ -152,7 +159,7 @@ def plot_steering(case_dir: Path, out_dir: Path) -> Path:
     axes[1].set_title(f"hand-wheel angle (steering ratio {ratio:g})", fontsize=10)
     axes[1].set_ylabel("[deg]")
     axes[2].plot(t, ts["ay_mps2"], **_ACTUAL)
-    mu_g = summary["mu"] * G_MPS2
+    mu_g = manoeuvre_mu(summary, ts)[0] * G_MPS2
     for sign in (1, -1):
         axes[2].axhline(sign * mu_g, color="#e53935", linestyle=":", linewidth=1)
     axes[2].set_title(f"lateral acceleration (dotted: ±μg = ±{mu_g:.2f} m/s²)", fontsize=10)
@@ -167,20 +174,27 @@ def plot_steering(case_dir: Path, out_dir: Path) -> Path:
         ax.set_xlabel("time [s]")
     fig.legend(handles=_mode_legend(_modes_in(ts)), loc="outside lower center", ncols=6,
                fontsize=8, title="background: EOAM mode", title_fontsize=8)
-    fig.suptitle("Steering, lateral acceleration and yaw rate (cf. paper Figure 23) — "
-                 + run_title(summary), fontsize=11)
+    fig.suptitle(fit("Steering, lateral acceleration and yaw rate (cf. paper Figure 23) — "
+                     + run_title(summary, ts, case_dir), 13, 11), fontsize=11)
     return save(fig, Path(out_dir) / "steering.png")
 
 
 def plot_gg(case_dir: Path, out_dir: Path) -> Path:
     """Figure 24: the g-g diagram with the friction circle of radius mu g."""
     summary, ts = load_run(case_dir)
-    mu_g = summary["mu"] * G_MPS2
+    mu, what = manoeuvre_mu(summary, ts)
+    mu_g = mu * G_MPS2
     fig = Figure(figsize=(7.5, 7.5), layout="constrained")
     ax = fig.add_subplot()
     angle = np.linspace(0.0, 2.0 * np.pi, 361)
     ax.plot(mu_g * np.cos(angle), mu_g * np.sin(angle), color="#e53935", linewidth=1.5,
-            label=f"friction circle μg = {mu_g:.2f} m/s²")
+            label=f"friction circle μg = {mu_g:.2f} m/s² (μ = {mu_text(mu)}, {what})")
+    for other in frictions_seen(ts):
+        if abs(other - mu) > 1e-6:
+            r = other * G_MPS2
+            ax.plot(r * np.cos(angle), r * np.sin(angle), color="#e53935", linewidth=1.0,
+                    linestyle="--", label=f"friction circle μ = {mu_text(other)} (also met)")
+            mu_g = max(mu_g, r)
     for mode in sorted(_modes_in(ts)):
         sel = ts[ts["mode"] == mode]
         ax.scatter(sel["ay_mps2"], sel["ax_mps2"], s=5, color=MODE_COLOURS[mode],
@@ -195,7 +209,8 @@ def plot_gg(case_dir: Path, out_dir: Path) -> Path:
     ax.set_ylabel("longitudinal acceleration a_x [m/s²]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper right", markerscale=3)
-    ax.set_title("g-g diagram (cf. paper Figure 24)\n" + run_title(summary), fontsize=10)
+    ax.set_title(fit("g-g diagram (cf. paper Figure 24)\n" + run_title(summary, ts, case_dir),
+                     7.0, 10), fontsize=10)
     return save(fig, Path(out_dir) / "gg.png")
 
 
@@ -217,7 +232,7 @@ def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = No
     from eoam_sumo.decision.dmm import SECTOR_ORDER
 
     summary, ts = load_run(case_dir)
-    mu = summary["mu"]
+    mu, what = manoeuvre_mu(summary, ts)
     seen = ts[np.isfinite(ts["aro_range_m"]) & np.isfinite(ts["aro_range_rate_mps"])]
     closing = -seen["aro_range_rate_mps"]
     v_max = max(float(closing.max()) if len(seen) else 0.0,
@@ -277,8 +292,9 @@ def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = No
     ax.set_xlabel("closing speed to the ARO (-range rate) [m/s]")
     ax.set_ylabel("range to the ARO [m]")
     ax.legend(fontsize=8, loc="upper left", framealpha=0.9)
-    ax.set_title(f"DMM phase diagram at μ = {mu_text(mu)} with the ARO phase trace "
-                 f"(cf. paper Figure 21)\n{run_title(summary)}{note}", fontsize=10)
+    ax.set_title(fit(f"DMM phase diagram at μ = {mu_text(mu)} (the friction {what}) with the "
+                     f"ARO phase trace (cf. paper Figure 21)\n"
+                     f"{run_title(summary, ts, case_dir)}{note}", 9.5, 10), fontsize=10)
     return save(fig, Path(out_dir) / "phase_trace.png")
 
 

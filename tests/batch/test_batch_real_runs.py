@@ -151,7 +151,8 @@ def test_plots_of_a_run_folder_and_a_batch_folder(reference, tmp_path):
     assert sorted(p.name for p in run_pngs) == ["dynamics.png", "gg.png", "phase_trace.png",
                                                 "steering.png"]
     batch_pngs = plot_folder(out, tmp_path / "batch")
-    assert sorted(p.name for p in batch_pngs) == ["lateral_offsets_120kmh.png", "table2.png"]
+    assert sorted(p.name for p in batch_pngs) == ["lateral_offsets_120kmh.png",
+                                                  "lateral_offsets_90kmh.png", "table2.png"]
     tables_pngs = plot_folder(out.parent / "tables", tmp_path / "tables")
     assert tables_pngs
     for png in run_pngs + batch_pngs + tables_pngs:
