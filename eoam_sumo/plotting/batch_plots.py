@@ -202,19 +202,18 @@ def plot_lateral_offsets(batch_dir: Path, results: pd.DataFrame, out_dir: Path,
     dry = at_speed[at_speed["mu"] == top_mu].sort_values(
         "oncoming_start_m", ascending=False, na_position="first")
     left_keys = [k for k in keys if k != "oncoming_start_m"] or ["mu"]
+    across = ", ".join(_KEY_NAMES.get(k, k) for k in left_keys)
     if any(facts(c)[2] for c in no_onc["case_dir"]):
         left_keys.append("oncoming_start_m")  # the scenario's own traffic: say which saw it
         left_title = "no oncoming car added"
     else:
         left_title = "no oncoming traffic"
-    right_keys = ["oncoming_start_m", *(k for k in keys if k not in ("mu",
-                                                                   "oncoming_start_m"))]
+    right_keys = ["oncoming_start_m",
+                  *(k for k in keys if k not in ("mu", "oncoming_start_m"))]
     fig = Figure(figsize=(13, 5.2), layout="constrained")
     left, right = fig.subplots(1, 2, sharey=True)
     _panel(left, batch_dir, no_onc, lambda r: _label(r, left_keys, facts), "Blues", facts)
-    left.set_title(fit(f"{speed_kmh:g} km/h, {left_title}, across "
-                       f"{', '.join(_KEY_NAMES.get(k, k) for k in left_keys if k != 'oncoming_start_m')}",
-                       6.3, 12))
+    left.set_title(fit(f"{speed_kmh:g} km/h, {left_title}, across {across}", 6.3, 12))
     _panel(right, batch_dir, dry, lambda r: _label(r, right_keys, facts), "Purples", facts)
     right.set_title(fit(f"{speed_kmh:g} km/h, μ = {mu_text(top_mu)}, across oncoming settings",
                         6.3, 12))

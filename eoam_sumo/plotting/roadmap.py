@@ -57,34 +57,41 @@ def read_road_map(net_file: Path, bbox: tuple[float, float, float, float],
                   margin_m: float = 50.0) -> RoadMap:
     """The lanes of ``net_file`` with a shape point within ``margin_m`` of ``bbox``
     (xmin, ymin, xmax, ymax) or crossing it. InputError naming the file if it cannot be read."""
-    x0, y0, x1, y1 = bbox[0] - margin_m, bbox[1] - margin_m, bbox[2] + margin_m, bbox[3] + margin_m
+    box = (bbox[0] - margin_m, bbox[1] - margin_m, bbox[2] + margin_m, bbox[3] + margin_m)
     out = RoadMap()
-    edge_lanes: list[tuple[np.ndarray, float, bool]] = []
-    internal = False
-    source = gzip.open(net_file) if Path(net_file).suffix == ".gz" else net_file
+    opener = gzip.open if Path(net_file).suffix == ".gz" else open
     try:
-        for event, elem in ET.iterparse(source, events=("start", "end")):
-            if event == "start" and elem.tag == "edge":
-                internal = elem.get("function") == "internal"
-                edge_lanes = []
-            elif event == "end" and elem.tag == "lane":
-                pts = _shape(elem.get("shape", ""))
-                if pts is None:
-                    continue
-                lo, hi = pts.min(axis=0), pts.max(axis=0)
-                if hi[0] < x0 or lo[0] > x1 or hi[1] < y0 or lo[1] > y1:
-                    continue
-                width = float(elem.get("width", DEFAULT_LANE_WIDTH_M))
-                walk = elem.get("allow", "").split() == ["pedestrian"]
-                edge_lanes.append((pts, width, walk, int(elem.get("index", "0"))))
-            elif event == "end" and elem.tag == "edge":
-                _add_edge(out, edge_lanes, internal)
-                elem.clear()
-            elif event == "end" and elem.tag in ("junction", "connection", "tlLogic"):
-                elem.clear()
+        with opener(net_file, "rb") as source:
+            _read_lanes(ET.iterparse(source, events=("start", "end")), box, out)
     except (ET.ParseError, OSError, ValueError) as exc:
         raise InputError(f"{net_file}: cannot be read as a SUMO network: {exc}") from exc
     return out
+
+
+def _read_lanes(events, box: tuple, out: RoadMap) -> None:
+    """The lanes of the parse ``events`` that reach into ``box`` into ``out``, by edge."""
+    x0, y0, x1, y1 = box
+    edge_lanes: list[tuple[np.ndarray, float, bool, int]] = []
+    internal = False
+    for event, elem in events:
+        if event == "start" and elem.tag == "edge":
+            internal = elem.get("function") == "internal"
+            edge_lanes = []
+        elif event == "end" and elem.tag == "lane":
+            pts = _shape(elem.get("shape", ""))
+            if pts is None:
+                continue
+            lo, hi = pts.min(axis=0), pts.max(axis=0)
+            if hi[0] < x0 or lo[0] > x1 or hi[1] < y0 or lo[1] > y1:
+                continue
+            width = float(elem.get("width", DEFAULT_LANE_WIDTH_M))
+            walk = elem.get("allow", "").split() == ["pedestrian"]
+            edge_lanes.append((pts, width, walk, int(elem.get("index", "0"))))
+        elif event == "end" and elem.tag == "edge":
+            _add_edge(out, edge_lanes, internal)
+            elem.clear()
+        elif event == "end" and elem.tag in ("junction", "connection", "tlLogic"):
+            elem.clear()
 
 
 def _add_edge(out: RoadMap, lanes: list, internal: bool) -> None:

@@ -8,8 +8,15 @@ import math
 import pandas as pd
 import pytest
 
-from eoam_sumo.plotting.runfacts import (fit, frictions_seen, lane_width_m, manoeuvre_mu,
-                                         oncoming_seen, point_of_no_return_m, traffic_text)
+from eoam_sumo.plotting.runfacts import (
+    fit,
+    frictions_seen,
+    lane_width_m,
+    manoeuvre_mu,
+    oncoming_seen,
+    point_of_no_return_m,
+    traffic_text,
+)
 
 
 def _ts(modes, mus) -> pd.DataFrame:
