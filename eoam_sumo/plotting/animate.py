@@ -37,6 +37,7 @@ ROLE_COLOURS = {"ego": "#1e88e5", "aro": "#e53935", "oncoming": "#fb8c00",
 _ROLE_RANK = {"ego": 0, "aro": 1, "oncoming": 2, "parked": 3, "other": 4}
 PLAN_AHEAD_S = 3.0  # the planned path drawn this far ahead of the frame's time [s]
 VIEW_BEHIND_M, VIEW_AHEAD_M = 40.0, 110.0  # view along the ego's heading [m]
+MIN_DRAWN_M = 1.0  # road users are drawn at least this long and wide [m]
 DEFAULT_FPS = 10
 DEFAULT_RADAR_FOV_DEG = 18.0
 
@@ -173,8 +174,11 @@ class _Scene:
         by_rank = {v: k for k, v in _ROLE_RANK.items()}
         self.tr_colour = np.array([ROLE_COLOURS[by_rank[r]] for r in best])
         self.roles_present = {by_rank[r] for r in set(best)}
-        self.tr_boxes = _boxes(*(traffic[c].to_numpy() for c in
-                                 ("x_m", "y_m", "heading_rad", "length_m", "width_m")))
+        x, y, heading, length, width = (traffic[c].to_numpy() for c in
+                                        ("x_m", "y_m", "heading_rad", "length_m", "width_m"))
+        # a person (0.2 x 0.5 m) would be a pixel or two: small road users drawn larger
+        self.tr_boxes = _boxes(x, y, heading, np.maximum(length, MIN_DRAWN_M),
+                               np.maximum(width, MIN_DRAWN_M))
         self.tr_is_ego = (traffic["role"] == "ego").to_numpy()
         self.tr_xy = traffic[["x_m", "y_m"]].to_numpy()
         ego = traffic[self.tr_is_ego]
