@@ -15,7 +15,7 @@ from eoam_sumo.plotting.batch_plots import _CaseFacts, _panel
 from eoam_sumo.plotting.run_plots import load_run, plot_run, run_title
 from eoam_sumo.plotting.runfacts import manoeuvre_mu
 from eoam_sumo.sim.cosim import RunSettings, run_case
-from eoam_sumo.sim.sumo_adapter import ScenarioOverrides
+from eoam_sumo.sim.scenario import ScenarioOverrides
 
 pytestmark = pytest.mark.sumo
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
