@@ -159,7 +159,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "traffic.csv)")
     p.add_argument("--out", type=Path, help="GIF, or MP4 with ffmpeg (default: "
                    "RUN_DIR/animation.gif)")
-    p.add_argument("--fps", type=_finite, default=10.0, help="frames per second of run time")
+    p.add_argument("--fps", type=_positive_int, default=10, help="frames per second of run time")
 
     p = sub.add_parser("bench", help="the performance benchmark")
     p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder")

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.animation import FFMpegWriter, PillowWriter
+from matplotlib.artist import Artist
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.figure import Figure
@@ -59,7 +60,7 @@ def _frame_rows(times: np.ndarray, fps: float) -> np.ndarray:
     return np.unique(np.clip(np.searchsorted(times, wanted - 1e-9), 0, len(times) - 1))
 
 
-def animate_run(run_dir: Path, out: Path | None = None, fps: float = DEFAULT_FPS,
+def animate_run(run_dir: Path, out: Path | None = None, fps: int = DEFAULT_FPS,
                 size_in: tuple[float, float] = (9.0, 3.6), dpi: int = 90) -> tuple[Path, int]:
     """Write the animation of ``run_dir``; (its path, the number of frames)."""
     run_dir = Path(run_dir)
@@ -67,8 +68,8 @@ def animate_run(run_dir: Path, out: Path | None = None, fps: float = DEFAULT_FPS
         raise InputError(f"{run_dir}: no such run folder")
     if not (run_dir / "summary.json").is_file():
         raise InputError(f"{run_dir}: not a run folder (no summary.json)")
-    if not (math.isfinite(fps) and fps > 0.0):
-        raise InputError(f"--fps {fps:g} must be a number > 0")
+    if fps < 1:
+        raise InputError(f"--fps {fps} must be a whole number >= 1")
     summary, ts = load_run(run_dir)
     traffic_path = run_dir / TRAFFIC_FILE
     if not traffic_path.is_file():
@@ -148,8 +149,8 @@ class _Scene:
         text would otherwise be laid out again for each frame, a third of its cost)."""
         over = Figure(figsize=size_in, dpi=dpi)
         over.patch.set_alpha(0.0)
-        handles = [Patch(facecolor=ROLE_COLOURS[r], edgecolor="black", label=r)
-                   for r in ROLE_COLOURS if r in self.roles_present]
+        handles: list[Artist] = [Patch(facecolor=ROLE_COLOURS[r], edgecolor="black", label=r)
+                                 for r in ROLE_COLOURS if r in self.roles_present]
         handles.append(Line2D([], [], color="black", linestyle="--", label="planned path"))
         over.legend(handles=handles, loc="lower right", bbox_to_anchor=(0.985, 0.02),
                     fontsize=7, ncols=3, framealpha=0.85)
@@ -212,8 +213,8 @@ class _Scene:
         x, y, yaw = self.x[k], self.y[k], self.yaw[k]
         c, s = math.cos(yaw), math.sin(yaw)
         a, b = self.tr_start[k], self.tr_end[k]
-        self.bodies.set_verts(self.tr_boxes[a:b])
-        self.bodies.set_facecolor(self.tr_colour[a:b])
+        self.bodies.set_verts(list(self.tr_boxes[a:b]))
+        self.bodies.set_facecolor(self.tr_colour[a:b].tolist())
         fx = self.ego_cx[k] + self.ego_front_m * c
         fy = self.ego_cy[k] + self.ego_front_m * s
         r, h = self.radar_m, 0.5 * self.fov_rad
@@ -225,7 +226,7 @@ class _Scene:
         n = int(np.argmin(phase == phase[0])) if not phase.all() and phase.any() else len(phase)
         self.plan.set_data(self.plan_x[k:k + n], self.plan_y[k:k + n])
         if self.contact_t is not None and self.t[k] >= self.contact_t - 1e-9:
-            self.contact.set_data(*self._contact_point())
+            self.contact.set_data(*self._contact_point(self.contact_t))
         else:
             self.contact.set_data([], [])
         mid = 0.5 * (VIEW_AHEAD_M - VIEW_BEHIND_M)  # the view looks ahead along the road
@@ -244,13 +245,13 @@ class _Scene:
         return (f"t = {self.t[k]:6.2f} s   mode {name}   {3.6 * self.vx[k]:5.1f} km/h   "
                 f"DMM sector {sector}{fcw}\nview {VIEW_BEHIND_M + VIEW_AHEAD_M:g} m wide")
 
-    def _contact_point(self) -> tuple[list, list]:
+    def _contact_point(self, contact_t: float) -> tuple[list, list]:
         """The contact point of summary.json, else the midpoint between the ego and the
-        road user nearest to it when the contact was found."""
+        road user nearest to it when the contact was found (``contact_t``)."""
         point = self.summary.get("contact_point_m")
         if point:
             return [point[0]], [point[1]]
-        k = min(int(np.searchsorted(self.t, self.contact_t - 1e-9)), len(self.t) - 1)
+        k = min(int(np.searchsorted(self.t, contact_t - 1e-9)), len(self.t) - 1)
         a, b = self.tr_start[k], self.tr_end[k]
         xy, ego = self.tr_xy[a:b], self.tr_is_ego[a:b]
         if ego.sum() != 1 or len(xy) < 2:
@@ -261,8 +262,8 @@ class _Scene:
         return [0.5 * (e[0] + near[0])], [0.5 * (e[1] + near[1])]
 
 
-def animate_cli(run_dir: Path, out: Path | None, fps: float) -> str:
+def animate_cli(run_dir: Path, out: Path | None, fps: int) -> str:
     """The line ``eoam-sumo animate`` prints."""
     path, n = animate_run(run_dir, out, fps)
-    return f"{path} ({n} frames at {fps:g} fps)"
+    return f"{path} ({n} frames at {fps} fps)"
 

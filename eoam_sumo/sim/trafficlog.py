@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -61,7 +61,7 @@ class TrafficLog:
     ``centreline`` and ``lane_width_m`` give the ego's original lane for the roles."""
 
     def __init__(self, ego_id: str, ego_vclass: str, ego_length_m: float, ego_width_m: float,
-                 cg_to_centre_m: float, centreline: Sequence[Sequence[float]],
+                 cg_to_centre_m: float, centreline: Iterable[Sequence[float]],
                  lane_width_m: float, radius_m: float = TRAFFIC_RADIUS_M):
         if not (math.isfinite(radius_m) and radius_m > 0.0):
             raise ValueError(f"radius_m={radius_m!r} must be a finite number > 0")
@@ -99,10 +99,7 @@ class TrafficLog:
             rows += [(ti, i, b.vid, b.vclass, b.x_m, b.y_m, b.yaw_rad, b.speed_mps, b.length_m,
                       b.width_m, b.parked) for b in bodies
                      if (b.x_m - ex) * (b.x_m - ex) + (b.y_m - ey) * (b.y_m - ey) <= r2]
-        if not rows:
-            rows_t = [()] * 11
-        else:
-            rows_t = list(zip(*rows))
+        rows_t = list(zip(*rows)) if rows else [()] * 11
         t, step_of, ids, vclasses, *nums, parked = rows_t
         num = np.array(nums, dtype=float).reshape(6, -1).T  # x, y, heading, speed, L, W
         ego_rows = np.flatnonzero(np.diff(np.asarray(step_of, dtype=np.int64), prepend=-1))

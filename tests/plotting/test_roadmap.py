@@ -47,5 +47,5 @@ def test_dashed_lines_between_lanes_and_a_pavement(tmp_path):
 def test_a_broken_network_is_named(tmp_path):
     bad = tmp_path / "bad.net.xml"
     bad.write_text("<net><edge")
-    with pytest.raises(InputError, match="bad.net.xml: cannot be read as a SUMO network"):
+    with pytest.raises(InputError, match=r"bad\.net\.xml: cannot be read as a SUMO network"):
         read_road_map(bad, (0.0, 0.0, 1.0, 1.0))

@@ -101,7 +101,7 @@ def test_written_file_has_the_columns_and_reads_back(tmp_path):
 def test_read_traffic_names_a_damaged_file(tmp_path):
     path = tmp_path / "traffic.csv"
     path.write_text("time_s,id,role\n1.0,ego,ego\n")
-    with pytest.raises(InputError, match="traffic.csv.*no column vclass"):
+    with pytest.raises(InputError, match=r"traffic\.csv.*no column vclass"):
         read_traffic(path)
 
 
