@@ -223,7 +223,9 @@ def plot_lateral_offsets(batch_dir: Path, results: pd.DataFrame, out_dir: Path,
 
 _KEY_NAMES = {"mu": "frictions", "aro_hold_s": "ARO hold times",
               "aro_decel_mps2": "ARO decelerations", "max_time_s": "time limits",
-              "radar_range_m": "radar ranges", "sumocfg": "scenarios"}
+              "radar_range_m": "radar ranges", "sumocfg": "scenarios", "policy": "policies",
+              "v2x_range_m": "V2X ranges", "mu_belief": "friction beliefs",
+              "radar_model": "radar models", "seed": "seeds"}
 
 
 def plot_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
