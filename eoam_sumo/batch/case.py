@@ -15,10 +15,11 @@ from eoam_sumo.matrix import Case
 #: The files a case writes (``sim.runlog.write_run``), in the order they are written, by
 #: ``--timeseries`` format.
 TIMESERIES_FORMATS = ("csv", "parquet", "none")
-CASE_FILES_OF = {"csv": ("timeseries.csv", "summary.json"),
-                 "parquet": ("timeseries.parquet", "summary.json"),
+CASE_FILES_OF = {"csv": ("timeseries.csv", "traffic.csv", "summary.json"),
+                 "parquet": ("timeseries.parquet", "traffic.parquet", "summary.json"),
                  "none": ("summary.json",)}
-ALL_CASE_FILES = ("timeseries.csv", "timeseries.parquet", "summary.json")
+ALL_CASE_FILES = ("timeseries.csv", "timeseries.parquet", "traffic.csv", "traffic.parquet",
+                  "summary.json")
 #: Modules a worker imports before its first case, so start-up is not charged to a case.
 PRELOAD = ("eoam_sumo.sim.cosim",)
 

@@ -69,10 +69,12 @@ class OutcomeGrid:
         return [self.cells[k] for k in keys if self.cells[k].ours != "green"]
 
 
-def traffic_label(oncoming_start_m: float) -> str:
+def traffic_label(oncoming_start_m: float, scenario_traffic: bool = False) -> str:
+    """A row's traffic: the oncoming car the co-simulation added, else whether the runs
+    without one had oncoming traffic of their scenario (``oncoming_traffic``)."""
     if oncoming_start_m is None or (isinstance(oncoming_start_m, float)
                                     and math.isnan(oncoming_start_m)):
-        return "No oncoming"
+        return "Scenario's oncoming traffic" if scenario_traffic else "No oncoming"
     return f"Oncoming, {oncoming_start_m:g} m"
 
 
@@ -100,10 +102,13 @@ def outcome_grid(results: pd.DataFrame) -> OutcomeGrid:
     rows: list[tuple[str, str]] = []
     mus: list[float] = []
     cells = {}
+    no_car = results["oncoming_start_m"].isna()
+    scenario_traffic = bool((results.loc[no_car, "oncoming_traffic"].astype(str) == "True").any())
     for _, row in results.iterrows():
         speed = f"{row['ego_speed_kmh']:g} km/h"
         extra = [fmt.format(row[col]) for col, fmt in varying if pd.notna(row[col])]
-        key = (traffic_label(row["oncoming_start_m"]), ", ".join([speed, *extra]))
+        key = (traffic_label(row["oncoming_start_m"], scenario_traffic),
+               ", ".join([speed, *extra]))
         if key not in rows:
             rows.append(key)
         if row["mu"] not in mus:

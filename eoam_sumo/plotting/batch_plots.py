@@ -22,8 +22,13 @@ from eoam_sumo.colours import DARK_TEXT
 from eoam_sumo.colours import HEX as OUTCOME_COLOURS
 from eoam_sumo.params import PONR_FRACTION
 from eoam_sumo.plotting.figures import save
-from eoam_sumo.plotting.runfacts import (fit, lane_width_m, oncoming_seen, point_of_no_return_m,
-                                         traffic_text)
+from eoam_sumo.plotting.runfacts import (
+    fit,
+    lane_width_m,
+    oncoming_seen,
+    point_of_no_return_m,
+    traffic_text,
+)
 from eoam_sumo.sim.runlog import read_timeseries
 
 _MISSING = "#ffffff"

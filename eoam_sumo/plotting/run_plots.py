@@ -30,8 +30,13 @@ from eoam_sumo.batch.report import mu_text
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import G_MPS2, ego_e_class_sedan
 from eoam_sumo.plotting.figures import save
-from eoam_sumo.plotting.runfacts import (fit, frictions_seen, manoeuvre_mu, oncoming_seen,
-                                         traffic_text)
+from eoam_sumo.plotting.runfacts import (
+    fit,
+    frictions_seen,
+    manoeuvre_mu,
+    oncoming_seen,
+    traffic_text,
+)
 from eoam_sumo.sim.runlog import COLUMNS, read_timeseries
 
 MODE_NAMES = {0: "0 NORMAL", 1: "1 UPDATE BRAKE", 2: "2 STEER+BRAKE", 3: "3 ONCOMING BRAKE",

@@ -48,6 +48,7 @@ from eoam_sumo.sim.scenario import ScenarioOverrides
 from eoam_sumo.sim.session import SumoSession
 from eoam_sumo.sim.session.gui import GuiSettings
 from eoam_sumo.sim.summary import RunSummary, finite_or_none, rounded
+from eoam_sumo.sim.trafficlog import TrafficLog
 
 
 @dataclass(frozen=True)
@@ -202,9 +203,14 @@ class CoSimulation:
         self.ctrl = EoamController(p, self.tables, st.eoam)
         self.ctrl.reset(ego.speed_mps)
         self.lane_sensing = self._next_lane_sensing(session)  # safe policy only
-        # from the front bumper, where the radar is; further for V2X and the corner radars
+        self.traffic = TrafficLog(st.ego_id, ego.vclass, p.length_m, p.width_m,
+                                  p.cg_to_front_bumper_m - 0.5 * p.length_m,
+                                  session.ego_lane_centreline(), self.lane_width_m)
+        # from the front bumper, where the radar is; further for V2X and the corner radars,
+        # and for the traffic log (its radius is from the centre of gravity)
         self._sense_radius_m = max(
-            st.radar.range_m, self.lane_sensing.reach_m if self.lane_sensing else 0.0)
+            st.radar.range_m, self.lane_sensing.reach_m if self.lane_sensing else 0.0,
+            self.traffic.radius_m + p.cg_to_front_bumper_m)
         self.max_steps = round(st.max_time_s / st.step_s)
         self._end_s_m = road.length_m - ROAD_END_MARGIN_M  # the run ends this close to the end
         self._front = front = p.cg_to_front_bumper_m
@@ -229,7 +235,7 @@ class CoSimulation:
         self.radar = make_radar(st.radar_model, st.radar, st.seed)  # fresh state per run
         self.mu_true = self.mu_start
         self.timeseries, self.extremes = TimeSeries(), Extremes()
-        self.observers = (self.timeseries, self.extremes, *self.extra_observers)
+        self.observers = (self.timeseries, self.extremes, self.traffic, *self.extra_observers)
         for obs in self.observers:
             obs.start(self)
         self._after_step = tuple(obs.after_step for obs in self.observers)
@@ -412,6 +418,11 @@ class CoSimulation:
             max_abs_heading_error_rad=rounded(ext.max_abs_heading_error_rad),
             left_road=left_road(ext.min_d_m, ext.max_d_m, self.lane_width_m, left_width),
             ego_initial_speed_mps=rounded(self.ego_initial_speed_mps),
+            lane_width_m=rounded(self.lane_width_m),
+            oncoming_traffic=self.traffic.had_role("oncoming"),
+            net_file=str(self.session.net_file.resolve()),
+            radar_range_m=self.settings.radar.range_m,
+            radar_fov_deg=self.settings.radar.fov_deg,
             sim_time_s=rounded(sim_time),
             wall_time_s=time.perf_counter() - self._wall0,
             realtime_factor=sim_time / loop_wall_s,
@@ -488,13 +499,14 @@ def run_case(
     extra: dict | None = None,
     timeseries: str = "csv",
 ) -> dict:
-    """Run one case; write the time series (``timeseries``: csv, parquet or none) and
-    ``summary.json`` to ``out_dir`` if given."""
-    summary, log = CoSimulation(cfg, overrides, settings).run()
+    """Run one case; write the time series and the traffic log (``timeseries``: csv, parquet
+    or none) and ``summary.json`` to ``out_dir`` if given."""
+    sim = CoSimulation(cfg, overrides, settings)
+    summary, log = sim.run()
     if extra:
         summary = {**extra, **summary}
     if out_dir is not None:
-        write_run(Path(out_dir), summary, log, timeseries)
+        write_run(Path(out_dir), summary, log, timeseries, sim.traffic)
     return summary
 
 

@@ -43,6 +43,8 @@ class RunView(Protocol):
     def x(self) -> list[float]: ...  # plant state now
     @property
     def bodies(self) -> Sequence[Any]: ...  # the road users near the ego now (``Body``)
+    @property
+    def bodies_before(self) -> Sequence[Any]: ...  # and at the last step's start
 
 
 class StepObserver:

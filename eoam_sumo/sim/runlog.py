@@ -159,9 +159,11 @@ def read_timeseries(path: Path, columns: list[str] | None = None):
     return frame
 
 
-def write_run(out_dir: Path, summary: dict, log: RunLog, timeseries: str = "csv") -> None:
+def write_run(out_dir: Path, summary: dict, log: RunLog, timeseries: str = "csv",
+              traffic=None) -> None:
     """Write the time series (``timeseries.csv``, ``timeseries.parquet`` through pyarrow, or
-    none) then ``summary.json`` (each atomically) into ``out_dir``."""
+    none), the traffic log (a ``TrafficLog``, if given, in the same format: ``traffic.csv``
+    or ``traffic.parquet``) then ``summary.json`` (each atomically) into ``out_dir``."""
     out_dir.mkdir(parents=True, exist_ok=True)
     if timeseries == "csv":
         csv = log.frame().to_csv(index=False, float_format="%.9g")
@@ -171,4 +173,6 @@ def write_run(out_dir: Path, summary: dict, log: RunLog, timeseries: str = "csv"
         write_atomic(out_dir / "timeseries.parquet", data)
     elif timeseries != "none":
         raise InputError(f"time series format {timeseries!r} is not csv, parquet or none")
+    if traffic is not None and timeseries != "none":
+        traffic.write(out_dir / f"traffic.{timeseries}")
     write_atomic(out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")

@@ -57,6 +57,12 @@ class RunSummary:
     max_abs_heading_error_rad: float = _doc("largest |heading - road heading|")
     left_road: bool = _doc("the ego's centre went more than 0.5 m beyond a road edge")
     ego_initial_speed_mps: float = _doc("ego speed at its departure")
+    lane_width_m: float = _doc("width of the ego's start lane (the lane change's height)")
+    oncoming_traffic: bool = _doc(
+        "a road user within 250 m moved against the ego's lane direction (traffic.csv role)")
+    net_file: str = _doc("the scenario's network file (for eoam-sumo animate)")
+    radar_range_m: float = _doc("the radar's range")
+    radar_fov_deg: float = _doc("the radar's full horizontal field of view")
     sim_time_s: float = _doc("simulated time from the ego's departure")
     wall_time_s: float = _doc("wall time of the whole run, SUMO start-up included")
     realtime_factor: float = _doc("simulated seconds per wall second of the step loop")

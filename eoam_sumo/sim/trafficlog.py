@@ -31,12 +31,13 @@ once, when the log is written.
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 import numpy as np
 
+from eoam_sumo.fileio import write_atomic
+from eoam_sumo.sim.observers import RunView, StepObserver
 from eoam_sumo.sim.radar import LANE_MARGIN_M, ONCOMING_SPEED_MPS
 from eoam_sumo.sim.roadframe import RoadFrame
 
@@ -53,7 +54,7 @@ _DECIMALS = {"time_s": 6, "x_m": 4, "y_m": 4, "heading_rad": 6, "speed_mps": 4,
              "length_m": 4, "width_m": 4}
 
 
-class TrafficLog:
+class TrafficLog(StepObserver):
     """Observer of the step loop that keeps the road users near the ego at each step.
 
     ``ego_vclass``, ``ego_length_m`` and ``ego_width_m`` describe the ego's box;
@@ -75,20 +76,39 @@ class TrafficLog:
         self.radius_m = float(radius_m)
         self._r2 = self.radius_m * self.radius_m
         self._steps: list[tuple] = []
+        self._columns: dict | None = None
 
     def __len__(self) -> int:
         return len(self._steps)
+
+    def after_step(self, sim: RunView) -> None:
+        """The ego and the road users at the start of the step just made."""
+        self.add(sim.meas.time_s, sim.x_prev, sim.bodies_before)
+
+    def end(self, sim: RunView) -> None:
+        """The ego and the road users when the run ended."""
+        self.add(sim.t, sim.x, sim.bodies)
 
     def add(self, t: float, x: Sequence[float], bodies: Sequence) -> None:
         """Keep the ego state ``x`` (plant state: X, Y at the centre of gravity, yaw, vx, ...)
         and ``bodies``, the other road users at time ``t`` (immutable ``Body`` tuples in a
         list the caller does not change afterwards)."""
         self._steps.append((t, x[0], x[1], x[2], x[3], bodies))
+        self._columns = None
+
+    def had_role(self, role: str) -> bool:
+        """Some road user had ``role`` at some logged step."""
+        return role in self.columns()["role"]
 
     def columns(self) -> dict:
         """The log as columns (TRAFFIC_COLUMNS order): numpy arrays, and lists of str for
         ``id``, ``vclass`` and ``role``. Rows are by time, then the ego, then in the order
-        the road users were given."""
+        the road users were given. Worked out once (until the next ``add``)."""
+        if self._columns is None:
+            self._columns = self._lay_out()
+        return self._columns
+
+    def _lay_out(self) -> dict:
         r2, to_centre = self._r2, self._to_centre
         length, width = self._ego_size
         rows = []
@@ -143,20 +163,25 @@ class TrafficLog:
         return roles
 
     def write(self, path: Path) -> None:
-        """Write the log as CSV to ``path`` (atomically). Formatted here, a row a string
-        (three times faster than pandas' writer): numbers rounded (``_DECIMALS``) and
-        written in their shortest form."""
+        """Write the log (atomically) as CSV, or as Parquet through pyarrow when ``path``
+        ends in ``.parquet``. The CSV is formatted here, a row a string (three times faster
+        than pandas' writer): numbers rounded (``_DECIMALS``), in their shortest form."""
+        path = Path(path)
         cols = self.columns()
+        if path.suffix == ".parquet":
+            import pandas as pd
+
+            frame = pd.DataFrame(cols, columns=list(TRAFFIC_COLUMNS))
+            write_atomic(path, frame.to_parquet(None, index=False, engine="pyarrow",
+                                                compression="zstd"))
+            return
         text = [_csv_text(v) for v in cols["id"]], cols["vclass"], cols["role"]
         num = [(np.round(cols[name], decimals) + 0.0).tolist()
                for name, decimals in _DECIMALS.items()]
         lines = [",".join(TRAFFIC_COLUMNS)]
         lines += [f"{t},{i},{v},{r},{x},{y},{h},{s},{ln},{w}" for t, i, v, r, x, y, h, s, ln, w
                   in zip(num[0], *text, *num[1:])]
-        path = Path(path)
-        tmp = path.with_name(path.name + ".tmp")
-        tmp.write_text("\n".join(lines) + "\n")
-        os.replace(tmp, path)
+        write_atomic(path, "\n".join(lines) + "\n")
 
 
 def _csv_text(value: str) -> str:

@@ -21,8 +21,8 @@ from eoam_sumo.sim.trafficlog import TRAFFIC_COLUMNS, read_traffic
 pytestmark = pytest.mark.sumo
 ROOT = Path(__file__).resolve().parents[2]
 STEP_S = 0.01
-WALKER = '<person id="walker" depart="1.00"><walk edges="E0" departPos="260" ' \
-         'arrivalPos="400"/></person>'
+WALKER = ('<person id="walker" depart="1.00" departPos="260"><walk edges="E0" '
+          'arrivalPos="400"/></person>')
 
 
 @pytest.fixture(scope="module")
@@ -59,7 +59,8 @@ def test_traffic_csv_holds_the_ego_the_parked_cars_and_the_walker(run_dir):
     assert len(walker) == len(ego)  # on the road, ahead, in the log at every step
     assert set(walker["vclass"]) == {"pedestrian"}
     assert set(walker["role"]) == {"aro"}  # in the ego's lane, ahead of it
-    assert walker["speed_mps"].between(0.5, 2.0).all()
+    assert walker["speed_mps"].iloc[1:].between(0.5, 2.0).all()  # walking (from rest)
+    assert (np.diff(walker["x_m"]) >= 0.0).all() and walker["x_m"].iloc[-1] > 262.0
     assert set(traffic.loc[traffic["id"] == "aro", "role"]) == {"aro"}
     assert set(traffic.loc[traffic["id"] == "oncoming", "role"]) == {"oncoming"}
 

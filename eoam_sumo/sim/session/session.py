@@ -274,6 +274,11 @@ class SumoSession:
     def step_length_s(self) -> float:
         return self._dt
 
+    @property
+    def net_file(self) -> Path:
+        """The scenario's network file."""
+        return self._files.net_file
+
     # ----------------------------------------------------------------------------- queries
     def ego_lane_centreline(self) -> np.ndarray:
         """(N, 2) centre line of the ego's start lane followed along its route (lane index kept)."""
