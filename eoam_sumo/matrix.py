@@ -3,7 +3,8 @@
 The format is documented in ``scenarios/table2.toml`` (the paper's Table 2, 4 x 4 x 4 = 64 runs).
 Cases come in the paper's Table 2 order: traffic outermost (no oncoming car first, then the
 oncoming start distances in file order), then ego speed, then friction, then the optional ARO
-stop parameters, each in file order.
+stop parameters, each in file order. A ``[sample]`` table (:mod:`eoam_sumo.sampling`) turns
+each combination into a group of draws, in turn.
 
 Two levels of checks, both raising ``InputError`` naming the matrix file and the key:
 :func:`load_matrix` checks the TOML on its own (keys, types, ranges, files exist);

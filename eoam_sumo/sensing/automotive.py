@@ -104,16 +104,13 @@ class AutomotiveRadar:
         self._next_scan_s: float | None = None
         self._queue: deque[_Scan] = deque()
         self._report = EMPTY_REPORT
-        self._t_internal = 0.0
 
     def scan(self, ego_front_xy: tuple[float, float], ego_yaw_rad: float, ego_speed_mps: float,
              road_frame: RoadProjection, targets: Sequence[Body], lane_width_m: float,
              time_s: float | None = None) -> RadarReport:
-        """The report the EOAM reads at ``time_s`` (scans when a cycle is due; without a
-        time, calls are taken as 10 ms apart)."""
+        """The report the EOAM reads at ``time_s`` (scans when a cycle is due)."""
         if time_s is None:
-            time_s = self._t_internal
-            self._t_internal += 0.01
+            raise ValueError("the automotive radar needs the time of each scan (time_s)")
         if self._next_scan_s is None:
             self._next_scan_s = time_s
         if time_s + 1e-9 >= self._next_scan_s:

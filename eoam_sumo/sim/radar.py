@@ -10,7 +10,9 @@ and inside the field of view. This is computed exactly as the distance from the 
 part of the box inside the field-of-view cone: the box's nearest point when that lies in the
 cone, otherwise the first crossing of the box by one of the two edge rays of the cone (this
 also covers the corners and the nearest point of the rear face). That distance is the
-reported range. Occlusion is ignored: a target hidden behind another is still seen.
+reported range. Occlusion is ignored: a target hidden behind another is still seen. An
+optional second, wide near-range beam (``near_range_m``, ``near_fov_deg``; off by default, as
+the paper's radar has one beam) covers what is close beside the boresight.
 
 Measurements per detection: range to the nearest visible point, range rate (relative velocity
 projected on the line of sight to that point, negative when closing; ego velocity taken
