@@ -8,10 +8,11 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from eoam_sumo.batch.runner import run_batch
 from eoam_sumo.params import LANE_CHANGE_HEIGHT_M, PONR_FRACTION
 from eoam_sumo.sim.cosim import RunSettings, policy_settings, run_case
 from eoam_sumo.sim.scenario import ScenarioOverrides
-from tests.builders import netconvert, write_sumocfg
+from tests.builders import netconvert, write_matrix, write_sumocfg
 
 pytestmark = pytest.mark.sumo
 
@@ -180,3 +181,26 @@ def test_a_speeder_heard_after_the_commit_is_met_by_the_tie_breaker(tmp_path):
     assert safe["modes_visited"][-2:] == [2, 3]
     assert ts[ts["mode"] == 3]["lateral_offset_m"].iloc[0] > PONR_M
     assert safe["collision_with"] == "none" and safe["outcome"] == "green"
+
+
+#: Table 2 cells where the paper policy ends in a head-on (red) with its 100 m radar.
+PAPER_RED_CELLS = ("oncoming_start_m = [500, 400]\nego_speed_kmh = [165, 120]\n"
+                   "mu = [0.3, 0.1]\n")
+
+
+@pytest.mark.parametrize("v2x", [0.0, 1000.0])
+def test_a_safe_batch_over_the_papers_red_cells_has_no_red_or_orange(tmp_path, v2x):
+    """The Table 2 cells the paper policy loses head-on, as a batch under the safe policy:
+    no red, no orange; results.csv carries the policy, the V2X link and the sight figures,
+    table2.md names the policy and lists every cell's sight distance."""
+    scenario = 'policy = "safe"\n' + (f"v2x_range_m = {v2x}\n" if v2x else "")
+    matrix = write_matrix(tmp_path / "red.toml", PAPER_RED_CELLS, scenario=scenario,
+                          paper_table=True)
+    results = run_batch(matrix, tmp_path / "out", jobs=2, progress=False)
+    assert len(results) == 8 and (results["status"] == "ok").all()
+    assert not results["outcome"].isin(["red", "orange"]).any(), results["reason"].tolist()
+    assert (results["policy"] == "safe").all() and (results["v2x_range_m"] == v2x).all()
+    asked = results[results["sight_gate"].fillna("") != ""]
+    assert len(asked) and (asked["sight_needed_m"] > 0).all()
+    md = (tmp_path / "out" / "table2.md").read_text(encoding="utf-8")
+    assert "Policy **safe**" in md and "## Sight distance of each lane change" in md
