@@ -11,152 +11,44 @@ References per mode (road frame of the ego's original lane, d left positive):
   speed PID, 1 brakes at the no-lock limit (``limit_brake_fraction`` of it), to standstill
   and holding, unless a steering sector, oncoming traffic or the obstacle leaving the path
   (or pulling away) ends it.
-* 2 / 4 STEER+BRAKE: the table lane change (trigger speed and friction) from the offset at the
+* 2 STEER+BRAKE: the table lane change (trigger speed and friction) from the offset at the
   trigger to one lane width to the left; the table acceleration profile tracked by the
   acceleration PID until the end of the path, then the speed reached is held.
-* 3 ONCOMING BRAKE: limit braking to standstill in the original lane: lane keeping to d = 0
-  (the lane change is abandoned), the brake force shrunk by the friction ellipse while the
-  ego still turns so that no wheel locks.
-* 5 RETURN: a quintic (sec. 4.2) from the current offset back to d = 0 at the speed held
-  when the return began, long enough for its peak lateral acceleration to be
-  ``return_lateral_g`` mu g (``evasive_return_lateral_g`` when oncoming traffic ended the lane
-  change, mode 4). The table's minimum-distance path is not reused: it is that short only
-  with its braking profile, which a return does not need.
+* 3 ONCOMING BRAKE: limit braking to standstill in the original lane after the lateral motion
+  is arrested: a quintic from the ego's lateral state to where that motion can stop within
+  ``evasive_lateral_g`` mu g (``QuinticShift.stopping``), held there; the brake gets what the
+  friction ellipse leaves to it meanwhile, so that no wheel locks.
+* 4 ONCOMING STEER+BRAKE: the shortest quintic from the ego's lateral state to just past the
+  obstacle's side within ``evasive_lateral_g`` mu g, without overshooting it.
+* 5 RETURN: the shortest quintic (sec. 4.2) from the ego's lateral state back to d = 0 at the
+  speed held when the return began, within ``return_lateral_g`` mu g
+  (``evasive_lateral_g`` when oncoming traffic ended the lane change, mode 4). The table's
+  minimum-distance path is not reused: it is that short only with its braking profile.
+
+The point of no return (sec. 8.1) is judged where the lateral motion would stop if arrested
+now (``ponr_at_lateral_stop``), and the DMM also places a braking obstacle where it will stop
+(``obstacle_decel_in_dmm``); both can be set back to the paper's rules.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
-from typing import NamedTuple
 
-from eoam_sumo.control.longitudinal import LongitudinalController, LongitudinalGains
+from eoam_sumo.control.longitudinal import LongitudinalController
 from eoam_sumo.control.paths import PathReference, QuinticShift
-from eoam_sumo.control.steering import SteeringController, SteeringGains
+from eoam_sumo.control.steering import SteeringController
 from eoam_sumo.decision import modes
-from eoam_sumo.decision.dmm import Action, BoundaryCurve, Sector
+from eoam_sumo.decision.dmm import SECTOR_ORDER, Action, BoundaryCurve, Sector
 from eoam_sumo.decision.modes import Mode, next_mode
-from eoam_sumo.decision.policy import NextLaneView, PolicySettings, SafePolicy
-from eoam_sumo.params import G_MPS2, PONR_FRACTION, VehicleParams
+from eoam_sumo.decision.obstacle import ObstacleDecel, stopping_range_m
+from eoam_sumo.decision.policy import SafePolicy
+from eoam_sumo.eoam_messages import Command, EgoMeasurement, ObjectState, Perception
+from eoam_sumo.eoam_settings import EoamSettings
+from eoam_sumo.params import G_MPS2, VehicleParams
 
 _TWO_PI = 2.0 * math.pi
-
-
-class EgoMeasurement(NamedTuple):
-    """Ego state in the road frame of its original lane (s along, d left of its centre).
-
-    The per-step messages (this, ``ObjectState``, ``Perception``, ``Command``) are named
-    tuples: as immutable as frozen dataclasses and built in a quarter of the time."""
-
-    time_s: float
-    vx_mps: float
-    vy_mps: float
-    yaw_rate_radps: float
-    ax_mps2: float
-    ay_mps2: float
-    s_m: float
-    d_m: float
-    e_yaw_rad: float
-    road_curvature_1pm: float
-    mu: float
-    lane_width_m: float
-    left_lane_available: bool = True  # map: a lane (either direction) left of the ego's lane
-
-
-class ObjectState(NamedTuple):
-    """A tracked object in the road frame of the ego's original lane (a sensor's object list)."""
-
-    s_m: float  # station of its centre
-    d_m: float  # lateral offset of its centre, left positive
-    speed_mps: float  # along the road
-    length_m: float
-    width_m: float
-
-
-class Perception(NamedTuple):
-    """Radar-derived view: the in-path obstacle (None when nothing) and oncoming traffic."""
-
-    aro_range_m: float | None = None
-    aro_range_rate_mps: float | None = None
-    oncoming_detected: bool = False
-    aro_object: ObjectState | None = None  # the in-path obstacle as an object, when tracked
-    next_lane_obstacle_range_m: float | None = None  # nearest standing object in the next lane
-    next_lane: NextLaneView | None = None  # what is known of the next lane (safe policy)
-
-
-class Command(NamedTuple):
-    """Actuator commands for the next step plus what the controller decided, for logging."""
-
-    steer_cmd_rad: float
-    drive_force_cmd_n: float
-    brake_force_cmd_n: float
-    mode: int
-    fcw: bool
-    sector: str
-    ax_target_mps2: float
-    y_target_m: float
-    dx_m: float
-    lateral_error_m: float
-    lookahead_error_m: float
-    steer_ff_rad: float
-    steer_fb_rad: float
-    steer_yd_rad: float
-    speed_target_mps: float
-
-
-@dataclass(frozen=True)
-class EoamSettings:
-    """Tunable values of the EOAM logic (the paper's defaults where it gives them)."""
-
-    ponr_fraction: float = PONR_FRACTION  # point of no return / lane-change height
-    manoeuvre_time_s: float = 8.0  # steering manoeuvre timer before RETURN (sec. 3.1 step 5)
-    arrive_tolerance_m: float = 0.3  # 2 -> 5 early: within this of the next lane's centre ...
-    pass_margin_m: float = 1.0  # mode 4 -> 5: ego rear this far past the obstacle's front
-    side_clearance_m: float = 0.5  # mode 4: lateral gap kept to the obstacle's side
-    unknown_obstacle_length_m: float = 12.0  # assumed without an object track (a truck)
-    track_gate_m: float = 5.0  # modes 2, 4: a sensed object further off the track is another
-    settle_offset_m: float = 0.1  # mode 5 -> 0: |d| below this ...
-    settle_heading_rad: float = 0.02  # ... and |e_yaw| below this ...
-    settle_dwell_s: float = 0.5  # ... for this long after the return path ended
-    release_opening_speed_mps: float = 0.5  # mode 1 -> 0: obstacle pulls away faster than this
-    min_steer_speed_mps: float = 20.0 / 3.6  # below it a STEER sector brakes instead
-    limit_brake_fraction: float = 0.95  # share of the no-lock brake force used as limit braking
-    reference_step_m: float = 0.25  # dx spacing of the sampled manoeuvre reference
-    return_when_stable: bool = True  # ... heading within settle_heading_rad and clear of the
-    # obstacle: 2 -> 5 before the timer (False: the timer alone, as in the paper's runs)
-    return_lateral_g: float = 0.3  # mode 5 after 2: return's peak lateral acceleration / (mu g)
-    evasive_lateral_g: float = 0.8  # mode 4 and the return after it (oncoming traffic): the same
-    return_min_length_m: float = 10.0  # mode 5: shortest return path
-    next_lane_clear_m: float = 50.0  # a standing object in the next lane closer than the
-    # in-path obstacle's range plus this (room to pass it and return) blocks the lane change
-    # as oncoming traffic does (modes 3, 4); the paper checks the next lane for oncoming only
-    preview_time_s: float = 0.3  # feedforward curvature taken this far ahead on the path
-    steering: SteeringGains = field(default_factory=SteeringGains)
-    longitudinal: LongitudinalGains = field(default_factory=LongitudinalGains)
-    policy: PolicySettings = field(default_factory=PolicySettings)  # paper or safe
-
-    def __post_init__(self) -> None:
-        for f in fields(self):
-            v = getattr(self, f.name)
-            if isinstance(v, float) and not (math.isfinite(v) and v >= 0.0):
-                raise ValueError(f"EOAM setting {f.name}={v!r} must be finite and >= 0")
-        if not 0.0 < self.ponr_fraction < 1.0:
-            raise ValueError(f"ponr_fraction={self.ponr_fraction} must be in (0, 1)")
-        if not 0.0 < self.limit_brake_fraction <= 1.0:
-            raise ValueError(f"limit_brake_fraction={self.limit_brake_fraction} must be in (0, 1]")
-        for name in (
-            "manoeuvre_time_s",
-            "reference_step_m",
-            "return_lateral_g",
-            "evasive_lateral_g",
-            "return_min_length_m",
-            "settle_offset_m",
-            "settle_heading_rad",
-            "unknown_obstacle_length_m",
-            "arrive_tolerance_m",
-        ):
-            if getattr(self, name) <= 0.0:
-                raise ValueError(f"EOAM setting {name} must be > 0")
+__all__ = ["Command", "EgoMeasurement", "EoamController", "EoamSettings", "ObjectState",
+           "Perception"]
 
 
 # Enum members bound once for ``step`` (the modes in decision.modes): on Python 3.11 each
@@ -170,6 +62,7 @@ _WARNING_MODES = (_UPDATE_BRAKE, _STEER_BRAKE, _ONCOMING_BRAKE, _ONCOMING_STEER)
 _STEERING = (_STEER_BRAKE, _ONCOMING_STEER)
 _COMMITTING = (_NORMAL, _UPDATE_BRAKE)  # a STEER here begins a lane change (safe policy gate)
 _WATCHING = (_STEER_BRAKE, _RETURN)  # the safe policy watches the next lane in these modes
+_URGENCY = {s: i for i, s in enumerate(SECTOR_ORDER)}  # A most urgent, G least
 
 
 class EoamController:
@@ -177,13 +70,14 @@ class EoamController:
 
     _curve: BoundaryCurve  # the DMM boundaries at the sensed friction, set by _friction()
 
-    def __init__(self, params: VehicleParams, tables, settings: EoamSettings = EoamSettings()):
+    def __init__(self, params: VehicleParams, tables, settings: EoamSettings | None = None):
         self.params = params
         self.tables = tables
-        self.settings = settings
+        self.settings = settings = settings or EoamSettings()
         self._steer = SteeringController(params, settings.steering)
         self._long = LongitudinalController(params, settings.longitudinal)
         self._mass = params.mass_kg
+        self._decel = ObstacleDecel(settings.obstacle_decel_time_constant_s)
         self._brake_mu = math.nan
         self._brake_limit = 0.0
         self._initial_speed: float | None = None
@@ -205,7 +99,10 @@ class EoamController:
         self._settle_since: float | None = None
         self._hold_speed: float | None = None
         self._urgent_return = False
-        self._obstacle: tuple[float, float, float, float] | None = None  # t, front s, v, left
+        self._stop_path: QuinticShift | None = None  # lateral stop judged for the PONR
+        # t, front s, speed, left edge, deceleration of the in-path obstacle
+        self._obstacle: tuple[float, float, float, float, float] | None = None
+        self._decel.reset()
         self._long.reset()
         if self.policy is not None:
             self.policy.reset()
@@ -239,17 +136,21 @@ class EoamController:
         self._shift_to(0.0, meas, st.evasive_lateral_g if urgent else st.return_lateral_g)
 
     def _shift_to(self, target_m: float, meas: EgoMeasurement, lateral_g: float) -> None:
-        """A quintic (``QuinticShift``) from the ego's offset and heading to ``target_m``, with
-        its peak lateral acceleration ``lateral_g`` mu g."""
+        """The shortest quintic (``QuinticShift``) from the ego's lateral state (offset, course,
+        path curvature) to ``target_m`` within ``lateral_g`` mu g that does not pass it."""
+        slope, kappa, speed = _lateral_state(meas)
         traj = QuinticShift.for_lateral_accel(
-            meas.d_m,
-            math.tan(_wrap(meas.e_yaw_rad)),
-            target_m,
-            meas.vx_mps,
-            lateral_g * meas.mu * G_MPS2,
-            self.settings.return_min_length_m,
-        )
+            meas.d_m, slope, target_m, speed, lateral_g * meas.mu * G_MPS2,
+            self.settings.return_min_length_m, kappa)
         self._start_path(meas, traj, meas.d_m, None)
+
+    def _lateral_stop(self, meas: EgoMeasurement) -> QuinticShift:
+        """The quintic that arrests the ego's lateral motion soonest within
+        ``evasive_lateral_g`` mu g; it ends where the lateral motion stops."""
+        slope, kappa, speed = _lateral_state(meas)
+        return QuinticShift.stopping(
+            meas.d_m, slope, speed, self.settings.evasive_lateral_g * meas.mu * G_MPS2,
+            self.settings.return_min_length_m, kappa, self.settings.lateral_reaction_s)
 
     def _passing_offset_m(self, meas: EgoMeasurement) -> float:
         """Mode 4's target: just far enough left to pass the obstacle with ``side_clearance_m``
@@ -287,6 +188,12 @@ class EoamController:
             self._start_return(meas, urgent=previous is Mode.ONCOMING_STEER_BRAKE)
         elif mode is Mode.ONCOMING_STEER_BRAKE:
             self._shift_to(self._passing_offset_m(meas), meas, self.settings.evasive_lateral_g)
+        elif mode is Mode.ONCOMING_BRAKE:
+            # arrest the lateral motion first (the brake gets what the friction ellipse
+            # leaves), then hold that offset while braking to standstill
+            if self._stop_path is None:
+                self._stop_path = self._lateral_stop(meas)
+            self._start_path(meas, self._stop_path, meas.d_m, None)
         else:
             self._path = None
             self._long.reset()
@@ -312,21 +219,52 @@ class EoamController:
             speed = max(meas.vx_mps - closing_mps, 0.0)
             left_edge = 0.5 * meas.lane_width_m
         if self._obstacle is not None and self.mode in _STEERING:
-            t0, front0, speed0, _ = self._obstacle
-            if abs(front_s - front0 - speed0 * (meas.time_s - t0)) > self.settings.track_gate_m:
+            t0, front0, speed0, _, decel0 = self._obstacle
+            moved = _travel_m(speed0, decel0, meas.time_s - t0)
+            if abs(front_s - front0 - moved) > self.settings.track_gate_m:
                 return
-        self._obstacle = (meas.time_s, front_s, speed, left_edge)
+        decel = self._decel.decel_mps2 if self.settings.obstacle_decel_in_dmm else 0.0
+        self._obstacle = (meas.time_s, front_s, speed, left_edge, max(0.0, decel))
 
     def _clear_of_obstacle(self, meas: EgoMeasurement, path, dx_m: float) -> bool:
         """Mode 4's "desired position": the ego's rear is ``pass_margin_m`` past the obstacle's
-        front, predicted at its last sensed speed (a braking obstacle is further back, so the
-        prediction errs on the late side). Without a track, the end of the lane change."""
+        front, predicted from its last sensed speed and measured deceleration (to its stop).
+        Without a track, the end of the lane change."""
         if self._obstacle is None:
             return path is not None and dx_m >= path.length_m
-        t0, front_s, speed, _ = self._obstacle
-        front_s += speed * (meas.time_s - t0)
+        t0, front_s, speed, _, decel = self._obstacle
+        front_s += _travel_m(speed, decel, meas.time_s - t0)
         ego_rear_s = meas.s_m - self.params.cg_to_rear_bumper_m
         return ego_rear_s - front_s >= self.settings.pass_margin_m
+
+    def _past_ponr(self, meas: EgoMeasurement, travel: float, height: float) -> bool:
+        """Past the point of no return (sec. 8.1): the lateral travel since the trigger
+        reaches ``ponr_fraction`` of the lane change's, judged where the lateral motion will
+        stop if it is arrested now (``ponr_at_lateral_stop``) or, as in the paper, at the
+        offset reached (mode 2 only: the other modes do not ask)."""
+        st = self.settings
+        self._stop_path = None
+        if st.ponr_at_lateral_stop:
+            self._stop_path = self._lateral_stop(meas)
+            travel += self._stop_path.y1_m - meas.d_m
+        return travel >= st.ponr_fraction * height
+
+    def _dmm(self, t: float, v: float, rng: float, closing: float) -> tuple[Sector, float]:
+        """The DMM sector of the in-path obstacle and the range to where it will stand.
+
+        The paper's sector of (range, closing speed), or, with ``obstacle_decel_in_dmm``,
+        the more urgent of it and the sector of the obstacle standing where its measured
+        braking stops it, approached at the ego's speed (``decision.obstacle``)."""
+        sector = self._curve.sector(rng, closing)
+        decel = self._decel.update(t, v - closing)
+        if not self.settings.obstacle_decel_in_dmm:
+            return sector, math.inf
+        stop_range = stopping_range_m(rng, v - closing, decel)
+        if stop_range < math.inf:
+            standing = self._curve.sector(stop_range, v)
+            if _URGENCY[standing] < _URGENCY[sector]:
+                sector = standing
+        return sector, stop_range
 
     # ----------------------------------------------------------------------------- the step
     def step(self, meas: EgoMeasurement, perception: Perception, dt_s: float) -> Command:
@@ -349,12 +287,13 @@ class EoamController:
         rate = perception.aro_range_rate_mps
         if rng is not None and math.isfinite(rng):
             closing = -rate if rate is not None and math.isfinite(rate) else 0.0
-            sector = self._curve.sector(rng, closing)
+            sector, stop_range = self._dmm(t, v, rng, closing)
             action = sector.action
             if action is _STEER and v < st.min_steer_speed_mps:
                 action = _BRAKE  # too slow for a lane change: braking needs less room
             elif (action is _STEER and self.mode is _UPDATE_BRAKE
-                  and rng > self._curve.at(closing).stop_m):
+                  and rng > self._curve.at(closing).stop_m
+                  and stop_range > self._curve.at(v).stop_m):
                 action = _BRAKE  # braking already stops short of it: no lane change
             elif action is _STEER and not meas.left_lane_available:
                 action = _LIMIT_BRAKE  # no lane to change into: brake in lane
@@ -364,6 +303,7 @@ class EoamController:
             sector = None
             action = _NO_ACTION
             threat_gone = True
+            self._decel.reset()
         oncoming = bool(perception.oncoming_detected)
         block_m = perception.next_lane_obstacle_range_m
         if block_m is not None and rng is not None and block_m <= rng + st.next_lane_clear_m:
@@ -398,7 +338,7 @@ class EoamController:
             and abs(d - path.start_offset_m - height) <= st.arrive_tolerance_m
             and abs(_wrap(meas.e_yaw_rad)) <= st.settle_heading_rad
         )
-        past_ponr = travel >= st.ponr_fraction * height
+        past_ponr = oncoming and mode is _STEER_BRAKE and self._past_ponr(meas, travel, height)
         if (past_ponr and oncoming and mode is _STEER_BRAKE and policy is not None
                 and policy.prefer_braking(meas, perception)):
             past_ponr = False  # severity tie-breaker: braking in lane ends softer
@@ -418,6 +358,11 @@ class EoamController:
             self.mode = mode = new
         elif mode is _RETURN and oncoming and not self._urgent_return:
             self._start_return(meas, urgent=True)  # oncoming traffic seen during the return
+        elif (mode is _ONCOMING_BRAKE and path is not None and dx >= path.length_m
+              and self._stop_path is not None):
+            # lateral motion arrested: back to the lane centre while braking on
+            self._stop_path = None
+            self._shift_to(0.0, meas, st.evasive_lateral_g)
         path = self._path
         dx = meas.s_m - self._s0 if path is not None else 0.0
 
@@ -433,16 +378,12 @@ class EoamController:
                 yaw_ref = kappa_ref = 0.0
         e_lat = d - y_ref
         road_kappa = meas.road_curvature_1pm
-        e_head = meas.e_yaw_rad - yaw_ref
-        if road_kappa:
-            # following a curved road the body points off it by the steady-state sideslip,
-            # which the look-ahead would turn into a steady offset (Kapania and Gerdes 2015)
-            e_head += self._steer.steady_sideslip(v, road_kappa)
         delta, ff, fb, yd, e_la = self._steer.command(
             v,
             meas.yaw_rate_radps,
+            meas.vy_mps,
             e_lat,
-            _wrap(e_head),
+            _wrap(meas.e_yaw_rad - yaw_ref),
             kappa_ref + road_kappa,
             kappa_ff + road_kappa,
             mu,
@@ -451,7 +392,7 @@ class EoamController:
         # ---- longitudinal: force limits from the friction ellipse with the lateral acceleration
         # in use (measured; outside the table's profile also the one this steering command asks
         # for, so that the brake yields before a turning axle locks), then the mode's loop -----
-        tracking = in_path and mode is not _RETURN  # the table's ax already fits the ellipse
+        tracking = in_path and mode in _STEERING  # the table's ax already fits the ellipse
         ay_use = abs(meas.ay_mps2)
         if not tracking:
             ay_use = max(ay_use, abs(self._steer.lateral_accel(v, delta)))
@@ -501,6 +442,26 @@ class EoamController:
             yd,
             v_target,
         )
+
+
+def _travel_m(speed_mps: float, decel_mps2: float, dt_s: float) -> float:
+    """Distance a body covers in ``dt_s`` from ``speed_mps`` braking at ``decel_mps2`` (to
+    its stop)."""
+    if decel_mps2 > 0.0 and dt_s * decel_mps2 > speed_mps:
+        return 0.5 * speed_mps * speed_mps / decel_mps2
+    return dt_s * (speed_mps - 0.5 * decel_mps2 * dt_s)
+
+
+def _lateral_state(meas: EgoMeasurement) -> tuple[float, float, float]:
+    """(slope of the course relative to the road, path curvature relative to the road [1/m],
+    speed along the road [m/s]) from the ego's motion: lateral speed vx sin e + vy cos e,
+    curvature from the measured lateral acceleration less the road's."""
+    e = meas.e_yaw_rad
+    c, s = math.cos(e), math.sin(e)
+    along = meas.vx_mps * c - meas.vy_mps * s
+    along = max(1.0, along)
+    lateral = meas.vx_mps * s + meas.vy_mps * c
+    return lateral / along, meas.ay_mps2 / (along * along) - meas.road_curvature_1pm, along
 
 
 def _wrap(angle_rad: float) -> float:

@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from eoam_sumo.batch.runner import run_batch
+from eoam_sumo.eoam_settings import EoamSettings
 from eoam_sumo.params import LANE_CHANGE_HEIGHT_M, PONR_FRACTION
 from eoam_sumo.sim.cosim import RunSettings, policy_settings, run_case
 from eoam_sumo.sim.scenario import ScenarioOverrides
@@ -65,8 +66,11 @@ def _scenario(tmp_path: Path, *, van_x_m: float | None = None,
 
 
 def _run(cfg, tmp_path, name, policy="paper", v2x_range_m=0.0, radar_model="ideal", **over):
-    settings = policy_settings(RunSettings(max_time_s=30.0, radar_model=radar_model), policy,
-                               v2x_range_m)
+    # the DMM judges the ARO by its closing speed alone (the paper's rule), so that the ego at
+    # 120 km/h changes lanes (judged where the ARO will stop, it brakes to a stop in lane)
+    eoam = EoamSettings(obstacle_decel_in_dmm=False)
+    settings = policy_settings(RunSettings(max_time_s=30.0, radar_model=radar_model, eoam=eoam),
+                               policy, v2x_range_m)
     out = tmp_path / name
     summary = run_case(cfg, ScenarioOverrides(**over), out, settings)
     return summary, pd.read_csv(out / "timeseries.csv")

@@ -1,0 +1,72 @@
+"""Tunable values of the EOAM module (``eoam.EoamController``), the paper's where it gives them."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+
+from eoam_sumo.control.longitudinal import LongitudinalGains
+from eoam_sumo.control.steering import SteeringGains
+from eoam_sumo.decision.policy import PolicySettings
+from eoam_sumo.params import PONR_FRACTION
+
+
+@dataclass(frozen=True)
+class EoamSettings:
+    """Tunable values of the EOAM logic (the paper's defaults where it gives them)."""
+
+    ponr_fraction: float = PONR_FRACTION  # point of no return / lane-change height
+    manoeuvre_time_s: float = 8.0  # steering manoeuvre timer before RETURN (sec. 3.1 step 5)
+    arrive_tolerance_m: float = 0.3  # 2 -> 5 early: within this of the next lane's centre ...
+    pass_margin_m: float = 1.0  # mode 4 -> 5: ego rear this far past the obstacle's front
+    side_clearance_m: float = 0.5  # mode 4: lateral gap kept to the obstacle's side
+    unknown_obstacle_length_m: float = 12.0  # assumed without an object track (a truck)
+    track_gate_m: float = 5.0  # modes 2, 4: a sensed object further off the track is another
+    settle_offset_m: float = 0.1  # mode 5 -> 0: |d| below this ...
+    settle_heading_rad: float = 0.02  # ... and |e_yaw| below this ...
+    settle_dwell_s: float = 0.5  # ... for this long after the return path ended
+    release_opening_speed_mps: float = 0.5  # mode 1 -> 0: obstacle pulls away faster than this
+    min_steer_speed_mps: float = 20.0 / 3.6  # below it a STEER sector brakes instead
+    limit_brake_fraction: float = 0.95  # share of the no-lock brake force used as limit braking
+    reference_step_m: float = 0.25  # dx spacing of the sampled manoeuvre reference
+    return_when_stable: bool = True  # ... heading within settle_heading_rad and clear of the
+    # obstacle: 2 -> 5 before the timer (False: the timer alone, as in the paper's runs)
+    obstacle_decel_in_dmm: bool = True  # also judge the obstacle where its measured braking
+    # stops it (False: the paper's closing speed as if the obstacle held it)
+    obstacle_decel_time_constant_s: float = 0.1  # low-pass of the obstacle's deceleration
+    lateral_reaction_s: float = 0.3  # steering and yaw lag before the lateral motion turns
+    ponr_at_lateral_stop: bool = True  # judge the point of no return where the lateral
+    # motion stops if arrested now (False: on the offset reached, as in the paper)
+    return_lateral_g: float = 0.3  # mode 5 after 2: return's peak lateral acceleration / (mu g)
+    evasive_lateral_g: float = 0.9  # modes 3, 4 and the return after 4 (oncoming traffic): the same
+    return_min_length_m: float = 10.0  # mode 5: shortest return path
+    next_lane_clear_m: float = 50.0  # a standing object in the next lane closer than the
+    # in-path obstacle's range plus this (room to pass it and return) blocks the lane change
+    # as oncoming traffic does (modes 3, 4); the paper checks the next lane for oncoming only
+    preview_time_s: float = 0.3  # feedforward curvature taken this far ahead on the path
+    steering: SteeringGains = field(default_factory=SteeringGains)
+    longitudinal: LongitudinalGains = field(default_factory=LongitudinalGains)
+    policy: PolicySettings = field(default_factory=PolicySettings)  # paper or safe
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if isinstance(v, float) and not (math.isfinite(v) and v >= 0.0):
+                raise ValueError(f"EOAM setting {f.name}={v!r} must be finite and >= 0")
+        if not 0.0 < self.ponr_fraction < 1.0:
+            raise ValueError(f"ponr_fraction={self.ponr_fraction} must be in (0, 1)")
+        if not 0.0 < self.limit_brake_fraction <= 1.0:
+            raise ValueError(f"limit_brake_fraction={self.limit_brake_fraction} must be in (0, 1]")
+        for name in (
+            "manoeuvre_time_s",
+            "reference_step_m",
+            "return_lateral_g",
+            "evasive_lateral_g",
+            "return_min_length_m",
+            "settle_offset_m",
+            "settle_heading_rad",
+            "unknown_obstacle_length_m",
+            "arrive_tolerance_m",
+        ):
+            if getattr(self, name) <= 0.0:
+                raise ValueError(f"EOAM setting {name} must be > 0")
