@@ -278,6 +278,11 @@ def test_curved_two_way_road(tmp_path):
     assert calm["lateral_offset_m"].abs().max() < 0.2
 
 
+# a 120 m left curve from (200, 0) to (320, 120), a point every 10 degrees
+ICE_CURVE = " ".join(f"{200 + 120 * math.sin(math.radians(a)):.2f},"
+                     f"{120 * (1 - math.cos(math.radians(a))):.2f}" for a in range(0, 91, 10))
+
+
 @pytest.mark.sumo
 def test_ice_patch_road_departure_is_orange_not_green(tmp_path):
     """Dry road, then mu 0.05 on a 120 m left curve from x = 200 m: at 30 m/s (7.5 m/s^2 asked,
@@ -288,7 +293,7 @@ def test_ice_patch_road_departure_is_orange_not_green(tmp_path):
         '<node id="c" x="320" y="120"/><node id="d" x="320" y="1500"/></nodes>',
         '<edges><edge id="dry" from="a" to="b" numLanes="2" speed="40"/>'
         '<edge id="ice" from="b" to="c" numLanes="2" speed="40" friction="0.05" '
-        'shape="200.00,0.00 220.84,1.82 241.04,7.24 260.00,16.08 277.13,28.07 291.93,42.87 303.92,60.00 312.76,78.96 318.18,99.16 320.00,120.00"/>'
+        f'shape="{ICE_CURVE}"/>'
         '<edge id="end" from="c" to="d" numLanes="2" speed="40"/></edges>',
         "--no-turnarounds", "true",
     )

@@ -54,9 +54,9 @@ def _pixels_like(png, rgb) -> int:
 def test_a_screenshot_mid_manoeuvre_shows_the_ego_and_the_obstacle(display, tmp_path):
     gui = GuiSettings(delay_ms=0.0, screenshots_s=(6.0,), screenshot_dir=tmp_path,
                       keep_open=False)
-    summary = run_case(BASELINE, ScenarioOverrides(ego_speed_mps=120 / 3.6, mu=1.0), tmp_path,
+    summary = run_case(BASELINE, ScenarioOverrides(ego_speed_mps=165 / 3.6, mu=1.0), tmp_path,
                        RunSettings(gui=True, use_traci=True, gui_settings=gui))
-    assert 2 in summary["modes_visited"]  # the lane change ran (at 6 s the ego is in it)
+    assert 2 in summary["modes_visited"]  # the lane change ran (at 6 s the ego is beside the ARO)
     png = tmp_path / "screenshot_6.00s.png"
     assert png.is_file()
     assert _pixels_like(png, EGO_RGB) > 100 and _pixels_like(png, ARO_RGB) > 100

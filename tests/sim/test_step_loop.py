@@ -15,7 +15,7 @@ from eoam_sumo.sim.summary import TIMING_FIELDS
 pytestmark = pytest.mark.sumo
 
 BASELINE = Path(__file__).resolve().parents[2] / "scenarios" / "baseline.sumocfg"
-OVER = ScenarioOverrides(ego_speed_mps=120 / 3.6, mu=1.0)
+OVER = ScenarioOverrides(ego_speed_mps=165 / 3.6, mu=1.0)  # a lane change (120 km/h stops)
 
 
 class Recorder(StepObserver):
