@@ -46,6 +46,7 @@ from eoam_sumo.sim.scenario.files import float_attr
 from eoam_sumo.sim.scenario.values import number
 from eoam_sumo.sim.session.collisions import CollisionRecord, write_collision_output
 from eoam_sumo.sim.session.gui import GuiSettings, GuiView
+from eoam_sumo.sim.session.handover import SAVE_STATE_OPTIONS, handover_plan, run_and_hand_over
 from eoam_sumo.sim.session.insertion import EgoStart, add_oncoming, place_ego
 from eoam_sumo.sim.session.launch import (
     ERROR_LOG_STDERR,
@@ -139,7 +140,7 @@ class SumoSession:
             )
         extra = tuple(str(a) for a in extra_args)
         files = check_scenario(Path(cfg), ego_id)
-        scripted_stops(files, overrides, ego_id)
+        scripted = scripted_stops(files, overrides, ego_id)
 
         import sumo
         import sumolib
@@ -154,16 +155,21 @@ class SumoSession:
             raise RuntimeError("a libsumo session is already open in this process; close it first")
         workdir = Path(tempfile.mkdtemp(prefix="eoam-sumo-"))
         error_log = workdir / "sumo-errors.log"
-        cmd, sumo_overrides = sumo_command(
-            sumolib.checkBinary("sumo-gui" if gui else "sumo"), files.cfg, files.options, step,
-            error_log, extra, gui, keep_gui_open=gui_settings.keep_open)
+        binary = sumolib.checkBinary("sumo-gui" if gui else "sumo")
+        cmd, sumo_overrides = sumo_command(binary, files.cfg, files.options, step, error_log,
+                                           extra, gui, keep_gui_open=gui_settings.keep_open)
+        plan = handover_plan(files, ego_id, step, scripted, extra, gui)
+        first_cmd = cmd
+        if plan is not None:
+            first_cmd = [*sumo_command(binary, files.cfg, files.options, plan[0], error_log,
+                                       extra, gui)[0], *SAVE_STATE_OPTIONS]
         try:
             if via_traci:
                 import traci
 
                 errors = (traci.exceptions.TraCIException, traci.exceptions.FatalTraCIError)
                 try:
-                    api, process = traci_connect(cmd)
+                    api, process = traci_connect(first_cmd)
                 except (*errors, OSError) as exc:
                     raise InputError(start_error(files.cfg, error_log, exc)) from exc
                 constants = traci.constants
@@ -173,10 +179,17 @@ class SumoSession:
                 errors = (libsumo.TraCIException, libsumo.FatalTraCIError)
                 try:
                     with stderr_into(workdir / ERROR_LOG_STDERR):
-                        libsumo.start(cmd)
+                        libsumo.start(first_cmd)
                 except errors as exc:
                     raise InputError(start_error(files.cfg, error_log, exc)) from exc
                 api, constants, process = libsumo, libsumo.constants, None
+            if plan is not None:
+                try:
+                    with stderr_into(workdir / ERROR_LOG_STDERR):
+                        run_and_hand_over(api, cmd, plan[1], workdir)
+                except errors as exc:
+                    shut_down(api, process)
+                    raise InputError(start_error(files.cfg, error_log, exc)) from exc
         except BaseException:
             shutil.rmtree(workdir, ignore_errors=True)
             raise
