@@ -9,7 +9,14 @@ Figures:
 - ``tables_wall_s``: a full ``eoam-sumo tables`` build with 2 jobs;
 - ``batch_wall_s`` / ``batch_cases`` / ``jobs``: the Table 2 batch with 2 jobs;
 - per-step costs of decision + control and of the plant, plant sub-steps per second;
-- ``peak_rss_mb`` of one ``eoam-sumo run`` in its own process.
+- ``peak_rss_mb`` of one ``eoam-sumo run`` in its own process;
+- the traffic case (``traffic_scenario``: 3 lanes each way, the ego departing at 120 s behind a
+  broken-down car, SUMO's step 0.5 s before that): ``traffic_vehicles`` in SUMO at the ego's
+  departure, ``traffic_cosim_wall_s`` of the whole co-simulation run (SUMO's start, the time
+  before the departure at 0.5 s, the manoeuvre at 10 ms), ``traffic_sumo_only_wall_s`` of
+  SUMO alone stepping the same scenario at 10 ms for the same simulated time, and
+  ``traffic_us_per_user_step``: the co-simulation's own cost per road user in SUMO per step
+  (CPU time of the step loop less SUMO alone's for as many steps).
 """
 
 from __future__ import annotations
@@ -24,6 +31,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+from eoam_sumo.sim.observers import StepObserver
+
 ROOT = Path(__file__).resolve().parents[1]
 BASELINE = ROOT / "scenarios" / "baseline.sumocfg"
 TABLE2 = ROOT / "scenarios" / "table2.toml"
@@ -35,7 +44,10 @@ TARGETS = {
     "tables_wall_s": ("<=", 60.0),
     "control_us_per_step": ("<=", 50.0),
     "peak_rss_mb": ("<=", 300.0),
+    "traffic_cosim_over_sumo_only": ("<", 1.0),
+    "traffic_us_per_user_step": ("<=", 2.0),
 }
+TRAFFIC_DEPART_S = 120.0  # the ego's departure in the traffic case (about 280 vehicles)
 
 
 def _cosim_and_sumo_only(repeats: int) -> dict:
@@ -99,6 +111,67 @@ def _sumo_only_rate(sim_time_s: float, step_s: float) -> float:
         session.close()
 
 
+class _LoopCpu(StepObserver):
+    """CPU time of this thread over a run's step loop (SUMO's too: libsumo runs in-process),
+    which other load on the machine disturbs far less than wall time."""
+
+    cpu_s = 0.0
+
+    def start(self, sim) -> None:
+        self._t0 = time.thread_time()
+
+    def end(self, sim) -> None:
+        self.cpu_s = time.thread_time() - self._t0
+
+
+def _traffic(tmp: Path, quick: bool) -> dict:
+    """The traffic case: a co-simulation run and SUMO alone at 10 ms for as long. Our side's
+    cost per road user and step: the step loop's CPU time less SUMO alone's for the same steps
+    (the ego driven by SUMO), over the steps and the vehicles in SUMO at the departure."""
+    import libsumo
+    import sumolib
+
+    from eoam_sumo.sim.cosim import CoSimulation, RunSettings
+    from eoam_sumo.sim.scenario import ScenarioOverrides, check_scenario
+    from eoam_sumo.sim.session.launch import sumo_command
+    from eoam_sumo.traffic_scenario import write_traffic_scenario
+
+    depart_s = 20.0 if quick else TRAFFIC_DEPART_S
+    cfg = write_traffic_scenario(tmp / "traffic", ego_depart_s=depart_s)
+    loop_cpu = _LoopCpu()
+    sim = CoSimulation(cfg, ScenarioOverrides(), RunSettings(), observers=[loop_cpu])
+    t0 = time.perf_counter()
+    summary, _log = sim.run()
+    cosim_wall_s = time.perf_counter() - t0
+    depart_step = round(depart_s / 0.01)
+    steps = depart_step + max(1, round(summary["sim_time_s"] / 0.01))
+    cmd, _ = sumo_command(sumolib.checkBinary("sumo"), cfg, check_scenario(cfg).options, 0.01,
+                          tmp / "traffic-errors.log", (), False)
+    t0 = time.perf_counter()
+    libsumo.start(cmd)
+    try:
+        vehicles, cpu_depart = 0, time.thread_time()
+        for k in range(steps):
+            libsumo.simulationStep()
+            if k == depart_step:
+                vehicles = libsumo.vehicle.getIDCount()
+                cpu_depart = time.thread_time()
+        sumo_only_wall_s = time.perf_counter() - t0
+        sumo_cpu_s = time.thread_time() - cpu_depart
+    finally:
+        libsumo.close()
+    manoeuvre_steps = max(1, steps - depart_step - 1)
+    return {
+        "traffic_vehicles": vehicles,
+        "traffic_cosim_wall_s": cosim_wall_s,
+        "traffic_sumo_only_wall_s": sumo_only_wall_s,
+        "traffic_cosim_over_sumo_only": cosim_wall_s / sumo_only_wall_s,
+        "traffic_cosim_sim_time_s": summary["sim_time_s"],
+        "traffic_us_per_user_step":
+            1e6 * (loop_cpu.cpu_s - sumo_cpu_s) / (manoeuvre_steps * max(1, vehicles)),
+    }
+
+
 def _peak_rss_mb(out_dir: Path) -> float:
     """Peak resident memory of one ``eoam-sumo run`` (its own process, from wait4)."""
     cmd = [sys.executable, "-m", "eoam_sumo", "run", str(BASELINE), "--speed-kmh", "120",
@@ -147,6 +220,7 @@ def run_bench(out_dir: Path, quick: bool = False) -> dict:
         result: dict[str, Any] = {"quick": quick, "jobs": 2}
         result["peak_rss_mb"] = _peak_rss_mb(tmp / "rss")
         result.update(_cosim_and_sumo_only(repeats))
+        result.update(_traffic(tmp, quick))
         result["tables_wall_s"] = _tables(tmp / "tables", quick)
         result["batch_wall_s"], result["batch_cases"] = _batch(tmp, quick)
     result["targets"] = {

@@ -14,7 +14,8 @@ pytestmark = pytest.mark.sumo
 KEYS = (
     "realtime_factor", "sumo_only_realtime_factor", "tables_wall_s", "batch_wall_s",
     "batch_cases", "jobs", "control_us_per_step", "plant_substeps_per_s", "peak_rss_mb",
-    "cosim_over_sumo_cost",
+    "cosim_over_sumo_cost", "traffic_vehicles", "traffic_cosim_wall_s",
+    "traffic_sumo_only_wall_s",
 )
 
 
@@ -26,3 +27,4 @@ def test_quick_bench_writes_every_key(tmp_path):
         assert key in saved and math.isfinite(saved[key]) and saved[key] > 0, key
     assert saved["batch_cases"] == 2 and saved["jobs"] == 2
     assert set(saved["targets"]) == set(TARGETS)
+    assert math.isfinite(saved["traffic_us_per_user_step"])

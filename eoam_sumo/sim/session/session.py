@@ -260,11 +260,10 @@ class SumoSession:
         self._api.simulationStep()
         users.new_step()
         self._time_s = self._sim.getTime()
-        if users.tracking or scripts.pending:
-            departed = self._sim.getDepartedIDList()
-            if users.tracking:
-                users.track(departed)
-            for vid in departed:
+        if users.tracking:
+            users.track()
+        if scripts.pending:
+            for vid in self._sim.getDepartedIDList():
                 if vid in scripts.pending:
                     scripts.start(vid, users.watch)
 
