@@ -246,11 +246,12 @@ class _Scene:
                 f"DMM sector {sector}{fcw}\nview {VIEW_BEHIND_M + VIEW_AHEAD_M:g} m wide")
 
     def _contact_point(self, contact_t: float) -> tuple[list, list]:
-        """The contact point of summary.json, else the midpoint between the ego and the
-        road user nearest to it when the contact was found (``contact_t``)."""
-        point = self.summary.get("contact_point_m")
-        if point:
-            return [point[0]], [point[1]]
+        """The contact point of summary.json, else (a run of an older eoam-sumo) the midpoint
+        between the ego and the road user nearest to it when the contact was found
+        (``contact_t``)."""
+        x, y = self.summary.get("contact_x_m"), self.summary.get("contact_y_m")
+        if x is not None and y is not None:
+            return [x], [y]
         k = min(int(np.searchsorted(self.t, contact_t - 1e-9)), len(self.t) - 1)
         a, b = self.tr_start[k], self.tr_end[k]
         xy, ego = self.tr_xy[a:b], self.tr_is_ego[a:b]

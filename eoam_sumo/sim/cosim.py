@@ -401,6 +401,8 @@ class CoSimulation:
             impact_speed_mps=rounded(outcome.impact_speed_mps),
             contact_kind=contact_info.kind if contact_info else "none",
             contact_time_s=t_contact,
+            contact_x_m=rounded(contact_info.point[0]) if contact_info else None,
+            contact_y_m=rounded(contact_info.point[1]) if contact_info else None,
             reason=outcome.reason,
             modes_visited=tuple(self.ctrl.modes_visited),
             fcw_raised=bool(self.ctrl.fcw_raised),

@@ -27,6 +27,9 @@ class RunSummary:
     impact_speed_mps: float = _doc("relative speed of the box centres at the first contact")
     contact_kind: str = _doc("none, head_on, oblique, rear_end or side")
     contact_time_s: float | None = _doc("SUMO time of the first contact (empty: none)")
+    contact_x_m: float | None = _doc("where the first contact was: the centroid of the boxes'"
+                                     " overlap, network x (empty: none)")
+    contact_y_m: float | None = _doc("and its network y (empty: none)")
     reason: str = _doc("one sentence on why the run got its colour")
     modes_visited: tuple[int, ...] = _doc("EOAM modes 0-5 in order of first visit")
     fcw_raised: bool = _doc("the forward collision warning was raised")

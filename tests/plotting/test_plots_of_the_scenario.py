@@ -16,6 +16,7 @@ from eoam_sumo.plotting.run_plots import load_run, plot_run, run_title
 from eoam_sumo.plotting.runfacts import manoeuvre_mu
 from eoam_sumo.sim.cosim import RunSettings, run_case
 from eoam_sumo.sim.scenario import ScenarioOverrides
+from eoam_sumo.sim.trafficlog import read_traffic
 
 pytestmark = pytest.mark.sumo
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
@@ -60,6 +61,20 @@ def patch_run(tmp_path_factory) -> Path:
     cfg = _patch_scenario(folder)
     run_case(cfg, ScenarioOverrides(), folder / "run", RunSettings(max_time_s=12.0))
     return folder / "run"
+
+
+def test_the_contact_point_lies_between_the_ego_and_the_obstacle(patch_run):
+    summary, _ = load_run(patch_run)
+    assert summary["collision_with"] == "aro"
+    traffic = read_traffic(patch_run / "traffic.csv")
+    at = traffic[traffic["time_s"] == traffic["time_s"].max()].set_index("id")
+    ego, aro = at.loc["ego"], at.loc["aro"]
+    # a rear-end hit: the point is at the ego's front and the obstacle's back
+    assert summary["contact_x_m"] == pytest.approx(ego["x_m"] + 0.5 * ego["length_m"],
+                                                   abs=0.2)
+    assert summary["contact_x_m"] == pytest.approx(aro["x_m"] - 0.5 * aro["length_m"],
+                                                   abs=0.2)
+    assert abs(summary["contact_y_m"] - ego["y_m"]) < 0.5 * ego["width_m"]
 
 
 def test_plots_use_the_friction_the_manoeuvre_ran_on(patch_run, tmp_path):
