@@ -14,6 +14,7 @@ from pathlib import Path
 
 from eoam_sumo import __version__
 from eoam_sumo.errors import InputError
+from eoam_sumo.matrix import DEFAULT_MAX_TIME_S
 from eoam_sumo.params import MU_MAX
 
 EXIT_BAD_INPUT = 2
@@ -109,7 +110,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="add an oncoming car this far ahead (m), or 'none'")
     p.add_argument("--ego", default="ego", help="the ego vehicle's id (default: ego)")
     p.add_argument("--out", type=Path, default=Path("out/run"), help="output folder")
-    p.add_argument("--max-time-s", type=_finite, default=40.0, help="simulated time limit")
+    p.add_argument("--max-time-s", type=_finite, default=DEFAULT_MAX_TIME_S,
+                   help="simulated time limit")
     p.add_argument("--tables", type=Path, help="lookup tables folder (default: tables/)")
     p.add_argument("--radar-range-m", type=_finite, help="ego radar range (default 100 m)")
     p.add_argument("--mu-belief", default="known",

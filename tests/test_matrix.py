@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from eoam_sumo.errors import InputError
-from eoam_sumo.matrix import load_matrix, load_paper_table
+from eoam_sumo.matrix import DEFAULT_MAX_TIME_S, load_matrix, load_paper_table
 from eoam_sumo.sim.scenario import ScenarioOverrides
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -32,7 +32,7 @@ def test_table2_has_the_papers_64_cases_in_the_papers_order():
             float(row["mu"]),
         )
         assert case.sumocfg == (ROOT / "scenarios" / "baseline.sumocfg").resolve()
-        assert case.max_time_s == 40.0
+        assert case.max_time_s == 60.0
     assert cases[0].case_id == "onc-none_v165_mu1.0"
     assert cases[-1].case_id == "onc-300_v55_mu0.1"
     assert len({c.case_id for c in cases}) == 64
@@ -89,7 +89,7 @@ def test_optional_aro_keys_extend_the_sweep_and_the_ids(tmp_path):
     ]
     assert cases[1].overrides().aro_hold_s == 0.5
     assert cases[1].overrides().aro_decel_mps2 == 8.0
-    assert cases[0].max_time_s == 40.0  # documented default
+    assert cases[0].max_time_s == DEFAULT_MAX_TIME_S == 60.0  # documented default
     assert cases[0].radar_range_m is None  # the radar's own default
 
 

@@ -18,6 +18,7 @@ import pandas as pd
 
 from eoam_sumo.colours import FAILED, LEGEND, MARKERS, OUTCOMES
 
+NEAR_MISS_MARK = "⚡"
 TABLE_MD = "table2.md"
 TABLE_PNG = "table2.png"
 _EXTRA_PARAMS = (("aro_hold_s", "ARO hold {:g} s"), ("aro_decel_mps2", "ARO decel {:g} m/s²"))
@@ -32,6 +33,8 @@ class Cell:
     paper: str | None
     case_dir: str
     detail: str
+    near_miss: bool = False
+    margins: str = ""  # the smallest gaps and time to collision, as table2.md shows them
 
     @property
     def compared(self) -> bool:
@@ -94,6 +97,17 @@ def _detail(row) -> str:
     return "; ".join(parts)
 
 
+def _figure(value, unit: str) -> str:
+    return "—" if value is None or pd.isna(value) else f"{value:.2f} {unit}"
+
+
+def _margins(row) -> str:
+    """'ARO 0.49 m · oncoming 0.54 m · TTC 1.03 s' (— where there was none)."""
+    return (f"ARO {_figure(row.get('min_gap_aro_m'), 'm')} · oncoming "
+            f"{_figure(row.get('min_gap_oncoming_m'), 'm')} · TTC "
+            f"{_figure(row.get('min_ttc_oncoming_s'), 's')}")
+
+
 def outcome_grid(results: pd.DataFrame) -> OutcomeGrid:
     """The grid of a results frame (``runner.read_results``), the paper's colours from its
     ``paper_outcome`` column (empty where unpublished)."""
@@ -115,7 +129,8 @@ def outcome_grid(results: pd.DataFrame) -> OutcomeGrid:
             mus.append(row["mu"])
         ours = row["outcome"] if row["status"] == "ok" else FAILED
         cells[(rows.index(key), mus.index(row["mu"]))] = Cell(
-            row["case_id"], ours, row["paper_outcome"] or None, row["case_dir"], _detail(row))
+            row["case_id"], ours, row["paper_outcome"] or None, row["case_dir"], _detail(row),
+            str(row.get("near_miss", "")) == "True", _margins(row))
     return OutcomeGrid(tuple(rows), tuple(mus), cells,
                        has_paper=any(c.paper for c in cells.values()))
 
@@ -167,6 +182,8 @@ def table2_markdown(grid: OutcomeGrid, title: str = "Table 2") -> str:
                 cols.append("")
                 continue
             text = f"**{_mark(cell.ours)}**"
+            if cell.near_miss:
+                text += f" {NEAR_MISS_MARK}"
             if grid.has_paper:
                 text += f" / {_mark(cell.paper)}"
             if cell.case_id in listed:
@@ -175,7 +192,9 @@ def table2_markdown(grid: OutcomeGrid, title: str = "Table 2") -> str:
         lines.append(f"| {traffic if traffic != previous else ''} | {speed} | "
                      + " | ".join(cols) + " |")
         previous = traffic
-    lines += ["", "Legend: " + "; ".join(f"{MARKERS[c]} {c}: {LEGEND[c]}" for c in LEGEND), ""]
+    lines += ["", "Legend: " + "; ".join(f"{MARKERS[c]} {c}: {LEGEND[c]}" for c in LEGEND)
+              + f"; {NEAR_MISS_MARK} near miss: no contact, but within 0.5 m of a road user or "
+              "a time to collision with oncoming traffic under 1.5 s", ""]
     differing = grid.differing()
     heading = "Cells that differ from the paper" if grid.has_paper else "Cases that were not green"
     lines += [f"## {heading} ({len(differing)})", ""]
@@ -189,4 +208,29 @@ def table2_markdown(grid: OutcomeGrid, title: str = "Table 2") -> str:
                      f"{cell.detail}.{link}")
     if not differing:
         lines.append("None.")
+    lines += ["", *margins_markdown(grid)]
     return "\n".join(lines) + "\n"
+
+
+def margins_markdown(grid: OutcomeGrid) -> list[str]:
+    """Each cell's margins in the grid's layout: the smallest gap to the in-lane obstacle and
+    to oncoming traffic, the smallest time to collision with it; near misses marked."""
+    near = sum(c.near_miss for c in grid.cells.values())
+    lines = [f"## Margins ({near} near miss{'es' if near != 1 else ''})", "",
+             ("Each cell: smallest box gap to the obstacle (ARO) · to opposite-direction traffic "
+              "· smallest time to collision with it (— none); "
+              f"{NEAR_MISS_MARK} near miss."), "",
+             "| Traffic | Initial ego speed | "
+             + " | ".join(f"{mu_text(mu)} surface mu" for mu in grid.mus) + " |",
+             "|---|---|" + "---|" * len(grid.mus)]
+    previous = None
+    for i, (traffic, speed) in enumerate(grid.rows):
+        cols = []
+        for j in range(len(grid.mus)):
+            cell = grid.cells.get((i, j))
+            cols.append("" if cell is None else
+                        cell.margins + (f" {NEAR_MISS_MARK}" if cell.near_miss else ""))
+        lines.append(f"| {traffic if traffic != previous else ''} | {speed} | "
+                     + " | ".join(cols) + " |")
+        previous = traffic
+    return lines

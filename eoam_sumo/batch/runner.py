@@ -47,7 +47,7 @@ from eoam_sumo.batch.results import (
 from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.matrix import Case, Matrix, check_matrix, load_matrix
-from eoam_sumo.plotting.batch_plots import plot_table2
+from eoam_sumo.plotting.batch_plots import MARGINS_PNG, plot_margins, plot_table2
 
 #: Exit status of ``eoam-sumo batch`` when at least one case failed (bad input is 2).
 EXIT_CASES_FAILED = 1
@@ -181,7 +181,8 @@ def run_batch(
 
 
 def write_report(out_dir: Path, results: pd.DataFrame) -> list[Path]:
-    """Write ``table2.md`` and ``table2.png`` of a results frame into ``out_dir``."""
+    """Write ``table2.md``, ``table2.png`` and ``margins.png`` of a results frame into
+    ``out_dir``."""
     out_dir = Path(out_dir)
     grid = outcome_grid(results)
     text = table2_markdown(grid, policy_title(results))
@@ -189,7 +190,8 @@ def write_report(out_dir: Path, results: pd.DataFrame) -> list[Path]:
     sight = sight_markdown(results)
     text = f"{head}\n\n{policy_line(results)}\n\n{rest}" + (f"\n{sight}" if sight else "")
     md = write_atomic(out_dir / TABLE_MD, text)
-    return [md, plot_table2(grid, out_dir / TABLE_PNG)]
+    return [md, plot_table2(grid, out_dir / TABLE_PNG),
+            plot_margins(results, out_dir / MARGINS_PNG)]
 
 
 def _raise_interrupt(signum, frame):

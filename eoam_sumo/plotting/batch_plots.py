@@ -29,9 +29,11 @@ from eoam_sumo.plotting.runfacts import (
     point_of_no_return_m,
     traffic_text,
 )
+from eoam_sumo.sim.margins import NEAR_MISS_GAP_M, NEAR_MISS_TTC_S
 from eoam_sumo.sim.runlog import read_timeseries
 
 _MISSING = "#ffffff"
+MARGINS_PNG = "margins.png"
 _STYLES = ("-", "--", "-.", ":")
 
 
@@ -240,10 +242,48 @@ def plot_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
         from eoam_sumo.plotting.envelope_plots import plot_envelopes
 
         return plot_envelopes(results, out_dir)
-    paths = [plot_table2(outcome_grid(results), Path(out_dir) / TABLE_PNG)]
+    paths = [plot_table2(outcome_grid(results), Path(out_dir) / TABLE_PNG),
+             plot_margins(results, Path(out_dir) / MARGINS_PNG)]
     ok = results[results["status"] == "ok"]
     for speed_kmh in pd.unique(ok["ego_speed_kmh"]):
         fig25 = plot_lateral_offsets(batch_dir, results, out_dir, float(speed_kmh))
         if fig25 is not None:
             paths.append(fig25)
     return paths
+
+
+def plot_margins(results: pd.DataFrame, path: Path) -> Path:
+    """Each case's margins (summary ``min_gap_aro_m``, ``min_gap_oncoming_m``,
+    ``min_ttc_oncoming_s``) in the matrix's order, with the near-miss thresholds; near misses
+    marked, contacts shown at zero."""
+    ok = results[results["status"] == "ok"].reset_index(drop=True)
+    x = np.arange(len(ok))
+    fig = Figure(figsize=(max(8.0, 0.22 * len(ok) + 2.0), 7.0), layout="constrained")
+    gaps, ttcs = fig.subplots(2, 1, sharex=True)
+    cap_m, cap_s = 6.0, 6.0  # larger margins are drawn at the cap
+    for column, marker, label in (("min_gap_aro_m", "o", "gap to the obstacle (ARO)"),
+                                  ("min_gap_oncoming_m", "s", "gap to oncoming traffic")):
+        gaps.scatter(x, ok[column].clip(upper=cap_m), marker=marker, s=22, label=label)
+    gaps.axhline(NEAR_MISS_GAP_M, color="red", linestyle="--", linewidth=0.9,
+                 label=f"near miss: {NEAR_MISS_GAP_M:g} m")
+    gaps.set_ylabel(f"smallest box gap [m] (capped at {cap_m:g})")
+    ttcs.scatter(x, ok["min_ttc_oncoming_s"].clip(upper=cap_s), marker="D", s=22,
+                 color="0.3", label="time to collision with oncoming traffic")
+    ttcs.axhline(NEAR_MISS_TTC_S, color="red", linestyle="--", linewidth=0.9,
+                 label=f"near miss: {NEAR_MISS_TTC_S:g} s")
+    ttcs.set_ylabel(f"smallest time to collision [s] (capped at {cap_s:g})")
+    for k, row in ok.iterrows():
+        colour = OUTCOME_COLOURS.get(row["outcome"], _MISSING)
+        for ax in (gaps, ttcs):
+            ax.axvspan(k - 0.5, k + 0.5, color=colour, alpha=0.18, linewidth=0)
+            if str(row.get("near_miss")) == "True":
+                ax.axvspan(k - 0.5, k + 0.5, fill=False, hatch="//", edgecolor="red",
+                           linewidth=0)
+    ttcs.set_xticks(x, ok["case_id"], rotation=90, fontsize=7)
+    for ax in (gaps, ttcs):
+        ax.set_xlim(-0.5, max(len(ok), 1) - 0.5)
+        ax.set_ylim(bottom=0.0)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="upper right")
+    gaps.set_title("Margins per case (background: outcome colour; hatched: near miss)")
+    return save(fig, path)

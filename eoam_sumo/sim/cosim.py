@@ -19,8 +19,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-import numpy as np
-
 from eoam_sumo.eoam import (
     Command,
     EgoMeasurement,
@@ -30,6 +28,7 @@ from eoam_sumo.eoam import (
     Perception,
 )
 from eoam_sumo.errors import InputError
+from eoam_sumo.matrix import DEFAULT_MAX_TIME_S
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.plant import Plant, initial_state
@@ -38,17 +37,20 @@ from eoam_sumo.sensing.friction import FrictionBelief
 from eoam_sumo.sensing.next_lane import CornerRadarSettings, NextLaneSensing
 from eoam_sumo.sensing.v2x import V2XSettings
 from eoam_sumo.sim.bodies import nav_angle_deg
-from eoam_sumo.sim.geometry import OrientedBox, box_distance, boxes_overlap, contact
+from eoam_sumo.sim.geometry import OrientedBox, box_distance, boxes_overlap
+from eoam_sumo.sim.margins import Margins
 from eoam_sumo.sim.observers import Extremes, StepObserver, TimeSeries
-from eoam_sumo.sim.outcome import classify_outcome, left_road, role_of
+from eoam_sumo.sim.outcome import role_of
 from eoam_sumo.sim.radar import RadarReport, RadarSettings
 from eoam_sumo.sim.roadframe import RoadFrame
 from eoam_sumo.sim.runlog import RunLog, write_run
 from eoam_sumo.sim.scenario import ScenarioOverrides
 from eoam_sumo.sim.session import SumoSession
 from eoam_sumo.sim.session.gui import GuiSettings
-from eoam_sumo.sim.summary import RunSummary, finite_or_none, rounded
+from eoam_sumo.sim.severity import ContactRecord, substep_contact
+from eoam_sumo.sim.summary import RunSummary
 from eoam_sumo.sim.trafficlog import TrafficLog
+from eoam_sumo.sim.verdict import AvoidedObstacle, summarise
 
 
 @dataclass(frozen=True)
@@ -57,7 +59,7 @@ class RunSettings:
 
     step_s: float = 0.01  # SUMO and decision/control step [s]; whole milliseconds in SUMO
     plant_dt_s: float = 0.001  # plant integration step [s]
-    max_time_s: float = 40.0  # simulated time limit [s]
+    max_time_s: float = DEFAULT_MAX_TIME_S  # simulated time limit [s]
     settle_s: float = 2.0  # run on this long after the hand-back or a stop [s]
     ego_id: str = "ego"
     gui: bool = False
@@ -188,7 +190,8 @@ class CoSimulation:
         and observers; refuses a road user overlapping the ego at its departure."""
         st, p = self.settings, self.params
         self.session = session
-        self._wall0 = time.perf_counter() if wall0 is None else wall0
+        self.wall0 = time.perf_counter() if wall0 is None else wall0
+        self.step_s = st.step_s
         ego = session.ego_body()
         self.mu_start = session.friction_at_ego()
         self.tables.check_run(self.mu_start, ego.speed_mps)
@@ -217,7 +220,7 @@ class CoSimulation:
         self._back = front - 0.5 * p.length_m  # CG to the ego box's centre, as in OrientedBox
         self._ego_box_radius = math.hypot(0.5 * p.length_m, 0.5 * p.width_m)
         self._ego_radius = 0.5 * math.hypot(p.length_m, p.width_m) + front - 0.5 * p.length_m
-        self.first_contact: tuple | None = None  # (Contact, role, time)
+        self.first_contact: ContactRecord | None = None
         self.min_gap_aro_m = math.inf
         self.end_cause: str | None = None
         self.n_steps = 0
@@ -235,7 +238,10 @@ class CoSimulation:
         self.radar = make_radar(st.radar_model, st.radar, st.seed)  # fresh state per run
         self.mu_true = self.mu_start
         self.timeseries, self.extremes = TimeSeries(), Extremes()
-        self.observers = (self.timeseries, self.extremes, self.traffic, *self.extra_observers)
+        self.margins = Margins(p.length_m, p.width_m, front)
+        self.avoided = AvoidedObstacle()
+        self.observers = (self.timeseries, self.extremes, self.traffic, self.margins,
+                          self.avoided, *self.extra_observers)
         for obs in self.observers:
             obs.start(self)
         self._after_step = tuple(obs.after_step for obs in self.observers)
@@ -266,6 +272,7 @@ class CoSimulation:
         front_xy = (X + front * self._cy, Y + front * self._sy)
         report = self.radar.scan(front_xy, yaw, vx, road, self.bodies, self.lane_width_m,
                                  self.t)
+        self.report = report
         perception = _perception(report)
         if self.lane_sensing is not None:
             perception = perception._replace(next_lane=self.lane_sensing.update(
@@ -335,9 +342,13 @@ class CoSimulation:
             # contact during the step is possible only if the gap is within both moves
             if self.first_contact is None and gap <= reach_m:
                 before = next((o for o in self.bodies_before if o.vid == b.vid), b)
-                hit = self._substep_contact(x_prev, x, b, before)
-                if hit is not None:
-                    self.first_contact = (hit, role or role_of(b, road, lane_width), self.t)
+                p = self.params
+                found = substep_contact(x_prev, x, b, before, p.length_m, p.width_m,
+                                        self._front, self.settings.substeps)
+                if found is not None:
+                    hit, ebox, obox = found
+                    self.first_contact = ContactRecord(
+                        hit, role or role_of(b, road, lane_width), self.t, b, ebox, obox)
 
     def finished(self) -> bool:
         """Whether the run is over: a contact, ``settle_s`` after the EOAM handed back to
@@ -346,10 +357,7 @@ class CoSimulation:
         if self.first_contact is not None:
             self.end_cause = "contact"
             return True
-        ctrl = self.ctrl
-        mode = ctrl.mode
-        if not ((mode == 0 and len(ctrl.modes_visited) > 1)
-                or (mode in (1, 3) and self.x[3] < 0.05)):
+        if not self.eoam_done():
             self._stop_at = None  # (again) a manoeuvre under way: run on to its end
         elif self._stop_at is None:
             self._stop_at = self.t + self.settings.settle_s
@@ -362,6 +370,13 @@ class CoSimulation:
         else:
             return False
         return True
+
+    def eoam_done(self) -> bool:
+        """The EOAM is over: handed back to NORMAL after a manoeuvre, or stopped."""
+        ctrl = self.ctrl
+        mode = ctrl.mode
+        return ((mode == 0 and len(ctrl.modes_visited) > 1)
+                or (mode in (1, 3) and self.x[3] < 0.05))
 
     # ----------------------------------------------------------------------------- the end
     def finish(self) -> RunSummary:
@@ -376,61 +391,8 @@ class CoSimulation:
             self.mu_true, self.lane_width_m, self.left_lane)
         for obs in self.observers:
             obs.end(self)
-        ext = self.extremes
-        left_width = self.lane_width_m if self.left_lane else 0.0
-        contact_info, role, t_contact = self.first_contact or (None, "none", None)
-        outcome = classify_outcome(
-            modes_visited=self.ctrl.modes_visited,
-            max_lateral_offset_m=ext.max_abs_offset_m,
-            lane_width_m=self.lane_width_m,
-            contact=contact_info,
-            role=role,
-            final_offset_m=d,
-            final_speed_mps=vx,
-            max_abs_heading_error_rad=ext.max_abs_heading_error_rad,
-            min_speed_mps=ext.min_vx_mps,
-            min_offset_m=ext.min_d_m,
-            max_offset_m=ext.max_d_m,
-            left_width_m=left_width,
-        )
-        sim_time = self.t - self.t_start
         self.loop_wall_s = loop_wall_s
-        return RunSummary(
-            outcome=outcome.colour,
-            collision_with=outcome.collision_with,
-            impact_speed_mps=rounded(outcome.impact_speed_mps),
-            contact_kind=contact_info.kind if contact_info else "none",
-            contact_time_s=t_contact,
-            contact_x_m=rounded(contact_info.point[0]) if contact_info else None,
-            contact_y_m=rounded(contact_info.point[1]) if contact_info else None,
-            reason=outcome.reason,
-            modes_visited=tuple(self.ctrl.modes_visited),
-            fcw_raised=bool(self.ctrl.fcw_raised),
-            mu=self.mu_start,
-            mu_belief=self.belief.label,
-            radar_model=self.settings.radar_model,
-            seed=self.settings.seed,
-            **_trigger(self.timeseries.log, self.belief),
-            min_gap_aro_m=finite_or_none(self.min_gap_aro_m),
-            max_abs_lat_accel_mps2=rounded(self.timeseries.log.max_abs("ay_mps2")),
-            max_lateral_offset_m=rounded(ext.max_abs_offset_m),
-            final_lateral_offset_m=rounded(d),
-            final_speed_mps=rounded(vx),
-            min_speed_mps=rounded(ext.min_vx_mps),
-            max_abs_heading_error_rad=rounded(ext.max_abs_heading_error_rad),
-            left_road=left_road(ext.min_d_m, ext.max_d_m, self.lane_width_m, left_width),
-            ego_initial_speed_mps=rounded(self.ego_initial_speed_mps),
-            lane_width_m=rounded(self.lane_width_m),
-            oncoming_traffic=self.traffic.had_role("oncoming"),
-            net_file=str(self.session.net_file.resolve()),
-            radar_range_m=self.settings.radar.range_m,
-            radar_fov_deg=self.settings.radar.fov_deg,
-            sim_time_s=rounded(sim_time),
-            wall_time_s=time.perf_counter() - self._wall0,
-            realtime_factor=sim_time / loop_wall_s,
-            sumo_overrides=dict(self.session.sumo_overrides),
-            **self._policy_record(),
-        )
+        return summarise(self, loop_wall_s)
 
     def _next_lane_sensing(self, session: SumoSession) -> NextLaneSensing | None:
         """The next lane's sensing for the safe policy (None for the paper's)."""
@@ -444,7 +406,7 @@ class CoSimulation:
             ego_length_m=self.params.length_m, ego_width_m=self.params.width_m, v2x=st.v2x,
             corner=st.corner_radar, fastest_mps=st.eoam.policy.opposing_speed_mps)
 
-    def _policy_record(self) -> dict:
+    def policy_record(self) -> dict:
         """The policy, the V2X settings and what the sight-distance gate needed."""
         st = self.settings
         record = {"policy": st.eoam.policy.name, "v2x_range_m": st.v2x.range_m,
@@ -454,34 +416,6 @@ class CoSimulation:
             return {**record, **self.ctrl.policy.summary()}
         return {**record, "sight_gate": "", "sight_needed_m": None, "sight_known_free_m": None,
                 "sight_time_s": None, "tie_break": ""}
-
-    def _substep_contact(self, x_prev, x_next, body, b0):
-        """First contact at any plant sub-step between ego and body (``b0`` its pose at the
-        start of the step), both poses interpolated linearly over the step."""
-        p = self.params
-        n = self.settings.substeps
-        for k in range(1, n + 1):
-            w = k / n
-            ex = x_prev[0] + w * (x_next[0] - x_prev[0])
-            ey = x_prev[1] + w * (x_next[1] - x_prev[1])
-            eyaw = x_prev[2] + w * (x_next[2] - x_prev[2])
-            bx = b0.x_m + w * (body.x_m - b0.x_m)
-            by = b0.y_m + w * (body.y_m - b0.y_m)
-            byaw = body.yaw_rad
-            ebox = OrientedBox.from_axis_point(
-                ex, ey, eyaw, p.length_m, p.width_m, p.cg_to_front_bumper_m
-            )
-            obox = OrientedBox(bx, by, byaw, body.length_m, body.width_m)
-            vx = x_prev[3] + w * (x_next[3] - x_prev[3])
-            vy = x_prev[4] + w * (x_next[4] - x_prev[4])
-            ce, se = math.cos(eyaw), math.sin(eyaw)
-            ve = (vx * ce - vy * se, vx * se + vy * ce)
-            vb = (body.speed_mps * math.cos(byaw), body.speed_mps * math.sin(byaw))
-            hit = contact(ebox, obox, ve, vb)
-            if hit is not None:
-                return hit
-        return None
-
 
 def policy_settings(settings: RunSettings, policy: str, v2x_range_m: float = 0.0,
                     v2x_latency_s: float = 0.1, v2x_loss: float = 0.0,
@@ -510,21 +444,6 @@ def run_case(
     if out_dir is not None:
         write_run(Path(out_dir), summary, log, timeseries, sim.traffic)
     return summary
-
-
-def _trigger(log: RunLog, belief: FrictionBelief) -> dict:
-    """When the EOAM first left NORMAL (mode 0): SUMO time, the obstacle's range then and the
-    friction it believed (all None when it never did)."""
-    modes = log.column("mode")
-    acting = np.flatnonzero(np.isfinite(modes) & (modes != 0))
-    if acting.size == 0:
-        return {"trigger_time_s": None, "trigger_range_m": None, "mu_believed_at_trigger": None}
-    k = int(acting[0])
-    t = float(log.column("time_s")[k])
-    rng = float(log.column("aro_range_m")[k])
-    return {"trigger_time_s": round(t, 6),
-            "trigger_range_m": round(rng, 6) if math.isfinite(rng) else None,
-            "mu_believed_at_trigger": belief.at(t)}
 
 
 _NOTHING = Perception(None, None, False)  # immutable, so shared by all steps that see nothing

@@ -44,7 +44,19 @@ class RunView(Protocol):
     @property
     def bodies(self) -> Sequence[Any]: ...  # the road users near the ego now (``Body``)
     @property
-    def bodies_before(self) -> Sequence[Any]: ...  # and at the last step's start
+    def bodies_before(self) -> Sequence[Any]: ...  # the road users at the last step's start
+    @property
+    def report(self) -> Any: ...  # the radar's report at the last step's start
+    @property
+    def session(self) -> Any: ...  # the SUMO session (queries only)
+    @property
+    def road(self) -> Any: ...  # the road frame of the ego's original lane
+    @property
+    def step_s(self) -> float: ...  # the step
+    @property
+    def lane_width_m(self) -> float: ...  # the ego's lane's width
+    @property
+    def left_lane(self) -> bool: ...  # a lane (either direction) lies left of the ego's
 
 
 class StepObserver:

@@ -24,27 +24,41 @@ Definitions:
   session reports neither): an ego that starts in a middle lane and moves a whole lane to the
   right is reported as having left the road.
 
+* direct hit: the ego's front face hit the other body with at least ``DIRECT_HIT_MIN_OVERLAP``
+  (50 %) of the narrower of the two widths in line (``geometry.face_overlap``); less is an
+  offset hit (the frontal offset crash tests use 40 % and 25 % of the car's width);
+* cut off: the run ended at its time limit or at the end of the road, not by the rules of
+  the step loop (a contact, or the EOAM done and settled).
+
 Rules, in order:
 
-1. no contact, and the ego lost control or left the road: ``orange`` (a spin or a road
+1. front against front (``head_on`` or ``oblique``) with an oncoming road user: ``red``, with
+   or without a lane change (a frontal hit on oncoming traffic is the most severe outcome);
+2. no lane change and a direct hit of the ego's front on a body that is not oncoming
+   (front-to-rear or frontal, not a side contact): ``yellow`` (direct hit at reduced speed,
+   paper sec. 8.1);
+3. every other contact: ``orange`` (lateral or offset contact: side contact with the oncoming
+   vehicle, any contact after a lane change with the ARO or a parked car, any side contact,
+   an offset front hit, the ego hit from behind); an offset front-to-rear hit is orange, not
+   yellow: the paper's yellow is a direct hit after straight-line braking, and an offset hit
+   loads one side of the car as a lateral glance does;
+4. no contact, and the ego lost control or left the road: ``orange`` (a spin or a road
    departure ends in lateral or roadside contact, the paper's orange; the run stops before
    it), ``collision_with`` ``none``, the reason saying what happened;
-2. no contact and no mode other than 0 (NORMAL): ``none``;
-3. no contact otherwise: ``green``; the reason says whether the lane change was completed and
-   the ego returned, or it stopped behind the obstacle; a run that ended before the ego was
-   back in lane or stopped is still green (nothing was hit) and the reason says so;
-4. front against front (``head_on`` or ``oblique``) with the oncoming vehicle: ``red``, with or
-   without a lane change (a frontal hit on oncoming traffic is the most severe outcome);
-5. no lane change and the ego's front hit a body that is not oncoming (front-to-rear or
-   frontal, not a side contact): ``yellow`` (direct hit at reduced speed, paper sec. 8.1);
-6. every other contact: ``orange`` (lateral or offset contact: side contact with the oncoming
-   vehicle, any contact after a lane change with the ARO or a parked car, any side contact,
-   the ego hit from behind).
+5. no contact and no mode other than 0 (NORMAL): ``none``;
+6. no contact, the run cut off with the ego not back in its lane or a manoeuvre still
+   running: ``unfinished`` (never green: nothing says how it would have ended);
+7. no contact otherwise: ``green``; the reason says whether the lane change was completed
+   (the ego back in its lane ahead of the obstacle it avoided), abandoned (back in its lane
+   behind that obstacle: green, since nothing was hit and the ego is back where braking would
+   have left it, but not "completed"), or the ego stopped or braked behind the obstacle.
 
-Runs with contact are classified by rules 4-6 whatever the ego's motion before the contact.
+Runs with contact are classified by rules 1-3 whatever the ego's motion before the contact.
 ``collision_with`` is the role of the body hit: ``aro``, ``oncoming``, ``parked`` or ``other``
 (moving with the traffic outside the ego lane band, e.g. a car overtaking in the next
-lane).
+lane). Roles come from ground-truth position and motion, never from the radar's classes: a
+road user heading against the road's direction (more than 90 deg off it) and not parked is
+oncoming whatever its speed, a van creeping at 1.5 m/s as a car at 30 m/s.
 """
 
 from __future__ import annotations
@@ -56,10 +70,9 @@ from dataclasses import dataclass
 from eoam_sumo.colours import OUTCOMES
 from eoam_sumo.params import PONR_FRACTION
 from eoam_sumo.sim.bodies import Body
-from eoam_sumo.sim.geometry import Contact
+from eoam_sumo.sim.geometry import HEAD_ON_MIN_OVERLAP, Contact
 from eoam_sumo.sim.radar import (
     LANE_MARGIN_M,
-    ONCOMING_SPEED_MPS,
     STATIONARY_SPEED_MPS,
     RoadProjection,
 )
@@ -85,6 +98,9 @@ REVERSING_SPEED_MPS = -0.5
 # 0.33 m at most (Table 2), half a lane inside the right edge.
 ROAD_EDGE_MARGIN_M = 0.5
 
+#: A front hit covering less than this share of the narrower width in line is an offset hit.
+DIRECT_HIT_MIN_OVERLAP = HEAD_ON_MIN_OVERLAP
+
 ROLES = ("aro", "oncoming", "parked", "other")
 _COLLISION_WITH = {"aro": "aro", "oncoming": "oncoming", "parked": "parked", "other": "other"}
 _ROLE_NAMES = {
@@ -102,21 +118,20 @@ def role_of(
     *,
     in_lane_at_start: bool = False,
     stationary_speed_mps: float = STATIONARY_SPEED_MPS,
-    oncoming_speed_mps: float = ONCOMING_SPEED_MPS,
     lane_margin_m: float = LANE_MARGIN_M,
 ) -> str:
     """Ground-truth role of a body relative to the ego's original lane (``road_frame``).
 
-    ``oncoming``: moving against the road direction faster than ``oncoming_speed_mps``;
-    ``aro``: otherwise, when its centre is inside the ego lane band (half-width lane_width/2 +
-    lane_margin_m) or it was the vehicle ahead in the ego lane at the start
-    (``in_lane_at_start``); ``parked``: slower than ``stationary_speed_mps`` outside the band;
-    ``other``: the rest. Thresholds default to the radar's, so roles and radar classes agree.
+    ``oncoming``: heading against the road direction there (more than 90 deg off it) and not
+    parked, whatever its speed; ``aro``: otherwise, when its centre is inside the ego lane
+    band (half-width lane_width/2 + lane_margin_m) or it was the vehicle ahead in the ego lane
+    at the start (``in_lane_at_start``); ``parked``: slower than ``stationary_speed_mps``
+    outside the band; ``other``: the rest.
     """
     if not lane_width_m > 0.0:
         raise ValueError(f"lane_width_m={lane_width_m} must be > 0")
     _, d, road_yaw = road_frame.project(body.x_m, body.y_m)
-    if body.speed_mps * math.cos(body.yaw_rad - road_yaw) < -oncoming_speed_mps:
+    if not body.parked and math.cos(body.yaw_rad - road_yaw) < 0.0:
         return "oncoming"
     if in_lane_at_start or abs(d) < 0.5 * lane_width_m + lane_margin_m:
         return "aro"
@@ -227,6 +242,10 @@ def classify_outcome(
     min_offset_m: float = 0.0,
     max_offset_m: float = 0.0,
     left_width_m: float = 0.0,
+    direct_overlap: float = 1.0,
+    cut_off: str | None = None,
+    manoeuvre_running: bool = False,
+    passed_obstacle: bool | None = None,
 ) -> Outcome:
     """Colour of a run by the rules of the module docstring.
 
@@ -240,6 +259,12 @@ def classify_outcome(
     and ``min_speed_mps`` the lowest forward speed vx (signed) during the run;
     ``min_offset_m``/``max_offset_m`` the signed extremes of d and ``left_width_m`` the road
     width to the left of the original lane (``road_departure``).
+
+    Contact and end of the run (keyword-only): ``direct_overlap`` the share of the narrower
+    width in line covered at the contact (direct or offset hit); ``cut_off`` what cut the run
+    off (``"time limit"``, ``"end of the road"``; None when it ended by the loop's rules),
+    ``manoeuvre_running`` whether a manoeuvre was still under way then; ``passed_obstacle``
+    whether the ego ended ahead of the obstacle its lane change avoided (None: unknown).
     """
     modes = set(modes_visited)
     if not modes <= {0, 1, 2, 3, 4, 5}:
@@ -269,7 +294,8 @@ def classify_outcome(
             # an offset past the point of no return is a lane change only if the EOAM steered
             done = _manoeuvre_phrase(modes, lane_change and bool(modes & {2, 4, 5}))
             return Outcome("orange", "none", 0.0, f"{done}, no contact; {'; '.join(lost)}")
-        return _no_contact(modes, lane_change, final_offset_m, final_speed_mps, settings)
+        return _no_contact(modes, lane_change, final_offset_m, final_speed_mps, settings,
+                           cut_off, manoeuvre_running, passed_obstacle)
     if role not in ROLES:
         raise ValueError(f"role={role!r} of the body hit must be one of {ROLES}")
     what = _ROLE_NAMES[role]
@@ -281,9 +307,13 @@ def classify_outcome(
         colour, reason = "red", f"{done}, {how} with the oncoming vehicle at {v:.1f} m/s"
     elif (
         not lane_change and role != "oncoming" and contact.face_a == "front"
-        and contact.kind != "side"
+        and contact.kind != "side" and direct_overlap >= DIRECT_HIT_MIN_OVERLAP
     ):
         colour, reason = "yellow", f"{done}, front hit {what} at {v:.1f} m/s"
+    elif contact.face_a == "front" and contact.kind != "side" and role != "oncoming":
+        colour, reason = "orange", (
+            f"{done}, offset front hit {what} ({100 * direct_overlap:.0f} % of the narrower "
+            f"width in line) at {v:.1f} m/s")
     else:
         how = contact.kind.replace("_", "-")
         part = f"ego {contact.face_a} against its {contact.face_b}"
@@ -313,13 +343,23 @@ def _loss_of_control(
 
 def _no_contact(
     modes: set[int], lane_change: bool, final_offset_m: float, final_speed_mps: float,
-    settings: OutcomeSettings,
+    settings: OutcomeSettings, cut_off: str | None = None, manoeuvre_running: bool = False,
+    passed_obstacle: bool | None = None,
 ) -> Outcome:
     if not modes - {0}:
         return Outcome("none", "none", 0.0, "no manoeuvre needed, no contact")
     in_lane = abs(final_offset_m) <= settings.in_lane_tolerance_m
     stopped = final_speed_mps <= settings.stopped_speed_mps
-    if lane_change:
+    if cut_off is not None and (manoeuvre_running or not in_lane):
+        where = ("a manoeuvre still running" if in_lane else
+                 f"the ego {final_offset_m:+.1f} m from its lane centre"
+                 + (" and a manoeuvre still running" if manoeuvre_running else ""))
+        return Outcome("unfinished", "none", 0.0,
+                       f"no contact, but the run was cut off at its {cut_off} with {where}")
+    if lane_change and passed_obstacle is False:
+        reason = ("lane change not completed: returned to its lane behind the obstacle it was "
+                  "avoiding, no contact")
+    elif lane_change:
         reason = (
             "lane change completed, returned to lane, no contact" if in_lane
             else "lane change completed, no contact, not back in lane when the run ended"

@@ -22,7 +22,7 @@ def _doc(text: str):
 class RunSummary:
     """What one run came to (summary.json, in this order)."""
 
-    outcome: str = _doc("outcome colour: none, green, yellow, orange or red")
+    outcome: str = _doc("outcome colour: none, green, yellow, orange, red or unfinished")
     collision_with: str = _doc("role of the road user hit: none, aro, oncoming, parked, other")
     impact_speed_mps: float = _doc("relative speed of the box centres at the first contact")
     contact_kind: str = _doc("none, head_on, oblique, rear_end or side")
@@ -30,6 +30,13 @@ class RunSummary:
     contact_x_m: float | None = _doc("where the first contact was: the centroid of the boxes'"
                                      " overlap, network x (empty: none)")
     contact_y_m: float | None = _doc("and its network y (empty: none)")
+    collision_with_id: str | None = _doc("SUMO id of the road user hit")
+    collision_with_class: str | None = _doc("its SUMO vClass (pedestrian for a person)")
+    contact_overlap: float | None = _doc(
+        "share of the ego's face hit that the other covers (front/rear: of its width)")
+    impact_angle_rad: float | None = _doc("angle between the headings: 0 same way, pi head-on")
+    delta_v_ego_mps: float | None = _doc("the ego's change of velocity (plastic impact)")
+    collision_with_mass_kg: float | None = _doc("mass of the road user hit, as used")
     reason: str = _doc("one sentence on why the run got its colour")
     modes_visited: tuple[int, ...] = _doc("EOAM modes 0-5 in order of first visit")
     fcw_raised: bool = _doc("the forward collision warning was raised")
@@ -52,6 +59,15 @@ class RunSummary:
     seed: int = _doc("the seed of every random model of the run")
     min_gap_aro_m: float | None = _doc(
         "smallest box-to-box gap to the in-lane obstacle within 20 m (empty: never that close)")
+    min_gap_oncoming_m: float | None = _doc(
+        "smallest box gap to an opposite-direction road user in reach (empty: none)")
+    min_ttc_oncoming_s: float | None = _doc(
+        "smallest time to collision with one (empty: never on a collision course)")
+    time_in_opposite_lane_s: float = _doc("time with the ego's centre left of its lane")
+    near_miss: bool = _doc("no contact, but within 0.5 m of a road user or TTC below 1.5 s")
+    passed_obstacle: bool | None = _doc(
+        "a lane change ended ahead of the obstacle it avoided (empty: no lane change)")
+    end_cause: str = _doc("contact, settled, road_end or time_limit")
     max_abs_lat_accel_mps2: float = _doc("largest |lateral acceleration| of the ego")
     max_lateral_offset_m: float = _doc("largest |lateral offset| from the original lane centre")
     final_lateral_offset_m: float = _doc("lateral offset when the run ended (left +)")

@@ -58,7 +58,8 @@ def test_table2_counts_agreement_and_links_each_difference(tmp_path):
     md = table2_markdown(outcome_grid(results))
     assert "**59/64 cells agree.**" in md
     # the paper's layout: 16 rows (traffic x speed), friction columns 1.0 .. 0.1
-    table = [ln for ln in md.splitlines() if ln.startswith("| ") and "km/h" in ln]
+    table = [ln for ln in md.split("## Margins")[0].splitlines()
+             if ln.startswith("| ") and "km/h" in ln]
     assert len(table) == 16
     assert "| 1.0 surface mu | 0.7 surface mu | 0.3 surface mu | 0.1 surface mu |" in md
     assert table[0].startswith("| No oncoming | 165 km/h |")
@@ -97,7 +98,8 @@ def test_own_sweep_gets_a_plain_pivot(tmp_path):
     _, results = _results(tmp_path, matrix_path, differ=(1,))
     md = table2_markdown(outcome_grid(results))
     assert "agree" not in md and " / " not in md
-    table = [ln for ln in md.splitlines() if ln.startswith("| ") and "km/h" in ln]
+    table = [ln for ln in md.split("## Margins")[0].splitlines()
+             if ln.startswith("| ") and "km/h" in ln]
     # the varying ARO deceleration is part of the row label: 2 speeds x 2 decelerations
     assert len(table) == 4 and "100 km/h, ARO decel 6 m/s²" in table[0]
     assert "| 0.9 surface mu | 0.5 surface mu | 0.2 surface mu |" in md
@@ -108,11 +110,13 @@ def test_own_sweep_gets_a_plain_pivot(tmp_path):
 def test_write_report_writes_markdown_and_a_png(tmp_path):
     _, results = _results(tmp_path, REPO / "scenarios" / "table2.toml", differ=(5,),
                           failed=(6,))
-    md, png = write_report(tmp_path, results)
+    md, png, margins = write_report(tmp_path, results)
     head, _, rest = table2_markdown(outcome_grid(results)).partition("\n\n")
     text = md.read_text(encoding="utf-8")  # the grid, with the policy's line below the title
     assert text.startswith(f"{head}\n\nPolicy **paper**; forward radar") and text.endswith(rest)
-    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
+    for image in (png, margins):
+        assert image.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and image.stat().st_size > 20_000
+    assert "## Margins" in text
 
 
 @pytest.mark.parametrize("colour", ["green", "red"])

@@ -22,9 +22,10 @@ import pandas as pd
 REPO = Path(__file__).resolve().parents[2]
 MATRIX = REPO / "scenarios" / "table2.toml"
 EXPECTED = Path(__file__).with_name("table2_expected.csv")
-FIGURES = ("impact_speed_mps", "min_gap_aro_m", "max_lateral_offset_m", "sim_time_s")
-COLUMNS = ("case_id", "outcome", "collision_with", *FIGURES, "modes_visited",
-           "timeseries_sha256")
+FIGURES = ("impact_speed_mps", "min_gap_aro_m", "max_lateral_offset_m", "sim_time_s",
+           "contact_overlap", "delta_v_ego_mps", "min_gap_oncoming_m", "min_ttc_oncoming_s")
+COLUMNS = ("case_id", "outcome", "collision_with", "collision_with_id", *FIGURES, "near_miss",
+           "modes_visited", "timeseries_sha256")
 
 
 def _figure(value) -> str:
@@ -47,7 +48,9 @@ def observed(out_dir: Path, jobs: int = 2) -> pd.DataFrame:
             "case_id": r["case_id"],
             "outcome": summary["outcome"],
             "collision_with": summary["collision_with"],
+            "collision_with_id": summary["collision_with_id"] or "",
             **{k: _figure(summary.get(k)) for k in FIGURES},
+            "near_miss": str(summary["near_miss"]).lower(),
             "modes_visited": " ".join(str(m) for m in summary["modes_visited"]),
             "timeseries_sha256": digest,
         })
@@ -68,7 +71,7 @@ def differences(got: pd.DataFrame, want: pd.DataFrame) -> list[str]:
             lines.append(f"{cid}: {'missing' if cid not in got_by_id else 'unexpected'}")
             continue
         for col in COLUMNS[1:]:
-            a, b = str(want_by_id[cid][col]), str(got_by_id[cid][col])
+            a, b = str(want_by_id[cid].get(col, "(none)")), str(got_by_id[cid][col])
             if a != b:
                 lines.append(f"{cid} {col}: {a} -> {b}")
     return lines

@@ -38,7 +38,7 @@ PONR_PASSED = [0, 1, 2, 4, 5, 0]
 
 
 def _hit(kind, face_a="front", face_b="rear", speed=7.2):
-    return Contact(kind, face_a, face_b, speed, (0.0, 0.0))
+    return Contact(kind, face_a, face_b, speed, (0.0, 0.0), (1.0, 0.0), speed)
 
 
 def _classify(modes, max_offset, contact_=None, role="none", final_offset=0.0, final_speed=0.0):
@@ -67,7 +67,12 @@ def _body(s_m, d_m, yaw_rad, speed_mps, dims=CAR):
         (_body(80.0, -4.15, 0.0, 0.0, (4.3, 1.8)), "parked"),  # 1.5 m beyond the marker
         (_body(80.0, LANE_M, 0.0, 0.0), "parked"),  # stopped outside the ego lane band
         (_body(80.0, LANE_M, 0.0, 30.0), "other"),  # overtaking in the left lane
-        (_body(80.0, LANE_M, math.pi, 1.0), "other"),  # creeping backwards, not oncoming
+        # against the road's direction: oncoming whatever its speed (a van at 1.5 m/s, a car
+        # halted in the opposite lane), unless SUMO has it parked
+        (_body(80.0, LANE_M, math.pi, 1.5), "oncoming"),
+        (_body(80.0, LANE_M, math.pi, 0.0), "oncoming"),
+        (Body("t", "passenger", 80.0, -4.15, math.pi, 0.0, *CAR, parked=True), "parked"),
+        (_body(80.0, 0.0, math.pi, 1.3, (0.215, 0.478)), "oncoming"),  # a person walking at us
     ],
 )
 def test_role_of(body, role):
@@ -261,7 +266,7 @@ def test_invariants(modes, max_offset, hit, role, final_offset, final_speed):
 
 def test_aborted_steer_that_drifts_past_the_ponr_is_still_limit_braking():
     """Mode 3 (oncoming seen before the PONR) then a front hit on the ARO: yellow."""
-    hit = Contact("rear_end", "front", "rear", 9.0, (0.0, 0.0))
+    hit = Contact("rear_end", "front", "rear", 9.0, (0.0, 0.0), (1.0, 0.0), 9.0)
     out = classify_outcome([0, 1, 2, 3], 1.6, 3.5, hit, "aro")
     assert out.colour == "yellow" and "limit braking" in out.reason
 

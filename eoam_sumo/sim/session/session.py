@@ -398,6 +398,14 @@ class SumoSession:
                                         veh.getSpeed(vid), veh.getTypeID(vid),
                                         veh.getStopState(vid))
 
+    def mass_kg(self, vid: str) -> float:
+        """A road user's mass as SUMO has it (``getMass``: its vType's ``mass``, or SUMO's
+        default for its vClass), a vehicle or a person."""
+        self._check_open()
+        if vid not in self._veh.getIDList() and vid in self._api.person.getIDList():
+            return float(self._api.person.getMass(vid))
+        return float(self._veh.getMass(vid))
+
     def vehicle_ids(self) -> list[str]:
         return list(self._veh.getIDList())
 

@@ -1,0 +1,112 @@
+"""Safety margins of a run, as an observer of the step: how close the ego came to the road
+users around it, how soon it would have hit opposite-direction traffic, how long it spent
+left of its lane, and whether a run without contact was a near miss.
+
+* ``min_gap_oncoming_m``: the smallest box-to-box gap to any opposite-direction road user
+  (not parked, heading more than 90 deg from the road's direction at the ego): at every step
+  while SUMO reports it within the sensing reach, and for every such road user in the
+  simulation at the start and at the end of the run (one never within reach has neither met
+  nor passed the ego, so the smaller of those two gaps is its smallest); infinite (empty in
+  the summary) when there is none;
+* ``min_ttc_oncoming_s``: the smallest time to collision with such a road user, both keeping
+  their velocities (``geometry.time_to_contact``); infinite when never on a collision course;
+* ``time_in_opposite_lane_s``: steps with the ego's centre left of its lane (in the next lane
+  to the left, the opposite lane on a two-way road) times the step;
+* ``closest_gap_m`` and ``closest_id``: the smallest gap to any road user once within
+  ``NEAR_MISS_GAP_M`` (gaps farther out are not measured);
+* a run without contact is a **near miss** when it came within ``NEAR_MISS_GAP_M`` of any
+  road user or its ``min_ttc_oncoming_s`` fell below ``NEAR_MISS_TTC_S``.
+"""
+
+from __future__ import annotations
+
+import math
+
+from eoam_sumo.sim.geometry import OrientedBox, box_distance, time_to_contact
+from eoam_sumo.sim.observers import RunView, StepObserver
+
+#: A run without contact that came this close to another road user is a near miss [m].
+NEAR_MISS_GAP_M = 0.5
+#: ... or that was on a collision course with opposite-direction traffic less than this far
+#: from the contact [s]: the minimum time to collision under which traffic-conflict studies
+#: count an encounter as serious (van der Horst, *A time-based analysis of road user
+#: interaction*, 1990: 1.5 s).
+NEAR_MISS_TTC_S = 1.5
+_ROUNDING_M = 1e-6  # lower bounds of a gap are lowered by this before ruling a gap out
+
+
+class Margins(StepObserver):
+    """The margins of the module docstring, for an ego of ``length_m`` x ``width_m`` whose
+    CG is ``cg_to_front_m`` behind its front."""
+
+    def __init__(self, length_m: float, width_m: float, cg_to_front_m: float):
+        self.length_m, self.width_m, self.front_m = length_m, width_m, cg_to_front_m
+        self._back_m = cg_to_front_m - 0.5 * length_m  # CG to the box centre
+        self._radius_m = math.hypot(0.5 * length_m, 0.5 * width_m)
+
+    def start(self, sim: RunView) -> None:
+        self.min_gap_oncoming_m = self._opposite_gap(sim, sim.x)
+        self.min_ttc_oncoming_s = math.inf
+        self.closest_gap_m = math.inf
+        self.closest_id: str | None = None
+        self._opposite_steps = 0
+        self._step_s = sim.step_s
+        self._half_lane_m = 0.5 * sim.lane_width_m
+        self._left_lane = sim.left_lane
+
+    @property
+    def time_in_opposite_lane_s(self) -> float:
+        return self._opposite_steps * self._step_s
+
+    def end(self, sim: RunView) -> None:
+        self.min_gap_oncoming_m = min(self.min_gap_oncoming_m, self._opposite_gap(sim, sim.x))
+
+    def _opposite_gap(self, sim: RunView, x) -> float:
+        """The smallest gap from the ego (plant state ``x``) to any opposite-direction road
+        user in the simulation (infinite when there is none)."""
+        X, Y, yaw = x[0], x[1], x[2]
+        road_yaw = sim.road.project(X, Y)[2]
+        cr, sr = math.cos(road_yaw), math.sin(road_yaw)
+        ego = OrientedBox.from_axis_point(X, Y, yaw, self.length_m, self.width_m, self.front_m)
+        return min((box_distance(ego, b.box) for b in sim.session.road_users()
+                    if not b.parked and b.box.cos_yaw * cr + b.box.sin_yaw * sr < 0.0),
+                   default=math.inf)
+
+    def near_miss(self) -> bool:
+        return (self.closest_gap_m <= NEAR_MISS_GAP_M
+                or self.min_ttc_oncoming_s < NEAR_MISS_TTC_S)
+
+    def after_step(self, sim: RunView) -> None:
+        meas = sim.meas
+        if self._left_lane and meas.d_m > self._half_lane_m:
+            self._opposite_steps += 1
+        X, Y, yaw, vx, vy = sim.x[:5]
+        c, s = math.cos(yaw), math.sin(yaw)
+        ex, ey = X + self._back_m * c, Y + self._back_m * s
+        road_yaw = sim.x_prev[2] - meas.e_yaw_rad  # the road's heading at the ego
+        cr, sr = math.cos(road_yaw), math.sin(road_yaw)
+        ego_box = None
+        for b in sim.bodies:
+            box = b.box
+            bound = (math.hypot(box.x_m - ex, box.y_m - ey) - self._radius_m - box.radius_m
+                     - _ROUNDING_M)
+            opposite = not b.parked and box.cos_yaw * cr + box.sin_yaw * sr < 0.0
+            near = bound < NEAR_MISS_GAP_M
+            if not (opposite or near):
+                continue
+            if ego_box is None:
+                ego_box = OrientedBox(ex, ey, yaw, self.length_m, self.width_m)
+                ve = (vx * c - vy * s, vx * s + vy * c)
+            gap = -1.0
+            if opposite:
+                if bound < self.min_gap_oncoming_m:
+                    gap = box_distance(ego_box, box)
+                    self.min_gap_oncoming_m = min(self.min_gap_oncoming_m, gap)
+                vb = (b.speed_mps * box.cos_yaw, b.speed_mps * box.sin_yaw)
+                ttc = time_to_contact(ego_box, box, ve, vb, self.min_ttc_oncoming_s)
+                self.min_ttc_oncoming_s = min(self.min_ttc_oncoming_s, ttc)
+            if near and bound < self.closest_gap_m:
+                if gap < 0.0:
+                    gap = box_distance(ego_box, box)
+                if gap < self.closest_gap_m:
+                    self.closest_gap_m, self.closest_id = gap, b.vid
