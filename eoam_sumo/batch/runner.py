@@ -47,7 +47,6 @@ from eoam_sumo.batch.results import (
 from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.matrix import Case, Matrix, check_matrix, load_matrix
-from eoam_sumo.plotting.batch_plots import MARGINS_PNG, plot_margins, plot_table2
 
 #: Exit status of ``eoam-sumo batch`` when at least one case failed (bad input is 2).
 EXIT_CASES_FAILED = 1
@@ -183,6 +182,10 @@ def run_batch(
 def write_report(out_dir: Path, results: pd.DataFrame) -> list[Path]:
     """Write ``table2.md``, ``table2.png`` and ``margins.png`` of a results frame into
     ``out_dir``."""
+    # matplotlib is imported only when a report is drawn: the batch's workers and its tests'
+    # case functions import this module and need none of it
+    from eoam_sumo.plotting.batch_plots import MARGINS_PNG, plot_margins, plot_table2
+
     out_dir = Path(out_dir)
     grid = outcome_grid(results)
     text = table2_markdown(grid, policy_title(results))
