@@ -272,7 +272,6 @@ class CoSimulation:
         front_xy = (X + front * self._cy, Y + front * self._sy)
         report = self.radar.scan(front_xy, yaw, vx, road, self.bodies, self.lane_width_m,
                                  self.t)
-        self.report = report
         perception = _perception(report)
         if self.lane_sensing is not None:
             perception = perception._replace(next_lane=self.lane_sensing.update(

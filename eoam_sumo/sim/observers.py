@@ -46,8 +46,6 @@ class RunView(Protocol):
     @property
     def bodies_before(self) -> Sequence[Any]: ...  # the road users at the last step's start
     @property
-    def report(self) -> Any: ...  # the radar's report at the last step's start
-    @property
     def session(self) -> Any: ...  # the SUMO session (queries only)
     @property
     def road(self) -> Any: ...  # the road frame of the ego's original lane

@@ -13,6 +13,7 @@ import numpy as np
 from eoam_sumo.sensing.friction import FrictionBelief
 from eoam_sumo.sim.observers import RunView, StepObserver
 from eoam_sumo.sim.outcome import classify_outcome, left_road
+from eoam_sumo.sim.radar import LANE_MARGIN_M
 from eoam_sumo.sim.runlog import RunLog
 from eoam_sumo.sim.severity import ContactRecord, contact_severity
 from eoam_sumo.sim.summary import RunSummary, finite_or_none, rounded
@@ -56,21 +57,26 @@ class EndedRun(RunView, Protocol):
 
 
 class AvoidedObstacle(StepObserver):
-    """The SUMO id of the in-path obstacle when the EOAM first began a lane change (mode 2 or
-    4): the road user that lane change avoided (ground truth for the verdict only)."""
+    """The SUMO id of the obstacle a lane change avoided: when the EOAM first began one (mode 2
+    or 4), the nearest road user ahead of the ego with its centre in the ego's lane band (from
+    ground truth, for the verdict only; the EOAM never sees it)."""
 
     vid: str | None
 
     def start(self, sim: RunView) -> None:
         self.vid = None
+        self._done = False
 
     def after_step(self, sim: RunView) -> None:
-        if self.vid is not None or sim.cmd.mode not in _LANE_CHANGE_MODES:
+        if self._done or sim.cmd.mode not in _LANE_CHANGE_MODES:
             return
-        det = sim.report.in_path
-        scanned = sim.bodies_before  # the road users the radar scanned this step
-        if det is not None and 0 <= det.target_index < len(scanned):
-            self.vid = scanned[det.target_index].vid
+        self._done = True
+        band_m = 0.5 * sim.lane_width_m + LANE_MARGIN_M
+        s_ego, nearest = sim.meas.s_m, math.inf
+        for b in sim.bodies_before:  # the road users at the start of that step
+            s, d, _ = sim.road.project(b.x_m, b.y_m)
+            if abs(d) < band_m and s_ego < s < s_ego + nearest:
+                self.vid, nearest = b.vid, s - s_ego
 
 
 def passed_obstacle(sim: EndedRun, vid: str | None) -> bool | None:

@@ -38,3 +38,6 @@ def check_verdicts(results) -> None:
     close = green[(green["min_gap_aro_m"] <= NEAR_MISS_GAP_M)
                   | (green["min_gap_oncoming_m"] <= NEAR_MISS_GAP_M)]
     assert (close["near_miss"] == "True").all()
+    # the lane changes that ended green passed the obstacle they avoided (the ARO)
+    changed = green[green["time_in_opposite_lane_s"] > 0.0]
+    assert len(changed) > 0 and (changed["passed_obstacle"] == "True").all()
