@@ -119,6 +119,10 @@ def place_poles(A: np.ndarray, B: np.ndarray, poles) -> np.ndarray:
     return last @ np.linalg.solve(ctrb, phi)
 
 
+#: Gain tables by (vehicle parameters, gains, friction), shared by the runs of a process.
+_GAIN_TABLES: dict[tuple, list[tuple[float, float, float, float]]] = {}
+
+
 class SteeringController:
     """Eq. 38 steering law; ``command`` returns the clipped road-wheel angle and its parts."""
 
@@ -188,11 +192,15 @@ class SteeringController:
         """(k_vy [rad s/m], k_r [rad s/rad], k_psi [rad/rad], k_e [rad/m]) at this speed and
         friction, blended from the gain table."""
         if mu != self._table_mu:
-            self._table = []
-            for v in self._speeds:
-                A, B = single_track_matrices(self._params, v)
-                k = place_poles(A, B, self.design_poles(v, mu))
-                self._table.append((float(k[0]), float(k[1]), float(k[2]), float(k[3])))
+            key = (self._params, self._gains, mu)
+            if key not in _GAIN_TABLES:  # ~50 ms of pole placements: once per process
+                rows = []
+                for v in self._speeds:
+                    A, B = single_track_matrices(self._params, v)
+                    k = place_poles(A, B, self.design_poles(v, mu))
+                    rows.append((float(k[0]), float(k[1]), float(k[2]), float(k[3])))
+                _GAIN_TABLES[key] = rows
+            self._table = _GAIN_TABLES[key]
             self._table_mu = mu
         speeds, table = self._speeds, self._table
         j = bisect_right(speeds, speed_mps)
