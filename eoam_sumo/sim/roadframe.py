@@ -90,9 +90,7 @@ class RoadFrame:
         self._hint = i
         s_m = self._s[i] + along
         j = self._break_interval(s_m)
-        h = s_m if s_m > 0.0 else 0.0  # beyond its ends the road runs straight on
-        if h > self._s[-1]:
-            h = self._s[-1]
+        h = min(max(0.0, s_m), self._s[-1])  # beyond its ends the road runs straight on
         yaw = self._break_yaw[j] + (h - self._breaks[j]) * self._break_slope[j]
         return s_m, ry * hx[i] - rx * hy[i], yaw
 
