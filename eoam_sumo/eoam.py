@@ -37,7 +37,6 @@ import math
 from eoam_sumo.control.longitudinal import LongitudinalController
 from eoam_sumo.control.paths import PathReference, QuinticShift
 from eoam_sumo.control.steering import SteeringController
-from eoam_sumo.decision import modes
 from eoam_sumo.decision.dmm import SECTOR_ORDER, Action, BoundaryCurve, Sector
 from eoam_sumo.decision.modes import Mode, next_mode
 from eoam_sumo.decision.obstacle import ObstacleDecel, stopping_range_m
@@ -51,17 +50,13 @@ __all__ = ["Command", "EgoMeasurement", "EoamController", "EoamSettings", "Objec
            "Perception"]
 
 
-# Enum members bound once for ``step`` (the modes in decision.modes): on Python 3.11 each
-# ``Mode.X`` read goes through the enum metaclass (~80 ns), and a step reads about fifteen.
-_NORMAL, _UPDATE_BRAKE, _STEER_BRAKE = modes.NORMAL, modes.UPDATE_BRAKE, modes.STEER_BRAKE
-_ONCOMING_BRAKE, _ONCOMING_STEER, _RETURN = modes.ONCOMING_BRAKE, modes.ONCOMING_STEER, modes.RETURN
-_STEER, _BRAKE, _LIMIT_BRAKE = Action.STEER, Action.BRAKE, Action.LIMIT_BRAKE
-_NO_ACTION = Action.NONE
-_SECTOR_G = Sector.G
-_WARNING_MODES = (_UPDATE_BRAKE, _STEER_BRAKE, _ONCOMING_BRAKE, _ONCOMING_STEER)  # FCW stays on
-_STEERING = (_STEER_BRAKE, _ONCOMING_STEER)
-_COMMITTING = (_NORMAL, _UPDATE_BRAKE)  # a STEER here begins a lane change (safe policy gate)
-_WATCHING = (_STEER_BRAKE, _RETURN)  # the safe policy watches the next lane in these modes
+_WARNING_MODES = (Mode.UPDATE_BRAKE, Mode.UPDATE_STEER_BRAKE, Mode.ONCOMING_BRAKE,
+                  Mode.ONCOMING_STEER_BRAKE)  # FCW stays on
+_STEERING = (Mode.UPDATE_STEER_BRAKE, Mode.ONCOMING_STEER_BRAKE)
+# a STEER in these modes begins a lane change (safe policy gate)
+_COMMITTING = (Mode.NORMAL, Mode.UPDATE_BRAKE)
+# the safe policy watches the next lane in these modes
+_WATCHING = (Mode.UPDATE_STEER_BRAKE, Mode.RETURN)
 _URGENCY = {s: i for i, s in enumerate(SECTOR_ORDER)}  # A most urgent, G least
 
 
@@ -289,19 +284,19 @@ class EoamController:
             closing = -rate if rate is not None and math.isfinite(rate) else 0.0
             sector, stop_range = self._dmm(t, v, rng, closing)
             action = sector.action
-            if action is _STEER and v < st.min_steer_speed_mps:
-                action = _BRAKE  # too slow for a lane change: braking needs less room
-            elif (action is _STEER and self.mode is _UPDATE_BRAKE
+            if action is Action.STEER and v < st.min_steer_speed_mps:
+                action = Action.BRAKE  # too slow for a lane change: braking needs less room
+            elif (action is Action.STEER and self.mode is Mode.UPDATE_BRAKE
                   and rng > self._curve.at(closing).stop_m
                   and stop_range > self._curve.at(v).stop_m):
-                action = _BRAKE  # braking already stops short of it: no lane change
-            elif action is _STEER and not meas.left_lane_available:
-                action = _LIMIT_BRAKE  # no lane to change into: brake in lane
+                action = Action.BRAKE  # braking already stops short of it: no lane change
+            elif action is Action.STEER and not meas.left_lane_available:
+                action = Action.LIMIT_BRAKE  # no lane to change into: brake in lane
             threat_gone = closing < -st.release_opening_speed_mps
             self._track_obstacle(meas, rng, closing, perception.aro_object)
         else:
             sector = None
-            action = _NO_ACTION
+            action = Action.NONE
             threat_gone = True
             self._decel.reset()
         oncoming = bool(perception.oncoming_detected)
@@ -310,7 +305,7 @@ class EoamController:
             oncoming = True  # the lane change would end against a standing car: as deadly
         policy = self.policy
         if policy is not None and policy.blocks(
-                meas, perception, action is _STEER and self.mode in _COMMITTING,
+                meas, perception, action is Action.STEER and self.mode in _COMMITTING,
                 self.mode in _WATCHING):
             oncoming = True  # the next lane is not known free (safe policy): as oncoming
 
@@ -321,7 +316,7 @@ class EoamController:
         travel = d - path.start_offset_m if path is not None else 0.0
         height = self._height
         settled = False
-        if mode is _RETURN and path is not None and dx >= path.length_m:
+        if mode is Mode.RETURN and path is not None and dx >= path.length_m:
             if abs(d) <= st.settle_offset_m and abs(_wrap(meas.e_yaw_rad)) <= st.settle_heading_rad:
                 if self._settle_since is None:
                     self._settle_since = t
@@ -333,13 +328,14 @@ class EoamController:
             clear
             and path is not None
             and st.return_when_stable
-            and mode is _STEER_BRAKE
+            and mode is Mode.UPDATE_STEER_BRAKE
             and dx >= path.length_m
             and abs(d - path.start_offset_m - height) <= st.arrive_tolerance_m
             and abs(_wrap(meas.e_yaw_rad)) <= st.settle_heading_rad
         )
-        past_ponr = oncoming and mode is _STEER_BRAKE and self._past_ponr(meas, travel, height)
-        if (past_ponr and oncoming and mode is _STEER_BRAKE and policy is not None
+        past_ponr = (oncoming and mode is Mode.UPDATE_STEER_BRAKE
+                     and self._past_ponr(meas, travel, height))
+        if (past_ponr and oncoming and mode is Mode.UPDATE_STEER_BRAKE and policy is not None
                 and policy.prefer_braking(meas, perception)):
             past_ponr = False  # severity tie-breaker: braking in lane ends softer
         new = next_mode(
@@ -356,9 +352,9 @@ class EoamController:
         if new is not mode:
             self._enter(new, mode, meas)
             self.mode = mode = new
-        elif mode is _RETURN and oncoming and not self._urgent_return:
+        elif mode is Mode.RETURN and oncoming and not self._urgent_return:
             self._start_return(meas, urgent=True)  # oncoming traffic seen during the return
-        elif (mode is _ONCOMING_BRAKE and path is not None and dx >= path.length_m
+        elif (mode is Mode.ONCOMING_BRAKE and path is not None and dx >= path.length_m
               and self._stop_path is not None):
             # lateral motion arrested: back to the lane centre while braking on
             self._stop_path = None
@@ -397,12 +393,12 @@ class EoamController:
         if not tracking:
             ay_use = max(ay_use, abs(self._steer.lateral_accel(v, delta)))
         drive_lim, brake_lim = self._long.limits(v, mu, ay_use, self._brake_limit)
-        if mode is _NORMAL:
+        if mode is Mode.NORMAL:
             drive, brake, ax_target = self._long.track_speed(
                 self._initial_speed, v, mu, drive_lim, brake_lim, dt_s
             )
             v_target = self._initial_speed
-        elif mode is _UPDATE_BRAKE or mode is _ONCOMING_BRAKE:
+        elif mode is Mode.UPDATE_BRAKE or mode is Mode.ONCOMING_BRAKE:
             drive, brake = 0.0, brake_lim  # limit braking without locking
             ax_target = -brake_lim / self._mass
             v_target = 0.0
@@ -420,7 +416,7 @@ class EoamController:
             )
             v_target = self._hold_speed
 
-        warns = sector is not None and sector is not _SECTOR_G
+        warns = sector is not None and sector is not Sector.G
         fcw = warns or mode in _WARNING_MODES
         if fcw:
             self.fcw_raised = True

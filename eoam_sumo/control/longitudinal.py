@@ -68,10 +68,7 @@ class Pid:
         deriv = 0.0 if self.prev_error is None or dt_s <= 0.0 else (error - self.prev_error) / dt_s
         self.prev_error = error
         trial = self.integral + self.ki * error * dt_s
-        if trial > self.i_limit:  # clamp (comparisons: min/max calls cost more per step)
-            trial = self.i_limit
-        elif trial < -self.i_limit:
-            trial = -self.i_limit
+        trial = min(max(trial, -self.i_limit), self.i_limit)
         out = self.kp * error + trial + self.kd * deriv
         if out > hi:
             if error < 0.0:
@@ -138,18 +135,16 @@ class LongitudinalController:
         """(drive, brake) force limits at this speed, friction and lateral acceleration."""
         q = self._margin * abs(lateral_accel_mps2) / mu
         ellipse = math.sqrt(1.0 - q * q) if q < 1.0 else 0.0
-        drive = self._fmax
-        if speed_mps > 1.0 and self._pmax / speed_mps < drive:
-            drive = self._pmax / speed_mps
-        drive = mu * (self._rear_n if self._rear_n < drive else drive)
+        drive = min(self._fmax, self._pmax / speed_mps) if speed_mps > 1.0 else self._fmax
+        drive = mu * min(drive, self._rear_n)
         return drive * ellipse, no_lock_brake_n * ellipse
 
     @staticmethod
     def split(net_force_n: float, drive_limit_n: float, brake_limit_n: float):
         """(drive, brake) realising a net force within the limits; never both."""
         if net_force_n > 0.0:
-            return (drive_limit_n if drive_limit_n < net_force_n else net_force_n), 0.0
-        return 0.0, (brake_limit_n if brake_limit_n < -net_force_n else -net_force_n)
+            return min(net_force_n, drive_limit_n), 0.0
+        return 0.0, min(-net_force_n, brake_limit_n)
 
     def track_accel(
         self,

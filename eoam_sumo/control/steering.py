@@ -166,7 +166,7 @@ class SteeringController:
     def natural_freq(self, speed_mps: float, mu: float) -> float:
         """omega = omega_0 mu^p min(1, v / v_full) [rad/s], v floored."""
         g = self._gains
-        v = speed_mps if speed_mps > self._vmin else self._vmin
+        v = max(self._vmin, speed_mps)
         return g.natural_freq_radps * mu**g.friction_exponent * min(
             1.0, v / g.full_bandwidth_speed_mps)
 
@@ -242,7 +242,7 @@ class SteeringController:
         road), ``preview_curvature_1pm`` the one a preview distance ahead, used by the
         feedforward to make up for the steering and tyre lags.
         """
-        v = speed_mps if speed_mps > 0.0 else 0.0
+        v = max(0.0, speed_mps)
         k_vy, k_r, k_psi, k_e = self.gains_at(v, mu)
         beta = curvature_1pm * (self._b - self._slip_k * v * v)  # steady_sideslip, inlined
         psi = heading_error_rad + beta
@@ -254,13 +254,6 @@ class SteeringController:
         if v > 1.0:
             course_f = (lateral_speed_mps + self._a * yaw_rate_radps) / v
             slip = self._slip_frac * mu
-            if delta > course_f + slip:
-                delta = course_f + slip
-            elif delta < course_f - slip:
-                delta = course_f - slip
-        lim = self._max
-        if delta > lim:
-            delta = lim
-        elif delta < -lim:
-            delta = -lim
+            delta = min(max(delta, course_f - slip), course_f + slip)
+        delta = min(max(delta, -self._max), self._max)
         return _new(SteeringCommand, (delta, ff, fb, yd, -fb / k_e))

@@ -11,8 +11,6 @@ then the observers (time series, running extremes, anything added) and ``finishe
 
 from __future__ import annotations
 
-import contextlib
-import gc
 import math
 import time
 from collections.abc import Sequence
@@ -97,20 +95,6 @@ ROAD_END_MARGIN_M = 50.0  # a run ends when the ego is this close to the end of 
 ROUNDING_M = 1e-6  # margin for rounding when a lower bound of a gap rules the gap out [m]
 
 
-@contextlib.contextmanager
-def _collector_paused():
-    """Pause Python's cyclic garbage collector (restored after): the step loop makes no
-    reference cycles, reference counting frees all it allocates, and the collector's passes
-    over the young tuples cost ~2 us per step on average."""
-    was_enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was_enabled:
-            gc.enable()
-
-
 class CoSimulation:
     """One run of a SUMO scenario with the ego driven by the plant under the EOAM logic.
 
@@ -167,11 +151,10 @@ class CoSimulation:
         wall0 = time.perf_counter()
         session = self.open_session()
         try:
-            with _collector_paused():
-                self.start(session, wall0)
-                while not self.step():
-                    pass
-                summary = self.finish()
+            self.start(session, wall0)
+            while not self.step():
+                pass
+            summary = self.finish()
         finally:
             session.close()
         return summary.as_dict(), self.timeseries.log
@@ -302,7 +285,7 @@ class CoSimulation:
         front = self._front
         session = self.session
         session.move_ego(X + front * cy, Y + front * sy, nav_angle_deg(yaw),
-                         0.0 if vx < 0.0 else vx)
+                         max(vx, 0.0))
         session.step()
         self.t = session.time_s
         self.bodies_before, self.bodies = self.bodies, session.nearby(self._sense_radius_m)

@@ -321,27 +321,6 @@ def test_ice_patch_road_departure_is_orange_not_green(tmp_path):
         ts["lateral_offset_m"].iloc[:-1].abs().max(), abs=1e-6)
 
 
-@pytest.mark.parametrize("enabled", [True, False])
-def test_collector_pause_restores_the_collector_state(enabled):
-    """The step loop pauses Python's cyclic collector and leaves it as it found it, also when
-    the loop raises."""
-    import gc
-
-    from eoam_sumo.sim.cosim import _collector_paused
-
-    was = gc.isenabled()
-    try:
-        (gc.enable if enabled else gc.disable)()
-        with _collector_paused():
-            assert not gc.isenabled()
-        assert gc.isenabled() is enabled
-        with pytest.raises(RuntimeError), _collector_paused():
-            raise RuntimeError("loop failed")
-        assert gc.isenabled() is enabled
-    finally:
-        (gc.enable if was else gc.disable)()
-
-
 def test_the_run_log_grows_to_its_limit_and_no_further():
     """A huge time limit costs nothing up front; rows past the limit are not kept."""
     from eoam_sumo.eoam import EgoMeasurement
