@@ -68,8 +68,6 @@ class Sector(Enum):
 
 #: Sectors in order of increasing distance for a fixed closing speed.
 SECTOR_ORDER = (Sector.A, Sector.C, Sector.F, Sector.B, Sector.D, Sector.E, Sector.G)
-# members bound once for ``classify``: each ``Sector.X`` read costs ~80 ns on Python 3.11
-_A, _B, _C, _D, _E, _F, _G = Sector
 
 
 def classify(
@@ -87,16 +85,16 @@ def classify(
     """
     d, v = range_m, rel_speed_mps
     if not (v > 0.0 and math.isfinite(v) and math.isfinite(d)):
-        return _G
+        return Sector.G
     if d <= clear_m:
-        return _A if d <= stop_m else _C
+        return Sector.A if d <= stop_m else Sector.C
     if d <= clear_buffered_m:
-        return _F if d <= stop_buffered_m else _B
+        return Sector.F if d <= stop_buffered_m else Sector.B
     if d <= stop_buffered_m:
-        return _D
+        return Sector.D
     if d <= ttc_s * v:
-        return _E
-    return _G
+        return Sector.E
+    return Sector.G
 
 
 def dmm_sector(boundary, range_m: float, rel_speed_mps: float) -> Sector:
@@ -179,6 +177,6 @@ class BoundaryCurve:
     def sector(self, range_m: float, rel_speed_mps: float) -> Sector:
         """Sector of (range, closing speed); G when not closing or not finite."""
         if not (rel_speed_mps > 0.0 and math.isfinite(rel_speed_mps)):
-            return _G
+            return Sector.G
         s, sb, b0, bb, ttc = self._blend(rel_speed_mps)
         return classify(range_m, rel_speed_mps, s, sb, b0, bb, ttc)
