@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 from eoam_sumo.decision.policy import NextLaneView
 from eoam_sumo.sensing.v2x import V2XReceiver, V2XSettings
-from eoam_sumo.sim.geometry import OrientedBox
+from eoam_sumo.sim.geometry import OrientedBox, slab_entry
 
 MIN_OVERLAP_M = 0.1  # a road user reaching this far into the lane is in it [m]
 FUSION_GATE_M = 3.0  # radar and V2X objects closer than this (centre, plus half lengths) [m]
@@ -76,20 +76,8 @@ def hides(box, ox: float, oy: float, px: float, py: float) -> bool:
     end: the box hides the point from a sensor at (ox, oy) (slab test in the box's frame)."""
     ax, ay = box.to_local(ox, oy)
     bx, by = box.to_local(px, py)
-    t_in, t_out = 0.0, 1.0
-    for a, b, h in ((ax, bx, box.half_length_m), (ay, by, box.half_width_m)):
-        u = b - a
-        if abs(u) < 1e-12:
-            if abs(a) > h:
-                return False
-            continue
-        t1, t2 = (-h - a) / u, (h - a) / u
-        if t1 > t2:
-            t1, t2 = t2, t1
-        t_in, t_out = max(t_in, t1), min(t_out, t2)
-        if t_in > t_out:
-            return False
-    return t_in < 1.0 - 1e-9
+    slabs = ((ax, bx - ax, box.half_length_m), (ay, by - ay, box.half_width_m))
+    return slab_entry(slabs, 1.0) < 1.0 - 1e-9
 
 
 class NextLaneSensing:

@@ -363,20 +363,30 @@ def time_to_contact(
     the projections changes linearly with time; contact needs every axis closed at once."""
     dx, dy = b.x_m - a.x_m, b.y_m - a.y_m
     rvx, rvy = vb[0] - va[0], vb[1] - va[1]
-    t_in, t_out = 0.0, horizon_s
-    for nx, ny in _axes(a, b):
-        centre = dx * nx + dy * ny  # b's centre on the axis, relative to a's
-        rate = rvx * nx + rvy * ny
-        reach = _half_extent(a, nx, ny) + _half_extent(b, nx, ny)
-        # overlap on this axis while -reach <= centre + rate t <= reach
-        if abs(rate) < 1e-12:
-            if abs(centre) > reach:
+    # b's centre on each axis relative to a's, its rate, and the pair's reach on that axis
+    return slab_entry(
+        [(dx * nx + dy * ny, rvx * nx + rvy * ny, _half_extent(a, nx, ny) + _half_extent(b, nx, ny))
+         for nx, ny in _axes(a, b)],
+        horizon_s,
+    )
+
+
+def slab_entry(slabs, t_max: float) -> float:
+    """First t in [0, t_max] at which every slab holds, or ``inf`` if none does.
+
+    Each slab ``(o, u, h)`` holds while ``-h <= o + u t <= h`` (a point moving at rate u
+    inside a slab of half-width h): the slab test of a ray against a box, or of two boxes'
+    projections closing on a separating axis."""
+    t_in, t_out = 0.0, t_max
+    for o, u, h in slabs:
+        if abs(u) < 1e-12:
+            if abs(o) > h:
                 return math.inf
             continue
-        t0, t1 = (-reach - centre) / rate, (reach - centre) / rate
-        if t0 > t1:
-            t0, t1 = t1, t0
-        t_in, t_out = max(t_in, t0), min(t_out, t1)
+        t1, t2 = (-h - o) / u, (h - o) / u
+        if t1 > t2:
+            t1, t2 = t2, t1
+        t_in, t_out = max(t_in, t1), min(t_out, t2)
         if t_in > t_out:
             return math.inf
     return t_in

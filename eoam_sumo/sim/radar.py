@@ -47,7 +47,7 @@ from operator import attrgetter
 from typing import NamedTuple, Protocol
 
 from eoam_sumo.sim.bodies import Body
-from eoam_sumo.sim.geometry import OrientedBox
+from eoam_sumo.sim.geometry import OrientedBox, slab_entry
 
 #: Below this speed a target counts as stopped [m/s]: SUMO reports exactly 0 for parked and
 #: stopped vehicles, and automotive radars resolve Doppler to about 0.1-0.3 m/s.
@@ -141,19 +141,7 @@ def ray_entry_m(box: OrientedBox, ox: float, oy: float, ux: float, uy: float) ->
     lox, loy = box.to_local(ox, oy)
     lux = box.cos_yaw * ux + box.sin_yaw * uy
     luy = -box.sin_yaw * ux + box.cos_yaw * uy
-    t_in, t_out = 0.0, math.inf
-    for o, u, h in ((lox, lux, box.half_length_m), (loy, luy, box.half_width_m)):
-        if abs(u) < 1e-12:
-            if abs(o) > h:
-                return math.inf
-            continue
-        t1, t2 = (-h - o) / u, (h - o) / u
-        if t1 > t2:
-            t1, t2 = t2, t1
-        t_in, t_out = max(t_in, t1), min(t_out, t2)
-        if t_in > t_out:
-            return math.inf
-    return t_in
+    return slab_entry(((lox, lux, box.half_length_m), (loy, luy, box.half_width_m)), math.inf)
 
 
 def report_of(detections: list[Detection]) -> RadarReport:
