@@ -68,6 +68,23 @@ def on_highway(folder: Path, routes_xml: str, net: Path = HIGHWAY_NET) -> Path:
     return write_sumocfg(folder / "v.sumocfg", net, "v.rou.xml", [VTYPES])
 
 
+def walker_on_highway(folder: Path, depart_pos_m: float, arrival_pos_m: float,
+                      ego_speed_mps: float, person_depart_s: float = 1.0) -> Path:
+    """The ego at ``ego_speed_mps`` (front bumper at x = 100 m, departing at 1 s) and a person
+    walking along its lane (no sidewalk: SUMO's persons walk on the road) from
+    ``depart_pos_m`` to ``arrival_pos_m`` along E0 (towards the ego when the arrival lies
+    behind the departure)."""
+    return on_highway(folder, f"""<routes>
+  <vType id="walker" vClass="pedestrian" length="0.30" width="0.55" maxSpeed="1.4"/>
+  <route id="eastbound" edges="E0"/>
+  <vehicle id="ego" type="ego" route="eastbound" depart="1.00" departLane="0"
+           departPos="100.00" departSpeed="{ego_speed_mps:.3f}" insertionChecks="none"/>
+  <person id="walker" type="walker" depart="{person_depart_s:.2f}" departPos="{depart_pos_m}">
+    <walk edges="E0" arrivalPos="{arrival_pos_m}"/>
+  </person>
+</routes>""")
+
+
 def baseline_variant(folder: Path, old: str, new: str, extra_additional: str = "") -> Path:
     """The baseline scenario with one edit to its route file (and an additional file of
     ``folder`` besides the vehicle types, if given): ``variant.sumocfg``."""

@@ -302,7 +302,7 @@ class CoSimulation:
         ego_move = math.hypot(Xn - x_prev[0], Yn - x_prev[1]) + self._ego_radius * abs(
             yawn - x_prev[2])
         road, lane_width, step_s = self.road, self.lane_width_m, self.settings.step_s
-        ego_box_radius = self._ego_box_radius
+        ego_box_radius, p = self._ego_box_radius, self.params
         for b in self.bodies:
             centres_m = math.hypot(b.x_m - ego_cx, b.y_m - ego_cy)
             if centres_m > GAP_WATCH_M:
@@ -315,7 +315,6 @@ class CoSimulation:
             if circles_m > reach_m and (role != "aro" or circles_m >= self.min_gap_aro_m):
                 continue  # the box gap can be neither the ARO's least nor a contact
             if ego_box is None:
-                p = self.params
                 ego_box = OrientedBox.from_axis_point(Xn, Yn, yawn, p.length_m, p.width_m,
                                                       self._front)
             gap = box_distance(ego_box, b.box)
@@ -324,7 +323,6 @@ class CoSimulation:
             # contact during the step is possible only if the gap is within both moves
             if self.first_contact is None and gap <= reach_m:
                 before = next((o for o in self.bodies_before if o.vid == b.vid), b)
-                p = self.params
                 found = substep_contact(x_prev, x, b, before, p.length_m, p.width_m,
                                         self._front, self.settings.substeps)
                 if found is not None:

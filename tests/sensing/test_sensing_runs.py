@@ -12,6 +12,7 @@ import pytest
 from eoam_sumo.sim.cosim import RunSettings, run_case
 from eoam_sumo.sim.radar import RadarSettings
 from eoam_sumo.sim.scenario import ScenarioOverrides
+from tests.builders import walker_on_highway
 
 pytestmark = pytest.mark.sumo
 
@@ -114,21 +115,8 @@ def test_automotive_radar_same_seed_same_summary_and_a_stalled_car_is_avoided(tm
 
 
 def _walker_scenario(folder: Path, depart_pos_m: float, arrival_pos_m: float) -> Path:
-    """The ego at 90 km/h (front bumper at x = 100 m) and a person walking along its lane
-    (no sidewalk: SUMO's persons walk on the road), from ``depart_pos_m`` to ``arrival_pos_m``
-    along E0 (backwards, towards the ego, when the arrival lies behind the departure)."""
-    routes = f"""<routes>
-  <vType id="walker" vClass="pedestrian" length="0.30" width="0.55" maxSpeed="1.4"/>
-  <route id="eastbound" edges="E0"/>
-  <vehicle id="ego" type="ego" route="eastbound" depart="1.00" departLane="0"
-           departPos="100.00" departSpeed="25.0" insertionChecks="none"/>
-  <person id="walker" type="walker" depart="0" departPos="{depart_pos_m}">
-    <walk edges="E0" arrivalPos="{arrival_pos_m}"/>
-  </person>
-</routes>"""
-    from tests.builders import on_highway
-
-    return on_highway(folder, routes)
+    """The ego at 90 km/h and a person walking along its lane (``walker_on_highway``)."""
+    return walker_on_highway(folder, depart_pos_m, arrival_pos_m, 25.0, person_depart_s=0.0)
 
 
 RADARS = {  # the paper's beam plus a near-range beam; the automotive model (which has one)

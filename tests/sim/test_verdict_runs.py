@@ -11,7 +11,7 @@ import pytest
 from eoam_sumo.params import ego_e_class_sedan
 from eoam_sumo.sim.cosim import RunSettings, run_case
 from eoam_sumo.sim.scenario import ScenarioOverrides
-from tests.builders import on_highway
+from tests.builders import walker_on_highway
 from tests.sim.test_safe_policy_runs import _scenario as beside_the_obstacle
 
 pytestmark = pytest.mark.sumo
@@ -25,17 +25,9 @@ WALKER_KG = 70.0  # SUMO's default mass of a person
 
 
 def _walker(folder: Path, ahead_m: float, speed_kmh: float = 100.0) -> Path:
-    """The ego at ``speed_kmh`` (front bumper at x = 100 m) and a person walking away from it
-    along its lane (no sidewalk: SUMO's persons walk on the road), ``ahead_m`` ahead."""
-    return on_highway(folder, f"""<routes>
-  <vType id="walker" vClass="pedestrian" length="0.30" width="0.55" maxSpeed="1.4"/>
-  <route id="eastbound" edges="E0"/>
-  <vehicle id="ego" type="ego" route="eastbound" depart="1.00" departLane="0"
-           departPos="100.00" departSpeed="{speed_kmh / 3.6:.3f}" insertionChecks="none"/>
-  <person id="walker" type="walker" depart="1.00" departPos="{100.0 + ahead_m}">
-    <walk edges="E0" arrivalPos="3000"/>
-  </person>
-</routes>""")
+    """The ego at ``speed_kmh`` and a person walking away from it along its lane, ``ahead_m``
+    ahead of its front bumper."""
+    return walker_on_highway(folder, 100.0 + ahead_m, 3000, speed_kmh / 3.6)
 
 
 def test_a_pedestrian_hit_in_the_lane_is_named_by_id_and_class(tmp_path):
