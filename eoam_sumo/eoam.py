@@ -57,6 +57,8 @@ _STEERING = (Mode.UPDATE_STEER_BRAKE, Mode.ONCOMING_STEER_BRAKE)
 _COMMITTING = (Mode.NORMAL, Mode.UPDATE_BRAKE)
 # the safe policy watches the next lane in these modes
 _WATCHING = (Mode.UPDATE_STEER_BRAKE, Mode.RETURN)
+# a coasted object keeps these modes braking (sensing.md: track persistence)
+_HOLDING = (Mode.NORMAL, Mode.UPDATE_BRAKE)
 _URGENCY = {s: i for i, s in enumerate(SECTOR_ORDER)}  # A most urgent, G least
 
 
@@ -299,6 +301,19 @@ class EoamController:
             action = Action.NONE
             threat_gone = True
             self._decel.reset()
+        coasted_m = perception.coasted_range_m
+        if coasted_m is not None and self.mode in _HOLDING:
+            # an object lost from view, predicted in the path: no hand-back while it does not
+            # pull away; braking while it is within the stopping distance (at the ego's speed
+            # or the closing speed, the larger) plus a margin
+            closing_c = -perception.coasted_range_rate_mps
+            vc = max(v, closing_c)
+            near = coasted_m <= 0.5 * vc * vc * self._mass / self._brake_limit + (
+                st.coasted_margin_m)
+            if near or closing_c > -st.release_opening_speed_mps:
+                threat_gone = False
+            if near and action is Action.NONE:
+                action = Action.BRAKE
         oncoming = bool(perception.oncoming_detected)
         block_m = perception.next_lane_obstacle_range_m
         if block_m is not None and rng is not None and block_m <= rng + st.next_lane_clear_m:

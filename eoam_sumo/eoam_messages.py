@@ -48,6 +48,10 @@ class Perception(NamedTuple):
     aro_object: ObjectState | None = None  # the in-path obstacle as an object, when tracked
     next_lane_obstacle_range_m: float | None = None  # nearest standing object in the next lane
     next_lane: NextLaneView | None = None  # what is known of the next lane (safe policy)
+    # an in-path object the radar lost from view at close range, predicted at its last
+    # velocity (a coasted track): its range and range rate now, or None
+    coasted_range_m: float | None = None
+    coasted_range_rate_mps: float = 0.0
 
 
 class Command(NamedTuple):

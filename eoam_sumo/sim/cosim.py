@@ -36,7 +36,7 @@ from eoam_sumo.sensing.next_lane import CornerRadarSettings, NextLaneSensing
 from eoam_sumo.sensing.v2x import V2XSettings
 from eoam_sumo.sim.bodies import nav_angle_deg
 from eoam_sumo.sim.geometry import OrientedBox, box_distance, boxes_overlap
-from eoam_sumo.sim.margins import Margins
+from eoam_sumo.sim.margins import STOPPED_MPS, Margins, road_user_close_ahead
 from eoam_sumo.sim.observers import Extremes, StepObserver, TimeSeries
 from eoam_sumo.sim.outcome import role_of
 from eoam_sumo.sim.radar import RadarReport, RadarSettings
@@ -332,8 +332,10 @@ class CoSimulation:
 
     def finished(self) -> bool:
         """Whether the run is over: a contact, ``settle_s`` after the EOAM handed back to
-        NORMAL after a manoeuvre or stopped (a manoeuvre begun in that time runs to its end),
-        the end of the road, or the time limit. Sets ``end_cause``."""
+        NORMAL after a manoeuvre or stopped (a manoeuvre begun in that time runs to its end;
+        not while the ego moves towards a road user close ahead in its lane:
+        :func:`~eoam_sumo.sim.margins.road_user_close_ahead`), the end of the road, or the
+        time limit. Sets ``end_cause``."""
         if self.first_contact is not None:
             self.end_cause = "contact"
             return True
@@ -341,7 +343,9 @@ class CoSimulation:
             self._stop_at = None  # (again) a manoeuvre under way: run on to its end
         elif self._stop_at is None:
             self._stop_at = self.t + self.settings.settle_s
-        if self._stop_at is not None and self.t >= self._stop_at - 1e-9:
+        if (self._stop_at is not None and self.t >= self._stop_at - 1e-9
+                and not road_user_close_ahead(self.x, self._front, self.road,
+                                              self.lane_width_m, self.mu_true, self.bodies)):
             self.end_cause = "settled"
         elif self.meas.s_m > self._end_s_m:
             self.end_cause = "road_end"
@@ -356,7 +360,7 @@ class CoSimulation:
         ctrl = self.ctrl
         mode = ctrl.mode
         return ((mode == 0 and len(ctrl.modes_visited) > 1)
-                or (mode in (1, 3) and self.x[3] < 0.05))
+                or (mode in (1, 3) and self.x[3] < STOPPED_MPS))
 
     # ----------------------------------------------------------------------------- the end
     def finish(self) -> RunSummary:
@@ -432,10 +436,16 @@ _ONCOMING_ONLY = Perception(None, None, True)
 
 def _perception(report: RadarReport) -> Perception:
     """The EOAM's view of a radar report: the in-path obstacle as an object, the oncoming
-    flag."""
+    flag, the range of a coasted in-path object."""
     det = report.in_path
     if det is None:
-        return _ONCOMING_ONLY if report.oncoming_detected else _NOTHING
-    obstacle = ObjectState(det.s_m, det.d_m, det.road_speed_mps, det.length_m, det.width_m)
-    return Perception(det.range_m, det.range_rate_mps, report.oncoming_detected, obstacle,
-                      report.next_lane_range_m)
+        perception = _ONCOMING_ONLY if report.oncoming_detected else _NOTHING
+    else:
+        obstacle = ObjectState(det.s_m, det.d_m, det.road_speed_mps, det.length_m,
+                               det.width_m)
+        perception = Perception(det.range_m, det.range_rate_mps, report.oncoming_detected,
+                                obstacle, report.next_lane_range_m)
+    if report.coasted is None:
+        return perception
+    return perception._replace(coasted_range_m=report.coasted.range_m,
+                               coasted_range_rate_mps=report.coasted.range_rate_mps)

@@ -16,14 +16,21 @@ left of its lane, and whether a run without contact was a near miss.
   ``NEAR_MISS_GAP_M`` (gaps farther out are not measured);
 * a run without contact is a **near miss** when it came within ``NEAR_MISS_GAP_M`` of any
   road user or its ``min_ttc_oncoming_s`` fell below ``NEAR_MISS_TTC_S``.
+
+``road_user_close_ahead`` is the ground truth the step loop asks before it ends a run as
+settled: a run does not end while the ego moves towards a road user close ahead in its lane.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
+from eoam_sumo.params import G_MPS2
+from eoam_sumo.sim.bodies import Body
 from eoam_sumo.sim.geometry import OrientedBox, box_distance, time_to_contact
 from eoam_sumo.sim.observers import RunView, StepObserver
+from eoam_sumo.sim.radar import LANE_MARGIN_M, RoadProjection
 
 #: A run without contact that came this close to another road user is a near miss [m].
 NEAR_MISS_GAP_M = 0.5
@@ -32,6 +39,11 @@ NEAR_MISS_GAP_M = 0.5
 #: count an encounter as serious (van der Horst, *A time-based analysis of road user
 #: interaction*, 1990: 1.5 s).
 NEAR_MISS_TTC_S = 1.5
+#: A run does not end settled while a road user is in the ego's lane ahead within the ego's
+#: stopping distance plus this [m] (``road_user_close_ahead``): the end is then a stop behind
+#: it, passing it, or a contact.
+CLOSE_AHEAD_MARGIN_M = 5.0
+STOPPED_MPS = 0.05  # the ego counts as stopped below this speed [m/s] (as ``eoam_done``)
 _ROUNDING_M = 1e-6  # lower bounds of a gap are lowered by this before ruling a gap out
 
 
@@ -110,3 +122,29 @@ class Margins(StepObserver):
                     gap = box_distance(ego_box, box)
                 if gap < self.closest_gap_m:
                     self.closest_gap_m, self.closest_id = gap, b.vid
+
+
+def road_user_close_ahead(x: Sequence[float], cg_to_front_m: float, road: RoadProjection,
+                          lane_width_m: float, mu: float, bodies: Sequence[Body]) -> bool:
+    """Whether the ego (plant state ``x``) is moving and a road user's centre is in the ego's
+    lane (the one its centre is in; band as the radar's) ahead of its front bumper, with a gap
+    along the road within what the ego needs to stop behind where that road user would stop
+    (both braking at the road's friction: (v^2 - u^2) / (2 mu g), u its speed along the road)
+    plus ``CLOSE_AHEAD_MARGIN_M``."""
+    X, Y, _, vx = x[:4]
+    if vx < STOPPED_MPS:
+        return False  # stopped behind it: the run's real end
+    s_ego, d_ego, _ = road.project(X, Y)
+    front_s = s_ego + cg_to_front_m
+    lane_d = lane_width_m * round(d_ego / lane_width_m)  # centre of the lane the ego is in
+    band = 0.5 * lane_width_m + LANE_MARGIN_M
+    two_decel = 2.0 * mu * G_MPS2
+    for b in bodies:
+        s, d, road_yaw = road.project(b.x_m, b.y_m)
+        if s <= front_s or abs(d - lane_d) >= band:
+            continue
+        u = max(b.speed_mps * math.cos(b.yaw_rad - road_yaw), 0.0)
+        need = max(vx * vx - u * u, 0.0) / two_decel + CLOSE_AHEAD_MARGIN_M
+        if s - 0.5 * b.length_m - front_s <= need:
+            return True
+    return False

@@ -12,7 +12,9 @@ cone, otherwise the first crossing of the box by one of the two edge rays of the
 also covers the corners and the nearest point of the rear face). That distance is the
 reported range. Occlusion is ignored: a target hidden behind another is still seen. An
 optional second, wide near-range beam (``near_range_m``, ``near_fov_deg``; off by default, as
-the paper's radar has one beam) covers what is close beside the boresight.
+the paper's radar has one beam) covers what is close beside the boresight. An in-path target
+that leaves the beams within range is kept as a predicted object (``RadarReport.coasted``,
+:mod:`eoam_sumo.sim.coasting`).
 
 Measurements per detection: range to the nearest visible point, range rate (relative velocity
 projected on the line of sight to that point, negative when closing; ego velocity taken
@@ -47,6 +49,7 @@ from operator import attrgetter
 from typing import NamedTuple, Protocol
 
 from eoam_sumo.sim.bodies import Body
+from eoam_sumo.sim.coasting import Coaster
 from eoam_sumo.sim.geometry import OrientedBox, slab_entry
 
 #: Below this speed a target counts as stopped [m/s]: SUMO reports exactly 0 for parked and
@@ -130,6 +133,7 @@ class RadarReport(NamedTuple):
     in_path_index: int | None = None  # target-list index of the nearest in-path target
     in_path: Detection | None = None  # the nearest in-path detection itself
     next_lane_range_m: float | None = None  # nearest standing object in the next lane
+    coasted: Detection | None = None  # an in-path object out of view, predicted (not measured)
 
 
 _range_of = attrgetter("range_m")
@@ -173,6 +177,7 @@ class Radar:
         self._cos_half_fov = math.cos(self._half_fov_rad)
         self._sin_half_fov = math.sin(self._half_fov_rad)
         self._near = None  # the near-range beam, as a radar of its own
+        self._coaster = Coaster()
         if settings.near_range_m > 0.0:
             self._near = Radar(replace(settings, range_m=settings.near_range_m,
                                        fov_deg=settings.near_fov_deg, near_range_m=0.0))
@@ -283,7 +288,23 @@ class Radar:
                 Detection(index, rng, range_rate, bearing, s, d, road_speed, category,
                           tgt.length_m, tgt.width_m)
             )
-        return report_of(detections)
+        report = report_of(detections)
+        coaster = self._coaster
+        if coaster.coasted is None:  # nothing coasted: only remember the in-path object
+            det, last = report.in_path, coaster.last
+            if det is not None:
+                body = targets[det.target_index]
+                if last is None or last.vid == body.vid:
+                    coaster.last, coaster.last_t = body, time_s
+                    return report
+            elif last is None:
+                return report
+        seen = None if report.in_path is None else targets[report.in_path.target_index]
+        coasted = coaster.coast(
+            self, range_m, seen, [targets[det.target_index] for det in report.detections],
+            ox, oy, ego_yaw_rad, evx, evy, ego_s, road_frame.project, band_m, lane_width_m,
+            time_s)
+        return report if coasted is None else report._replace(coasted=Detection(*coasted))
 
     def classify(
         self, ahead: bool, d_m: float, speed_mps: float, road_speed_mps: float, band_m: float,
