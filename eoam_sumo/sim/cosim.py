@@ -11,6 +11,7 @@ then the observers (time series, running extremes, anything added) and ``finishe
 
 from __future__ import annotations
 
+import gc
 import math
 import time
 from collections.abc import Sequence
@@ -147,13 +148,22 @@ class CoSimulation:
 
     # ----------------------------------------------------------------------------- a whole run
     def run(self) -> tuple[dict, RunLog]:
-        """The whole run: (summary as summary.json writes it, the time series)."""
+        """The whole run: (summary as summary.json writes it, the time series).
+
+        The objects built before the step loop (modules, tables, SUMO's set-up) are frozen out
+        of Python's garbage collector over the loop, so that its collections scan only what the
+        loop made (a full collection otherwise walks the whole heap: 4 % of the loop's
+        instructions in the benchmark's run)."""
         wall0 = time.perf_counter()
         session = self.open_session()
         try:
             self.start(session, wall0)
-            while not self.step():
-                pass
+            gc.freeze()
+            try:
+                while not self.step():
+                    pass
+            finally:
+                gc.unfreeze()
             summary = self.finish()
         finally:
             session.close()
