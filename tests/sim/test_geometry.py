@@ -234,6 +234,18 @@ def test_overlap_invariant_under_common_rigid_motion(a, b, rot, tx, ty):
     assert box_distance(ma, mb) == pytest.approx(box_distance(a, b), abs=1e-8)
 
 
+@settings(max_examples=300, deadline=None, database=None)
+@given(boxes, boxes)
+def test_distance_is_the_nearest_corner_bit_for_bit(a, b):
+    """The inlined corner search gives exactly (same floating-point value) the least distance
+    from a corner of either box to its nearest point of the other (``nearest_point``)."""
+    assume(not boxes_overlap(a, b))
+    corner_gaps = [math.hypot(cx - px, cy - py)
+                   for src, dst in ((a, b), (b, a)) for cx, cy in src.corners()
+                   for px, py in [dst.nearest_point(cx, cy)]]
+    assert box_distance(a, b) == min(corner_gaps)
+
+
 # --- contact classification -----------------------------------------------------------------
 
 
