@@ -39,10 +39,10 @@ TABLE2 = ROOT / "scenarios" / "table2.toml"
 SPEED_MPS = 120 / 3.6
 TARGETS = {
     "realtime_factor": (">=", 100.0),
-    "cosim_over_sumo_cost": ("<=", 10.0),
+    "cosim_over_sumo_cost": ("<=", 5.0),
     "batch_wall_s": ("<=", 60.0),
     "tables_wall_s": ("<=", 60.0),
-    "control_us_per_step": ("<=", 50.0),
+    "control_us_per_step": ("<=", 10.0),
     "peak_rss_mb": ("<=", 300.0),
     "traffic_cosim_over_sumo_only": ("<", 1.0),
     "traffic_us_per_user_step": ("<=", 2.0),
