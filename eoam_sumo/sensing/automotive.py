@@ -14,12 +14,20 @@ as the ideal radar, classified by the same rules on the tracked position and vel
 
 Defaults (``AutomotiveRadarSettings``) from the data sheet of the Continental ARS 408-21
 long-range radar (Continental Engineering Services, "ARS 408-21 Premium Long Range Radar
-Sensor 77 GHz", technical data, far range): distance accuracy +-0.40 m, azimuth accuracy
-+-0.1 deg, velocity resolution 0.37 km/h, cycle time about 72 ms, far-range field of view
-+-9 deg (the ideal radar's 18 deg). Accuracies are used as one standard deviation (a
-conservative reading); the range stays the ideal radar's setting (100 m, the paper's; the
-data sheet gives 250 m). The data sheet gives no detection probability or output latency:
-0.9 per cycle and one cycle are assumptions.
+Sensor 77 GHz", ARS-408-21_EN_HS-1.pdf), far range: distance accuracy +-0.40 m, azimuth
+accuracy +-0.1 deg, velocity resolution 0.37 km/h, field of view +-9 deg (the ideal radar's
+18 deg); near range 0.20-70 m within +-45 deg. The data sheet itself could not be read here:
+these figures were checked against a transcription of it (airou-lab/SynthCRAV,
+utils/synthesizer.py, which cites that PDF) and, for the velocity accuracy (+-0.1 km/h) and
+the range (up to 250 m), the nuScenes sensor table (Caesar et al. 2020, "nuScenes: A
+multimodal dataset for autonomous driving", CVPR). The cycle time, about 72 ms, is
+UNVERIFIED (nuScenes records this radar at 13 Hz, 77 ms). Accuracies are used as one
+standard deviation (a conservative reading), the velocity resolution as the range-rate
+noise (the accuracy is +-0.1 km/h); the near range's own accuracies (+-0.10 m; +-0.3 deg at
+boresight to +-1 deg at +-45 deg) and its +-60 deg sector to 20 m are not modelled; the
+range stays the ideal radar's setting (100 m, the paper's; the data sheet gives 250 m). The
+data sheet gives no detection probability or output latency: 0.9 per cycle and one cycle
+are assumptions.
 """
 
 from __future__ import annotations
@@ -54,10 +62,11 @@ _SEEN_EPS_M = 1e-6  # a blocker must start this much before the target's point [
 class AutomotiveRadarSettings:
     """Noise, timing and detection of the automotive radar (sources: module docstring)."""
 
-    range_sd_m: float = 0.40  # ARS 408-21 distance accuracy, far range
-    azimuth_sd_deg: float = 0.1  # ARS 408-21 azimuth accuracy, far range
+    range_sd_m: float = 0.40  # ARS 408-21 distance accuracy, far range (checked: SynthCRAV)
+    azimuth_sd_deg: float = 0.1  # ARS 408-21 azimuth accuracy, far range (checked: SynthCRAV)
     range_rate_sd_mps: float = 0.37 / 3.6  # ARS 408-21 velocity resolution, far range
-    cycle_s: float = 0.072  # ARS 408-21 cycle time (about 72 ms)
+    # (checked: SynthCRAV); its velocity accuracy is +-0.1 km/h (nuScenes)
+    cycle_s: float = 0.072  # ARS 408-21 cycle time, about 72 ms: UNVERIFIED (nuScenes: 13 Hz)
     latency_s: float = 0.072  # one cycle from scan to object list (assumed)
     detection_probability: float = 0.9  # per target and cycle (assumed)
     tracker: TrackerSettings = field(default_factory=TrackerSettings)
@@ -213,7 +222,8 @@ def _blocked(nearer, ox, oy, px, py, r) -> bool:
     return any(ray_entry_m(box, ox, oy, ux, uy) < r - _SEEN_EPS_M for box in nearer)
 
 
-#: The ARS 408-21's near-range beam: 0.20-70 m within +-45 deg (data sheet, near range).
+#: The ARS 408-21's near-range beam: 0.20-70 m within +-45 deg (data sheet, near range;
+#: checked: SynthCRAV); its +-60 deg sector out to 20 m is not modelled.
 NEAR_RANGE_M = 70.0
 NEAR_FOV_DEG = 90.0
 

@@ -63,21 +63,30 @@ def test_believing_a_dry_road_on_snow_acts_later_than_knowing(tmp_path):
     assert dry["trigger_range_m"] < known["trigger_range_m"] - 10.0
 
 
-TRUCK = ('<vType id="truck" vClass="truck" length="16.50" width="2.55" minGap="2.50" '
-         'maxSpeed="30.00" accel="1.00" decel="6.00" emergencyDecel="9.00" sigma="0" '
-         'speedDev="0"/>')
+VEHICLES = {  # vType, length [m]: the longest SUMO default vehicle and a short, narrow one
+    "truck": ('<vType id="lead" vClass="truck" length="16.50" width="2.55" minGap="2.50" '
+              'maxSpeed="30.00" accel="1.00" decel="6.00" emergencyDecel="9.00" sigma="0" '
+              'speedDev="0"/>', 16.5),
+    "motorcycle": ('<vType id="lead" vClass="motorcycle" length="2.20" width="0.90" '
+                   'minGap="2.50" maxSpeed="30.00" accel="1.00" decel="6.00" '
+                   'emergencyDecel="9.00" sigma="0" speedDev="0"/>', 2.2),
+}
 
 
+@pytest.mark.parametrize("vehicle", VEHICLES)
 @pytest.mark.parametrize("range_m", [100.0, 150.0])
-def test_a_long_truck_is_first_seen_at_the_radars_range(tmp_path, range_m):
-    """A 16.5 m truck 300 m ahead (rear bumper), driving at 60 km/h; the ego closes at
-    16.7 m/s, 0.17 m per step: its rear is first reported within 1 m of the radar's range
-    (it was 93.5 m for 100 m when sensing looked for front bumpers within range + 10 m)."""
+def test_any_length_of_vehicle_is_first_seen_at_the_radars_range(tmp_path, range_m, vehicle):
+    """A 16.5 m truck or a 2.2 m motorcycle 300 m ahead (rear bumper), driving at 60 km/h;
+    the ego closes at 16.7 m/s, 0.17 m per step: its rear is first reported within 1 m of the
+    radar's range (the truck was first seen at 93.5 m for 100 m, the motorcycle at 99.9 m,
+    when sensing looked for front bumpers within range + 10 m)."""
+    vtype, length_m = VEHICLES[vehicle]
     cfg = variant(tmp_path, {
         'type="aro" route="eastbound" depart="1.00" departLane="0" departPos="225.09"':
-        'type="truck" route="eastbound" depart="1.00" departLane="0" departPos="416.50"',
+        'type="lead" route="eastbound" depart="1.00" departLane="0" '
+        f'departPos="{400.0 + length_m:.2f}"',
         '<param key="eoam.aro_hold_s" value="2.0"/>': '<param key="eoam.aro_hold_s" '
-        'value="100.0"/>'}, TRUCK)
+        'value="100.0"/>'}, vtype)
     settings = RunSettings(max_time_s=14.0, radar=RadarSettings(range_m=range_m))
     out = tmp_path / "run"
     run_case(cfg, ScenarioOverrides(ego_speed_mps=120 / 3.6), out, settings)
