@@ -34,12 +34,14 @@ from __future__ import annotations
 
 import math
 
+from eoam_sumo.control.escape import MinTimeShift, lateral_state
 from eoam_sumo.control.longitudinal import LongitudinalController
 from eoam_sumo.control.paths import PathReference, QuinticShift
 from eoam_sumo.control.steering import SteeringController
 from eoam_sumo.decision.dmm import SECTOR_ORDER, Action, BoundaryCurve, Sector
 from eoam_sumo.decision.modes import Mode, next_mode
-from eoam_sumo.decision.obstacle import ObstacleDecel, stopping_range_m
+from eoam_sumo.decision.obstacle import ObstacleDecel, ObstacleTrack, stopping_range_m
+from eoam_sumo.decision.oncoming import Budget, Choice, commit_choice, return_clears
 from eoam_sumo.decision.policy import SafePolicy
 from eoam_sumo.eoam_messages import Command, EgoMeasurement, ObjectState, Perception
 from eoam_sumo.eoam_settings import EoamSettings
@@ -97,8 +99,8 @@ class EoamController:
         self._hold_speed: float | None = None
         self._urgent_return = False
         self._stop_path: QuinticShift | None = None  # lateral stop judged for the PONR
-        # t, front s, speed, left edge, deceleration of the in-path obstacle
-        self._obstacle: tuple[float, float, float, float, float] | None = None
+        self._obstacle: ObstacleTrack | None = None  # the in-path obstacle
+        self.oncoming_choice: Choice | None = None  # the commit/abort decision, when made
         self._decel.reset()
         self._long.reset()
         if self.policy is not None:
@@ -125,12 +127,28 @@ class EoamController:
         bounds = self.tables.boundaries
         self._curve = BoundaryCurve(bounds, mu, bounds.speed_grid_mps)
 
+    def _budget(self, mu: float) -> Budget:
+        return Budget.of(self.params, self.settings, mu, self._brake_limit / self._mass)
+
     def _start_return(self, meas: EgoMeasurement, *, urgent: bool) -> None:
         """Mode 5's path back to the lane centre; urgent (oncoming traffic) at the evasive
         lateral acceleration, else at the comfortable one."""
         self._urgent_return = urgent
+        if urgent:
+            self._escape_to(0.0, meas)
+        else:
+            self._shift_to(0.0, meas, self.settings.return_lateral_g)
+
+    def _escape_to(self, target_m: float, meas: EgoMeasurement) -> None:
+        """An evasive shift to ``target_m`` within ``evasive_lateral_g`` mu g: time-optimal
+        (``MinTimeShift``) with ``min_time_escapes``, else the shortest quintic."""
         st = self.settings
-        self._shift_to(0.0, meas, st.evasive_lateral_g if urgent else st.return_lateral_g)
+        if not st.min_time_escapes:
+            return self._shift_to(target_m, meas, st.evasive_lateral_g)
+        v_lat, a_lat, speed = lateral_state(meas)
+        accel = st.evasive_lateral_g * meas.mu * G_MPS2
+        traj = MinTimeShift(meas.d_m, v_lat, a_lat, target_m, speed, accel, st.escape_ramp_s)
+        self._start_path(meas, traj, meas.d_m, None)
 
     def _shift_to(self, target_m: float, meas: EgoMeasurement, lateral_g: float) -> None:
         """The shortest quintic (``QuinticShift``) from the ego's lateral state (offset, course,
@@ -153,7 +171,8 @@ class EoamController:
         """Mode 4's target: just far enough left to pass the obstacle with ``side_clearance_m``
         (less exposure to the oncoming vehicle than a whole lane), at most a lane width, and
         never back towards the obstacle from where the ego already is."""
-        left_edge = self._obstacle[3] if self._obstacle is not None else 0.5 * meas.lane_width_m
+        obstacle = self._obstacle
+        left_edge = obstacle.left_edge_m if obstacle is not None else 0.5 * meas.lane_width_m
         need = left_edge + 0.5 * self.params.width_m + self.settings.side_clearance_m
         return max(min(need, meas.lane_width_m), meas.d_m)
 
@@ -184,7 +203,12 @@ class EoamController:
             self._hold_speed = meas.vx_mps
             self._start_return(meas, urgent=previous is Mode.ONCOMING_STEER_BRAKE)
         elif mode is Mode.ONCOMING_STEER_BRAKE:
-            self._shift_to(self._passing_offset_m(meas), meas, self.settings.evasive_lateral_g)
+            self._escape_to(self._passing_offset_m(meas), meas)
+        elif mode is Mode.ONCOMING_BRAKE and self.settings.min_time_escapes:
+            # arrest the lateral motion and return to the lane centre in one time-optimal
+            # shift (the brake gets what the friction ellipse leaves)
+            self._stop_path = None
+            self._escape_to(0.0, meas)
         elif mode is Mode.ONCOMING_BRAKE:
             # arrest the lateral motion first (the brake gets what the friction ellipse
             # leaves), then hold that offset while braking to standstill
@@ -206,22 +230,14 @@ class EoamController:
         length (``unknown_obstacle_length_m``) and a width filling its lane. During a lane
         change (modes 2, 4) only the obstacle being avoided is followed: one whose front is
         more than ``track_gate_m`` off the prediction is another object."""
-        if obj is not None:
-            front_s = obj.s_m + 0.5 * obj.length_m
-            speed = max(obj.speed_mps, 0.0)
-            left_edge = obj.d_m + 0.5 * obj.width_m
-        else:
-            front_s = (meas.s_m + self.params.cg_to_front_bumper_m + range_m
-                       + self.settings.unknown_obstacle_length_m)
-            speed = max(meas.vx_mps - closing_mps, 0.0)
-            left_edge = 0.5 * meas.lane_width_m
-        if self._obstacle is not None and self.mode in _STEERING:
-            t0, front0, speed0, _, decel0 = self._obstacle
-            moved = _travel_m(speed0, decel0, meas.time_s - t0)
-            if abs(front_s - front0 - moved) > self.settings.track_gate_m:
-                return
-        decel = self._decel.decel_mps2 if self.settings.obstacle_decel_in_dmm else 0.0
-        self._obstacle = (meas.time_s, front_s, speed, left_edge, max(0.0, decel))
+        st = self.settings
+        decel = max(self._decel.decel_mps2, 0.0) if st.obstacle_decel_in_dmm else 0.0
+        track = ObstacleTrack.sensed(meas, self.params.cg_to_front_bumper_m, range_m,
+                                     closing_mps, obj, st.unknown_obstacle_length_m, decel)
+        last = self._obstacle
+        if (last is None or self.mode not in _STEERING
+                or abs(track.front_s_m - last.at(meas.time_s)[0]) <= st.track_gate_m):
+            self._obstacle = track
 
     def _clear_of_obstacle(self, meas: EgoMeasurement, path, dx_m: float) -> bool:
         """Mode 4's "desired position": the ego's rear is ``pass_margin_m`` past the obstacle's
@@ -229,10 +245,24 @@ class EoamController:
         Without a track, the end of the lane change."""
         if self._obstacle is None:
             return path is not None and dx_m >= path.length_m
-        t0, front_s, speed, _, decel = self._obstacle
-        front_s += _travel_m(speed, decel, meas.time_s - t0)
+        if self.mode is Mode.ONCOMING_STEER_BRAKE and self.settings.compare_outcomes:
+            return return_clears(meas, self._obstacle, self._budget(meas.mu))
+        front_s = self._obstacle.at(meas.time_s)[0]
         ego_rear_s = meas.s_m - self.params.cg_to_rear_bumper_m
         return ego_rear_s - front_s >= self.settings.pass_margin_m
+
+    def _commits(self, meas: EgoMeasurement, perception: Perception, travel: float,
+                 height: float) -> bool:
+        """Oncoming traffic seen in mode 2: pass on (True) or abort (mode 3). With
+        ``compare_outcomes`` and tracks of it and of the obstacle, the option of lower
+        predicted delta-v (``decision.oncoming``); else the point of no return."""
+        onc = perception.oncoming_object
+        if not (self.settings.compare_outcomes and onc is not None
+                and self._obstacle is not None):
+            return self._past_ponr(meas, travel, height)
+        self._stop_path = None
+        self.oncoming_choice = commit_choice(meas, onc, self._obstacle, self._budget(meas.mu))
+        return self.oncoming_choice.pass_on
 
     def _past_ponr(self, meas: EgoMeasurement, travel: float, height: float) -> bool:
         """Past the point of no return (sec. 8.1): the lateral travel since the trigger
@@ -349,7 +379,7 @@ class EoamController:
             and abs(_wrap(meas.e_yaw_rad)) <= st.settle_heading_rad
         )
         past_ponr = (oncoming and mode is Mode.UPDATE_STEER_BRAKE
-                     and self._past_ponr(meas, travel, height))
+                     and self._commits(meas, perception, travel, height))
         if (past_ponr and oncoming and mode is Mode.UPDATE_STEER_BRAKE and policy is not None
                 and policy.prefer_braking(meas, perception)):
             past_ponr = False  # severity tie-breaker: braking in lane ends softer
@@ -455,24 +485,11 @@ class EoamController:
         )
 
 
-def _travel_m(speed_mps: float, decel_mps2: float, dt_s: float) -> float:
-    """Distance a body covers in ``dt_s`` from ``speed_mps`` braking at ``decel_mps2`` (to
-    its stop)."""
-    if decel_mps2 > 0.0 and dt_s * decel_mps2 > speed_mps:
-        return 0.5 * speed_mps * speed_mps / decel_mps2
-    return dt_s * (speed_mps - 0.5 * decel_mps2 * dt_s)
-
-
 def _lateral_state(meas: EgoMeasurement) -> tuple[float, float, float]:
     """(slope of the course relative to the road, path curvature relative to the road [1/m],
-    speed along the road [m/s]) from the ego's motion: lateral speed vx sin e + vy cos e,
-    curvature from the measured lateral acceleration less the road's."""
-    e = meas.e_yaw_rad
-    c, s = math.cos(e), math.sin(e)
-    along = meas.vx_mps * c - meas.vy_mps * s
-    along = max(1.0, along)
-    lateral = meas.vx_mps * s + meas.vy_mps * c
-    return lateral / along, meas.ay_mps2 / (along * along) - meas.road_curvature_1pm, along
+    speed along the road [m/s]) of the ego (``control.escape.lateral_state``)."""
+    v_lat, a_lat, along = lateral_state(meas)
+    return v_lat / along, a_lat / (along * along), along
 
 
 def _wrap(angle_rad: float) -> float:

@@ -52,6 +52,7 @@ class Perception(NamedTuple):
     # velocity (a coasted track): its range and range rate now, or None
     coasted_range_m: float | None = None
     coasted_range_rate_mps: float = 0.0
+    oncoming_object: ObjectState | None = None  # the nearest oncoming road user, when tracked
 
 
 class Command(NamedTuple):

@@ -39,6 +39,17 @@ class EoamSettings:
     lateral_reaction_s: float = 0.3  # steering and yaw lag before the lateral motion turns
     ponr_at_lateral_stop: bool = True  # judge the point of no return where the lateral
     # motion stops if arrested now (False: on the offset reached, as in the paper)
+    compare_outcomes: bool = True  # oncoming traffic seen in mode 2 with the oncoming road
+    # user and the obstacle tracked: pass on or abort by the lower predicted delta-v
+    # (decision.oncoming; False: the point of no return above)
+    oncoming_margin_m: float = 0.2  # ... the ego's side this far short of the other's path
+    oncoming_margin_s: float = 0.2  # ... that long before the fronts meet
+    min_time_escapes: bool = True  # modes 3, 4 and the returns from oncoming traffic:
+    # jerk-limited time-optimal shifts (control.escape; False: the shortest quintics)
+    escape_ramp_s: float = 0.15  # their time from no lateral acceleration to the full budget
+    escape_lag_s: float = 0.1  # the commit/abort prediction: the closed loop follows a new
+    # shift as if its lateral acceleration held this long first (Table 2: peaks 0.4-0.6 m
+    # past the plan's after a lane change aborted at 1-3.5 m/s of lateral speed)
     return_lateral_g: float = 0.3  # mode 5 after 2: return's peak lateral acceleration / (mu g)
     evasive_lateral_g: float = 0.9  # modes 3, 4 and the return after 4 (oncoming traffic): the same
     return_min_length_m: float = 10.0  # mode 5: shortest return path
@@ -65,6 +76,7 @@ class EoamSettings:
             "return_lateral_g",
             "evasive_lateral_g",
             "return_min_length_m",
+            "escape_ramp_s",
             "settle_offset_m",
             "settle_heading_rad",
             "unknown_obstacle_length_m",

@@ -18,6 +18,7 @@ track: the estimate starts again from it.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 
 class ObstacleDecel:
@@ -57,3 +58,42 @@ def stopping_range_m(range_m: float, obstacle_speed_mps: float, decel_mps2: floa
     if decel_mps2 <= 0.0 or obstacle_speed_mps <= 0.0:
         return math.inf if obstacle_speed_mps > 0.0 else range_m
     return range_m + obstacle_speed_mps * obstacle_speed_mps / (2.0 * decel_mps2)
+
+
+def travel_m(speed_mps: float, decel_mps2: float, dt_s: float) -> float:
+    """Distance a body covers in ``dt_s`` from ``speed_mps`` braking at ``decel_mps2`` (to
+    its stop)."""
+    if decel_mps2 > 0.0 and dt_s * decel_mps2 > speed_mps:
+        return 0.5 * speed_mps * speed_mps / decel_mps2
+    return dt_s * (speed_mps - 0.5 * decel_mps2 * dt_s)
+
+
+class ObstacleTrack(NamedTuple):
+    """The in-path obstacle as last sensed, road frame of the ego's lane."""
+
+    time_s: float
+    front_s_m: float  # station of its front
+    speed_mps: float
+    left_edge_m: float  # offset of its left side
+    decel_mps2: float  # its braking (0: holds its speed)
+    length_m: float
+
+    @classmethod
+    def sensed(cls, meas, front_offset_m: float, range_m: float, closing_mps: float, obj,
+               unknown_length_m: float, decel_mps2: float) -> ObstacleTrack:
+        """From an ``EgoMeasurement`` and the sensor: the object track ``obj`` (an
+        ``ObjectState``) when it gives one; else the range from the ego's front bumper
+        (``front_offset_m`` ahead of its centre of gravity), an assumed length and a width
+        filling the ego's lane."""
+        if obj is not None:
+            return cls(meas.time_s, obj.s_m + 0.5 * obj.length_m, max(obj.speed_mps, 0.0),
+                       obj.d_m + 0.5 * obj.width_m, decel_mps2, obj.length_m)
+        return cls(meas.time_s, meas.s_m + front_offset_m + range_m + unknown_length_m,
+                   max(meas.vx_mps - closing_mps, 0.0), 0.5 * meas.lane_width_m, decel_mps2,
+                   unknown_length_m)
+
+    def at(self, time_s: float) -> tuple[float, float]:
+        """(front station, speed) predicted at ``time_s`` from its speed and braking."""
+        dt = time_s - self.time_s
+        return (self.front_s_m + travel_m(self.speed_mps, self.decel_mps2, dt),
+                max(self.speed_mps - self.decel_mps2 * dt, 0.0))

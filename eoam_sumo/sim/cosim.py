@@ -446,16 +446,28 @@ _ONCOMING_ONLY = Perception(None, None, True)
 
 def _perception(report: RadarReport) -> Perception:
     """The EOAM's view of a radar report: the in-path obstacle as an object, the oncoming
-    flag, the range of a coasted in-path object."""
+    flag, the nearest oncoming road user as an object, the range of a coasted in-path
+    object."""
     det = report.in_path
+    oncoming = _nearest_oncoming(report) if report.oncoming_detected else None
     if det is None:
         perception = _ONCOMING_ONLY if report.oncoming_detected else _NOTHING
+        if oncoming is not None:
+            perception = Perception(None, None, True, oncoming_object=oncoming)
     else:
         obstacle = ObjectState(det.s_m, det.d_m, det.road_speed_mps, det.length_m,
                                det.width_m)
         perception = Perception(det.range_m, det.range_rate_mps, report.oncoming_detected,
-                                obstacle, report.next_lane_range_m)
+                                obstacle, report.next_lane_range_m, oncoming_object=oncoming)
     if report.coasted is None:
         return perception
     return perception._replace(coasted_range_m=report.coasted.range_m,
                                coasted_range_rate_mps=report.coasted.range_rate_mps)
+
+
+def _nearest_oncoming(report: RadarReport) -> ObjectState | None:
+    """The nearest detection classed oncoming, as an object (detections are sorted by range)."""
+    for det in report.detections:
+        if det.category == "oncoming":
+            return ObjectState(det.s_m, det.d_m, det.road_speed_mps, det.length_m, det.width_m)
+    return None

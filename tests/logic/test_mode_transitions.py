@@ -208,9 +208,9 @@ def test_1_to_0_when_the_obstacle_leaves_the_path(tables):
     assert drive.mode is Mode.NORMAL
 
 
-def start_steer(tables, lane_m=LANE):
+def start_steer(tables, lane_m=LANE, settings=None):
     v = speed_with(tables, 1.0, "F")
-    drive = Drive(tables, v, lane_m=lane_m)
+    drive = Drive(tables, v, lane_m=lane_m, settings=settings)
     drive.step(range_m=range_in(tables, 1.0, v, "F"))
     assert drive.mode is Mode.UPDATE_STEER_BRAKE
     return drive
@@ -265,12 +265,16 @@ def test_4_aims_just_past_the_obstacle_side_then_5_once_past_it(tables, width_m,
     follow_return_to_its_end(drive)
 
 
-def test_return_turns_urgent_when_oncoming_traffic_appears(tables):
+@pytest.mark.parametrize("min_time", [True, False])
+def test_return_turns_urgent_when_oncoming_traffic_appears(tables, min_time):
     """An oncoming vehicle seen during a comfortable return re-plans it at the evasive
-    lateral acceleration: it reaches the lane centre sooner."""
+    lateral acceleration: it reaches the lane centre sooner. Time-optimal (jerk-limited
+    bang-bang, ramp r): r + sqrt(r^2 + 4 D / A) for the lane width D; as a quintic, quicker
+    by sqrt(a_comfortable / a_evasive)."""
+    st = EoamSettings(min_time_escapes=min_time)
     ends = {}
     for seen in (False, True):
-        drive = start_steer(tables)
+        drive = start_steer(tables, settings=st)
         while drive.mode is not Mode.RETURN:
             drive.step(d_m=LANE)
         t0 = drive.t
@@ -279,9 +283,14 @@ def test_return_turns_urgent_when_oncoming_traffic_appears(tables):
             if cmd.dx_m > 0.0 and abs(cmd.y_target_m) < 1e-9:
                 break
         ends[seen] = drive.t - t0
-    st = EoamSettings()
-    ratio = math.sqrt(st.return_lateral_g / st.evasive_lateral_g)  # quintic time ~ 1/sqrt(a)
-    assert ends[True] == pytest.approx(ends[False] * ratio, rel=0.06)
+    if min_time:
+        accel, ramp = st.evasive_lateral_g * 9.81, st.escape_ramp_s
+        expected = ramp + math.sqrt(ramp * ramp + 4.0 * LANE / accel)
+        assert ends[True] == pytest.approx(DT + expected, abs=2.5 * DT)
+        assert ends[True] < ends[False]
+    else:
+        ratio = math.sqrt(st.return_lateral_g / st.evasive_lateral_g)  # quintic ~ 1/sqrt(a)
+        assert ends[True] == pytest.approx(ends[False] * ratio, rel=0.06)
 
 
 def follow_return_to_its_end(drive):
