@@ -12,8 +12,9 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from eoam_sumo.control.escape import MinTimeShift
+from eoam_sumo.control.escape import MinTimeShift, lateral_state
 from eoam_sumo.control.paths import QuinticShift
+from eoam_sumo.eoam_messages import EgoMeasurement
 
 SPEED = 30.0  # forward speed [m/s]
 
@@ -97,3 +98,12 @@ def test_bad_budget_is_refused(bad):
     kw.update(bad)
     with pytest.raises(ValueError):
         MinTimeShift(**kw)
+
+
+def test_lateral_state_of_a_measurement():
+    e, vx, vy = 0.1, 30.0, -0.5  # heading 0.1 rad left of the road, sliding right in the body
+    meas = EgoMeasurement(0.0, vx, vy, 0.0, 0.0, 2.0, 0.0, 1.0, e, 0.001, 1.0, 3.5)
+    v_lat, a_lat, along = lateral_state(meas)
+    assert v_lat == pytest.approx(vx * math.sin(e) + vy * math.cos(e))
+    assert along == pytest.approx(vx * math.cos(e) - vy * math.sin(e))
+    assert a_lat == pytest.approx(2.0 - 0.001 * along * along)  # less the road's curving

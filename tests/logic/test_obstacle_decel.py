@@ -6,7 +6,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from eoam_sumo.decision.obstacle import ObstacleDecel, stopping_range_m
+from eoam_sumo.decision.obstacle import ObstacleDecel, ObstacleTrack, stopping_range_m
+from eoam_sumo.eoam_messages import EgoMeasurement, ObjectState
 
 
 @given(decel=st.floats(0.5, 10.0), v0=st.floats(10.0, 40.0), ego=st.floats(15.0, 45.0))
@@ -39,3 +40,22 @@ def test_stopping_range():
     assert stopping_range_m(30.0, 0.0, 4.0) == 30.0  # already standing
     with pytest.raises(ValueError):
         ObstacleDecel(time_constant_s=0.0)
+
+
+def test_obstacle_track_predicts_its_stop():
+    track = ObstacleTrack(1.0, 100.0, 10.0, 0.995, 4.0, 5.09)
+    # within its stop: s = v t - a t^2 / 2; after it, where it stopped (v^2 / 2a = 12.5 m)
+    assert track.at(2.0) == pytest.approx((100.0 + 10.0 - 2.0, 6.0))
+    assert track.at(10.0) == pytest.approx((112.5, 0.0))
+    holding = track._replace(decel_mps2=0.0)
+    assert holding.at(4.0) == pytest.approx((130.0, 10.0))
+
+
+def test_obstacle_track_from_the_sensor():
+    meas = EgoMeasurement(2.0, 30.0, 0.0, 0.0, 0.0, 0.0, 50.0, 0.0, 0.0, 0.0, 1.0, 3.5)
+    obj = ObjectState(90.0, 0.1, 12.0, 5.0, 2.0)
+    assert ObstacleTrack.sensed(meas, 3.9, 30.0, 18.0, obj, 12.0, 1.5) == (
+        2.0, 92.5, 12.0, 1.1, 1.5, 5.0)
+    # without an object: the range from the front bumper, an assumed length, a lane's width
+    assert ObstacleTrack.sensed(meas, 3.9, 30.0, 18.0, None, 12.0, 0.0) == pytest.approx(
+        (2.0, 50.0 + 3.9 + 30.0 + 12.0, 12.0, 1.75, 0.0, 12.0))
