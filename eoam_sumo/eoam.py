@@ -408,27 +408,25 @@ class EoamController:
         dx = meas.s_m - self._s0 if path is not None else 0.0
 
         # ---- lateral reference (lane centre unless a path is active) and steering, eq. 38 ----
-        y_ref = yaw_ref = kappa_ref = kappa_ff = ax_ref = v_plan = 0.0
+        y_ref = yaw_ref = kappa_ref = kappa_ff = ax_ref = v_plan = steer_ff = 0.0
+        beta_ref: float | None = None
         in_path = False
-        if path is not None:
-            y_ref, yaw_ref, kappa_ref, ax_ref, v_plan = path.at(dx)
-            in_path = dx < path.length_m
-            if in_path:
-                kappa_ff = path.at(dx + v * st.preview_time_s).curvature_1pm
-            else:
-                yaw_ref = kappa_ref = 0.0
-        e_lat = d - y_ref
         road_kappa = meas.road_curvature_1pm
+        if path is not None:
+            y_ref, yaw_ref, kappa_ref, ax_ref, v_plan, _, beta_plan = path.at(dx)
+            in_path = dx < path.length_m
+            if not in_path:
+                yaw_ref = kappa_ref = 0.0
+            elif path.planned_steering:
+                # the plan's steering (planned with the plant's tyre), ahead by the lag
+                steer_ff = path.at(dx + v * st.planned_preview_time_s).steer_rad
+                beta_ref = beta_plan + self._steer.steady_sideslip(v, road_kappa)
+            else:
+                kappa_ff = path.at(dx + v * st.preview_time_s).curvature_1pm
+        e_lat = d - y_ref
         delta, ff, fb, yd, e_la = self._steer.command(
-            v,
-            meas.yaw_rate_radps,
-            meas.vy_mps,
-            e_lat,
-            _wrap(meas.e_yaw_rad - yaw_ref),
-            kappa_ref + road_kappa,
-            kappa_ff + road_kappa,
-            mu,
-        )
+            v, meas.yaw_rate_radps, meas.vy_mps, e_lat, _wrap(meas.e_yaw_rad - yaw_ref),
+            kappa_ref + road_kappa, kappa_ff + road_kappa, mu, steer_ff, beta_ref)
 
         # ---- longitudinal: force limits from the friction ellipse with the lateral acceleration
         # in use (measured; outside the table's profile also the one this steering command asks

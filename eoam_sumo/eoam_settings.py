@@ -57,6 +57,8 @@ class EoamSettings:
     # in-path obstacle's range plus this (room to pass it and return) blocks the lane change
     # as oncoming traffic does (modes 3, 4); the paper checks the next lane for oncoming only
     preview_time_s: float = 0.3  # feedforward curvature taken this far ahead on the path
+    planned_preview_time_s: float = 0.05  # the table lane change's planned steering taken
+    # this far ahead on the path (the steering actuator's lag)
     steering: SteeringGains = field(default_factory=SteeringGains)
     longitudinal: LongitudinalGains = field(default_factory=LongitudinalGains)
     policy: PolicySettings = field(default_factory=PolicySettings)  # paper or safe

@@ -26,6 +26,8 @@ class PathPoint(NamedTuple):
     curvature_1pm: float  # signed path curvature, left positive
     ax_mps2: float  # planned longitudinal acceleration
     speed_mps: float  # planned speed
+    steer_rad: float  # planned road-wheel angle (0: not planned)
+    sideslip_rad: float  # planned body sideslip, course less body yaw (0: not planned)
 
 
 # ``tuple.__new__(NamedTuple, values)`` builds a named tuple in ~70 ns, its constructor in
@@ -38,13 +40,16 @@ class PathReference:
 
     __slots__ = (
         "_ax",
+        "_beta",
         "_inv",
         "_k",
         "_n",
+        "_steer",
         "_v",
         "_y",
         "_yaw",
         "length_m",
+        "planned_steering",
         "start_offset_m",
     )
 
@@ -79,6 +84,14 @@ class PathReference:
         self._ax = [float(s.ax_mps2) for s in samples]
         self._yaw = [scale * float(s.yaw_rad) for s in samples]
         self._k = [scale * float(s.curvature_1pm) for s in samples]
+        # the planned steering and sideslip where the trajectory has them (the tables' lane
+        # changes, planned with the plant's tyre), scaled with the path like the curvature
+        self.planned_steering = not math.isnan(samples[0].sideslip_rad)
+        if self.planned_steering:
+            self._steer = [scale * float(s.steer_rad) for s in samples]
+            self._beta = [scale * float(s.sideslip_rad) for s in samples]
+        else:
+            self._steer = self._beta = [0.0] * (n + 1)
         v2 = speed_mps * speed_mps
         self._v = [speed_mps]
         for i in range(n):
@@ -92,21 +105,26 @@ class PathReference:
         """The reference at ``dx_m``, held at the ends of the path."""
         u = dx_m * self._inv
         if u <= 0.0:
-            return PathPoint(self._y[0], self._yaw[0], self._k[0], self._ax[0], self._v[0])
-        i = int(u)
-        if i >= self._n:
-            n = self._n
-            return PathPoint(self._y[n], self._yaw[n], self._k[n], self._ax[n], self._v[n])
-        w = u - i
-        j = i + 1
-        y, yaw, k, ax, v = self._y, self._yaw, self._k, self._ax, self._v
-        return _new(PathPoint, (
-            y[i] + w * (y[j] - y[i]),
-            yaw[i] + w * (yaw[j] - yaw[i]),
-            k[i] + w * (k[j] - k[i]),
-            ax[i] + w * (ax[j] - ax[i]),
-            v[i] + w * (v[j] - v[i]),
-        ))
+            i = 0
+        elif u >= self._n:
+            i = self._n
+        else:
+            i = int(u)
+            w = u - i
+            j = i + 1
+            y, yaw, k, ax, v, st, beta = (self._y, self._yaw, self._k, self._ax, self._v,
+                                          self._steer, self._beta)
+            return _new(PathPoint, (
+                y[i] + w * (y[j] - y[i]),
+                yaw[i] + w * (yaw[j] - yaw[i]),
+                k[i] + w * (k[j] - k[i]),
+                ax[i] + w * (ax[j] - ax[i]),
+                v[i] + w * (v[j] - v[i]),
+                st[i] + w * (st[j] - st[i]),
+                beta[i] + w * (beta[j] - beta[i]),
+            ))
+        return PathPoint(self._y[i], self._yaw[i], self._k[i], self._ax[i], self._v[i],
+                         self._steer[i], self._beta[i])
 
 
 PEAK_SAMPLES = 200  # intervals over which a shift's peak curvature is checked

@@ -233,6 +233,8 @@ class SteeringController:
         curvature_1pm: float,
         preview_curvature_1pm: float,
         mu: float,
+        planned_steer_rad: float = 0.0,
+        sideslip_rad: float | None = None,
     ) -> SteeringCommand:
         """The steering command; delta clipped to the lock.
 
@@ -244,9 +246,12 @@ class SteeringController:
         """
         v = max(0.0, speed_mps)
         k_vy, k_r, k_psi, k_e = self.gains_at(v, mu)
-        beta = curvature_1pm * (self._b - self._slip_k * v * v)  # steady_sideslip, inlined
+        if sideslip_rad is None:
+            beta = curvature_1pm * (self._b - self._slip_k * v * v)  # steady_sideslip, inlined
+        else:
+            beta = sideslip_rad
         psi = heading_error_rad + beta
-        ff = (self._L + self._kus * v * v) * preview_curvature_1pm
+        ff = (self._L + self._kus * v * v) * preview_curvature_1pm + planned_steer_rad
         fb = -(k_e * lateral_error_m + k_psi * psi)
         yd = -(k_vy * (lateral_speed_mps - v * beta) + k_r * (yaw_rate_radps - v * curvature_1pm))
         delta = ff + fb + yd

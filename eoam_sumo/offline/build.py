@@ -66,15 +66,17 @@ def sample_on_grid(resim: Resimulation, step_m: float) -> np.ndarray:
     """Lookup-table rows on the uniform differential-x grid up to the manoeuvre end.
 
     Path y; body longitudinal acceleration (eq. 1); path yaw theta = atan2(y', x') (eq. 10);
-    signed path curvature (x' y'' - y' x'') / |v|^3 (eq. 9); steering angle; speed.
+    signed path curvature (x' y'' - y' x'') / |v|^3 (eq. 9); steering angle; body sideslip
+    (course less body yaw); speed.
     """
     s = resim.states
     x, vx, vy, yaw = s[:, 0], s[:, 1], s[:, 3], s[:, 4]
     ax_g = resim.ax_body_mps2 * np.cos(yaw) - resim.ay_body_mps2 * np.sin(yaw)
     ay_g = resim.ax_body_mps2 * np.sin(yaw) + resim.ay_body_mps2 * np.cos(yaw)
     speed = np.hypot(vx, vy)
-    quantities = (s[:, 2], resim.ax_body_mps2, np.arctan2(vy, vx),
-                  (vx * ay_g - vy * ax_g) / speed**3, s[:, 6], speed)
+    course = np.arctan2(vy, vx)
+    quantities = (s[:, 2], resim.ax_body_mps2, course, (vx * ay_g - vy * ax_g) / speed**3,
+                  s[:, 6], course - yaw, speed)
     grid = np.arange(0.0, x[-1] + 1e-9, step_m)
     return np.stack([np.interp(grid, x, q) for q in quantities])
 

@@ -53,6 +53,19 @@ class DesignSettings:
     max_quintic_time_s: float = _p(
         6.0, "s", DESIGN + ": upper bound of T; binds only below mu 0.07 and keeps the lane "
         "change well inside the 8 s manoeuvre timer")
+    plant_tyre: bool = _p(
+        True, "-", DESIGN + ": the lane change is planned with the plant's Fiala tyre (cornering "
+        "stiffness C at any friction, peak derated by the longitudinal force), not the paper's "
+        "eq. 6 tyre (stiffness mu C, the ellipse reached at a few degrees of slip): the plan's "
+        "steering and sideslip are then the ones the plant needs (False: the paper's tyre)")
+    friction_use: float = _p(
+        0.9, "-", DESIGN + ": each axle's planned tyre force stays within this share of its "
+        "friction limit mu Fz (eqs. 25, 28: ellipse <= share^2); the rest is the tracking loop's: "
+        "at the whole ellipse the plant's tyre is at its peak slip, where no force is left to "
+        "correct with (measured: 0.92 m of tracking error at 55 km/h, mu 1.0)")
+    continuation_steps: int = _p(
+        4, "-", DESIGN + ": steps from the paper's tyre and the whole ellipse to the plant's tyre "
+        "and friction_use, each warm-started from the last, where a direct solve fails")
     ocp_intervals: int = _p(40, "-", DESIGN + ": collocation intervals (speed vs. accuracy)")
     collocation_degree: int = _p(3, "-", DESIGN + ": Radau collocation points per interval")
     min_speed_fraction: float = _p(
@@ -88,7 +101,7 @@ class DesignSettings:
     def __post_init__(self) -> None:
         positive = (
             "lane_change_m", "obstacle_width_m", "dx_step_m", "lat_accel_fraction",
-            "max_quintic_time_s", "min_speed_fraction", "max_yaw_rad", "ipopt_tol",
+            "max_quintic_time_s", "min_speed_fraction", "max_yaw_rad", "ipopt_tol", "friction_use",
             "verify_lateral_tol_m", "verify_distance_tol_m", "verify_lat_speed_tol_mps",
             "verify_yaw_tol_rad", "verify_yaw_rate_tol_radps", "verify_ellipse_tol",
         )
@@ -101,7 +114,12 @@ class DesignSettings:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0.0):
                 raise ValueError(f"design setting {name}={v!r} must be a finite number >= 0")
-        for name in ("ocp_intervals", "collocation_degree", "ipopt_max_iter"):
+        if self.friction_use > 1.0:
+            raise ValueError(f"friction_use={self.friction_use} must be <= 1")
+        if not isinstance(self.plant_tyre, bool):
+            raise ValueError(f"design setting plant_tyre={self.plant_tyre!r} must be true or false")
+        for name in ("ocp_intervals", "collocation_degree", "ipopt_max_iter",
+                     "continuation_steps"):
             v = getattr(self, name)
             if not (isinstance(v, int) and v >= 1):
                 raise ValueError(f"design setting {name}={v!r} must be an integer >= 1")
@@ -133,6 +151,11 @@ class DesignSettings:
                 w = (mu - mus[i - 1]) / (mus[i] - mus[i - 1])
                 return float(ttcs[i - 1] + w * (ttcs[i] - ttcs[i - 1]))
         return float(ttcs[-1])
+
+    @property
+    def tyre_blend(self) -> float:
+        """Weight of the plant's tyre in the design model (``model.dynamics``)."""
+        return 1.0 if self.plant_tyre else 0.0
 
     def quintic_time_s(self, mu: float) -> float:
         """Lane-change time T of the quintic: 5.77 h / T^2 = k mu g, capped (sec. 4.2)."""

@@ -1,9 +1,10 @@
 """Minimum-distance lane change: the nonlinear optimal control problem of eqs. 14-29 in CasADi.
 
 Minimise x(t_f) (eq. 14) over the free final time t_f, subject to the design model
-(``model.dynamics``, eqs. 15-20), x(0) = 0 and the given entry speed (eqs. 21-22, 24), the
-lateral offset y(t_f) = y_f (eq. 23), the friction ellipse of each axle (eqs. 25, 28), the
-steering angle limits (eqs. 26-27), the brake limit and the engine limit (eq. 29).
+(``model.dynamics``, eqs. 15-20, with the plant's tyre), x(0) = 0 and the given entry speed
+(eqs. 21-22, 24), the lateral offset y(t_f) = y_f (eq. 23), the friction ellipse of each axle
+within ``friction_use`` of it (eqs. 25, 28), the steering angle limits (eqs. 26-27), the brake
+limit and the engine limit (eq. 29).
 
 Final conditions imposed besides eq. 23, so that the ego ends parallel and settled in the next
 lane: lateral speed, yaw angle, yaw rate and steering angle all zero at t_f.
@@ -14,7 +15,9 @@ lateral dynamics stiff at low speed), piecewise-constant controls (steering rate
 force); the path constraints hold at every interval start (with the new control) and at every
 collocation point. A small penalty on the control steps (``settings.regularisation``) smooths
 the bang-bang optimum. IPOPT solves it; the problem is built once per ``LaneChangeOcp`` with
-the entry speed and the friction as parameters.
+the entry speed, the friction, the tyre blend and the ellipse bound as parameters, so that a
+solve that fails directly is reached by continuation from the paper's tyre and the whole
+ellipse (``solve_chain``).
 """
 
 from __future__ import annotations
@@ -49,6 +52,7 @@ class OcpSolution:
     controls: np.ndarray
     iterations: int = 0
     colloc_states: np.ndarray | None = None  # (N * degree, 7), interval-major
+    tyre_blend: float = 0.0  # the design model's tyre: 0 the paper's, 1 the plant's
 
     @property
     def distance_m(self) -> float:
@@ -69,7 +73,8 @@ def solver_options(settings: DesignSettings) -> dict:
 
 
 def _interval_function(params: VehicleParams, degree: int) -> ca.Function:
-    """Radau collocation on one interval: (x0, xc, u, mu, h) -> (defects, x_end, path values).
+    """Radau collocation on one interval: (x0, xc, u, mu, h, blend) -> (defects, x_end, path
+    values), ``blend`` the tyre blend of ``model.dynamics``.
 
     ``xc`` holds the states at the ``degree`` collocation points (7 x degree); the defects are
     h f(x_j, u) - sum_r C[r, j] x_r; path values are (ellipse front, ellipse rear, body speed)
@@ -89,15 +94,16 @@ def _interval_function(params: VehicleParams, degree: int) -> ca.Function:
     u = ca.SX.sym("u", N_CONTROLS)
     mu = ca.SX.sym("mu")
     h = ca.SX.sym("h")
+    blend = ca.SX.sym("blend")
     points = ca.horzcat(x0, xc)
     defects, path = [], []
     for j in range(degree + 1):
-        xdot, out = dynamics(points[:, j], u, mu, params, ca)
+        xdot, out = dynamics(points[:, j], u, mu, params, ca, blend)
         path += [out.ellipse_front, out.ellipse_rear, out.vx_body_mps]
         if j > 0:
             slope = sum(deriv[r, j] * points[:, r] for r in range(degree + 1))
             defects.append(h * ca.vertcat(*xdot) - slope)
-    return ca.Function("radau_interval", [x0, xc, u, mu, h],
+    return ca.Function("radau_interval", [x0, xc, u, mu, h, blend],
                        [ca.horzcat(*defects), points[:, degree], ca.vertcat(*path)])
 
 
@@ -116,6 +122,8 @@ class LaneChangeOcp:
         self._tau = opti.variable()
         self._v0 = opti.parameter()
         self._mu = opti.parameter()
+        self._blend = opti.parameter()
+        self._ellipse = opti.parameter()
         mg = p.mass_kg * G_MPS2
         self._control_scale = np.array([p.max_steer_rate_radps, mg])
         scale = ca.diag(ca.DM(_STATE_SCALE))
@@ -125,7 +133,8 @@ class LaneChangeOcp:
         t_f = _TIME_SCALE_S * self._tau
         interval = _interval_function(p, d).map(n)
         defects, x_end, path = interval(
-            xs[:, :-1], xc, us, ca.repmat(self._mu, 1, n), ca.repmat(t_f / n, 1, n))
+            xs[:, :-1], xc, us, ca.repmat(self._mu, 1, n), ca.repmat(t_f / n, 1, n),
+            ca.repmat(self._blend, 1, n))
         opti.subject_to(ca.vec(defects / ca.repmat(ca.DM(_STATE_SCALE), 1, n * d)) == 0.0)
         opti.subject_to(self._z[:, 1:] == x_end / ca.DM(_STATE_SCALE))
         # eqs. 21, 22, 24 (steering starts centred)
@@ -133,7 +142,7 @@ class LaneChangeOcp:
         # eq. 23 and the settled end: no lateral speed, yaw, yaw rate or steering
         opti.subject_to(xs[2:, -1] == ca.vertcat(settings.lane_change_m, 0.0, 0.0, 0.0, 0.0))
         for j in range(d + 1):
-            opti.subject_to(ca.vec(path[3 * j:3 * j + 2, :]) <= 1.0)  # eqs. 25, 28
+            opti.subject_to(ca.vec(path[3 * j:3 * j + 2, :]) <= self._ellipse)  # eqs. 25, 28
             opti.subject_to(path[3 * j + 2, :] >= settings.min_speed_fraction * self._v0)
         steer = xs[6, :]
         opti.subject_to(opti.bounded(-p.max_steer_rad, steer, p.max_steer_rad))  # eqs. 26-27
@@ -151,11 +160,20 @@ class LaneChangeOcp:
         self._opti = opti
         self._degree = d
 
-    def solve(self, speed_mps: float, mu: float, guess: OcpSolution) -> OcpSolution:
-        """Solve for this entry speed and friction from ``guess``; raise ``OcpError`` on failure."""
+    def solve(self, speed_mps: float, mu: float, guess: OcpSolution,
+              step: float = 1.0) -> OcpSolution:
+        """Solve for this entry speed and friction from ``guess``; raise ``OcpError`` on failure.
+
+        ``step`` in [0, 1] is the continuation parameter: 1 is the problem of the settings
+        (tyre ``settings.tyre_blend``, ellipse within ``settings.friction_use``), 0 the paper's
+        (its tyre, the whole ellipse), linear in between."""
         opti = self._opti
+        st = self.settings
+        blend = step * st.tyre_blend
         opti.set_value(self._v0, speed_mps)
         opti.set_value(self._mu, mu)
+        opti.set_value(self._blend, blend)
+        opti.set_value(self._ellipse, 1.0 + step * (st.friction_use**2 - 1.0))
         opti.set_initial(self._z, (guess.states / _STATE_SCALE).T)
         colloc = guess.colloc_states
         if colloc is None:
@@ -163,7 +181,11 @@ class LaneChangeOcp:
         opti.set_initial(self._zc, (colloc / _STATE_SCALE).T)
         opti.set_initial(self._w, (guess.controls / self._control_scale).T)
         opti.set_initial(self._tau, guess.duration_s / _TIME_SCALE_S)
-        sol = opti.solve_limited()
+        try:
+            sol = opti.solve_limited()
+        except RuntimeError as exc:  # IPOPT gave up (e.g. restoration failed)
+            raise OcpError(f"optimal lane change at mu={mu:g}, {speed_mps * 3.6:g} km/h did not "
+                           f"converge: {opti.stats()['return_status']}") from exc
         stats = opti.stats()
         if not stats["success"]:
             raise OcpError(
@@ -177,6 +199,7 @@ class LaneChangeOcp:
             controls=np.asarray(sol.value(self._w)).T * self._control_scale,
             iterations=int(stats["iter_count"]),
             colloc_states=np.asarray(sol.value(self._zc)).T * _STATE_SCALE,
+            tyre_blend=blend,
         )
 
 
@@ -219,14 +242,39 @@ def rescaled_guess(previous: OcpSolution, speed_mps: float) -> OcpSolution:
     colloc = previous.colloc_states.copy()
     colloc[:, :2] *= ratio
     return OcpSolution(float(speed_mps), previous.mu, previous.duration_s, states,
-                       previous.controls.copy(), colloc_states=colloc)
+                       previous.controls.copy(), colloc_states=colloc,
+                       tyre_blend=previous.tyre_blend)
+
+
+def solve_continued(ocp: LaneChangeOcp, speed_mps: float, mu: float,
+                    guess: OcpSolution) -> OcpSolution:
+    """Solve the paper's problem (``step`` 0) from ``guess``, then step to the settings' one
+    in ``settings.continuation_steps`` equal steps, each warm-started from the last; a step
+    that fails is halved (down to 1/16 of one) before the failure is raised."""
+    sol = ocp.solve(speed_mps, mu, guess, 0.0)
+    step = 0.0
+    size = base = 1.0 / ocp.settings.continuation_steps
+    while step < 1.0:
+        target = min(1.0, step + size)
+        try:
+            sol = ocp.solve(speed_mps, mu, sol, target)
+        except OcpError:
+            if size <= base / 16.0:
+                raise
+            size *= 0.5
+            continue
+        step = target
+        size = min(base, 2.0 * size)
+    return sol
 
 
 def solve_chain(ocp: LaneChangeOcp, mu: float, speeds_mps, on_solved=None) -> list[OcpSolution]:
     """Solve one friction's speeds from the highest down, each warm-started from the previous.
 
     The highest speed starts from ``quintic_guess`` (fast lane changes converge easily from
-    it); ``on_solved(solution)`` is called after each. Returns the solutions, highest first.
+    it), the next ones from the previous solution; where a direct solve fails, by
+    continuation from the same guess (``solve_continued``). ``on_solved(solution)`` is called
+    after each. Returns the solutions, highest first.
     """
     solutions: list[OcpSolution] = []
     for v in sorted(speeds_mps, reverse=True):
@@ -234,7 +282,10 @@ def solve_chain(ocp: LaneChangeOcp, mu: float, speeds_mps, on_solved=None) -> li
             guess = rescaled_guess(solutions[-1], v)
         else:
             guess = quintic_guess(v, mu, ocp.params, ocp.settings)
-        sol = ocp.solve(v, mu, guess)
+        try:
+            sol = ocp.solve(v, mu, guess)
+        except OcpError:
+            sol = solve_continued(ocp, v, mu, guess)
         solutions.append(sol)
         if on_solved is not None:
             on_solved(sol)

@@ -51,7 +51,7 @@ def resimulate(solution: OcpSolution, params: VehicleParams, max_spacing_m: floa
     n = solution.controls.shape[0]
     h = solution.duration_s / n
     per = max(8, math.ceil(solution.distance_m / (n * max_spacing_m)))
-    mu = solution.mu
+    mu, blend = solution.mu, solution.tyre_blend
     x = solution.states[0].astype(float)
     times, states, controls = [np.array([0.0])], [x[None, :]], [solution.controls[:1]]
     for k in range(n):
@@ -59,7 +59,7 @@ def resimulate(solution: OcpSolution, params: VehicleParams, max_spacing_m: floa
         t_eval = np.linspace(k * h, (k + 1) * h, per + 1)
 
         def rhs(_t, y, u=u):
-            return dynamics(y, u, mu, params, math)[0]
+            return dynamics(y, u, mu, params, math, blend)[0]
 
         res = solve_ivp(rhs, (k * h, (k + 1) * h), x, method="DOP853", t_eval=t_eval,
                         rtol=_RTOL, atol=_ATOL)
@@ -74,8 +74,9 @@ def resimulate(solution: OcpSolution, params: VehicleParams, max_spacing_m: floa
     xs = np.vstack(states)
     us = np.vstack(controls)
     # at each interval start the state belongs to both intervals: audit it with the new control
-    outs = [dynamics(xs[i], us[i], mu, params, math)[1] for i in range(len(t))]
-    starts = [dynamics(xs[k * per], solution.controls[k], mu, params, math)[1] for k in range(n)]
+    outs = [dynamics(xs[i], us[i], mu, params, math, blend)[1] for i in range(len(t))]
+    starts = [dynamics(xs[k * per], solution.controls[k], mu, params, math, blend)[1]
+              for k in range(n)]
     ef = np.array([o.ellipse_front for o in outs])
     er = np.array([o.ellipse_rear for o in outs])
     ef[::per][:n] = np.maximum(ef[::per][:n], [o.ellipse_front for o in starts])
@@ -106,9 +107,9 @@ def audit(solution: OcpSolution, resim: Resimulation, params: VehicleParams,
         ("final lateral speed", abs(end[3]), s.verify_lat_speed_tol_mps, "m/s"),
         ("final yaw", abs(end[4]), s.verify_yaw_tol_rad, "rad"),
         ("final yaw rate", abs(end[5]), s.verify_yaw_rate_tol_radps, "rad/s"),
-        ("front friction ellipse (eqs. 25, 28)", resim.ellipse_front.max() - 1.0,
-         s.verify_ellipse_tol, "-"),
-        ("rear friction ellipse (eq. 28)", resim.ellipse_rear.max() - 1.0,
+        ("front friction ellipse (eqs. 25, 28)",
+         resim.ellipse_front.max() - s.friction_use**2, s.verify_ellipse_tol, "-"),
+        ("rear friction ellipse (eq. 28)", resim.ellipse_rear.max() - s.friction_use**2,
          s.verify_ellipse_tol, "-"),
         ("steering angle (eqs. 26-27)", np.abs(resim.states[:, 6]).max() - p.max_steer_rad,
          1e-6, "rad"),

@@ -25,6 +25,7 @@ from __future__ import annotations
 import bisect
 import csv
 import json
+import math
 import os
 from pathlib import Path
 from typing import NamedTuple, cast
@@ -38,8 +39,8 @@ from eoam_sumo.params import VehicleParams, describe, ego_e_class_sedan
 CSV_NAME = "phase_boundaries.csv"
 NPZ_NAME = "lookup_tables.npz"
 METADATA_NAME = "metadata.json"
-FORMAT_VERSION = 1
-TABLE_NAMES = ("y_m", "ax_mps2", "yaw_rad", "curvature_1pm", "steer_rad")
+FORMAT_VERSION = 2
+TABLE_NAMES = ("y_m", "ax_mps2", "yaw_rad", "curvature_1pm", "steer_rad", "sideslip_rad")
 BOUNDARY_COLUMNS = ("stop_distance_m", "stop_distance_buffered_m", "clear_distance_const_m",
                     "clear_distance_opt_m", "clear_distance_buffered_m", "ttc_s")
 
@@ -82,6 +83,7 @@ class TrajectoryPoint(NamedTuple):
     yaw_rad: float  # path direction of travel (course)
     curvature_1pm: float  # signed path curvature, left positive
     steer_rad: float  # road-wheel steering angle
+    sideslip_rad: float = math.nan  # body sideslip (course less body yaw); NaN: not planned
 
 
 class PhaseBoundaries:
@@ -160,16 +162,12 @@ class Trajectory:
         """The trajectory at differential x ``dx_m``."""
         f = dx_m * self._inv_step
         if f <= 0.0:
-            y, ax, yaw, k, st = self._cols
-            return TrajectoryPoint(y[0], ax[0], yaw[0], k[0], st[0])
+            return TrajectoryPoint(*(c[0] for c in self._cols))
         i = int(f)
         if i >= self._last:
             return self._final
         w = f - i
-        y, ax, yaw, k, st = self._cols
-        return TrajectoryPoint(y[i] + w * (y[i + 1] - y[i]), ax[i] + w * (ax[i + 1] - ax[i]),
-                               yaw[i] + w * (yaw[i + 1] - yaw[i]), k[i] + w * (k[i + 1] - k[i]),
-                               st[i] + w * (st[i + 1] - st[i]))
+        return TrajectoryPoint(*(c[i] + w * (c[i + 1] - c[i]) for c in self._cols))
 
 
 class LookupTables:
@@ -248,7 +246,7 @@ class LookupTables:
         rows = min(rows, self._tables.shape[-1])
         cols = cast(np.ndarray, sum(c * self._tables[:, m, v, :rows] for m, v, c in corners))
         length = sum(c * lengths[m, v] for m, v, c in corners)
-        final = TrajectoryPoint(self.lane_change_m, 0.0, 0.0, 0.0, 0.0)
+        final = TrajectoryPoint(self.lane_change_m, 0.0, 0.0, 0.0, 0.0, 0.0)
         return Trajectory(length, self.dx_step_m, cols, final)
 
 

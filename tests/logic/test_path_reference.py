@@ -35,8 +35,9 @@ def test_scaled_path_and_planned_speed(start, height):
     k = height / H_TABLE
     assert ref.length_m == LENGTH and ref.start_offset_m == start
     for dx in (0.0, 7.3, 30.0, 44.4, 59.9):
-        y, yaw, curv, ax, v = ref.at(dx)
-        y_t, _, yaw_t, curv_t, _ = QuinticTrajectory().at(dx)
+        y, yaw, curv, ax, v, steer, beta = ref.at(dx)
+        y_t, _, yaw_t, curv_t, _, _ = QuinticTrajectory().at(dx)
+        assert steer == beta == 0.0 and not ref.planned_steering  # none in the trajectory
         assert y == pytest.approx(start + k * y_t, abs=2e-4)
         assert yaw == pytest.approx(k * yaw_t, abs=1e-5)
         assert curv == pytest.approx(k * curv_t, abs=1e-5)
@@ -47,6 +48,28 @@ def test_scaled_path_and_planned_speed(start, height):
     assert ref.at(-5.0)[0] == pytest.approx(start)
     assert ref.at(LENGTH + 50.0)[0] == pytest.approx(start + height, abs=1e-12)
     assert ref.at(LENGTH + 50.0)[4] == pytest.approx(math.sqrt(25.0**2 + 2 * AX * LENGTH))
+
+
+class PlannedTrajectory(QuinticTrajectory):
+    """The same with planned steering and sideslip, as the lookup tables give them."""
+
+    def at(self, dx):
+        p = super().at(dx)
+        return p._replace(steer_rad=0.5 * p.curvature_1pm, sideslip_rad=-0.2 * p.yaw_rad)
+
+
+def test_planned_steering_and_sideslip_scale_with_the_path():
+    ref = PathReference(
+        PlannedTrajectory(), start_offset_m=0.2, height_m=3.0, speed_mps=25.0, step_m=0.25
+    )
+    k = 3.0 / H_TABLE
+    assert ref.planned_steering
+    for dx in (0.0, 12.5, 33.3):
+        _, yaw, curv, _, _, steer, beta = ref.at(dx)
+        assert steer == pytest.approx(0.5 * curv, abs=1e-6)
+        assert beta == pytest.approx(-0.2 * yaw, abs=1e-6)
+        assert steer == pytest.approx(k * PlannedTrajectory().at(dx).steer_rad, abs=1e-6)
+    assert ref.at(LENGTH + 5.0)[5:] == pytest.approx((0.0, 0.0), abs=1e-9)
 
 
 def test_speed_profile_stops_at_zero():
@@ -118,11 +141,11 @@ def test_quintic_shift_starts_from_the_state_and_never_passes_its_target(
     straight, and never passes y1 (no overshoot beyond the planned offset), whatever the
     start; from rest its peak lateral acceleration is within the asked value."""
     traj = QuinticShift.for_lateral_accel(y0, slope0, y1, speed, accel, 5.0, kappa0)
-    y, _, yaw, kappa, _ = traj.at(0.0)
+    y, _, yaw, kappa, *_ = traj.at(0.0)
     assert y == pytest.approx(y0, abs=1e-9)
     assert math.tan(yaw) == pytest.approx(slope0, abs=1e-9)
     assert kappa * (1.0 + slope0 * slope0) ** 1.5 == pytest.approx(kappa0, abs=1e-9)
-    y, _, yaw, kappa, _ = traj.at(traj.length_m)
+    y, _, yaw, kappa, *_ = traj.at(traj.length_m)
     assert y == pytest.approx(y1, abs=1e-9)
     assert yaw == pytest.approx(0.0, abs=1e-9) and kappa == pytest.approx(0.0, abs=1e-9)
     if abs(y1 - y0) > 0.05:  # (at the target already, any excursion would count)

@@ -56,7 +56,7 @@ def test_optimised_clearing_beats_constant_speed_and_respects_point_mass_floor(s
     clear = clearing_distance_m(resim.states[:, 0], resim.states[:, 2], resim.states[:, 4], P,
                                 S.obstacle_width_m)
     w = 0.5 * (P.width_m + S.obstacle_width_m)
-    floor = V * math.sqrt(2 * w / (MU * G_MPS2))
+    floor = V * math.sqrt(2 * w / (S.friction_use * MU * G_MPS2))  # the plan's friction share
     assert floor - w <= clear <= constant_speed_clearing_distance_m(V, MU, P, S)
     assert clear / floor <= 1.3
 

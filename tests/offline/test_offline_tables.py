@@ -64,16 +64,20 @@ def test_stopping_distance_is_eq_33_and_above_the_friction_floor():
 
 
 def test_clearing_distances_respect_the_point_mass_floors():
+    """The optimum uses at most ``friction_use`` of the friction: its floor is that share's;
+    it is never longer than the constant-speed quintic (at 0.8 mu g) by more than 1 % (with
+    the 10 % reserve the two meet at 165-175 km/h on dry road)."""
     for (mu, kmh), r in ROWS.items():
         v = kmh / 3.6
-        floor = v * math.sqrt(2 * W / (mu * G_MPS2))
-        assert r["clear_distance_const_m"] >= floor
+        assert r["clear_distance_const_m"] >= v * math.sqrt(2 * W / (mu * G_MPS2))
+        floor = v * math.sqrt(2 * W / (S.friction_use * mu * G_MPS2))
         assert r["clear_distance_opt_m"] >= floor - W
-        assert r["clear_distance_opt_m"] <= r["clear_distance_const_m"]
+        assert r["clear_distance_opt_m"] <= 1.01 * r["clear_distance_const_m"]
 
 
 def test_optimised_clearing_is_within_1_3_of_the_point_mass_bound_from_60_kmh():
-    ratios = [r["clear_distance_opt_m"] / (kmh / 3.6 * math.sqrt(2 * W / (mu * G_MPS2)))
+    ratios = [r["clear_distance_opt_m"]
+              / (kmh / 3.6 * math.sqrt(2 * W / (S.friction_use * mu * G_MPS2)))
               for (mu, kmh), r in ROWS.items() if kmh >= 60]
     assert max(ratios) <= 1.3
     assert min(ratios) >= 1.0
@@ -136,7 +140,7 @@ def test_boundaries_outside_the_grid(tables):
 
 def test_trajectory_matches_the_stored_rows_and_is_linear_between(tables):
     with np.load(DIR / "lookup_tables.npz") as data:
-        names = ("y_m", "ax_mps2", "yaw_rad", "curvature_1pm", "steer_rad")
+        names = ("y_m", "ax_mps2", "yaw_rad", "curvature_1pm", "steer_rad", "sideslip_rad")
         stored = np.stack([data[n] for n in names])
         lengths = data["length_m"]
         step = float(data["dx_step_m"])
@@ -149,7 +153,7 @@ def test_trajectory_matches_the_stored_rows_and_is_linear_between(tables):
         a, b = stored[:, i, j, k], stored[:, i, j, k + 1]
         assert traj.at((k + 0.25) * step) == pytest.approx(tuple(a + 0.25 * (b - a)), abs=1e-12)
     assert traj.at(-1.0) == traj.at(0.0)
-    assert traj.at(1e4) == (S.lane_change_m, 0.0, 0.0, 0.0, 0.0)
+    assert traj.at(1e4) == (S.lane_change_m, 0.0, 0.0, 0.0, 0.0, 0.0)
     # half-way between two grid speeds: the mean of the two rows
     half = tables.trajectory(0.7, 0.5 * (v_grid[j] + v_grid[j + 1]))
     mean = 0.5 * (stored[:, i, j, 20] + stored[:, i, j + 1, 20])
@@ -166,7 +170,7 @@ def test_rows_past_the_end_hold_the_final_values():
         for j in range(len(data["speed_grid_mps"])):
             end = math.ceil(data["length_m"][i, j] / step) + 1
             assert np.all(data["y_m"][i, j, end:] == S.lane_change_m)
-            for name in ("ax_mps2", "yaw_rad", "curvature_1pm", "steer_rad"):
+            for name in ("ax_mps2", "yaw_rad", "curvature_1pm", "steer_rad", "sideslip_rad"):
                 assert np.all(data[name][i, j, end:] == 0.0)
             # and the manoeuvre itself ends in the next lane, parallel
             assert data["y_m"][i, j, end - 2] == pytest.approx(S.lane_change_m, abs=0.03)
