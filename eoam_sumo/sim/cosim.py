@@ -36,7 +36,7 @@ from eoam_sumo.sensing.friction import FrictionBelief
 from eoam_sumo.sensing.next_lane import CornerRadarSettings, NextLaneSensing
 from eoam_sumo.sensing.v2x import V2XSettings
 from eoam_sumo.sim.bodies import nav_angle_deg
-from eoam_sumo.sim.geometry import OrientedBox, box_distance, boxes_overlap
+from eoam_sumo.sim.geometry import OrientedBox, box_distance, boxes_overlap, gap_lower_bound
 from eoam_sumo.sim.margins import STOPPED_MPS, Margins, road_user_close_ahead
 from eoam_sumo.sim.observers import Extremes, StepObserver, TimeSeries
 from eoam_sumo.sim.outcome import role_of
@@ -215,6 +215,8 @@ class CoSimulation:
         self._ego_radius = 0.5 * math.hypot(p.length_m, p.width_m) + front - 0.5 * p.length_m
         self.first_contact: ContactRecord | None = None
         self.min_gap_aro_m = math.inf
+        self._gaps: dict = {}  # vid -> (box, gap) measured at the last step's ego pose
+        self._gaps_pose: tuple | None = None
         self.end_cause: str | None = None
         self.n_steps = 0
         self._stop_at: float | None = None
@@ -313,21 +315,32 @@ class CoSimulation:
             yawn - x_prev[2])
         road, lane_width, step_s = self.road, self.lane_width_m, self.settings.step_s
         ego_box_radius, p = self._ego_box_radius, self.params
+        gaps = self._gaps if (Xn, Yn, yawn) == self._gaps_pose else {}
+        self._gaps, self._gaps_pose = {}, (Xn, Yn, yawn)
+        min_gap_aro = self.min_gap_aro_m
         for b in self.bodies:
             centres_m = math.hypot(b.x_m - ego_cx, b.y_m - ego_cy)
             if centres_m > GAP_WATCH_M:
                 continue
             reach_m = ego_move + b.speed_mps * step_s + 0.05
-            # a parked car cannot be the ARO: its role is worked out only if it is hit
-            role = None if b.parked else role_of(b, road, lane_width)
             # the bounding circles' gap is a lower bound of the boxes' gap
             circles_m = centres_m - ego_box_radius - b.box.radius_m - ROUNDING_M
-            if circles_m > reach_m and (role != "aro" or circles_m >= self.min_gap_aro_m):
+            if circles_m > reach_m and circles_m >= min_gap_aro:
                 continue  # the box gap can be neither the ARO's least nor a contact
+            # a parked car cannot be the ARO: its role is worked out only if it is hit
+            role = None if b.parked else role_of(b, road, lane_width)
+            if circles_m > reach_m and role != "aro":
+                continue
             if ego_box is None:
                 ego_box = OrientedBox.from_axis_point(Xn, Yn, yawn, p.length_m, p.width_m,
                                                       self._front)
-            gap = box_distance(ego_box, b.box)
+            bound_m = gap_lower_bound(ego_box, b.box) - ROUNDING_M  # tighter, dearer
+            if bound_m > reach_m and (role != "aro" or bound_m >= min_gap_aro):
+                continue
+            known = gaps.get(b.vid)  # the same boxes as at the last step: the same gap
+            gap = known[1] if known is not None and known[0] is b.box else box_distance(
+                ego_box, b.box)
+            self._gaps[b.vid] = (b.box, gap)
             if role == "aro" and gap < self.min_gap_aro_m:
                 self.min_gap_aro_m = gap
             # contact during the step is possible only if the gap is within both moves

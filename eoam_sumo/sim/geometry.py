@@ -194,25 +194,66 @@ def boxes_overlap(a: OrientedBox, b: OrientedBox, tol_m: float = CONTACT_TOLERAN
     return True
 
 
+def gap_lower_bound(a: OrientedBox, b: OrientedBox) -> float:
+    """A lower bound of the boxes' gap [m]: their largest separation along one of the four box
+    axes (an axis separates the boxes by at most their distance; <= 0 when they overlap along
+    every axis), equal to the gap for boxes end to end in one lane or side by side. The four
+    projections of ``boxes_overlap`` written out: a tenth of the cost of ``box_distance``."""
+    dx, dy = b.x_m - a.x_m, b.y_m - a.y_m
+    ac, asin, bc, bsin = a.cos_yaw, a.sin_yaw, b.cos_yaw, b.sin_yaw
+    ahl, ahw, bhl, bhw = a.half_length_m, a.half_width_m, b.half_length_m, b.half_width_m
+    c, s = abs(ac * bc + asin * bsin), abs(ac * bsin - asin * bc)  # b's yaw relative to a's
+    return max(abs(dx * ac + dy * asin) - ahl - bhl * c - bhw * s,
+               abs(dy * ac - dx * asin) - ahw - bhl * s - bhw * c,
+               abs(dx * bc + dy * bsin) - bhl - ahl * c - ahw * s,
+               abs(dy * bc - dx * bsin) - bhw - ahl * s - ahw * c)
+
+
+def _nearest_corner(src: OrientedBox, dst: OrientedBox) -> tuple[float, float, float, float,
+                                                                  float]:
+    """(distance, x, y of the corner, x, y of its nearest point of dst) of the first corner of
+    ``src`` nearest to ``dst`` (distance inf, zeros if none is finite). ``nearest_point``
+    inlined: the contact check and the margins measure gaps at every step near a body."""
+    c, s = dst.cos_yaw, dst.sin_yaw
+    ox, oy, hl, hw = dst.x_m, dst.y_m, dst.half_length_m, dst.half_width_m
+    best = (math.inf, 0.0, 0.0, 0.0, 0.0)
+    for cx, cy in src.corners():
+        dx, dy = cx - ox, cy - oy
+        lx, ly = c * dx + s * dy, -s * dx + c * dy
+        if lx > hl:
+            lx = hl
+        elif lx < -hl:
+            lx = -hl
+        if ly > hw:
+            ly = hw
+        elif ly < -hw:
+            ly = -hw
+        px, py = ox + c * lx - s * ly, oy + s * lx + c * ly
+        dist = math.hypot(cx - px, cy - py)
+        if dist < best[0]:
+            best = (dist, cx, cy, px, py)
+    return best
+
+
 def _closest_points(
     a: OrientedBox, b: OrientedBox
 ) -> tuple[float, tuple[float, float], tuple[float, float]]:
-    """(distance, point on a, point on b) for disjoint boxes: attained at a corner of one box."""
-    best = (math.inf, (a.x_m, a.y_m), (b.x_m, b.y_m))
-    for src, dst, flip in ((a, b, False), (b, a, True)):
-        for cx, cy in src.corners():
-            px, py = dst.nearest_point(cx, cy)
-            dist = math.hypot(cx - px, cy - py)
-            if dist < best[0]:
-                best = (dist, (px, py), (cx, cy)) if flip else (dist, (cx, cy), (px, py))
-    return best
+    """(distance, point on a, point on b) for disjoint boxes: attained at a corner of one box
+    (a's corners first on a tie)."""
+    dist, cx, cy, px, py = _nearest_corner(a, b)
+    dist_b, bx, by, qx, qy = _nearest_corner(b, a)
+    if dist_b < dist:
+        return dist_b, (qx, qy), (bx, by)
+    if dist < math.inf:
+        return dist, (cx, cy), (px, py)
+    return math.inf, (a.x_m, a.y_m), (b.x_m, b.y_m)
 
 
 def box_distance(a: OrientedBox, b: OrientedBox, tol_m: float = CONTACT_TOLERANCE_M) -> float:
     """Euclidean gap between two boxes [m]; 0.0 when they overlap or touch."""
     if boxes_overlap(a, b, tol_m):
         return 0.0
-    return _closest_points(a, b)[0]
+    return min(_nearest_corner(a, b)[0], _nearest_corner(b, a)[0])
 
 
 def _face(box: OrientedBox, nx: float, ny: float) -> str:

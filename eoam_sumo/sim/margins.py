@@ -28,7 +28,7 @@ from collections.abc import Sequence
 
 from eoam_sumo.params import G_MPS2
 from eoam_sumo.sim.bodies import Body
-from eoam_sumo.sim.geometry import OrientedBox, box_distance, time_to_contact
+from eoam_sumo.sim.geometry import OrientedBox, box_distance, gap_lower_bound, time_to_contact
 from eoam_sumo.sim.observers import RunView, StepObserver
 from eoam_sumo.sim.radar import LANE_MARGIN_M, RoadProjection
 
@@ -118,9 +118,11 @@ class Margins(StepObserver):
                 ttc = time_to_contact(ego_box, box, ve, vb, self.min_ttc_oncoming_s)
                 self.min_ttc_oncoming_s = min(self.min_ttc_oncoming_s, ttc)
             if near and bound < self.closest_gap_m:
-                if gap < 0.0:
+                # the separating-axis bound rules out most of what the circles let through
+                # (a car parked beside the ego)
+                if gap < 0.0 and gap_lower_bound(ego_box, box) - _ROUNDING_M < NEAR_MISS_GAP_M:
                     gap = box_distance(ego_box, box)
-                if gap < self.closest_gap_m:
+                if 0.0 <= gap < self.closest_gap_m:
                     self.closest_gap_m, self.closest_id = gap, b.vid
 
 

@@ -14,6 +14,7 @@ from eoam_sumo.sim.geometry import (
     box_distance,
     boxes_overlap,
     contact,
+    gap_lower_bound,
 )
 
 EGO = (4.92, 1.85)  # length, width [m]
@@ -244,6 +245,28 @@ def test_distance_is_the_nearest_corner_bit_for_bit(a, b):
                    for src, dst in ((a, b), (b, a)) for cx, cy in src.corners()
                    for px, py in [dst.nearest_point(cx, cy)]]
     assert box_distance(a, b) == min(corner_gaps)
+
+
+@settings(max_examples=300, deadline=None, database=None)
+@given(boxes, boxes)
+def test_gap_lower_bound_never_exceeds_the_gap(a, b):
+    """The separating-axis bound that lets the contact check skip a gap is a lower bound of
+    the brute-force gap (to rounding far below the check's 1e-6 m margin), <= 0 when the
+    boxes overlap."""
+    ref = _brute_distance(a, b)
+    assert gap_lower_bound(a, b) <= ref + 1e-9
+    if ref == 0.0:
+        assert gap_lower_bound(a, b) <= CONTACT_TOLERANCE_M
+
+
+def test_gap_lower_bound_is_the_gap_end_to_end_and_side_by_side():
+    a = OrientedBox(0.0, 0.0, 0.3, *EGO)
+    c, s = math.cos(0.3), math.sin(0.3)
+    ahead = OrientedBox(10.0 * c, 10.0 * s, 0.3, *ARO)
+    beside = OrientedBox(-3.0 * s, 3.0 * c, 0.3, *CAR)
+    assert gap_lower_bound(a, ahead) == pytest.approx(10.0 - 0.5 * (EGO[0] + ARO[0]), abs=1e-12)
+    assert gap_lower_bound(a, beside) == pytest.approx(3.0 - 0.5 * (EGO[1] + CAR[1]), abs=1e-12)
+    assert gap_lower_bound(a, ahead) == pytest.approx(box_distance(a, ahead), abs=1e-12)
 
 
 # --- contact classification -----------------------------------------------------------------
