@@ -74,6 +74,7 @@ class EoamController:
         self.tables = tables
         self.settings = settings = settings or EoamSettings()
         self._steer = SteeringController(params, settings.steering)
+        self._steer_plan = SteeringController(params, settings.planned_steering)
         self._long = LongitudinalController(params, settings.longitudinal)
         self._mass = params.mass_kg
         self._decel = ObstacleDecel(settings.obstacle_decel_time_constant_s)
@@ -410,7 +411,7 @@ class EoamController:
         # ---- lateral reference (lane centre unless a path is active) and steering, eq. 38 ----
         y_ref = yaw_ref = kappa_ref = kappa_ff = ax_ref = v_plan = steer_ff = 0.0
         beta_ref: float | None = None
-        in_path = False
+        in_path, steer = False, self._steer
         road_kappa = meas.road_curvature_1pm
         if path is not None:
             y_ref, yaw_ref, kappa_ref, ax_ref, v_plan, _, beta_plan = path.at(dx)
@@ -419,12 +420,14 @@ class EoamController:
                 yaw_ref = kappa_ref = 0.0
             elif path.planned_steering:
                 # the plan's steering (planned with the plant's tyre), ahead by the lag
-                steer_ff = path.at(dx + v * st.planned_preview_time_s).steer_rad
-                beta_ref = beta_plan + self._steer.steady_sideslip(v, road_kappa)
+                ahead = max(0.0, st.planned_preview_time_s - st.planned_preview_slope_s2pm * v)
+                steer_ff = path.at(dx + v * ahead).steer_rad
+                beta_ref = beta_plan + steer.steady_sideslip(v, road_kappa)
+                steer = self._steer_plan
             else:
                 kappa_ff = path.at(dx + v * st.preview_time_s).curvature_1pm
         e_lat = d - y_ref
-        delta, ff, fb, yd, e_la = self._steer.command(
+        delta, ff, fb, yd, e_la = steer.command(
             v, meas.yaw_rate_radps, meas.vy_mps, e_lat, _wrap(meas.e_yaw_rad - yaw_ref),
             kappa_ref + road_kappa, kappa_ff + road_kappa, mu, steer_ff, beta_ref)
 

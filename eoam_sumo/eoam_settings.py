@@ -57,9 +57,12 @@ class EoamSettings:
     # in-path obstacle's range plus this (room to pass it and return) blocks the lane change
     # as oncoming traffic does (modes 3, 4); the paper checks the next lane for oncoming only
     preview_time_s: float = 0.3  # feedforward curvature taken this far ahead on the path
-    planned_preview_time_s: float = 0.05  # the table lane change's planned steering taken
-    # this far ahead on the path (the steering actuator's lag)
+    planned_preview_time_s: float = 0.15  # the table lane change's planned steering taken
+    planned_preview_slope_s2pm: float = 0.003  # (this - slope * speed, >= 0) s ahead on the
+    # path: the actuator's lag, and its rate limit where the plan steers fast (low speed)
     steering: SteeringGains = field(default_factory=SteeringGains)
+    planned_steering: SteeringGains = field(  # the table lane change (plans keep 10 % of
+        default_factory=lambda: SteeringGains(natural_freq_radps=9.0))  # the friction for it)
     longitudinal: LongitudinalGains = field(default_factory=LongitudinalGains)
     policy: PolicySettings = field(default_factory=PolicySettings)  # paper or safe
 

