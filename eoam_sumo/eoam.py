@@ -12,8 +12,8 @@ References per mode (road frame of the ego's original lane, d left positive):
   and holding, unless a steering sector, oncoming traffic or the obstacle leaving the path
   (or pulling away) ends it.
 * 2 STEER+BRAKE: the table lane change (trigger speed and friction) from the offset at the
-  trigger to one lane width to the left; the table acceleration profile tracked by the
-  acceleration PID until the end of the path, then the speed reached is held.
+  trigger to one lane width to the left, steered with the plan's own road-wheel angle; the
+  table acceleration profile tracked by the acceleration PID to the path's end, then held.
 * 3 ONCOMING BRAKE: limit braking to standstill in the original lane after the lateral motion
   is arrested: a quintic from the ego's lateral state to where that motion can stop within
   ``evasive_lateral_g`` mu g (``QuinticShift.stopping``), held there; the brake gets what the

@@ -13,6 +13,10 @@
   change) would make at the look-ahead distance. The equivalent look-ahead error
   e + (k_psi / k_e) psi~ is logged.
 
+On a planned manoeuvre (the lookup tables' lane change, planned with the plant's tyre) the
+feedforward is the plan's own road-wheel angle taken a little ahead and the reference sideslip
+is the plan's (``command``'s ``planned_steer_rad``, ``sideslip_rad``).
+
 Gains by pole placement (Ackermann's formula) on the linear single-track model with states
 (vy, r, psi, e) at each speed: the path-following pair at s^2 + 2 zeta omega s + omega^2 with
 omega = omega_0 mu^p min(1, v / v_full) (the friction factor keeps the feedback inside what
@@ -242,7 +246,10 @@ class SteeringController:
         the body heading minus the path's course (left positive), ``lateral_speed_mps`` the
         body's lateral velocity; ``curvature_1pm`` the reference curvature here (path plus
         road), ``preview_curvature_1pm`` the one a preview distance ahead, used by the
-        feedforward to make up for the steering and tyre lags.
+        feedforward to make up for the steering and tyre lags. A planned manoeuvre (the
+        tables' lane change) adds its own road-wheel angle ``planned_steer_rad`` to the
+        feedforward (its path's curvature then left out of ``preview_curvature_1pm``) and
+        gives its body sideslip ``sideslip_rad`` in place of the steady-state one.
         """
         v = max(0.0, speed_mps)
         k_vy, k_r, k_psi, k_e = self.gains_at(v, mu)

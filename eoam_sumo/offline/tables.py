@@ -82,7 +82,7 @@ class TrajectoryPoint(NamedTuple):
     ax_mps2: float  # body longitudinal acceleration (the optimised profile)
     yaw_rad: float  # path direction of travel (course)
     curvature_1pm: float  # signed path curvature, left positive
-    steer_rad: float  # road-wheel steering angle
+    steer_rad: float  # road-wheel steering angle (planned with the plant's tyre)
     sideslip_rad: float = math.nan  # body sideslip (course less body yaw); NaN: not planned
 
 
