@@ -397,8 +397,9 @@ def time_to_contact(
     a: OrientedBox, b: OrientedBox, va: tuple[float, float], vb: tuple[float, float],
     horizon_s: float = math.inf,
 ) -> float:
-    """Time [s] until the boxes touch if both keep their velocities (no turning): 0 when they
-    overlap now, ``inf`` when they never touch within ``horizon_s``.
+    """Time [s] until the boxes touch (within ``CONTACT_TOLERANCE_M``, as ``boxes_overlap``)
+    if both keep their velocities (no turning): 0 when they overlap now, ``inf`` when they never
+    touch within ``horizon_s``.
 
     Separating-axis test of the moving pair: on each of the four box axes the gap between
     the projections changes linearly with time; contact needs every axis closed at once."""
@@ -406,7 +407,8 @@ def time_to_contact(
     rvx, rvy = vb[0] - va[0], vb[1] - va[1]
     # b's centre on each axis relative to a's, its rate, and the pair's reach on that axis
     return slab_entry(
-        [(dx * nx + dy * ny, rvx * nx + rvy * ny, _half_extent(a, nx, ny) + _half_extent(b, nx, ny))
+        [(dx * nx + dy * ny, rvx * nx + rvy * ny,
+          _half_extent(a, nx, ny) + _half_extent(b, nx, ny) + CONTACT_TOLERANCE_M)
          for nx, ny in _axes(a, b)],
         horizon_s,
     )

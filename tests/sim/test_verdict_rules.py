@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 
 from eoam_sumo.sim.geometry import Contact, OrientedBox, face_overlap, time_to_contact
@@ -97,6 +97,7 @@ def test_time_to_contact_of_a_head_on_is_gap_over_closing_speed():
 
 
 @given(st.floats(0.5, 60.0), st.floats(-30.0, 30.0), st.floats(-3.0, 3.0))
+@example(7.0, 0.0, 1.85)  # side by side, touching: within the contact tolerance on both sides
 def test_time_to_contact_matches_stepping_the_boxes(closing, lateral_speed, offset_m):
     """Step both boxes in 1 ms steps: the first overlap is within one step of the TTC."""
     from eoam_sumo.sim.geometry import boxes_overlap
