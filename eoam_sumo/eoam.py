@@ -39,7 +39,16 @@ from eoam_sumo.control.longitudinal import LongitudinalController
 from eoam_sumo.control.paths import PathReference, QuinticShift
 from eoam_sumo.control.steering import SteeringController
 from eoam_sumo.decision.dmm import SECTOR_ORDER, Action, BoundaryCurve, Sector
-from eoam_sumo.decision.modes import Mode, next_mode
+from eoam_sumo.decision.modes import (
+    NORMAL,
+    ONCOMING_BRAKE,
+    ONCOMING_STEER_BRAKE,
+    RETURN,
+    UPDATE_BRAKE,
+    UPDATE_STEER_BRAKE,
+    Mode,
+    next_mode,
+)
 from eoam_sumo.decision.obstacle import ObstacleDecel, ObstacleTrack, stopping_range_m
 from eoam_sumo.decision.oncoming import Budget, Choice, commit_choice, return_clears
 from eoam_sumo.decision.policy import SafePolicy
@@ -52,16 +61,15 @@ __all__ = ["Command", "EgoMeasurement", "EoamController", "EoamSettings", "Objec
            "Perception"]
 
 
-_WARNING_MODES = (Mode.UPDATE_BRAKE, Mode.UPDATE_STEER_BRAKE, Mode.ONCOMING_BRAKE,
-                  Mode.ONCOMING_STEER_BRAKE)  # FCW stays on
-_STEERING = (Mode.UPDATE_STEER_BRAKE, Mode.ONCOMING_STEER_BRAKE)
+_WARNING_MODES = (UPDATE_BRAKE, UPDATE_STEER_BRAKE, ONCOMING_BRAKE,
+                  ONCOMING_STEER_BRAKE)  # FCW stays on
+_STEERING = (UPDATE_STEER_BRAKE, ONCOMING_STEER_BRAKE)
 # a STEER in these modes begins a lane change (safe policy gate)
-_COMMITTING = (Mode.NORMAL, Mode.UPDATE_BRAKE)
+_COMMITTING = (NORMAL, UPDATE_BRAKE)
 # the safe policy watches the next lane in these modes
-_WATCHING = (Mode.UPDATE_STEER_BRAKE, Mode.RETURN)
+_WATCHING = (UPDATE_STEER_BRAKE, RETURN)
 # a coasted object keeps these modes braking (sensing.md: track persistence)
-_HOLDING = (Mode.NORMAL, Mode.UPDATE_BRAKE)
-_URGENCY = {s: i for i, s in enumerate(SECTOR_ORDER)}  # A most urgent, G least
+_HOLDING = (NORMAL, UPDATE_BRAKE)
 
 
 class EoamController:
@@ -88,7 +96,7 @@ class EoamController:
     # ----------------------------------------------------------------------------- lifecycle
     def _reset_state(self) -> None:
         """Back to NORMAL with no manoeuvre and an empty history (keeps the set speed)."""
-        self.mode = Mode.NORMAL
+        self.mode = NORMAL
         self.modes_visited: list[int] = [0]
         self.fcw_raised = False
         self.sector = ""
@@ -194,23 +202,23 @@ class EoamController:
 
     def _enter(self, mode: Mode, previous: Mode, meas: EgoMeasurement) -> None:
         """Entry actions of a new mode (mode 4 keeps the lane change of mode 2 going)."""
-        if mode is Mode.UPDATE_STEER_BRAKE:
+        if mode is UPDATE_STEER_BRAKE:
             self._hold_speed = None
             self._height = meas.lane_width_m
             self._t_steer = meas.time_s
             traj = self.tables.trajectory(meas.mu, meas.vx_mps)  # clamped to the speed grid
             self._start_path(meas, traj, meas.d_m, meas.lane_width_m)
-        elif mode is Mode.RETURN:
+        elif mode is RETURN:
             self._hold_speed = meas.vx_mps
-            self._start_return(meas, urgent=previous is Mode.ONCOMING_STEER_BRAKE)
-        elif mode is Mode.ONCOMING_STEER_BRAKE:
+            self._start_return(meas, urgent=previous is ONCOMING_STEER_BRAKE)
+        elif mode is ONCOMING_STEER_BRAKE:
             self._escape_to(self._passing_offset_m(meas), meas)
-        elif mode is Mode.ONCOMING_BRAKE and self.settings.min_time_escapes:
+        elif mode is ONCOMING_BRAKE and self.settings.min_time_escapes:
             # arrest the lateral motion and return to the lane centre in one time-optimal
             # shift (the brake gets what the friction ellipse leaves)
             self._stop_path = None
             self._escape_to(0.0, meas)
-        elif mode is Mode.ONCOMING_BRAKE:
+        elif mode is ONCOMING_BRAKE:
             # arrest the lateral motion first (the brake gets what the friction ellipse
             # leaves), then hold that offset while braking to standstill
             if self._stop_path is None:
@@ -246,7 +254,7 @@ class EoamController:
         Without a track, the end of the lane change."""
         if self._obstacle is None:
             return path is not None and dx_m >= path.length_m
-        if self.mode is Mode.ONCOMING_STEER_BRAKE and self.settings.compare_outcomes:
+        if self.mode is ONCOMING_STEER_BRAKE and self.settings.compare_outcomes:
             return return_clears(meas, self._obstacle, self._budget(meas.mu))
         front_s = self._obstacle.at(meas.time_s)[0]
         ego_rear_s = meas.s_m - self.params.cg_to_rear_bumper_m
@@ -290,7 +298,7 @@ class EoamController:
         stop_range = stopping_range_m(rng, v - closing, decel)
         if stop_range < math.inf:
             standing = self._curve.sector(stop_range, v)
-            if _URGENCY[standing] < _URGENCY[sector]:
+            if SECTOR_ORDER.index(standing) < SECTOR_ORDER.index(sector):  # more urgent
                 sector = standing
         return sector, stop_range
 
@@ -317,14 +325,15 @@ class EoamController:
             closing = -rate if rate is not None and math.isfinite(rate) else 0.0
             sector, stop_range = self._dmm(t, v, rng, closing)
             action = sector.action
-            if action is Action.STEER and v < st.min_steer_speed_mps:
-                action = Action.BRAKE  # too slow for a lane change: braking needs less room
-            elif (action is Action.STEER and self.mode is Mode.UPDATE_BRAKE
-                  and rng > self._curve.at(closing).stop_m
-                  and stop_range > self._curve.at(v).stop_m):
-                action = Action.BRAKE  # braking already stops short of it: no lane change
-            elif action is Action.STEER and not meas.left_lane_available:
-                action = Action.LIMIT_BRAKE  # no lane to change into: brake in lane
+            if action is Action.STEER:
+                if v < st.min_steer_speed_mps:
+                    action = Action.BRAKE  # too slow for a lane change: braking needs less room
+                elif (self.mode is UPDATE_BRAKE
+                      and rng > self._curve.at(closing).stop_m
+                      and stop_range > self._curve.at(v).stop_m):
+                    action = Action.BRAKE  # braking already stops short of it: no lane change
+                elif not meas.left_lane_available:
+                    action = Action.LIMIT_BRAKE  # no lane to change into: brake in lane
             threat_gone = closing < -st.release_opening_speed_mps
             self._track_obstacle(meas, rng, closing, perception.aro_object)
         else:
@@ -362,7 +371,7 @@ class EoamController:
         travel = d - path.start_offset_m if path is not None else 0.0
         height = self._height
         settled = False
-        if mode is Mode.RETURN and path is not None and dx >= path.length_m:
+        if mode is RETURN and path is not None and dx >= path.length_m:
             if abs(d) <= st.settle_offset_m and abs(_wrap(meas.e_yaw_rad)) <= st.settle_heading_rad:
                 if self._settle_since is None:
                     self._settle_since = t
@@ -374,14 +383,14 @@ class EoamController:
             clear
             and path is not None
             and st.return_when_stable
-            and mode is Mode.UPDATE_STEER_BRAKE
+            and mode is UPDATE_STEER_BRAKE
             and dx >= path.length_m
             and abs(d - path.start_offset_m - height) <= st.arrive_tolerance_m
             and abs(_wrap(meas.e_yaw_rad)) <= st.settle_heading_rad
         )
-        past_ponr = (oncoming and mode is Mode.UPDATE_STEER_BRAKE
+        past_ponr = (oncoming and mode is UPDATE_STEER_BRAKE
                      and self._commits(meas, perception, travel, height))
-        if (past_ponr and oncoming and mode is Mode.UPDATE_STEER_BRAKE and policy is not None
+        if (past_ponr and oncoming and mode is UPDATE_STEER_BRAKE and policy is not None
                 and policy.prefer_braking(meas, perception)):
             past_ponr = False  # severity tie-breaker: braking in lane ends softer
         new = next_mode(
@@ -398,9 +407,9 @@ class EoamController:
         if new is not mode:
             self._enter(new, mode, meas)
             self.mode = mode = new
-        elif mode is Mode.RETURN and oncoming and not self._urgent_return:
+        elif mode is RETURN and oncoming and not self._urgent_return:
             self._start_return(meas, urgent=True)  # oncoming traffic seen during the return
-        elif (mode is Mode.ONCOMING_BRAKE and path is not None and dx >= path.length_m
+        elif (mode is ONCOMING_BRAKE and path is not None and dx >= path.length_m
               and self._stop_path is not None):
             # lateral motion arrested: back to the lane centre while braking on
             self._stop_path = None
@@ -437,14 +446,16 @@ class EoamController:
         tracking = in_path and mode in _STEERING  # the table's ax already fits the ellipse
         ay_use = abs(meas.ay_mps2)
         if not tracking:
-            ay_use = max(ay_use, abs(self._steer.lateral_accel(v, delta)))
+            ay_steer = abs(self._steer.lateral_accel(v, delta))
+            if ay_steer > ay_use:
+                ay_use = ay_steer
         drive_lim, brake_lim = self._long.limits(v, mu, ay_use, self._brake_limit)
-        if mode is Mode.NORMAL:
+        if mode is NORMAL:
             drive, brake, ax_target = self._long.track_speed(
                 self._initial_speed, v, mu, drive_lim, brake_lim, dt_s
             )
             v_target = self._initial_speed
-        elif mode is Mode.UPDATE_BRAKE or mode is Mode.ONCOMING_BRAKE:
+        elif mode is UPDATE_BRAKE or mode is ONCOMING_BRAKE:
             drive, brake = 0.0, brake_lim  # limit braking without locking
             ax_target = -brake_lim / self._mass
             v_target = 0.0

@@ -251,7 +251,7 @@ class SteeringController:
         feedforward (its path's curvature then left out of ``preview_curvature_1pm``) and
         gives its body sideslip ``sideslip_rad`` in place of the steady-state one.
         """
-        v = max(0.0, speed_mps)
+        v = speed_mps if speed_mps > 0.0 else 0.0
         k_vy, k_r, k_psi, k_e = self.gains_at(v, mu)
         if sideslip_rad is None:
             beta = curvature_1pm * (self._b - self._slip_k * v * v)  # steady_sideslip, inlined
@@ -263,9 +263,16 @@ class SteeringController:
         yd = -(k_vy * (lateral_speed_mps - v * beta) + k_r * (yaw_rate_radps - v * curvature_1pm))
         delta = ff + fb + yd
         # front slip envelope: the front tyre's slip stays short of where its force peaks
+        # (the clips written as comparisons: min and max cost more at every step)
         if v > 1.0:
             course_f = (lateral_speed_mps + self._a * yaw_rate_radps) / v
             slip = self._slip_frac * mu
-            delta = min(max(delta, course_f - slip), course_f + slip)
-        delta = min(max(delta, -self._max), self._max)
+            if delta < course_f - slip:
+                delta = course_f - slip
+            if delta > course_f + slip:
+                delta = course_f + slip
+        if delta < -self._max:
+            delta = -self._max
+        if delta > self._max:
+            delta = self._max
         return _new(SteeringCommand, (delta, ff, fb, yd, -fb / k_e))

@@ -66,7 +66,7 @@ class Sector(Enum):
         return self is not Sector.G
 
 
-#: Sectors in order of increasing distance for a fixed closing speed.
+#: Sectors in order of increasing distance for a fixed closing speed (A most urgent, G least).
 SECTOR_ORDER = (Sector.A, Sector.C, Sector.F, Sector.B, Sector.D, Sector.E, Sector.G)
 
 

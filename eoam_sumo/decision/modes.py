@@ -34,6 +34,10 @@ class Mode(IntEnum):
     RETURN = 5
 
 
+# The members as module names, for the per-step code: reading a member off an Enum class goes
+# through the Enum metaclass's attribute hook (about 700 instructions in CPython 3.11).
+NORMAL, UPDATE_BRAKE, UPDATE_STEER_BRAKE, ONCOMING_BRAKE, ONCOMING_STEER_BRAKE, RETURN = Mode
+
 _BRAKING = (Action.BRAKE, Action.LIMIT_BRAKE)
 
 
@@ -50,28 +54,28 @@ def next_mode(
     threat_gone: bool,
 ) -> Mode:
     """The mode after one step; at most one transition per call."""
-    if mode is Mode.NORMAL:
+    if mode is NORMAL:
         if action is Action.STEER:
-            return Mode.ONCOMING_BRAKE if oncoming else Mode.UPDATE_STEER_BRAKE
+            return ONCOMING_BRAKE if oncoming else UPDATE_STEER_BRAKE
         if action in _BRAKING:
-            return Mode.UPDATE_BRAKE
+            return UPDATE_BRAKE
         return mode
-    if mode is Mode.UPDATE_BRAKE:
+    if mode is UPDATE_BRAKE:
         if oncoming:
-            return Mode.ONCOMING_BRAKE
+            return ONCOMING_BRAKE
         if action is Action.STEER:
-            return Mode.UPDATE_STEER_BRAKE
+            return UPDATE_STEER_BRAKE
         if threat_gone:
-            return Mode.NORMAL
+            return NORMAL
         return mode
-    if mode is Mode.UPDATE_STEER_BRAKE:
+    if mode is UPDATE_STEER_BRAKE:
         if oncoming:
-            return Mode.ONCOMING_STEER_BRAKE if past_ponr else Mode.ONCOMING_BRAKE
+            return ONCOMING_STEER_BRAKE if past_ponr else ONCOMING_BRAKE
         if timer_expired or stable_in_next_lane:
-            return Mode.RETURN
+            return RETURN
         return mode
-    if mode is Mode.ONCOMING_STEER_BRAKE:
-        return Mode.RETURN if clear_of_obstacle else mode
-    if mode is Mode.RETURN:
-        return Mode.NORMAL if settled else mode
+    if mode is ONCOMING_STEER_BRAKE:
+        return RETURN if clear_of_obstacle else mode
+    if mode is RETURN:
+        return NORMAL if settled else mode
     return mode
