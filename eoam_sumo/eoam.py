@@ -57,6 +57,7 @@ from eoam_sumo.eoam_settings import EoamSettings
 from eoam_sumo.params import G_MPS2, VehicleParams
 
 _TWO_PI = 2.0 * math.pi
+_new = tuple.__new__  # builds the per-step Command without its Python-level constructor
 __all__ = ["Command", "EgoMeasurement", "EoamController", "EoamSettings", "ObjectState",
            "Perception"]
 
@@ -296,7 +297,7 @@ class EoamController:
         if not self.settings.obstacle_decel_in_dmm:
             return sector, math.inf
         stop_range = stopping_range_m(rng, v - closing, decel)
-        if stop_range < math.inf:
+        if stop_range < math.inf and (stop_range != rng or v != closing):  # else the same point
             standing = self._curve.sector(stop_range, v)
             if SECTOR_ORDER.index(standing) < SECTOR_ORDER.index(sector):  # more urgent
                 sector = standing
@@ -473,12 +474,12 @@ class EoamController:
             )
             v_target = self._hold_speed
 
-        warns = sector is not None and sector is not Sector.G
+        warns = sector is not None and sector.warns
         fcw = warns or mode in _WARNING_MODES
         if fcw:
             self.fcw_raised = True
-        self.sector = sector.value if sector is not None else ""
-        return Command(
+        self.sector = sector.letter if sector is not None else ""
+        return _new(Command, (
             delta,
             drive,
             brake,
@@ -494,7 +495,7 @@ class EoamController:
             fb,
             yd,
             v_target,
-        )
+        ))
 
 
 def _lateral_state(meas: EgoMeasurement) -> tuple[float, float, float]:

@@ -42,9 +42,12 @@ class Action(Enum):
 
 class Sector(Enum):
     """DMM phase-diagram sector (paper Figure 14): value the letter, ``action`` what it asks
-    for (a plain attribute: it is read at every step with an obstacle in range)."""
+    for, ``letter`` the value and ``warns`` whether it raises the forward-collision warning
+    (A-F): plain attributes, read at every step with an obstacle in range."""
 
     action: Action
+    letter: str
+    warns: bool
 
     A = ("A", Action.LIMIT_BRAKE)
     B = ("B", Action.STEER)
@@ -58,12 +61,9 @@ class Sector(Enum):
         member = object.__new__(cls)
         member._value_ = letter
         member.action = action
+        member.letter = letter
+        member.warns = letter != "G"
         return member
-
-    @property
-    def warns(self) -> bool:
-        """Forward-collision warning raised in this sector (A-F)."""
-        return self is not Sector.G
 
 
 #: Sectors in order of increasing distance for a fixed closing speed (A most urgent, G least).
