@@ -86,6 +86,7 @@ class EoamController:
         self._steer_plan = SteeringController(params, settings.planned_steering)
         self._long = LongitudinalController(params, settings.longitudinal)
         self._mass = params.mass_kg
+        self._front_offset_m = params.cg_to_front_bumper_m
         self._decel = ObstacleDecel(settings.obstacle_decel_time_constant_s)
         self._brake_mu = math.nan
         self._brake_limit = 0.0
@@ -126,9 +127,8 @@ class EoamController:
 
     # ----------------------------------------------------------------------------- helpers
     def _friction(self, mu: float) -> None:
-        """Refresh what depends on the sensed friction: brake limit and DMM boundaries."""
-        if mu == self._brake_mu:
-            return
+        """Refresh what depends on the sensed friction (``step`` calls it when the friction
+        changes): brake limit and DMM boundaries."""
         if not mu > 0.0:
             raise ValueError(f"friction mu={mu!r} must be > 0")
         self._brake_mu = mu
@@ -241,8 +241,10 @@ class EoamController:
         change (modes 2, 4) only the obstacle being avoided is followed: one whose front is
         more than ``track_gate_m`` off the prediction is another object."""
         st = self.settings
-        decel = max(self._decel.decel_mps2, 0.0) if st.obstacle_decel_in_dmm else 0.0
-        track = ObstacleTrack.sensed(meas, self.params.cg_to_front_bumper_m, range_m,
+        decel = self._decel.decel_mps2 if st.obstacle_decel_in_dmm else 0.0
+        if decel < 0.0:
+            decel = 0.0
+        track = ObstacleTrack.sensed(meas, self._front_offset_m, range_m,
                                      closing_mps, obj, st.unknown_obstacle_length_m, decel)
         last = self._obstacle
         if (last is None or self.mode not in _STEERING
@@ -315,7 +317,8 @@ class EoamController:
         if not meas.lane_width_m > 0.0:
             raise ValueError(f"lane_width_m={meas.lane_width_m!r} must be > 0")
         mu = meas.mu
-        self._friction(mu)
+        if mu != self._brake_mu:
+            self._friction(mu)
         st = self.settings
         t, v, d = meas.time_s, meas.vx_mps, meas.d_m
 
