@@ -38,7 +38,15 @@ from eoam_sumo.control.escape import MinTimeShift, lateral_state
 from eoam_sumo.control.longitudinal import LongitudinalController
 from eoam_sumo.control.paths import PathReference, QuinticShift
 from eoam_sumo.control.steering import SteeringController
-from eoam_sumo.decision.dmm import SECTOR_ORDER, Action, BoundaryCurve, Sector
+from eoam_sumo.decision.dmm import (
+    BRAKE,
+    LIMIT_BRAKE,
+    NONE,
+    SECTOR_ORDER,
+    STEER,
+    BoundaryCurve,
+    Sector,
+)
 from eoam_sumo.decision.modes import (
     NORMAL,
     ONCOMING_BRAKE,
@@ -329,20 +337,20 @@ class EoamController:
             closing = -rate if rate is not None and math.isfinite(rate) else 0.0
             sector, stop_range = self._dmm(t, v, rng, closing)
             action = sector.action
-            if action is Action.STEER:
+            if action is STEER:
                 if v < st.min_steer_speed_mps:
-                    action = Action.BRAKE  # too slow for a lane change: braking needs less room
+                    action = BRAKE  # too slow for a lane change: braking needs less room
                 elif (self.mode is UPDATE_BRAKE
                       and rng > self._curve.at(closing).stop_m
                       and stop_range > self._curve.at(v).stop_m):
-                    action = Action.BRAKE  # braking already stops short of it: no lane change
+                    action = BRAKE  # braking already stops short of it: no lane change
                 elif not meas.left_lane_available:
-                    action = Action.LIMIT_BRAKE  # no lane to change into: brake in lane
+                    action = LIMIT_BRAKE  # no lane to change into: brake in lane
             threat_gone = closing < -st.release_opening_speed_mps
             self._track_obstacle(meas, rng, closing, perception.aro_object)
         else:
             sector = None
-            action = Action.NONE
+            action = NONE
             threat_gone = True
             self._decel.reset()
         coasted_m = perception.coasted_range_m
@@ -356,15 +364,15 @@ class EoamController:
                 st.coasted_margin_m)
             if near or closing_c > -st.release_opening_speed_mps:
                 threat_gone = False
-            if near and action is Action.NONE:
-                action = Action.BRAKE
+            if near and action is NONE:
+                action = BRAKE
         oncoming = bool(perception.oncoming_detected)
         block_m = perception.next_lane_obstacle_range_m
         if block_m is not None and rng is not None and block_m <= rng + st.next_lane_clear_m:
             oncoming = True  # the lane change would end against a standing car: as deadly
         policy = self.policy
         if policy is not None and policy.blocks(
-                meas, perception, action is Action.STEER and self.mode in _COMMITTING,
+                meas, perception, action is STEER and self.mode in _COMMITTING,
                 self.mode in _WATCHING):
             oncoming = True  # the next lane is not known free (safe policy): as oncoming
 

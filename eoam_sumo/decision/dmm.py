@@ -66,6 +66,11 @@ class Sector(Enum):
         return member
 
 
+# The members as module names, for the per-step code (as the modes in ``decision.modes``):
+# reading a member off an Enum class goes through the Enum metaclass's attribute hook.
+NONE, FCW, BRAKE, STEER, LIMIT_BRAKE = Action
+A, B, C, D, E, F, G = Sector
+
 #: Sectors in order of increasing distance for a fixed closing speed (A most urgent, G least).
 SECTOR_ORDER = (Sector.A, Sector.C, Sector.F, Sector.B, Sector.D, Sector.E, Sector.G)
 
@@ -85,16 +90,16 @@ def classify(
     """
     d, v = range_m, rel_speed_mps
     if not (v > 0.0 and math.isfinite(v) and math.isfinite(d)):
-        return Sector.G
+        return G
     if d <= clear_m:
-        return Sector.A if d <= stop_m else Sector.C
+        return A if d <= stop_m else C
     if d <= clear_buffered_m:
-        return Sector.F if d <= stop_buffered_m else Sector.B
+        return F if d <= stop_buffered_m else B
     if d <= stop_buffered_m:
-        return Sector.D
+        return D
     if d <= ttc_s * v:
-        return Sector.E
-    return Sector.G
+        return E
+    return G
 
 
 def dmm_sector(boundary, range_m: float, rel_speed_mps: float) -> Sector:
@@ -177,6 +182,6 @@ class BoundaryCurve:
     def sector(self, range_m: float, rel_speed_mps: float) -> Sector:
         """Sector of (range, closing speed); G when not closing or not finite."""
         if not (rel_speed_mps > 0.0 and math.isfinite(rel_speed_mps)):
-            return Sector.G
+            return G
         s, sb, b0, bb, ttc = self._blend(rel_speed_mps)
         return classify(range_m, rel_speed_mps, s, sb, b0, bb, ttc)

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from enum import IntEnum
 
-from eoam_sumo.decision.dmm import Action
+from eoam_sumo.decision.dmm import BRAKE, LIMIT_BRAKE, STEER, Action
 
 
 class Mode(IntEnum):
@@ -38,7 +38,7 @@ class Mode(IntEnum):
 # through the Enum metaclass's attribute hook (about 700 instructions in CPython 3.11).
 NORMAL, UPDATE_BRAKE, UPDATE_STEER_BRAKE, ONCOMING_BRAKE, ONCOMING_STEER_BRAKE, RETURN = Mode
 
-_BRAKING = (Action.BRAKE, Action.LIMIT_BRAKE)
+_BRAKING = (BRAKE, LIMIT_BRAKE)
 
 
 def next_mode(
@@ -55,7 +55,7 @@ def next_mode(
 ) -> Mode:
     """The mode after one step; at most one transition per call."""
     if mode is NORMAL:
-        if action is Action.STEER:
+        if action is STEER:
             return ONCOMING_BRAKE if oncoming else UPDATE_STEER_BRAKE
         if action in _BRAKING:
             return UPDATE_BRAKE
@@ -63,7 +63,7 @@ def next_mode(
     if mode is UPDATE_BRAKE:
         if oncoming:
             return ONCOMING_BRAKE
-        if action is Action.STEER:
+        if action is STEER:
             return UPDATE_STEER_BRAKE
         if threat_gone:
             return NORMAL
