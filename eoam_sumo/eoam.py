@@ -7,34 +7,29 @@ longitudinal controllers. It sees only ego measurements and radar-derived percep
 
 References per mode (road frame of the ego's original lane, d left positive):
 
-* 0 NORMAL, 1 UPDATE BRAKE: keep the lane centre (d = 0); 0 holds the initial speed with the
-  speed PID, 1 brakes at the no-lock limit (``limit_brake_fraction`` of it), to standstill
-  and holding, unless a steering sector, oncoming traffic or the obstacle leaving the path
-  (or pulling away) ends it.
-* 2 STEER+BRAKE: the table lane change (trigger speed and friction) from the offset at the
-  trigger to one lane width to the left, steered with the plan's own road-wheel angle; the
-  table acceleration profile tracked by the acceleration PID to the path's end, then held.
-* 3 ONCOMING BRAKE: limit braking to standstill in the original lane after the lateral motion
-  is arrested: a quintic from the ego's lateral state to where that motion can stop within
-  ``evasive_lateral_g`` mu g (``QuinticShift.stopping``), held there; the brake gets what the
-  friction ellipse leaves to it meanwhile, so that no wheel locks.
-* 4 ONCOMING STEER+BRAKE: the shortest quintic from the ego's lateral state to just past the
-  obstacle's side within ``evasive_lateral_g`` mu g, without overshooting it.
-* 5 RETURN: the shortest quintic (sec. 4.2) from the ego's lateral state back to d = 0 at the
-  speed held when the return began, within ``return_lateral_g`` mu g
-  (``evasive_lateral_g`` when oncoming traffic ended the lane change, mode 4). The table's
-  minimum-distance path is not reused: it is that short only with its braking profile.
+* 0 NORMAL, 1 UPDATE BRAKE: keep the lane centre; 0 holds the initial speed (speed PID), 1
+  brakes at the no-lock limit to standstill unless a steering sector, oncoming traffic or the
+  obstacle leaving the path (or pulling away) ends it.
+* 2 STEER+BRAKE: the table lane change (trigger speed and friction) to one lane width left,
+  steered with the plan's own road-wheel angle; the table acceleration profile, then held.
+* 3 ONCOMING BRAKE: the lateral motion arrested and taken back to the lane centre (a
+  time-optimal ``MinTimeShift`` within ``evasive_lateral_g`` mu g, or a quintic), braking with
+  what the friction ellipse leaves meanwhile, then at the limit to standstill.
+* 4 ONCOMING STEER+BRAKE: the same kind of shift to just past the obstacle's side.
+* 5 RETURN: back to d = 0: a quintic within ``return_lateral_g`` mu g, an escape after mode 4.
 
-The point of no return (sec. 8.1) is judged where the lateral motion would stop if arrested
-now (``ponr_at_lateral_stop``), and the DMM also places a braking obstacle where it will stop
-(``obstacle_decel_in_dmm``); both can be set back to the paper's rules.
+When an oncoming road user is seen during a lane change, passing on and aborting are both
+predicted and the less severe taken (``compare_outcomes``; ``decision.oncoming``); otherwise the
+point of no return (sec. 8.1) is judged where the lateral motion would stop
+(``ponr_at_lateral_stop``). The DMM places a braking obstacle where it will stop
+(``obstacle_decel_in_dmm``). Each can be set back to the paper's rule.
 """
 
 from __future__ import annotations
 
 import math
 
-from eoam_sumo.control.escape import MinTimeShift, lateral_state
+from eoam_sumo.control.escape import MinTimeShift, course_state, lateral_state, wrap_angle
 from eoam_sumo.control.longitudinal import LongitudinalController
 from eoam_sumo.control.paths import PathReference, QuinticShift
 from eoam_sumo.control.steering import SteeringController
@@ -64,21 +59,15 @@ from eoam_sumo.eoam_messages import Command, EgoMeasurement, ObjectState, Percep
 from eoam_sumo.eoam_settings import EoamSettings
 from eoam_sumo.params import G_MPS2, VehicleParams
 
-_TWO_PI = 2.0 * math.pi
 _new = tuple.__new__  # builds the per-step Command without its Python-level constructor
 __all__ = ["Command", "EgoMeasurement", "EoamController", "EoamSettings", "ObjectState",
            "Perception"]
 
-
-_WARNING_MODES = (UPDATE_BRAKE, UPDATE_STEER_BRAKE, ONCOMING_BRAKE,
-                  ONCOMING_STEER_BRAKE)  # FCW stays on
+_WARNING_MODES = (UPDATE_BRAKE, UPDATE_STEER_BRAKE, ONCOMING_BRAKE, ONCOMING_STEER_BRAKE)  # FCW
 _STEERING = (UPDATE_STEER_BRAKE, ONCOMING_STEER_BRAKE)
-# a STEER in these modes begins a lane change (safe policy gate)
-_COMMITTING = (NORMAL, UPDATE_BRAKE)
-# the safe policy watches the next lane in these modes
-_WATCHING = (UPDATE_STEER_BRAKE, RETURN)
-# a coasted object keeps these modes braking (sensing.md: track persistence)
-_HOLDING = (NORMAL, UPDATE_BRAKE)
+_COMMITTING = (NORMAL, UPDATE_BRAKE)  # a STEER here begins a lane change (safe policy gate)
+_WATCHING = (UPDATE_STEER_BRAKE, RETURN)  # the safe policy watches the next lane
+_HOLDING = (NORMAL, UPDATE_BRAKE)  # a coasted object keeps these braking (track persistence)
 
 
 class EoamController:
@@ -171,7 +160,7 @@ class EoamController:
     def _shift_to(self, target_m: float, meas: EgoMeasurement, lateral_g: float) -> None:
         """The shortest quintic (``QuinticShift``) from the ego's lateral state (offset, course,
         path curvature) to ``target_m`` within ``lateral_g`` mu g that does not pass it."""
-        slope, kappa, speed = _lateral_state(meas)
+        slope, kappa, speed = course_state(meas)
         traj = QuinticShift.for_lateral_accel(
             meas.d_m, slope, target_m, speed, lateral_g * meas.mu * G_MPS2,
             self.settings.return_min_length_m, kappa)
@@ -180,7 +169,7 @@ class EoamController:
     def _lateral_stop(self, meas: EgoMeasurement) -> QuinticShift:
         """The quintic that arrests the ego's lateral motion soonest within
         ``evasive_lateral_g`` mu g; it ends where the lateral motion stops."""
-        slope, kappa, speed = _lateral_state(meas)
+        slope, kappa, speed = course_state(meas)
         return QuinticShift.stopping(
             meas.d_m, slope, speed, self.settings.evasive_lateral_g * meas.mu * G_MPS2,
             self.settings.return_min_length_m, kappa, self.settings.lateral_reaction_s)
@@ -384,7 +373,8 @@ class EoamController:
         height = self._height
         settled = False
         if mode is RETURN and path is not None and dx >= path.length_m:
-            if abs(d) <= st.settle_offset_m and abs(_wrap(meas.e_yaw_rad)) <= st.settle_heading_rad:
+            heading_ok = abs(wrap_angle(meas.e_yaw_rad)) <= st.settle_heading_rad
+            if abs(d) <= st.settle_offset_m and heading_ok:
                 if self._settle_since is None:
                     self._settle_since = t
                 settled = t - self._settle_since >= st.settle_dwell_s - 1e-9
@@ -398,7 +388,7 @@ class EoamController:
             and mode is UPDATE_STEER_BRAKE
             and dx >= path.length_m
             and abs(d - path.start_offset_m - height) <= st.arrive_tolerance_m
-            and abs(_wrap(meas.e_yaw_rad)) <= st.settle_heading_rad
+            and abs(wrap_angle(meas.e_yaw_rad)) <= st.settle_heading_rad
         )
         past_ponr = (oncoming and mode is UPDATE_STEER_BRAKE
                      and self._commits(meas, perception, travel, height))
@@ -449,7 +439,7 @@ class EoamController:
                 kappa_ff = path.at(dx + v * st.preview_time_s).curvature_1pm
         e_lat = d - y_ref
         delta, ff, fb, yd, e_la = steer.command(
-            v, meas.yaw_rate_radps, meas.vy_mps, e_lat, _wrap(meas.e_yaw_rad - yaw_ref),
+            v, meas.yaw_rate_radps, meas.vy_mps, e_lat, wrap_angle(meas.e_yaw_rad - yaw_ref),
             kappa_ref + road_kappa, kappa_ff + road_kappa, mu, steer_ff, beta_ref)
 
         # ---- longitudinal: force limits from the friction ellipse with the lateral acceleration
@@ -508,16 +498,3 @@ class EoamController:
             v_target,
         ))
 
-
-def _lateral_state(meas: EgoMeasurement) -> tuple[float, float, float]:
-    """(slope of the course relative to the road, path curvature relative to the road [1/m],
-    speed along the road [m/s]) of the ego (``control.escape.lateral_state``)."""
-    v_lat, a_lat, along = lateral_state(meas)
-    return v_lat / along, a_lat / (along * along), along
-
-
-def _wrap(angle_rad: float) -> float:
-    """Angle wrapped to [-pi, pi)."""
-    if -math.pi <= angle_rad < math.pi:
-        return angle_rad
-    return (angle_rad + math.pi) % _TWO_PI - math.pi

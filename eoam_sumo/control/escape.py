@@ -200,3 +200,17 @@ def lateral_state(meas) -> tuple[float, float, float]:
     along = max(1.0, meas.vx_mps * c - meas.vy_mps * s)
     return (meas.vx_mps * s + meas.vy_mps * c,
             meas.ay_mps2 - meas.road_curvature_1pm * along * along, along)
+
+
+def course_state(meas) -> tuple[float, float, float]:
+    """(slope of the course relative to the road, path curvature relative to the road [1/m],
+    speed along the road [m/s]) of an ``EgoMeasurement`` (from ``lateral_state``)."""
+    v_lat, a_lat, along = lateral_state(meas)
+    return v_lat / along, a_lat / (along * along), along
+
+
+def wrap_angle(angle_rad: float) -> float:
+    """Angle wrapped to [-pi, pi)."""
+    if -math.pi <= angle_rad < math.pi:
+        return angle_rad
+    return (angle_rad + math.pi) % (2.0 * math.pi) - math.pi
