@@ -454,7 +454,6 @@ def run_case(
 
 
 _NOTHING = Perception(None, None, False)  # immutable, so shared by all steps that see nothing
-_ONCOMING_ONLY = Perception(None, None, True)
 
 
 def _perception(report: RadarReport) -> Perception:
@@ -464,9 +463,8 @@ def _perception(report: RadarReport) -> Perception:
     det = report.in_path
     oncoming = _nearest_oncoming(report) if report.oncoming_detected else None
     if det is None:
-        perception = _ONCOMING_ONLY if report.oncoming_detected else _NOTHING
-        if oncoming is not None:
-            perception = Perception(None, None, True, oncoming_object=oncoming)
+        perception = (_NOTHING if oncoming is None
+                      else Perception(None, None, True, oncoming_object=oncoming))
     else:
         obstacle = ObjectState(det.s_m, det.d_m, det.road_speed_mps, det.length_m,
                                det.width_m)
