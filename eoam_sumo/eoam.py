@@ -12,9 +12,10 @@ References per mode (road frame of the ego's original lane, d left positive):
   obstacle leaving the path (or pulling away) ends it.
 * 2 STEER+BRAKE: the table lane change (trigger speed and friction) to one lane width left,
   steered with the plan's own road-wheel angle; the table acceleration profile, then held.
-* 3 ONCOMING BRAKE: the lateral motion arrested and taken back to the lane centre (a
-  time-optimal ``MinTimeShift`` within ``evasive_lateral_g`` mu g, or a quintic), braking with
-  what the friction ellipse leaves meanwhile, then at the limit to standstill.
+* 3 ONCOMING BRAKE: a lateral motion away from the lane centre arrested at the front tyre's
+  slip envelope, then back to the lane centre (a time-optimal ``MinTimeShift`` within
+  ``arrest_return_g`` mu g, ``evasive_lateral_g`` without an arrest; or a quintic), braking
+  with what the friction ellipse leaves meanwhile, then at the limit to standstill.
 * 4 ONCOMING STEER+BRAKE: the same kind of shift to just past the obstacle's side.
 * 5 RETURN: back to d = 0: a quintic within ``return_lateral_g`` mu g, an escape after mode 4.
 
@@ -107,6 +108,7 @@ class EoamController:
         self._hold_speed: float | None = None
         self._urgent_return = False
         self._stop_path: QuinticShift | None = None  # lateral stop judged for the PONR
+        self._arrest = 0.0  # mode 3: sign of the lateral motion being arrested (0: none)
         self._obstacle: ObstacleTrack | None = None  # the in-path obstacle
         self.oncoming_choice: Choice | None = None  # the commit/abort decision, when made
         self._decel.reset()
@@ -146,14 +148,17 @@ class EoamController:
         else:
             self._shift_to(0.0, meas, self.settings.return_lateral_g)
 
-    def _escape_to(self, target_m: float, meas: EgoMeasurement) -> None:
-        """An evasive shift to ``target_m`` within ``evasive_lateral_g`` mu g: time-optimal
-        (``MinTimeShift``) with ``min_time_escapes``, else the shortest quintic."""
+    def _escape_to(self, target_m: float, meas: EgoMeasurement,
+                   lateral_g: float | None = None) -> None:
+        """An evasive shift to ``target_m`` within ``lateral_g`` (default
+        ``evasive_lateral_g``) mu g: time-optimal (``MinTimeShift``) with
+        ``min_time_escapes``, else the shortest quintic."""
         st = self.settings
+        lateral_g = st.evasive_lateral_g if lateral_g is None else lateral_g
         if not st.min_time_escapes:
-            return self._shift_to(target_m, meas, st.evasive_lateral_g)
+            return self._shift_to(target_m, meas, lateral_g)
         v_lat, a_lat, speed = lateral_state(meas)
-        accel = st.evasive_lateral_g * meas.mu * G_MPS2
+        accel = lateral_g * meas.mu * G_MPS2
         traj = MinTimeShift(meas.d_m, v_lat, a_lat, target_m, speed, accel, st.escape_ramp_s)
         self._start_path(meas, traj, meas.d_m, None)
 
@@ -183,23 +188,17 @@ class EoamController:
         need = left_edge + 0.5 * self.params.width_m + self.settings.side_clearance_m
         return max(min(need, meas.lane_width_m), meas.d_m)
 
-    def _start_path(
-        self, meas: EgoMeasurement, traj, start: float, height: float | None
-    ) -> None:
-        v = meas.vx_mps
-        self._path = PathReference(
-            traj,
-            start_offset_m=start,
-            height_m=height,
-            speed_mps=v,
-            step_m=self.settings.reference_step_m,
-        )
+    def _start_path(self, meas: EgoMeasurement, traj, start: float, height: float | None
+                    ) -> None:
+        self._path = PathReference(traj, start_offset_m=start, height_m=height,
+                                   speed_mps=meas.vx_mps, step_m=self.settings.reference_step_m)
         self._s0 = meas.s_m
         self._settle_since = None
         self._long.reset()
 
     def _enter(self, mode: Mode, previous: Mode, meas: EgoMeasurement) -> None:
         """Entry actions of a new mode (mode 4 keeps the lane change of mode 2 going)."""
+        self._arrest = 0.0
         if mode is UPDATE_STEER_BRAKE:
             self._hold_speed = None
             self._height = meas.lane_width_m
@@ -212,10 +211,16 @@ class EoamController:
         elif mode is ONCOMING_STEER_BRAKE:
             self._escape_to(self._passing_offset_m(meas), meas)
         elif mode is ONCOMING_BRAKE and self.settings.min_time_escapes:
-            # arrest the lateral motion and return to the lane centre in one time-optimal
-            # shift (the brake gets what the friction ellipse leaves)
+            # a lateral motion away from the lane centre arrested at the front tyre's limit
+            # (``arrest_first``), then a time-optimal shift back; the brake gets what the
+            # friction ellipse leaves
             self._stop_path = None
-            self._escape_to(0.0, meas)
+            v_lat = lateral_state(meas)[0]
+            if self.settings.arrest_first and v_lat * meas.d_m > 0.0:
+                self._arrest = math.copysign(1.0, v_lat)
+                self._path = None
+            else:
+                self._escape_to(0.0, meas)
         elif mode is ONCOMING_BRAKE:
             # arrest the lateral motion first (the brake gets what the friction ellipse
             # leaves), then hold that offset while braking to standstill
@@ -411,6 +416,9 @@ class EoamController:
             self.mode = mode = new
         elif mode is RETURN and oncoming and not self._urgent_return:
             self._start_return(meas, urgent=True)  # oncoming traffic seen during the return
+        elif self._arrest and lateral_state(meas)[0] * self._arrest <= 0.0:
+            self._arrest = 0.0  # lateral motion arrested: back to the lane centre
+            self._escape_to(0.0, meas, st.arrest_return_g)
         elif (mode is ONCOMING_BRAKE and path is not None and dx >= path.length_m
               and self._stop_path is not None):
             # lateral motion arrested: back to the lane centre while braking on
@@ -437,10 +445,15 @@ class EoamController:
                 steer = self._steer_plan
             else:
                 kappa_ff = path.at(dx + v * st.preview_time_s).curvature_1pm
-        e_lat = d - y_ref
-        delta, ff, fb, yd, e_la = steer.command(
-            v, meas.yaw_rate_radps, meas.vy_mps, e_lat, wrap_angle(meas.e_yaw_rad - yaw_ref),
-            kappa_ref + road_kappa, kappa_ff + road_kappa, mu, steer_ff, beta_ref)
+        if self._arrest:  # the most lateral force against the motion the envelope allows
+            y_ref, e_lat, fb, yd, e_la = d, 0.0, 0.0, 0.0, 0.0
+            delta = ff = steer.envelope_edge(v, meas.yaw_rate_radps, meas.vy_mps, mu,
+                                             -self._arrest)
+        else:
+            e_lat = d - y_ref
+            delta, ff, fb, yd, e_la = steer.command(
+                v, meas.yaw_rate_radps, meas.vy_mps, e_lat, wrap_angle(meas.e_yaw_rad - yaw_ref),
+                kappa_ref + road_kappa, kappa_ff + road_kappa, mu, steer_ff, beta_ref)
 
         # ---- longitudinal: force limits from the friction ellipse with the lateral acceleration
         # in use (measured; outside the table's profile also the one this steering command asks
@@ -480,21 +493,6 @@ class EoamController:
         if fcw:
             self.fcw_raised = True
         self.sector = sector.letter if sector is not None else ""
-        return _new(Command, (
-            delta,
-            drive,
-            brake,
-            int(mode),
-            fcw,
-            self.sector,
-            ax_target,
-            y_ref,
-            dx,
-            e_lat,
-            e_la,
-            ff,
-            fb,
-            yd,
-            v_target,
-        ))
+        return _new(Command, (delta, drive, brake, int(mode), fcw, self.sector, ax_target, y_ref,
+                              dx, e_lat, e_la, ff, fb, yd, v_target))
 

@@ -46,6 +46,10 @@ class EoamSettings:
     oncoming_margin_s: float = 0.2  # ... that long before the fronts meet
     min_time_escapes: bool = True  # modes 3, 4 and the returns from oncoming traffic:
     # jerk-limited time-optimal shifts (control.escape; False: the shortest quintics)
+    arrest_first: bool = True  # mode 3 from a lane change: a lateral motion away from the
+    # lane centre is first arrested at the front tyre's slip envelope, then the shift back
+    arrest_return_g: float = 0.6  # ... within this / (mu g): the body leaves the arrest
+    # sliding (Table 2: up to 10 deg of sideslip); at 0.75 the closed loop spun the car on mu 0.3
     escape_ramp_s: float = 0.15  # their time from no lateral acceleration to the full budget
     escape_lag_s: float = 0.1  # the commit/abort prediction: the closed loop follows a new
     # shift as if its lateral acceleration held this long first (Table 2: peaks 0.4-0.6 m
@@ -82,6 +86,7 @@ class EoamSettings:
             "evasive_lateral_g",
             "return_min_length_m",
             "escape_ramp_s",
+            "arrest_return_g",
             "settle_offset_m",
             "settle_heading_rad",
             "unknown_obstacle_length_m",

@@ -160,6 +160,25 @@ class MinTimeShift:
                     best = max(best, _advance(y, v, a, j, t)[0])
         return best
 
+    def turn_s(self) -> float:
+        """When the lateral speed first falls to zero from its initial sign (0 when the motion
+        starts towards the target or at rest): where an arrest of the motion ends."""
+        v0 = self.state_at(0.0)[1]
+        if v0 * (self.y1_m - self.state_at(0.0)[0]) >= 0.0:
+            return 0.0
+        for t0, dur, _, v, a, j in self._segs:
+            roots = []
+            if j != 0.0:  # v + a t + j t^2 / 2 = 0
+                disc = a * a - 2.0 * j * v
+                if disc >= 0.0:
+                    roots = [(-a + r) / j for r in (math.sqrt(disc), -math.sqrt(disc))]
+            elif a != 0.0:
+                roots = [-v / a]
+            within = [t for t in roots if 0.0 <= t <= dur]
+            if within:
+                return t0 + min(within)
+        return self.duration_s
+
     def time_within_s(self, line_m: float, below: bool = True) -> float:
         """First time from which the offset stays at or below ``line_m`` (above it when not
         ``below``) to the end of the path; inf when it ends beyond the line."""

@@ -276,3 +276,13 @@ class SteeringController:
         if delta > self._max:
             delta = self._max
         return _new(SteeringCommand, (delta, ff, fb, yd, -fb / k_e))
+
+    def envelope_edge(self, speed_mps: float, yaw_rate_radps: float, lateral_speed_mps: float,
+                      mu: float, towards: float) -> float:
+        """The road-wheel angle at the edge of ``command``'s front slip envelope on the side
+        ``towards`` (+1 left, -1 right), clipped to the lock: the most lateral force towards
+        that side the steering law allows (front slip at ``front_slip_fraction`` of its
+        peak's, where the Fiala force is 7/8 of the peak)."""
+        v = speed_mps if speed_mps > 1.0 else 1.0
+        delta = (lateral_speed_mps + self._a * yaw_rate_radps) / v + towards * self._slip_frac * mu
+        return max(-self._max, min(self._max, delta))

@@ -6,10 +6,12 @@ ends against the oncoming road user, so both are predicted here from the radar's
 (station, offset, speed, size) and of the obstacle being avoided, and the least severe one is
 taken:
 
-* **abort** (mode 3): arrest the lateral motion and steer back into the own lane at once, the
-  lateral motion a time-optimal shift to the lane centre within the evasive budget
-  (``control.escape.MinTimeShift``), braking at the limit with what the friction ellipse
-  leaves during the shift and at the full limit after it;
+* **abort** (mode 3): arrest the lateral motion and steer back into the own lane at once: a
+  time-optimal shift to the lane centre within the evasive budget
+  (``control.escape.MinTimeShift``) up to where the lateral motion away from it stops, and
+  from there one within the (gentler) budget of the shift back after an arrest; braking at
+  the limit with what the friction ellipse leaves during the shifts and at the full limit
+  after them;
 * **pass** (mode 4): go on to just past the obstacle's side (its left edge + half the ego +
   the side clearance), hold the speed until the ego's rear is past the obstacle's front, then
   the same time-optimal shift back from there.
@@ -74,15 +76,17 @@ class Budget(NamedTuple):
     pass_margin_m: float  # the ego's rear this far past the obstacle's front ends the pass
     margin_m: float  # lateral margin to the oncoming path
     margin_s: float  # time margin before the fronts meet
+    return_mps2: float  # lateral budget of the shift back after an arrest
 
     @classmethod
     def of(cls, params, settings, mu: float, brake_mps2: float) -> Budget:
         """From the ego's ``VehicleParams``, the ``EoamSettings`` and the friction."""
         mu_g, st = mu * G_MPS2, settings
+        back_g = st.arrest_return_g if st.arrest_first else st.evasive_lateral_g
         return cls(st.evasive_lateral_g * mu_g, st.escape_ramp_s, st.escape_lag_s, brake_mps2,
                    mu_g, params.width_m, params.length_m, params.cg_to_front_bumper_m,
                    st.side_clearance_m, st.pass_margin_m, st.oncoming_margin_m,
-                   st.oncoming_margin_s)
+                   st.oncoming_margin_s, back_g * mu_g)
 
 
 class Option(NamedTuple):
@@ -161,17 +165,24 @@ def _head_on(escape: MinTimeShift, start_s: float, line_m: float, meet_s: float,
 
 def predict_abort(lat: Lateral, v_mps: float, obstacle: Tracked | None, oncoming: Tracked,
                   b: Budget) -> Option:
-    """Abort: the time-optimal shift to the lane centre, braking with what the friction
-    ellipse leaves during it and at the limit after it."""
+    """Abort: the time-optimal shift to the lane centre up to where the lateral motion away
+    from it stops, then one from rest there within ``return_mps2``; braking with what the
+    friction ellipse leaves during them and at the limit after them."""
     escape = _escape(lat, 0.0, v_mps, b)
+    start = b.lag_s
+    turn = escape.turn_s()
+    if turn > 0.0 and b.return_mps2 != b.lateral_mps2:
+        start += turn
+        escape = MinTimeShift(escape.state_at(turn)[0], 0.0, 0.0, 0.0, v_mps, b.return_mps2,
+                              b.ramp_s)
     share = math.sqrt(max(1.0 - (b.lateral_mps2 / b.mu_g_mps2) ** 2, 0.0))
-    t_lat = b.lag_s + escape.duration_s if escape.duration_s > 1e-6 else 0.0
+    t_lat = start + escape.duration_s if escape.duration_s > 1e-6 else 0.0
 
     def decel(t: float) -> float:
         return b.brake_mps2 * (share if t < t_lat else 1.0)
 
     meet, closing, impact = _braking(v_mps, decel, obstacle, oncoming)
-    head_on, out = _head_on(escape, b.lag_s, _out_line_m(oncoming, b), meet, b)
+    head_on, out = _head_on(escape, start, _out_line_m(oncoming, b), meet, b)
     if head_on:
         return Option(True, 0.5 * closing, out, meet)
     return Option(False, 0.5 * impact, out, meet)

@@ -107,3 +107,21 @@ def test_lateral_state_of_a_measurement():
     assert v_lat == pytest.approx(vx * math.sin(e) + vy * math.cos(e))
     assert along == pytest.approx(vx * math.cos(e) - vy * math.sin(e))
     assert a_lat == pytest.approx(2.0 - 0.001 * along * along)  # less the road's curving
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(0.5, 4.0), st.floats(1.0, 9.0), st.floats(0.05, 0.3))
+def test_turn_time_is_the_closed_form(v0, accel, ramp):
+    """Moving away from the target at v0 with no lateral acceleration, the motion turns after
+    the ramp to -A and the hold: v0 = A r / 2 + A (t - r), t = v0 / A + r / 2 (v0 >= A r / 2)."""
+    assume(v0 >= 0.5 * accel * ramp)
+    shift = MinTimeShift(0.0, v0, 0.0, -1.0, SPEED, accel, ramp)
+    t = shift.turn_s()
+    assert t == pytest.approx(v0 / accel + 0.5 * ramp, rel=1e-9, abs=1e-9)
+    assert shift.state_at(t)[1] == pytest.approx(0.0, abs=1e-9)
+    assert shift.state_at(t)[0] == pytest.approx(shift.max_offset_m(), abs=1e-9)
+
+
+def test_no_turn_when_moving_towards_the_target():
+    assert MinTimeShift(1.0, -1.0, 0.0, 0.0, SPEED, 5.0, 0.15).turn_s() == 0.0
+    assert MinTimeShift(1.0, 0.0, 0.0, 0.0, SPEED, 5.0, 0.15).turn_s() == 0.0

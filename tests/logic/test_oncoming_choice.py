@@ -29,7 +29,7 @@ MU_G = 0.7 * 9.81
 BUDGET = Budget(lateral_mps2=0.9 * MU_G, ramp_s=0.15, lag_s=0.1, brake_mps2=0.95 * MU_G,
                 mu_g_mps2=MU_G, width_m=1.85, length_m=4.92, cg_to_front_m=3.9,
                 side_clearance_m=0.5,
-                pass_margin_m=1.0, margin_m=0.2, margin_s=0.2)
+                pass_margin_m=1.0, margin_m=0.2, margin_s=0.2, return_mps2=0.9 * MU_G)
 LINE = 3.5 - 0.91 - 0.925 - 0.2  # the ego's centre out of the oncoming path [m]
 V = 40.0  # ego speed [m/s]
 

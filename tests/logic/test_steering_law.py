@@ -5,6 +5,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from eoam_sumo.control import SteeringController, SteeringGains, understeer_gradient
 from eoam_sumo.eoam_settings import EoamSettings
@@ -96,6 +98,23 @@ def test_clipped_to_the_front_slip_envelope_and_the_lock():
         assert delta == pytest.approx(envelope * mu, rel=1e-12)  # front slip = delta here
     assert ctrl.command(0.5, 0.0, 0.0, -50.0, 0.0, 0.0, 0.0, 1.0).steer_rad == P.max_steer_rad
     assert ctrl.command(0.5, 0.0, 0.0, 50.0, 0.0, 0.0, 0.0, 1.0).steer_rad == -P.max_steer_rad
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.floats(5.0, 50.0), st.floats(-2.0, 2.0), st.floats(-0.5, 0.5), st.floats(0.1, 1.2),
+       st.sampled_from((1.0, -1.0)))
+def test_envelope_edge_is_the_front_slip_limit_the_law_clips_to(v, vy, r, mu, side):
+    """The edge's front slip (delta less the front axle's course) is the envelope's, on the
+    side asked for, and the law's largest error towards that side lands on it."""
+    ctrl = SteeringController(P)
+    fz = P.mass_kg * 9.81 * P.cg_to_rear_m / P.wheelbase_m
+    envelope = SteeringGains().front_slip_fraction * 3.0 * fz / P.cornering_stiffness_front_npr
+    edge = ctrl.envelope_edge(v, r, vy, mu, side)
+    course_f = (vy + P.cg_to_front_m * r) / v
+    assume(abs(course_f) + envelope * mu < P.max_steer_rad)
+    assert edge - course_f == pytest.approx(side * envelope * mu, rel=1e-9)
+    clipped = ctrl.command(v, r, vy, -side * 50.0, 0.0, 0.0, 0.0, mu).steer_rad
+    assert clipped == pytest.approx(edge, rel=1e-9, abs=1e-12)
 
 
 GAINS = {"default": SteeringGains(), "planned": EoamSettings().planned_steering}
