@@ -216,7 +216,8 @@ class EoamController:
             # friction ellipse leaves
             self._stop_path = None
             v_lat = lateral_state(meas)[0]
-            if self.settings.arrest_first and v_lat * meas.d_m > 0.0:
+            if (self.settings.arrest_first and v_lat * meas.d_m > 0.0
+                    and abs(v_lat) >= self.settings.arrest_min_speed_mps):
                 self._arrest = math.copysign(1.0, v_lat)
                 self._path = None
             else:

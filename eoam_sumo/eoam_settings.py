@@ -48,6 +48,8 @@ class EoamSettings:
     # jerk-limited time-optimal shifts (control.escape; False: the shortest quintics)
     arrest_first: bool = True  # mode 3 from a lane change: a lateral motion away from the
     # lane centre is first arrested at the front tyre's slip envelope, then the shift back
+    arrest_min_speed_mps: float = 0.5  # ... when it is at least this fast (a lane change's,
+    # not a lane-keeping drift: the arrest steers hard)
     arrest_return_g: float = 0.6  # ... within this / (mu g): the body leaves the arrest
     # sliding (Table 2: up to 10 deg of sideslip); at 0.75 the closed loop spun the car on mu 0.3
     escape_ramp_s: float = 0.15  # their time from no lateral acceleration to the full budget

@@ -8,6 +8,7 @@ import math
 
 import pytest
 
+from eoam_sumo.control import SteeringController
 from eoam_sumo.decision import Mode
 from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, ObjectState, Perception
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
@@ -363,3 +364,21 @@ def test_a_standing_car_in_the_next_lane_blocks_the_steer_like_oncoming_traffic(
         EgoMeasurement(0.0, v, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, LANE),
         Perception(rng, -v, False, None, rng + beyond_m), DT)
     assert drive.mode is mode
+
+
+@pytest.mark.parametrize(("v_lat_mps", "arrests"), [(2.0, True), (0.6, True), (0.3, False)])
+def test_an_abort_moving_out_fast_is_arrested_at_the_envelope_edge(tables, v_lat_mps, arrests):
+    """Mode 3 entered moving away from the lane centre at a lane change's lateral speed steers
+    at the front slip envelope's edge against the motion (no feedback) until the motion stops;
+    a slower drift gets the time-optimal shift back at once."""
+    drive = start_steer(tables, settings=EoamSettings(ponr_at_lateral_stop=False))
+    e_yaw = math.asin(v_lat_mps / drive.v)  # vy = 0: the lateral speed is vx sin(e_yaw)
+    drive.step(d_m=0.5, e_yaw=e_yaw, n=3)
+    cmd = drive.step(oncoming=True, e_yaw=e_yaw)
+    assert drive.mode is Mode.ONCOMING_BRAKE
+    edge = SteeringController(P).envelope_edge(drive.v, 0.0, 0.0, 1.0, -1.0)
+    if arrests:
+        assert cmd.steer_cmd_rad == pytest.approx(edge, rel=1e-12)
+        assert cmd.steer_fb_rad == 0.0 and cmd.lateral_error_m == 0.0
+        cmd = drive.step(oncoming=True, e_yaw=-0.01)  # moving right: arrested, shift back
+    assert cmd.steer_cmd_rad > edge + 0.05  # a shift's command, well inside the envelope
