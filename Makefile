@@ -4,10 +4,12 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 OUT    ?= out
+# the modules compiled at install (setup.py): a change to one installs (compiles) again
+COMPILED_SOURCES := $(shell sed -n 's/^ *"\(eoam_sumo\/[a-z0-9_/]*\.py\)",$$/\1/p' setup.py)
 
 .PHONY: run test test-fast tables bench lint network clean
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml setup.py $(COMPILED_SOURCES)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test]'
@@ -46,4 +48,5 @@ network: $(STAMP)
 	$(BIN)/python -m eoam_sumo.netbuild networks
 
 clean:
-	rm -rf $(VENV) $(OUT)
+	rm -rf $(VENV) $(OUT) build eoam_sumo/compiled_sources.json
+	find eoam_sumo -name '*.so' -delete

@@ -10,6 +10,7 @@ Figures:
 - ``batch_wall_s`` / ``batch_cases`` / ``jobs``: the Table 2 batch with 2 jobs;
 - per-step costs of decision + control and of the plant, plant sub-steps per second;
 - ``peak_rss_mb`` of one ``eoam-sumo run`` in its own process;
+- ``compiled``: whether the step loop ran compiled (setup.py) or from the Python sources;
 - the traffic case (``traffic_scenario``: 3 lanes each way, the ego departing at 120 s behind a
   broken-down car, SUMO's step 0.5 s before that): ``traffic_vehicles`` in SUMO at the ego's
   departure, ``traffic_cosim_wall_s`` of the whole co-simulation run (SUMO's start, the time
@@ -31,6 +32,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from eoam_sumo import native
 from eoam_sumo.sim.observers import StepObserver
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -217,7 +219,7 @@ def run_bench(out_dir: Path, quick: bool = False) -> dict:
     repeats = 1 if quick else 15  # short runs on a shared machine: a median of many
     with tempfile.TemporaryDirectory(prefix="eoam-bench-") as tmp_dir:
         tmp = Path(tmp_dir)
-        result: dict[str, Any] = {"quick": quick, "jobs": 2}
+        result: dict[str, Any] = {"quick": quick, "jobs": 2, "compiled": native.compiled()}
         result["peak_rss_mb"] = _peak_rss_mb(tmp / "rss")
         result.update(_cosim_and_sumo_only(repeats))
         result.update(_traffic(tmp, quick))
@@ -233,9 +235,11 @@ def run_bench(out_dir: Path, quick: bool = False) -> dict:
 
 
 def format_table(result: dict) -> str:
-    rows = [(k, v) for k, v in result.items() if isinstance(v, (int, float)) and k != "quick"]
+    rows = [(k, v) for k, v in result.items()
+            if isinstance(v, (int, float)) and k not in ("quick", "compiled")]
     width = max(len(k) for k, _ in rows)
-    lines = [f"{'figure':<{width}}  value        target"]
+    lines = [f"step loop: {'compiled' if result['compiled'] else 'Python sources'}",
+             f"{'figure':<{width}}  value        target"]
     for k, v in rows:
         tgt = result["targets"].get(k)
         mark = "" if tgt is None else f"{tgt['target']:<9} {'met' if tgt['met'] else 'MISSED'}"

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import json
 import math
+from importlib import machinery
 
 import pytest
 
 from eoam_sumo.bench import TARGETS, run_bench
+from eoam_sumo.sim import cosim
 
 pytestmark = pytest.mark.sumo
 
@@ -26,5 +28,7 @@ def test_quick_bench_writes_every_key(tmp_path):
     for key in KEYS:
         assert key in saved and math.isfinite(saved[key]) and saved[key] > 0, key
     assert saved["batch_cases"] == 2 and saved["jobs"] == 2
+    loader = cosim.__spec__.loader  # what ran the step loop: an extension module or a source
+    assert saved["compiled"] is isinstance(loader, machinery.ExtensionFileLoader)
     assert set(saved["targets"]) == set(TARGETS)
     assert math.isfinite(saved["traffic_us_per_user_step"])

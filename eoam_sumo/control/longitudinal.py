@@ -20,9 +20,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
+from mypy_extensions import mypyc_attr
+
 from eoam_sumo.params import AIR_DENSITY_KGPM3, G_MPS2, VehicleParams
 
 
+@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True)
 class LongitudinalGains:
     """PID gains and limits of the two longitudinal loops (acceleration in m/s^2 units)."""

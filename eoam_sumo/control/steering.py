@@ -34,10 +34,12 @@ from dataclasses import dataclass, fields
 from typing import NamedTuple
 
 import numpy as np
+from mypy_extensions import mypyc_attr
 
 from eoam_sumo.params import VehicleParams
 
 
+@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True)
 class SteeringGains:
     """Design values of the steering schedule."""

@@ -41,6 +41,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import NamedTuple
 
+from mypy_extensions import mypyc_attr
+
 from eoam_sumo.control.paths import QuinticShift
 from eoam_sumo.params import G_MPS2
 
@@ -87,6 +89,7 @@ class NextLaneView:
         return cover if self.nearest_ahead_m is None else min(cover, self.nearest_ahead_m)
 
 
+@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True)
 class PolicySettings:
     """The decision policy and the safe policy's sight-distance terms."""

@@ -38,6 +38,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+from mypy_extensions import mypyc_attr
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.sensing.tracker import Measurement, Tracker, TrackerSettings
@@ -58,6 +59,7 @@ STREAM = 2  # random stream of the run seed (the friction estimator draws from s
 _SEEN_EPS_M = 1e-6  # a blocker must start this much before the target's point [m]
 
 
+@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True)
 class AutomotiveRadarSettings:
     """Noise, timing and detection of the automotive radar (sources: module docstring)."""

@@ -29,6 +29,7 @@ from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
+from mypy_extensions import mypyc_attr
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import G_MPS2, MU_MAX
@@ -37,6 +38,7 @@ KINDS = ("known", "estimate")
 STREAM = 1  # random stream of the run seed (the radar draws from stream 2)
 
 
+@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True)
 class EstimatorSettings:
     """The friction estimator model (``estimate`` belief); reasons in the module docstring."""

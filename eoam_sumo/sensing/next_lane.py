@@ -33,6 +33,8 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from mypy_extensions import mypyc_attr
+
 from eoam_sumo.decision.policy import NextLaneView
 from eoam_sumo.sensing.v2x import V2XReceiver, V2XSettings
 from eoam_sumo.sim.geometry import OrientedBox, slab_entry
@@ -47,6 +49,7 @@ Sensor = tuple[float, float, float, float, float]
 COVERAGE_STEP_M = 1.0  # spacing of the points at which coverage is tested [m]
 
 
+@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True)
 class CornerRadarSettings:
     """Left corner radars (module doc: Autoliv 24 GHz SRR, LCA mode)."""

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
+from mypy_extensions import mypyc_attr
 
 from eoam_sumo.errors import InputError
 
@@ -39,6 +40,7 @@ GATE_CHI2_99 = 9.21
 SD_FLOOR = (1e-3, 1e-6, 1e-3)
 
 
+@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True)
 class TrackerSettings:
     """Tracker tuning (values assumed; reasons in the comments)."""

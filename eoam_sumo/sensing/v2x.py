@@ -25,11 +25,14 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import NamedTuple
 
+from mypy_extensions import mypyc_attr
+
 #: Consecutive losses the "no message means no road user" reasoning allows for: the chance of
 #: a longer run of losses is below 1e-6.
 LOSS_RUN_PROBABILITY = 1e-6
 
 
+@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True)
 class V2XSettings:
     """V2X link and fleet: range 0 turns V2X off."""

@@ -18,6 +18,8 @@ from __future__ import annotations
 import math
 from collections import namedtuple
 
+from mypy_extensions import mypyc_attr
+
 from eoam_sumo.sim.geometry import OrientedBox
 
 PEDESTRIAN = "pedestrian"  # SUMO's vClass of persons
@@ -27,6 +29,7 @@ _BodyFields = namedtuple(
 )  # untyped: introspection sees Body's own constructor, without ``box``
 
 
+@mypyc_attr(native_class=False)  # a tuple subclass: a Python class when compiled too
 class Body(_BodyFields):
     """A road user: SUMO id and vClass, centre (x_m, y_m), yaw CCW from +x, speed along it,
     footprint, parked flag and its oriented box.

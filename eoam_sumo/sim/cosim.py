@@ -14,9 +14,12 @@ from __future__ import annotations
 import gc
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any, ClassVar
+
+from mypy_extensions import mypyc_attr
 
 from eoam_sumo.eoam import (
     Command,
@@ -52,6 +55,7 @@ from eoam_sumo.sim.trafficlog import TrafficLog
 from eoam_sumo.sim.verdict import AvoidedObstacle, summarise
 
 
+@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True)
 class RunSettings:
     """Rates, limits and sub-settings of one co-simulation run."""
@@ -106,7 +110,11 @@ class CoSimulation:
     """
 
     #: The phases of a step, in order (``step``); a PhaseTimer times each.
-    PHASES: tuple[str, ...] = ("sense", "decide", "actuate", "write_back", "check_contact")
+    PHASES: ClassVar[tuple[str, ...]] = ("sense", "decide", "actuate", "write_back",
+                                         "check_contact")
+    #: What ``step`` calls for each phase, in that order: the methods of the same names, set by
+    #: ``start`` before the observers start (an observer may wrap them, as PhaseTimer does).
+    phase_calls: tuple[Callable[..., Any], ...]
     # the run's state, set by ``start`` and the steps
     session: SumoSession
     meas: EgoMeasurement
@@ -237,6 +245,8 @@ class CoSimulation:
         self.avoided = AvoidedObstacle()
         self.observers = (self.timeseries, self.extremes, self.traffic, self.margins,
                           self.avoided, *self.extra_observers)
+        self.phase_calls = (self.sense, self.decide, self.actuate, self.write_back,
+                            self.check_contact)
         for obs in self.observers:
             obs.start(self)
         self._after_step = tuple(obs.after_step for obs in self.observers)
@@ -246,11 +256,12 @@ class CoSimulation:
     def step(self) -> bool:
         """One co-simulation step (as highway-env's ``AbstractEnv.step``: named phases in
         order); True when the run is over."""
-        self.meas, self.perception = meas, perception = self.sense()
-        self.cmd = cmd = self.decide(meas, perception)
-        self.actuate(cmd)
-        self.write_back()
-        self.check_contact()
+        sense, decide, actuate, write_back, check_contact = self.phase_calls
+        self.meas, self.perception = meas, perception = sense()
+        self.cmd = cmd = decide(meas, perception)
+        actuate(cmd)
+        write_back()
+        check_contact()
         self.n_steps += 1
         for after_step in self._after_step:
             after_step(self)

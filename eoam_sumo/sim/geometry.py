@@ -35,6 +35,8 @@ import math
 from collections import namedtuple
 from dataclasses import dataclass
 
+from mypy_extensions import mypyc_attr
+
 #: Boxes closer than this count as touching [m]: far below the 1 mm that tests resolve and far
 #: above the rounding error of a rotation of road-scale coordinates (~1e-12 m).
 CONTACT_TOLERANCE_M = 1e-6
@@ -57,6 +59,7 @@ _BoxFields = namedtuple(
 )
 
 
+@mypyc_attr(native_class=False)  # a tuple subclass: a Python class when compiled too
 class OrientedBox(_BoxFields):
     """Rectangle footprint of a body: centre, heading and size (validated), with the cosine,
     sine, half sizes and bounding radius worked out once.
@@ -155,6 +158,7 @@ class OrientedBox(_BoxFields):
         )
 
 
+@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True, slots=True)
 class Contact:
     """First contact between box ``a`` and box ``b`` (faces as seen from each box)."""

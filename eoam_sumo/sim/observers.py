@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any, Protocol
+
+from mypy_extensions import mypyc_attr
 
 from eoam_sumo.eoam import Command, EgoMeasurement, Perception
 from eoam_sumo.sim.runlog import RunLog
@@ -23,6 +25,7 @@ class RunView(Protocol):
 
     @property
     def PHASES(self) -> tuple[str, ...]: ...
+    phase_calls: tuple[Callable[..., Any], ...]  # what the step calls for each phase
     @property
     def max_steps(self) -> int: ...  # the time limit in steps
     @property
@@ -57,6 +60,7 @@ class RunView(Protocol):
     def left_lane(self) -> bool: ...  # a lane (either direction) lies left of the ego's
 
 
+@mypyc_attr(allow_interpreted_subclasses=True)  # observers are written in Python
 class StepObserver:
     """An observer that does nothing: subclass it and override the hooks needed."""
 
@@ -124,19 +128,21 @@ class Extremes(StepObserver):
 class PhaseTimer(StepObserver):
     """Wall time spent in each phase of the step (``CoSimulation.PHASES``), for the benchmark.
 
-    It wraps the simulation's phase methods when the run starts; ``totals`` maps each phase to
-    its seconds, ``steps`` counts the steps. Without a PhaseTimer the phases run unwrapped.
+    It wraps the simulation's phase calls (``phase_calls``) when the run starts and puts them
+    back at its end; ``totals`` maps each phase to its seconds, ``steps`` counts the steps.
+    Without a PhaseTimer the phases run unwrapped.
     """
 
     def __init__(self) -> None:
         self.totals: dict[str, float] = {}
         self.steps = 0
+        self._unwrapped: tuple[Callable[..., Any], ...] = ()
 
     def start(self, sim: RunView) -> None:
         self.totals = dict.fromkeys(sim.PHASES, 0.0)
         self.steps = 0
-        for name in sim.PHASES:
-            setattr(sim, name, self._timed(name, getattr(sim, name)))
+        self._unwrapped = calls = sim.phase_calls
+        sim.phase_calls = tuple(self._timed(name, call) for name, call in zip(sim.PHASES, calls))
 
     def _timed(self, name: str, phase):
         clock, totals = time.perf_counter, self.totals
@@ -153,5 +159,4 @@ class PhaseTimer(StepObserver):
         self.steps += 1
 
     def end(self, sim: RunView) -> None:
-        for name in sim.PHASES:
-            vars(sim).pop(name, None)
+        sim.phase_calls = self._unwrapped

@@ -67,6 +67,8 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from mypy_extensions import mypyc_attr
+
 from eoam_sumo.colours import OUTCOMES
 from eoam_sumo.params import PONR_FRACTION
 from eoam_sumo.sim.bodies import Body
@@ -140,6 +142,7 @@ def role_of(
     return "other"
 
 
+@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True)
 class OutcomeSettings:
     """Thresholds that turn the end state of a run into the facts the colours need."""
@@ -174,6 +177,7 @@ class OutcomeSettings:
             )
 
 
+@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True)
 class Outcome:
     """Colour of a run, what was hit, how fast, and a one-line reason."""

@@ -48,6 +48,8 @@ from dataclasses import dataclass, replace
 from operator import attrgetter
 from typing import NamedTuple, Protocol
 
+from mypy_extensions import mypyc_attr
+
 from eoam_sumo.sim.bodies import Body
 from eoam_sumo.sim.coasting import Coaster
 from eoam_sumo.sim.geometry import OrientedBox, slab_entry
@@ -75,6 +77,7 @@ class RoadProjection(Protocol):
         ...
 
 
+@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True)
 class RadarSettings:
     """Radar coverage and the classification thresholds (reasons at the module constants)."""

@@ -24,6 +24,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from mypy_extensions import mypyc_attr
+
 from eoam_sumo.sim.bodies import Body
 from eoam_sumo.sim.geometry import Contact, OrientedBox, contact, face_overlap
 
@@ -54,6 +56,7 @@ def impact_angle_rad(yaw_self_rad: float, yaw_other_rad: float) -> float:
     return abs(math.remainder(yaw_other_rad - yaw_self_rad, math.tau))
 
 
+@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True)
 class ContactRecord:
     """The first contact of a run: the contact, the role of the road user hit, when, the road
@@ -68,6 +71,7 @@ class ContactRecord:
     other_box: OrientedBox
 
 
+@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True)
 class Severity:
     """How hard and how squarely the ego hit: ``overlap`` the share of the ego's face hit that
