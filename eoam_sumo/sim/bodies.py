@@ -16,7 +16,7 @@ its navigation angle (degrees clockwise from north); :func:`yaw_rad` and
 from __future__ import annotations
 
 import math
-from collections import namedtuple
+from typing import NamedTuple
 
 from mypy_extensions import mypyc_attr
 
@@ -24,9 +24,20 @@ from eoam_sumo.sim.geometry import OrientedBox
 
 PEDESTRIAN = "pedestrian"  # SUMO's vClass of persons
 
-_BodyFields = namedtuple(
-    "_BodyFields", "vid vclass x_m y_m yaw_rad speed_mps length_m width_m parked box"
-)  # untyped: introspection sees Body's own constructor, without ``box``
+class _BodyFields(NamedTuple):
+    """Body's fields, typed so that compiled code reads them as floats (hypothesis' ``builds``
+    would ask for every field: build bodies with the constructor)."""
+
+    vid: str
+    vclass: str
+    x_m: float
+    y_m: float
+    yaw_rad: float
+    speed_mps: float
+    length_m: float
+    width_m: float
+    parked: bool
+    box: OrientedBox
 
 
 @mypyc_attr(native_class=False)  # a tuple subclass: a Python class when compiled too

@@ -32,8 +32,8 @@ Contact rules (the paper's colours, sec. 11, need the faces and the kind of the 
 from __future__ import annotations
 
 import math
-from collections import namedtuple
 from dataclasses import dataclass
+from typing import NamedTuple
 
 from mypy_extensions import mypyc_attr
 
@@ -51,12 +51,20 @@ FACES = ("front", "rear", "left", "right")
 CONTACT_KINDS = ("head_on", "rear_end", "side", "oblique")
 
 
-# untyped on purpose: introspection (help, hypothesis' builds) then sees OrientedBox's own
-# five-argument constructor rather than ten tuple fields
-_BoxFields = namedtuple(
-    "_BoxFields",
-    "x_m y_m yaw_rad length_m width_m cos_yaw sin_yaw half_length_m half_width_m radius_m",
-)
+class _BoxFields(NamedTuple):
+    """OrientedBox's fields, typed so that compiled code reads them as floats (hypothesis'
+    ``builds`` would ask for every field: build boxes with the constructor)."""
+
+    x_m: float
+    y_m: float
+    yaw_rad: float
+    length_m: float
+    width_m: float
+    cos_yaw: float
+    sin_yaw: float
+    half_length_m: float
+    half_width_m: float
+    radius_m: float
 
 
 @mypyc_attr(native_class=False)  # a tuple subclass: a Python class when compiled too

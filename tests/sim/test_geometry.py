@@ -203,7 +203,8 @@ coord = st.floats(-8.0, 8.0, allow_nan=False)
 yaw = st.floats(-math.pi, math.pi, allow_nan=False)
 length = st.floats(0.5, 6.0, allow_nan=False)
 width = st.floats(0.5, 2.5, allow_nan=False)
-boxes = st.builds(OrientedBox, coord, coord, yaw, length, width)
+# built through the constructor (st.builds would ask for all ten typed tuple fields)
+boxes = st.tuples(coord, coord, yaw, length, width).map(lambda a: OrientedBox(*a))
 
 
 def _moved(box: OrientedBox, rot: float, tx: float, ty: float) -> OrientedBox:

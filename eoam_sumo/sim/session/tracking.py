@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from typing import Any
 
 from eoam_sumo.sim.bodies import PEDESTRIAN, Body
 
@@ -172,28 +173,33 @@ class RoadUsers:
                   for vid in veh.getIDList() if vid != self.ego_id]
         return bodies + self._persons_near(0.0, 0.0, math.inf)
 
-    def _vehicles_near(self, results: dict, ex: float, ey: float, radius_m: float) -> list:
+    def _vehicles_near(self, results: dict[str, dict[int, Any]], ex: float, ey: float,
+                       radius_m: float) -> list:
         """Bodies of the vehicles of ``results`` (this step's context) within reach of
-        (ex, ey); a vehicle whose values did not change keeps its body."""
+        (ex, ey); a vehicle whose values did not change keeps its body. (The values are typed
+        so that the compiled module works out the reach in floats.)"""
         near: list[Body] = []
         bodies, kept = self._bodies, {}
         types, type_of, tc, veh = self._types, self.type_of, self._tc, self._veh
-        pos_k, type_k = tc.VAR_POSITION, tc.VAR_TYPE
+        pos_k: int = tc.VAR_POSITION
+        type_k: int = tc.VAR_TYPE
         angle_k, speed_k, stop_k = tc.VAR_ANGLE, tc.VAR_SPEED, tc.VAR_STOPSTATE
         getters = self._getters
         for vid, r in results.items():
-            fx, fy = r[pos_k]
-            t = types.get(r[type_k]) or type_of(r[type_k])
+            front: tuple[float, float] = r[pos_k]
+            fx, fy = front
+            type_id: str = r[type_k]
+            t = types.get(type_id) or type_of(type_id)
             reach_m = radius_m + t[3]
             if (fx - ex) * (fx - ex) + (fy - ey) * (fy - ey) > reach_m * reach_m:
                 continue
             if vid == self.ego_id:
                 continue
             if getters:
-                values = (r[pos_k], veh.getAngle(vid), veh.getSpeed(vid), r[type_k],
+                values = (front, veh.getAngle(vid), veh.getSpeed(vid), type_id,
                           veh.getStopState(vid))
             else:
-                values = (r[pos_k], r[angle_k], r[speed_k], r[type_k], r[stop_k])
+                values = (front, r[angle_k], r[speed_k], type_id, r[stop_k])
             known = bodies.get(vid)
             if known is None or known[0] != values:
                 known = (values, self.vehicle_body(vid, *values))
