@@ -77,16 +77,17 @@ class Budget(NamedTuple):
     margin_m: float  # lateral margin to the oncoming path
     margin_s: float  # time margin before the fronts meet
     return_mps2: float  # lateral budget of the shift back after an arrest
+    arrest_min_mps: float  # the least lateral speed away from the lane centre arrested
 
     @classmethod
     def of(cls, params, settings, mu: float, brake_mps2: float) -> Budget:
         """From the ego's ``VehicleParams``, the ``EoamSettings`` and the friction."""
         mu_g, st = mu * G_MPS2, settings
-        back_g = st.arrest_return_g if st.arrest_first else st.evasive_lateral_g
+        arrest_min = st.arrest_min_speed_mps if st.arrest_first else math.inf
         return cls(st.evasive_lateral_g * mu_g, st.escape_ramp_s, st.escape_lag_s, brake_mps2,
                    mu_g, params.width_m, params.length_m, params.cg_to_front_bumper_m,
                    st.side_clearance_m, st.pass_margin_m, st.oncoming_margin_m,
-                   st.oncoming_margin_s, back_g * mu_g)
+                   st.oncoming_margin_s, st.arrest_return_g * mu_g, arrest_min)
 
 
 class Option(NamedTuple):
@@ -171,7 +172,7 @@ def predict_abort(lat: Lateral, v_mps: float, obstacle: Tracked | None, oncoming
     escape = _escape(lat, 0.0, v_mps, b)
     start = b.lag_s
     turn = escape.turn_s()
-    if turn > 0.0 and b.return_mps2 != b.lateral_mps2:
+    if turn > 0.0 and abs(lat.v_mps) >= b.arrest_min_mps:  # arrested first, as mode 3 does
         start += turn
         escape = MinTimeShift(escape.state_at(turn)[0], 0.0, 0.0, 0.0, v_mps, b.return_mps2,
                               b.ramp_s)

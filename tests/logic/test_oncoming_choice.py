@@ -29,7 +29,8 @@ MU_G = 0.7 * 9.81
 BUDGET = Budget(lateral_mps2=0.9 * MU_G, ramp_s=0.15, lag_s=0.1, brake_mps2=0.95 * MU_G,
                 mu_g_mps2=MU_G, width_m=1.85, length_m=4.92, cg_to_front_m=3.9,
                 side_clearance_m=0.5,
-                pass_margin_m=1.0, margin_m=0.2, margin_s=0.2, return_mps2=0.9 * MU_G)
+                pass_margin_m=1.0, margin_m=0.2, margin_s=0.2, return_mps2=0.6 * MU_G,
+                arrest_min_mps=0.5)
 LINE = 3.5 - 0.91 - 0.925 - 0.2  # the ego's centre out of the oncoming path [m]
 V = 40.0  # ego speed [m/s]
 
@@ -94,7 +95,9 @@ def test_seeing_the_oncoming_car_later_never_makes_an_option_safer(d, v_lat, gap
 
 def test_choice_is_the_lower_predicted_delta_v():
     lat = Lateral(0.65, 2.4, 5.3)  # early in a lane change at 165 km/h, mu 0.7
-    seen_late = choose(lat, V, standing(31.0), oncoming(99.0), BUDGET, passed=False)
+    # seen 1.74 s before the fronts meet: the abort (arrested, then back at 0.6 mu g) leaves
+    # the oncoming path in time, passing does not
+    seen_late = choose(lat, V, standing(31.0), oncoming(104.0), BUDGET, passed=False)
     assert seen_late.passing.head_on and not seen_late.abort.head_on
     assert not seen_late.pass_on  # a hit on the obstacle is softer than the head-on
     seen_early = choose(lat, V, standing(31.0), oncoming(400.0), BUDGET, passed=False)
