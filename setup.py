@@ -30,6 +30,7 @@ COMPILED = [
     "eoam_sumo/control/longitudinal.py",
     "eoam_sumo/control/paths.py",
     "eoam_sumo/control/steering.py",
+    "eoam_sumo/decision/dmm.py",
     "eoam_sumo/decision/modes.py",
     "eoam_sumo/decision/obstacle.py",
     "eoam_sumo/decision/oncoming.py",
@@ -97,6 +98,9 @@ class BuildCompiled(build_ext):
         in_source = self.inplace or getattr(self, "editable_mode", False)
         package = ROOT / "eoam_sumo" if in_source else Path(self.build_lib) / "eoam_sumo"
         (package / MANIFEST).unlink(missing_ok=True)  # written again once the build is done
+        if in_source:  # no extension module of an earlier build left to shadow its source
+            for ext in package.rglob(f"*{sysconfig.get_config_var('EXT_SUFFIX')}"):
+                ext.unlink()
         if self.extensions:
             try:
                 super().run()
@@ -106,9 +110,6 @@ class BuildCompiled(build_ext):
         if self.extensions:
             record["compiled"] = {rel: hashlib.sha256((ROOT / rel).read_bytes()).hexdigest()
                                   for rel in COMPILED}
-        elif in_source:  # no extension modules of an earlier build left to shadow the sources
-            for ext in package.rglob(f"*{sysconfig.get_config_var('EXT_SUFFIX')}"):
-                ext.unlink()
         if self.extensions or self.failed:
             package.mkdir(parents=True, exist_ok=True)
             (package / MANIFEST).write_text(json.dumps(record, indent=1) + "\n")

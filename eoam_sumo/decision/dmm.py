@@ -43,27 +43,27 @@ class Action(Enum):
 class Sector(Enum):
     """DMM phase-diagram sector (paper Figure 14): value the letter, ``action`` what it asks
     for, ``letter`` the value and ``warns`` whether it raises the forward-collision warning
-    (A-F): plain attributes, read at every step with an obstacle in range."""
+    (A-F): plain attributes (set below), read at every step with an obstacle in range."""
 
     action: Action
     letter: str
     warns: bool
 
-    A = ("A", Action.LIMIT_BRAKE)
-    B = ("B", Action.STEER)
-    C = ("C", Action.BRAKE)
-    D = ("D", Action.BRAKE)
-    E = ("E", Action.FCW)
-    F = ("F", Action.STEER)
-    G = ("G", Action.NONE)
+    A = "A"
+    B = "B"
+    C = "C"
+    D = "D"
+    E = "E"
+    F = "F"
+    G = "G"
 
-    def __new__(cls, letter: str, action: Action):
-        member = object.__new__(cls)
-        member._value_ = letter
-        member.action = action
-        member.letter = letter
-        member.warns = letter != "G"
-        return member
+
+_ACTIONS = {"A": Action.LIMIT_BRAKE, "B": Action.STEER, "C": Action.BRAKE, "D": Action.BRAKE,
+            "E": Action.FCW, "F": Action.STEER, "G": Action.NONE}
+for _sector in Sector:
+    _sector.action = _ACTIONS[_sector.value]
+    _sector.letter = _sector.value
+    _sector.warns = _sector.value != "G"
 
 
 # The members as module names, for the per-step code (as the modes in ``decision.modes``):
