@@ -112,8 +112,11 @@ class CoSimulation:
     #: The phases of a step, in order (``step``); a PhaseTimer times each.
     PHASES: ClassVar[tuple[str, ...]] = ("sense", "decide", "actuate", "write_back",
                                          "check_contact")
-    #: What ``step`` calls for each phase, in that order: the methods of the same names, set by
-    #: ``start`` before the observers start (an observer may wrap them, as PhaseTimer does).
+    #: What ``step`` calls for each phase, in that order, with the simulation first: the class's
+    #: methods of the same names, set by ``start`` before the observers start (an observer may
+    #: wrap them, as PhaseTimer does). Not bound methods: those would make each simulation a
+    #: reference cycle, freed only by a full garbage collection (in a batch worker, after
+    #: hundreds of runs' memory).
     phase_calls: tuple[Callable[..., Any], ...]
     # the run's state, set by ``start`` and the steps
     session: SumoSession
@@ -245,8 +248,9 @@ class CoSimulation:
         self.avoided = AvoidedObstacle()
         self.observers = (self.timeseries, self.extremes, self.traffic, self.margins,
                           self.avoided, *self.extra_observers)
-        self.phase_calls = (self.sense, self.decide, self.actuate, self.write_back,
-                            self.check_contact)
+        cls = type(self)
+        self.phase_calls = (cls.sense, cls.decide, cls.actuate, cls.write_back,
+                            cls.check_contact)
         for obs in self.observers:
             obs.start(self)
         self._after_step = tuple(obs.after_step for obs in self.observers)
@@ -257,11 +261,11 @@ class CoSimulation:
         """One co-simulation step (as highway-env's ``AbstractEnv.step``: named phases in
         order); True when the run is over."""
         sense, decide, actuate, write_back, check_contact = self.phase_calls
-        self.meas, self.perception = meas, perception = sense()
-        self.cmd = cmd = decide(meas, perception)
-        actuate(cmd)
-        write_back()
-        check_contact()
+        self.meas, self.perception = meas, perception = sense(self)
+        self.cmd = cmd = decide(self, meas, perception)
+        actuate(self, cmd)
+        write_back(self)
+        check_contact(self)
         self.n_steps += 1
         for after_step in self._after_step:
             after_step(self)

@@ -25,7 +25,8 @@ class RunView(Protocol):
 
     @property
     def PHASES(self) -> tuple[str, ...]: ...
-    phase_calls: tuple[Callable[..., Any], ...]  # what the step calls for each phase
+    phase_calls: tuple[Callable[..., Any], ...]  # what the step calls for each phase (with
+    # the simulation first)
     @property
     def max_steps(self) -> int: ...  # the time limit in steps
     @property
