@@ -125,8 +125,11 @@ def place_poles(A: np.ndarray, B: np.ndarray, poles) -> np.ndarray:
     return last @ np.linalg.solve(ctrb, phi)
 
 
-#: Gain tables by (vehicle parameters, gains, friction), shared by the runs of a process.
-_GAIN_TABLES: dict[tuple, list[tuple[float, float, float, float]]] = {}
+_Gains = tuple[float, float, float, float]
+#: Gain tables by (vehicle parameters, gains, friction), shared by the runs of a process; a
+#: row (one speed) is placed when first needed: an estimated friction takes many values a run.
+_GAIN_TABLES: dict[tuple, list[_Gains | None]] = {}
+_MAX_GAIN_TABLES = 512  # beyond this many frictions the tables are dropped (memory)
 
 
 class SteeringController:
@@ -167,7 +170,7 @@ class SteeringController:
         n = math.ceil((gains.schedule_max_speed_mps - self._vmin) / gains.schedule_step_mps)
         self._speeds = [self._vmin + i * gains.schedule_step_mps for i in range(n + 1)]
         self._table_mu = math.nan
-        self._table: list[tuple[float, float, float, float]] = []
+        self._table: list[_Gains | None] = []
 
     def natural_freq(self, speed_mps: float, mu: float) -> float:
         """omega = omega_0 mu^p min(1, v / v_full) [rad/s], v floored."""
@@ -194,30 +197,40 @@ class SteeringController:
                                                   p.imag)))
         return np.array(path + body)
 
-    def gains_at(self, speed_mps: float, mu: float) -> tuple[float, float, float, float]:
+    def gains_at(self, speed_mps: float, mu: float) -> _Gains:
         """(k_vy [rad s/m], k_r [rad s/rad], k_psi [rad/rad], k_e [rad/m]) at this speed and
         friction, blended from the gain table."""
         if mu != self._table_mu:
             key = (self._params, self._gains, mu)
-            if key not in _GAIN_TABLES:  # ~50 ms of pole placements: once per process
-                rows = []
-                for v in self._speeds:
-                    A, B = single_track_matrices(self._params, v)
-                    k = place_poles(A, B, self.design_poles(v, mu))
-                    rows.append((float(k[0]), float(k[1]), float(k[2]), float(k[3])))
-                _GAIN_TABLES[key] = rows
+            if key not in _GAIN_TABLES:
+                if len(_GAIN_TABLES) >= _MAX_GAIN_TABLES:
+                    _GAIN_TABLES.clear()
+                _GAIN_TABLES[key] = [None] * len(self._speeds)
             self._table = _GAIN_TABLES[key]
             self._table_mu = mu
         speeds, table = self._speeds, self._table
         j = bisect_right(speeds, speed_mps)
-        if j <= 0:
-            return table[0]
-        if j >= len(speeds):
-            return table[-1]
+        if j <= 0 or j >= len(speeds):  # below or above the table: its end row
+            i = 0 if j <= 0 else len(speeds) - 1
+            end = table[i]
+            return end if end is not None else self._place(i)
         a, b = table[j - 1], table[j]
+        if a is None:
+            a = self._place(j - 1)
+        if b is None:
+            b = self._place(j)
         w = (speed_mps - speeds[j - 1]) / (speeds[j] - speeds[j - 1])
         return (a[0] + w * (b[0] - a[0]), a[1] + w * (b[1] - a[1]), a[2] + w * (b[2] - a[2]),
                 a[3] + w * (b[3] - a[3]))
+
+    def _place(self, i: int) -> _Gains:
+        """Row ``i`` of the gain table at the table's friction (pole placement, ~0.3 ms)."""
+        v = self._speeds[i]
+        A, B = single_track_matrices(self._params, v)
+        k = place_poles(A, B, self.design_poles(v, self._table_mu))
+        row = (float(k[0]), float(k[1]), float(k[2]), float(k[3]))
+        self._table[i] = row
+        return row
 
     def steady_sideslip(self, speed_mps: float, curvature_1pm: float) -> float:
         """Body sideslip angle [rad] of steady cornering on a curvature (linear bicycle model):

@@ -9,6 +9,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from eoam_sumo.control import SteeringController, SteeringGains, understeer_gradient
+from eoam_sumo.control.steering import _GAIN_TABLES, place_poles, single_track_matrices
 from eoam_sumo.eoam_settings import EoamSettings
 from eoam_sumo.params import ego_e_class_sedan
 
@@ -175,3 +176,22 @@ def test_gains_validate():
         SteeringGains(natural_freq_radps=0.0)
     with pytest.raises(ValueError, match="body_damping"):
         SteeringGains(body_damping_ratio=math.nan)
+
+
+def test_gain_rows_are_placed_when_first_needed_and_blend_the_placed_ones():
+    """A friction seen for the first time (an estimate) places the two rows around the speed
+    only, and the gains are those rows' linear blend (the same as a whole table's)."""
+    ctrl = SteeringController(P)
+    mu, v = 0.4321, 20.2
+    k = ctrl.gains_at(v, mu)
+    rows = _GAIN_TABLES[(P, SteeringGains(), mu)]
+    placed = [i for i, row in enumerate(rows) if row is not None]
+    assert len(placed) == 2
+    v0, v1 = (ctrl._speeds[i] for i in placed)
+    assert v0 <= v < v1
+    ends = []
+    for vi in (v0, v1):
+        A, B = single_track_matrices(P, vi)
+        ends.append(place_poles(A, B, ctrl.design_poles(vi, mu)))
+    w = (v - v0) / (v1 - v0)
+    assert k == pytest.approx(tuple(ends[0] + w * (ends[1] - ends[0])), rel=1e-12)
