@@ -32,6 +32,20 @@ def _advance(y: float, v: float, a: float, jerk: float, t: float) -> tuple[float
             a + jerk * t)
 
 
+def _speed_zeros(v: float, a: float, jerk: float, dur: float) -> list[float]:
+    """Times in [0, dur] at which a constant-jerk segment's speed v + a t + j t^2 / 2 is 0."""
+    if jerk != 0.0:
+        disc = a * a - 2.0 * jerk * v
+        if disc < 0.0:
+            return []
+        roots = [(-a + r) / jerk for r in (math.sqrt(disc), -math.sqrt(disc))]
+    elif a != 0.0:
+        roots = [-v / a]
+    else:
+        return []
+    return [t for t in roots if 0.0 <= t <= dur]
+
+
 class MinTimeShift:
     """Jerk-limited time-optimal lateral shift to ``y1_m`` (module doc)."""
 
@@ -148,16 +162,8 @@ class MinTimeShift:
         speed is zero within a segment)."""
         best = self.state_at(0.0)[0]
         for _, dur, y, v, a, j in self._segs:
-            times = [dur]
-            if j != 0.0:  # v + a t + j t^2 / 2 = 0
-                disc = a * a - 2.0 * j * v
-                if disc >= 0.0:
-                    times += [(-a + r) / j for r in (math.sqrt(disc), -math.sqrt(disc))]
-            elif a != 0.0:
-                times.append(-v / a)
-            for t in times:
-                if 0.0 <= t <= dur:
-                    best = max(best, _advance(y, v, a, j, t)[0])
+            for t in [dur, *_speed_zeros(v, a, j, dur)]:
+                best = max(best, _advance(y, v, a, j, t)[0])
         return best
 
     def turn_s(self) -> float:
@@ -167,16 +173,9 @@ class MinTimeShift:
         if v0 * (self.y1_m - self.state_at(0.0)[0]) >= 0.0:
             return 0.0
         for t0, dur, _, v, a, j in self._segs:
-            roots = []
-            if j != 0.0:  # v + a t + j t^2 / 2 = 0
-                disc = a * a - 2.0 * j * v
-                if disc >= 0.0:
-                    roots = [(-a + r) / j for r in (math.sqrt(disc), -math.sqrt(disc))]
-            elif a != 0.0:
-                roots = [-v / a]
-            within = [t for t in roots if 0.0 <= t <= dur]
-            if within:
-                return t0 + min(within)
+            zeros = _speed_zeros(v, a, j, dur)
+            if zeros:
+                return t0 + min(zeros)
         return self.duration_s
 
     def time_within_s(self, line_m: float, below: bool = True) -> float:

@@ -144,19 +144,7 @@ class OrientedBox(_BoxFields):
 
     def nearest_point(self, x_m: float, y_m: float) -> tuple[float, float]:
         """The point of the box (boundary or inside) closest to a world point."""
-        c, s = self.cos_yaw, self.sin_yaw
-        dx, dy = x_m - self.x_m, y_m - self.y_m
-        lx, ly = c * dx + s * dy, -s * dx + c * dy  # to_local, to_world inlined (hot path)
-        hl, hw = self.half_length_m, self.half_width_m
-        if lx > hl:  # clamp to the box (comparisons: min/max calls cost more here)
-            lx = hl
-        elif lx < -hl:
-            lx = -hl
-        if ly > hw:
-            ly = hw
-        elif ly < -hw:
-            ly = -hw
-        return self.x_m + c * lx - s * ly, self.y_m + s * lx + c * ly
+        return _nearest_point(self, x_m, y_m)
 
     def distance_to_point(self, x_m: float, y_m: float) -> float:
         """Euclidean distance from a world point to the box (0 inside)."""
@@ -221,26 +209,30 @@ def gap_lower_bound(a: OrientedBox, b: OrientedBox) -> float:
                abs(dy * bc - dx * bsin) - bhw - ahl * s - ahw * c)
 
 
+def _nearest_point(box: OrientedBox, x_m: float, y_m: float) -> tuple[float, float]:
+    """``OrientedBox.nearest_point`` (a module function: compiled code calls it directly)."""
+    c, s = box.cos_yaw, box.sin_yaw
+    dx, dy = x_m - box.x_m, y_m - box.y_m
+    lx, ly = c * dx + s * dy, -s * dx + c * dy  # to_local, to_world inlined (hot path)
+    hl, hw = box.half_length_m, box.half_width_m
+    if lx > hl:  # clamp to the box (comparisons: min/max calls cost more here)
+        lx = hl
+    elif lx < -hl:
+        lx = -hl
+    if ly > hw:
+        ly = hw
+    elif ly < -hw:
+        ly = -hw
+    return box.x_m + c * lx - s * ly, box.y_m + s * lx + c * ly
+
+
 def _nearest_corner(src: OrientedBox, dst: OrientedBox) -> tuple[float, float, float, float,
                                                                   float]:
     """(distance, x, y of the corner, x, y of its nearest point of dst) of the first corner of
-    ``src`` nearest to ``dst`` (distance inf, zeros if none is finite). ``nearest_point``
-    inlined: the contact check and the margins measure gaps at every step near a body."""
-    c, s = dst.cos_yaw, dst.sin_yaw
-    ox, oy, hl, hw = dst.x_m, dst.y_m, dst.half_length_m, dst.half_width_m
+    ``src`` nearest to ``dst`` (distance inf, zeros if none is finite)."""
     best = (math.inf, 0.0, 0.0, 0.0, 0.0)
     for cx, cy in src.corners():
-        dx, dy = cx - ox, cy - oy
-        lx, ly = c * dx + s * dy, -s * dx + c * dy
-        if lx > hl:
-            lx = hl
-        elif lx < -hl:
-            lx = -hl
-        if ly > hw:
-            ly = hw
-        elif ly < -hw:
-            ly = -hw
-        px, py = ox + c * lx - s * ly, oy + s * lx + c * ly
+        px, py = _nearest_point(dst, cx, cy)
         dist = math.hypot(cx - px, cy - py)
         if dist < best[0]:
             best = (dist, cx, cy, px, py)
