@@ -52,6 +52,8 @@ COMPILED = [
     "eoam_sumo/sim/severity.py",
     "eoam_sumo/sim/trafficlog.py",
     "eoam_sumo/sim/verdict.py",
+    "eoam_sumo/sim/session/calls.py",
+    "eoam_sumo/sim/session/scripts.py",
     "eoam_sumo/sim/session/session.py",
     "eoam_sumo/sim/session/tracking.py",
 ]

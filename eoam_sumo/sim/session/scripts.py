@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from eoam_sumo.params import G_MPS2
+from eoam_sumo.sim.session.calls import StepCalls
 
 SCRIPTED_SPEED_MODE = 25  # safe speed, right of way, red lights; no accel/decel bound
 
@@ -28,8 +29,8 @@ class _Script:
 class StopScripts:
     """The scripted stops of a run: waiting for their vehicle's departure, then running."""
 
-    def __init__(self, api, constants, stops: dict) -> None:
-        self._veh, self._tc = api.vehicle, constants
+    def __init__(self, api, calls: StepCalls, constants, stops: dict) -> None:
+        self._veh, self._calls, self._tc = api.vehicle, calls, constants
         self._stops = stops  # vid -> (hold_s, decel_mps2)
         self.pending = set(stops)  # not yet departed
         self.running: dict[str, _Script] = {}
@@ -46,7 +47,7 @@ class StopScripts:
     def apply(self, t_next_s: float, dt_s: float, results: dict, friction, watch) -> None:
         """Command each running stop's speed at the end of the coming step, ending at
         ``t_next_s`` (``results``: this step's subscription results; ``friction(lane_id)``)."""
-        tc, veh = self._tc, self._veh
+        tc, set_speed = self._tc, self._calls.set_speed
         for vid, script in list(self.running.items()):
             res = results.get(vid)
             if not res:
@@ -60,7 +61,7 @@ class StopScripts:
                 decel = min(script.decel_mps2, script.mu * G_MPS2)
                 cmd = max(0.0, res[tc.VAR_SPEED] - decel * min(dt_s, t_next_s - script.hold_end_s))
             if cmd != script.last_cmd_mps:
-                veh.setSpeed(vid, cmd)
+                set_speed(vid, cmd)
                 script.last_cmd_mps = cmd
             elif cmd == 0.0 and res[tc.VAR_SPEED] == 0.0:
                 # stopped under a standing zero command: every later command is zero too

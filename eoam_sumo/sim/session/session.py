@@ -44,6 +44,7 @@ from eoam_sumo.sim.scenario import (
 )
 from eoam_sumo.sim.scenario.files import float_attr
 from eoam_sumo.sim.scenario.values import number
+from eoam_sumo.sim.session.calls import StepCalls
 from eoam_sumo.sim.session.collisions import CollisionRecord, write_collision_output
 from eoam_sumo.sim.session.gui import GuiSettings, GuiView
 from eoam_sumo.sim.session.handover import SAVE_STATE_OPTIONS, handover_plan, run_and_hand_over
@@ -96,11 +97,13 @@ class SumoSession:
         output = files.options.get("collision-output")
         self.collision_output = files.cfg.parent / output if output else None
         self._veh, self._lane, self._sim = api.vehicle, api.lane, api.simulation
+        self._calls = calls = StepCalls(api)
         self._closed = False
         self._time_s = self._sim.getTime()
         self._mu_cache: dict[str, float] = {}
-        self._scripts = StopScripts(api, constants, scripted_stops(files, overrides, ego_id))
-        self._users = RoadUsers(api, constants, ego_id, self._scripts.running)
+        self._scripts = StopScripts(api, calls, constants,
+                                    scripted_stops(files, overrides, ego_id))
+        self._users = RoadUsers(api, calls, constants, ego_id, self._scripts.running)
         self._radius_m: float | None = None
         self._ego_mu = 1.0
         self._over_limit: dict[str, float] = {}  # vid -> speed of a departure above the limit
@@ -257,13 +260,14 @@ class SumoSession:
         if scripts.running:
             scripts.apply(self._time_s + self._dt, self._dt, users.step_results(),
                           self._friction, users.watch)
-        self._api.simulationStep()
+        calls = self._calls
+        calls.step(0.0)
         users.new_step()
-        self._time_s = self._sim.getTime()
+        self._time_s = calls.time()
         if users.tracking:
             users.track()
         if scripts.pending:
-            for vid in self._sim.getDepartedIDList():
+            for vid in calls.departed_ids():
                 if vid in scripts.pending:
                     scripts.start(vid, users.watch)
 
@@ -336,8 +340,9 @@ class SumoSession:
     ) -> None:
         """Place the ego's front bumper for the next step (keepRoute=2: any lane, even opposite)."""
         self._check_open()
-        self._veh.moveToXY(self.ego_id, "", -1, x_front_m, y_front_m, angle_nav_deg, 2)
-        self._veh.setSpeed(self.ego_id, speed_mps)
+        calls = self._calls
+        calls.move_to_xy(self.ego_id, "", -1, x_front_m, y_front_m, angle_nav_deg, 2)
+        calls.set_speed(self.ego_id, speed_mps)
 
     def nearby(self, radius_m: float) -> list[Body]:
         """Every other road user (vehicles of every class, persons on foot) some part of which

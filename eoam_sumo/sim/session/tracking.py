@@ -31,6 +31,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from eoam_sumo.sim.bodies import PEDESTRIAN, Body
+from eoam_sumo.sim.session.calls import StepCalls
 
 PARKING_BIT = 2  # bit of VAR_STOPSTATE set while a vehicle is parked
 RANGE_MARGIN_M = 1.0  # added to the context subscription's range (rounding in SUMO) [m]
@@ -46,9 +47,10 @@ def _reach2(radius_m: float, body: Body) -> float:
 class RoadUsers:
     """The road users other than the ego, followed through SUMO's subscriptions."""
 
-    def __init__(self, api, constants, ego_id: str, scripted: Mapping) -> None:
-        self._api, self._tc, self.ego_id = api, constants, ego_id
-        self._veh, self._person, self._sim = api.vehicle, api.person, api.simulation
+    def __init__(self, api, calls: StepCalls, constants, ego_id: str,
+                 scripted: Mapping) -> None:
+        self._api, self._calls, self._tc, self.ego_id = api, calls, constants, ego_id
+        self._veh, self._person = api.vehicle, api.person
         self._scripted = scripted  # vid -> its running scripted stop (needs speed and lane)
         self.tracking = False  # the road users are followed (from ``start``)
         self._bodies: dict[str, tuple] = {}  # vid -> (values, Body) of the last step's near
@@ -78,7 +80,7 @@ class RoadUsers:
         """Vehicle id -> its variable-subscription results at this step (the ego and the
         vehicles of running scripted stops; one read a step)."""
         if self._results is None:
-            self._results = self._veh.getAllSubscriptionResults()
+            self._results = self._calls.vehicle_results()
         return self._results
 
     def watch(self, vid: str) -> None:
@@ -105,10 +107,10 @@ class RoadUsers:
 
     def track(self) -> None:
         """Follow the persons that departed in this step, drop those that arrived."""
-        sim = self._sim
-        for pid in sim.getArrivedPersonIDList():
+        calls = self._calls
+        for pid in calls.arrived_person_ids():
             self._persons.pop(pid, None)
-        for pid in sim.getDepartedPersonIDList():
+        for pid in calls.departed_person_ids():
             self._follow_person(pid)
 
     def _context(self, radius_m: float) -> dict:
@@ -116,7 +118,7 @@ class RoadUsers:
         the range set for ``radius_m`` and the vehicle types SUMO has (set anew when either
         changes: a type added later may be longer)."""
         types = self._api.vehicletype
-        n_types = types.getIDCount()
+        n_types = self._calls.type_count()
         if radius_m != self._context_radius_m or n_types != self._n_types:
             diagonal = max((self.type_of(t)[3] for t in types.getIDList()), default=0.0)
             range_m = radius_m + diagonal + RANGE_MARGIN_M
@@ -126,7 +128,7 @@ class RoadUsers:
             self._veh.subscribeContext(self.ego_id, self._tc.CMD_GET_VEHICLE_VARIABLE,
                                        range_m, self._sense_vars)
             self._context_radius_m, self._n_types = radius_m, n_types
-        return self._veh.getContextSubscriptionResults(self.ego_id)
+        return self._calls.context_results(self.ego_id)
 
     # ------------------------------------------------------------------------- bodies
     def type_of(self, type_id: str) -> tuple[float, float, str, float]:
@@ -180,7 +182,7 @@ class RoadUsers:
         so that the compiled module works out the reach in floats.)"""
         near: list[Body] = []
         bodies, kept = self._bodies, {}
-        types, type_of, tc, veh = self._types, self.type_of, self._tc, self._veh
+        types, type_of, tc, calls = self._types, self.type_of, self._tc, self._calls
         pos_k: int = tc.VAR_POSITION
         type_k: int = tc.VAR_TYPE
         angle_k, speed_k, stop_k = tc.VAR_ANGLE, tc.VAR_SPEED, tc.VAR_STOPSTATE
@@ -196,8 +198,8 @@ class RoadUsers:
             if vid == self.ego_id:
                 continue
             if getters:
-                values = (front, veh.getAngle(vid), veh.getSpeed(vid), type_id,
-                          veh.getStopState(vid))
+                values = (front, calls.angle(vid), calls.speed(vid), type_id,
+                          calls.stop_state(vid))
             else:
                 values = (front, r[angle_k], r[speed_k], type_id, r[stop_k])
             known = bodies.get(vid)
@@ -211,7 +213,7 @@ class RoadUsers:
     def _persons_near(self, ex: float, ey: float, radius_m: float) -> list:
         """Bodies of the persons on foot within reach (as in :meth:`near`) of (ex, ey)."""
         if self._person_results is None:
-            self._person_results = self._person.getAllSubscriptionResults()
+            self._person_results = self._calls.person_results()
         results, tc = self._person_results, self._tc
         near = []
         for pid, known in self._persons.items():
