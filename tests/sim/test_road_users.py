@@ -104,3 +104,26 @@ def test_a_person_who_arrives_is_dropped(tmp_path, monkeypatch):
         for _ in range(500):  # 1.5 m at up to 1.39 m/s: arrived within 5 s
             s.step()
         assert s.nearby(50.0) == [] and s.road_users() == []
+
+
+def test_a_long_vehicle_that_departs_later_is_found_by_its_reach(tmp_path, monkeypatch):
+    """The context range grows with the longest vehicle SUMO has: a 60 m road train departing
+    after following began, its front 75 m ahead of the ego's (beyond a 20 m radius plus any
+    car's diagonal, within its own), is nearby at its first step, as SUMO's getters say."""
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    cfg = on_highway(
+        tmp_path, '<routes><vType id="train" vClass="truck" length="60" width="2.5"/>'
+        '<route id="east" edges="E0"/>'
+        '<vehicle id="ego" type="ego" route="east" depart="0" departPos="100" '
+        'departSpeed="0"/>'
+        '<vehicle id="long" type="train" route="east" depart="2" departLane="0" '
+        'departPos="175" departSpeed="0"/></routes>')
+    with SumoSession.start(cfg, ScenarioOverrides()) as s:
+        assert s.nearby(20.0) == []
+        while "long" not in s.vehicle_ids():
+            s.step()
+            s.move_ego(100.0, -1.75, 90.0, 0.0)
+        fx, fy, _angle, _speed = _sumo_truth(s, "long")
+        ex, ey, _a, _v = _sumo_truth(s, "ego")
+        assert 20.0 + 2 * math.hypot(2.5, 0.9) < math.hypot(fx - ex, fy - ey) < 20.0 + 60.0
+        assert [b.vid for b in s.nearby(20.0)] == ["long"]

@@ -52,4 +52,3 @@ class StepCalls:
         self.context_results: Callable[..., Any] = bind("vehicle",
                                                         "getContextSubscriptionResults")
         self.person_results: Callable[..., Any] = bind("person", "getAllSubscriptionResults")
-        self.type_count: Callable[..., Any] = bind("vehicletype", "getIDCount")

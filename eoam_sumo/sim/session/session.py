@@ -264,12 +264,14 @@ class SumoSession:
         calls.step(0.0)
         users.new_step()
         self._time_s = calls.time()
-        if users.tracking:
-            users.track()
-        if scripts.pending:
-            for vid in calls.departed_ids():
-                if vid in scripts.pending:
-                    scripts.start(vid, users.watch)
+        if users.tracking or scripts.pending:
+            departed = calls.departed_ids()
+            if users.tracking:
+                users.track(departed)
+            if scripts.pending:
+                for vid in departed:
+                    if vid in scripts.pending:
+                        scripts.start(vid, users.watch)
 
     def step(self) -> None:
         """Advance SUMO by one step."""

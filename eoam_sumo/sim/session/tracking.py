@@ -3,16 +3,20 @@
 From :meth:`RoadUsers.start` on, the vehicles around the ego are found through one context
 subscription on the ego (SUMO collects those whose front is within the range, parked ones
 included; one ``getContextSubscriptionResults`` a step), its range the sensing radius plus the
-largest diagonal of any vehicle type, so that every vehicle some part of which may be within
-the radius is in it. Persons are subscribed one by one (a person riding in a vehicle is not a
-road user of its own). A road user whose values did not change since the last step is the
-same :class:`Body` object as then; a body is built only for a road user within reach.
+largest diagonal of the vehicles SUMO has had since (each departing vehicle's type is read),
+so that every vehicle some part of which may be within the radius is in it. (The largest
+diagonal of every type SUMO knows would count SUMO's 135 m default rail type: a range of 236
+m instead of 107 m for a 100 m radius, and as many more vehicles for SUMO to collect and the
+binding to convert each step.) Persons are subscribed one by one (a person riding in a
+vehicle is not a road user of its own). A road user whose values did not change since the
+last step is the same :class:`Body` object as then; a body is built only for a road user
+within reach.
 
 Through libsumo the context subscription carries the position and type only (the type gives
 each vehicle's reach), and the angle, speed and stop state of the vehicles within reach are
 read with getters: a subscribed value costs SUMO's step and the binding's conversion more than
-a getter does, and the vehicles beyond reach (the range allows for SUMO's 135 m default rail
-type) are not read at all. Instructions of the step loop (callgrind): 2.8 % fewer in the
+a getter does, and the vehicles beyond reach (the range allows for the longest vehicle) are
+not read at all. Instructions of the step loop (callgrind): 2.8 % fewer in the
 benchmark's baseline case, 2.4 % in its traffic case. Through TraCI every getter is a round
 trip, so all five values are subscribed.
 
@@ -55,7 +59,8 @@ class RoadUsers:
         self.tracking = False  # the road users are followed (from ``start``)
         self._bodies: dict[str, tuple] = {}  # vid -> (values, Body) of the last step's near
         self._context_radius_m: float | None = None  # radius the context range was set for
-        self._n_types = 0  # vehicle types SUMO had when the context range was set
+        self._context_diagonal_m = 0.0  # the vehicles' largest diagonal it was set for
+        self._diagonal_m = 0.0  # largest diagonal of the vehicles SUMO has had (``start`` on)
         self._persons: dict[str, tuple | None] = {}  # pid -> (results, front, Body) once read
         # type -> length, width, vClass, diagonal (twice the box's bounding radius)
         self._types: dict[str, tuple[float, float, str, float]] = {}
@@ -97,16 +102,27 @@ class RoadUsers:
         self.tracking = True
         self._veh.subscribe(self.ego_id, [*self.ego_vars, self._tc.VAR_POSITION])
         self._results = None  # re-read: this step's cached results lack the ego's position
+        self._vehicles_in(self._veh.getIDList())
         for pid in self._person.getIDList():
             self._follow_person(pid)
+
+    def _vehicles_in(self, vids) -> None:
+        """Vehicles ``vids`` are in SUMO now: the largest diagonal of the types of the
+        vehicles SUMO has had since following began grows with theirs."""
+        type_id = self._veh.getTypeID
+        for vid in vids:
+            self._diagonal_m = max(self._diagonal_m, self.type_of(type_id(vid))[3])
 
     def _follow_person(self, pid: str) -> None:
         self._persons[pid] = None
         self._person.subscribe(pid, self._person_vars)
         self._person_results = None
 
-    def track(self) -> None:
-        """Follow the persons that departed in this step, drop those that arrived."""
+    def track(self, departed) -> None:
+        """Vehicles ``departed`` in this step (:meth:`_vehicles_in`); follow the persons that
+        departed, drop those that arrived."""
+        if departed:
+            self._vehicles_in(departed)
         calls = self._calls
         for pid in calls.arrived_person_ids():
             self._persons.pop(pid, None)
@@ -115,19 +131,17 @@ class RoadUsers:
 
     def _context(self, radius_m: float) -> dict:
         """This step's context subscription results (vid -> values; the ego's among them),
-        the range set for ``radius_m`` and the vehicle types SUMO has (set anew when either
-        changes: a type added later may be longer)."""
-        types = self._api.vehicletype
-        n_types = self._calls.type_count()
-        if radius_m != self._context_radius_m or n_types != self._n_types:
-            diagonal = max((self.type_of(t)[3] for t in types.getIDList()), default=0.0)
+        its range ``radius_m`` plus the largest diagonal of the vehicles SUMO has had (set
+        anew when either changes: a longer vehicle may depart)."""
+        diagonal = self._diagonal_m
+        if radius_m != self._context_radius_m or diagonal != self._context_diagonal_m:
             range_m = radius_m + diagonal + RANGE_MARGIN_M
             if self._context_radius_m is not None:
                 self._veh.unsubscribeContext(self.ego_id, self._tc.CMD_GET_VEHICLE_VARIABLE,
                                              0.0)
             self._veh.subscribeContext(self.ego_id, self._tc.CMD_GET_VEHICLE_VARIABLE,
                                        range_m, self._sense_vars)
-            self._context_radius_m, self._n_types = radius_m, n_types
+            self._context_radius_m, self._context_diagonal_m = radius_m, diagonal
         return self._calls.context_results(self.ego_id)
 
     # ------------------------------------------------------------------------- bodies
