@@ -1,15 +1,20 @@
 """The fast online plant: all sub-steps of a co-simulation step in one compiled C call.
 
-The compiled library (``codegen.py``) is called through ``ctypes`` with pre-allocated ctypes
-buffers: about 1 us of Python overhead per call, against ~45 us for calling the same
-library through ``casadi.external``. Without a working C compiler the same SX function runs
-on CasADi's virtual machine (identical arithmetic, slower) and a ``RuntimeWarning`` says so.
+Where Python's headers are installed, ``advance`` is the ``advance`` of the same C code built
+as a Python extension module (``codegen.extension_source``): floats in and lists out in C.
+Otherwise the compiled library (``codegen.py``) is called through ``ctypes`` with
+pre-allocated ctypes buffers: about 1 us of Python overhead per call more, against ~45 us for
+calling the same library through ``casadi.external``. Without a working C compiler the same SX
+function runs on CasADi's virtual machine (identical arithmetic, slower) and a
+``RuntimeWarning`` says so.
 """
 
 from __future__ import annotations
 
 import ctypes
 import functools
+import importlib.machinery
+import importlib.util
 import warnings
 from pathlib import Path
 
@@ -17,11 +22,14 @@ import numpy as np
 
 from eoam_sumo.params import VehicleParams
 from eoam_sumo.plant.codegen import (
+    EXTENSION_NAME,
     FUNCTION_NAME,
     build_library,
     c_source,
     default_cache_dir,
+    extension_source,
     find_compiler,
+    python_include,
     step_function,
 )
 from eoam_sumo.plant.model import INPUT_NAMES, OUTPUT_NAMES, STATE_NAMES
@@ -46,6 +54,32 @@ def _load_library(path: str):
     fn.argtypes = [ctypes.c_void_p] * 4 + [ctypes.c_int]
     fn.restype = ctypes.c_int
     return lib, fn, tuple(s.value for s in sizes)
+
+
+@functools.lru_cache(maxsize=16)
+def _load_extension(path: str):
+    """The ``advance`` of a compiled extension module (``codegen.extension_source``)."""
+    loader = importlib.machinery.ExtensionFileLoader(EXTENSION_NAME, path)
+    spec = importlib.util.spec_from_file_location(EXTENSION_NAME, path, loader=loader)
+    if spec is None:
+        raise ImportError(f"cannot load {path}")
+    module = importlib.util.module_from_spec(spec)
+    loader.exec_module(module)
+    return module.advance
+
+
+def _extension_advance(params, dt_s, substeps, cache_dir):
+    """``advance`` of the step built as a Python extension module, or None where Python's
+    headers are missing or the build fails (``Plant.advance`` then calls through ctypes)."""
+    include, compiler = python_include(), find_compiler()
+    if include is None or compiler is None:
+        return None
+    source = extension_source(c_source(step_function(params, dt_s, substeps)), _NX, _NU, _NY)
+    try:
+        path = build_library(source, cache_dir, compiler, (f"-I{include}",), EXTENSION_NAME)
+        return _load_extension(str(path))
+    except (OSError, RuntimeError, ImportError):
+        return None
 
 
 def _compiled_library(params, dt_s, substeps, cache_dir) -> str | None:
@@ -119,6 +153,9 @@ class Plant:
             *map(ctypes.addressof, (self._arg, self._res, self._iw, self._w)),
             0,
         )
+        extension = _extension_advance(params, self.dt_s, substeps, self._cache_dir)
+        if extension is not None:
+            self.advance = extension  # type: ignore[method-assign]  # the same, in C
 
     @property
     def backend(self) -> str:

@@ -6,9 +6,11 @@ import threading
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from eoam_sumo.plant import OUTPUT_NAMES, Plant, ReferencePlant, initial_state
-from eoam_sumo.plant.codegen import build_library, find_compiler
+from eoam_sumo.plant.codegen import build_library, find_compiler, python_include
 
 FRONT_LOCKED = OUTPUT_NAMES.index("front_locked")
 
@@ -142,3 +144,32 @@ def test_bad_step_inputs_are_rejected(plant, params):
         initial_state(0.0, 0.0, 0.0, -1.0)
     with pytest.raises(ValueError, match="steer_lag_s"):
         ReferencePlant(params.__class__(steer_lag_s=0.0))
+
+
+finite = st.floats(-1e4, 1e4, allow_nan=False)
+
+
+@settings(max_examples=300, deadline=None)
+@given(x=st.lists(finite, min_size=9, max_size=9), u=st.tuples(finite, finite, finite),
+       mu=st.floats(0.01, 1.5))
+def test_the_extension_module_steps_as_the_ctypes_call_does(plant, x, u, mu):
+    """Where Python's headers are installed, ``advance`` is the extension module's: the same
+    C step, so the same numbers to the last bit as through ctypes, NaNs in the same places."""
+    assert python_include() is not None  # this machine has them: the extension is used
+    assert type(plant.advance).__name__ == "builtin_function_or_method"
+    through_ctypes = Plant.advance.__get__(plant)
+    got, want = plant.advance(x, u, mu), through_ctypes(x, u, mu)
+    assert np.array_equal(got[0], want[0], equal_nan=True)
+    assert np.array_equal(got[1], want[1], equal_nan=True)
+    assert all(type(v) is float for v in got[0] + got[1])
+
+
+def test_without_python_headers_the_plant_steps_through_ctypes(params, plant_cache_dir,
+                                                                monkeypatch):
+    from eoam_sumo.plant import compiled
+
+    monkeypatch.setattr(compiled, "python_include", lambda: None)
+    plain = Plant(params, cache_dir=plant_cache_dir)
+    assert plain.backend == "compiled-c" and "advance" not in vars(plain)
+    x = initial_state(0.0, 0.0, 0.0, 20.0)
+    assert plain.advance(x, (0.01, 0.0, 0.0), 0.8)[0][0] > 0.0
