@@ -48,6 +48,7 @@ class StepCalls:
         self.angle: Callable[..., Any] = bind("vehicle", "getAngle")
         self.speed: Callable[..., Any] = bind("vehicle", "getSpeed")
         self.stop_state: Callable[..., Any] = bind("vehicle", "getStopState")
+        self.type_id: Callable[..., Any] = bind("vehicle", "getTypeID")
         self.vehicle_results: Callable[..., Any] = bind("vehicle", "getAllSubscriptionResults")
         self.context_results: Callable[..., Any] = bind("vehicle",
                                                         "getContextSubscriptionResults")
