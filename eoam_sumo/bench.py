@@ -10,6 +10,11 @@ Figures:
 - ``batch_wall_s`` / ``batch_cases`` / ``jobs``: the Table 2 batch with 2 jobs;
 - per-step costs of decision + control and of the plant, plant sub-steps per second;
 - ``peak_rss_mb`` of one ``eoam-sumo run`` in its own process;
+- ``floor_over_sumo_cost``: the least the co-simulation step can cost over SUMO alone's, on
+  the same scenario: only the SUMO calls a step makes (the ego written back, SUMO's step with
+  the subscriptions, their results, the getters of the vehicles around the ego) and the plant's
+  C step, none of the sensing, decision, control, contact check or logging (median of paired
+  runs, as the cost ratio);
 - ``compiled``: whether the step loop ran compiled (setup.py) or from the Python sources;
 - the traffic case (``traffic_scenario``: 3 lanes each way, the ego departing at 120 s behind a
   broken-down car, SUMO's step 0.5 s before that): ``traffic_vehicles`` in SUMO at the ego's
@@ -111,6 +116,46 @@ def _sumo_only_rate(sim_time_s: float, step_s: float) -> float:
         return steps * step_s / (time.perf_counter() - t0)
     finally:
         session.close()
+
+
+def _floor_over_sumo(repeats: int, steps: int = 903) -> float:
+    """``floor_over_sumo_cost`` (module doc): a straight drive at the bench's speed, each run
+    paired with SUMO alone for as many steps right after it."""
+    import libsumo
+
+    from eoam_sumo.params import ego_e_class_sedan
+    from eoam_sumo.plant import Plant
+    from eoam_sumo.sim.scenario import ScenarioOverrides
+    from eoam_sumo.sim.session import SumoSession
+    from eoam_sumo.sim.session.calls import StepCalls
+
+    over = ScenarioOverrides(ego_speed_mps=SPEED_MPS, mu=1.0)
+    advance = Plant(ego_e_class_sedan()).advance
+    calls, u = StepCalls(libsumo), (0.0, 300.0, 0.0)
+    ratios = []
+    for _ in range(repeats):
+        session = SumoSession.start(BASELINE, over)
+        try:
+            ego = session.ego_id
+            session.nearby(100.0)  # the step's subscriptions, as the co-simulation sets them
+            body = session.ego_body()  # heading east (nav angle 90)
+            x = [body.x_m, body.y_m, 0.0, SPEED_MPS, 0.0, 0.0, 0.0, 300.0, 0.0]
+            t0 = time.perf_counter()
+            for _k in range(steps):
+                x, _y = advance(x, u, 1.0)
+                calls.move_to_xy(ego, "", -1, x[0] + 0.5 * body.length_m, x[1], 90.0, 2)
+                calls.set_speed(ego, SPEED_MPS)
+                calls.step(0.0)
+                calls.vehicle_results()
+                for vid in calls.context_results(ego):
+                    if vid != ego:
+                        calls.type_id(vid), calls.angle(vid), calls.speed(vid)
+                        calls.stop_state(vid)
+            floor_s = time.perf_counter() - t0
+        finally:
+            session.close()
+        ratios.append(floor_s / (steps * 0.01 / _sumo_only_rate(steps * 0.01, 0.01)))
+    return statistics.median(ratios)
 
 
 class _LoopCpu(StepObserver):
@@ -222,6 +267,7 @@ def run_bench(out_dir: Path, quick: bool = False) -> dict:
         result: dict[str, Any] = {"quick": quick, "jobs": 2, "compiled": native.compiled()}
         result["peak_rss_mb"] = _peak_rss_mb(tmp / "rss")
         result.update(_cosim_and_sumo_only(repeats))
+        result["floor_over_sumo_cost"] = _floor_over_sumo(repeats)
         result.update(_traffic(tmp, quick))
         result["tables_wall_s"] = _tables(tmp / "tables", quick)
         result["batch_wall_s"], result["batch_cases"] = _batch(tmp, quick)
