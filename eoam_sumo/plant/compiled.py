@@ -57,6 +57,13 @@ def _load_library(path: str):
 
 
 @functools.lru_cache(maxsize=16)
+def _source(params, dt_s, substeps) -> str:
+    """The step's C source (CasADi's code generation takes about 3 ms; a batch worker builds a
+    plant for every case)."""
+    return c_source(step_function(params, dt_s, substeps))
+
+
+@functools.lru_cache(maxsize=16)
 def _load_extension(path: str):
     """The ``advance`` of a compiled extension module (``codegen.extension_source``)."""
     loader = importlib.machinery.ExtensionFileLoader(EXTENSION_NAME, path)
@@ -74,7 +81,7 @@ def _extension_advance(params, dt_s, substeps, cache_dir):
     include, compiler = python_include(), find_compiler()
     if include is None or compiler is None:
         return None
-    source = extension_source(c_source(step_function(params, dt_s, substeps)), _NX, _NU, _NY)
+    source = extension_source(_source(params, dt_s, substeps), _NX, _NU, _NY)
     try:
         path = build_library(source, cache_dir, compiler, (f"-I{include}",), EXTENSION_NAME)
         return _load_extension(str(path))
@@ -93,7 +100,7 @@ def _compiled_library(params, dt_s, substeps, cache_dir) -> str | None:
         )
         return None
     try:
-        source = c_source(step_function(params, dt_s, substeps))
+        source = _source(params, dt_s, substeps)
         return str(build_library(source, cache_dir, compiler))
     except (OSError, RuntimeError) as err:
         warnings.warn(

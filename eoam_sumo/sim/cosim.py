@@ -139,7 +139,7 @@ class CoSimulation:
         self.settings = settings = settings or RunSettings()
         self.params = params or ego_e_class_sedan()
         tables_dir = settings.tables_dir or default_tables_dir()
-        self.tables = LookupTables.load(tables_dir, params=self.params)
+        self.tables = LookupTables.cached(tables_dir, params=self.params)
         # refuse what the tables do not cover before starting SUMO (checked again at the start)
         self.tables.check_run(
             overrides.mu if overrides.mu is not None else self.tables.mu_grid[-1],
