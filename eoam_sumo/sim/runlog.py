@@ -45,6 +45,7 @@ class RunLog:
         self.n = 0
         self._col = {c: i for i, c in enumerate(COLUMNS)}
         self._array: np.ndarray | None = None
+        self._columns: dict[str, np.ndarray] = {}  # columns read before the whole table
 
     def add(self, meas, x, cmd, perception, mu) -> None:
         """Log the ego at ``meas`` (an ``EgoMeasurement``) with its plant state ``x`` (copied),
@@ -60,6 +61,8 @@ class RunLog:
         self._rows[self.n] = (meas, tuple(x), cmd, perception, mu)
         self.n += 1
         self._array = None
+        if self._columns:
+            self._columns = {}
 
     def array(self) -> np.ndarray:
         """(n, len(COLUMNS)) float array of the rows logged so far."""
@@ -68,7 +71,13 @@ class RunLog:
         return self._array
 
     def column(self, name: str) -> np.ndarray:
-        return self.array()[:, self._col[name]]
+        """One column, without laying out the others while the whole table is not needed."""
+        if self._array is not None:
+            return self._array[:, self._col[name]]
+        col = self._columns.get(name)
+        if col is None:
+            col = self._columns[name] = _column(self._rows[: self.n], name)
+        return col
 
     def max_abs(self, name: str) -> float:
         col = self.column(name)
@@ -115,32 +124,32 @@ _ROAD_MU = "mu"  # the road's friction under the ego
 
 def _table(rows: list) -> np.ndarray:
     """The (n, len(COLUMNS)) float array of logged steps, each column filled by name."""
-    n = len(rows)
-    out = np.full((n, len(COLUMNS)), _NAN)
-    if not n:
-        return out
-    col = {c: i for i, c in enumerate(COLUMNS)}
-    states = np.array([r[1] for r in rows], dtype=float)
-    for name, k in _FROM_STATE.items():
-        out[:, col[name]] = states[:, k]
-    get = attrgetter(*_FROM_MEAS.values())
-    meas = np.array([get(r[0]) for r in rows], dtype=float)
-    for k, name in enumerate(_FROM_MEAS):
-        out[:, col[name]] = meas[:, k]
-    with_cmd = [i for i, r in enumerate(rows) if r[2] is not None]
-    if with_cmd:
-        get = attrgetter(*_FROM_CMD.values())
-        cmds = np.array([get(rows[i][2]) for i in with_cmd], dtype=float)
-        for k, name in enumerate(_FROM_CMD):
-            out[with_cmd, col[name]] = cmds[:, k]
-        out[with_cmd, col[_SECTOR]] = [
-            float(ord(rows[i][2].sector)) if rows[i][2].sector else _NAN for i in with_cmd]
-    out[:, col[_ROAD_MU]] = [r[4] for r in rows]
-    for name, field in _FROM_PERCEPTION.items():
-        out[:, col[name]] = [
-            _NAN if r[3] is None or getattr(r[3], field) is None else getattr(r[3], field)
-            for r in rows]
+    out = np.full((len(rows), len(COLUMNS)), _NAN)
+    for i, name in enumerate(COLUMNS):
+        out[:, i] = _column(rows, name)
     return out
+
+
+def _column(rows: list, name: str) -> np.ndarray:
+    """One column of the logged steps (``_table``'s, without the rest: a run's summary reads
+    four of the 34)."""
+    if name in _FROM_STATE:
+        k = _FROM_STATE[name]
+        return np.array([r[1][k] for r in rows], dtype=float)
+    if name in _FROM_MEAS:
+        get = attrgetter(_FROM_MEAS[name])
+        return np.array([get(r[0]) for r in rows], dtype=float)
+    if name in _FROM_CMD:
+        get = attrgetter(_FROM_CMD[name])
+        return np.array([_NAN if r[2] is None else get(r[2]) for r in rows], dtype=float)
+    if name == _SECTOR:
+        return np.array([float(ord(r[2].sector)) if r[2] is not None and r[2].sector
+                         else _NAN for r in rows], dtype=float)
+    if name == _ROAD_MU:
+        return np.array([r[4] for r in rows], dtype=float)
+    field = _FROM_PERCEPTION[name]
+    return np.array([_NAN if r[3] is None or getattr(r[3], field) is None
+                     else getattr(r[3], field) for r in rows], dtype=float)
 
 
 def read_timeseries(path: Path, columns: list[str] | None = None):

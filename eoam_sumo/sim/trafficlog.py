@@ -98,7 +98,34 @@ class TrafficLog(StepObserver):
 
     def had_role(self, role: str) -> bool:
         """Some road user had ``role`` at some logged step."""
+        if role == "oncoming" and self._columns is None:
+            return self._had_oncoming()
         return role in self.columns()["role"]
+
+    def _had_oncoming(self) -> bool:
+        """``had_role("oncoming")`` without laying the log out (a run's summary asks it of
+        every run, written or not): the rows ``_roles`` would judge (the road users within
+        the radius, not parked), walked as it walks them (by id, in time order, the road
+        frame placed at each one's first row), until one is oncoming."""
+        r2 = self._r2
+        rows: dict[str, list] = {}
+        for _ti, ex, ey, _yaw, _vx, bodies in self._steps:
+            for b in bodies:
+                if ((b.x_m - ex) * (b.x_m - ex) + (b.y_m - ey) * (b.y_m - ey) <= r2
+                        and not b.parked):
+                    rows.setdefault(b.vid, []).append(b)
+        if not rows:
+            return False
+        road = RoadFrame(self._centreline)
+        band = 0.5 * self._lane_width + LANE_MARGIN_M
+        for vid in sorted(rows):
+            first = rows[vid][0]
+            road.locate(first.x_m, first.y_m)
+            for b in rows[vid]:
+                _s, d, road_yaw = road.project(b.x_m, b.y_m)
+                if b.speed_mps * math.cos(b.yaw_rad - road_yaw) < -ONCOMING_SPEED_MPS and d > -band:
+                    return True
+        return False
 
     def columns(self) -> dict:
         """The log as columns (TRAFFIC_COLUMNS order): numpy arrays, and lists of str for

@@ -7,6 +7,8 @@ import math
 from collections import namedtuple
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.sim.trafficlog import TRAFFIC_COLUMNS, TrafficLog, read_traffic
@@ -132,3 +134,26 @@ def test_read_traffic_names_a_damaged_file(tmp_path):
 def test_bad_radius_is_refused():
     with pytest.raises(ValueError, match="radius_m"):
         _log(radius_m=0.0)
+
+
+CURVE = [(200.0 * math.sin(a / 20), 200.0 * (1 - math.cos(a / 20)) - 1.75) for a in range(40)]
+coord = st.floats(-250.0, 250.0, allow_nan=False)
+users = st.lists(st.builds(
+    User, vid=st.sampled_from(["a", "b", "c", "z"]), vclass=st.just("passenger"), x_m=coord,
+    y_m=coord, yaw_rad=st.floats(-4.0, 4.0), speed_mps=st.floats(0.0, 40.0), length_m=st.just(4.5),
+    width_m=st.just(1.8), parked=st.booleans()), max_size=4, unique_by=lambda u: u.vid)
+
+
+@settings(max_examples=200, deadline=None)
+@given(steps=st.lists(st.tuples(coord, coord, users), min_size=1, max_size=6),
+       curved=st.booleans())
+def test_had_oncoming_without_the_layout_is_the_layout_s_answer(steps, curved):
+    """The summary's shortcut (no rows laid out) answers as the roles column does, on a
+    straight and a curved lane (where a road-frame walk depends on where it starts)."""
+    log = TrafficLog("ego", "passenger", EGO_LEN, EGO_WID, TO_CENTRE, CURVE if curved else LANE,
+                     3.5, 150.0)
+    for k, (x, y, near) in enumerate(steps):
+        log.add(0.01 * k, _ego(x, y), near)
+    fast = log.had_role("oncoming")
+    assert fast == ("oncoming" in log.columns()["role"])
+    assert log.had_role("oncoming") == fast  # the laid-out answer, asked again
