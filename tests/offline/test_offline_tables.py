@@ -230,3 +230,25 @@ def test_default_tables_dir_env_override(monkeypatch, tmp_path):
     assert default_tables_dir() == tmp_path
     monkeypatch.delenv("EOAM_TABLES_DIR")
     assert (default_tables_dir() / "phase_boundaries.csv").is_file()
+
+
+def test_cached_tables_are_read_again_when_a_file_changes(tmp_path):
+    """A batch worker keeps the tables it read while their files are unchanged; a rebuilt
+    file (another size or modification time) is read again, and the kept arrays are
+    read-only (shared by every run of the process)."""
+    import os
+
+    folder = tmp_path / "tables"
+    shutil.copytree(default_tables_dir(), folder)
+    first = LookupTables.cached(folder)
+    assert LookupTables.cached(folder) is first
+    with pytest.raises(ValueError, match="read-only"):
+        first.length_m[0, 0] = 1.0
+    npz = folder / "lookup_tables.npz"
+    stat = npz.stat()
+    os.utime(npz, ns=(stat.st_atime_ns, stat.st_mtime_ns + 1_000_000_000))
+    again = LookupTables.cached(folder)
+    assert again is not first and np.array_equal(again.length_m, first.length_m)
+    (folder / "metadata.json").unlink()
+    with pytest.raises(InputError, match="metadata"):
+        LookupTables.cached(folder)
