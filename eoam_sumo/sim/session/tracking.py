@@ -7,10 +7,11 @@ largest diagonal of the vehicles SUMO has had since (each departing vehicle's ty
 so that every vehicle some part of which may be within the radius is in it. (The largest
 diagonal of every type SUMO knows would count SUMO's 135 m default rail type: a range of 236
 m instead of 107 m for a 100 m radius, and as many more vehicles for SUMO to collect and the
-binding to convert each step.) Persons are subscribed one by one (a person riding in a
-vehicle is not a road user of its own). A road user whose values did not change since the
-last step is the same :class:`Body` object as then; a body is built only for a road user
-within reach.
+binding to convert each step. A vehicle switched to a longer type after it departed, through
+TraCI's ``setType``, is counted with its departure type: it is found once its front is within
+the range.) Persons are subscribed one by one (a person riding in a vehicle is not a road user
+of its own). A road user whose values did not change since the last step is the same
+:class:`Body` object as then; a body is built only for a road user within reach.
 
 Through libsumo the context subscription carries the position only; the type of each vehicle
 in it (its reach) and the angle, speed and stop state of those within reach are read with
