@@ -70,8 +70,12 @@ class BuildCompiled(build_ext):
     failed: str | None = None  # why the build is pure Python, if it failed
 
     def _pure(self, reason: str, failed: bool = True) -> None:
-        warnings.warn(f"eoam-sumo installs as pure Python ({reason}): results are the same, "
-                      "the step loop slower", RuntimeWarning, stacklevel=2)
+        warnings.warn(
+            f"eoam-sumo installs as pure Python ({reason}): results are the same, "
+            "the step loop slower",
+            RuntimeWarning,
+            stacklevel=2,
+        )
         self.extensions = []
         if failed:
             self.failed = reason
@@ -110,13 +114,16 @@ class BuildCompiled(build_ext):
                 self._pure(f"compiling failed: {err}")
         record: dict = {"compiled": {}, "failed": self.failed}
         if self.extensions:
-            record["compiled"] = {rel: hashlib.sha256((ROOT / rel).read_bytes()).hexdigest()
-                                  for rel in COMPILED}
+            record["compiled"] = {
+                rel: hashlib.sha256((ROOT / rel).read_bytes()).hexdigest() for rel in COMPILED
+            }
         if self.extensions or self.failed:
             package.mkdir(parents=True, exist_ok=True)
             (package / MANIFEST).write_text(json.dumps(record, indent=1) + "\n")
 
 
 # a placeholder, so that setuptools runs build_ext, which puts the real extensions in its place
-setup(ext_modules=[Extension(f"{GROUP}_placeholder", sources=[])],
-      cmdclass={"build_ext": BuildCompiled})
+setup(
+    ext_modules=[Extension(f"{GROUP}_placeholder", sources=[])],
+    cmdclass={"build_ext": BuildCompiled},
+)

@@ -71,10 +71,15 @@ def _cosim_and_sumo_only(repeats: int) -> dict:
     runs, sumo_rates = [], []
     for _ in range(repeats):
         summary, _log = sim.run()
-        prof = {"sense": timer.totals["sense"], "control": timer.totals["decide"],
-                "plant": timer.totals["actuate"], "sumo": timer.totals["write_back"],
-                "contact": timer.totals["check_contact"], "loop_wall_s": sim.loop_wall_s,
-                "steps": timer.steps}
+        prof = {
+            "sense": timer.totals["sense"],
+            "control": timer.totals["decide"],
+            "plant": timer.totals["actuate"],
+            "sumo": timer.totals["write_back"],
+            "contact": timer.totals["check_contact"],
+            "loop_wall_s": sim.loop_wall_s,
+            "steps": timer.steps,
+        }
         prof["sim_time_s"] = summary["sim_time_s"]
         prof["wall_time_s"] = summary["wall_time_s"]
         runs.append(prof)
@@ -192,8 +197,15 @@ def _traffic(tmp: Path, quick: bool) -> dict:
     cosim_wall_s = time.perf_counter() - t0
     depart_step = round(depart_s / 0.01)
     steps = depart_step + max(1, round(summary["sim_time_s"] / 0.01))
-    cmd, _ = sumo_command(sumolib.checkBinary("sumo"), cfg, check_scenario(cfg).options, 0.01,
-                          tmp / "traffic-errors.log", (), False)
+    cmd, _ = sumo_command(
+        sumolib.checkBinary("sumo"),
+        cfg,
+        check_scenario(cfg).options,
+        0.01,
+        tmp / "traffic-errors.log",
+        (),
+        False,
+    )
     t0 = time.perf_counter()
     libsumo.start(cmd)
     try:
@@ -214,15 +226,27 @@ def _traffic(tmp: Path, quick: bool) -> dict:
         "traffic_sumo_only_wall_s": sumo_only_wall_s,
         "traffic_cosim_over_sumo_only": cosim_wall_s / sumo_only_wall_s,
         "traffic_cosim_sim_time_s": summary["sim_time_s"],
-        "traffic_us_per_user_step":
-            1e6 * (loop_cpu.cpu_s - sumo_cpu_s) / (manoeuvre_steps * max(1, vehicles)),
+        "traffic_us_per_user_step": 1e6
+        * (loop_cpu.cpu_s - sumo_cpu_s)
+        / (manoeuvre_steps * max(1, vehicles)),
     }
 
 
 def _peak_rss_mb(out_dir: Path) -> float:
     """Peak resident memory of one ``eoam-sumo run`` (its own process, from wait4)."""
-    cmd = [sys.executable, "-m", "eoam_sumo", "run", str(BASELINE), "--speed-kmh", "120",
-           "--mu", "1.0", "--out", str(out_dir)]
+    cmd = [
+        sys.executable,
+        "-m",
+        "eoam_sumo",
+        "run",
+        str(BASELINE),
+        "--speed-kmh",
+        "120",
+        "--mu",
+        "1.0",
+        "--out",
+        str(out_dir),
+    ]
     err = out_dir.with_suffix(".stderr")
     with open(err, "wb") as sink:  # a file, not a pipe: a full pipe would block the child
         proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=sink)
@@ -281,11 +305,16 @@ def run_bench(out_dir: Path, quick: bool = False) -> dict:
 
 
 def format_table(result: dict) -> str:
-    rows = [(k, v) for k, v in result.items()
-            if isinstance(v, (int, float)) and k not in ("quick", "compiled")]
+    rows = [
+        (k, v)
+        for k, v in result.items()
+        if isinstance(v, (int, float)) and k not in ("quick", "compiled")
+    ]
     width = max(len(k) for k, _ in rows)
-    lines = [f"step loop: {'compiled' if result['compiled'] else 'Python sources'}",
-             f"{'figure':<{width}}  value        target"]
+    lines = [
+        f"step loop: {'compiled' if result['compiled'] else 'Python sources'}",
+        f"{'figure':<{width}}  value        target",
+    ]
     for k, v in rows:
         tgt = result["targets"].get(k)
         mark = "" if tgt is None else f"{tgt['target']:<9} {'met' if tgt['met'] else 'MISSED'}"

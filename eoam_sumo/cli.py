@@ -106,50 +106,89 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("cfg", type=Path, help="the scenario's .sumocfg")
     p.add_argument("--speed-kmh", type=_speed_kmh, help="ego initial speed (km/h)")
     p.add_argument("--mu", type=_mu, help="surface friction for every lane")
-    p.add_argument("--oncoming-m", type=_distance_or_none, default=None,
-                   help="add an oncoming car this far ahead (m), or 'none'")
+    p.add_argument(
+        "--oncoming-m",
+        type=_distance_or_none,
+        default=None,
+        help="add an oncoming car this far ahead (m), or 'none'",
+    )
     p.add_argument("--ego", default="ego", help="the ego vehicle's id (default: ego)")
     p.add_argument("--out", type=Path, default=Path("out/run"), help="output folder")
-    p.add_argument("--max-time-s", type=_finite, default=DEFAULT_MAX_TIME_S,
-                   help="simulated time limit")
+    p.add_argument(
+        "--max-time-s", type=_finite, default=DEFAULT_MAX_TIME_S, help="simulated time limit"
+    )
     p.add_argument("--tables", type=Path, help="lookup tables folder (default: tables/)")
     p.add_argument("--radar-range-m", type=_finite, help="ego radar range (default 100 m)")
-    p.add_argument("--mu-belief", default="known",
-                   help="friction the EOAM decides with: known (the road's), estimate (a "
-                   "friction estimator's output) or a number (default: known)")
-    p.add_argument("--radar-model", default="ideal",
-                   help="ideal (exact, every step) or automotive (noise, misses, latency, "
-                   "occlusion, tracker; docs/sensing.md)")
+    p.add_argument(
+        "--mu-belief",
+        default="known",
+        help="friction the EOAM decides with: known (the road's), estimate (a "
+        "friction estimator's output) or a number (default: known)",
+    )
+    p.add_argument(
+        "--radar-model",
+        default="ideal",
+        help="ideal (exact, every step) or automotive (noise, misses, latency, "
+        "occlusion, tracker; docs/sensing.md)",
+    )
     p.add_argument("--seed", type=_seed, default=0, help="seed of every random model (0)")
     p.add_argument("--gui", action="store_true", help="run in sumo-gui through TraCI")
-    p.add_argument("--policy", choices=("paper", "safe"), default="paper",
-                   help="decision policy: the paper's (default) or safe (sight-distance gate)")
-    p.add_argument("--v2x-range-m", type=_finite, default=0.0,
-                   help="V2X reception range (m), 0 = no V2X (safe policy only)")
+    p.add_argument(
+        "--policy",
+        choices=("paper", "safe"),
+        default="paper",
+        help="decision policy: the paper's (default) or safe (sight-distance gate)",
+    )
+    p.add_argument(
+        "--v2x-range-m",
+        type=_finite,
+        default=0.0,
+        help="V2X reception range (m), 0 = no V2X (safe policy only)",
+    )
     p.add_argument("--v2x-latency-s", type=_finite, default=0.1, help="V2X latency (s)")
-    p.add_argument("--v2x-loss", type=_finite, default=0.0,
-                   help="V2X packet-loss probability, in [0, 1)")
-    p.add_argument("--v2x-penetration", type=_finite, default=1.0,
-                   help="share of road users equipped with V2X, in [0, 1]")
-    p.add_argument("--gui-delay-ms", type=_finite, metavar="N",
-                   help="with --gui: wall ms per SUMO step (default: real time)")
-    p.add_argument("--gui-screenshot", type=_seconds_list, metavar="T[,T...]", default=(),
-                   help="with --gui: screenshots at these simulation times (s) into --out")
+    p.add_argument(
+        "--v2x-loss", type=_finite, default=0.0, help="V2X packet-loss probability, in [0, 1)"
+    )
+    p.add_argument(
+        "--v2x-penetration",
+        type=_finite,
+        default=1.0,
+        help="share of road users equipped with V2X, in [0, 1]",
+    )
+    p.add_argument(
+        "--gui-delay-ms",
+        type=_finite,
+        metavar="N",
+        help="with --gui: wall ms per SUMO step (default: real time)",
+    )
+    p.add_argument(
+        "--gui-screenshot",
+        type=_seconds_list,
+        metavar="T[,T...]",
+        default=(),
+        help="with --gui: screenshots at these simulation times (s) into --out",
+    )
 
     p = sub.add_parser(
-        "batch", help="run every case of an experiment matrix",
+        "batch",
+        help="run every case of an experiment matrix",
         description="Run every case of an experiment matrix. Exit status: 0 every case ran; "
         "1 at least one case failed (results.csv and the report are still written, the "
         "failed count is the last line on stderr); 2 bad input, found before any case runs "
-        "(the matrix, its scenario files, a speed or friction outside the lookup tables).")
+        "(the matrix, its scenario files, a speed or friction outside the lookup tables).",
+    )
     p.add_argument("matrix", type=Path, help="experiment matrix (.toml)")
     p.add_argument("--out", type=Path, default=Path("out/batch"), help="output folder")
     p.add_argument("--jobs", type=_positive_int, default=1, help="parallel processes")
     p.add_argument("--scheduler", help="Dask scheduler address, or 'local' for a LocalCluster")
     p.add_argument("--resume", action="store_true", help="run only the cases not yet done")
     p.add_argument("--timeout-s", type=_finite, default=300.0, help="per-case time limit")
-    p.add_argument("--timeseries", choices=("csv", "parquet", "none"), default="csv",
-                   help="per-case time series format, or none (summary.json only)")
+    p.add_argument(
+        "--timeseries",
+        choices=("csv", "parquet", "none"),
+        default="csv",
+        help="per-case time series format, or none (summary.json only)",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
     p = sub.add_parser("plot", help="plots of a run, a batch or a tables folder")
@@ -157,10 +196,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, help="where to put the PNGs (default: the folder)")
 
     p = sub.add_parser("animate", help="animated bird's-eye view of a run folder")
-    p.add_argument("run_dir", type=Path, help="a run folder (summary.json, timeseries.csv, "
-                   "traffic.csv)")
-    p.add_argument("--out", type=Path, help="GIF, or MP4 with ffmpeg (default: "
-                   "RUN_DIR/animation.gif)")
+    p.add_argument(
+        "run_dir", type=Path, help="a run folder (summary.json, timeseries.csv, traffic.csv)"
+    )
+    p.add_argument(
+        "--out", type=Path, help="GIF, or MP4 with ffmpeg (default: RUN_DIR/animation.gif)"
+    )
     p.add_argument("--fps", type=_positive_int, default=10, help="frames per second of run time")
 
     p = sub.add_parser("bench", help="the performance benchmark")
@@ -184,8 +225,9 @@ def _cmd_tables(args) -> int:
     from eoam_sumo.offline.build import build_tables
 
     out = _writable_dir(args.out)
-    build_tables(out, jobs=args.jobs, speeds_kmh=args.speeds_kmh, mus=args.mu,
-                 progress=not args.no_progress)
+    build_tables(
+        out, jobs=args.jobs, speeds_kmh=args.speeds_kmh, mus=args.mu, progress=not args.no_progress
+    )
     print(f"tables written to {out}")
     return 0
 
@@ -208,23 +250,35 @@ def _cmd_run(args) -> int:
     if not args.gui and (args.gui_delay_ms is not None or args.gui_screenshot):
         raise InputError("--gui-delay-ms and --gui-screenshot need --gui")
     out = _writable_dir(args.out)
-    gui = GuiSettings(delay_ms=args.gui_delay_ms, screenshots_s=args.gui_screenshot,
-                      screenshot_dir=out)
+    gui = GuiSettings(
+        delay_ms=args.gui_delay_ms, screenshots_s=args.gui_screenshot, screenshot_dir=out
+    )
     overrides = ScenarioOverrides(
         ego_speed_mps=None if args.speed_kmh is None else args.speed_kmh / 3.6,
         mu=args.mu,
         oncoming_start_m=args.oncoming_m,
     )
     settings = RunSettings(
-        max_time_s=args.max_time_s, ego_id=args.ego, gui=args.gui, use_traci=args.gui,
+        max_time_s=args.max_time_s,
+        ego_id=args.ego,
+        gui=args.gui,
+        use_traci=args.gui,
         gui_settings=gui,
-        tables_dir=args.tables, mu_belief=parse_mu_belief(args.mu_belief), seed=args.seed,
+        tables_dir=args.tables,
+        mu_belief=parse_mu_belief(args.mu_belief),
+        seed=args.seed,
         radar_model=parse_radar_model(args.radar_model),
     )
     if args.radar_range_m is not None:
         settings = replace(settings, radar=RadarSettings(range_m=args.radar_range_m))
-    settings = policy_settings(settings, args.policy, args.v2x_range_m, args.v2x_latency_s,
-                               args.v2x_loss, args.v2x_penetration)
+    settings = policy_settings(
+        settings,
+        args.policy,
+        args.v2x_range_m,
+        args.v2x_latency_s,
+        args.v2x_loss,
+        args.v2x_penetration,
+    )
     s = run_case(args.cfg, overrides, out, settings)
     print(
         f"{s['outcome']}: collision_with={s['collision_with']} "
@@ -261,8 +315,10 @@ def _sight_text(summary: dict) -> str:
         return ""
     need = summary["sight_needed_m"]
     need_text = "never passes" if need is None else f"{need:.0f} m"
-    return (f"gate={summary['sight_gate']} (needed {need_text}, known free "
-            f"{summary['sight_known_free_m']:.0f} m) ")
+    return (
+        f"gate={summary['sight_gate']} (needed {need_text}, known free "
+        f"{summary['sight_known_free_m']:.0f} m) "
+    )
 
 
 def _cmd_batch(args) -> int:
@@ -295,8 +351,12 @@ def _cmd_bench(args) -> int:
 
 
 _COMMANDS = {
-    "tables": _cmd_tables, "run": _cmd_run, "batch": _cmd_batch,
-    "plot": _cmd_plot, "animate": _cmd_animate, "bench": _cmd_bench,
+    "tables": _cmd_tables,
+    "run": _cmd_run,
+    "batch": _cmd_batch,
+    "plot": _cmd_plot,
+    "animate": _cmd_animate,
+    "bench": _cmd_bench,
 }
 
 

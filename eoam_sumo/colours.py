@@ -10,12 +10,24 @@ OUTCOMES = ("none", "green", "yellow", "orange", "red", "unfinished")
 FAILED = "failed"
 #: Plot colour of each outcome; grey for none, dark grey for a failed case.
 HEX = {
-    "green": "#43a047", "yellow": "#fdd835", "orange": "#fb8c00", "red": "#e53935",
-    "none": "#bdbdbd", "unfinished": "#8e24aa", FAILED: "#616161",
+    "green": "#43a047",
+    "yellow": "#fdd835",
+    "orange": "#fb8c00",
+    "red": "#e53935",
+    "none": "#bdbdbd",
+    "unfinished": "#8e24aa",
+    FAILED: "#616161",
 }
 #: Markdown marker of each outcome.
-MARKERS = {"green": "🟩", "yellow": "🟨", "orange": "🟧", "red": "🟥", "none": "⬜",
-           "unfinished": "🟪", FAILED: "⚠️"}
+MARKERS = {
+    "green": "🟩",
+    "yellow": "🟨",
+    "orange": "🟧",
+    "red": "🟥",
+    "none": "⬜",
+    "unfinished": "🟪",
+    FAILED: "⚠️",
+}
 #: Paper sec. 11 colour definitions, shortened (the table legend).
 LEGEND = {
     "green": "lane change completed without collision and back in lane (or stopped, no contact)",

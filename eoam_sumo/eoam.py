@@ -61,8 +61,14 @@ from eoam_sumo.eoam_settings import EoamSettings
 from eoam_sumo.params import G_MPS2, VehicleParams
 
 _new = tuple.__new__  # builds the per-step Command without its Python-level constructor
-__all__ = ["Command", "EgoMeasurement", "EoamController", "EoamSettings", "ObjectState",
-           "Perception"]
+__all__ = [
+    "Command",
+    "EgoMeasurement",
+    "EoamController",
+    "EoamSettings",
+    "ObjectState",
+    "Perception",
+]
 
 _WARNING_MODES = (UPDATE_BRAKE, UPDATE_STEER_BRAKE, ONCOMING_BRAKE, ONCOMING_STEER_BRAKE)  # FCW
 _STEERING = (UPDATE_STEER_BRAKE, ONCOMING_STEER_BRAKE)
@@ -89,8 +95,11 @@ class EoamController:
         self._brake_mu = math.nan
         self._brake_limit = 0.0
         self._initial_speed: float | None = None
-        self.policy = (SafePolicy(params, tables, settings, settings.policy)
-                       if settings.policy.name == "safe" else None)
+        self.policy = (
+            SafePolicy(params, tables, settings, settings.policy)
+            if settings.policy.name == "safe"
+            else None
+        )
         self._reset_state()
 
     # ----------------------------------------------------------------------------- lifecycle
@@ -148,8 +157,9 @@ class EoamController:
         else:
             self._shift_to(0.0, meas, self.settings.return_lateral_g)
 
-    def _escape_to(self, target_m: float, meas: EgoMeasurement,
-                   lateral_g: float | None = None) -> None:
+    def _escape_to(
+        self, target_m: float, meas: EgoMeasurement, lateral_g: float | None = None
+    ) -> None:
         """An evasive shift to ``target_m`` within ``lateral_g`` (default
         ``evasive_lateral_g``) mu g: time-optimal (``MinTimeShift``) with
         ``min_time_escapes``, else the shortest quintic."""
@@ -167,8 +177,14 @@ class EoamController:
         path curvature) to ``target_m`` within ``lateral_g`` mu g that does not pass it."""
         slope, kappa, speed = course_state(meas)
         traj = QuinticShift.for_lateral_accel(
-            meas.d_m, slope, target_m, speed, lateral_g * meas.mu * G_MPS2,
-            self.settings.return_min_length_m, kappa)
+            meas.d_m,
+            slope,
+            target_m,
+            speed,
+            lateral_g * meas.mu * G_MPS2,
+            self.settings.return_min_length_m,
+            kappa,
+        )
         self._start_path(meas, traj, meas.d_m, None)
 
     def _lateral_stop(self, meas: EgoMeasurement) -> QuinticShift:
@@ -176,8 +192,14 @@ class EoamController:
         ``evasive_lateral_g`` mu g; it ends where the lateral motion stops."""
         slope, kappa, speed = course_state(meas)
         return QuinticShift.stopping(
-            meas.d_m, slope, speed, self.settings.evasive_lateral_g * meas.mu * G_MPS2,
-            self.settings.return_min_length_m, kappa, self.settings.lateral_reaction_s)
+            meas.d_m,
+            slope,
+            speed,
+            self.settings.evasive_lateral_g * meas.mu * G_MPS2,
+            self.settings.return_min_length_m,
+            kappa,
+            self.settings.lateral_reaction_s,
+        )
 
     def _passing_offset_m(self, meas: EgoMeasurement) -> float:
         """Mode 4's target: just far enough left to pass the obstacle with ``side_clearance_m``
@@ -188,10 +210,14 @@ class EoamController:
         need = left_edge + 0.5 * self.params.width_m + self.settings.side_clearance_m
         return max(min(need, meas.lane_width_m), meas.d_m)
 
-    def _start_path(self, meas: EgoMeasurement, traj, start: float, height: float | None
-                    ) -> None:
-        self._path = PathReference(traj, start_offset_m=start, height_m=height,
-                                   speed_mps=meas.vx_mps, step_m=self.settings.reference_step_m)
+    def _start_path(self, meas: EgoMeasurement, traj, start: float, height: float | None) -> None:
+        self._path = PathReference(
+            traj,
+            start_offset_m=start,
+            height_m=height,
+            speed_mps=meas.vx_mps,
+            step_m=self.settings.reference_step_m,
+        )
         self._s0 = meas.s_m
         self._settle_since = None
         self._long.reset()
@@ -216,8 +242,11 @@ class EoamController:
             # friction ellipse leaves
             self._stop_path = None
             v_lat = lateral_state(meas)[0]
-            if (self.settings.arrest_first and v_lat * meas.d_m > 0.0
-                    and abs(v_lat) >= self.settings.arrest_min_speed_mps):
+            if (
+                self.settings.arrest_first
+                and v_lat * meas.d_m > 0.0
+                and abs(v_lat) >= self.settings.arrest_min_speed_mps
+            ):
                 self._arrest = math.copysign(1.0, v_lat)
                 self._path = None
             else:
@@ -247,11 +276,21 @@ class EoamController:
         decel = self._decel.decel_mps2 if st.obstacle_decel_in_dmm else 0.0
         if decel < 0.0:
             decel = 0.0
-        track = ObstacleTrack.sensed(meas, self._front_offset_m, range_m,
-                                     closing_mps, obj, st.unknown_obstacle_length_m, decel)
+        track = ObstacleTrack.sensed(
+            meas,
+            self._front_offset_m,
+            range_m,
+            closing_mps,
+            obj,
+            st.unknown_obstacle_length_m,
+            decel,
+        )
         last = self._obstacle
-        if (last is None or self.mode not in _STEERING
-                or abs(track.front_s_m - last.at(meas.time_s)[0]) <= st.track_gate_m):
+        if (
+            last is None
+            or self.mode not in _STEERING
+            or abs(track.front_s_m - last.at(meas.time_s)[0]) <= st.track_gate_m
+        ):
             self._obstacle = track
 
     def _clear_of_obstacle(self, meas: EgoMeasurement, path, dx_m: float) -> bool:
@@ -266,14 +305,14 @@ class EoamController:
         ego_rear_s = meas.s_m - self.params.cg_to_rear_bumper_m
         return ego_rear_s - front_s >= self.settings.pass_margin_m
 
-    def _commits(self, meas: EgoMeasurement, perception: Perception, travel: float,
-                 height: float) -> bool:
+    def _commits(
+        self, meas: EgoMeasurement, perception: Perception, travel: float, height: float
+    ) -> bool:
         """Oncoming traffic seen in mode 2: pass on (True) or abort (mode 3). With
         ``compare_outcomes`` and tracks of it and of the obstacle, the option of lower
         predicted delta-v (``decision.oncoming``); else the point of no return."""
         onc = perception.oncoming_object
-        if not (self.settings.compare_outcomes and onc is not None
-                and self._obstacle is not None):
+        if not (self.settings.compare_outcomes and onc is not None and self._obstacle is not None):
             return self._past_ponr(meas, travel, height)
         self._stop_path = None
         self.oncoming_choice = commit_choice(meas, onc, self._obstacle, self._budget(meas.mu))
@@ -335,9 +374,11 @@ class EoamController:
             if action is STEER:
                 if v < st.min_steer_speed_mps:
                     action = BRAKE  # too slow for a lane change: braking needs less room
-                elif (self.mode is UPDATE_BRAKE
-                      and rng > self._curve.at(closing).stop_m
-                      and stop_range > self._curve.at(v).stop_m):
+                elif (
+                    self.mode is UPDATE_BRAKE
+                    and rng > self._curve.at(closing).stop_m
+                    and stop_range > self._curve.at(v).stop_m
+                ):
                     action = BRAKE  # braking already stops short of it: no lane change
                 elif not meas.left_lane_available:
                     action = LIMIT_BRAKE  # no lane to change into: brake in lane
@@ -356,7 +397,8 @@ class EoamController:
             closing_c = -perception.coasted_range_rate_mps
             vc = max(v, closing_c)
             near = coasted_m <= 0.5 * vc * vc * self._mass / self._brake_limit + (
-                st.coasted_margin_m)
+                st.coasted_margin_m
+            )
             if near or closing_c > -st.release_opening_speed_mps:
                 threat_gone = False
             if near and action is NONE:
@@ -367,8 +409,8 @@ class EoamController:
             oncoming = True  # the lane change would end against a standing car: as deadly
         policy = self.policy
         if policy is not None and policy.blocks(
-                meas, perception, action is STEER and self.mode in _COMMITTING,
-                self.mode in _WATCHING):
+            meas, perception, action is STEER and self.mode in _COMMITTING, self.mode in _WATCHING
+        ):
             oncoming = True  # the next lane is not known free (safe policy): as oncoming
 
         # ---- mode machine --------------------------------------------------------------
@@ -396,10 +438,18 @@ class EoamController:
             and abs(d - path.start_offset_m - height) <= st.arrive_tolerance_m
             and abs(wrap_angle(meas.e_yaw_rad)) <= st.settle_heading_rad
         )
-        past_ponr = (oncoming and mode is UPDATE_STEER_BRAKE
-                     and self._commits(meas, perception, travel, height))
-        if (past_ponr and oncoming and mode is UPDATE_STEER_BRAKE and policy is not None
-                and policy.prefer_braking(meas, perception)):
+        past_ponr = (
+            oncoming
+            and mode is UPDATE_STEER_BRAKE
+            and self._commits(meas, perception, travel, height)
+        )
+        if (
+            past_ponr
+            and oncoming
+            and mode is UPDATE_STEER_BRAKE
+            and policy is not None
+            and policy.prefer_braking(meas, perception)
+        ):
             past_ponr = False  # severity tie-breaker: braking in lane ends softer
         new = next_mode(
             mode,
@@ -420,8 +470,12 @@ class EoamController:
         elif self._arrest and lateral_state(meas)[0] * self._arrest <= 0.0:
             self._arrest = 0.0  # lateral motion arrested: back to the lane centre
             self._escape_to(0.0, meas, st.arrest_return_g)
-        elif (mode is ONCOMING_BRAKE and path is not None and dx >= path.length_m
-              and self._stop_path is not None):
+        elif (
+            mode is ONCOMING_BRAKE
+            and path is not None
+            and dx >= path.length_m
+            and self._stop_path is not None
+        ):
             # lateral motion arrested: back to the lane centre while braking on
             self._stop_path = None
             self._shift_to(0.0, meas, st.evasive_lateral_g)
@@ -448,13 +502,21 @@ class EoamController:
                 kappa_ff = path.at(dx + v * st.preview_time_s).curvature_1pm
         if self._arrest:  # the most lateral force against the motion the envelope allows
             y_ref, e_lat, fb, yd, e_la = d, 0.0, 0.0, 0.0, 0.0
-            delta = ff = steer.envelope_edge(v, meas.yaw_rate_radps, meas.vy_mps, mu,
-                                             -self._arrest)
+            delta = ff = steer.envelope_edge(v, meas.yaw_rate_radps, meas.vy_mps, mu, -self._arrest)
         else:
             e_lat = d - y_ref
             delta, ff, fb, yd, e_la = steer.command(
-                v, meas.yaw_rate_radps, meas.vy_mps, e_lat, wrap_angle(meas.e_yaw_rad - yaw_ref),
-                kappa_ref + road_kappa, kappa_ff + road_kappa, mu, steer_ff, beta_ref)
+                v,
+                meas.yaw_rate_radps,
+                meas.vy_mps,
+                e_lat,
+                wrap_angle(meas.e_yaw_rad - yaw_ref),
+                kappa_ref + road_kappa,
+                kappa_ff + road_kappa,
+                mu,
+                steer_ff,
+                beta_ref,
+            )
 
         # ---- longitudinal: force limits from the friction ellipse with the lateral acceleration
         # in use (measured; outside the table's profile also the one this steering command asks
@@ -494,6 +556,23 @@ class EoamController:
         if fcw:
             self.fcw_raised = True
         self.sector = sector.letter if sector is not None else ""
-        return _new(Command, (delta, drive, brake, int(mode), fcw, self.sector, ax_target, y_ref,
-                              dx, e_lat, e_la, ff, fb, yd, v_target))
-
+        return _new(
+            Command,
+            (
+                delta,
+                drive,
+                brake,
+                int(mode),
+                fcw,
+                self.sector,
+                ax_target,
+                y_ref,
+                dx,
+                e_lat,
+                e_la,
+                ff,
+                fb,
+                yd,
+                v_target,
+            ),
+        )

@@ -68,7 +68,8 @@ class EoamSettings:
     # path: the actuator's lag, and its rate limit where the plan steers fast (low speed)
     steering: SteeringGains = field(default_factory=SteeringGains)
     planned_steering: SteeringGains = field(  # the table lane change (plans keep 10 % of
-        default_factory=lambda: SteeringGains(natural_freq_radps=9.0))  # the friction for it)
+        default_factory=lambda: SteeringGains(natural_freq_radps=9.0)
+    )  # the friction for it)
     longitudinal: LongitudinalGains = field(default_factory=LongitudinalGains)
     policy: PolicySettings = field(default_factory=PolicySettings)  # paper or safe
 

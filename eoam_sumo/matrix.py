@@ -35,9 +35,19 @@ from eoam_sumo.sim.scenario import ScenarioOverrides, check_scenario, scripted_s
 DEFAULT_MAX_TIME_S = 60.0
 NO_ONCOMING = "none"
 SCHEMA = {
-    "scenario": ("sumocfg", "max_time_s", "radar_range_m", "policy", "v2x_range_m",
-                 "v2x_latency_s", "v2x_loss", "v2x_penetration", "mu_belief", "radar_model",
-                 "seed"),
+    "scenario": (
+        "sumocfg",
+        "max_time_s",
+        "radar_range_m",
+        "policy",
+        "v2x_range_m",
+        "v2x_latency_s",
+        "v2x_loss",
+        "v2x_penetration",
+        "mu_belief",
+        "radar_model",
+        "seed",
+    ),
     "sweep": ("ego_speed_kmh", "mu", "oncoming_start_m", "aro_hold_s", "aro_decel_mps2"),
     "paper": ("table",),
     "sample": (),  # draws, seed and the sampled keys: checked by sampling.parse_sample
@@ -132,18 +142,32 @@ class Matrix:
                     for hold in holds:
                         for decel in decels:
                             parts = [
-                                "" if "oncoming_start_m" in sampled else
-                                f"onc-{NO_ONCOMING if onc is None else _id_number(onc)}",
+                                ""
+                                if "oncoming_start_m" in sampled
+                                else f"onc-{NO_ONCOMING if onc is None else _id_number(onc)}",
                                 "" if speed is None else f"v{_id_number(speed)}",
                                 "" if mu is None else f"mu{_mu_text(mu)}",
                                 "" if hold is None else f"hold{_id_number(hold)}",
                                 "" if decel is None else f"dec{_id_number(decel)}",
                             ]
-                            cases.append(Case(
-                                "_".join(p for p in parts if p) or "all", self.sumocfg, speed,
-                                mu, onc, hold, decel, self.max_time_s, self.radar_range_m,
-                                self.policy, *self.v2x, mu_belief=self.mu_belief,
-                                radar_model=self.radar_model, seed=self.seed))
+                            cases.append(
+                                Case(
+                                    "_".join(p for p in parts if p) or "all",
+                                    self.sumocfg,
+                                    speed,
+                                    mu,
+                                    onc,
+                                    hold,
+                                    decel,
+                                    self.max_time_s,
+                                    self.radar_range_m,
+                                    self.policy,
+                                    *self.v2x,
+                                    mu_belief=self.mu_belief,
+                                    radar_model=self.radar_model,
+                                    seed=self.seed,
+                                )
+                            )
         return cases if self.sample is None else self._draws(cases, self.sample)
 
     @staticmethod
@@ -153,9 +177,16 @@ class Matrix:
         for group in groups:
             for k in range(sample.draws):
                 values, seed = sample.values(group.case_id, k)
-                cases.append(replace(group, **values, seed=seed, draw=k,
-                                     group_id=group.case_id,
-                                     case_id=f"{group.case_id}_d{k:0{width}d}"))
+                cases.append(
+                    replace(
+                        group,
+                        **values,
+                        seed=seed,
+                        draw=k,
+                        group_id=group.case_id,
+                        case_id=f"{group.case_id}_d{k:0{width}d}",
+                    )
+                )
         return cases
 
     def paper_outcomes(self) -> dict[str, str]:
@@ -246,8 +277,13 @@ def _number_list(
     return tuple(out)
 
 
-def _checked(minimum: float, inclusive: bool, maximum: float | None = None,
-             allow_none: bool = False, max_inclusive: bool = True):
+def _checked(
+    minimum: float,
+    inclusive: bool,
+    maximum: float | None = None,
+    allow_none: bool = False,
+    max_inclusive: bool = True,
+):
     """The check of one value of a numeric key (for sampled values)."""
 
     def check(value):
@@ -255,11 +291,11 @@ def _checked(minimum: float, inclusive: bool, maximum: float | None = None,
             return None
         if not _is_number(value):
             raise InputError("is not a number" + (f' or "{NO_ONCOMING}"' if allow_none else ""))
-        if (value < minimum if inclusive else value <= minimum) or (maximum is not None and (
-                value > maximum if max_inclusive else value >= maximum)):
+        if (value < minimum if inclusive else value <= minimum) or (
+            maximum is not None and (value > maximum if max_inclusive else value >= maximum)
+        ):
             low = "[" if inclusive else "("
-            high = "inf)" if maximum is None else f"{maximum:g}" + ("]" if max_inclusive
-                                                                     else ")")
+            high = "inf)" if maximum is None else f"{maximum:g}" + ("]" if max_inclusive else ")")
             raise InputError(f"is outside {low}{minimum:g}, {high}")
         return float(value)
 
@@ -284,8 +320,10 @@ SAMPLED = {
     "mu_belief": parse_mu_belief,
     "radar_model": parse_radar_model,
     "policy": _policy,
-    **{key: _checked(low, True, high, max_inclusive=high_in)
-       for key, (_, low, high, high_in) in V2X_KEYS.items()},
+    **{
+        key: _checked(low, True, high, max_inclusive=high_in)
+        for key, (_, low, high, high_in) in V2X_KEYS.items()
+    },
 }
 
 
@@ -321,11 +359,14 @@ def load_matrix(path: Path) -> Matrix:
     for key in sampled:
         for table in ("scenario", "sweep"):
             if key in doc[table]:
-                raise InputError(f"{path}: '{key}' is both in [{table}] and sampled in "
-                                 "[sample]; keep one")
+                raise InputError(
+                    f"{path}: '{key}' is both in [{table}] and sampled in [sample]; keep one"
+                )
     if sample is not None and "seed" in scenario:
-        raise InputError(f"{path}: [scenario] seed with a [sample] table: the draws' seeds "
-                         "come from [sample] seed")
+        raise InputError(
+            f"{path}: [scenario] seed with a [sample] table: the draws' seeds "
+            "come from [sample] seed"
+        )
     sumocfg = _existing_file(path, "[scenario] sumocfg", scenario["sumocfg"])
     max_time = scenario.get("max_time_s", DEFAULT_MAX_TIME_S)
     if not _is_number(max_time) or max_time <= 0:
@@ -335,20 +376,28 @@ def load_matrix(path: Path) -> Matrix:
         raise InputError(f"{path}: [scenario] radar_range_m = {radar_range!r} must be a number > 0")
     policy = scenario.get("policy", "paper")
     if policy not in POLICIES:
-        raise InputError(f"{path}: [scenario] policy = {policy!r} must be one of "
-                         f"{', '.join(repr(p) for p in POLICIES)}")
+        raise InputError(
+            f"{path}: [scenario] policy = {policy!r} must be one of "
+            f"{', '.join(repr(p) for p in POLICIES)}"
+        )
     v2x = []
     for key, (default, low, high, high_in) in V2X_KEYS.items():
         value = scenario.get(key, default)
-        if (not _is_number(value) or value < low
-                or (high is not None and (value > high or (value == high and not high_in)))):
-            bound = f">= {low:g}" + ("" if high is None else
-                                     f" and {'<=' if high_in else '<'} {high:g}")
+        if (
+            not _is_number(value)
+            or value < low
+            or (high is not None and (value > high or (value == high and not high_in)))
+        ):
+            bound = f">= {low:g}" + (
+                "" if high is None else f" and {'<=' if high_in else '<'} {high:g}"
+            )
             raise InputError(f"{path}: [scenario] {key} = {value!r} must be a number {bound}")
         v2x.append(float(value))
     if v2x[0] > 0.0 and policy != "safe":
-        raise InputError(f"{path}: [scenario] v2x_range_m = {v2x[0]:g} needs policy = "
-                         "\"safe\" (V2X informs the safe policy only)")
+        raise InputError(
+            f"{path}: [scenario] v2x_range_m = {v2x[0]:g} needs policy = "
+            '"safe" (V2X informs the safe policy only)'
+        )
     paper = None
     if "table" in doc.get("paper", {}):
         paper = _existing_file(path, "[paper] table", doc["paper"]["table"])
@@ -370,12 +419,17 @@ def load_matrix(path: Path) -> Matrix:
         **settings,
         seed=seed,
         sample=sample,
-        ego_speeds_kmh=(None,) if "ego_speed_kmh" in sampled else _number_list(
+        ego_speeds_kmh=(None,)
+        if "ego_speed_kmh" in sampled
+        else _number_list(
             path, "ego_speed_kmh", sweep["ego_speed_kmh"], minimum=0.0, inclusive=False
         ),
-        mus=(None,) if "mu" in sampled else _number_list(
-            path, "mu", sweep["mu"], minimum=0.0, inclusive=False, maximum=MU_MAX),
-        oncoming_starts_m=(None,) if "oncoming_start_m" in sampled else _number_list(
+        mus=(None,)
+        if "mu" in sampled
+        else _number_list(path, "mu", sweep["mu"], minimum=0.0, inclusive=False, maximum=MU_MAX),
+        oncoming_starts_m=(None,)
+        if "oncoming_start_m" in sampled
+        else _number_list(
             path,
             "oncoming_start_m",
             sweep.get("oncoming_start_m", [NO_ONCOMING]),
@@ -436,12 +490,21 @@ def check_within_tables(matrix: Matrix, tables, folder: Path | str | None = None
     """
     beliefs = (matrix.mu_belief, *_extremes(matrix, "mu_belief"))
     for key, values, check in (
-        ("ego_speed_kmh", (*matrix.ego_speeds_kmh, *_extremes(matrix, "ego_speed_kmh")),
-         lambda v: tables.check_run(tables.mu_grid[-1], v / 3.6)),
-        ("mu", (*matrix.mus, *_extremes(matrix, "mu")),
-         lambda m: tables.check_run(m, tables.speed_grid_mps[0])),
-        ("mu_belief", tuple(b for b in beliefs if isinstance(b, float)),
-         lambda m: tables.check_run(m, tables.speed_grid_mps[0])),
+        (
+            "ego_speed_kmh",
+            (*matrix.ego_speeds_kmh, *_extremes(matrix, "ego_speed_kmh")),
+            lambda v: tables.check_run(tables.mu_grid[-1], v / 3.6),
+        ),
+        (
+            "mu",
+            (*matrix.mus, *_extremes(matrix, "mu")),
+            lambda m: tables.check_run(m, tables.speed_grid_mps[0]),
+        ),
+        (
+            "mu_belief",
+            tuple(b for b in beliefs if isinstance(b, float)),
+            lambda m: tables.check_run(m, tables.speed_grid_mps[0]),
+        ),
     ):
         for value in values:
             if value is None:  # the placeholder of a sampled key

@@ -32,9 +32,12 @@ def source_digest(path: Path) -> str:
 
 def extension_modules(package_dir: Path = PACKAGE_DIR) -> list[Path]:
     """The extension modules of a source tree's package whose source lies beside them."""
-    return sorted(ext for suffix in machinery.EXTENSION_SUFFIXES
-                  for ext in package_dir.rglob(f"*{suffix}")
-                  if ext.with_name(ext.name[: -len(suffix)] + ".py").is_file())
+    return sorted(
+        ext
+        for suffix in machinery.EXTENSION_SUFFIXES
+        for ext in package_dir.rglob(f"*{suffix}")
+        if ext.with_name(ext.name[: -len(suffix)] + ".py").is_file()
+    )
 
 
 def build_record(package_dir: Path = PACKAGE_DIR) -> dict:
@@ -49,8 +52,11 @@ def stale_sources(package_dir: Path = PACKAGE_DIR) -> list[str]:
     are now: changed since the build, or with no record of it."""
     root = package_dir.parent
     built = build_record(package_dir).get("compiled", {})
-    stale = [rel for rel, sha in built.items()
-             if not (root / rel).is_file() or source_digest(root / rel) != sha]
+    stale = [
+        rel
+        for rel, sha in built.items()
+        if not (root / rel).is_file() or source_digest(root / rel) != sha
+    ]
     for ext in extension_modules(package_dir):
         rel = ext.relative_to(root).as_posix().split(".", 1)[0] + ".py"
         if rel not in built:
@@ -74,7 +80,8 @@ class SourcesOnly:
             return None
         for entry in path:
             finder = machinery.FileFinder(
-                entry, (machinery.SourceFileLoader, machinery.SOURCE_SUFFIXES))
+                entry, (machinery.SourceFileLoader, machinery.SOURCE_SUFFIXES)
+            )
             spec = finder.find_spec(name, target)
             if spec is not None:
                 return spec
@@ -90,14 +97,20 @@ def choose() -> None:
         return
     failed = build_record().get("failed")
     if failed:
-        warnings.warn(f"eoam_sumo runs its Python sources: the install built no compiled "
-                      f"modules ({failed}); the step loop is slower", RuntimeWarning,
-                      stacklevel=3)
+        warnings.warn(
+            f"eoam_sumo runs its Python sources: the install built no compiled "
+            f"modules ({failed}); the step loop is slower",
+            RuntimeWarning,
+            stacklevel=3,
+        )
     stale = stale_sources()
     if stale:
         named = ", ".join(stale[:3]) + (f" and {len(stale) - 3} more" if len(stale) > 3 else "")
         warnings.warn(
             f"eoam_sumo runs its Python sources: the compiled modules were not built from "
             f"{named} as they are now; rebuild with 'make' or 'pip install -e .' (or set "
-            f"{PURE_ENV}=1)", RuntimeWarning, stacklevel=3)
+            f"{PURE_ENV}=1)",
+            RuntimeWarning,
+            stacklevel=3,
+        )
         sys.meta_path.insert(0, SourcesOnly())

@@ -49,17 +49,19 @@ class VehicleParams:
     steering_ratio: float = _p(16.0, "-", GILLESPIE)
     max_steer_rad: float = _p(math.radians(35.0), "rad", GILLESPIE + " (road-wheel lock)")
     max_steer_rate_radps: float = _p(
-        math.radians(50.0), "rad/s", ASSUMED + " (800 deg/s hand wheel / 16)")
+        math.radians(50.0), "rad/s", ASSUMED + " (800 deg/s hand wheel / 16)"
+    )
     cornering_stiffness_front_npr: float = _p(
-        2 * 66900.0, "N/rad", JI + " (per tyre x 2, per axle)")
-    cornering_stiffness_rear_npr: float = _p(
-        2 * 62700.0, "N/rad", JI + " (per tyre x 2, per axle)")
+        2 * 66900.0, "N/rad", JI + " (per tyre x 2, per axle)"
+    )
+    cornering_stiffness_rear_npr: float = _p(2 * 62700.0, "N/rad", JI + " (per tyre x 2, per axle)")
     slip_angle_sat_rad: float = _p(math.radians(5.0), "rad", PAPER + ", eq. 6 (alpha* = 5 deg)")
     sliding_friction_ratio: float = _p(0.8, "-", GILLESPIE + " (locked-wheel / peak friction)")
     max_drive_force_n: float = _p(6500.0, "N", ASSUMED + " (rear-drive, ~0.38 g launch)")
     max_drive_power_w: float = _p(180000.0, "W", ASSUMED + " (E-class 6-cylinder petrol)")
     max_brake_force_n: float = _p(
-        22000.0, "N", ASSUMED + " (brakes able to lock all wheels on dry)")
+        22000.0, "N", ASSUMED + " (brakes able to lock all wheels on dry)"
+    )
     brake_front_share: float = _p(0.65, "-", GILLESPIE + " (fixed front brake proportion)")
     rolling_resistance_coeff: float = _p(0.012, "-", GILLESPIE)
     drag_area_m2: float = _p(0.62, "m^2", ASSUMED + " (Cd 0.27 x 2.3 m^2 frontal area)")

@@ -95,8 +95,7 @@ class Sample:
 
 
 def _pair(where: str, value) -> tuple[float, float]:
-    if (not isinstance(value, list) or len(value) != 2
-            or not all(_is_number(v) for v in value)):
+    if not isinstance(value, list) or len(value) != 2 or not all(_is_number(v) for v in value):
         raise InputError(f"{where} = {value!r} must be a list of two numbers")
     return float(value[0]), float(value[1])
 
@@ -110,13 +109,16 @@ def parse_distribution(path, key: str, spec, check: Check) -> Distribution:
     returns the value as a case holds it or raises InputError (the key's own check)."""
     where = f"{path}: [sample] {key}"
     if not isinstance(spec, dict):
-        raise InputError(f"{where} = {spec!r} must be a distribution: {{ uniform = [low, high] "
-                         "}, { normal = [mean, sd] } or { choice = [...] }")
+        raise InputError(
+            f"{where} = {spec!r} must be a distribution: {{ uniform = [low, high] "
+            "}, { normal = [mean, sd] } or { choice = [...] }"
+        )
     kinds = [k for k in spec if k in KINDS]
     extra = [k for k in spec if k not in (*KINDS, "clip")]
     if len(kinds) != 1 or extra:
-        raise InputError(f"{where} = {spec!r} must name one of {', '.join(KINDS)} "
-                         "(and clip, for normal)")
+        raise InputError(
+            f"{where} = {spec!r} must name one of {', '.join(KINDS)} (and clip, for normal)"
+        )
     kind = kinds[0]
     if "clip" in spec and kind != "normal":
         raise InputError(f"{where}: clip applies to a normal distribution only, not {kind}")
@@ -140,13 +142,16 @@ def parse_distribution(path, key: str, spec, check: Check) -> Distribution:
     if not high > 0.0:
         raise InputError(f"{where}: normal = [{low:g}, {high:g}] needs sd > 0")
     if "clip" not in spec:
-        raise InputError(f"{where}: normal = [{low:g}, {high:g}] needs clip = [low, high] "
-                         "within the key's valid values")
+        raise InputError(
+            f"{where}: normal = [{low:g}, {high:g}] needs clip = [low, high] "
+            "within the key's valid values"
+        )
     clip = _pair(f"{where}: clip", spec["clip"])
     if not clip[0] <= clip[1]:
         raise InputError(f"{where}: clip = [{clip[0]:g}, {clip[1]:g}] needs low <= high")
-    return Distribution(key, kind, (low, high),
-                        (checked(clip[0], "clip low"), checked(clip[1], "clip high")))
+    return Distribution(
+        key, kind, (low, high), (checked(clip[0], "clip low"), checked(clip[1], "clip high"))
+    )
 
 
 def parse_sample(path, table: dict, checks: dict[str, Check]) -> Sample:
@@ -162,8 +167,9 @@ def parse_sample(path, table: dict, checks: dict[str, Check]) -> Sample:
     distributions = []
     for key in sorted(k for k in table if k not in ("draws", "seed")):
         if key not in checks:
-            raise InputError(f"{where}: '{key}' cannot be sampled (keys that can: "
-                             f"{', '.join(sorted(checks))})")
+            raise InputError(
+                f"{where}: '{key}' cannot be sampled (keys that can: {', '.join(sorted(checks))})"
+            )
         distributions.append(parse_distribution(path, key, table[key], checks[key]))
     return Sample(draws, seed, tuple(distributions))
 

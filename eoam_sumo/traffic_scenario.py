@@ -20,8 +20,9 @@ BROKEN_POS_M = 600.0  # the broken-down car's position on the ego's lane [m]
 EGO_POS_M = 350.0  # the ego's departure position [m]
 
 
-def write_traffic_scenario(folder: Path, *, ego_depart_s: float = 160.0,
-                           step_length_s: float = 0.5, seed: int = 42) -> Path:
+def write_traffic_scenario(
+    folder: Path, *, ego_depart_s: float = 160.0, step_length_s: float = 0.5, seed: int = 42
+) -> Path:
     """Write the network (netconvert), routes and ``traffic.sumocfg`` into ``folder``; the
     sumocfg's path. ``ego_depart_s`` whole multiples of ``step_length_s`` keep the handover
     at the departure."""
@@ -29,17 +30,28 @@ def write_traffic_scenario(folder: Path, *, ego_depart_s: float = 160.0,
 
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "t.nod.xml").write_text(
-        f'<nodes><node id="a" x="0" y="0"/><node id="b" x="{ROAD_M:g}" y="0"/></nodes>')
+        f'<nodes><node id="a" x="0" y="0"/><node id="b" x="{ROAD_M:g}" y="0"/></nodes>'
+    )
     (folder / "t.edg.xml").write_text(
-        '<edges>'
+        "<edges>"
         f'<edge id="fwd" from="a" to="b" numLanes="3" speed="{SPEED_MPS:g}"/>'
         f'<edge id="back" from="b" to="a" numLanes="3" speed="{SPEED_MPS:g}"/>'
-        '</edges>')
+        "</edges>"
+    )
     subprocess.run(
-        [sumolib.checkBinary("netconvert"), "-n", str(folder / "t.nod.xml"),
-         "-e", str(folder / "t.edg.xml"), "--no-turnarounds", "true",
-         "-o", str(folder / "t.net.xml")],
-        check=True, capture_output=True,
+        [
+            sumolib.checkBinary("netconvert"),
+            "-n",
+            str(folder / "t.nod.xml"),
+            "-e",
+            str(folder / "t.edg.xml"),
+            "--no-turnarounds",
+            "true",
+            "-o",
+            str(folder / "t.net.xml"),
+        ],
+        check=True,
+        capture_output=True,
     )
     prob = LANE_FLOW_VPH / 3600.0  # departures per second of a lane
     flows = "".join(
@@ -50,7 +62,7 @@ def write_traffic_scenario(folder: Path, *, ego_depart_s: float = 160.0,
         for lane in lanes
     )
     (folder / "t.rou.xml").write_text(
-        '<routes>'
+        "<routes>"
         '<vType id="car" length="4.6" width="1.8" decel="7.5" sigma="0.5"/>'
         '<vType id="keep" length="4.6" width="1.8" decel="7.5" sigma="0.5"'
         ' lcStrategic="-1" lcKeepRight="0" lcSpeedGain="0" lcCooperative="-1"/>'
@@ -59,14 +71,16 @@ def write_traffic_scenario(folder: Path, *, ego_depart_s: float = 160.0,
         f'<vehicle id="broken" type="car" route="fwd" depart="0" departLane="0"'
         f' departPos="{BROKEN_POS_M:g}" departSpeed="0">'
         f'<stop lane="fwd_0" endPos="{BROKEN_POS_M:g}" duration="100000"/></vehicle>'
-        f'{flows}'
+        f"{flows}"
         f'<vehicle id="ego" type="ego" route="fwd" depart="{ego_depart_s:g}" departLane="0"'
         f' departPos="{EGO_POS_M:g}" departSpeed="{SPEED_MPS:g}"/>'
-        '</routes>')
+        "</routes>"
+    )
     cfg = folder / "traffic.sumocfg"
     cfg.write_text(
         '<configuration><input><net-file value="t.net.xml"/>'
         '<route-files value="t.rou.xml"/></input>'
         f'<time><begin value="0"/><step-length value="{step_length_s:g}"/></time>'
-        f'<random_number><seed value="{seed}"/></random_number></configuration>')
+        f'<random_number><seed value="{seed}"/></random_number></configuration>'
+    )
     return cfg

@@ -20,13 +20,16 @@ BASELINE = SCENARIOS / "baseline.sumocfg"
 PARKED_ONLY = SCENARIOS / "parked_only.sumocfg"
 
 
-def write_sumocfg(path: Path, net: Path | str, routes: Path | str,
-                  additional: Iterable[Path | str] = (),
-                  step_length_s: float | None = None) -> Path:
+def write_sumocfg(
+    path: Path,
+    net: Path | str,
+    routes: Path | str,
+    additional: Iterable[Path | str] = (),
+    step_length_s: float | None = None,
+) -> Path:
     """A sumocfg at ``path`` naming these files (relative names are relative to its folder)."""
     files = ",".join(str(a) for a in additional)
-    text = (f'<configuration><input><net-file value="{net}"/>'
-            f'<route-files value="{routes}"/>')
+    text = f'<configuration><input><net-file value="{net}"/><route-files value="{routes}"/>'
     if files:
         text += f'<additional-files value="{files}"/>'
     text += "</input>"
@@ -44,8 +47,7 @@ def network(folder: Path, stem: str, nodes_xml: str, edges_xml: str) -> Path:
     return netbuild.build_network(folder / f"{stem}.nod.xml")
 
 
-def netconvert(folder: Path, stem: str, nodes_xml: str, edges_xml: str,
-               *options: str) -> Path:
+def netconvert(folder: Path, stem: str, nodes_xml: str, edges_xml: str, *options: str) -> Path:
     """``STEM.net.xml`` built by plain netconvert with these options, as a user would build it
     (netconvert's defaults otherwise)."""
     import sumolib
@@ -54,9 +56,18 @@ def netconvert(folder: Path, stem: str, nodes_xml: str, edges_xml: str,
     (folder / f"{stem}.edg.xml").write_text(edges_xml)
     net = folder / f"{stem}.net.xml"
     subprocess.run(
-        [sumolib.checkBinary("netconvert"), "-n", str(folder / f"{stem}.nod.xml"),
-         "-e", str(folder / f"{stem}.edg.xml"), *options, "-o", str(net)],
-        check=True, capture_output=True,
+        [
+            sumolib.checkBinary("netconvert"),
+            "-n",
+            str(folder / f"{stem}.nod.xml"),
+            "-e",
+            str(folder / f"{stem}.edg.xml"),
+            *options,
+            "-o",
+            str(net),
+        ],
+        check=True,
+        capture_output=True,
     )
     return net
 
@@ -68,13 +79,20 @@ def on_highway(folder: Path, routes_xml: str, net: Path = HIGHWAY_NET) -> Path:
     return write_sumocfg(folder / "v.sumocfg", net, "v.rou.xml", [VTYPES])
 
 
-def walker_on_highway(folder: Path, depart_pos_m: float, arrival_pos_m: float,
-                      ego_speed_mps: float, person_depart_s: float = 1.0) -> Path:
+def walker_on_highway(
+    folder: Path,
+    depart_pos_m: float,
+    arrival_pos_m: float,
+    ego_speed_mps: float,
+    person_depart_s: float = 1.0,
+) -> Path:
     """The ego at ``ego_speed_mps`` (front bumper at x = 100 m, departing at 1 s) and a person
     walking along its lane (no sidewalk: SUMO's persons walk on the road) from
     ``depart_pos_m`` to ``arrival_pos_m`` along E0 (towards the ego when the arrival lies
     behind the departure)."""
-    return on_highway(folder, f"""<routes>
+    return on_highway(
+        folder,
+        f"""<routes>
   <vType id="walker" vClass="pedestrian" length="0.30" width="0.55" maxSpeed="1.4"/>
   <route id="eastbound" edges="E0"/>
   <vehicle id="ego" type="ego" route="eastbound" depart="1.00" departLane="0"
@@ -82,7 +100,8 @@ def walker_on_highway(folder: Path, depart_pos_m: float, arrival_pos_m: float,
   <person id="walker" type="walker" depart="{person_depart_s:.2f}" departPos="{depart_pos_m}">
     <walk edges="E0" arrivalPos="{arrival_pos_m}"/>
   </person>
-</routes>""")
+</routes>""",
+    )
 
 
 def baseline_variant(folder: Path, old: str, new: str, extra_additional: str = "") -> Path:
@@ -91,17 +110,22 @@ def baseline_variant(folder: Path, old: str, new: str, extra_additional: str = "
     routes = (SCENARIOS / "baseline.rou.xml").read_text()
     assert old in routes
     (folder / "r.rou.xml").write_text(routes.replace(old, new, 1))
-    return write_sumocfg(folder / "variant.sumocfg", HIGHWAY_NET, "r.rou.xml",
-                         filter(None, [str(VTYPES), extra_additional]))
+    return write_sumocfg(
+        folder / "variant.sumocfg",
+        HIGHWAY_NET,
+        "r.rou.xml",
+        filter(None, [str(VTYPES), extra_additional]),
+    )
 
 
-def halted_car_scenario(folder: Path, nodes_xml: str, edges_xml: str, obstacle_pos_m: float,
-                        *netconvert_options: str) -> Path:
+def halted_car_scenario(
+    folder: Path, nodes_xml: str, edges_xml: str, obstacle_pos_m: float, *netconvert_options: str
+) -> Path:
     """A small user scenario: the given road (edge ``fwd`` first), a car halted on it at
     ``obstacle_pos_m`` by a plain ``<stop>``, the ego 20 m from the start at 27 m/s."""
-    netconvert(folder, "n", nodes_xml, edges_xml, "--no-turnarounds", "true",
-               *netconvert_options)
-    (folder / "r.rou.xml").write_text(textwrap.dedent(f"""\
+    netconvert(folder, "n", nodes_xml, edges_xml, "--no-turnarounds", "true", *netconvert_options)
+    (folder / "r.rou.xml").write_text(
+        textwrap.dedent(f"""\
         <routes>
           <vType id="car" length="4.6" width="1.8" decel="9" sigma="0"/>
           <route id="r" edges="fwd"/>
@@ -110,12 +134,14 @@ def halted_car_scenario(folder: Path, nodes_xml: str, edges_xml: str, obstacle_p
             <stop lane="fwd_0" endPos="{obstacle_pos_m + 5}" duration="1000"/>
           </vehicle>
           <vehicle id="ego" type="car" route="r" depart="0" departPos="20" departSpeed="27"/>
-        </routes>"""))
+        </routes>""")
+    )
     return write_sumocfg(folder / "s.sumocfg", "n.net.xml", "r.rou.xml")
 
 
-def write_matrix(path: Path, sweep: str, sumocfg: Path = BASELINE, scenario: str = "",
-                 paper_table: bool = False) -> Path:
+def write_matrix(
+    path: Path, sweep: str, sumocfg: Path = BASELINE, scenario: str = "", paper_table: bool = False
+) -> Path:
     """An experiment matrix at ``path``: ``[scenario]`` with ``sumocfg`` and the extra
     ``scenario`` lines, ``[sweep]`` with the ``sweep`` lines, and the paper's Table 2 to
     compare with if ``paper_table``."""

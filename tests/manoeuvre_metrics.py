@@ -21,14 +21,15 @@ import pandas as pd
 
 def case_figures(case_dir: Path) -> dict:
     """The per-case figures from one ``timeseries.csv``."""
-    ts = pd.read_csv(case_dir / "timeseries.csv", usecols=["mode", "lateral_offset_m",
-                                                           "lateral_error_m"])
+    ts = pd.read_csv(
+        case_dir / "timeseries.csv", usecols=["mode", "lateral_offset_m", "lateral_error_m"]
+    )
     lane_change = ts[ts["mode"] == 2]
     err = float(lane_change["lateral_error_m"].abs().max()) if len(lane_change) else 0.0
     drift = 0.0
     in_3 = (ts["mode"] == 3).to_numpy().nonzero()[0]
     if len(in_3):
-        d = ts["lateral_offset_m"].iloc[in_3[0]:].abs()
+        d = ts["lateral_offset_m"].iloc[in_3[0] :].abs()
         drift = float(d.max() - d.iloc[0])
     return {"max_lateral_error_m": err, "mode3_drift_m": drift}
 
@@ -43,7 +44,8 @@ def batch_figures(out_dir: Path) -> tuple[pd.DataFrame, dict]:
     summary = {
         "max_lane_change_error_m": float(res["max_lateral_error_m"].max()),
         "min_green_lane_change_gap_m": float(green_lc["min_gap_aro_m"].min())
-        if len(green_lc) else float("nan"),
+        if len(green_lc)
+        else float("nan"),
         "max_mode3_drift_m": float(res["mode3_drift_m"].max()),
         "red_at_mu_0_3_up": int(((res["outcome"] == "red") & (res["mu"] >= 0.3)).sum()),
         "colours": res["outcome"].value_counts().to_dict(),
@@ -58,8 +60,15 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     res, summary = batch_figures(args.out_dir)
     if args.cases:
-        cols = ["case_id", "outcome", "impact_speed_mps", "min_gap_aro_m",
-                "max_lateral_error_m", "mode3_drift_m", "modes_visited"]
+        cols = [
+            "case_id",
+            "outcome",
+            "impact_speed_mps",
+            "min_gap_aro_m",
+            "max_lateral_error_m",
+            "mode3_drift_m",
+            "modes_visited",
+        ]
         print(res[cols].to_string(index=False))
     for k, v in summary.items():
         print(f"{k}: {v}")

@@ -14,10 +14,20 @@ from eoam_sumo.sim import cosim
 pytestmark = pytest.mark.sumo
 
 KEYS = (
-    "realtime_factor", "sumo_only_realtime_factor", "tables_wall_s", "batch_wall_s",
-    "batch_cases", "jobs", "control_us_per_step", "plant_substeps_per_s", "peak_rss_mb",
-    "cosim_over_sumo_cost", "traffic_vehicles", "traffic_cosim_wall_s",
-    "traffic_sumo_only_wall_s", "floor_over_sumo_cost",
+    "realtime_factor",
+    "sumo_only_realtime_factor",
+    "tables_wall_s",
+    "batch_wall_s",
+    "batch_cases",
+    "jobs",
+    "control_us_per_step",
+    "plant_substeps_per_s",
+    "peak_rss_mb",
+    "cosim_over_sumo_cost",
+    "traffic_vehicles",
+    "traffic_cosim_wall_s",
+    "traffic_sumo_only_wall_s",
+    "floor_over_sumo_cost",
 )
 
 

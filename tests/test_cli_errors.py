@@ -77,7 +77,8 @@ def test_unwritable_output_folder(capsys, tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("not a folder")
     _check(
-        capsys, ["run", str(SCEN / "baseline.sumocfg"), "--out", str(blocker / "sub")],
+        capsys,
+        ["run", str(SCEN / "baseline.sumocfg"), "--out", str(blocker / "sub")],
         str(blocker),
     )
 
@@ -86,12 +87,25 @@ def test_unwritable_output_folder(capsys, tmp_path):
     "text, needle",
     [
         ("[scenario\nsumocfg = 1", "m.toml"),
-        ('[scenario]\nsumocfg = "baseline.sumocfg"\n[sweep]\nego_sped_kmh = [120]\n',
-         "ego_sped_kmh"),
-        ('[scenario]\nsumocfg = "baseline.sumocfg"\n[sweep]\nego_speed_kmh = [120]\nmu = [2.0]\n',
-         "mu"),
-        (('[scenario]\nsumocfg = "baseline.sumocfg"\n[sweep]\nego_speed_kmh = [120]\nmu = [1.0]\n'
-          'oncoming_start_m = [-3]\n'), "oncoming_start_m"),
+        (
+            '[scenario]\nsumocfg = "baseline.sumocfg"\n[sweep]\nego_sped_kmh = [120]\n',
+            "ego_sped_kmh",
+        ),
+        (
+            (
+                '[scenario]\nsumocfg = "baseline.sumocfg"\n[sweep]\n'
+                "ego_speed_kmh = [120]\nmu = [2.0]\n"
+            ),
+            "mu",
+        ),
+        (
+            (
+                '[scenario]\nsumocfg = "baseline.sumocfg"\n[sweep]\n'
+                "ego_speed_kmh = [120]\nmu = [1.0]\n"
+                "oncoming_start_m = [-3]\n"
+            ),
+            "oncoming_start_m",
+        ),
         ('[scenario]\nsumocfg = "baseline.sumocfg"\n[weather]\nrain = true\n', "weather"),
     ],
 )
@@ -106,15 +120,22 @@ def test_results_already_written_survive_a_bad_resume(capsys, tmp_path):
     out = tmp_path / "o"
     out.mkdir()
     (out / "results.csv").write_text("case_id,outcome\nx,green\n")
-    _check(capsys, ["batch", str(tmp_path / "missing.toml"), "--out", str(out), "--resume"],
-           "missing.toml")
+    _check(
+        capsys,
+        ["batch", str(tmp_path / "missing.toml"), "--out", str(out), "--resume"],
+        "missing.toml",
+    )
     assert (out / "results.csv").read_text() == "case_id,outcome\nx,green\n"
 
 
 def test_python_dash_m_behaves_the_same(tmp_path):
     proc = subprocess.run(
         [sys.executable, "-m", "eoam_sumo", "run", str(SCEN / "baseline.sumocfg"), "--mu", "9"],
-        check=False, capture_output=True, text=True, timeout=120, cwd=tmp_path,
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=tmp_path,
     )
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "9" in proc.stderr
@@ -188,8 +209,10 @@ def _tables_copy(tmp_path: Path) -> Path:
     return dst
 
 
-@pytest.mark.parametrize("damage", ["summary", "timeseries-header-only", "timeseries-empty",
-                                    "timeseries-cut", "npz-missing"])
+@pytest.mark.parametrize(
+    "damage",
+    ["summary", "timeseries-header-only", "timeseries-empty", "timeseries-cut", "npz-missing"],
+)
 def test_plot_of_a_damaged_folder_names_the_file(tmp_path, capsys, damage):
     """A damaged run or tables folder: one line and exit 2, not a traceback."""
     if damage == "npz-missing":
@@ -217,10 +240,13 @@ def test_plot_of_a_damaged_folder_names_the_file(tmp_path, capsys, damage):
     _check(capsys, ["plot", str(folder), "--out", str(tmp_path / "png")], name)
 
 
-@pytest.mark.parametrize("grid,needle", [(["--speeds-kmh", "1"], "speeds_kmh holds 1.0"),
-                                         (["--mu", "0.001"], "mus holds 0.001")])
-def test_tables_grid_values_the_optimisation_cannot_solve_are_refused(tmp_path, capsys, grid,
-                                                                      needle):
+@pytest.mark.parametrize(
+    "grid,needle",
+    [(["--speeds-kmh", "1"], "speeds_kmh holds 1.0"), (["--mu", "0.001"], "mus holds 0.001")],
+)
+def test_tables_grid_values_the_optimisation_cannot_solve_are_refused(
+    tmp_path, capsys, grid, needle
+):
     _check(capsys, ["tables", "--out", str(tmp_path / "t"), *grid], needle)
 
 
@@ -231,8 +257,18 @@ def test_a_tables_folder_mixing_two_builds_is_refused(tmp_path, capsys):
     meta = json.loads((folder / "metadata.json").read_text())
     meta["grids"]["mu"] = meta["grids"]["mu"][1:]  # as if the metadata came from another build
     (folder / "metadata.json").write_text(json.dumps(meta))
-    _check(capsys, ["run", str(SCEN / "baseline.sumocfg"), "--tables", str(folder),
-                    "--out", str(tmp_path / "run")], "mixes two builds")
+    _check(
+        capsys,
+        [
+            "run",
+            str(SCEN / "baseline.sumocfg"),
+            "--tables",
+            str(folder),
+            "--out",
+            str(tmp_path / "run"),
+        ],
+        "mixes two builds",
+    )
 
 
 @pytest.mark.sumo
@@ -241,5 +277,8 @@ def test_gui_without_a_display_fails_at_once(tmp_path, capsys, monkeypatch):
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     if not sys.platform.startswith("linux"):
         pytest.skip("the display check is for Linux")
-    _check(capsys, ["run", str(SCEN / "baseline.sumocfg"), "--gui",
-                    "--out", str(tmp_path / "run")], "DISPLAY is not set")
+    _check(
+        capsys,
+        ["run", str(SCEN / "baseline.sumocfg"), "--gui", "--out", str(tmp_path / "run")],
+        "DISPLAY is not set",
+    )

@@ -24,19 +24,27 @@ SOURCE = "eoam_sumo/sim/geometry.py"
 
 def test_the_compiled_modules_were_built_from_the_sources_as_they_are():
     stale = native.stale_sources()
-    assert not stale, (f"extension modules not built from {stale} as they are now: rebuild "
-                       "with 'make' or 'pip install -e .' (or set EOAM_SUMO_PURE=1)")
+    assert not stale, (
+        f"extension modules not built from {stale} as they are now: rebuild "
+        "with 'make' or 'pip install -e .' (or set EOAM_SUMO_PURE=1)"
+    )
 
 
 def _package_copy(tmp_path: Path, recorded_digest: str) -> Path:
     """The package's sources, with a broken extension module for MODULE and a build record
     giving ``recorded_digest`` for its source."""
-    shutil.copytree(ROOT / "eoam_sumo", tmp_path / "eoam_sumo", ignore=shutil.ignore_patterns(
-        "__pycache__", native.MANIFEST.name, *(f"*{s}" for s in machinery.EXTENSION_SUFFIXES)))
+    shutil.copytree(
+        ROOT / "eoam_sumo",
+        tmp_path / "eoam_sumo",
+        ignore=shutil.ignore_patterns(
+            "__pycache__", native.MANIFEST.name, *(f"*{s}" for s in machinery.EXTENSION_SUFFIXES)
+        ),
+    )
     source = tmp_path / SOURCE
     source.with_suffix(machinery.EXTENSION_SUFFIXES[0]).write_bytes(b"not a shared library")
     (tmp_path / "eoam_sumo" / native.MANIFEST.name).write_text(
-        json.dumps({"compiled": {SOURCE: recorded_digest}, "failed": None}))
+        json.dumps({"compiled": {SOURCE: recorded_digest}, "failed": None})
+    )
     return tmp_path
 
 
@@ -46,8 +54,14 @@ def _import(root: Path, pure: bool = False) -> subprocess.CompletedProcess:
     if pure:
         env[native.PURE_ENV] = "1"
     code = f"import {MODULE} as m; print(m.__spec__.origin)"
-    return subprocess.run([sys.executable, "-W", "always", "-c", code], cwd=root, env=env,
-                          capture_output=True, text=True, check=False)
+    return subprocess.run(
+        [sys.executable, "-W", "always", "-c", code],
+        cwd=root,
+        env=env,
+        capture_output=True,
+        text=True,
+        check=False,
+    )
 
 
 def test_an_extension_module_built_from_the_source_as_it_is_is_used(tmp_path):
@@ -81,7 +95,8 @@ def test_an_install_whose_compiling_failed_says_so(tmp_path):
     for ext in (root / "eoam_sumo").rglob(f"*{machinery.EXTENSION_SUFFIXES[0]}"):
         ext.unlink()
     (root / "eoam_sumo" / native.MANIFEST.name).write_text(
-        json.dumps({"compiled": {}, "failed": "no C compiler"}))
+        json.dumps({"compiled": {}, "failed": "no C compiler"})
+    )
     run = _import(root)
     assert run.returncode == 0 and run.stdout.strip() == str(root / SOURCE), run.stderr
     assert "RuntimeWarning" in run.stderr and "no C compiler" in run.stderr
@@ -96,10 +111,18 @@ def test_eoam_sumo_pure_runs_the_sources_without_a_warning(tmp_path):
 
 
 def test_the_makefile_reinstalls_when_a_compiled_source_changes():
-    compiled = [line.strip().strip('",') for line in (ROOT / "setup.py").read_text().splitlines()
-                if line.strip().startswith('"eoam_sumo/')]
+    compiled = [
+        line.strip().strip('",')
+        for line in (ROOT / "setup.py").read_text().splitlines()
+        if line.strip().startswith('"eoam_sumo/')
+    ]
     assert len(compiled) > 20 and all((ROOT / rel).is_file() for rel in compiled)
-    run = subprocess.run(["make", "-s", "-p", "-n", "-f", "Makefile", "clean"], cwd=ROOT,
-                         capture_output=True, text=True, check=True)
+    run = subprocess.run(
+        ["make", "-s", "-p", "-n", "-f", "Makefile", "clean"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     line = next(x for x in run.stdout.splitlines() if x.startswith("COMPILED_SOURCES :="))
     assert line.split(":=", 1)[1].split() == compiled

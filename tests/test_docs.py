@@ -16,13 +16,15 @@ OUTSIDE = re.compile(r"design\.md|\.\./shared|/work/|\bissue \d+|\bissues? #\d+"
 
 def _tracked_text_files() -> list[Path]:
     try:
-        listed = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True,
-                                check=True).stdout.split()
+        listed = subprocess.run(
+            ["git", "ls-files"], cwd=ROOT, capture_output=True, text=True, check=True
+        ).stdout.split()
     except (OSError, subprocess.CalledProcessError):
         pytest.skip("not a git checkout: the tracked files are unknown")
     suffixes = {".py", ".md", ".toml", ".xml", ".cfg", ".sumocfg", ".txt", ""}
-    return [ROOT / name for name in listed
-            if Path(name).suffix in suffixes and (ROOT / name).is_file()]
+    return [
+        ROOT / name for name in listed if Path(name).suffix in suffixes and (ROOT / name).is_file()
+    ]
 
 
 def test_readme_is_short():
@@ -45,8 +47,9 @@ def test_no_reference_to_files_outside_the_repository():
     for path in _tracked_text_files():
         if path.name == "test_docs.py":
             continue
-        for n, line in enumerate(path.read_text(encoding="utf-8", errors="replace")
-                                 .splitlines(), 1):
+        for n, line in enumerate(
+            path.read_text(encoding="utf-8", errors="replace").splitlines(), 1
+        ):
             if OUTSIDE.search(line):
                 found.append(f"{path.relative_to(ROOT)}:{n}: {line.strip()}")
     assert found == []

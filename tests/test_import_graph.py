@@ -35,8 +35,10 @@ def _imports(path: Path, modules: set[str]) -> set[str]:
 def _graph() -> dict[str, set[str]]:
     files = {_module_name(p): p for p in PACKAGE.rglob("*.py")}
     # a module's own parent packages are always initialised before it: no edge to them
-    return {m: {n for n in _imports(p, set(files)) if not (m + ".").startswith(n + ".")}
-            for m, p in files.items()}
+    return {
+        m: {n for n in _imports(p, set(files)) if not (m + ".").startswith(n + ".")}
+        for m, p in files.items()
+    }
 
 
 def _cycle(graph: dict[str, set[str]]) -> list[str] | None:
@@ -48,7 +50,7 @@ def _cycle(graph: dict[str, set[str]]) -> list[str] | None:
         stack.append(m)
         for n in sorted(graph.get(m, ())):
             if state.get(n) == 1:
-                return [*stack[stack.index(n):], n]
+                return [*stack[stack.index(n) :], n]
             if n not in state and (found := visit(n)):
                 return found
         stack.pop()

@@ -322,8 +322,10 @@ def test_check_matrix_refuses_a_stop_profile_for_a_scenario_without_an_aro(tmp_p
 
     cfg = ROOT / "scenarios" / "parked_only.sumocfg"  # the ego and parked cars: no ARO
     path = tmp_path / "m.toml"
-    path.write_text(f'[scenario]\nsumocfg = "{cfg.as_posix()}"\n'
-                    "[sweep]\nego_speed_kmh = [120]\nmu = [1.0]\naro_hold_s = [1.0]\n")
+    path.write_text(
+        f'[scenario]\nsumocfg = "{cfg.as_posix()}"\n'
+        "[sweep]\nego_speed_kmh = [120]\nmu = [1.0]\naro_hold_s = [1.0]\n"
+    )
     with pytest.raises(InputError, match=r"m\.toml: \[scenario\] sumocfg: .*eoam.role"):
         check_matrix(load_matrix(path))
 

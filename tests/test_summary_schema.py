@@ -32,14 +32,16 @@ def test_the_readme_names_every_results_column():
     named = {n.strip() for quoted in re.findall(r"`([^`]+)`", text) for n in quoted.split(",")}
     assert set(COLUMNS) - set(SUMMARY_COLUMNS) - named == set()
     listing = re.search(r"settings \(`([^`]+)`\)", text).group(1)
-    assert tuple(c.strip() for c in listing.split(",")) == COLUMNS[:len(PARAMETERS) - 1]
+    assert tuple(c.strip() for c in listing.split(",")) == COLUMNS[: len(PARAMETERS) - 1]
 
 
 def test_results_columns_are_the_parameters_status_and_every_summary_field():
     # every summary field is a column once: those that repeat a case parameter are that column
     assert set(COLUMNS) >= {RENAMED.get(f, f) for f in FIELDS}
-    assert tuple(c for c in (RENAMED.get(f, f) for f in FIELDS)
-                                    if c not in PARAMETERS) == SUMMARY_COLUMNS
+    assert (
+        tuple(c for c in (RENAMED.get(f, f) for f in FIELDS) if c not in PARAMETERS)
+        == SUMMARY_COLUMNS
+    )
     assert COLUMNS[: len(PARAMETERS) - 1] == PARAMETERS[:-1]
     assert COLUMNS[-1] == "sumocfg" and len(set(COLUMNS)) == len(COLUMNS)
     # numbers are the fields typed as numbers (or None), and nothing typed otherwise
@@ -51,8 +53,14 @@ def test_results_columns_are_the_parameters_status_and_every_summary_field():
 
 
 def test_every_timeseries_column_has_one_source():
-    sources = [*runlog._FROM_STATE, *runlog._FROM_MEAS, *runlog._FROM_CMD,
-               *runlog._FROM_PERCEPTION, runlog._SECTOR, runlog._ROAD_MU]
+    sources = [
+        *runlog._FROM_STATE,
+        *runlog._FROM_MEAS,
+        *runlog._FROM_CMD,
+        *runlog._FROM_PERCEPTION,
+        runlog._SECTOR,
+        runlog._ROAD_MU,
+    ]
     assert sorted(sources) == sorted(runlog.COLUMNS)
     assert set(runlog._FROM_MEAS.values()) <= set(EgoMeasurement._fields)
     assert set(runlog._FROM_CMD.values()) <= set(Command._fields)
@@ -63,8 +71,9 @@ def test_a_logged_step_lands_in_its_named_columns():
     log = runlog.RunLog(3)
     meas = EgoMeasurement(1.5, 30.0, 0.1, 0.02, -1.0, 0.5, 200.0, 0.25, 0.01, 0.0, 0.7, 3.5)
     x = [10.0, -1.75, 0.05, 30.0, 0.1, 0.02, 0.003, 100.0, 200.0]
-    cmd = Command(0.004, 110.0, 0.0, 2, True, "F", -2.0, 1.0, 3.0, 0.1, 0.2, 0.001, 0.002,
-                  0.0005, 29.0)
+    cmd = Command(
+        0.004, 110.0, 0.0, 2, True, "F", -2.0, 1.0, 3.0, 0.1, 0.2, 0.001, 0.002, 0.0005, 29.0
+    )
     log.add(meas, x, cmd, Perception(55.0, -12.0, True), 0.9)
     log.add(meas, x, None, None, 0.9)
     first, end = (dict(zip(runlog.COLUMNS, row)) for row in log.array())

@@ -15,11 +15,18 @@ from eoam_sumo.matrix import Case
 #: The files a case writes (``sim.runlog.write_run``), in the order they are written, by
 #: ``--timeseries`` format.
 TIMESERIES_FORMATS = ("csv", "parquet", "none")
-CASE_FILES_OF = {"csv": ("timeseries.csv", "traffic.csv", "summary.json"),
-                 "parquet": ("timeseries.parquet", "traffic.parquet", "summary.json"),
-                 "none": ("summary.json",)}
-ALL_CASE_FILES = ("timeseries.csv", "timeseries.parquet", "traffic.csv", "traffic.parquet",
-                  "summary.json")
+CASE_FILES_OF = {
+    "csv": ("timeseries.csv", "traffic.csv", "summary.json"),
+    "parquet": ("timeseries.parquet", "traffic.parquet", "summary.json"),
+    "none": ("summary.json",),
+}
+ALL_CASE_FILES = (
+    "timeseries.csv",
+    "timeseries.parquet",
+    "traffic.csv",
+    "traffic.parquet",
+    "summary.json",
+)
 #: Modules a worker imports before its first case, so start-up is not charged to a case.
 PRELOAD = ("eoam_sumo.sim.cosim",)
 
@@ -61,16 +68,20 @@ class CaseParameters:
 
     @classmethod
     def of(cls, case: Case) -> CaseParameters:
-        return cls(**{f.name: getattr(case, f.name) for f in fields(cls)
-                      if f.name != "sumocfg"}, sumocfg=str(case.sumocfg))
+        return cls(
+            **{f.name: getattr(case, f.name) for f in fields(cls) if f.name != "sumocfg"},
+            sumocfg=str(case.sumocfg),
+        )
 
 
 #: The parameter names, in order.
 PARAMETERS: tuple[str, ...] = tuple(f.name for f in fields(CaseParameters))
 #: The parameters that are numbers (or empty).
 NUMERIC_PARAMETERS: tuple[str, ...] = tuple(
-    name for name, tp in get_type_hints(CaseParameters).items()
-    if tp in (float, int, float | None, int | None))
+    name
+    for name, tp in get_type_hints(CaseParameters).items()
+    if tp in (float, int, float | None, int | None)
+)
 
 
 def case_parameters(case: Case) -> dict:
@@ -88,9 +99,19 @@ def run_matrix_case(task: CaseTask) -> dict:
 
     case = task.case
     settings = policy_settings(
-        RunSettings(max_time_s=case.max_time_s, tables_dir=task.tables_dir,
-                    mu_belief=case.mu_belief, radar_model=case.radar_model, seed=case.seed),
-        case.policy, case.v2x_range_m, case.v2x_latency_s, case.v2x_loss, case.v2x_penetration)
+        RunSettings(
+            max_time_s=case.max_time_s,
+            tables_dir=task.tables_dir,
+            mu_belief=case.mu_belief,
+            radar_model=case.radar_model,
+            seed=case.seed,
+        ),
+        case.policy,
+        case.v2x_range_m,
+        case.v2x_latency_s,
+        case.v2x_loss,
+        case.v2x_penetration,
+    )
     if case.radar_range_m is not None:
         settings = replace(settings, radar=RadarSettings(range_m=case.radar_range_m))
     extra = {"case": case_parameters(case)}
@@ -99,12 +120,25 @@ def run_matrix_case(task: CaseTask) -> dict:
         case_dir.mkdir(parents=True, exist_ok=True)
         for name in ALL_CASE_FILES:
             (case_dir / name).unlink(missing_ok=True)
-        summary = run_case(case.sumocfg, case.overrides(), case_dir, settings, extra=extra,
-                           timeseries=task.timeseries)
+        summary = run_case(
+            case.sumocfg,
+            case.overrides(),
+            case_dir,
+            settings,
+            extra=extra,
+            timeseries=task.timeseries,
+        )
         return {"summary": summary, "files": None}
     with tempfile.TemporaryDirectory(prefix="eoam-case-") as scratch:
-        summary = run_case(case.sumocfg, case.overrides(), Path(scratch), settings, extra=extra,
-                           timeseries=task.timeseries)
-        files = {name: (Path(scratch) / name).read_bytes()
-                 for name in CASE_FILES_OF[task.timeseries]}
+        summary = run_case(
+            case.sumocfg,
+            case.overrides(),
+            Path(scratch),
+            settings,
+            extra=extra,
+            timeseries=task.timeseries,
+        )
+        files = {
+            name: (Path(scratch) / name).read_bytes() for name in CASE_FILES_OF[task.timeseries]
+        }
     return {"summary": summary, "files": files}

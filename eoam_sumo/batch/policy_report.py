@@ -39,9 +39,11 @@ def policy_line(results: pd.DataFrame) -> str:
     line = f"Policy **{policy}**; forward radar {radar_text}"
     v2x = _first(results, "v2x_range_m", 0.0)
     if v2x and v2x > 0:
-        line += (f"; V2X range {v2x:g} m, latency {_first(results, 'v2x_latency_s'):g} s, "
-                 f"loss {_first(results, 'v2x_loss'):g}, penetration "
-                 f"{_first(results, 'v2x_penetration'):g}")
+        line += (
+            f"; V2X range {v2x:g} m, latency {_first(results, 'v2x_latency_s'):g} s, "
+            f"loss {_first(results, 'v2x_loss'):g}, penetration "
+            f"{_first(results, 'v2x_penetration'):g}"
+        )
     elif policy == "safe":
         line += "; no V2X"
     return line + "."
@@ -72,19 +74,25 @@ def sight_markdown(results: pd.DataFrame) -> str:
             mus.append(row["mu"])
         cells[(rows.index(key), mus.index(row["mu"]))] = _sight_cell(row)
     lines = [
-        "## Sight distance of each lane change (safe policy)", "",
-        ("Each cell: passing sight distance needed [m] / length of the next lane known free "
-        "[m], when the DMM first asked for the lane change; ✓ the gate let it begin, ✗ it "
-        "braked in lane instead; — no lane change was asked for; ∞ the ego would never get "
-        "past the obstacle."), "",
+        "## Sight distance of each lane change (safe policy)",
+        "",
+        (
+            "Each cell: passing sight distance needed [m] / length of the next lane known free "
+            "[m], when the DMM first asked for the lane change; ✓ the gate let it begin, ✗ it "
+            "braked in lane instead; — no lane change was asked for; ∞ the ego would never get "
+            "past the obstacle."
+        ),
+        "",
         "| Traffic | Initial ego speed | "
-        + " | ".join(f"{mu_text(mu)} surface mu" for mu in mus) + " |",
+        + " | ".join(f"{mu_text(mu)} surface mu" for mu in mus)
+        + " |",
         "|---|---|" + "---|" * len(mus),
     ]
     previous = None
     for i, (traffic, speed) in enumerate(rows):
         cols = [cells.get((i, j), "") for j in range(len(mus))]
-        lines.append(f"| {traffic if traffic != previous else ''} | {speed} | "
-                     + " | ".join(cols) + " |")
+        lines.append(
+            f"| {traffic if traffic != previous else ''} | {speed} | " + " | ".join(cols) + " |"
+        )
         previous = traffic
     return "\n".join(lines) + "\n"

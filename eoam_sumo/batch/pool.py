@@ -90,7 +90,9 @@ class _Worker:
         self.log = tempfile.TemporaryFile()  # noqa: SIM115 - lives as long as the worker
         self.proc = subprocess.Popen(
             [sys.executable, "-c", "from eoam_sumo.batch.pool import _child_main; _child_main()"],
-            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.log,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=self.log,
         )
         stdin, stdout = self.proc.stdin, self.proc.stdout
         assert stdin is not None and stdout is not None  # both are pipes
@@ -131,7 +133,8 @@ class _Worker:
             reason = self._death_reason()
             if not self.busy:
                 raise RuntimeError(
-                    f"a worker process ended before its first task: {reason}") from None
+                    f"a worker process ended before its first task: {reason}"
+                ) from None
             key, self.key = self.key, None
             assert key is not None  # busy
             return TaskResult(key, error=f"worker process died ({reason})")
@@ -267,8 +270,9 @@ def _check(jobs: int, timeout_s: float) -> None:
 _thread_local = threading.local()
 
 
-def _dask_task(func: Callable, key: str, payload: Any, timeout_s: float,
-               preload: tuple[str, ...]) -> TaskResult:
+def _dask_task(
+    func: Callable, key: str, payload: Any, timeout_s: float, preload: tuple[str, ...]
+) -> TaskResult:
     """Dask task body: run one task in this Dask thread's own long-lived worker process."""
     worker = getattr(_thread_local, "worker", None)
     if worker is None or not worker.alive:
@@ -299,8 +303,7 @@ def run_dask(
     _check(1, timeout_s)
     futures = {}
     for key, payload in tasks:
-        fut = client.submit(_dask_task, func, key, payload, timeout_s, tuple(preload),
-                            pure=False)
+        fut = client.submit(_dask_task, func, key, payload, timeout_s, tuple(preload), pure=False)
         futures[fut] = key
     for fut in as_completed(list(futures)):
         key = futures.pop(fut)

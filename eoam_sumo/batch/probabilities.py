@@ -20,8 +20,17 @@ PROBABILITIES_FILE = "outcome_probabilities.csv"
 OUTCOME_ORDER = ("none", "green", "unfinished", "yellow", "orange", "red")
 FAILED = "failed"
 #: Parameter columns that may identify a group (those constant within every group are kept).
-GROUP_COLUMNS = ("ego_speed_kmh", "mu", "oncoming_start_m", "aro_hold_s", "aro_decel_mps2",
-                 "max_time_s", "radar_range_m", "mu_belief", "radar_model")
+GROUP_COLUMNS = (
+    "ego_speed_kmh",
+    "mu",
+    "oncoming_start_m",
+    "aro_hold_s",
+    "aro_decel_mps2",
+    "max_time_s",
+    "radar_range_m",
+    "mu_belief",
+    "radar_model",
+)
 _DRAW_SUFFIX = re.compile(r"_d\d+$")
 
 
@@ -36,13 +45,15 @@ def _outcomes(results: pd.DataFrame) -> pd.Series:
 
 def outcome_probabilities(results: pd.DataFrame) -> pd.DataFrame:
     """The outcome probabilities of a results frame (``runner.read_results``) of draws."""
-    results = results.assign(group=results["case_id"].map(group_of),
-                             _outcome=_outcomes(results))
+    results = results.assign(group=results["case_id"].map(group_of), _outcome=_outcomes(results))
     seen = set(results["_outcome"])
     order = [o for o in OUTCOME_ORDER if o != "unfinished" or o in seen]  # listed at 0 too
     order += sorted(seen - set(order) - {FAILED}) + ([FAILED] if FAILED in seen else [])
-    keep = [c for c in GROUP_COLUMNS
-            if (results.groupby("group", sort=False)[c].nunique(dropna=False) <= 1).all()]
+    keep = [
+        c
+        for c in GROUP_COLUMNS
+        if (results.groupby("group", sort=False)[c].nunique(dropna=False) <= 1).all()
+    ]
     rows = []
     for group, draws in results.groupby("group", sort=False):
         n = len(draws)
@@ -50,9 +61,18 @@ def outcome_probabilities(results: pd.DataFrame) -> pd.DataFrame:
         for outcome in order:
             count = int((draws["_outcome"] == outcome).sum())
             low, high = wilson_interval(count, n)
-            rows.append({"group": group, **{c: first[c] for c in keep}, "outcome": outcome,
-                         "count": count, "n": n, "p": count / n, "ci_low": low,
-                         "ci_high": high})
+            rows.append(
+                {
+                    "group": group,
+                    **{c: first[c] for c in keep},
+                    "outcome": outcome,
+                    "count": count,
+                    "n": n,
+                    "p": count / n,
+                    "ci_low": low,
+                    "ci_high": high,
+                }
+            )
     return pd.DataFrame(rows)
 
 

@@ -67,16 +67,18 @@ class OutcomeGrid:
         that were not green (own sweep)."""
         keys = sorted(self.cells)
         if self.has_paper:
-            return [self.cells[k] for k in keys if self.cells[k].compared
-                    and not self.cells[k].agrees]
+            return [
+                self.cells[k] for k in keys if self.cells[k].compared and not self.cells[k].agrees
+            ]
         return [self.cells[k] for k in keys if self.cells[k].ours != "green"]
 
 
 def traffic_label(oncoming_start_m: float, scenario_traffic: bool = False) -> str:
     """A row's traffic: the oncoming car the co-simulation added, else whether the runs
     without one had oncoming traffic of their scenario (``oncoming_traffic``)."""
-    if oncoming_start_m is None or (isinstance(oncoming_start_m, float)
-                                    and math.isnan(oncoming_start_m)):
+    if oncoming_start_m is None or (
+        isinstance(oncoming_start_m, float) and math.isnan(oncoming_start_m)
+    ):
         return "Scenario's oncoming traffic" if scenario_traffic else "No oncoming"
     return f"Oncoming, {oncoming_start_m:g} m"
 
@@ -90,8 +92,10 @@ def _detail(row) -> str:
         parts.append(f"modes {row['modes_visited']}")
     if row["collision_with"] and row["collision_with"] != "none":
         v = float(row["impact_speed_mps"])
-        parts.append(f"hit {row['collision_with']} ({row['contact_kind']}) at {v:.1f} m/s "
-                     f"({v * 3.6:.0f} km/h)")
+        parts.append(
+            f"hit {row['collision_with']} ({row['contact_kind']}) at {v:.1f} m/s "
+            f"({v * 3.6:.0f} km/h)"
+        )
     else:
         parts.append("no contact")
     return "; ".join(parts)
@@ -103,16 +107,21 @@ def _figure(value, unit: str) -> str:
 
 def _margins(row) -> str:
     """'ARO 0.49 m · oncoming 0.54 m · TTC 1.03 s' (— where there was none)."""
-    return (f"ARO {_figure(row.get('min_gap_aro_m'), 'm')} · oncoming "
-            f"{_figure(row.get('min_gap_oncoming_m'), 'm')} · TTC "
-            f"{_figure(row.get('min_ttc_oncoming_s'), 's')}")
+    return (
+        f"ARO {_figure(row.get('min_gap_aro_m'), 'm')} · oncoming "
+        f"{_figure(row.get('min_gap_oncoming_m'), 'm')} · TTC "
+        f"{_figure(row.get('min_ttc_oncoming_s'), 's')}"
+    )
 
 
 def outcome_grid(results: pd.DataFrame) -> OutcomeGrid:
     """The grid of a results frame (``runner.read_results``), the paper's colours from its
     ``paper_outcome`` column (empty where unpublished)."""
-    varying = [(col, fmt) for col, fmt in _EXTRA_PARAMS
-               if results[col].notna().any() and results[col].nunique(dropna=False) > 1]
+    varying = [
+        (col, fmt)
+        for col, fmt in _EXTRA_PARAMS
+        if results[col].notna().any() and results[col].nunique(dropna=False) > 1
+    ]
     rows: list[tuple[str, str]] = []
     mus: list[float] = []
     cells = {}
@@ -121,18 +130,24 @@ def outcome_grid(results: pd.DataFrame) -> OutcomeGrid:
     for _, row in results.iterrows():
         speed = f"{row['ego_speed_kmh']:g} km/h"
         extra = [fmt.format(row[col]) for col, fmt in varying if pd.notna(row[col])]
-        key = (traffic_label(row["oncoming_start_m"], scenario_traffic),
-               ", ".join([speed, *extra]))
+        key = (traffic_label(row["oncoming_start_m"], scenario_traffic), ", ".join([speed, *extra]))
         if key not in rows:
             rows.append(key)
         if row["mu"] not in mus:
             mus.append(row["mu"])
         ours = row["outcome"] if row["status"] == "ok" else FAILED
         cells[(rows.index(key), mus.index(row["mu"]))] = Cell(
-            row["case_id"], ours, row["paper_outcome"] or None, row["case_dir"], _detail(row),
-            str(row.get("near_miss", "")) == "True", _margins(row))
-    return OutcomeGrid(tuple(rows), tuple(mus), cells,
-                       has_paper=any(c.paper for c in cells.values()))
+            row["case_id"],
+            ours,
+            row["paper_outcome"] or None,
+            row["case_dir"],
+            _detail(row),
+            str(row.get("near_miss", "")) == "True",
+            _margins(row),
+        )
+    return OutcomeGrid(
+        tuple(rows), tuple(mus), cells, has_paper=any(c.paper for c in cells.values())
+    )
 
 
 def mu_text(mu: float) -> str:
@@ -156,13 +171,17 @@ def _ref(cell: Cell, n: int) -> str:
 def table2_markdown(grid: OutcomeGrid, title: str = "Table 2") -> str:
     """The grid as markdown: ours / paper per cell, the agreement count, the differences."""
     listed = {c.case_id: i for i, c in enumerate(grid.differing(), start=1)}
-    lines = [f"# {title}: EOAM outcomes" + (" — this run / the paper" if grid.has_paper else ""),
-             ""]
+    lines = [
+        f"# {title}: EOAM outcomes" + (" — this run / the paper" if grid.has_paper else ""),
+        "",
+    ]
     ours = [c.ours for c in grid.cells.values()]
     if grid.has_paper:
         lines += [
-            ("Each cell: **ours** / paper (Lowe & Guvenc, Table 2). "
-             f"**{grid.agreeing}/{grid.compared} cells agree.**"),
+            (
+                "Each cell: **ours** / paper (Lowe & Guvenc, Table 2). "
+                f"**{grid.agreeing}/{grid.compared} cells agree.**"
+            ),
             "",
             f"- ours: {_counts(ours)}",
             f"- paper: {_counts([c.paper for c in grid.cells.values() if c.paper])}",
@@ -170,8 +189,11 @@ def table2_markdown(grid: OutcomeGrid, title: str = "Table 2") -> str:
         ]
     else:
         lines += [f"Our outcomes ({len(ours)} cases): {_counts(ours)}.", ""]
-    lines.append("| Traffic | Initial ego speed | "
-                 + " | ".join(f"{mu_text(mu)} surface mu" for mu in grid.mus) + " |")
+    lines.append(
+        "| Traffic | Initial ego speed | "
+        + " | ".join(f"{mu_text(mu)} surface mu" for mu in grid.mus)
+        + " |"
+    )
     lines.append("|---|---|" + "---|" * len(grid.mus))
     previous = None
     for i, (traffic, speed) in enumerate(grid.rows):
@@ -189,12 +211,18 @@ def table2_markdown(grid: OutcomeGrid, title: str = "Table 2") -> str:
             if cell.case_id in listed:
                 text += f" {'✗ ' if grid.has_paper else ''}{_ref(cell, listed[cell.case_id])}"
             cols.append(text)
-        lines.append(f"| {traffic if traffic != previous else ''} | {speed} | "
-                     + " | ".join(cols) + " |")
+        lines.append(
+            f"| {traffic if traffic != previous else ''} | {speed} | " + " | ".join(cols) + " |"
+        )
         previous = traffic
-    lines += ["", "Legend: " + "; ".join(f"{MARKERS[c]} {c}: {LEGEND[c]}" for c in LEGEND)
-              + f"; {NEAR_MISS_MARK} near miss: no contact, but within 0.5 m of a road user or "
-              "a time to collision with oncoming traffic under 1.5 s", ""]
+    lines += [
+        "",
+        "Legend: "
+        + "; ".join(f"{MARKERS[c]} {c}: {LEGEND[c]}" for c in LEGEND)
+        + f"; {NEAR_MISS_MARK} near miss: no contact, but within 0.5 m of a road user or "
+        "a time to collision with oncoming traffic under 1.5 s",
+        "",
+    ]
     differing = grid.differing()
     heading = "Cells that differ from the paper" if grid.has_paper else "Cases that were not green"
     lines += [f"## {heading} ({len(differing)})", ""]
@@ -202,10 +230,14 @@ def table2_markdown(grid: OutcomeGrid, title: str = "Table 2") -> str:
     for n, cell in enumerate(differing, start=1):
         (traffic, speed), mu = grid.rows[where[cell.case_id][0]], grid.mus[where[cell.case_id][1]]
         versus = f"ours {_mark(cell.ours)}" + (f", paper {_mark(cell.paper)}" if cell.paper else "")
-        link = ("" if cell.ours == FAILED
-                else f" [{cell.case_dir}/summary.json]({cell.case_dir}/summary.json)")
-        lines.append(f"{n}. **{traffic}, {speed}, mu {mu_text(mu)}** — {versus}: "
-                     f"{cell.detail}.{link}")
+        link = (
+            ""
+            if cell.ours == FAILED
+            else f" [{cell.case_dir}/summary.json]({cell.case_dir}/summary.json)"
+        )
+        lines.append(
+            f"{n}. **{traffic}, {speed}, mu {mu_text(mu)}** — {versus}: {cell.detail}.{link}"
+        )
     if not differing:
         lines.append("None.")
     lines += ["", *margins_markdown(grid)]
@@ -216,21 +248,32 @@ def margins_markdown(grid: OutcomeGrid) -> list[str]:
     """Each cell's margins in the grid's layout: the smallest gap to the in-lane obstacle and
     to oncoming traffic, the smallest time to collision with it; near misses marked."""
     near = sum(c.near_miss for c in grid.cells.values())
-    lines = [f"## Margins ({near} near miss{'es' if near != 1 else ''})", "",
-             ("Each cell: smallest box gap to the obstacle (ARO) · to opposite-direction traffic "
-              "· smallest time to collision with it (— none); "
-              f"{NEAR_MISS_MARK} near miss."), "",
-             "| Traffic | Initial ego speed | "
-             + " | ".join(f"{mu_text(mu)} surface mu" for mu in grid.mus) + " |",
-             "|---|---|" + "---|" * len(grid.mus)]
+    lines = [
+        f"## Margins ({near} near miss{'es' if near != 1 else ''})",
+        "",
+        (
+            "Each cell: smallest box gap to the obstacle (ARO) · to opposite-direction traffic "
+            "· smallest time to collision with it (— none); "
+            f"{NEAR_MISS_MARK} near miss."
+        ),
+        "",
+        "| Traffic | Initial ego speed | "
+        + " | ".join(f"{mu_text(mu)} surface mu" for mu in grid.mus)
+        + " |",
+        "|---|---|" + "---|" * len(grid.mus),
+    ]
     previous = None
     for i, (traffic, speed) in enumerate(grid.rows):
         cols = []
         for j in range(len(grid.mus)):
             cell = grid.cells.get((i, j))
-            cols.append("" if cell is None else
-                        cell.margins + (f" {NEAR_MISS_MARK}" if cell.near_miss else ""))
-        lines.append(f"| {traffic if traffic != previous else ''} | {speed} | "
-                     + " | ".join(cols) + " |")
+            cols.append(
+                ""
+                if cell is None
+                else cell.margins + (f" {NEAR_MISS_MARK}" if cell.near_miss else "")
+            )
+        lines.append(
+            f"| {traffic if traffic != previous else ''} | {speed} | " + " | ".join(cols) + " |"
+        )
         previous = traffic
     return lines

@@ -29,12 +29,21 @@ RENAMED = {"mu": "mu_at_start"}
 PARAM_COLUMNS = tuple(p for p in PARAMETERS if p != "sumocfg")
 #: the summary's fields, but those that repeat a case parameter (policy, V2X settings)
 SUMMARY_COLUMNS = tuple(c for c in (RENAMED.get(f, f) for f in FIELDS) if c not in PARAMETERS)
-COLUMNS = (*PARAM_COLUMNS, "status", "paper_outcome", *SUMMARY_COLUMNS, "error", "case_dir",
-           "sumocfg")
+COLUMNS = (
+    *PARAM_COLUMNS,
+    "status",
+    "paper_outcome",
+    *SUMMARY_COLUMNS,
+    "error",
+    "case_dir",
+    "sumocfg",
+)
 #: Columns that measure the machine, not the physics: they differ between runs.
 TIMING_COLUMNS = TIMING_FIELDS
-NUMERIC_COLUMNS = (*NUMERIC_PARAMETERS, *(
-    c for c in (RENAMED.get(f, f) for f in NUMERIC_FIELDS) if c in SUMMARY_COLUMNS))
+NUMERIC_COLUMNS = (
+    *NUMERIC_PARAMETERS,
+    *(c for c in (RENAMED.get(f, f) for f in NUMERIC_FIELDS) if c in SUMMARY_COLUMNS),
+)
 
 
 def case_dir_of(case_id: str) -> str:
@@ -51,8 +60,10 @@ def result_row(case: Case, result: TaskResult, paper_outcome: str | None = None)
     row.update(paper_outcome=paper_outcome, case_dir=case_dir_of(case.case_id))
     summary = result.value.get("summary") if isinstance(result.value, dict) else None
     if not result.ok or not isinstance(summary, dict):
-        row.update(status="failed",
-                   error=_one_line(result.error or "the case function returned no summary"))
+        row.update(
+            status="failed",
+            error=_one_line(result.error or "the case function returned no summary"),
+        )
         return row
     row["status"] = "ok"
     for key, value in summary.items():
@@ -93,8 +104,10 @@ def read_rows(path: Path) -> pd.DataFrame:
     except (pd.errors.ParserError, ValueError) as exc:
         raise InputError(f"{path}: cannot be read as a results file: {exc}") from exc
     if tuple(frame.columns) != COLUMNS:
-        raise InputError(f"{path}: its columns are not those of this version's results.csv; "
-                         "use another --out folder or remove the file")
+        raise InputError(
+            f"{path}: its columns are not those of this version's results.csv; "
+            "use another --out folder or remove the file"
+        )
     return frame
 
 
@@ -132,8 +145,10 @@ RESUME_KEYS = tuple(p for p in PARAMETERS if p not in ("case_id", "draw"))
 def _case_keys(cases: list[Case]) -> dict[str, tuple[str, ...]]:
     """case_id -> its ``RESUME_KEYS`` settings as results.csv writes them."""
     params = [asdict(CaseParameters.of(c)) for c in cases]
-    frame = pd.DataFrame([(p["case_id"], *(p[k] for k in RESUME_KEYS)) for p in params],
-                         columns=["case_id", *RESUME_KEYS])
+    frame = pd.DataFrame(
+        [(p["case_id"], *(p[k] for k in RESUME_KEYS)) for p in params],
+        columns=["case_id", *RESUME_KEYS],
+    )
     text = pd.read_csv(io.StringIO(frame.to_csv(index=False)), dtype=str, keep_default_na=False)
     return {r[0]: tuple(r[1:]) for r in text.itertuples(index=False)}
 
@@ -144,8 +159,10 @@ def kept_rows(path: Path, cases: list[Case]) -> pd.DataFrame:
     results.csv)."""
     rows = read_rows(path)
     want = _case_keys(cases)
-    same = [want.get(cid) == key for cid, key in zip(
-        rows["case_id"], zip(*(rows[k] for k in RESUME_KEYS)))]
+    same = [
+        want.get(cid) == key
+        for cid, key in zip(rows["case_id"], zip(*(rows[k] for k in RESUME_KEYS)))
+    ]
     keep = (rows["status"] == "ok").to_numpy() & pd.Series(same, dtype=bool).to_numpy()
     return rows[keep].drop_duplicates("case_id", keep="last")
 

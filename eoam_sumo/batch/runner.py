@@ -53,6 +53,7 @@ EXIT_CASES_FAILED = 1
 #: How long to keep trying to reach a Dask scheduler [s].
 DASK_CONNECT_TIMEOUT_S = 20.0
 
+
 def _store_case_files(case_dir: Path, result: TaskResult, ok: bool) -> None:
     """Write the files a remote case sent back; a failed case leaves no older run's files."""
     files = result.value.get("files") if ok else None
@@ -75,10 +76,15 @@ def _dask_client(scheduler: str, jobs: int):
         from dask.distributed import Client, LocalCluster
     except ImportError as exc:
         raise InputError(
-            f"--scheduler needs dask.distributed, which is not installed: {exc}") from exc
+            f"--scheduler needs dask.distributed, which is not installed: {exc}"
+        ) from exc
     if scheduler == "local":
-        with LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True,
-                          dashboard_address=None) as cluster, Client(cluster) as client:
+        with (
+            LocalCluster(
+                n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None
+            ) as cluster,
+            Client(cluster) as client,
+        ):
             yield client
         return
     try:
@@ -89,21 +95,32 @@ def _dask_client(scheduler: str, jobs: int):
         yield client
 
 
-def _results(to_run: list[Case], out_dir: Path, jobs: int, scheduler: str | None,
-             timeout_s: float, case_func: Callable, tables_dir: Path | None,
-             timeseries: str = "csv") -> Iterator[tuple[Case, TaskResult]]:
+def _results(
+    to_run: list[Case],
+    out_dir: Path,
+    jobs: int,
+    scheduler: str | None,
+    timeout_s: float,
+    case_func: Callable,
+    tables_dir: Path | None,
+    timeseries: str = "csv",
+) -> Iterator[tuple[Case, TaskResult]]:
     by_id = {c.case_id: c for c in to_run}
     preload = PRELOAD if case_func is run_matrix_case else ()
     if scheduler is None:
-        tasks = [(c.case_id, CaseTask(c, out_dir / case_dir_of(c.case_id), tables_dir,
-                                      timeseries)) for c in to_run]
+        tasks = [
+            (c.case_id, CaseTask(c, out_dir / case_dir_of(c.case_id), tables_dir, timeseries))
+            for c in to_run
+        ]
         with contextlib.closing(run_local(case_func, tasks, jobs, timeout_s, preload)) as it:
             for result in it:
                 yield by_id[result.key], result
         return
     tasks = [(c.case_id, CaseTask(c, None, tables_dir, timeseries)) for c in to_run]
-    with (_dask_client(scheduler, jobs) as client,
-          contextlib.closing(run_dask(case_func, tasks, client, timeout_s, preload)) as it):
+    with (
+        _dask_client(scheduler, jobs) as client,
+        contextlib.closing(run_dask(case_func, tasks, client, timeout_s, preload)) as it,
+    ):
         for result in it:
             yield by_id[result.key], result
 
@@ -139,8 +156,9 @@ def run_batch(
     if not timeout_s > 0:
         raise InputError(f"--timeout-s {timeout_s!r} must be > 0")
     if timeseries not in TIMESERIES_FORMATS:
-        raise InputError(f"--timeseries {timeseries!r} is not one of "
-                         f"{', '.join(TIMESERIES_FORMATS)}")
+        raise InputError(
+            f"--timeseries {timeseries!r} is not one of {', '.join(TIMESERIES_FORMATS)}"
+        )
     matrix: Matrix = load_matrix(Path(matrix_path))
     check_matrix(matrix, tables_dir)
     cases = matrix.cases()
@@ -151,17 +169,28 @@ def run_batch(
         (out_dir / CASES_DIR).mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise InputError(f"output folder {out_dir} cannot be written: {exc.strerror}") from exc
-    kept = (kept_rows(results_path, cases) if resume and results_path.is_file()
-            else pd.DataFrame(columns=list(COLUMNS), dtype=str))
+    kept = (
+        kept_rows(results_path, cases)
+        if resume and results_path.is_file()
+        else pd.DataFrame(columns=list(COLUMNS), dtype=str)
+    )
     done = set(kept["case_id"])
     to_run = [c for c in cases if c.case_id not in done]
     log = RowLog(results_path, kept)
-    bar = tqdm(total=len(cases), initial=len(done), unit="case", desc="cases", file=sys.stderr,
-               disable=not progress, dynamic_ncols=True)
+    bar = tqdm(
+        total=len(cases),
+        initial=len(done),
+        unit="case",
+        desc="cases",
+        file=sys.stderr,
+        disable=not progress,
+        dynamic_ncols=True,
+    )
     failed = 0
     try:
-        for case, result in _results(to_run, out_dir, jobs, scheduler, timeout_s, case_func,
-                                     tables_dir, timeseries):
+        for case, result in _results(
+            to_run, out_dir, jobs, scheduler, timeout_s, case_func, tables_dir, timeseries
+        ):
             row = result_row(case, result, paper.get(case.case_id))
             _store_case_files(out_dir / case_dir_of(case.case_id), result, row["status"] == "ok")
             log.add(row)
@@ -193,8 +222,11 @@ def write_report(out_dir: Path, results: pd.DataFrame) -> list[Path]:
     sight = sight_markdown(results)
     text = f"{head}\n\n{policy_line(results)}\n\n{rest}" + (f"\n{sight}" if sight else "")
     md = write_atomic(out_dir / TABLE_MD, text)
-    return [md, plot_table2(grid, out_dir / TABLE_PNG),
-            plot_margins(results, out_dir / MARGINS_PNG)]
+    return [
+        md,
+        plot_table2(grid, out_dir / TABLE_PNG),
+        plot_margins(results, out_dir / MARGINS_PNG),
+    ]
 
 
 def _raise_interrupt(signum, frame):
@@ -212,22 +244,37 @@ def run_batch_cli(args) -> int:
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGTERM, _raise_interrupt)
     try:
-        results = run_batch(args.matrix, args.out, jobs=args.jobs, scheduler=args.scheduler,
-                            resume=args.resume, timeout_s=args.timeout_s,
-                            progress=not args.no_progress, timeseries=args.timeseries)
+        results = run_batch(
+            args.matrix,
+            args.out,
+            jobs=args.jobs,
+            scheduler=args.scheduler,
+            resume=args.resume,
+            timeout_s=args.timeout_s,
+            progress=not args.no_progress,
+            timeseries=args.timeseries,
+        )
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
     failed = results[results["status"] != "ok"]
     results_path = Path(args.out) / RESULTS_FILE
-    report = ("outcome probabilities in " + str(Path(args.out) / "outcome_probabilities.csv")
-              if results["draw"].notna().any() else f"Table 2 in {Path(args.out) / 'table2.md'}")
-    print(f"{len(results)} cases, {len(results) - len(failed)} ok, {len(failed)} failed; "
-          f"results in {results_path}, {report}")
+    report = (
+        "outcome probabilities in " + str(Path(args.out) / "outcome_probabilities.csv")
+        if results["draw"].notna().any()
+        else f"Table 2 in {Path(args.out) / 'table2.md'}"
+    )
+    print(
+        f"{len(results)} cases, {len(results) - len(failed)} ok, {len(failed)} failed; "
+        f"results in {results_path}, {report}"
+    )
     if failed.empty:
         return 0
     for _, row in failed.iterrows():
         print(f"failed: {row['case_id']}: {row['error']}", file=sys.stderr)
-    print(f"eoam-sumo: {len(failed)} of {len(results)} cases failed; their errors are in the "
-          f"'error' column of {results_path}", file=sys.stderr)
+    print(
+        f"eoam-sumo: {len(failed)} of {len(results)} cases failed; their errors are in the "
+        f"'error' column of {results_path}",
+        file=sys.stderr,
+    )
     return EXIT_CASES_FAILED

@@ -28,8 +28,11 @@ _BISECTIONS = 48
 
 def _advance(y: float, v: float, a: float, jerk: float, t: float) -> tuple[float, float, float]:
     """State after ``t`` seconds of constant jerk."""
-    return (y + t * (v + t * (0.5 * a + t * jerk / 6.0)), v + t * (a + 0.5 * t * jerk),
-            a + jerk * t)
+    return (
+        y + t * (v + t * (0.5 * a + t * jerk / 6.0)),
+        v + t * (a + 0.5 * t * jerk),
+        a + jerk * t,
+    )
 
 
 def _speed_zeros(v: float, a: float, jerk: float, dur: float) -> list[float]:
@@ -51,13 +54,22 @@ class MinTimeShift:
 
     __slots__ = ("_segs", "duration_s", "length_m", "speed_mps", "y1_m", "y_end_m")
 
-    def __init__(self, y0_m: float, v0_mps: float, a0_mps2: float, y1_m: float,
-                 speed_mps: float, accel_mps2: float, ramp_s: float):
+    def __init__(
+        self,
+        y0_m: float,
+        v0_mps: float,
+        a0_mps2: float,
+        y1_m: float,
+        speed_mps: float,
+        accel_mps2: float,
+        ramp_s: float,
+    ):
         if not (accel_mps2 > 0.0 and ramp_s > 0.0 and speed_mps > 0.0):
             raise ValueError("accel_mps2, ramp_s and speed_mps must be > 0")
         if not all(math.isfinite(x) for x in (y0_m, v0_mps, a0_mps2, y1_m)):
-            raise ValueError(f"escape y0={y0_m!r}, v0={v0_mps!r}, a0={a0_mps2!r}, "
-                             f"y1={y1_m!r} not all finite")
+            raise ValueError(
+                f"escape y0={y0_m!r}, v0={v0_mps!r}, a0={a0_mps2!r}, y1={y1_m!r} not all finite"
+            )
         self.speed_mps = float(speed_mps)
         self.y1_m = float(y1_m)
         big_a, jerk = accel_mps2, accel_mps2 / ramp_s
@@ -65,8 +77,9 @@ class MinTimeShift:
         # are tried where the target is reachable without passing it, the quicker kept
         best = None
         for sign in (1.0, -1.0):
-            found = self._solve((sign * y0_m, sign * v0_mps, sign * a0_mps2), sign * y1_m,
-                                big_a, jerk)
+            found = self._solve(
+                (sign * y0_m, sign * v0_mps, sign * a0_mps2), sign * y1_m, big_a, jerk
+            )
             if found is not None and (best is None or found[0] < best[1][0]):
                 best = (sign, found)
         if best is None:  # too fast towards the target to stop there: brake at once
@@ -88,8 +101,7 @@ class MinTimeShift:
         self.y_end_m = sign * y
 
     @classmethod
-    def _solve(cls, state, target: float, big_a: float, jerk: float
-               ) -> tuple[float, list] | None:
+    def _solve(cls, state, target: float, big_a: float, jerk: float) -> tuple[float, list] | None:
         """(duration, segments) of the profile towards + that ends at ``target``, or None
         when no switching time ends there."""
 
@@ -113,8 +125,9 @@ class MinTimeShift:
         return sum(dur for dur, _ in segs), segs
 
     @staticmethod
-    def _profile(state, t_switch: float, big_a: float, jerk: float,
-                 segs: list | None) -> tuple[float, float, float]:
+    def _profile(
+        state, t_switch: float, big_a: float, jerk: float, segs: list | None
+    ) -> tuple[float, float, float]:
         """End state of the profile switching at ``t_switch`` (appending its segments)."""
         y, v, a = state
 
@@ -205,8 +218,9 @@ class MinTimeShift:
         v = self.speed_mps
         y, vy, ay = self.state_at(dx_m / v)
         slope = vy / v
-        return TrajectoryPoint(y, 0.0, math.atan(slope), ay / (v * v) / (1.0 + slope * slope)
-                               ** 1.5, 0.0)
+        return TrajectoryPoint(
+            y, 0.0, math.atan(slope), ay / (v * v) / (1.0 + slope * slope) ** 1.5, 0.0
+        )
 
 
 def lateral_state(meas) -> tuple[float, float, float]:
@@ -216,8 +230,11 @@ def lateral_state(meas) -> tuple[float, float, float]:
     e = meas.e_yaw_rad
     c, s = math.cos(e), math.sin(e)
     along = max(1.0, meas.vx_mps * c - meas.vy_mps * s)
-    return (meas.vx_mps * s + meas.vy_mps * c,
-            meas.ay_mps2 - meas.road_curvature_1pm * along * along, along)
+    return (
+        meas.vx_mps * s + meas.vy_mps * c,
+        meas.ay_mps2 - meas.road_curvature_1pm * along * along,
+        along,
+    )
 
 
 def course_state(meas) -> tuple[float, float, float]:

@@ -112,19 +112,36 @@ class PathReference:
             i = int(u)
             w = u - i
             j = i + 1
-            y, yaw, k, ax, v, st, beta = (self._y, self._yaw, self._k, self._ax, self._v,
-                                          self._steer, self._beta)
-            return _new(PathPoint, (
-                y[i] + w * (y[j] - y[i]),
-                yaw[i] + w * (yaw[j] - yaw[i]),
-                k[i] + w * (k[j] - k[i]),
-                ax[i] + w * (ax[j] - ax[i]),
-                v[i] + w * (v[j] - v[i]),
-                st[i] + w * (st[j] - st[i]),
-                beta[i] + w * (beta[j] - beta[i]),
-            ))
-        return PathPoint(self._y[i], self._yaw[i], self._k[i], self._ax[i], self._v[i],
-                         self._steer[i], self._beta[i])
+            y, yaw, k, ax, v, st, beta = (
+                self._y,
+                self._yaw,
+                self._k,
+                self._ax,
+                self._v,
+                self._steer,
+                self._beta,
+            )
+            return _new(
+                PathPoint,
+                (
+                    y[i] + w * (y[j] - y[i]),
+                    yaw[i] + w * (yaw[j] - yaw[i]),
+                    k[i] + w * (k[j] - k[i]),
+                    ax[i] + w * (ax[j] - ax[i]),
+                    v[i] + w * (v[j] - v[i]),
+                    st[i] + w * (st[j] - st[i]),
+                    beta[i] + w * (beta[j] - beta[i]),
+                ),
+            )
+        return PathPoint(
+            self._y[i],
+            self._yaw[i],
+            self._k[i],
+            self._ax[i],
+            self._v[i],
+            self._steer[i],
+            self._beta[i],
+        )
 
 
 PEAK_SAMPLES = 200  # intervals over which a shift's peak curvature is checked
@@ -150,19 +167,28 @@ class QuinticShift:
 
     __slots__ = ("_c", "length_m", "y1_m")
 
-    def __init__(self, y0_m: float, slope0: float, y1_m: float, length_m: float,
-                 curvature0_1pm: float = 0.0):
+    def __init__(
+        self, y0_m: float, slope0: float, y1_m: float, length_m: float, curvature0_1pm: float = 0.0
+    ):
         if not (math.isfinite(length_m) and length_m > 0.0):
             raise ValueError(f"quintic length_m={length_m!r} must be finite and > 0")
         if not all(math.isfinite(v) for v in (y0_m, slope0, y1_m, curvature0_1pm)):
-            raise ValueError(f"quintic y0={y0_m!r}, slope0={slope0!r}, y1={y1_m!r}, "
-                             f"curvature0={curvature0_1pm!r} not all finite")
+            raise ValueError(
+                f"quintic y0={y0_m!r}, slope0={slope0!r}, y1={y1_m!r}, "
+                f"curvature0={curvature0_1pm!r} not all finite"
+            )
         p = slope0 * length_m
         c2 = 0.5 * curvature0_1pm * length_m * length_m
         # what the u^3..u^5 terms must add to y, dy/du and d2y/du2 at u = 1
         e, f, g = y1_m - y0_m - p - c2, -p - 2.0 * c2, -2.0 * c2
-        self._c = (y0_m, p, c2, 10.0 * e - 4.0 * f + 0.5 * g, -15.0 * e + 7.0 * f - g,
-                   6.0 * e - 3.0 * f + 0.5 * g)
+        self._c = (
+            y0_m,
+            p,
+            c2,
+            10.0 * e - 4.0 * f + 0.5 * g,
+            -15.0 * e + 7.0 * f - g,
+            6.0 * e - 3.0 * f + 0.5 * g,
+        )
         self.length_m = float(length_m)
         self.y1_m = float(y1_m)
 
@@ -217,8 +243,9 @@ class QuinticShift:
         # from the shortest allowed: short shifts pass the target least
         length = max(min_length_m, 0.3 * rest) if slope0 == 0.0 else min_length_m
         # far enough to turn a lateral motion away from y1 round and come back
-        top = 4.0 * min_length_m + 8.0 * (rest + abs(slope0) * speed_mps * speed_mps
-                                           / lateral_accel_mps2)
+        top = 4.0 * min_length_m + 8.0 * (
+            rest + abs(slope0) * speed_mps * speed_mps / lateral_accel_mps2
+        )
         best, best_peak = None, math.inf
         while length <= top:
             traj = cls(y0_m, slope0, y1_m, length, curvature0_1pm)
@@ -268,8 +295,15 @@ class QuinticShift:
         hi = max(4.0 * lo, 0.05)
 
         def shift(dist: float) -> QuinticShift:
-            return cls.for_lateral_accel(y0_m, slope0, y0_m + side * dist, speed_mps,
-                                         lateral_accel_mps2, min_length_m, curvature0_1pm)
+            return cls.for_lateral_accel(
+                y0_m,
+                slope0,
+                y0_m + side * dist,
+                speed_mps,
+                lateral_accel_mps2,
+                min_length_m,
+                curvature0_1pm,
+            )
 
         best = shift(hi)
         while not best.within(speed_mps, lateral_accel_mps2) and hi < 50.0:

@@ -104,12 +104,14 @@ def single_track_matrices(params: VehicleParams, speed_mps: float):
     m, iz = params.mass_kg, params.yaw_inertia_kgm2
     a, b = params.cg_to_front_m, params.cg_to_rear_m
     cf, cr, v = params.cornering_stiffness_front_npr, params.cornering_stiffness_rear_npr, speed_mps
-    A = np.array([
-        [-(cf + cr) / (m * v), -(a * cf - b * cr) / (m * v) - v, 0.0, 0.0],
-        [-(a * cf - b * cr) / (iz * v), -(a * a * cf + b * b * cr) / (iz * v), 0.0, 0.0],
-        [0.0, 1.0, 0.0, 0.0],
-        [1.0, 0.0, v, 0.0],
-    ])
+    A = np.array(
+        [
+            [-(cf + cr) / (m * v), -(a * cf - b * cr) / (m * v) - v, 0.0, 0.0],
+            [-(a * cf - b * cr) / (iz * v), -(a * a * cf + b * b * cr) / (iz * v), 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [1.0, 0.0, v, 0.0],
+        ]
+    )
     B = np.array([cf / m, a * cf / iz, 0.0, 0.0])
     return A, B
 
@@ -160,10 +162,13 @@ class SteeringController:
         self._a = params.cg_to_front_m
         # Fiala: the front force peaks at tan(alpha) = 3 mu Fz_f / C_f; keep to a share of it
         fz_front = params.mass_kg * 9.81 * params.cg_to_rear_m / params.wheelbase_m
-        self._slip_frac = gains.front_slip_fraction * 3.0 * fz_front / (
-            params.cornering_stiffness_front_npr)
-        self._slip_k = params.mass_kg * params.cg_to_front_m / (
-            params.wheelbase_m * params.cornering_stiffness_rear_npr
+        self._slip_frac = (
+            gains.front_slip_fraction * 3.0 * fz_front / (params.cornering_stiffness_front_npr)
+        )
+        self._slip_k = (
+            params.mass_kg
+            * params.cg_to_front_m
+            / (params.wheelbase_m * params.cornering_stiffness_rear_npr)
         )
         self._max = params.max_steer_rad
         self._vmin = gains.schedule_min_speed_mps
@@ -176,8 +181,11 @@ class SteeringController:
         """omega = omega_0 mu^p min(1, v / v_full) [rad/s], v floored."""
         g = self._gains
         v = max(self._vmin, speed_mps)
-        return g.natural_freq_radps * mu**g.friction_exponent * min(
-            1.0, v / g.full_bandwidth_speed_mps)
+        return (
+            g.natural_freq_radps
+            * mu**g.friction_exponent
+            * min(1.0, v / g.full_bandwidth_speed_mps)
+        )
 
     def design_poles(self, speed_mps: float, mu: float) -> np.ndarray:
         """The closed-loop poles the gains place at this speed and friction."""
@@ -186,15 +194,19 @@ class SteeringController:
         w = self.natural_freq(v, mu)
         z = g.damping_ratio
         root = math.sqrt(abs(z * z - 1.0))
-        path = ([complex(-z * w, w * root), complex(-z * w, -w * root)] if z < 1.0
-                else [-w * (z - root), -w * (z + root)])
+        path = (
+            [complex(-z * w, w * root), complex(-z * w, -w * root)]
+            if z < 1.0
+            else [-w * (z - root), -w * (z + root)]
+        )
         A, _ = single_track_matrices(self._params, v)
         body = []
         for p in np.linalg.eigvals(A[:2, :2]):  # the car's own sideslip and yaw modes
             mag = abs(p)
             re = min(p.real, -g.body_damping_ratio * mag)
-            body.append(complex(re, math.copysign(math.sqrt(max(mag * mag - re * re, 0.0)),
-                                                  p.imag)))
+            body.append(
+                complex(re, math.copysign(math.sqrt(max(mag * mag - re * re, 0.0)), p.imag))
+            )
         return np.array(path + body)
 
     def gains_at(self, speed_mps: float, mu: float) -> _Gains:
@@ -220,8 +232,12 @@ class SteeringController:
         if b is None:
             b = self._place(j)
         w = (speed_mps - speeds[j - 1]) / (speeds[j] - speeds[j - 1])
-        return (a[0] + w * (b[0] - a[0]), a[1] + w * (b[1] - a[1]), a[2] + w * (b[2] - a[2]),
-                a[3] + w * (b[3] - a[3]))
+        return (
+            a[0] + w * (b[0] - a[0]),
+            a[1] + w * (b[1] - a[1]),
+            a[2] + w * (b[2] - a[2]),
+            a[3] + w * (b[3] - a[3]),
+        )
 
     def _place(self, i: int) -> _Gains:
         """Row ``i`` of the gain table at the table's friction (pole placement, ~0.3 ms)."""
@@ -292,8 +308,14 @@ class SteeringController:
             delta = self._max
         return _new(SteeringCommand, (delta, ff, fb, yd, -fb / k_e))
 
-    def envelope_edge(self, speed_mps: float, yaw_rate_radps: float, lateral_speed_mps: float,
-                      mu: float, towards: float) -> float:
+    def envelope_edge(
+        self,
+        speed_mps: float,
+        yaw_rate_radps: float,
+        lateral_speed_mps: float,
+        mu: float,
+        towards: float,
+    ) -> float:
         """The road-wheel angle at the edge of ``command``'s front slip envelope on the side
         ``towards`` (+1 left, -1 right), clipped to the lock: the most lateral force towards
         that side the steering law allows (front slip at ``front_slip_fraction`` of its

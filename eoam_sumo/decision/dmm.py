@@ -58,8 +58,15 @@ class Sector(Enum):
     G = "G"
 
 
-_ACTIONS = {"A": Action.LIMIT_BRAKE, "B": Action.STEER, "C": Action.BRAKE, "D": Action.BRAKE,
-            "E": Action.FCW, "F": Action.STEER, "G": Action.NONE}
+_ACTIONS = {
+    "A": Action.LIMIT_BRAKE,
+    "B": Action.STEER,
+    "C": Action.BRAKE,
+    "D": Action.BRAKE,
+    "E": Action.FCW,
+    "F": Action.STEER,
+    "G": Action.NONE,
+}
 for _sector in Sector:
     _sector.action = _ACTIONS[_sector.value]
     _sector.letter = _sector.value

@@ -82,8 +82,16 @@ class ObstacleTrack(NamedTuple):
     length_m: float
 
     @classmethod
-    def sensed(cls, meas, front_offset_m: float, range_m: float, closing_mps: float, obj,
-               unknown_length_m: float, decel_mps2: float) -> ObstacleTrack:
+    def sensed(
+        cls,
+        meas,
+        front_offset_m: float,
+        range_m: float,
+        closing_mps: float,
+        obj,
+        unknown_length_m: float,
+        decel_mps2: float,
+    ) -> ObstacleTrack:
         """From an ``EgoMeasurement`` and the sensor: the object track ``obj`` (an
         ``ObjectState``) when it gives one; else the range from the ego's front bumper
         (``front_offset_m`` ahead of its centre of gravity), an assumed length and a width
@@ -92,16 +100,36 @@ class ObstacleTrack(NamedTuple):
             speed = obj.speed_mps
             if speed < 0.0:
                 speed = 0.0
-            return _new(cls, (meas.time_s, obj.s_m + 0.5 * obj.length_m, speed,
-                              obj.d_m + 0.5 * obj.width_m, decel_mps2, obj.length_m))
+            return _new(
+                cls,
+                (
+                    meas.time_s,
+                    obj.s_m + 0.5 * obj.length_m,
+                    speed,
+                    obj.d_m + 0.5 * obj.width_m,
+                    decel_mps2,
+                    obj.length_m,
+                ),
+            )
         speed = meas.vx_mps - closing_mps
         if speed < 0.0:
             speed = 0.0
-        return _new(cls, (meas.time_s, meas.s_m + front_offset_m + range_m + unknown_length_m,
-                          speed, 0.5 * meas.lane_width_m, decel_mps2, unknown_length_m))
+        return _new(
+            cls,
+            (
+                meas.time_s,
+                meas.s_m + front_offset_m + range_m + unknown_length_m,
+                speed,
+                0.5 * meas.lane_width_m,
+                decel_mps2,
+                unknown_length_m,
+            ),
+        )
 
     def at(self, time_s: float) -> tuple[float, float]:
         """(front station, speed) predicted at ``time_s`` from its speed and braking."""
         dt = time_s - self.time_s
-        return (self.front_s_m + travel_m(self.speed_mps, self.decel_mps2, dt),
-                max(self.speed_mps - self.decel_mps2 * dt, 0.0))
+        return (
+            self.front_s_m + travel_m(self.speed_mps, self.decel_mps2, dt),
+            max(self.speed_mps - self.decel_mps2 * dt, 0.0),
+        )

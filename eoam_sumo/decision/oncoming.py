@@ -84,10 +84,22 @@ class Budget(NamedTuple):
         """From the ego's ``VehicleParams``, the ``EoamSettings`` and the friction."""
         mu_g, st = mu * G_MPS2, settings
         arrest_min = st.arrest_min_speed_mps if st.arrest_first else math.inf
-        return cls(st.evasive_lateral_g * mu_g, st.escape_ramp_s, st.escape_lag_s, brake_mps2,
-                   mu_g, params.width_m, params.length_m, params.cg_to_front_bumper_m,
-                   st.side_clearance_m, st.pass_margin_m, st.oncoming_margin_m,
-                   st.oncoming_margin_s, st.arrest_return_g * mu_g, arrest_min)
+        return cls(
+            st.evasive_lateral_g * mu_g,
+            st.escape_ramp_s,
+            st.escape_lag_s,
+            brake_mps2,
+            mu_g,
+            params.width_m,
+            params.length_m,
+            params.cg_to_front_bumper_m,
+            st.side_clearance_m,
+            st.pass_margin_m,
+            st.oncoming_margin_m,
+            st.oncoming_margin_s,
+            st.arrest_return_g * mu_g,
+            arrest_min,
+        )
 
 
 class Option(NamedTuple):
@@ -111,8 +123,9 @@ def _out_line_m(oncoming: Tracked, b: Budget) -> float:
     return oncoming.near_edge_m - 0.5 * b.width_m - b.margin_m
 
 
-def _braking(v_mps: float, decel_of, obstacle: Tracked | None, oncoming: Tracked
-             ) -> tuple[float, float, float]:
+def _braking(
+    v_mps: float, decel_of, obstacle: Tracked | None, oncoming: Tracked
+) -> tuple[float, float, float]:
     """(when the fronts meet, closing speed then, impact speed on the obstacle or 0) for the
     ego braking at ``decel_of(t)`` to its stop, the obstacle braking to its stop, the
     oncoming road user holding its speed."""
@@ -145,27 +158,29 @@ def _braking(v_mps: float, decel_of, obstacle: Tracked | None, oncoming: Tracked
 def _lagged(lat: Lateral, lag_s: float) -> Lateral:
     """The lateral motion ``lag_s`` on at its present acceleration."""
     t = lag_s
-    return Lateral(lat.d_m + t * (lat.v_mps + 0.5 * t * lat.a_mps2), lat.v_mps + t * lat.a_mps2,
-                   lat.a_mps2)
+    return Lateral(
+        lat.d_m + t * (lat.v_mps + 0.5 * t * lat.a_mps2), lat.v_mps + t * lat.a_mps2, lat.a_mps2
+    )
 
 
 def _escape(lat: Lateral, target_m: float, v_mps: float, b: Budget) -> MinTimeShift:
     """The time-optimal shift from the lateral motion ``b.lag_s`` on (it starts then)."""
     lat = _lagged(lat, b.lag_s)
-    return MinTimeShift(lat.d_m, lat.v_mps, lat.a_mps2, target_m, v_mps, b.lateral_mps2,
-                        b.ramp_s)
+    return MinTimeShift(lat.d_m, lat.v_mps, lat.a_mps2, target_m, v_mps, b.lateral_mps2, b.ramp_s)
 
 
-def _head_on(escape: MinTimeShift, start_s: float, line_m: float, meet_s: float,
-             b: Budget) -> tuple[bool, float]:
+def _head_on(
+    escape: MinTimeShift, start_s: float, line_m: float, meet_s: float, b: Budget
+) -> tuple[bool, float]:
     """(whether the ego is still in the oncoming path when the fronts meet, when it is out
     for good)."""
     out = start_s + escape.time_within_s(line_m)
     return out + b.margin_s > meet_s, out
 
 
-def predict_abort(lat: Lateral, v_mps: float, obstacle: Tracked | None, oncoming: Tracked,
-                  b: Budget) -> Option:
+def predict_abort(
+    lat: Lateral, v_mps: float, obstacle: Tracked | None, oncoming: Tracked, b: Budget
+) -> Option:
     """Abort: the time-optimal shift to the lane centre up to where the lateral motion away
     from it stops, then one from rest there within ``return_mps2``; braking with what the
     friction ellipse leaves during them and at the limit after them."""
@@ -174,8 +189,9 @@ def predict_abort(lat: Lateral, v_mps: float, obstacle: Tracked | None, oncoming
     turn = escape.turn_s()
     if turn > 0.0 and abs(lat.v_mps) >= b.arrest_min_mps:  # arrested first, as mode 3 does
         start += turn
-        escape = MinTimeShift(escape.state_at(turn)[0], 0.0, 0.0, 0.0, v_mps, b.return_mps2,
-                              b.ramp_s)
+        escape = MinTimeShift(
+            escape.state_at(turn)[0], 0.0, 0.0, 0.0, v_mps, b.return_mps2, b.ramp_s
+        )
     share = math.sqrt(max(1.0 - (b.lateral_mps2 / b.mu_g_mps2) ** 2, 0.0))
     t_lat = start + escape.duration_s if escape.duration_s > 1e-6 else 0.0
 
@@ -189,8 +205,9 @@ def predict_abort(lat: Lateral, v_mps: float, obstacle: Tracked | None, oncoming
     return Option(False, 0.5 * impact, out, meet)
 
 
-def predict_pass(lat: Lateral, v_mps: float, obstacle: Tracked | None, oncoming: Tracked,
-                 b: Budget) -> Option:
+def predict_pass(
+    lat: Lateral, v_mps: float, obstacle: Tracked | None, oncoming: Tracked, b: Budget
+) -> Option:
     """Pass: beside the obstacle at its side until the ego's rear is past its front, at the
     present speed, then the time-optimal shift back to the lane centre."""
     meet, closing, _ = _braking(v_mps, lambda t: 0.0, None, oncoming)
@@ -228,8 +245,9 @@ def time_to_pass_s(v_mps: float, to_pass_m: float, obstacle: Tracked) -> float:
     return to_pass_m / rel if rel > 1e-6 else math.inf
 
 
-def choose(lat: Lateral, v_mps: float, obstacle: Tracked | None, oncoming: Tracked,
-           b: Budget, passed: bool) -> Choice:
+def choose(
+    lat: Lateral, v_mps: float, obstacle: Tracked | None, oncoming: Tracked, b: Budget, passed: bool
+) -> Choice:
     """Pass on or abort, by the lower predicted delta-v (ties: abort). ``passed``: the ego's
     rear is already past the obstacle's front, so passing on is the escape alone (taken)."""
     abort = predict_abort(lat, v_mps, None if passed else obstacle, oncoming, b)
@@ -245,10 +263,16 @@ def commit_choice(meas, oncoming, obstacle: ObstacleTrack, b: Budget) -> Choice:
     front = meas.s_m + b.cg_to_front_m
     obs_front, obs_speed = obstacle.at(meas.time_s)
     length = obstacle.length_m
-    obs = Tracked(obs_front - length - front, obs_speed, obstacle.decel_mps2, length,
-                  obstacle.left_edge_m)
-    onc = Tracked(oncoming.s_m - 0.5 * oncoming.length_m - front, oncoming.speed_mps, 0.0,
-                  oncoming.length_m, oncoming.d_m - 0.5 * oncoming.width_m)
+    obs = Tracked(
+        obs_front - length - front, obs_speed, obstacle.decel_mps2, length, obstacle.left_edge_m
+    )
+    onc = Tracked(
+        oncoming.s_m - 0.5 * oncoming.length_m - front,
+        oncoming.speed_mps,
+        0.0,
+        oncoming.length_m,
+        oncoming.d_m - 0.5 * oncoming.width_m,
+    )
     passed = front - b.length_m - obs_front >= b.pass_margin_m
     return choose(Lateral(meas.d_m, v_lat, a_lat), along, obs, onc, b, passed)
 

@@ -56,16 +56,29 @@ class NextLaneView:
     The covered length is worked out only when read (``coverage`` a function returning it):
     the policy needs it at a commit, and its geometry is the costly part."""
 
-    __slots__ = ("_coverage", "_coverage_m", "nearest_ahead_m", "nearest_ahead_speed_mps",
-                 "nearest_behind_m", "nearest_behind_speed_mps", "opposing", "speed_limit_mps")
+    __slots__ = (
+        "_coverage",
+        "_coverage_m",
+        "nearest_ahead_m",
+        "nearest_ahead_speed_mps",
+        "nearest_behind_m",
+        "nearest_behind_speed_mps",
+        "opposing",
+        "speed_limit_mps",
+    )
 
-    def __init__(self, opposing: bool, speed_limit_mps: float, *,
-                 coverage_ahead_m: float | None = None,
-                 coverage: Callable[[], float] | None = None,
-                 nearest_ahead_m: float | None = None,
-                 nearest_ahead_speed_mps: float | None = None,
-                 nearest_behind_m: float | None = None,
-                 nearest_behind_speed_mps: float | None = None):
+    def __init__(
+        self,
+        opposing: bool,
+        speed_limit_mps: float,
+        *,
+        coverage_ahead_m: float | None = None,
+        coverage: Callable[[], float] | None = None,
+        nearest_ahead_m: float | None = None,
+        nearest_ahead_speed_mps: float | None = None,
+        nearest_behind_m: float | None = None,
+        nearest_behind_speed_mps: float | None = None,
+    ):
         self.opposing = opposing  # the lane carries opposing traffic
         self.speed_limit_mps = speed_limit_mps  # its speed limit (net file)
         self._coverage_m = coverage_ahead_m
@@ -245,17 +258,26 @@ class SafePolicy:
         gap, speed, length = self._obstacle(meas, perception)
         st, p = self.settings, self.params
         return sight_needed(
-            speed_mps=meas.vx_mps, mu=meas.mu, opposing_speed_mps=self._opposing_speed(view),
-            trajectory=self.tables.trajectory(meas.mu, meas.vx_mps), gap_m=gap,
-            obstacle_speed_mps=speed, obstacle_length_m=length, ego_length_m=p.length_m,
-            ego_width_m=p.width_m, lane_width_m=meas.lane_width_m,
-            pass_margin_m=self.eoam.pass_margin_m, return_lateral_g=self.eoam.return_lateral_g,
-            return_min_length_m=self.eoam.return_min_length_m, margin_s=st.margin_s,
+            speed_mps=meas.vx_mps,
+            mu=meas.mu,
+            opposing_speed_mps=self._opposing_speed(view),
+            trajectory=self.tables.trajectory(meas.mu, meas.vx_mps),
+            gap_m=gap,
+            obstacle_speed_mps=speed,
+            obstacle_length_m=length,
+            ego_length_m=p.length_m,
+            ego_width_m=p.width_m,
+            lane_width_m=meas.lane_width_m,
+            pass_margin_m=self.eoam.pass_margin_m,
+            return_lateral_g=self.eoam.return_lateral_g,
+            return_min_length_m=self.eoam.return_min_length_m,
+            margin_s=st.margin_s,
             margin_m=st.margin_m,
         )
 
-    def _lane_free(self, view: NextLaneView, speed_mps: float, t_left_s: float,
-                   need_m: float, committing: bool) -> bool:
+    def _lane_free(
+        self, view: NextLaneView, speed_mps: float, t_left_s: float, need_m: float, committing: bool
+    ) -> bool:
         """The next lane is free for ``t_left_s`` more seconds of manoeuvre; at a commit it
         must be seen ``need_m`` ahead (free of road users too, if it carries opposing
         traffic). In either kind of lane a road user behind must not catch the ego up (one
@@ -286,10 +308,14 @@ class SafePolicy:
         if committing:
             need = self.sight_need(meas, perception, view)
             if view is not None and not view.opposing:  # seen as far as it drives in it
-                need = need._replace(needed_m=meas.vx_mps * (
-                    need.t_lane_change_s + need.t_beside_s) + need.margin_m)
-            free = (view is not None and math.isfinite(need.needed_m)
-                    and self._lane_free(view, meas.vx_mps, need.t_total_s, need.needed_m, True))
+                need = need._replace(
+                    needed_m=meas.vx_mps * (need.t_lane_change_s + need.t_beside_s) + need.margin_m
+                )
+            free = (
+                view is not None
+                and math.isfinite(need.needed_m)
+                and self._lane_free(view, meas.vx_mps, need.t_total_s, need.needed_m, True)
+            )
             if not self.gate:
                 self.gate = "passed" if free else "refused"
                 self.known_free_m = view.known_free_ahead_m if view is not None else 0.0
@@ -343,9 +369,11 @@ class SafePolicy:
         return {
             "sight_gate": self.gate,
             "sight_needed_m": round(need.needed_m, 3) if need is not None else None,
-            "sight_known_free_m": (None if self.known_free_m is None
-                                   else round(self.known_free_m, 3)),
-            "sight_time_s": (round(need.t_total_s + need.t_escape_s, 3) if need is not None
-                             else None),
+            "sight_known_free_m": (
+                None if self.known_free_m is None else round(self.known_free_m, 3)
+            ),
+            "sight_time_s": (
+                round(need.t_total_s + need.t_escape_s, 3) if need is not None else None
+            ),
             "tie_break": self.tie_break,
         }

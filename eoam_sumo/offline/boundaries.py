@@ -50,8 +50,7 @@ def stop_distance_m(speed_mps: float, decel_mps2: float) -> float:
     return speed_mps * speed_mps / (2.0 * decel_mps2)
 
 
-def clearing_distance_m(x_m, y_m, yaw_rad, params: VehicleParams,
-                        obstacle_width_m: float) -> float:
+def clearing_distance_m(x_m, y_m, yaw_rad, params: VehicleParams, obstacle_width_m: float) -> float:
     """Minimum clearing distance of a sampled trajectory (eqs. 30-32).
 
     ``x_m``, ``y_m`` (CG, from the CG at the trigger) and ``yaw_rad`` (body heading Psi) are
@@ -73,17 +72,18 @@ def clearing_distance_m(x_m, y_m, yaw_rad, params: VehicleParams,
     return float(corner_x[i - 1] + w * (corner_x[i] - corner_x[i - 1]))
 
 
-def constant_speed_clearing_distance_m(speed_mps: float, mu: float, params: VehicleParams,
-                                       settings: DesignSettings) -> float:
+def constant_speed_clearing_distance_m(
+    speed_mps: float, mu: float, params: VehicleParams, settings: DesignSettings
+) -> float:
     """Clearing distance of the quintic lane change at constant speed (Figure 11's curve).
 
     The body heading is the path yaw less the sideslip from the inverse dynamics.
     """
-    path = quintic_path(speed_mps, settings.quintic_time_s(mu), settings.lane_change_m,
-                        samples=2001)
+    path = quintic_path(
+        speed_mps, settings.quintic_time_s(mu), settings.lane_change_m, samples=2001
+    )
     inv = inverse_dynamics(path, params, mu)
-    return clearing_distance_m(path.x_m, path.y_m, inv.yaw_rad, params,
-                               settings.obstacle_width_m)
+    return clearing_distance_m(path.x_m, path.y_m, inv.yaw_rad, params, settings.obstacle_width_m)
 
 
 def steer_buffered_m(clear_m: float, speed_mps: float, settings: DesignSettings) -> float:

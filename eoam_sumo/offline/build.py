@@ -42,12 +42,34 @@ from eoam_sumo.offline.ocp import LaneChangeOcp, solve_chain, solver_options
 from eoam_sumo.offline.resim import Resimulation, audit, resimulate
 from eoam_sumo.params import VehicleParams, aro_d_class_minivan, describe, ego_e_class_sedan
 
-CSV_COLUMNS = ("mu", "speed_kmh", "stop_distance_m", "stop_distance_buffered_m",
-               "clear_distance_const_m", "clear_distance_opt_m", "clear_distance_buffered_m",
-               "ttc_s", "max_decel_mps2", "manoeuvre_length_m", "manoeuvre_time_s",
-               "exit_speed_mps")
-_CSV_FORMATS = ("{:.2f}", "{:.1f}", "{:.4f}", "{:.4f}", "{:.4f}", "{:.4f}", "{:.4f}", "{:.3f}",
-                "{:.4f}", "{:.4f}", "{:.4f}", "{:.4f}")
+CSV_COLUMNS = (
+    "mu",
+    "speed_kmh",
+    "stop_distance_m",
+    "stop_distance_buffered_m",
+    "clear_distance_const_m",
+    "clear_distance_opt_m",
+    "clear_distance_buffered_m",
+    "ttc_s",
+    "max_decel_mps2",
+    "manoeuvre_length_m",
+    "manoeuvre_time_s",
+    "exit_speed_mps",
+)
+_CSV_FORMATS = (
+    "{:.2f}",
+    "{:.1f}",
+    "{:.4f}",
+    "{:.4f}",
+    "{:.4f}",
+    "{:.4f}",
+    "{:.4f}",
+    "{:.3f}",
+    "{:.4f}",
+    "{:.4f}",
+    "{:.4f}",
+    "{:.4f}",
+)
 EXTRA_TABLES = ("speed_mps",)  # stored for reference and plots, not interpolated at run time
 
 
@@ -75,14 +97,22 @@ def sample_on_grid(resim: Resimulation, step_m: float) -> np.ndarray:
     ay_g = resim.ax_body_mps2 * np.sin(yaw) + resim.ay_body_mps2 * np.cos(yaw)
     speed = np.hypot(vx, vy)
     course = np.arctan2(vy, vx)
-    quantities = (s[:, 2], resim.ax_body_mps2, course, (vx * ay_g - vy * ax_g) / speed**3,
-                  s[:, 6], course - yaw, speed)
+    quantities = (
+        s[:, 2],
+        resim.ax_body_mps2,
+        course,
+        (vx * ay_g - vy * ax_g) / speed**3,
+        s[:, 6],
+        course - yaw,
+        speed,
+    )
     grid = np.arange(0.0, x[-1] + 1e-9, step_m)
     return np.stack([np.interp(grid, x, q) for q in quantities])
 
 
-def _solve_friction(params: VehicleParams, settings: DesignSettings, mu: float,
-                    progress_queue=None) -> list[SpeedResult]:
+def _solve_friction(
+    params: VehicleParams, settings: DesignSettings, mu: float, progress_queue=None
+) -> list[SpeedResult]:
     """One friction's chain, audited and reduced to table rows (runs in a worker process)."""
     ocp = LaneChangeOcp(params, settings)
     decel = max_decel_no_lock_mps2(params, mu)
@@ -94,14 +124,31 @@ def _solve_friction(params: VehicleParams, settings: DesignSettings, mu: float,
         audit(sol, resim, params, settings)
         v = sol.speed_mps
         stop = stop_distance_m(v, decel)
-        clear_opt = clearing_distance_m(resim.states[:, 0], resim.states[:, 2],
-                                        resim.states[:, 4], params, settings.obstacle_width_m)
+        clear_opt = clearing_distance_m(
+            resim.states[:, 0],
+            resim.states[:, 2],
+            resim.states[:, 4],
+            params,
+            settings.obstacle_width_m,
+        )
         clear_const = constant_speed_clearing_distance_m(v, mu, params, settings)
-        values = (mu, v * 3.6, stop, stop_buffered_m(stop, v, settings), clear_const, clear_opt,
-                  steer_buffered_m(clear_opt, v, settings), ttc, decel, resim.distance_m,
-                  sol.duration_s, float(np.hypot(resim.states[-1, 1], resim.states[-1, 3])))
-        results.append(SpeedResult(mu, v, values, resim.distance_m,
-                                   sample_on_grid(resim, settings.dx_step_m)))
+        values = (
+            mu,
+            v * 3.6,
+            stop,
+            stop_buffered_m(stop, v, settings),
+            clear_const,
+            clear_opt,
+            steer_buffered_m(clear_opt, v, settings),
+            ttc,
+            decel,
+            resim.distance_m,
+            sol.duration_s,
+            float(np.hypot(resim.states[-1, 1], resim.states[-1, 3])),
+        )
+        results.append(
+            SpeedResult(mu, v, values, resim.distance_m, sample_on_grid(resim, settings.dx_step_m))
+        )
         if progress_queue is not None:
             progress_queue.put(1)
 
@@ -110,9 +157,15 @@ def _solve_friction(params: VehicleParams, settings: DesignSettings, mu: float,
     return sorted(results, key=lambda r: r.speed_mps)
 
 
-def build_tables(out_dir, jobs: int = 1, speeds_kmh=None, mus=None, progress: bool = True,
-                 params: VehicleParams | None = None,
-                 settings: DesignSettings | None = None) -> Path:
+def build_tables(
+    out_dir,
+    jobs: int = 1,
+    speeds_kmh=None,
+    mus=None,
+    progress: bool = True,
+    params: VehicleParams | None = None,
+    settings: DesignSettings | None = None,
+) -> Path:
     """Build ``phase_boundaries.csv``, ``lookup_tables.npz`` and ``metadata.json`` in out_dir.
 
     ``speeds_kmh`` / ``mus`` replace the grids of ``settings`` (default ``DesignSettings()``:
@@ -141,18 +194,20 @@ def build_tables(out_dir, jobs: int = 1, speeds_kmh=None, mus=None, progress: bo
 
 def _run(params, settings, jobs, progress) -> dict:
     total = len(settings.mus) * len(settings.speeds_kmh)
-    bar = tqdm(total=total, disable=not progress, file=sys.stderr, desc="EOAM tables",
-               unit="solve")
+    bar = tqdm(total=total, disable=not progress, file=sys.stderr, desc="EOAM tables", unit="solve")
     try:
         if jobs == 1 or len(settings.mus) == 1:
             callback = _BarQueue(bar)
             return {mu: _solve_friction(params, settings, mu, callback) for mu in settings.mus}
         ctx = multiprocessing.get_context("spawn")
-        with ctx.Manager() as manager, ProcessPoolExecutor(
-                max_workers=min(jobs, len(settings.mus)), mp_context=ctx) as pool:
+        with (
+            ctx.Manager() as manager,
+            ProcessPoolExecutor(max_workers=min(jobs, len(settings.mus)), mp_context=ctx) as pool,
+        ):
             q = manager.Queue()
-            futures = {pool.submit(_solve_friction, params, settings, mu, q): mu
-                       for mu in settings.mus}
+            futures = {
+                pool.submit(_solve_friction, params, settings, mu, q): mu for mu in settings.mus
+            }
             pending = set(futures)
             while pending:
                 done, pending = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
@@ -185,8 +240,10 @@ def _drain(q, bar) -> None:
 
 def _write_csv(path: Path, per_mu: dict, params: VehicleParams) -> None:
     buf = io.StringIO()
-    buf.write(f"# eoam-sumo {eoam_sumo.__version__} DMM phase boundaries for {params.name}; "
-              f"relative speed = entry speed of the lane change; see {tb.METADATA_NAME}\n")
+    buf.write(
+        f"# eoam-sumo {eoam_sumo.__version__} DMM phase boundaries for {params.name}; "
+        f"relative speed = entry speed of the lane change; see {tb.METADATA_NAME}\n"
+    )
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(CSV_COLUMNS)
     for results in per_mu.values():
@@ -211,17 +268,20 @@ def _write_npz(path: Path, per_mu: dict, settings: DesignSettings) -> None:
                 arrays[name][i, j, :n] = r.rows[k]
             arrays["y_m"][i, j, n:] = settings.lane_change_m  # final values past the end
             arrays["speed_mps"][i, j, n:] = r.rows[names.index("speed_mps"), -1]
-    arrays.update(mu_grid=np.array(mus), speed_grid_mps=np.array(speeds),
-                  dx_step_m=np.array(step), length_m=lengths,
-                  lane_change_m=np.array(settings.lane_change_m))
+    arrays.update(
+        mu_grid=np.array(mus),
+        speed_grid_mps=np.array(speeds),
+        dx_step_m=np.array(step),
+        length_m=lengths,
+        lane_change_m=np.array(settings.lane_change_m),
+    )
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_DEFLATED) as zf:
         for name in sorted(arrays):  # fixed order and timestamps: byte-identical rebuilds
             info = zipfile.ZipInfo(name + ".npy", date_time=(1980, 1, 1, 0, 0, 0))
             info.compress_type = zipfile.ZIP_DEFLATED
             item = io.BytesIO()
-            np.lib.format.write_array(item, np.array(arrays[name], order="C"),
-                                      allow_pickle=False)
+            np.lib.format.write_array(item, np.array(arrays[name], order="C"), allow_pickle=False)
             zf.writestr(info, item.getvalue())
     write_atomic(path, buf.getvalue())
 
@@ -247,7 +307,7 @@ def _write_metadata(path: Path, params: VehicleParams, settings: DesignSettings)
         "files": {
             tb.CSV_NAME: "DMM phase boundaries per friction and relative speed",
             tb.NPZ_NAME: "lookup tables [mu, entry speed, dx]: "
-                         + ", ".join(tb.TABLE_NAMES + EXTRA_TABLES),
+            + ", ".join(tb.TABLE_NAMES + EXTRA_TABLES),
         },
     }
     write_atomic(path, (json.dumps(meta, indent=2, sort_keys=True) + "\n").encode())

@@ -39,45 +39,70 @@ class DesignSettings:
     """Settings of the offline design (paths, optimal control, phase boundaries, tables)."""
 
     lane_change_m: float = _p(
-        LANE_CHANGE_HEIGHT_M, "m", PAPER + ", sec. 4.2 (y_f = 3.5 m, one lane)")
+        LANE_CHANGE_HEIGHT_M, "m", PAPER + ", sec. 4.2 (y_f = 3.5 m, one lane)"
+    )
     obstacle_width_m: float = _p(
-        aro_d_class_minivan().width_m, "m", "eoam_sumo.params.aro_d_class_minivan (sec. 10.1)")
+        aro_d_class_minivan().width_m, "m", "eoam_sumo.params.aro_d_class_minivan (sec. 10.1)"
+    )
     speeds_kmh: tuple = _p(
-        tuple(float(v) for v in range(20, 180, 5)), "km/h",
-        PAPER + ", sec. 2 (55-165 km/h), widened to 20-175 km/h so the runs' relative speeds fit")
+        tuple(float(v) for v in range(20, 180, 5)),
+        "km/h",
+        PAPER + ", sec. 2 (55-165 km/h), widened to 20-175 km/h so the runs' relative speeds fit",
+    )
     mus: tuple = _p((1.0, 0.7, 0.3, 0.1), "-", PAPER + ", sec. 10.1 (surface friction values)")
     dx_step_m: float = _p(0.5, "m", DESIGN + ": uniform differential-x grid of the tables")
     lat_accel_fraction: float = _p(
-        0.8, "-", DESIGN + ": quintic peak lateral acceleration 5.77 h/T^2 = k mu g; 20 % of the "
-        "friction is left for the tracking controller and the longitudinal profile")
+        0.8,
+        "-",
+        DESIGN + ": quintic peak lateral acceleration 5.77 h/T^2 = k mu g; 20 % of the "
+        "friction is left for the tracking controller and the longitudinal profile",
+    )
     max_quintic_time_s: float = _p(
-        6.0, "s", DESIGN + ": upper bound of T; binds only below mu 0.07 and keeps the lane "
-        "change well inside the 8 s manoeuvre timer")
+        6.0,
+        "s",
+        DESIGN + ": upper bound of T; binds only below mu 0.07 and keeps the lane "
+        "change well inside the 8 s manoeuvre timer",
+    )
     plant_tyre: bool = _p(
-        True, "-", DESIGN + ": the lane change is planned with the plant's Fiala tyre (cornering "
+        True,
+        "-",
+        DESIGN + ": the lane change is planned with the plant's Fiala tyre (cornering "
         "stiffness C at any friction, peak derated by the longitudinal force), not the paper's "
         "eq. 6 tyre (stiffness mu C, the ellipse reached at a few degrees of slip): the plan's "
-        "steering and sideslip are then the ones the plant needs (False: the paper's tyre)")
+        "steering and sideslip are then the ones the plant needs (False: the paper's tyre)",
+    )
     friction_use: float = _p(
-        0.9, "-", DESIGN + ": each axle's planned tyre force stays within this share of its "
+        0.9,
+        "-",
+        DESIGN + ": each axle's planned tyre force stays within this share of its "
         "friction limit mu Fz (eqs. 25, 28: ellipse <= share^2); the rest is the tracking loop's: "
         "at the whole ellipse the plant's tyre is at its peak slip, where no force is left to "
-        "correct with (measured: 0.92 m of tracking error at 55 km/h, mu 1.0)")
+        "correct with (measured: 0.92 m of tracking error at 55 km/h, mu 1.0)",
+    )
     continuation_steps: int = _p(
-        4, "-", DESIGN + ": steps from the paper's tyre and the whole ellipse to the plant's tyre "
-        "and friction_use, each warm-started from the last, where a direct solve fails")
+        4,
+        "-",
+        DESIGN + ": steps from the paper's tyre and the whole ellipse to the plant's tyre "
+        "and friction_use, each warm-started from the last, where a direct solve fails",
+    )
     ocp_intervals: int = _p(40, "-", DESIGN + ": collocation intervals (speed vs. accuracy)")
     collocation_degree: int = _p(3, "-", DESIGN + ": Radau collocation points per interval")
     min_speed_fraction: float = _p(
-        0.5, "-", DESIGN + ": the body speed stays above this fraction of the entry speed: the "
+        0.5,
+        "-",
+        DESIGN + ": the body speed stays above this fraction of the entry speed: the "
         "EOAM is a lane change, a manoeuvre shedding more speed is braking (the stopping "
-        "boundary covers it); also keeps the slip angles defined")
+        "boundary covers it); also keeps the slip angles defined",
+    )
     max_yaw_rad: float = _p(math.radians(45.0), "rad", DESIGN + ": bound keeping the OCP regular")
     regularisation: float = _p(
-        0.3, "m", DESIGN + ": weight of the squared steps between intervals of the controls "
+        0.3,
+        "m",
+        DESIGN + ": weight of the squared steps between intervals of the controls "
         "(scaled by mu m g and the steer-rate limit) added to the cost x(t_f): removes the chatter "
         "of the bang-bang optimum along the friction limit (a smooth, trackable, slightly "
-        "suboptimal profile, cf. the paper's 'suboptimal' profiles) and makes it unique")
+        "suboptimal profile, cf. the paper's 'suboptimal' profiles) and makes it unique",
+    )
     ipopt_tol: float = _p(1e-8, "-", "IPOPT default (tight, so warm starts reach the same optimum)")
     ipopt_max_iter: int = _p(1000, "-", DESIGN)
     verify_lateral_tol_m: float = _p(0.03, "m", DESIGN + ": re-simulated final y vs y_f")
@@ -86,31 +111,53 @@ class DesignSettings:
     verify_yaw_tol_rad: float = _p(0.005, "rad", DESIGN + ": final yaw angle")
     verify_yaw_rate_tol_radps: float = _p(0.02, "rad/s", DESIGN + ": final yaw rate")
     verify_ellipse_tol: float = _p(
-        0.03, "-", DESIGN + ": allowed excess of the friction-ellipse use between the nodes")
+        0.03, "-", DESIGN + ": allowed excess of the friction-ellipse use between the nodes"
+    )
     steer_buffer_time_s: float = _p(
-        0.6, "s", DESIGN + ": DMM step 10 ms + steering lag 0.05 s + closed-loop lateral lag "
-        "~0.25 s (measured) + the ARO still braking during the steer (~0.5 a t_c^2)")
+        0.6,
+        "s",
+        DESIGN + ": DMM step 10 ms + steering lag 0.05 s + closed-loop lateral lag "
+        "~0.25 s (measured) + the ARO still braking during the steer (~0.5 a t_c^2)",
+    )
     steer_buffer_m: float = _p(2.0, "m", DESIGN + ": visual-comfort margin (sec. 6.2)")
     brake_buffer_time_s: float = _p(
-        0.3, "s", DESIGN + ": DMM step + brake build-up (lag 0.1 s, about 3 time constants)")
+        0.3, "s", DESIGN + ": DMM step + brake build-up (lag 0.1 s, about 3 time constants)"
+    )
     brake_buffer_m: float = _p(2.0, "m", DESIGN + ": stop about 2 m short of the obstacle")
     ttc_mus: tuple = _p((0.1, 0.3, 0.7, 1.0), "-", PAPER + ", sec. 6.2")
     ttc_values_s: tuple = _p(
-        (20.0, 5.0, 2.5, 2.5), "s", PAPER + ", sec. 6.2 (linear in mu between, clamped outside)")
+        (20.0, 5.0, 2.5, 2.5), "s", PAPER + ", sec. 6.2 (linear in mu between, clamped outside)"
+    )
 
     def __post_init__(self) -> None:
         positive = (
-            "lane_change_m", "obstacle_width_m", "dx_step_m", "lat_accel_fraction",
-            "max_quintic_time_s", "min_speed_fraction", "max_yaw_rad", "ipopt_tol", "friction_use",
-            "verify_lateral_tol_m", "verify_distance_tol_m", "verify_lat_speed_tol_mps",
-            "verify_yaw_tol_rad", "verify_yaw_rate_tol_radps", "verify_ellipse_tol",
+            "lane_change_m",
+            "obstacle_width_m",
+            "dx_step_m",
+            "lat_accel_fraction",
+            "max_quintic_time_s",
+            "min_speed_fraction",
+            "max_yaw_rad",
+            "ipopt_tol",
+            "friction_use",
+            "verify_lateral_tol_m",
+            "verify_distance_tol_m",
+            "verify_lat_speed_tol_mps",
+            "verify_yaw_tol_rad",
+            "verify_yaw_rate_tol_radps",
+            "verify_ellipse_tol",
         )
         for name in positive:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0.0):
                 raise ValueError(f"design setting {name}={v!r} must be a finite number > 0")
-        for name in ("regularisation", "steer_buffer_time_s", "steer_buffer_m",
-                     "brake_buffer_time_s", "brake_buffer_m"):
+        for name in (
+            "regularisation",
+            "steer_buffer_time_s",
+            "steer_buffer_m",
+            "brake_buffer_time_s",
+            "brake_buffer_m",
+        ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0.0):
                 raise ValueError(f"design setting {name}={v!r} must be a finite number >= 0")
@@ -118,8 +165,7 @@ class DesignSettings:
             raise ValueError(f"friction_use={self.friction_use} must be <= 1")
         if not isinstance(self.plant_tyre, bool):
             raise ValueError(f"design setting plant_tyre={self.plant_tyre!r} must be true or false")
-        for name in ("ocp_intervals", "collocation_degree", "ipopt_max_iter",
-                     "continuation_steps"):
+        for name in ("ocp_intervals", "collocation_degree", "ipopt_max_iter", "continuation_steps"):
             v = getattr(self, name)
             if not (isinstance(v, int) and v >= 1):
                 raise ValueError(f"design setting {name}={v!r} must be an integer >= 1")
@@ -161,15 +207,17 @@ class DesignSettings:
         """Lane-change time T of the quintic: 5.77 h / T^2 = k mu g, capped (sec. 4.2)."""
         if not (math.isfinite(mu) and mu > 0.0):
             raise ValueError(f"mu={mu!r} must be > 0")
-        t = math.sqrt(QUINTIC_PEAK_COEFF * self.lane_change_m / (self.lat_accel_fraction * mu
-                                                                 * G_MPS2))
+        t = math.sqrt(
+            QUINTIC_PEAK_COEFF * self.lane_change_m / (self.lat_accel_fraction * mu * G_MPS2)
+        )
         return min(t, self.max_quintic_time_s)
 
     def as_dict(self) -> dict:
         """Every setting as {name: {value, unit, source}} (for metadata.json)."""
         return {
             f.name: {
-                "value": list(getattr(self, f.name)) if isinstance(getattr(self, f.name), tuple)
+                "value": list(getattr(self, f.name))
+                if isinstance(getattr(self, f.name), tuple)
                 else getattr(self, f.name),
                 "unit": f.metadata["unit"],
                 "source": f.metadata["source"],

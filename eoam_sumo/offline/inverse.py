@@ -76,8 +76,9 @@ def inverse_dynamics(path: ArcLengthPath, params: VehicleParams, mu: float) -> I
         beta = np.arcsin(np.clip(b * yaw_rate * np.cos(alpha_r) / speed, -1.0, 1.0)) - alpha_r
         steer = alpha_f + np.arctan2(speed * np.sin(beta) + a * yaw_rate, speed * np.cos(beta))
     peak = 0.999 * mu * p.slip_angle_sat_rad  # of the tyre force per unit cornering stiffness
-    tyre_ok = ((np.abs(fy_f) < peak * p.cornering_stiffness_front_npr)
-               & (np.abs(fy_r) < peak * p.cornering_stiffness_rear_npr))
+    tyre_ok = (np.abs(fy_f) < peak * p.cornering_stiffness_front_npr) & (
+        np.abs(fy_r) < peak * p.cornering_stiffness_rear_npr
+    )
     ax_min, ax_max, ellipse_ok = _accel_limits(fy_f, fy_r, steer, speed, p, mu)
     feasible = tyre_ok & ellipse_ok
     return InverseDynamics(
@@ -112,11 +113,13 @@ def _accel_limits(fy_f, fy_r, steer, speed, p: VehicleParams, mu: float):
     ax_min = -drag_lat / m
     for _ in range(_FIXED_POINT_ITERATIONS):
         fz_f, fz_r = axle_loads(ax_min, p)
-        brake = np.minimum.reduce([
-            spare(fz_f, fy_f) / share,
-            spare(fz_r, fy_r) / (1.0 - share),
-            np.full_like(fy_f, p.max_brake_force_n),
-        ])
+        brake = np.minimum.reduce(
+            [
+                spare(fz_f, fy_f) / share,
+                spare(fz_r, fy_r) / (1.0 - share),
+                np.full_like(fy_f, p.max_brake_force_n),
+            ]
+        )
         ax_min = (-(1.0 - share) * brake - share * brake * c_st - drag_lat) / m
     engine = np.minimum(p.max_drive_force_n, p.max_drive_power_w / np.maximum(speed, 1e-3))
     ax_max = -drag_lat / m
@@ -126,4 +129,3 @@ def _accel_limits(fy_f, fy_r, steer, speed, p: VehicleParams, mu: float):
     fz_f0, fz_r0 = axle_loads(-drag_lat / m, p)  # no longitudinal tyre force
     ellipse_ok = (np.abs(fy_f) <= mu * fz_f0) & (np.abs(fy_r) <= mu * fz_r0)
     return ax_min, ax_max, ellipse_ok
-

@@ -35,8 +35,7 @@ from dataclasses import dataclass
 
 from eoam_sumo.params import G_MPS2, VehicleParams
 
-STATE_NAMES = ("x_m", "x_speed_mps", "y_m", "y_speed_mps", "yaw_rad", "yaw_rate_radps",
-               "steer_rad")
+STATE_NAMES = ("x_m", "x_speed_mps", "y_m", "y_speed_mps", "yaw_rad", "yaw_rate_radps", "steer_rad")
 CONTROL_NAMES = ("steer_rate_radps", "long_force_n")
 FORCE_SMOOTHING_N = 100.0
 PEAK_FLOOR_N = 1.0  # keeps the derated Fiala peak > 0 (and its square root smooth)
@@ -156,4 +155,3 @@ def dynamics(x, u, mu, params: VehicleParams, ops, tyre_blend=0.0):
         ellipse_rear=(fx_r**2 + fy_r**2) / (mu * fz_r) ** 2,
     )
     return xdot, out
-

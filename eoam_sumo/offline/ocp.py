@@ -103,8 +103,11 @@ def _interval_function(params: VehicleParams, degree: int) -> ca.Function:
         if j > 0:
             slope = sum(deriv[r, j] * points[:, r] for r in range(degree + 1))
             defects.append(h * ca.vertcat(*xdot) - slope)
-    return ca.Function("radau_interval", [x0, xc, u, mu, h, blend],
-                       [ca.horzcat(*defects), points[:, degree], ca.vertcat(*path)])
+    return ca.Function(
+        "radau_interval",
+        [x0, xc, u, mu, h, blend],
+        [ca.horzcat(*defects), points[:, degree], ca.vertcat(*path)],
+    )
 
 
 class LaneChangeOcp:
@@ -133,8 +136,13 @@ class LaneChangeOcp:
         t_f = _TIME_SCALE_S * self._tau
         interval = _interval_function(p, d).map(n)
         defects, x_end, path = interval(
-            xs[:, :-1], xc, us, ca.repmat(self._mu, 1, n), ca.repmat(t_f / n, 1, n),
-            ca.repmat(self._blend, 1, n))
+            xs[:, :-1],
+            xc,
+            us,
+            ca.repmat(self._mu, 1, n),
+            ca.repmat(t_f / n, 1, n),
+            ca.repmat(self._blend, 1, n),
+        )
         opti.subject_to(ca.vec(defects / ca.repmat(ca.DM(_STATE_SCALE), 1, n * d)) == 0.0)
         opti.subject_to(self._z[:, 1:] == x_end / ca.DM(_STATE_SCALE))
         # eqs. 21, 22, 24 (steering starts centred)
@@ -142,7 +150,7 @@ class LaneChangeOcp:
         # eq. 23 and the settled end: no lateral speed, yaw, yaw rate or steering
         opti.subject_to(xs[2:, -1] == ca.vertcat(settings.lane_change_m, 0.0, 0.0, 0.0, 0.0))
         for j in range(d + 1):
-            opti.subject_to(ca.vec(path[3 * j:3 * j + 2, :]) <= self._ellipse)  # eqs. 25, 28
+            opti.subject_to(ca.vec(path[3 * j : 3 * j + 2, :]) <= self._ellipse)  # eqs. 25, 28
             opti.subject_to(path[3 * j + 2, :] >= settings.min_speed_fraction * self._v0)
         steer = xs[6, :]
         opti.subject_to(opti.bounded(-p.max_steer_rad, steer, p.max_steer_rad))  # eqs. 26-27
@@ -153,15 +161,17 @@ class LaneChangeOcp:
         opti.subject_to(drive * xs[1, :-1] <= p.max_drive_power_w)  # eq. 29, power
         opti.subject_to(opti.bounded(0.1 / _TIME_SCALE_S, self._tau, 30.0 / _TIME_SCALE_S))
         # control steps relative to the steer-rate limit and to the friction force mu m g
-        dw = ca.vertcat(self._w[0, 1:] - self._w[0, :-1],
-                        (self._w[1, 1:] - self._w[1, :-1]) / self._mu)
+        dw = ca.vertcat(
+            self._w[0, 1:] - self._w[0, :-1], (self._w[1, 1:] - self._w[1, :-1]) / self._mu
+        )
         opti.minimize(xs[0, -1] + settings.regularisation * ca.sumsqr(dw))  # eq. 14
         opti.solver("ipopt", solver_options(settings))
         self._opti = opti
         self._degree = d
 
-    def solve(self, speed_mps: float, mu: float, guess: OcpSolution,
-              step: float = 1.0) -> OcpSolution:
+    def solve(
+        self, speed_mps: float, mu: float, guess: OcpSolution, step: float = 1.0
+    ) -> OcpSolution:
         """Solve for this entry speed and friction from ``guess``; raise ``OcpError`` on failure.
 
         ``step`` in [0, 1] is the continuation parameter: 1 is the problem of the settings
@@ -184,13 +194,16 @@ class LaneChangeOcp:
         try:
             sol = opti.solve_limited()
         except RuntimeError as exc:  # IPOPT gave up (e.g. restoration failed)
-            raise OcpError(f"optimal lane change at mu={mu:g}, {speed_mps * 3.6:g} km/h did not "
-                           f"converge: {opti.stats()['return_status']}") from exc
+            raise OcpError(
+                f"optimal lane change at mu={mu:g}, {speed_mps * 3.6:g} km/h did not "
+                f"converge: {opti.stats()['return_status']}"
+            ) from exc
         stats = opti.stats()
         if not stats["success"]:
             raise OcpError(
                 f"optimal lane change at mu={mu:g}, {speed_mps * 3.6:g} km/h did not converge: "
-                f"IPOPT {stats['return_status']} after {stats['iter_count']} iterations")
+                f"IPOPT {stats['return_status']} after {stats['iter_count']} iterations"
+            )
         return OcpSolution(
             speed_mps=float(speed_mps),
             mu=float(mu),
@@ -211,8 +224,9 @@ def _interpolate_nodes(states: np.ndarray, degree: int) -> np.ndarray:
     return np.stack(points, axis=1).reshape(-1, states.shape[1])
 
 
-def quintic_guess(speed_mps: float, mu: float, params: VehicleParams,
-                  settings: DesignSettings) -> OcpSolution:
+def quintic_guess(
+    speed_mps: float, mu: float, params: VehicleParams, settings: DesignSettings
+) -> OcpSolution:
     """Initial guess: the quintic at constant speed with its inverse-dynamics steering."""
     n = settings.ocp_intervals
     t_f = settings.quintic_time_s(mu)
@@ -223,11 +237,20 @@ def quintic_guess(speed_mps: float, mu: float, params: VehicleParams,
     _, dy, _, _ = quintic_lateral(t, t_f, settings.lane_change_m)
     steer = np.clip(inv.steer_rad[idx], -params.max_steer_rad, params.max_steer_rad)
     steer[-1] = 0.0
-    states = np.column_stack([
-        speed_mps * t, np.full(n + 1, speed_mps), path.y_m[idx], dy, inv.yaw_rad[idx],
-        inv.yaw_rate_radps[idx], steer])
-    steer_rate = np.clip(np.diff(steer) / (t_f / n), -params.max_steer_rate_radps,
-                         params.max_steer_rate_radps)
+    states = np.column_stack(
+        [
+            speed_mps * t,
+            np.full(n + 1, speed_mps),
+            path.y_m[idx],
+            dy,
+            inv.yaw_rad[idx],
+            inv.yaw_rate_radps[idx],
+            steer,
+        ]
+    )
+    steer_rate = np.clip(
+        np.diff(steer) / (t_f / n), -params.max_steer_rate_radps, params.max_steer_rate_radps
+    )
     controls = np.column_stack([steer_rate, np.zeros(n)])
     return OcpSolution(float(speed_mps), float(mu), t_f, states, controls)
 
@@ -241,13 +264,20 @@ def rescaled_guess(previous: OcpSolution, speed_mps: float) -> OcpSolution:
     assert previous.colloc_states is not None  # every solved chain keeps its collocation states
     colloc = previous.colloc_states.copy()
     colloc[:, :2] *= ratio
-    return OcpSolution(float(speed_mps), previous.mu, previous.duration_s, states,
-                       previous.controls.copy(), colloc_states=colloc,
-                       tyre_blend=previous.tyre_blend)
+    return OcpSolution(
+        float(speed_mps),
+        previous.mu,
+        previous.duration_s,
+        states,
+        previous.controls.copy(),
+        colloc_states=colloc,
+        tyre_blend=previous.tyre_blend,
+    )
 
 
-def solve_continued(ocp: LaneChangeOcp, speed_mps: float, mu: float,
-                    guess: OcpSolution) -> OcpSolution:
+def solve_continued(
+    ocp: LaneChangeOcp, speed_mps: float, mu: float, guess: OcpSolution
+) -> OcpSolution:
     """Solve the paper's problem (``step`` 0) from ``guess``, then step to the settings' one
     in ``settings.continuation_steps`` equal steps, each warm-started from the last; a step
     that fails is halved (down to 1/16 of one) before the failure is raised."""

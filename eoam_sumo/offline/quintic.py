@@ -59,8 +59,9 @@ class ArcLengthPath:
         return float(self.s_m[-1])
 
 
-def quintic_path(speed_mps: float, duration_s: float, height_m: float,
-                 samples: int = 1001) -> ArcLengthPath:
+def quintic_path(
+    speed_mps: float, duration_s: float, height_m: float, samples: int = 1001
+) -> ArcLengthPath:
     """Quintic lane change at constant speed, parameterised in arc length (eqs. 7-13)."""
     if not (speed_mps > 0.0 and math.isfinite(speed_mps)):
         raise ValueError(f"speed_mps={speed_mps!r} must be finite and > 0")

@@ -61,11 +61,14 @@ def resimulate(solution: OcpSolution, params: VehicleParams, max_spacing_m: floa
         def rhs(_t, y, u=u):
             return dynamics(y, u, mu, params, math, blend)[0]
 
-        res = solve_ivp(rhs, (k * h, (k + 1) * h), x, method="DOP853", t_eval=t_eval,
-                        rtol=_RTOL, atol=_ATOL)
+        res = solve_ivp(
+            rhs, (k * h, (k + 1) * h), x, method="DOP853", t_eval=t_eval, rtol=_RTOL, atol=_ATOL
+        )
         if not res.success:
-            raise OcpError(f"re-simulation at mu={mu:g}, {solution.speed_mps * 3.6:g} km/h "
-                           f"failed in interval {k}: {res.message}")
+            raise OcpError(
+                f"re-simulation at mu={mu:g}, {solution.speed_mps * 3.6:g} km/h "
+                f"failed in interval {k}: {res.message}"
+            )
         x = res.y[:, -1]
         times.append(res.t[1:])
         states.append(res.y[:, 1:].T)
@@ -75,8 +78,9 @@ def resimulate(solution: OcpSolution, params: VehicleParams, max_spacing_m: floa
     us = np.vstack(controls)
     # at each interval start the state belongs to both intervals: audit it with the new control
     outs = [dynamics(xs[i], us[i], mu, params, math, blend)[1] for i in range(len(t))]
-    starts = [dynamics(xs[k * per], solution.controls[k], mu, params, math, blend)[1]
-              for k in range(n)]
+    starts = [
+        dynamics(xs[k * per], solution.controls[k], mu, params, math, blend)[1] for k in range(n)
+    ]
     ef = np.array([o.ellipse_front for o in outs])
     er = np.array([o.ellipse_rear for o in outs])
     ef[::per][:n] = np.maximum(ef[::per][:n], [o.ellipse_front for o in starts])
@@ -95,8 +99,9 @@ def resimulate(solution: OcpSolution, params: VehicleParams, max_spacing_m: floa
     )
 
 
-def audit(solution: OcpSolution, resim: Resimulation, params: VehicleParams,
-          settings: DesignSettings) -> None:
+def audit(
+    solution: OcpSolution, resim: Resimulation, params: VehicleParams, settings: DesignSettings
+) -> None:
     """Check the re-simulation against every constraint; raise ``OcpError`` listing breaches."""
     s, p = settings, params
     end = resim.states[-1]
@@ -107,24 +112,52 @@ def audit(solution: OcpSolution, resim: Resimulation, params: VehicleParams,
         ("final lateral speed", abs(end[3]), s.verify_lat_speed_tol_mps, "m/s"),
         ("final yaw", abs(end[4]), s.verify_yaw_tol_rad, "rad"),
         ("final yaw rate", abs(end[5]), s.verify_yaw_rate_tol_radps, "rad/s"),
-        ("front friction ellipse (eqs. 25, 28)",
-         resim.ellipse_front.max() - s.friction_use**2, s.verify_ellipse_tol, "-"),
-        ("rear friction ellipse (eq. 28)", resim.ellipse_rear.max() - s.friction_use**2,
-         s.verify_ellipse_tol, "-"),
-        ("steering angle (eqs. 26-27)", np.abs(resim.states[:, 6]).max() - p.max_steer_rad,
-         1e-6, "rad"),
-        ("steering rate", np.abs(resim.controls[:, 0]).max() - p.max_steer_rate_radps,
-         1e-6, "rad/s"),
+        (
+            "front friction ellipse (eqs. 25, 28)",
+            resim.ellipse_front.max() - s.friction_use**2,
+            s.verify_ellipse_tol,
+            "-",
+        ),
+        (
+            "rear friction ellipse (eq. 28)",
+            resim.ellipse_rear.max() - s.friction_use**2,
+            s.verify_ellipse_tol,
+            "-",
+        ),
+        (
+            "steering angle (eqs. 26-27)",
+            np.abs(resim.states[:, 6]).max() - p.max_steer_rad,
+            1e-6,
+            "rad",
+        ),
+        (
+            "steering rate",
+            np.abs(resim.controls[:, 0]).max() - p.max_steer_rate_radps,
+            1e-6,
+            "rad/s",
+        ),
         ("brake force", -brake.min() - p.max_brake_force_n, 1e-3, "N"),
         ("drive force (eq. 29)", drive.max() - p.max_drive_force_n, 1e-3, "N"),
-        ("drive power (eq. 29)", (drive * resim.vx_body_mps).max() - p.max_drive_power_w,
-         s.verify_ellipse_tol * p.max_drive_power_w, "W"),
-        ("speed floor", s.min_speed_fraction * solution.speed_mps - resim.vx_body_mps.min(),
-         s.verify_lat_speed_tol_mps, "m/s"),
+        (
+            "drive power (eq. 29)",
+            (drive * resim.vx_body_mps).max() - p.max_drive_power_w,
+            s.verify_ellipse_tol * p.max_drive_power_w,
+            "W",
+        ),
+        (
+            "speed floor",
+            s.min_speed_fraction * solution.speed_mps - resim.vx_body_mps.min(),
+            s.verify_lat_speed_tol_mps,
+            "m/s",
+        ),
     ]
-    breaches = [f"{name} off by {value:.4g} {unit} (tolerance {tol:g})"
-                for name, value, tol, unit in checks if not value <= tol]
+    breaches = [
+        f"{name} off by {value:.4g} {unit} (tolerance {tol:g})"
+        for name, value, tol, unit in checks
+        if not value <= tol
+    ]
     if breaches:
         raise OcpError(
             f"optimal lane change at mu={solution.mu:g}, {solution.speed_mps * 3.6:g} km/h "
-            "fails its re-simulation check: " + "; ".join(breaches))
+            "fails its re-simulation check: " + "; ".join(breaches)
+        )

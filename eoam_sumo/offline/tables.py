@@ -41,8 +41,14 @@ NPZ_NAME = "lookup_tables.npz"
 METADATA_NAME = "metadata.json"
 FORMAT_VERSION = 2
 TABLE_NAMES = ("y_m", "ax_mps2", "yaw_rad", "curvature_1pm", "steer_rad", "sideslip_rad")
-BOUNDARY_COLUMNS = ("stop_distance_m", "stop_distance_buffered_m", "clear_distance_const_m",
-                    "clear_distance_opt_m", "clear_distance_buffered_m", "ttc_s")
+BOUNDARY_COLUMNS = (
+    "stop_distance_m",
+    "stop_distance_buffered_m",
+    "clear_distance_const_m",
+    "clear_distance_opt_m",
+    "clear_distance_buffered_m",
+    "ttc_s",
+)
 
 
 def default_tables_dir() -> Path:
@@ -103,8 +109,9 @@ class PhaseBoundaries:
         try:
             text = path.read_text()
         except OSError as exc:
-            raise InputError(f"{path}: cannot read the phase boundaries ({exc.strerror}); "
-                             "run `eoam-sumo tables`") from None
+            raise InputError(
+                f"{path}: cannot read the phase boundaries ({exc.strerror}); run `eoam-sumo tables`"
+            ) from None
         lines = [ln for ln in text.splitlines() if ln and not ln.startswith("#")]
         table: dict[float, dict[float, tuple]] = {}
         try:
@@ -141,8 +148,9 @@ class PhaseBoundaries:
         if j_m != i_m:
             hi = self._row(j_m, i_v, j_v, w_v)
             lo = [x + w_m * (y - x) for x, y in zip(lo, hi)]
-        return Boundary(lo[0] * scale, lo[1] * scale, lo[2] * scale, lo[3] * scale,
-                        lo[4] * scale, lo[5])
+        return Boundary(
+            lo[0] * scale, lo[1] * scale, lo[2] * scale, lo[3] * scale, lo[4] * scale, lo[5]
+        )
 
 
 class Trajectory:
@@ -150,8 +158,7 @@ class Trajectory:
 
     __slots__ = ("_cols", "_final", "_inv_step", "_last", "length_m")
 
-    def __init__(self, length_m: float, step_m: float, columns: np.ndarray,
-                 final: TrajectoryPoint):
+    def __init__(self, length_m: float, step_m: float, columns: np.ndarray, final: TrajectoryPoint):
         self.length_m = float(length_m)
         self._inv_step = 1.0 / step_m
         self._last = columns.shape[1] - 1
@@ -177,8 +184,9 @@ _LOADED_MAX = 4
 class LookupTables:
     """The 3D lookup tables and the phase boundaries of one build."""
 
-    def __init__(self, arrays: dict, boundaries: PhaseBoundaries, metadata: dict,
-                 params: VehicleParams):
+    def __init__(
+        self, arrays: dict, boundaries: PhaseBoundaries, metadata: dict, params: VehicleParams
+    ):
         self.mu_grid = tuple(float(m) for m in arrays["mu_grid"])  # increasing
         self.speed_grid_mps = tuple(float(v) for v in arrays["speed_grid_mps"])  # increasing
         self.dx_step_m = float(arrays["dx_step_m"])
@@ -201,24 +209,39 @@ class LookupTables:
         try:
             metadata = json.loads(meta_path.read_text())
         except OSError as exc:
-            raise InputError(f"{meta_path}: cannot read the tables' metadata ({exc.strerror}); "
-                             "run `eoam-sumo tables`") from None
+            raise InputError(
+                f"{meta_path}: cannot read the tables' metadata ({exc.strerror}); "
+                "run `eoam-sumo tables`"
+            ) from None
         except json.JSONDecodeError as exc:
             raise InputError(
-                f"{meta_path}: malformed JSON ({exc.msg}, line {exc.lineno})") from None
+                f"{meta_path}: malformed JSON ({exc.msg}, line {exc.lineno})"
+            ) from None
         _check_metadata(meta_path, metadata, params)
         npz_path = folder / NPZ_NAME
         try:
             with np.load(npz_path) as data:
                 arrays = {k: data[k] for k in data.files}
         except (OSError, ValueError) as exc:
-            raise InputError(f"{npz_path}: cannot read the lookup tables ({exc}); "
-                             "run `eoam-sumo tables`") from None
-        missing = [k for k in (*TABLE_NAMES, "mu_grid", "speed_grid_mps", "dx_step_m",
-                               "length_m", "lane_change_m") if k not in arrays]
+            raise InputError(
+                f"{npz_path}: cannot read the lookup tables ({exc}); run `eoam-sumo tables`"
+            ) from None
+        missing = [
+            k
+            for k in (
+                *TABLE_NAMES,
+                "mu_grid",
+                "speed_grid_mps",
+                "dx_step_m",
+                "length_m",
+                "lane_change_m",
+            )
+            if k not in arrays
+        ]
         if missing:
-            raise InputError(f"{npz_path}: missing arrays {', '.join(missing)}; "
-                             "run `eoam-sumo tables`")
+            raise InputError(
+                f"{npz_path}: missing arrays {', '.join(missing)}; run `eoam-sumo tables`"
+            )
         boundaries = PhaseBoundaries.load(folder)
         _check_same_grids(folder, metadata, arrays, boundaries)
         return cls(arrays, boundaries, metadata, params)
@@ -231,8 +254,10 @@ class LookupTables:
         folder = Path(directory) if directory is not None else default_tables_dir()
         params = params or ego_e_class_sedan()
         try:
-            stamp = tuple((st.st_size, st.st_mtime_ns) for st in (
-                os.stat(folder / name) for name in (METADATA_NAME, NPZ_NAME, CSV_NAME)))
+            stamp = tuple(
+                (st.st_size, st.st_mtime_ns)
+                for st in (os.stat(folder / name) for name in (METADATA_NAME, NPZ_NAME, CSV_NAME))
+            )
         except OSError:
             return cls.load(folder, params)  # says which file is missing
         key = (str(folder.resolve()), params, stamp)
@@ -250,12 +275,16 @@ class LookupTables:
         less than the road gives)."""
         low, top = self.speed_grid_mps[0], self.speed_grid_mps[-1]
         if not low - 1e-9 <= speed_mps <= top + 1e-9:
-            raise InputError(f"ego speed {speed_mps * 3.6:.1f} km/h is outside the tables' "
-                             f"range [{low * 3.6:.0f}, {top * 3.6:.0f}] km/h; rebuild with "
-                             "`eoam-sumo tables --speeds-kmh ...`")
+            raise InputError(
+                f"ego speed {speed_mps * 3.6:.1f} km/h is outside the tables' "
+                f"range [{low * 3.6:.0f}, {top * 3.6:.0f}] km/h; rebuild with "
+                "`eoam-sumo tables --speeds-kmh ...`"
+            )
         if mu < self.mu_grid[0] - 1e-9:
-            raise InputError(f"mu {mu:g} is below the tables' lowest friction "
-                             f"{self.mu_grid[0]:g}; rebuild with `eoam-sumo tables --mu ...`")
+            raise InputError(
+                f"mu {mu:g} is below the tables' lowest friction "
+                f"{self.mu_grid[0]:g}; rebuild with `eoam-sumo tables --mu ...`"
+            )
 
     def max_decel_mps2(self, mu: float) -> float:
         """Largest straight-line deceleration without locking an axle at this friction."""
@@ -265,8 +294,12 @@ class LookupTables:
         """The manoeuvre reference for this friction and entry speed (bilinear blend, once)."""
         i_m, j_m, w_m = _bracket(self._mus, mu)
         i_v, j_v, w_v = _bracket(self._speeds, speed_mps)
-        corners = ((i_m, i_v, (1 - w_m) * (1 - w_v)), (i_m, j_v, (1 - w_m) * w_v),
-                   (j_m, i_v, w_m * (1 - w_v)), (j_m, j_v, w_m * w_v))
+        corners = (
+            (i_m, i_v, (1 - w_m) * (1 - w_v)),
+            (i_m, j_v, (1 - w_m) * w_v),
+            (j_m, i_v, w_m * (1 - w_v)),
+            (j_m, j_v, w_m * w_v),
+        )
         lengths = self.length_m
         rows = int(max(lengths[m, v] for m, v, _ in corners) / self.dx_step_m) + 3
         rows = min(rows, self._tables.shape[-1])
@@ -284,15 +317,19 @@ def _check_same_grids(folder: Path, metadata: dict, arrays: dict, boundaries) ->
         mus = sorted(float(m) for m in grids["mu"])
         speeds = sorted(float(v) / 3.6 for v in grids["speed_kmh"])
     except (KeyError, TypeError, ValueError):
-        raise InputError(f"{folder / METADATA_NAME}: no friction and speed grids; run "
-                         "`eoam-sumo tables`") from None
+        raise InputError(
+            f"{folder / METADATA_NAME}: no friction and speed grids; run `eoam-sumo tables`"
+        ) from None
     for name, mu_grid, speed_grid in (
-            (NPZ_NAME, arrays["mu_grid"], arrays["speed_grid_mps"]),
-            (CSV_NAME, boundaries.mu_grid, boundaries.speed_grid_mps)):
+        (NPZ_NAME, arrays["mu_grid"], arrays["speed_grid_mps"]),
+        (CSV_NAME, boundaries.mu_grid, boundaries.speed_grid_mps),
+    ):
         if not (_same(mu_grid, mus, 1e-9) and _same(speed_grid, speeds, 1e-6)):
-            raise InputError(f"{folder}: {name} holds other friction or speed grids than "
-                             f"{METADATA_NAME}: the folder mixes two builds; run `eoam-sumo "
-                             "tables`")
+            raise InputError(
+                f"{folder}: {name} holds other friction or speed grids than "
+                f"{METADATA_NAME}: the folder mixes two builds; run `eoam-sumo "
+                "tables`"
+            )
 
 
 def _same(grid, values: list[float], tol: float) -> bool:
@@ -301,16 +338,25 @@ def _same(grid, values: list[float], tol: float) -> bool:
 
 def _check_metadata(path: Path, metadata: dict, params: VehicleParams) -> None:
     if metadata.get("format") != FORMAT_VERSION:
-        raise InputError(f"{path}: tables format {metadata.get('format')!r} is not "
-                         f"{FORMAT_VERSION}; run `eoam-sumo tables`")
+        raise InputError(
+            f"{path}: tables format {metadata.get('format')!r} is not "
+            f"{FORMAT_VERSION}; run `eoam-sumo tables`"
+        )
     stored = metadata.get("vehicle", {})
     wanted = describe(params)
-    diffs = [name for name, rec in wanted.items()
-             if not isinstance(stored.get(name), dict) or stored[name].get("value") != rec["value"]]
+    diffs = [
+        name
+        for name, rec in wanted.items()
+        if not isinstance(stored.get(name), dict) or stored[name].get("value") != rec["value"]
+    ]
     diffs += [name for name in stored if name not in wanted]
     if diffs:
         shown = ", ".join(
             f"{n} (tables {stored.get(n, {}).get('value')!r}, in use "
-            f"{wanted.get(n, {}).get('value')!r})" for n in diffs[:3])
-        raise InputError(f"{path}: the tables were built for other vehicle parameters: {shown}; "
-                         "run `eoam-sumo tables` to rebuild them")
+            f"{wanted.get(n, {}).get('value')!r})"
+            for n in diffs[:3]
+        )
+        raise InputError(
+            f"{path}: the tables were built for other vehicle parameters: {shown}; "
+            "run `eoam-sumo tables` to rebuild them"
+        )

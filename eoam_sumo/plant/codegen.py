@@ -33,7 +33,11 @@ from eoam_sumo.plant.ops import CASADI_OPS
 
 FUNCTION_NAME = "eoam_plant_step"
 C_FLAGS = (
-    "-O2", "-shared", "-fPIC", "-ffp-contract=off", "-fno-semantic-interposition",
+    "-O2",
+    "-shared",
+    "-fPIC",
+    "-ffp-contract=off",
+    "-fno-semantic-interposition",
     "-fno-math-errno",
 )
 """``-ffp-contract=off``: no fused multiply-adds, so the C code rounds like the reference.
@@ -68,9 +72,13 @@ def step_function(params: VehicleParams, dt_s: float, substeps: int) -> casadi.F
     mu = casadi.SX.sym("mu")
     xs = [x[i] for i in range(x.numel())]
     one_step = casadi.Function(
-        f"{FUNCTION_NAME}_rk4", [x, u, mu],
-        [casadi.vertcat(*rk4_step(xs, [u[i] for i in range(u.numel())], mu, params, dt_s,
-                                  CASADI_OPS))],
+        f"{FUNCTION_NAME}_rk4",
+        [x, u, mu],
+        [
+            casadi.vertcat(
+                *rk4_step(xs, [u[i] for i in range(u.numel())], mu, params, dt_s, CASADI_OPS)
+            )
+        ],
     )
     measure = casadi.Function(
         f"{FUNCTION_NAME}_outputs", [x, mu], [casadi.vertcat(*outputs(xs, mu, params, CASADI_OPS))]
@@ -82,8 +90,11 @@ def step_function(params: VehicleParams, dt_s: float, substeps: int) -> casadi.F
     for _ in range(substeps):
         x_next = one_step(x_next, U, MU)
     return casadi.Function(
-        FUNCTION_NAME, [X, U, MU], [x_next, measure(x_next, MU)],
-        ["x", "u", "mu"], ["x_next", "y"],
+        FUNCTION_NAME,
+        [X, U, MU],
+        [x_next, measure(x_next, MU)],
+        ["x", "u", "mu"],
+        ["x_next", "y"],
     )
 
 
@@ -118,8 +129,13 @@ def find_compiler() -> list[str] | None:
     return None
 
 
-def build_library(source: str, cache_dir: Path, compiler: list[str],
-                  extra_flags: tuple[str, ...] = (), stem: str = FUNCTION_NAME) -> Path:
+def build_library(
+    source: str,
+    cache_dir: Path,
+    compiler: list[str],
+    extra_flags: tuple[str, ...] = (),
+    stem: str = FUNCTION_NAME,
+) -> Path:
     """Compile ``source`` (with ``C_FLAGS`` and ``extra_flags``) into ``cache_dir`` as
     ``<stem>_<hash>.so`` unless already there; return the library path.
 

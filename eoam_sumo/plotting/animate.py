@@ -33,8 +33,13 @@ from eoam_sumo.plotting.roadmap import read_road_map
 from eoam_sumo.plotting.run_plots import MODE_NAMES, load_run
 from eoam_sumo.sim.trafficlog import TRAFFIC_FILE, read_traffic
 
-ROLE_COLOURS = {"ego": "#1e88e5", "aro": "#e53935", "oncoming": "#fb8c00",
-                "parked": "#757575", "other": "#43a047"}
+ROLE_COLOURS = {
+    "ego": "#1e88e5",
+    "aro": "#e53935",
+    "oncoming": "#fb8c00",
+    "parked": "#757575",
+    "other": "#43a047",
+}
 _ROLE_RANK = {"ego": 0, "aro": 1, "oncoming": 2, "parked": 3, "other": 4}
 PLAN_AHEAD_S = 3.0  # the planned path drawn this far ahead of the frame's time [s]
 VIEW_BEHIND_M, VIEW_AHEAD_M = 40.0, 110.0  # view along the ego's heading [m]
@@ -49,8 +54,9 @@ def _boxes(x, y, yaw, length, width) -> np.ndarray:
     hl, hw = 0.5 * length, 0.5 * width
     corners = []
     for fl, fw in ((1, 1), (1, -1), (-1, -1), (-1, 1)):
-        corners.append(np.column_stack((x + fl * hl * c - fw * hw * s,
-                                        y + fl * hl * s + fw * hw * c)))
+        corners.append(
+            np.column_stack((x + fl * hl * c - fw * hw * s, y + fl * hl * s + fw * hw * c))
+        )
     return np.stack(corners, axis=1)
 
 
@@ -60,8 +66,13 @@ def _frame_rows(times: np.ndarray, fps: float) -> np.ndarray:
     return np.unique(np.clip(np.searchsorted(times, wanted - 1e-9), 0, len(times) - 1))
 
 
-def animate_run(run_dir: Path, out: Path | None = None, fps: int = DEFAULT_FPS,
-                size_in: tuple[float, float] = (9.0, 3.6), dpi: int = 90) -> tuple[Path, int]:
+def animate_run(
+    run_dir: Path,
+    out: Path | None = None,
+    fps: int = DEFAULT_FPS,
+    size_in: tuple[float, float] = (9.0, 3.6),
+    dpi: int = 90,
+) -> tuple[Path, int]:
     """Write the animation of ``run_dir``; (its path, the number of frames)."""
     run_dir = Path(run_dir)
     if not run_dir.is_dir():
@@ -73,8 +84,9 @@ def animate_run(run_dir: Path, out: Path | None = None, fps: int = DEFAULT_FPS,
     summary, ts = load_run(run_dir)
     traffic_path = run_dir / TRAFFIC_FILE
     if not traffic_path.is_file():
-        raise InputError(f"{run_dir}: has no {TRAFFIC_FILE} (a run of an older eoam-sumo; "
-                         "run it again)")
+        raise InputError(
+            f"{run_dir}: has no {TRAFFIC_FILE} (a run of an older eoam-sumo; run it again)"
+        )
     traffic = read_traffic(traffic_path)
     out = Path(out) if out is not None else run_dir / "animation.gif"
     mp4 = out.suffix.lower() == ".mp4"
@@ -116,8 +128,7 @@ class _Scene:
         self.sector = ts["sector"].fillna("").astype(str).to_list()
         self._traffic_index(traffic)
         self.radar_m = float(summary.get("radar_range_m") or 100.0)
-        self.fov_rad = math.radians(float(summary.get("radar_fov_deg")
-                                          or DEFAULT_RADAR_FOV_DEG))
+        self.fov_rad = math.radians(float(summary.get("radar_fov_deg") or DEFAULT_RADAR_FOV_DEG))
         self.contact_t = summary.get("contact_time_s")
         self.fig = Figure(figsize=size_in, dpi=dpi)
         # fixed margins (a layout engine per frame would double the cost) and no ticks: the
@@ -129,19 +140,42 @@ class _Scene:
         self.view_ratio = 0.90 * size_in[1] / (0.98 * size_in[0])  # view height / width
         ax.set_facecolor("#a5d6a7")  # verges
         self._draw_road(summary)
-        self.cone = Polygon(np.zeros((3, 2)), closed=True, facecolor="#ffee58", alpha=0.25,
-                            edgecolor="#f9a825", linewidth=0.6, zorder=2)
+        self.cone = Polygon(
+            np.zeros((3, 2)),
+            closed=True,
+            facecolor="#ffee58",
+            alpha=0.25,
+            edgecolor="#f9a825",
+            linewidth=0.6,
+            zorder=2,
+        )
         ax.add_patch(self.cone)
         (self.track,) = ax.plot([], [], color="#1e88e5", linewidth=0.8, alpha=0.6, zorder=3)
         (self.plan,) = ax.plot([], [], color="black", linestyle="--", linewidth=1.0, zorder=3)
         self.bodies = PolyCollection([], edgecolors="black", linewidths=0.5, zorder=4)
         ax.add_collection(self.bodies)
-        (self.contact,) = ax.plot([], [], marker="o", markersize=18, markerfacecolor="none",
-                                  markeredgecolor="#d50000", markeredgewidth=2.0,
-                                  linestyle="", zorder=5)
-        self.text = ax.text(0.01, 0.97, "", transform=ax.transAxes, va="top", fontsize=8,
-                            family="monospace", zorder=6,
-                            bbox={"facecolor": "white", "alpha": 0.85, "linewidth": 0})
+        (self.contact,) = ax.plot(
+            [],
+            [],
+            marker="o",
+            markersize=18,
+            markerfacecolor="none",
+            markeredgecolor="#d50000",
+            markeredgewidth=2.0,
+            linestyle="",
+            zorder=5,
+        )
+        self.text = ax.text(
+            0.01,
+            0.97,
+            "",
+            transform=ax.transAxes,
+            va="top",
+            fontsize=8,
+            family="monospace",
+            zorder=6,
+            bbox={"facecolor": "white", "alpha": 0.85, "linewidth": 0},
+        )
         self._static_overlay(size_in, dpi)
 
     def _static_overlay(self, size_in, dpi) -> None:
@@ -149,11 +183,20 @@ class _Scene:
         text would otherwise be laid out again for each frame, a third of its cost)."""
         over = Figure(figsize=size_in, dpi=dpi)
         over.patch.set_alpha(0.0)
-        handles: list[Artist] = [Patch(facecolor=ROLE_COLOURS[r], edgecolor="black", label=r)
-                                 for r in ROLE_COLOURS if r in self.roles_present]
+        handles: list[Artist] = [
+            Patch(facecolor=ROLE_COLOURS[r], edgecolor="black", label=r)
+            for r in ROLE_COLOURS
+            if r in self.roles_present
+        ]
         handles.append(Line2D([], [], color="black", linestyle="--", label="planned path"))
-        over.legend(handles=handles, loc="lower right", bbox_to_anchor=(0.985, 0.02),
-                    fontsize=7, ncols=3, framealpha=0.85)
+        over.legend(
+            handles=handles,
+            loc="lower right",
+            bbox_to_anchor=(0.985, 0.02),
+            fontsize=7,
+            ncols=3,
+            framealpha=0.85,
+        )
         over.suptitle(self._title(self.summary), fontsize=8, y=0.985)
         canvas = FigureCanvasAgg(over)
         canvas.draw()
@@ -175,11 +218,13 @@ class _Scene:
         by_rank = {v: k for k, v in _ROLE_RANK.items()}
         self.tr_colour = np.array([ROLE_COLOURS[by_rank[r]] for r in best])
         self.roles_present = {by_rank[r] for r in set(best)}
-        x, y, heading, length, width = (traffic[c].to_numpy() for c in
-                                        ("x_m", "y_m", "heading_rad", "length_m", "width_m"))
+        x, y, heading, length, width = (
+            traffic[c].to_numpy() for c in ("x_m", "y_m", "heading_rad", "length_m", "width_m")
+        )
         # a person (0.2 x 0.5 m) would be a pixel or two: small road users drawn larger
-        self.tr_boxes = _boxes(x, y, heading, np.maximum(length, MIN_DRAWN_M),
-                               np.maximum(width, MIN_DRAWN_M))
+        self.tr_boxes = _boxes(
+            x, y, heading, np.maximum(length, MIN_DRAWN_M), np.maximum(width, MIN_DRAWN_M)
+        )
         self.tr_is_ego = (traffic["role"] == "ego").to_numpy()
         self.tr_xy = traffic[["x_m", "y_m"]].to_numpy()
         ego = traffic[self.tr_is_ego]
@@ -195,18 +240,30 @@ class _Scene:
         pad = VIEW_AHEAD_M + 50.0
         bbox = (self.x.min() - pad, self.y.min() - pad, self.x.max() + pad, self.y.max() + pad)
         if not net or not Path(net).is_file():
-            self.ax.text(0.5, 0.5, f"road not drawn: network {net or '(not recorded)'} not "
-                         "found", transform=self.ax.transAxes, ha="center", fontsize=8)
+            self.ax.text(
+                0.5,
+                0.5,
+                f"road not drawn: network {net or '(not recorded)'} not found",
+                transform=self.ax.transAxes,
+                ha="center",
+                fontsize=8,
+            )
             return
         road = read_road_map(Path(net), bbox)
-        self.ax.add_collection(PolyCollection(road.road, facecolors="#616161",
-                                              edgecolors="none", zorder=1))
-        self.ax.add_collection(PolyCollection(road.pavement, facecolors="#bdbdbd",
-                                              edgecolors="none", zorder=1))
-        self.ax.add_collection(LineCollection(road.solid, colors="white", linewidths=1.0,
-                                              zorder=1.5))
-        self.ax.add_collection(LineCollection(road.dashed, colors="white", linewidths=0.8,
-                                              linestyles=(0, (4, 6)), zorder=1.5))
+        self.ax.add_collection(
+            PolyCollection(road.road, facecolors="#616161", edgecolors="none", zorder=1)
+        )
+        self.ax.add_collection(
+            PolyCollection(road.pavement, facecolors="#bdbdbd", edgecolors="none", zorder=1)
+        )
+        self.ax.add_collection(
+            LineCollection(road.solid, colors="white", linewidths=1.0, zorder=1.5)
+        )
+        self.ax.add_collection(
+            LineCollection(
+                road.dashed, colors="white", linewidths=0.8, linestyles=(0, (4, 6)), zorder=1.5
+            )
+        )
 
     def draw(self, k: int) -> None:
         """Update the artists to time-series row ``k``."""
@@ -218,13 +275,18 @@ class _Scene:
         fx = self.ego_cx[k] + self.ego_front_m * c
         fy = self.ego_cy[k] + self.ego_front_m * s
         r, h = self.radar_m, 0.5 * self.fov_rad
-        self.cone.set_xy([(fx, fy), (fx + r * math.cos(yaw + h), fy + r * math.sin(yaw + h)),
-                          (fx + r * math.cos(yaw - h), fy + r * math.sin(yaw - h))])
-        self.track.set_data(self.x[:k + 1], self.y[:k + 1])
+        self.cone.set_xy(
+            [
+                (fx, fy),
+                (fx + r * math.cos(yaw + h), fy + r * math.sin(yaw + h)),
+                (fx + r * math.cos(yaw - h), fy + r * math.sin(yaw - h)),
+            ]
+        )
+        self.track.set_data(self.x[: k + 1], self.y[: k + 1])
         end = int(np.searchsorted(self.t, self.t[k] + PLAN_AHEAD_S))
         phase = self.in_manoeuvre[k:end]  # ahead as long as the phase (manoeuvre or not) lasts
         n = int(np.argmin(phase == phase[0])) if not phase.all() and phase.any() else len(phase)
-        self.plan.set_data(self.plan_x[k:k + n], self.plan_y[k:k + n])
+        self.plan.set_data(self.plan_x[k : k + n], self.plan_y[k : k + n])
         if self.contact_t is not None and self.t[k] >= self.contact_t - 1e-9:
             self.contact.set_data(*self._contact_point(self.contact_t))
         else:
@@ -242,8 +304,10 @@ class _Scene:
         name = MODE_NAMES.get(int(mode), "?") if np.isfinite(mode) else "end"
         sector = self.sector[k] or "-"
         fcw = "  FCW" if np.isfinite(self.fcw[k]) and self.fcw[k] > 0 else ""
-        return (f"t = {self.t[k]:6.2f} s   mode {name}   {3.6 * self.vx[k]:5.1f} km/h   "
-                f"DMM sector {sector}{fcw}\nview {VIEW_BEHIND_M + VIEW_AHEAD_M:g} m wide")
+        return (
+            f"t = {self.t[k]:6.2f} s   mode {name}   {3.6 * self.vx[k]:5.1f} km/h   "
+            f"DMM sector {sector}{fcw}\nview {VIEW_BEHIND_M + VIEW_AHEAD_M:g} m wide"
+        )
 
     def _contact_point(self, contact_t: float) -> tuple[list, list]:
         """The contact point of summary.json, else (a run of an older eoam-sumo) the midpoint
@@ -267,4 +331,3 @@ def animate_cli(run_dir: Path, out: Path | None, fps: int) -> str:
     """The line ``eoam-sumo animate`` prints."""
     path, n = animate_run(run_dir, out, fps)
     return f"{path} ({n} frames at {fps} fps)"
-

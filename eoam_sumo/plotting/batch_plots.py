@@ -51,14 +51,32 @@ def plot_table2(grid, path: Path) -> Path:
         parts = [cell.ours, cell.paper] if halves == 2 else [cell.ours]
         for k, colour in enumerate(parts):
             x0 = j + k / halves
-            ax.add_patch(Rectangle((x0, i), 1 / halves, 1, facecolor=OUTCOME_COLOURS.get(
-                colour, _MISSING), edgecolor="white", linewidth=0.6))
-            ax.text(x0 + 0.5 / halves, i + 0.5, colour or "—", ha="center", va="center",
-                    fontsize=8, color=_text_colour(colour))
+            ax.add_patch(
+                Rectangle(
+                    (x0, i),
+                    1 / halves,
+                    1,
+                    facecolor=OUTCOME_COLOURS.get(colour, _MISSING),
+                    edgecolor="white",
+                    linewidth=0.6,
+                )
+            )
+            ax.text(
+                x0 + 0.5 / halves,
+                i + 0.5,
+                colour or "—",
+                ha="center",
+                va="center",
+                fontsize=8,
+                color=_text_colour(colour),
+            )
         ax.add_patch(Rectangle((j, i), 1, 1, fill=False, edgecolor="white", linewidth=3.5))
         if halves == 2 and cell.compared and not cell.agrees:
-            ax.add_patch(Rectangle((j + 0.03, i + 0.06), 0.94, 0.88, fill=False,
-                                   edgecolor="black", linewidth=2.2))
+            ax.add_patch(
+                Rectangle(
+                    (j + 0.03, i + 0.06), 0.94, 0.88, fill=False, edgecolor="black", linewidth=2.2
+                )
+            )
     labels = []
     previous = None
     for i, (traffic, speed) in enumerate(grid.rows):
@@ -70,34 +88,43 @@ def plot_table2(grid, path: Path) -> Path:
     ax.set_ylim(n_rows, 0)
     ax.set_yticks(np.arange(n_rows) + 0.5, labels, fontsize=9)
     sub = "\nours | paper" if halves == 2 else ""
-    ax.set_xticks(np.arange(n_cols) + 0.5, [f"μ = {mu_text(mu)}{sub}" for mu in grid.mus],
-                  fontsize=10)
+    ax.set_xticks(
+        np.arange(n_cols) + 0.5, [f"μ = {mu_text(mu)}{sub}" for mu in grid.mus], fontsize=10
+    )
     ax.xaxis.tick_top()
     ax.tick_params(length=0)
     for spine in ax.spines.values():
         spine.set_visible(False)
     if grid.has_paper:
-        title = (f"EOAM outcomes: each cell ours | paper (Table 2) — "
-                 f"{grid.agreeing}/{grid.compared} cells agree (differences framed)")
+        title = (
+            f"EOAM outcomes: each cell ours | paper (Table 2) — "
+            f"{grid.agreeing}/{grid.compared} cells agree (differences framed)"
+        )
     else:
         title = f"EOAM outcomes ({len(grid.cells)} cases)"
     ax.set_title(title, fontsize=11)
     present = {c.ours for c in grid.cells.values()} | {c.paper for c in grid.cells.values()}
-    handles = [Patch(facecolor=OUTCOME_COLOURS[c], label=c) for c in OUTCOME_COLOURS
-               if c in present]
+    handles = [
+        Patch(facecolor=OUTCOME_COLOURS[c], label=c) for c in OUTCOME_COLOURS if c in present
+    ]
     fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), frameon=False)
     return save(fig, path)
 
 
 def _offsets(batch_dir: Path, case_dir: str) -> pd.DataFrame:
-    return read_timeseries(Path(batch_dir) / case_dir / "timeseries.csv",
-                           ["time_s", "lateral_offset_m", "mode"])
+    return read_timeseries(
+        Path(batch_dir) / case_dir / "timeseries.csv", ["time_s", "lateral_offset_m", "mode"]
+    )
 
 
 #: How a swept matrix key is named in a legend (other keys: ``key = value``).
-_SWEEP_FORMATS = {"ego_speed_kmh": "{:g} km/h", "aro_hold_s": "ARO hold {:g} s",
-                  "aro_decel_mps2": "ARO decel {:g} m/s²", "max_time_s": "time limit {:g} s",
-                  "radar_range_m": "radar {:g} m"}
+_SWEEP_FORMATS = {
+    "ego_speed_kmh": "{:g} km/h",
+    "aro_hold_s": "ARO hold {:g} s",
+    "aro_decel_mps2": "ARO decel {:g} m/s²",
+    "max_time_s": "time limit {:g} s",
+    "radar_range_m": "radar {:g} m",
+}
 
 
 def swept_keys(results: pd.DataFrame) -> list[str]:
@@ -116,8 +143,13 @@ def _key_text(row, key: str) -> str:
     if pd.isna(value):
         return f"{key} default"
     fmt = _SWEEP_FORMATS.get(key)
-    return fmt.format(value) if fmt else f"{key} = {value:g}" if isinstance(
-        value, float) else f"{key} = {value}"
+    return (
+        fmt.format(value)
+        if fmt
+        else f"{key} = {value:g}"
+        if isinstance(value, float)
+        else f"{key} = {value}"
+    )
 
 
 class _CaseFacts:
@@ -150,8 +182,9 @@ def _label(row, keys: list[str], facts: _CaseFacts) -> str:
     return ", ".join(parts)
 
 
-def _panel(ax, batch_dir: Path, rows: pd.DataFrame, label_of, cmap_name: str,
-           facts: _CaseFacts) -> int:
+def _panel(
+    ax, batch_dir: Path, rows: pd.DataFrame, label_of, cmap_name: str, facts: _CaseFacts
+) -> int:
     """Lateral offset against time of each ``rows`` case, with the next lane's centre and
     the point of no return of each lane width the cases ran on; returns the number of
     lines."""
@@ -163,21 +196,35 @@ def _panel(ax, batch_dir: Path, rows: pd.DataFrame, label_of, cmap_name: str,
         width, recorded, _ = facts(row["case_dir"])
         widths[width] = widths.get(width, True) and recorded
         colour = cmap(0.45 + 0.55 * k / max(len(rows) - 1, 1))
-        ax.plot(ts["time_s"], ts["lateral_offset_m"], color=colour, linewidth=1.8,
-                linestyle=_STYLES[k % len(_STYLES)],
-                label=f"{label_of(row)} ({row['outcome']})")
-        ax.plot(ts["time_s"].iloc[-1], ts["lateral_offset_m"].iloc[-1], marker="s",
-                markersize=9, color=OUTCOME_COLOURS.get(row["outcome"], _MISSING),
-                markeredgecolor="black")
+        ax.plot(
+            ts["time_s"],
+            ts["lateral_offset_m"],
+            color=colour,
+            linewidth=1.8,
+            linestyle=_STYLES[k % len(_STYLES)],
+            label=f"{label_of(row)} ({row['outcome']})",
+        )
+        ax.plot(
+            ts["time_s"].iloc[-1],
+            ts["lateral_offset_m"].iloc[-1],
+            marker="s",
+            markersize=9,
+            color=OUTCOME_COLOURS.get(row["outcome"], _MISSING),
+            markeredgecolor="black",
+        )
     for width, recorded in widths.items():
         lane = f"{width:.2f} m lane" + ("" if recorded else ", assumed: not recorded")
         ponr = point_of_no_return_m(width)
         ax.axhline(width, color="0.4", linestyle="--", linewidth=0.8)
         ax.axhline(ponr, color="0.4", linestyle=":", linewidth=0.8)
-        ax.text(ax.get_xlim()[0], width, f" next lane centre ({lane})", va="bottom",
-                fontsize=8)
-        ax.text(ax.get_xlim()[0], ponr, f" point of no return ({PONR_FRACTION:g} x {width:.2f}"
-                " m)", va="bottom", fontsize=8)
+        ax.text(ax.get_xlim()[0], width, f" next lane centre ({lane})", va="bottom", fontsize=8)
+        ax.text(
+            ax.get_xlim()[0],
+            ponr,
+            f" point of no return ({PONR_FRACTION:g} x {width:.2f} m)",
+            va="bottom",
+            fontsize=8,
+        )
     ax.set_xlabel("time [s]")
     ax.set_ylabel("lateral offset from the original lane centre [m] (left +)")
     ax.grid(alpha=0.3)
@@ -192,8 +239,9 @@ def _colormap(name: str):
     return colormaps[name]
 
 
-def plot_lateral_offsets(batch_dir: Path, results: pd.DataFrame, out_dir: Path,
-                         speed_kmh: float) -> Path | None:
+def plot_lateral_offsets(
+    batch_dir: Path, results: pd.DataFrame, out_dir: Path, speed_kmh: float
+) -> Path | None:
     """Figure 25 at one speed: lateral offset vs time of the cases without an added oncoming
     car (left) and of the cases at the highest friction across the oncoming settings
     (right). Each line is named by every key the batch sweeps (but the speed); None when the
@@ -207,7 +255,8 @@ def plot_lateral_offsets(batch_dir: Path, results: pd.DataFrame, out_dir: Path,
     top_mu = float(at_speed["mu"].max())
     no_onc = at_speed[at_speed["oncoming_start_m"].isna()].sort_values("mu", ascending=False)
     dry = at_speed[at_speed["mu"] == top_mu].sort_values(
-        "oncoming_start_m", ascending=False, na_position="first")
+        "oncoming_start_m", ascending=False, na_position="first"
+    )
     left_keys = [k for k in keys if k != "oncoming_start_m"] or ["mu"]
     across = ", ".join(_KEY_NAMES.get(k, k) for k in left_keys)
     if any(facts(c)[2] for c in no_onc["case_dir"]):
@@ -215,24 +264,32 @@ def plot_lateral_offsets(batch_dir: Path, results: pd.DataFrame, out_dir: Path,
         left_title = "no oncoming car added"
     else:
         left_title = "no oncoming traffic"
-    right_keys = ["oncoming_start_m",
-                  *(k for k in keys if k not in ("mu", "oncoming_start_m"))]
+    right_keys = ["oncoming_start_m", *(k for k in keys if k not in ("mu", "oncoming_start_m"))]
     fig = Figure(figsize=(13, 5.2), layout="constrained")
     left, right = fig.subplots(1, 2, sharey=True)
     _panel(left, batch_dir, no_onc, lambda r: _label(r, left_keys, facts), "Blues", facts)
     left.set_title(fit(f"{speed_kmh:g} km/h, {left_title}, across {across}", 6.3, 12))
     _panel(right, batch_dir, dry, lambda r: _label(r, right_keys, facts), "Purples", facts)
-    right.set_title(fit(f"{speed_kmh:g} km/h, μ = {mu_text(top_mu)}, across oncoming settings",
-                        6.3, 12))
+    right.set_title(
+        fit(f"{speed_kmh:g} km/h, μ = {mu_text(top_mu)}, across oncoming settings", 6.3, 12)
+    )
     fig.suptitle("Ego lateral position during the EOAM (cf. paper Figure 25)")
     return save(fig, Path(out_dir) / f"lateral_offsets_{speed_kmh:g}kmh.png")
 
 
-_KEY_NAMES = {"mu": "frictions", "aro_hold_s": "ARO hold times",
-              "aro_decel_mps2": "ARO decelerations", "max_time_s": "time limits",
-              "radar_range_m": "radar ranges", "sumocfg": "scenarios", "policy": "policies",
-              "v2x_range_m": "V2X ranges", "mu_belief": "friction beliefs",
-              "radar_model": "radar models", "seed": "seeds"}
+_KEY_NAMES = {
+    "mu": "frictions",
+    "aro_hold_s": "ARO hold times",
+    "aro_decel_mps2": "ARO decelerations",
+    "max_time_s": "time limits",
+    "radar_range_m": "radar ranges",
+    "sumocfg": "scenarios",
+    "policy": "policies",
+    "v2x_range_m": "V2X ranges",
+    "mu_belief": "friction beliefs",
+    "radar_model": "radar models",
+    "seed": "seeds",
+}
 
 
 def plot_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
@@ -242,8 +299,10 @@ def plot_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
         from eoam_sumo.plotting.envelope_plots import plot_envelopes
 
         return plot_envelopes(results, out_dir)
-    paths = [plot_table2(outcome_grid(results), Path(out_dir) / TABLE_PNG),
-             plot_margins(results, Path(out_dir) / MARGINS_PNG)]
+    paths = [
+        plot_table2(outcome_grid(results), Path(out_dir) / TABLE_PNG),
+        plot_margins(results, Path(out_dir) / MARGINS_PNG),
+    ]
     ok = results[results["status"] == "ok"]
     for speed_kmh in pd.unique(ok["ego_speed_kmh"]):
         fig25 = plot_lateral_offsets(batch_dir, results, out_dir, float(speed_kmh))
@@ -261,24 +320,41 @@ def plot_margins(results: pd.DataFrame, path: Path) -> Path:
     fig = Figure(figsize=(max(8.0, 0.22 * len(ok) + 2.0), 7.0), layout="constrained")
     gaps, ttcs = fig.subplots(2, 1, sharex=True)
     cap_m, cap_s = 6.0, 6.0  # larger margins are drawn at the cap
-    for column, marker, label in (("min_gap_aro_m", "o", "gap to the obstacle (ARO)"),
-                                  ("min_gap_oncoming_m", "s", "gap to oncoming traffic")):
+    for column, marker, label in (
+        ("min_gap_aro_m", "o", "gap to the obstacle (ARO)"),
+        ("min_gap_oncoming_m", "s", "gap to oncoming traffic"),
+    ):
         gaps.scatter(x, ok[column].clip(upper=cap_m), marker=marker, s=22, label=label)
-    gaps.axhline(NEAR_MISS_GAP_M, color="red", linestyle="--", linewidth=0.9,
-                 label=f"near miss: {NEAR_MISS_GAP_M:g} m")
+    gaps.axhline(
+        NEAR_MISS_GAP_M,
+        color="red",
+        linestyle="--",
+        linewidth=0.9,
+        label=f"near miss: {NEAR_MISS_GAP_M:g} m",
+    )
     gaps.set_ylabel(f"smallest box gap [m] (capped at {cap_m:g})")
-    ttcs.scatter(x, ok["min_ttc_oncoming_s"].clip(upper=cap_s), marker="D", s=22,
-                 color="0.3", label="time to collision with oncoming traffic")
-    ttcs.axhline(NEAR_MISS_TTC_S, color="red", linestyle="--", linewidth=0.9,
-                 label=f"near miss: {NEAR_MISS_TTC_S:g} s")
+    ttcs.scatter(
+        x,
+        ok["min_ttc_oncoming_s"].clip(upper=cap_s),
+        marker="D",
+        s=22,
+        color="0.3",
+        label="time to collision with oncoming traffic",
+    )
+    ttcs.axhline(
+        NEAR_MISS_TTC_S,
+        color="red",
+        linestyle="--",
+        linewidth=0.9,
+        label=f"near miss: {NEAR_MISS_TTC_S:g} s",
+    )
     ttcs.set_ylabel(f"smallest time to collision [s] (capped at {cap_s:g})")
     for k, row in ok.iterrows():
         colour = OUTCOME_COLOURS.get(row["outcome"], _MISSING)
         for ax in (gaps, ttcs):
             ax.axvspan(k - 0.5, k + 0.5, color=colour, alpha=0.18, linewidth=0)
             if str(row.get("near_miss")) == "True":
-                ax.axvspan(k - 0.5, k + 0.5, fill=False, hatch="//", edgecolor="red",
-                           linewidth=0)
+                ax.axvspan(k - 0.5, k + 0.5, fill=False, hatch="//", edgecolor="red", linewidth=0)
     ttcs.set_xticks(x, ok["case_id"], rotation=90, fontsize=7)
     for ax in (gaps, ttcs):
         ax.set_xlim(-0.5, max(len(ok), 1) - 0.5)

@@ -28,10 +28,14 @@ def plot_folder(folder: Path, out_dir: Path) -> list[Path]:
         if not (folder / NPZ_NAME).is_file():
             raise InputError(f"{folder}: has phase_boundaries.csv but no {NPZ_NAME}")
 
-        return [*_paths(plot_phase_diagrams(folder, out_dir)),
-                *_paths(plot_accel_profiles(folder, out_dir))]
-    raise InputError(f"{folder}: not a run (summary.json), batch (results.csv) or tables "
-                     "(phase_boundaries.csv) folder")
+        return [
+            *_paths(plot_phase_diagrams(folder, out_dir)),
+            *_paths(plot_accel_profiles(folder, out_dir)),
+        ]
+    raise InputError(
+        f"{folder}: not a run (summary.json), batch (results.csv) or tables "
+        "(phase_boundaries.csv) folder"
+    )
 
 
 def _paths(result) -> list[Path]:

@@ -66,9 +66,15 @@ def plot_envelopes(results: pd.DataFrame, out_dir: Path) -> list[Path]:
                 if n[i, j] == 0:
                     continue
                 low, high = wilson_interval(int(count[i, j]), int(n[i, j]))
-                ax.text(j, i, f"{p[i, j]:.2f}\n[{low:.2f}, {high:.2f}]\nn={n[i, j]}",
-                        ha="center", va="center", fontsize=8,
-                        color="white" if p[i, j] > 0.6 else "black")
+                ax.text(
+                    j,
+                    i,
+                    f"{p[i, j]:.2f}\n[{low:.2f}, {high:.2f}]\nn={n[i, j]}",
+                    ha="center",
+                    va="center",
+                    fontsize=8,
+                    color="white" if p[i, j] > 0.6 else "black",
+                )
         ax.set_xticks(range(len(mus)), mus)
         ax.set_yticks(range(len(speeds)), speeds)
         ax.invert_yaxis()  # the highest speed on top
@@ -77,7 +83,9 @@ def plot_envelopes(results: pd.DataFrame, out_dir: Path) -> list[Path]:
         ax.set_title(title)
         fig.colorbar(image, ax=ax, shrink=0.8, label="probability")
     failed = int((results["status"] != "ok").sum())
-    fig.suptitle(f"Outcome envelopes: {int((results['status'] == 'ok').sum())} draws"
-                 + (f" ({failed} failed, left out)" if failed else "")
-                 + "; each cell p [Wilson 95 %] and n")
+    fig.suptitle(
+        f"Outcome envelopes: {int((results['status'] == 'ok').sum())} draws"
+        + (f" ({failed} failed, left out)" if failed else "")
+        + "; each cell p [Wilson 95 %] and n"
+    )
     return [save(fig, Path(out_dir) / ENVELOPE_PNG)]

@@ -46,27 +46,52 @@ def plot_phase_diagrams(tables_dir, out_dir) -> list[Path]:
         top = rows[-1]
         d_max = 1.1 * max(top.stop_buffered_m, top.clear_buffered_m, top.ttc_s * speeds[-1])
         dist = np.linspace(0.0, d_max, 400)
-        index = np.array([[_SECTORS.index(dmm_sector(b, d, v)) for d in dist]
-                          for v, b in zip(speeds, rows)])
+        index = np.array(
+            [[_SECTORS.index(dmm_sector(b, d, v)) for d in dist] for v, b in zip(speeds, rows)]
+        )
         fig = Figure(figsize=(8.0, 5.6))
         ax = fig.add_subplot()
         kmh = speeds * 3.6
-        ax.pcolormesh(dist, kmh, index, cmap=ListedColormap(_SECTOR_COLOURS), vmin=-0.5,
-                      vmax=len(_SECTORS) - 0.5, shading="nearest", rasterized=True)
+        ax.pcolormesh(
+            dist,
+            kmh,
+            index,
+            cmap=ListedColormap(_SECTOR_COLOURS),
+            vmin=-0.5,
+            vmax=len(_SECTORS) - 0.5,
+            shading="nearest",
+            rasterized=True,
+        )
         for field, label, colour, style in _CURVES:
-            ax.plot([getattr(b, field) for b in rows], kmh, style, color=colour, lw=1.6,
-                    label=label)
-        ax.plot([b.ttc_s * v for b, v in zip(rows, speeds)], kmh, "-.", color="#455a64",
-                lw=1.4, label=f"TTC = {top.ttc_s:g} s (eq. 34)")
+            ax.plot(
+                [getattr(b, field) for b in rows], kmh, style, color=colour, lw=1.6, label=label
+            )
+        ax.plot(
+            [b.ttc_s * v for b, v in zip(rows, speeds)],
+            kmh,
+            "-.",
+            color="#455a64",
+            lw=1.4,
+            label=f"TTC = {top.ttc_s:g} s (eq. 34)",
+        )
         for k, sector in enumerate(_SECTORS):
             vi, di = np.nonzero(index == k)
             if vi.size < 20:
                 continue
             cv, cd = vi.mean(), di.mean()
-            best = np.argmin((vi - cv) ** 2 / index.shape[0] ** 2
-                             + (di - cd) ** 2 / index.shape[1] ** 2)
-            ax.text(dist[di[best]], kmh[vi[best]], sector.value, fontsize=15, weight="bold",
-                    ha="center", va="center", color="#212121")
+            best = np.argmin(
+                (vi - cv) ** 2 / index.shape[0] ** 2 + (di - cd) ** 2 / index.shape[1] ** 2
+            )
+            ax.text(
+                dist[di[best]],
+                kmh[vi[best]],
+                sector.value,
+                fontsize=15,
+                weight="bold",
+                ha="center",
+                va="center",
+                color="#212121",
+            )
         ax.set_xlim(0.0, d_max)
         ax.set_ylim(0.0, kmh[-1])
         ax.set_xlabel("relative distance ARV-ARO (m)")
@@ -100,8 +125,10 @@ def plot_accel_profiles(tables_dir, out_dir) -> list[Path]:
             ax_y.plot(dx, y_tab[i, j, :n], color=colour, lw=1.4, label=label)
             ax_a.plot(dx, ax_tab[i, j, :n], color=colour, lw=1.4, label=label)
         ax_y.set_ylabel("lateral position y (m)")
-        ax_y.set_title(f"Lookup tables, surface mu = {mus[i]:g}: path and longitudinal "
-                       "acceleration vs. differential x")
+        ax_y.set_title(
+            f"Lookup tables, surface mu = {mus[i]:g}: path and longitudinal "
+            "acceleration vs. differential x"
+        )
         ax_a.set_ylabel("longitudinal acceleration (m/s$^2$)")
         ax_a.set_xlabel("differential x-position since the trigger (m)")
         for a in (ax_y, ax_a):

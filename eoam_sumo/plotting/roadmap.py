@@ -40,8 +40,13 @@ def _offset(line: np.ndarray, d_m: float) -> np.ndarray:
     vertex = np.vstack((normals[:1], normals[:-1] + normals[1:], normals[-1:]))
     vertex /= np.maximum(np.hypot(vertex[:, 0], vertex[:, 1]), 1e-12)[:, None]
     # keep the offset distance across a bend (mitre), capped for near-reversals
-    cos_half = np.vstack((np.ones((1, 1)), np.sum(vertex[1:-1] * normals[:-1], axis=1,
-                                                  keepdims=True), np.ones((1, 1))))
+    cos_half = np.vstack(
+        (
+            np.ones((1, 1)),
+            np.sum(vertex[1:-1] * normals[:-1], axis=1, keepdims=True),
+            np.ones((1, 1)),
+        )
+    )
     return line + d_m * vertex / np.maximum(cos_half, 0.3)
 
 
@@ -53,8 +58,9 @@ def _shape(text: str) -> np.ndarray | None:
     return pts if len(pts) >= 2 else None
 
 
-def read_road_map(net_file: Path, bbox: tuple[float, float, float, float],
-                  margin_m: float = 50.0) -> RoadMap:
+def read_road_map(
+    net_file: Path, bbox: tuple[float, float, float, float], margin_m: float = 50.0
+) -> RoadMap:
     """The lanes of ``net_file`` with a shape point within ``margin_m`` of ``bbox``
     (xmin, ymin, xmax, ymax) or crossing it. InputError naming the file if it cannot be read."""
     box = (bbox[0] - margin_m, bbox[1] - margin_m, bbox[2] + margin_m, bbox[3] + margin_m)

@@ -39,12 +39,24 @@ from eoam_sumo.plotting.runfacts import (
 )
 from eoam_sumo.sim.runlog import COLUMNS, read_timeseries
 
-MODE_NAMES = {0: "0 NORMAL", 1: "1 UPDATE BRAKE", 2: "2 STEER+BRAKE", 3: "3 ONCOMING BRAKE",
-              4: "4 ONCOMING STEER+BRAKE", 5: "5 RETURN"}
-MODE_COLOURS = {0: "#757575", 1: "#1e88e5", 2: "#43a047", 3: "#fdd835", 4: "#fb8c00",
-                5: "#8e24aa"}
-SECTOR_COLOURS = {"A": "#ef9a9a", "C": "#ffcc80", "F": "#c5e1a5", "B": "#81c784",
-                  "D": "#90caf9", "E": "#fff59d", "G": "#ffffff"}
+MODE_NAMES = {
+    0: "0 NORMAL",
+    1: "1 UPDATE BRAKE",
+    2: "2 STEER+BRAKE",
+    3: "3 ONCOMING BRAKE",
+    4: "4 ONCOMING STEER+BRAKE",
+    5: "5 RETURN",
+}
+MODE_COLOURS = {0: "#757575", 1: "#1e88e5", 2: "#43a047", 3: "#fdd835", 4: "#fb8c00", 5: "#8e24aa"}
+SECTOR_COLOURS = {
+    "A": "#ef9a9a",
+    "C": "#ffcc80",
+    "F": "#c5e1a5",
+    "B": "#81c784",
+    "D": "#90caf9",
+    "E": "#fff59d",
+    "G": "#ffffff",
+}
 _TARGET = {"color": "black", "linestyle": "--", "linewidth": 1.2}
 _ACTUAL = {"color": "#1e88e5", "linewidth": 1.6}
 
@@ -59,13 +71,17 @@ def load_run(case_dir: Path) -> tuple[dict, pd.DataFrame]:
     except (OSError, ValueError) as exc:
         raise InputError(f"{path}: cannot be read as a run summary: {exc}") from exc
     if not isinstance(summary, dict) or not {"outcome", "mu", "modes_visited"} <= summary.keys():
-        raise InputError(f"{path}: cannot be read as a run summary: not a JSON object with "
-                         "outcome, mu and modes_visited")
+        raise InputError(
+            f"{path}: cannot be read as a run summary: not a JSON object with "
+            "outcome, mu and modes_visited"
+        )
     frame = read_timeseries(case_dir / "timeseries.csv")
     missing = [c for c in COLUMNS if c not in frame.columns]
     if missing:
-        raise InputError(f"{case_dir / 'timeseries.csv'}: cannot be read as a run's time "
-                         f"series: no column {missing[0]}")
+        raise InputError(
+            f"{case_dir / 'timeseries.csv'}: cannot be read as a run's time "
+            f"series: no column {missing[0]}"
+        )
     return summary, frame
 
 
@@ -76,8 +92,10 @@ def run_title(summary: dict, ts: pd.DataFrame, run_dir: Path) -> str:
     speed_kmh = case.get("ego_speed_kmh") or 3.6 * summary.get("ego_initial_speed_mps", math.nan)
     traffic = traffic_text(case.get("oncoming_start_m"), oncoming_seen(run_dir))
     mu, _ = manoeuvre_mu(summary, ts)
-    return (f"{speed_kmh:.0f} km/h, μ = {mu_text(mu)}, {traffic}: "
-            f"{summary['outcome']} ({summary.get('reason', '')})")
+    return (
+        f"{speed_kmh:.0f} km/h, μ = {mu_text(mu)}, {traffic}: "
+        f"{summary['outcome']} ({summary.get('reason', '')})"
+    )
 
 
 def _mode_spans(ax, ts: pd.DataFrame) -> None:
@@ -88,14 +106,29 @@ def _mode_spans(ax, ts: pd.DataFrame) -> None:
     for k in range(1, len(mode) + 1):
         if k == len(mode) or mode[k] != mode[start]:
             if np.isfinite(mode[start]):
-                ax.axvspan(t[start], t[min(k, len(t) - 1)],
-                           color=MODE_COLOURS.get(int(mode[start]), "white"), alpha=0.10, lw=0)
+                ax.axvspan(
+                    t[start],
+                    t[min(k, len(t) - 1)],
+                    color=MODE_COLOURS.get(int(mode[start]), "white"),
+                    alpha=0.10,
+                    lw=0,
+                )
             start = k
 
 
 def _mode_legend(modes) -> list[Line2D]:
-    return [Line2D([], [], marker="s", linestyle="", markersize=8, color=MODE_COLOURS[m],
-                   label=MODE_NAMES[m]) for m in sorted(modes)]
+    return [
+        Line2D(
+            [],
+            [],
+            marker="s",
+            linestyle="",
+            markersize=8,
+            color=MODE_COLOURS[m],
+            label=MODE_NAMES[m],
+        )
+        for m in sorted(modes)
+    ]
 
 
 def _modes_in(ts: pd.DataFrame) -> set[int]:
@@ -110,14 +143,26 @@ def plot_dynamics(case_dir: Path, out_dir: Path) -> Path:
     axes = fig.subplots(4, 2, sharex=True).ravel()
     panels = [
         ("EOAM mode", [("mode", "mode", {"drawstyle": "steps-post", **_ACTUAL})], "-"),
-        ("forward-collision warning", [("fcw", "FCW flag", {"drawstyle": "steps-post",
-                                                            **_ACTUAL})], "-"),
-        ("longitudinal speed", [("vx_mps", "actual", _ACTUAL),
-                                ("speed_target_mps", "target", _TARGET)], "m/s"),
-        ("longitudinal acceleration", [("ax_mps2", "actual", _ACTUAL),
-                                       ("ax_target_mps2", "target", _TARGET)], "m/s²"),
-        ("lateral position (left +)", [("lateral_offset_m", "actual", _ACTUAL),
-                                       ("y_target_m", "target", _TARGET)], "m"),
+        (
+            "forward-collision warning",
+            [("fcw", "FCW flag", {"drawstyle": "steps-post", **_ACTUAL})],
+            "-",
+        ),
+        (
+            "longitudinal speed",
+            [("vx_mps", "actual", _ACTUAL), ("speed_target_mps", "target", _TARGET)],
+            "m/s",
+        ),
+        (
+            "longitudinal acceleration",
+            [("ax_mps2", "actual", _ACTUAL), ("ax_target_mps2", "target", _TARGET)],
+            "m/s²",
+        ),
+        (
+            "lateral position (left +)",
+            [("lateral_offset_m", "actual", _ACTUAL), ("y_target_m", "target", _TARGET)],
+            "m",
+        ),
         ("lateral offset error", [("lateral_error_m", "lateral error", _ACTUAL)], "m"),
         ("lateral lookahead error", [("lookahead_error_m", "lookahead error", _ACTUAL)], "m"),
         ("differential x-position (lookup-table input)", [("dx_m", "dx", _ACTUAL)], "m"),
@@ -135,10 +180,18 @@ def plot_dynamics(case_dir: Path, out_dir: Path) -> Path:
     axes[1].set_yticks([0, 1], ["off", "on"])
     for ax in axes[-2:]:
         ax.set_xlabel("time [s]")
-    fig.legend(handles=_mode_legend(_modes_in(ts)), loc="outside lower center",
-               ncols=6, fontsize=8, title="background: EOAM mode", title_fontsize=8)
-    fig.suptitle(fit("EOAM dynamics (cf. paper Figure 22) — " + run_title(summary, ts, case_dir),
-                     14, 11), fontsize=11)
+    fig.legend(
+        handles=_mode_legend(_modes_in(ts)),
+        loc="outside lower center",
+        ncols=6,
+        fontsize=8,
+        title="background: EOAM mode",
+        title_fontsize=8,
+    )
+    fig.suptitle(
+        fit("EOAM dynamics (cf. paper Figure 22) — " + run_title(summary, ts, case_dir), 14, 11),
+        fontsize=11,
+    )
     return save(fig, Path(out_dir) / "dynamics.png")
 
 
@@ -150,13 +203,21 @@ def plot_steering(case_dir: Path, out_dir: Path) -> Path:
     fig = Figure(figsize=(13, 9), layout="constrained")
     axes = fig.subplots(2, 2, sharex=True).ravel()
     deg = math.degrees(1.0)
-    for column, label, colour in (("steer_ff_rad", "feedforward", "#43a047"),
-                                  ("steer_fb_rad", "feedback", "#1e88e5"),
-                                  ("steer_yd_rad", "yaw damping", "#8e24aa"),
-                                  ("steer_cmd_rad", "total command", "black")):
+    for column, label, colour in (
+        ("steer_ff_rad", "feedforward", "#43a047"),
+        ("steer_fb_rad", "feedback", "#1e88e5"),
+        ("steer_yd_rad", "yaw damping", "#8e24aa"),
+        ("steer_cmd_rad", "total command", "black"),
+    ):
         axes[0].plot(t, ts[column] * deg, label=label, color=colour, linewidth=1.3)
-    axes[0].plot(t, ts["steer_rad"] * deg, label="actual (actuator)", color="#e53935",
-                 linestyle="--", linewidth=1.3)
+    axes[0].plot(
+        t,
+        ts["steer_rad"] * deg,
+        label="actual (actuator)",
+        color="#e53935",
+        linestyle="--",
+        linewidth=1.3,
+    )
     axes[0].set_title("road-wheel steering angle and its components", fontsize=10)
     axes[0].set_ylabel("[deg]")
     axes[0].legend(fontsize=8)
@@ -177,10 +238,23 @@ def plot_steering(case_dir: Path, out_dir: Path) -> Path:
         ax.grid(alpha=0.3)
     for ax in axes[2:]:
         ax.set_xlabel("time [s]")
-    fig.legend(handles=_mode_legend(_modes_in(ts)), loc="outside lower center", ncols=6,
-               fontsize=8, title="background: EOAM mode", title_fontsize=8)
-    fig.suptitle(fit("Steering, lateral acceleration and yaw rate (cf. paper Figure 23) — "
-                     + run_title(summary, ts, case_dir), 13, 11), fontsize=11)
+    fig.legend(
+        handles=_mode_legend(_modes_in(ts)),
+        loc="outside lower center",
+        ncols=6,
+        fontsize=8,
+        title="background: EOAM mode",
+        title_fontsize=8,
+    )
+    fig.suptitle(
+        fit(
+            "Steering, lateral acceleration and yaw rate (cf. paper Figure 23) — "
+            + run_title(summary, ts, case_dir),
+            13,
+            11,
+        ),
+        fontsize=11,
+    )
     return save(fig, Path(out_dir) / "steering.png")
 
 
@@ -192,18 +266,30 @@ def plot_gg(case_dir: Path, out_dir: Path) -> Path:
     fig = Figure(figsize=(7.5, 7.5), layout="constrained")
     ax = fig.add_subplot()
     angle = np.linspace(0.0, 2.0 * np.pi, 361)
-    ax.plot(mu_g * np.cos(angle), mu_g * np.sin(angle), color="#e53935", linewidth=1.5,
-            label=f"friction circle μg = {mu_g:.2f} m/s² (μ = {mu_text(mu)}, {what})")
+    ax.plot(
+        mu_g * np.cos(angle),
+        mu_g * np.sin(angle),
+        color="#e53935",
+        linewidth=1.5,
+        label=f"friction circle μg = {mu_g:.2f} m/s² (μ = {mu_text(mu)}, {what})",
+    )
     for other in frictions_seen(ts):
         if abs(other - mu) > 1e-6:
             r = other * G_MPS2
-            ax.plot(r * np.cos(angle), r * np.sin(angle), color="#e53935", linewidth=1.0,
-                    linestyle="--", label=f"friction circle μ = {mu_text(other)} (also met)")
+            ax.plot(
+                r * np.cos(angle),
+                r * np.sin(angle),
+                color="#e53935",
+                linewidth=1.0,
+                linestyle="--",
+                label=f"friction circle μ = {mu_text(other)} (also met)",
+            )
             mu_g = max(mu_g, r)
     for mode in sorted(_modes_in(ts)):
         sel = ts[ts["mode"] == mode]
-        ax.scatter(sel["ay_mps2"], sel["ax_mps2"], s=5, color=MODE_COLOURS[mode],
-                   label=MODE_NAMES[mode])
+        ax.scatter(
+            sel["ay_mps2"], sel["ax_mps2"], s=5, color=MODE_COLOURS[mode], label=MODE_NAMES[mode]
+        )
     lim = 1.15 * max(mu_g, float(np.nanmax(np.abs(ts[["ax_mps2", "ay_mps2"]].to_numpy()))))
     ax.set_xlim(-lim, lim)
     ax.set_ylim(-lim, lim)
@@ -214,8 +300,10 @@ def plot_gg(case_dir: Path, out_dir: Path) -> Path:
     ax.set_ylabel("longitudinal acceleration a_x [m/s²]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper right", markerscale=3)
-    ax.set_title(fit("g-g diagram (cf. paper Figure 24)\n" + run_title(summary, ts, case_dir),
-                     7.0, 10), fontsize=10)
+    ax.set_title(
+        fit("g-g diagram (cf. paper Figure 24)\n" + run_title(summary, ts, case_dir), 7.0, 10),
+        fontsize=10,
+    )
     return save(fig, Path(out_dir) / "gg.png")
 
 
@@ -240,8 +328,14 @@ def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = No
     mu, what = manoeuvre_mu(summary, ts)
     seen = ts[np.isfinite(ts["aro_range_m"]) & np.isfinite(ts["aro_range_rate_mps"])]
     closing = -seen["aro_range_rate_mps"]
-    v_max = max(float(closing.max()) if len(seen) else 0.0,
-                summary.get("ego_initial_speed_mps", 0.0) * 0.7, 5.0) * 1.15
+    v_max = (
+        max(
+            float(closing.max()) if len(seen) else 0.0,
+            summary.get("ego_initial_speed_mps", 0.0) * 0.7,
+            5.0,
+        )
+        * 1.15
+    )
     d_max = max(float(seen["aro_range_m"].max()) if len(seen) else 0.0, 20.0) * 1.1
     fig = Figure(figsize=(10, 7), layout="constrained")
     ax = fig.add_subplot()
@@ -261,49 +355,101 @@ def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = No
         index = _sector_map(bounds, vs, ds)
         order = [s.value for s in SECTOR_ORDER]
         cmap = ListedColormap([SECTOR_COLOURS[s] for s in order])
-        ax.imshow(index, origin="lower", extent=(0, v_max, 0, d_max), aspect="auto",
-                  cmap=cmap, vmin=-0.5, vmax=len(order) - 0.5, alpha=0.8,
-                  interpolation="nearest")
+        ax.imshow(
+            index,
+            origin="lower",
+            extent=(0, v_max, 0, d_max),
+            aspect="auto",
+            cmap=cmap,
+            vmin=-0.5,
+            vmax=len(order) - 0.5,
+            alpha=0.8,
+            interpolation="nearest",
+        )
         for k, letter in enumerate(order):
             rr, cc = np.nonzero(index == k)
             if len(rr) > 50:
-                ax.text(vs[int(np.median(cc))], ds[int(np.median(rr))], letter, fontsize=16,
-                        fontweight="bold", ha="center", va="center", color="0.25")
+                ax.text(
+                    vs[int(np.median(cc))],
+                    ds[int(np.median(rr))],
+                    letter,
+                    fontsize=16,
+                    fontweight="bold",
+                    ha="center",
+                    va="center",
+                    color="0.25",
+                )
         for field, label, style, colour in (
-                ("clear_opt_m", "S: min. clearing distance (opt. accel.)", "-", "#2e7d32"),
-                ("clear_buffered_m", "Sb: buffered clearing distance", "--", "#2e7d32"),
-                ("clear_const_m", "min. clearing distance at constant speed", ":", "#2e7d32"),
-                ("stop_m", "B0: stopping distance", "-", "#1565c0"),
-                ("stop_buffered_m", "Bb: buffered stopping distance", "--", "#1565c0")):
-            ax.plot(vs, [getattr(b, field) for b in bounds], linestyle=style, color=colour,
-                    linewidth=1.4, label=label)
+            ("clear_opt_m", "S: min. clearing distance (opt. accel.)", "-", "#2e7d32"),
+            ("clear_buffered_m", "Sb: buffered clearing distance", "--", "#2e7d32"),
+            ("clear_const_m", "min. clearing distance at constant speed", ":", "#2e7d32"),
+            ("stop_m", "B0: stopping distance", "-", "#1565c0"),
+            ("stop_buffered_m", "Bb: buffered stopping distance", "--", "#1565c0"),
+        ):
+            ax.plot(
+                vs,
+                [getattr(b, field) for b in bounds],
+                linestyle=style,
+                color=colour,
+                linewidth=1.4,
+                label=label,
+            )
         ttc = np.array([b.ttc_s for b in bounds])
-        ax.plot(vs, ttc * vs, ":", color="#6d4c41", linewidth=1.4,
-                label=f"T: TTC line ({ttc[-1]:g} s)")
+        ax.plot(
+            vs, ttc * vs, ":", color="#6d4c41", linewidth=1.4, label=f"T: TTC line ({ttc[-1]:g} s)"
+        )
     for mode in sorted(_modes_in(seen)):
         sel = seen[seen["mode"] == mode]
-        ax.scatter(-sel["aro_range_rate_mps"], sel["aro_range_m"], s=9,
-                   color=MODE_COLOURS[mode], edgecolors="black", linewidths=0.2,
-                   label=f"trace, mode {MODE_NAMES[mode]}", zorder=3)
+        ax.scatter(
+            -sel["aro_range_rate_mps"],
+            sel["aro_range_m"],
+            s=9,
+            color=MODE_COLOURS[mode],
+            edgecolors="black",
+            linewidths=0.2,
+            label=f"trace, mode {MODE_NAMES[mode]}",
+            zorder=3,
+        )
     if len(seen):
-        ax.annotate("first sensed", (closing.iloc[0], seen["aro_range_m"].iloc[0]),
-                    xytext=(10, 10), textcoords="offset points", fontsize=9,
-                    arrowprops={"arrowstyle": "->"})
-        ax.annotate("last sensed", (closing.iloc[-1], seen["aro_range_m"].iloc[-1]),
-                    xytext=(10, -15), textcoords="offset points", fontsize=9,
-                    arrowprops={"arrowstyle": "->"})
+        ax.annotate(
+            "first sensed",
+            (closing.iloc[0], seen["aro_range_m"].iloc[0]),
+            xytext=(10, 10),
+            textcoords="offset points",
+            fontsize=9,
+            arrowprops={"arrowstyle": "->"},
+        )
+        ax.annotate(
+            "last sensed",
+            (closing.iloc[-1], seen["aro_range_m"].iloc[-1]),
+            xytext=(10, -15),
+            textcoords="offset points",
+            fontsize=9,
+            arrowprops={"arrowstyle": "->"},
+        )
     ax.set_xlim(0, v_max)
     ax.set_ylim(0, d_max)
     ax.set_xlabel("closing speed to the ARO (-range rate) [m/s]")
     ax.set_ylabel("range to the ARO [m]")
     ax.legend(fontsize=8, loc="upper left", framealpha=0.9)
-    ax.set_title(fit(f"DMM phase diagram at μ = {mu_text(mu)} (the friction {what}) with the "
-                     f"ARO phase trace (cf. paper Figure 21)\n"
-                     f"{run_title(summary, ts, case_dir)}{note}", 9.5, 10), fontsize=10)
+    ax.set_title(
+        fit(
+            f"DMM phase diagram at μ = {mu_text(mu)} (the friction {what}) with the "
+            f"ARO phase trace (cf. paper Figure 21)\n"
+            f"{run_title(summary, ts, case_dir)}{note}",
+            9.5,
+            10,
+        ),
+        fontsize=10,
+    )
     return save(fig, Path(out_dir) / "phase_trace.png")
 
 
 def plot_run(case_dir: Path, out_dir: Path, tables_dir: Path | None = None) -> list[Path]:
     """Every run plot of a run folder."""
-    return [plot_phase_trace(case_dir, out_dir, tables_dir), plot_dynamics(case_dir, out_dir),
-            plot_steering(case_dir, out_dir), plot_gg(case_dir, out_dir)]
+    return [
+        plot_phase_trace(case_dir, out_dir, tables_dir),
+        plot_dynamics(case_dir, out_dir),
+        plot_steering(case_dir, out_dir),
+        plot_gg(case_dir, out_dir),
+    ]

@@ -65,8 +65,9 @@ def oncoming_seen(run_dir: Path) -> bool:
 def traffic_text(oncoming_start_m, saw_oncoming: bool) -> str:
     """How a run's oncoming traffic is named: the car the co-simulation added, else what the
     run saw of the scenario's own traffic."""
-    if oncoming_start_m is not None and not (isinstance(oncoming_start_m, float)
-                                             and math.isnan(oncoming_start_m)):
+    if oncoming_start_m is not None and not (
+        isinstance(oncoming_start_m, float) and math.isnan(oncoming_start_m)
+    ):
         return f"oncoming from {oncoming_start_m:g} m"
     return "oncoming traffic" if saw_oncoming else "no oncoming"
 

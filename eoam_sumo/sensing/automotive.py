@@ -81,8 +81,10 @@ class AutomotiveRadarSettings:
         if not (math.isfinite(self.cycle_s) and self.cycle_s > 0.0):
             raise InputError(f"automotive radar cycle_s = {self.cycle_s!r} must be > 0")
         if not 0.0 < self.detection_probability <= 1.0:
-            raise InputError("automotive radar detection_probability = "
-                             f"{self.detection_probability!r} must be in (0, 1]")
+            raise InputError(
+                "automotive radar detection_probability = "
+                f"{self.detection_probability!r} must be in (0, 1]"
+            )
 
 
 def parse_radar_model(value) -> str:
@@ -105,8 +107,12 @@ class _Scan:
 class AutomotiveRadar:
     """Drop-in for :class:`~eoam_sumo.sim.radar.Radar`: ``scan`` once per step with the time."""
 
-    def __init__(self, settings: RadarSettings | None = None,
-                 model: AutomotiveRadarSettings | None = None, seed: int = 0):
+    def __init__(
+        self,
+        settings: RadarSettings | None = None,
+        model: AutomotiveRadarSettings | None = None,
+        seed: int = 0,
+    ):
         self.settings = settings = settings or RadarSettings()
         self.model = model = model or AutomotiveRadarSettings()
         self._geometry = Radar(settings)
@@ -116,9 +122,16 @@ class AutomotiveRadar:
         self._queue: deque[_Scan] = deque()
         self._report = EMPTY_REPORT
 
-    def scan(self, ego_front_xy: tuple[float, float], ego_yaw_rad: float, ego_speed_mps: float,
-             road_frame: RoadProjection, targets: Sequence[Body], lane_width_m: float,
-             time_s: float | None = None) -> RadarReport:
+    def scan(
+        self,
+        ego_front_xy: tuple[float, float],
+        ego_yaw_rad: float,
+        ego_speed_mps: float,
+        road_frame: RoadProjection,
+        targets: Sequence[Body],
+        lane_width_m: float,
+        time_s: float | None = None,
+    ) -> RadarReport:
         """The report the EOAM reads at ``time_s`` (scans when a cycle is due)."""
         if time_s is None:
             raise ValueError("the automotive radar needs the time of each scan (time_s)")
@@ -126,14 +139,17 @@ class AutomotiveRadar:
             self._next_scan_s = time_s
         if time_s + 1e-9 >= self._next_scan_s:
             self._next_scan_s += self.model.cycle_s * max(
-                1, math.floor((time_s + 1e-9 - self._next_scan_s) / self.model.cycle_s) + 1)
-            self._queue.append(self._measure(time_s, ego_front_xy, ego_yaw_rad, ego_speed_mps,
-                                             road_frame, targets))
+                1, math.floor((time_s + 1e-9 - self._next_scan_s) / self.model.cycle_s) + 1
+            )
+            self._queue.append(
+                self._measure(time_s, ego_front_xy, ego_yaw_rad, ego_speed_mps, road_frame, targets)
+            )
         delivered = None
         while self._queue and self._queue[0].deliver_at <= time_s + 1e-9:
             delivered = self._queue.popleft()
-            self._tracker.update(delivered.t, delivered.measurements, delivered.origin,
-                                 delivered.ego_velocity)
+            self._tracker.update(
+                delivered.t, delivered.measurements, delivered.origin, delivered.ego_velocity
+            )
         if delivered is not None:
             self._report = self._build_report(delivered, road_frame, lane_width_m)
         return self._report
@@ -153,16 +169,28 @@ class AutomotiveRadar:
             los = math.atan2(py - oy, px - ox)
             ux, uy = math.cos(los), math.sin(los)
             box = tgt.box
-            rr = ((tgt.speed_mps * box.cos_yaw - speed * bx) * ux
-                  + (tgt.speed_mps * box.sin_yaw - speed * by) * uy)
+            rr = (tgt.speed_mps * box.cos_yaw - speed * bx) * ux + (
+                tgt.speed_mps * box.sin_yaw - speed * by
+            ) * uy
             e = draws[1]
-            measurements.append(Measurement(
-                max(r + model.range_sd_m * e[0], 0.0), los + az_sd * e[1],
-                rr + model.range_rate_sd_mps * e[2], model.range_sd_m, az_sd,
-                model.range_rate_sd_mps, box.x_m - px, box.y_m - py, tgt.length_m, tgt.width_m))
+            measurements.append(
+                Measurement(
+                    max(r + model.range_sd_m * e[0], 0.0),
+                    los + az_sd * e[1],
+                    rr + model.range_rate_sd_mps * e[2],
+                    model.range_sd_m,
+                    az_sd,
+                    model.range_rate_sd_mps,
+                    box.x_m - px,
+                    box.y_m - py,
+                    tgt.length_m,
+                    tgt.width_m,
+                )
+            )
         ego_s = road_frame.project(ox, oy)[0]
-        return _Scan(t, t + model.latency_s, measurements, (ox, oy), (speed * bx, speed * by),
-                     ego_s)
+        return _Scan(
+            t, t + model.latency_s, measurements, (ox, oy), (speed * bx, speed * by), ego_s
+        )
 
     def _visible(self, ox, oy, yaw, bx, by, targets) -> list:
         """(target, range, x, y) of each target with a part in a beam and a free line of
@@ -181,9 +209,14 @@ class AutomotiveRadar:
         seen = []
         for k, (r, tgt, px, py) in enumerate(inside):
             nearer = [item[1].box for item in inside[:k]]
-            candidates = [(r, px, py), *sorted(
-                (math.hypot(cx - ox, cy - oy), cx, cy) for cx, cy in tgt.box.corners()
-                if geo.covers(ox, oy, yaw, cx, cy))]
+            candidates = [
+                (r, px, py),
+                *sorted(
+                    (math.hypot(cx - ox, cy - oy), cx, cy)
+                    for cx, cy in tgt.box.corners()
+                    if geo.covers(ox, oy, yaw, cx, cy)
+                ),
+            ]
             for cr, cx, cy in candidates:
                 if not _blocked(nearer, ox, oy, cx, cy, cr):
                     seen.append((tgt, cr, cx, cy))
@@ -191,8 +224,9 @@ class AutomotiveRadar:
         return seen
 
     # ----------------------------------------------------------------------------- report
-    def _build_report(self, scan: _Scan, road_frame: RoadProjection,
-                      lane_width_m: float) -> RadarReport:
+    def _build_report(
+        self, scan: _Scan, road_frame: RoadProjection, lane_width_m: float
+    ) -> RadarReport:
         ox, oy = scan.origin
         evx, evy = scan.ego_velocity
         speed = math.hypot(evx, evy)
@@ -209,10 +243,23 @@ class AutomotiveRadar:
             road_speed = tr.vx_mps * math.cos(road_yaw) + tr.vy_mps * math.sin(road_yaw)
             # the lateral velocity of a track far ahead is poorly observed: stopped or not
             # is judged on the speed along the road
-            category = self._geometry.classify(s > scan.ego_s, d, abs(road_speed), road_speed,
-                                                band_m, lane_width_m)
-            detections.append(Detection(tr.track_id, rng, range_rate, bearing, s, d, road_speed,
-                                        category, tr.length_m, tr.width_m))
+            category = self._geometry.classify(
+                s > scan.ego_s, d, abs(road_speed), road_speed, band_m, lane_width_m
+            )
+            detections.append(
+                Detection(
+                    tr.track_id,
+                    rng,
+                    range_rate,
+                    bearing,
+                    s,
+                    d,
+                    road_speed,
+                    category,
+                    tr.length_m,
+                    tr.width_m,
+                )
+            )
         return report_of(detections)
 
 
@@ -237,6 +284,7 @@ def make_radar(model: str, settings: RadarSettings, seed: int = 0):
     if model == "ideal":
         return Radar(settings)
     if settings.near_range_m == 0.0:
-        settings = replace(settings, near_range_m=min(NEAR_RANGE_M, settings.range_m),
-                           near_fov_deg=NEAR_FOV_DEG)
+        settings = replace(
+            settings, near_range_m=min(NEAR_RANGE_M, settings.range_m), near_fov_deg=NEAR_FOV_DEG
+        )
     return AutomotiveRadar(settings, seed=seed)

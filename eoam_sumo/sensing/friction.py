@@ -55,11 +55,12 @@ class EstimatorSettings:
         for name in self.__dataclass_fields__:
             value = getattr(self, name)
             if not math.isfinite(value) or (name != "bias" and value < 0.0):
-                raise InputError(f"friction estimator {name} = {value!r} must be finite"
-                                 + ("" if name == "bias" else " and >= 0"))
+                raise InputError(
+                    f"friction estimator {name} = {value!r} must be finite"
+                    + ("" if name == "bias" else " and >= 0")
+                )
         if self.update_period_s <= 0.0 or self.time_constant_s <= 0.0:
-            raise InputError("friction estimator update_period_s and time_constant_s "
-                             "must be > 0")
+            raise InputError("friction estimator update_period_s and time_constant_s must be > 0")
 
 
 def parse_mu_belief(value) -> str | float:
@@ -71,8 +72,9 @@ def parse_mu_belief(value) -> str | float:
         try:
             value = float(text)
         except ValueError:
-            raise InputError(f"mu_belief {value!r} is not 'known', 'estimate' or a number "
-                             f"in (0, {MU_MAX:g}]") from None
+            raise InputError(
+                f"mu_belief {value!r} is not 'known', 'estimate' or a number in (0, {MU_MAX:g}]"
+            ) from None
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise InputError(f"mu_belief {value!r} is not 'known', 'estimate' or a number")
     if not (math.isfinite(value) and 0.0 < value <= MU_MAX):
@@ -87,8 +89,14 @@ class FrictionBelief:
     ``mu_min`` is the lowest friction the lookup tables cover (estimates are clipped to it).
     ``trace`` keeps (time_s, mu) at each change of the output."""
 
-    def __init__(self, belief: str | float = "known", *, seed: int = 0,
-                 settings: EstimatorSettings = EstimatorSettings(), mu_min: float = 0.1):
+    def __init__(
+        self,
+        belief: str | float = "known",
+        *,
+        seed: int = 0,
+        settings: EstimatorSettings = EstimatorSettings(),
+        mu_min: float = 0.1,
+    ):
         self.belief = parse_mu_belief(belief)
         self.settings = settings
         self.mu_min = mu_min
@@ -140,7 +148,8 @@ class FrictionBelief:
         if utilisation >= st.excitation_utilisation:
             observed = history[0][1] + st.noise_sd * noise
             self._estimate += (1.0 - math.exp(-dt / st.time_constant_s)) * (
-                observed - self._estimate)
+                observed - self._estimate
+            )
         self._output = self._clip(self._estimate + st.bias)
         return self._output
 

@@ -59,13 +59,15 @@ class CornerRadarSettings:
     boresight_deg: float = 40.0  # outward from the ego's axis, forward (front) and back (rear)
 
     def __post_init__(self) -> None:
-        if not (self.range_m >= 0.0 and 0.0 < self.fov_deg < 180.0
-                and 0.0 <= self.boresight_deg <= 90.0):
+        if not (
+            self.range_m >= 0.0 and 0.0 < self.fov_deg < 180.0 and 0.0 <= self.boresight_deg <= 90.0
+        ):
             raise ValueError(f"corner radar settings out of range: {self}")
 
 
-def sees(ox: float, oy: float, look_rad: float, half_fov_rad: float, range_m: float,
-         px: float, py: float) -> bool:
+def sees(
+    ox: float, oy: float, look_rad: float, half_fov_rad: float, range_m: float, px: float, py: float
+) -> bool:
     """A sensor at (ox, oy) looking along ``look_rad`` sees the point (px, py): within its
     range and field of view."""
     dx, dy = px - ox, py - oy
@@ -86,11 +88,20 @@ def hides(box, ox: float, oy: float, px: float, py: float) -> bool:
 class NextLaneSensing:
     """Builds the :class:`NextLaneView` of each step from the sensors (module doc)."""
 
-    def __init__(self, *, opposing: bool, speed_limit_mps: float, lane_width_m: float,
-                 radar_range_m: float, radar_fov_deg: float, ego_length_m: float,
-                 ego_width_m: float, v2x: V2XSettings | None = None,
-                 corner: CornerRadarSettings | None = None,
-                 fastest_mps: float | None = None):
+    def __init__(
+        self,
+        *,
+        opposing: bool,
+        speed_limit_mps: float,
+        lane_width_m: float,
+        radar_range_m: float,
+        radar_fov_deg: float,
+        ego_length_m: float,
+        ego_width_m: float,
+        v2x: V2XSettings | None = None,
+        corner: CornerRadarSettings | None = None,
+        fastest_mps: float | None = None,
+    ):
         self.opposing = opposing
         self.speed_limit_mps = speed_limit_mps
         self.lane_width_m = lane_width_m
@@ -101,8 +112,7 @@ class NextLaneSensing:
         self.corner = corner or CornerRadarSettings()
         self.v2x = V2XReceiver(v2x) if v2x.enabled else None
         fastest = speed_limit_mps if fastest_mps is None else fastest_mps
-        self._v2x_free_m = (v2x.range_m - fastest * v2x.blind_time_s()
-                            if v2x.covers_all else 0.0)
+        self._v2x_free_m = v2x.range_m - fastest * v2x.blind_time_s() if v2x.covers_all else 0.0
         w = lane_width_m
         self.lines_m = (0.5 * w + LINE_INSET_M, w, 1.5 * w - LINE_INSET_M)
         self._standing: dict[tuple[float, float], tuple[float, float, float]] = {}
@@ -110,11 +120,20 @@ class NextLaneSensing:
     @property
     def reach_m(self) -> float:
         """How far from the ego the road users it may sense can be (V2X or a corner radar)."""
-        return max(self.v2x.settings.range_m if self.v2x is not None else 0.0,
-                   self.corner.range_m + self.ego_length_m)
+        return max(
+            self.v2x.settings.range_m if self.v2x is not None else 0.0,
+            self.corner.range_m + self.ego_length_m,
+        )
 
-    def update(self, time_s: float, front_xy: tuple[float, float], yaw_rad: float, road,
-               report, bodies: Sequence) -> NextLaneView:
+    def update(
+        self,
+        time_s: float,
+        front_xy: tuple[float, float],
+        yaw_rad: float,
+        road,
+        report,
+        bodies: Sequence,
+    ) -> NextLaneView:
         """The view at ``time_s``: ``report`` the forward radar's (``sim.radar.RadarReport``),
         ``bodies`` the ground truth of the road users around (for the corner radars and V2X),
         ``road`` the original lane's frame (``project(x, y) -> (s, d, road_yaw)``)."""
@@ -126,12 +145,12 @@ class NextLaneSensing:
         shadows = []  # detections of road users outside the lane (they hide what is behind)
         for det in report.detections:
             if det is not in_path and self._in_lane(det.d_m, det.width_m, lane_lo, lane_hi):
-                objects.append((det.s_m, det.d_m, det.road_speed_mps, det.length_m,
-                                det.width_m))
+                objects.append((det.s_m, det.d_m, det.road_speed_mps, det.length_m, det.width_m))
             else:
                 shadows.append(det)
-        objects += self._corner_objects(front_xy, s_f, yaw_rad, road, bodies, lane_lo,
-                                        lane_hi, objects, in_path)
+        objects += self._corner_objects(
+            front_xy, s_f, yaw_rad, road, bodies, lane_lo, lane_hi, objects, in_path
+        )
         if self.v2x is not None:
             self.v2x.update(time_s, front_xy, bodies)
             for o in self.v2x.objects(time_s):
@@ -140,11 +159,14 @@ class NextLaneSensing:
                     continue
                 if in_path is not None and _same(s, o.length_m, in_path.s_m, in_path.length_m):
                     continue
-                if any(_same(s, o.length_m, q[0], q[3]) and abs(d - q[1]) < FUSION_GATE_M
-                       for q in objects):
+                if any(
+                    _same(s, o.length_m, q[0], q[3]) and abs(d - q[1]) < FUSION_GATE_M
+                    for q in objects
+                ):
                     continue  # fused with a radar object
-                objects.append((s, d, o.speed_mps * math.cos(o.yaw_rad - ryaw), o.length_m,
-                                o.width_m))
+                objects.append(
+                    (s, d, o.speed_mps * math.cos(o.yaw_rad - ryaw), o.length_m, o.width_m)
+                )
         ahead = behind = None
         s_rear = s_f - self.ego_length_m
         for s, _d, v, length, _width in objects:
@@ -161,20 +183,25 @@ class NextLaneSensing:
             return self._coverage(road, s_f, front_xy, yaw_rad, shadows)
 
         return NextLaneView(
-            self.opposing, self.speed_limit_mps, coverage=coverage,
+            self.opposing,
+            self.speed_limit_mps,
+            coverage=coverage,
             nearest_ahead_m=None if ahead is None else ahead[0],
             nearest_ahead_speed_mps=None if ahead is None else ahead[1],
             nearest_behind_m=None if behind is None else behind[0],
-            nearest_behind_speed_mps=None if behind is None else behind[1])
+            nearest_behind_speed_mps=None if behind is None else behind[1],
+        )
 
     # ----------------------------------------------------------------------------- parts
     @staticmethod
     def _in_lane(d_m: float, width_m: float, lane_lo: float, lane_hi: float) -> bool:
-        return min(d_m + 0.5 * width_m, lane_hi) - max(d_m - 0.5 * width_m, lane_lo) \
-            >= MIN_OVERLAP_M
+        return (
+            min(d_m + 0.5 * width_m, lane_hi) - max(d_m - 0.5 * width_m, lane_lo) >= MIN_OVERLAP_M
+        )
 
-    def _corner_objects(self, front_xy, s_f, yaw_rad, road, bodies, lane_lo, lane_hi, known,
-                        in_path) -> list:
+    def _corner_objects(
+        self, front_xy, s_f, yaw_rad, road, bodies, lane_lo, lane_hi, known, in_path
+    ) -> list:
         """Road users the corner radars see in the lane (or beside the body), not already
         known."""
         c = self.corner
@@ -188,23 +215,26 @@ class NextLaneSensing:
             if math.hypot(b.x_m - fx, b.y_m - fy) > reach + b.box.radius_m:
                 continue  # beyond both corner radars and not beside the body
             s, d, ryaw = self._project(road, b)
-            beside = (s - 0.5 * b.length_m <= s_f + BESIDE_M
-                      and s + 0.5 * b.length_m >= s_f - self.ego_length_m - BESIDE_M)
+            beside = (
+                s - 0.5 * b.length_m <= s_f + BESIDE_M
+                and s + 0.5 * b.length_m >= s_f - self.ego_length_m - BESIDE_M
+            )
             if not beside and not any(self._corner_sees(b, *corner) for corner in corners):
                 continue
             if not self._in_lane(d, b.width_m, lane_lo, lane_hi):
                 continue
             if in_path is not None and _same(s, b.length_m, in_path.s_m, in_path.length_m):
                 continue
-            if any(_same(s, b.length_m, q[0], q[3]) and abs(d - q[1]) < FUSION_GATE_M
-                   for q in (*known, *out)):
+            if any(
+                _same(s, b.length_m, q[0], q[3]) and abs(d - q[1]) < FUSION_GATE_M
+                for q in (*known, *out)
+            ):
                 continue
             out.append((s, d, b.speed_mps * math.cos(b.yaw_rad - ryaw), b.length_m, b.width_m))
         return out
 
     @staticmethod
-    def _corner_sees(b, ox: float, oy: float, look: float, half_fov: float,
-                     range_m: float) -> bool:
+    def _corner_sees(b, ox: float, oy: float, look: float, half_fov: float, range_m: float) -> bool:
         """Some part of the road user's box lies within the corner radar's range, at a
         bearing inside its field of view (its nearest point)."""
         if math.hypot(b.x_m - ox, b.y_m - oy) > range_m + b.box.radius_m:
@@ -231,9 +261,11 @@ class NextLaneSensing:
         fx, fy = front_xy[0] - half_w * sy, front_xy[1] + half_w * cy  # front-left corner
         rx, ry = fx - self.ego_length_m * cy, fy - self.ego_length_m * sy  # rear-left corner
         half, bore = math.radians(0.5 * c.fov_deg), math.radians(c.boresight_deg)
-        return ((front_xy[0], front_xy[1], yaw_rad, self._radar_half_fov, self.radar_range_m),
-                (fx, fy, yaw_rad + bore, half, c.range_m),
-                (rx, ry, yaw_rad + math.pi - bore, half, c.range_m))
+        return (
+            (front_xy[0], front_xy[1], yaw_rad, self._radar_half_fov, self.radar_range_m),
+            (fx, fy, yaw_rad + bore, half, c.range_m),
+            (rx, ry, yaw_rad + math.pi - bore, half, c.range_m),
+        )
 
     def _coverage(self, road, s_f: float, front_xy, yaw_rad: float, shadows: list) -> float:
         """Length of the lane ahead of the front bumper covered without a gap (module doc)."""
@@ -250,8 +282,7 @@ class NextLaneSensing:
             covered, x = 0.0, BESIDE_M
             while x <= reach:
                 px, py, _ = road.point_at(s_f + x, line)
-                seen = (sees(*radar, px, py)
-                        and not any(hides(box, ox, oy, px, py) for box in boxes))
+                seen = sees(*radar, px, py) and not any(hides(box, ox, oy, px, py) for box in boxes)
                 if not seen and not any(sees(*c, px, py) for c in corners):
                     break
                 covered, x = x, x + COVERAGE_STEP_M

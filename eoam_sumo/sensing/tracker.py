@@ -58,8 +58,9 @@ class TrackerSettings:
             if not (math.isfinite(value) and value > 0.0):
                 raise InputError(f"tracker {name} = {value!r} must be > 0")
         if not 1 <= self.confirm_hits <= self.confirm_window or self.delete_misses < 1:
-            raise InputError("tracker: need 1 <= confirm_hits <= confirm_window and "
-                             "delete_misses >= 1")
+            raise InputError(
+                "tracker: need 1 <= confirm_hits <= confirm_window and delete_misses >= 1"
+            )
 
 
 class Measurement(NamedTuple):
@@ -124,16 +125,17 @@ class Tracker:
             return
         F = np.eye(4)
         F[0, 2] = F[1, 3] = dt
-        q2 = self.settings.accel_noise_mps2 ** 2
-        a, b, c = dt ** 4 / 4.0, dt ** 3 / 2.0, dt ** 2
+        q2 = self.settings.accel_noise_mps2**2
+        a, b, c = dt**4 / 4.0, dt**3 / 2.0, dt**2
         Q = q2 * np.array([[a, 0, b, 0], [0, a, 0, b], [b, 0, c, 0], [0, b, 0, c]])
         track.x = F @ track.x
         track.P = F @ track.P @ F.T + Q
         track.t = t
 
     @staticmethod
-    def _update(track: _Track, z: np.ndarray, R: np.ndarray, m: Measurement,
-                ego_v: tuple[float, float]) -> None:
+    def _update(
+        track: _Track, z: np.ndarray, R: np.ndarray, m: Measurement, ego_v: tuple[float, float]
+    ) -> None:
         H = np.zeros((2, 4))
         H[0, 0] = H[1, 1] = 1.0
         S = H @ track.P @ H.T + R
@@ -149,8 +151,13 @@ class Tracker:
         track.P = track.P - np.outer(k, h @ track.P)
         track.P = 0.5 * (track.P + track.P.T)
 
-    def update(self, t: float, measurements: list[Measurement], origin: tuple[float, float],
-               ego_velocity: tuple[float, float]) -> None:
+    def update(
+        self,
+        t: float,
+        measurements: list[Measurement],
+        origin: tuple[float, float],
+        ego_velocity: tuple[float, float],
+    ) -> None:
         """One radar cycle: the detections of the scan at time ``t`` seen from ``origin``
         while the ego moved at ``ego_velocity`` (network frame)."""
         st = self.settings
@@ -200,14 +207,15 @@ class Tracker:
         radial = m.range_rate_mps + ux * ego_v[0] + uy * ego_v[1]
         P = np.zeros((4, 4))
         P[:2, :2] = R
-        sd_t2 = self.settings.initial_speed_sd_mps ** 2
+        sd_t2 = self.settings.initial_speed_sd_mps**2
         sd_r2 = max(m.range_rate_sd_mps, SD_FLOOR[2]) ** 2
         u = np.array([ux, uy])
         n = np.array([-uy, ux])
         P[2:, 2:] = sd_r2 * np.outer(u, u) + sd_t2 * np.outer(n, n)
         x = np.array([z[0], z[1], radial * ux, radial * uy])
-        track = _Track(self._next_id, x, P, t,
-                       (m.centre_dx_m, m.centre_dy_m, m.length_m, m.width_m))
+        track = _Track(
+            self._next_id, x, P, t, (m.centre_dx_m, m.centre_dy_m, m.length_m, m.width_m)
+        )
         self._next_id += 1
         if self.settings.confirm_hits <= 1:
             track.confirmed = True
@@ -215,6 +223,10 @@ class Tracker:
 
     def confirmed(self) -> list[TrackState]:
         """The confirmed tracks, as of the last update."""
-        return [TrackState(tr.tid, float(tr.x[0]), float(tr.x[1]), float(tr.x[2]),
-                           float(tr.x[3]), *tr.extent)
-                for tr in self._tracks if tr.confirmed]
+        return [
+            TrackState(
+                tr.tid, float(tr.x[0]), float(tr.x[1]), float(tr.x[2]), float(tr.x[3]), *tr.extent
+            )
+            for tr in self._tracks
+            if tr.confirmed
+        ]

@@ -122,7 +122,8 @@ class V2XReceiver:
         known = self._equipped.get(sender)
         if known is None:
             known = self._equipped[sender] = (
-                st.penetration >= 1.0 or _draw(st.seed, "equipped", sender) < st.penetration)
+                st.penetration >= 1.0 or _draw(st.seed, "equipped", sender) < st.penetration
+            )
             self._phase[sender] = st.period_s * _draw(st.seed, "phase", sender)
         return known
 
@@ -148,8 +149,9 @@ class V2XReceiver:
             self._next_send[b.vid] = k + 1
             if st.loss > 0.0 and _draw(st.seed, "loss", b.vid, k) < st.loss:
                 continue
-            self._in_flight.append(_Message(time_s, b.vid, b.x_m, b.y_m, b.yaw_rad,
-                                            b.speed_mps, b.length_m, b.width_m))
+            self._in_flight.append(
+                _Message(time_s, b.vid, b.x_m, b.y_m, b.yaw_rad, b.speed_mps, b.length_m, b.width_m)
+            )
         flight = self._in_flight
         while flight and flight[0].sent_s + st.latency_s <= time_s + 1e-9:
             msg = flight.popleft()
@@ -164,9 +166,18 @@ class V2XReceiver:
                 stale.append(sender)
                 continue
             step = m.speed_mps * age
-            out.append(V2XObject(sender, m.x_m + step * math.cos(m.yaw_rad),
-                                 m.y_m + step * math.sin(m.yaw_rad), m.yaw_rad, m.speed_mps,
-                                 m.length_m, m.width_m, age))
+            out.append(
+                V2XObject(
+                    sender,
+                    m.x_m + step * math.cos(m.yaw_rad),
+                    m.y_m + step * math.sin(m.yaw_rad),
+                    m.yaw_rad,
+                    m.speed_mps,
+                    m.length_m,
+                    m.width_m,
+                    age,
+                )
+            )
         for sender in stale:
             del self._newest[sender]
         out.sort()

@@ -24,6 +24,7 @@ from eoam_sumo.sim.geometry import OrientedBox
 
 PEDESTRIAN = "pedestrian"  # SUMO's vClass of persons
 
+
 class _BodyFields(NamedTuple):
     """Body's fields, typed so that compiled code reads them as floats (hypothesis' ``builds``
     would ask for every field: build bodies with the constructor)."""
@@ -53,32 +54,63 @@ class Body(_BodyFields):
 
     __slots__ = ()
 
-    def __new__(cls, vid: str, vclass: str, x_m: float, y_m: float, yaw_rad: float,
-                speed_mps: float, length_m: float, width_m: float, parked: bool = False):
+    def __new__(
+        cls,
+        vid: str,
+        vclass: str,
+        x_m: float,
+        y_m: float,
+        yaw_rad: float,
+        speed_mps: float,
+        length_m: float,
+        width_m: float,
+        parked: bool = False,
+    ):
         if not math.isfinite(speed_mps):
             raise ValueError(f"Body.speed_mps={speed_mps!r} must be finite")
         box = OrientedBox(x_m, y_m, yaw_rad, length_m, width_m)
-        return tuple.__new__(cls, (vid, vclass, x_m, y_m, yaw_rad, speed_mps, length_m,
-                                   width_m, parked, box))
+        return tuple.__new__(
+            cls, (vid, vclass, x_m, y_m, yaw_rad, speed_mps, length_m, width_m, parked, box)
+        )
 
     def __getnewargs__(self):
         return self[:9]
 
     def __repr__(self) -> str:
-        return (f"Body(vid={self.vid!r}, vclass={self.vclass!r}, x_m={self.x_m!r}, "
-                f"y_m={self.y_m!r}, yaw_rad={self.yaw_rad!r}, speed_mps={self.speed_mps!r}, "
-                f"length_m={self.length_m!r}, width_m={self.width_m!r}, "
-                f"parked={self.parked!r})")
+        return (
+            f"Body(vid={self.vid!r}, vclass={self.vclass!r}, x_m={self.x_m!r}, "
+            f"y_m={self.y_m!r}, yaw_rad={self.yaw_rad!r}, speed_mps={self.speed_mps!r}, "
+            f"length_m={self.length_m!r}, width_m={self.width_m!r}, "
+            f"parked={self.parked!r})"
+        )
 
     @classmethod
-    def from_front(cls, vid: str, vclass: str, x_front_m: float, y_front_m: float,
-                   angle_nav_deg: float, speed_mps: float, length_m: float, width_m: float,
-                   parked: bool = False) -> Body:
+    def from_front(
+        cls,
+        vid: str,
+        vclass: str,
+        x_front_m: float,
+        y_front_m: float,
+        angle_nav_deg: float,
+        speed_mps: float,
+        length_m: float,
+        width_m: float,
+        parked: bool = False,
+    ) -> Body:
         """The body of a road user from SUMO's front position and navigation angle."""
         yaw = yaw_rad(angle_nav_deg)
         half = 0.5 * length_m
-        return cls(vid, vclass, x_front_m - half * math.cos(yaw),
-                   y_front_m - half * math.sin(yaw), yaw, speed_mps, length_m, width_m, parked)
+        return cls(
+            vid,
+            vclass,
+            x_front_m - half * math.cos(yaw),
+            y_front_m - half * math.sin(yaw),
+            yaw,
+            speed_mps,
+            length_m,
+            width_m,
+            parked,
+        )
 
 
 def nav_angle_deg(yaw_rad: float) -> float:

@@ -37,8 +37,15 @@ from eoam_sumo.sim.geometry import OrientedBox
 class Beams(Protocol):
     """What coasting asks of the radar (``eoam_sumo.sim.radar.Radar``)."""
 
-    def classify(self, ahead: bool, d_m: float, speed_mps: float, road_speed_mps: float,
-                 band_m: float, lane_width_m: float) -> str:
+    def classify(
+        self,
+        ahead: bool,
+        d_m: float,
+        speed_mps: float,
+        road_speed_mps: float,
+        band_m: float,
+        lane_width_m: float,
+    ) -> str:
         """The radar's class of a target."""
         ...
 
@@ -58,10 +65,23 @@ class Coaster:
         self.coasted: Body | None = None  # the body as last seen, predicted from there
         self.coasted_t = 0.0
 
-    def coast(self, radar: Beams, range_m: float, seen: Body | None, detected: Sequence[Body],
-              ox: float, oy: float, yaw_rad: float, ego_vx: float, ego_vy: float,
-              ego_s: float, project: Callable[[float, float], tuple[float, float, float]],
-              band_m: float, lane_width_m: float, time_s: float | None) -> tuple | None:
+    def coast(
+        self,
+        radar: Beams,
+        range_m: float,
+        seen: Body | None,
+        detected: Sequence[Body],
+        ox: float,
+        oy: float,
+        yaw_rad: float,
+        ego_vx: float,
+        ego_vy: float,
+        ego_s: float,
+        project: Callable[[float, float], tuple[float, float, float]],
+        band_m: float,
+        lane_width_m: float,
+        time_s: float | None,
+    ) -> tuple | None:
         """The fields of the coasted object's ``Detection`` at ``time_s`` (None: none), given
         the scan's nearest in-path body ``seen`` and all ``detected`` bodies; called when
         ``seen`` is not the last scan's, or while an object is coasted."""
@@ -72,52 +92,97 @@ class Coaster:
         self.last, self.last_t = seen, time_s
         if seen is not None and self.coasted is not None and self.coasted.vid == seen.vid:
             self.coasted = None  # seen again
-        if (lost is not None and (seen is None or seen.vid != lost.vid)
-                and all(body.vid != lost.vid for body in detected)):
+        if (
+            lost is not None
+            and (seen is None or seen.vid != lost.vid)
+            and all(body.vid != lost.vid for body in detected)
+        ):
             lost_t = time_s if lost_t is None else lost_t
             box = _predicted(lost, time_s - lost_t)
             px, py = box.nearest_point(ox, oy)
-            nearer = self.coasted is None or _range(self.coasted, self.coasted_t, time_s, ox,
-                                                    oy) > math.hypot(px - ox, py - oy)
+            nearer = self.coasted is None or _range(
+                self.coasted, self.coasted_t, time_s, ox, oy
+            ) > math.hypot(px - ox, py - oy)
             if math.hypot(px - ox, py - oy) < range_m and nearer:
                 self.coasted, self.coasted_t = lost, lost_t
         body = self.coasted
         if body is None:
             return None
-        fields = self._detection(radar, body, time_s, ox, oy, yaw_rad, ego_vx, ego_vy, ego_s,
-                                 project, band_m, lane_width_m)
+        fields = self._detection(
+            radar,
+            body,
+            time_s,
+            ox,
+            oy,
+            yaw_rad,
+            ego_vx,
+            ego_vy,
+            ego_s,
+            project,
+            band_m,
+            lane_width_m,
+        )
         if fields is None:
             self.coasted = None
         return fields
 
-    def _detection(self, radar, body, time_s, ox, oy, yaw_rad, ego_vx, ego_vy, ego_s,
-                   project, band_m, lane_width_m) -> tuple | None:
+    def _detection(
+        self,
+        radar,
+        body,
+        time_s,
+        ox,
+        oy,
+        yaw_rad,
+        ego_vx,
+        ego_vy,
+        ego_s,
+        project,
+        band_m,
+        lane_width_m,
+    ) -> tuple | None:
         """The coasted body's detection fields at ``time_s``, or None when the prediction is
         out of the path, behind the ego or in a beam (where it would have been seen)."""
         box = _predicted(body, time_s - self.coasted_t)
         s, d, road_yaw = project(box.x_m, box.y_m)
         road_speed = body.speed_mps * math.cos(box.yaw_rad - road_yaw)
-        category = radar.classify(s > ego_s, d, body.speed_mps, road_speed, band_m,
-                                  lane_width_m)
+        category = radar.classify(s > ego_s, d, body.speed_mps, road_speed, band_m, lane_width_m)
         px, py = box.nearest_point(ox, oy)
         if category != "in_path" or radar.covers(ox, oy, yaw_rad, px, py):
             return None
         rng = math.hypot(px - ox, py - oy)
-        lx, ly = ((px - ox) / rng, (py - oy) / rng) if rng > 1e-9 else (
-            math.cos(yaw_rad), math.sin(yaw_rad))
+        lx, ly = (
+            ((px - ox) / rng, (py - oy) / rng)
+            if rng > 1e-9
+            else (math.cos(yaw_rad), math.sin(yaw_rad))
+        )
         tvx, tvy = body.speed_mps * box.cos_yaw, body.speed_mps * box.sin_yaw
         bx, by = math.cos(yaw_rad), math.sin(yaw_rad)
-        return (-1, rng, (tvx - ego_vx) * lx + (tvy - ego_vy) * ly,
-                math.atan2(bx * ly - by * lx, bx * lx + by * ly), s, d, road_speed, category,
-                body.length_m, body.width_m)
+        return (
+            -1,
+            rng,
+            (tvx - ego_vx) * lx + (tvy - ego_vy) * ly,
+            math.atan2(bx * ly - by * lx, bx * lx + by * ly),
+            s,
+            d,
+            road_speed,
+            category,
+            body.length_m,
+            body.width_m,
+        )
 
 
 def _predicted(body: Body, dt_s: float) -> OrientedBox:
     """The body's box moved ``dt_s`` at its velocity (constant-velocity prediction)."""
     box = body.box
     step = body.speed_mps * dt_s
-    return OrientedBox(box.x_m + step * box.cos_yaw, box.y_m + step * box.sin_yaw,
-                       box.yaw_rad, body.length_m, body.width_m)
+    return OrientedBox(
+        box.x_m + step * box.cos_yaw,
+        box.y_m + step * box.sin_yaw,
+        box.yaw_rad,
+        body.length_m,
+        body.width_m,
+    )
 
 
 def _range(body: Body, t0_s: float, time_s: float, ox: float, oy: float) -> float:

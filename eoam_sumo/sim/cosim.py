@@ -87,8 +87,7 @@ class RunSettings:
         if self.max_time_s <= 0:
             raise ValueError(f"max_time_s={self.max_time_s} must be > 0")
         if self.v2x.enabled and self.eoam.policy.name != "safe":
-            raise ValueError("V2X informs the safe policy only: set policy 'safe' or V2X "
-                             "range 0")
+            raise ValueError("V2X informs the safe policy only: set policy 'safe' or V2X range 0")
 
     @property
     def substeps(self) -> int:
@@ -110,8 +109,13 @@ class CoSimulation:
     """
 
     #: The phases of a step, in order (``step``); a PhaseTimer times each.
-    PHASES: ClassVar[tuple[str, ...]] = ("sense", "decide", "actuate", "write_back",
-                                         "check_contact")
+    PHASES: ClassVar[tuple[str, ...]] = (
+        "sense",
+        "decide",
+        "actuate",
+        "write_back",
+        "check_contact",
+    )
     #: What ``step`` calls for each phase, in that order, with the simulation first: the class's
     #: methods of the same names, set by ``start`` before the observers start (an observer may
     #: wrap them, as PhaseTimer does). Not bound methods: those would make each simulation a
@@ -143,7 +147,8 @@ class CoSimulation:
         # refuse what the tables do not cover before starting SUMO (checked again at the start)
         self.tables.check_run(
             overrides.mu if overrides.mu is not None else self.tables.mu_grid[-1],
-            overrides.ego_speed_mps if overrides.ego_speed_mps is not None
+            overrides.ego_speed_mps
+            if overrides.ego_speed_mps is not None
             else self.tables.speed_grid_mps[0],
         )
         self.plant = Plant(self.params, dt_s=settings.plant_dt_s, substeps=settings.substeps)
@@ -184,8 +189,13 @@ class CoSimulation:
         """Start SUMO on the scenario (the caller closes the session)."""
         st = self.settings
         return SumoSession.start(
-            self.cfg, self.overrides, ego_id=st.ego_id, step_length_s=st.step_s,
-            gui=st.gui, use_traci=st.use_traci, gui_settings=st.gui_settings,
+            self.cfg,
+            self.overrides,
+            ego_id=st.ego_id,
+            step_length_s=st.step_s,
+            gui=st.gui,
+            use_traci=st.use_traci,
+            gui_settings=st.gui_settings,
         )
 
     # ----------------------------------------------------------------------------- set-up
@@ -210,14 +220,22 @@ class CoSimulation:
         self.ctrl = EoamController(p, self.tables, st.eoam)
         self.ctrl.reset(ego.speed_mps)
         self.lane_sensing = self._next_lane_sensing(session)  # safe policy only
-        self.traffic = TrafficLog(st.ego_id, ego.vclass, p.length_m, p.width_m,
-                                  p.cg_to_front_bumper_m - 0.5 * p.length_m,
-                                  session.ego_lane_centreline(), self.lane_width_m)
+        self.traffic = TrafficLog(
+            st.ego_id,
+            ego.vclass,
+            p.length_m,
+            p.width_m,
+            p.cg_to_front_bumper_m - 0.5 * p.length_m,
+            session.ego_lane_centreline(),
+            self.lane_width_m,
+        )
         # from the front bumper, where the radar is; further for V2X and the corner radars,
         # and for the traffic log (its radius is from the centre of gravity)
         self._sense_radius_m = max(
-            st.radar.range_m, self.lane_sensing.reach_m if self.lane_sensing else 0.0,
-            self.traffic.radius_m + p.cg_to_front_bumper_m)
+            st.radar.range_m,
+            self.lane_sensing.reach_m if self.lane_sensing else 0.0,
+            self.traffic.radius_m + p.cg_to_front_bumper_m,
+        )
         self.max_steps = round(st.max_time_s / st.step_s)
         self._end_s_m = road.length_m - ROAD_END_MARGIN_M  # the run ends this close to the end
         self._front = front = p.cg_to_front_bumper_m
@@ -237,8 +255,7 @@ class CoSimulation:
         start_box = OrientedBox.from_axis_point(x[0], x[1], x[2], p.length_m, p.width_m, front)
         for b in self.bodies:
             if boxes_overlap(start_box, b.box):
-                raise InputError(f"{self.cfg}: vehicle '{b.vid}' overlaps the ego at its "
-                                 "departure")
+                raise InputError(f"{self.cfg}: vehicle '{b.vid}' overlaps the ego at its departure")
         self._cy, self._sy = math.cos(x[2]), math.sin(x[2])
         self.belief = self._new_belief()
         self.radar = make_radar(st.radar_model, st.radar, st.seed)  # fresh state per run
@@ -246,11 +263,16 @@ class CoSimulation:
         self.timeseries, self.extremes = TimeSeries(), Extremes()
         self.margins = Margins(p.length_m, p.width_m, front)
         self.avoided = AvoidedObstacle()
-        self.observers = (self.timeseries, self.extremes, self.traffic, self.margins,
-                          self.avoided, *self.extra_observers)
+        self.observers = (
+            self.timeseries,
+            self.extremes,
+            self.traffic,
+            self.margins,
+            self.avoided,
+            *self.extra_observers,
+        )
         cls = type(self)
-        self.phase_calls = (cls.sense, cls.decide, cls.actuate, cls.write_back,
-                            cls.check_contact)
+        self.phase_calls = (cls.sense, cls.decide, cls.actuate, cls.write_back, cls.check_contact)
         for obs in self.observers:
             obs.start(self)
         self._after_step = tuple(obs.after_step for obs in self.observers)
@@ -280,15 +302,26 @@ class CoSimulation:
         mu = self.belief.mu(mu_true, self.t, self.ax, self.ay)  # what the EOAM believes
         front = self._front
         front_xy = (X + front * self._cy, Y + front * self._sy)
-        report = self.radar.scan(front_xy, yaw, vx, road, self.bodies, self.lane_width_m,
-                                 self.t)
+        report = self.radar.scan(front_xy, yaw, vx, road, self.bodies, self.lane_width_m, self.t)
         perception = _perception(report)
         if self.lane_sensing is not None:
-            perception = perception._replace(next_lane=self.lane_sensing.update(
-                self.t, front_xy, yaw, road, report, self.bodies))
+            perception = perception._replace(
+                next_lane=self.lane_sensing.update(self.t, front_xy, yaw, road, report, self.bodies)
+            )
         meas = EgoMeasurement(
-            self.t, vx, vy, r, self.ax, self.ay, s, d, yaw - road_yaw,  # e_yaw not wrapped:
-            road.curvature_at(s), mu, self.lane_width_m, self.left_lane,  # yaw is continuous
+            self.t,
+            vx,
+            vy,
+            r,
+            self.ax,
+            self.ay,
+            s,
+            d,
+            yaw - road_yaw,  # e_yaw not wrapped:
+            road.curvature_at(s),
+            mu,
+            self.lane_width_m,
+            self.left_lane,  # yaw is continuous
         )
         return meas, perception
 
@@ -311,8 +344,7 @@ class CoSimulation:
         self._cy, self._sy = cy, sy = math.cos(yaw), math.sin(yaw)
         front = self._front
         session = self.session
-        session.move_ego(X + front * cy, Y + front * sy, nav_angle_deg(yaw),
-                         max(vx, 0.0))
+        session.move_ego(X + front * cy, Y + front * sy, nav_angle_deg(yaw), max(vx, 0.0))
         session.step()
         self.t = session.time_s
         self.bodies_before, self.bodies = self.bodies, session.nearby(self._sense_radius_m)
@@ -327,7 +359,8 @@ class CoSimulation:
         ego_box = None  # built when a body comes close
         # farthest any point of the ego box moved during the step (translation + rotation)
         ego_move = math.hypot(Xn - x_prev[0], Yn - x_prev[1]) + self._ego_radius * abs(
-            yawn - x_prev[2])
+            yawn - x_prev[2]
+        )
         road, lane_width, step_s = self.road, self.lane_width_m, self.settings.step_s
         ego_box_radius, p = self._ego_box_radius, self.params
         gaps = self._gaps if (Xn, Yn, yawn) == self._gaps_pose else {}
@@ -347,26 +380,32 @@ class CoSimulation:
             if circles_m > reach_m and role != "aro":
                 continue
             if ego_box is None:
-                ego_box = OrientedBox.from_axis_point(Xn, Yn, yawn, p.length_m, p.width_m,
-                                                      self._front)
+                ego_box = OrientedBox.from_axis_point(
+                    Xn, Yn, yawn, p.length_m, p.width_m, self._front
+                )
             bound_m = gap_lower_bound(ego_box, b.box) - ROUNDING_M  # tighter, dearer
             if bound_m > reach_m and (role != "aro" or bound_m >= min_gap_aro):
                 continue
             known = gaps.get(b.vid)  # the same boxes as at the last step: the same gap
-            gap = known[1] if known is not None and known[0] is b.box else box_distance(
-                ego_box, b.box)
+            gap = (
+                known[1]
+                if known is not None and known[0] is b.box
+                else box_distance(ego_box, b.box)
+            )
             self._gaps[b.vid] = (b.box, gap)
             if role == "aro" and gap < self.min_gap_aro_m:
                 self.min_gap_aro_m = gap
             # contact during the step is possible only if the gap is within both moves
             if self.first_contact is None and gap <= reach_m:
                 before = next((o for o in self.bodies_before if o.vid == b.vid), b)
-                found = substep_contact(x_prev, x, b, before, p.length_m, p.width_m,
-                                        self._front, self.settings.substeps)
+                found = substep_contact(
+                    x_prev, x, b, before, p.length_m, p.width_m, self._front, self.settings.substeps
+                )
                 if found is not None:
                     hit, ebox, obox = found
                     self.first_contact = ContactRecord(
-                        hit, role or role_of(b, road, lane_width), self.t, b, ebox, obox)
+                        hit, role or role_of(b, road, lane_width), self.t, b, ebox, obox
+                    )
 
     def finished(self) -> bool:
         """Whether the run is over: a contact, ``settle_s`` after the EOAM handed back to
@@ -381,9 +420,13 @@ class CoSimulation:
             self._stop_at = None  # (again) a manoeuvre under way: run on to its end
         elif self._stop_at is None:
             self._stop_at = self.t + self.settings.settle_s
-        if (self._stop_at is not None and self.t >= self._stop_at - 1e-9
-                and not road_user_close_ahead(self.x, self._front, self.road,
-                                              self.lane_width_m, self.mu_true, self.bodies)):
+        if (
+            self._stop_at is not None
+            and self.t >= self._stop_at - 1e-9
+            and not road_user_close_ahead(
+                self.x, self._front, self.road, self.lane_width_m, self.mu_true, self.bodies
+            )
+        ):
             self.end_cause = "settled"
         elif self.meas.s_m > self._end_s_m:
             self.end_cause = "road_end"
@@ -397,8 +440,9 @@ class CoSimulation:
         """The EOAM is over: handed back to NORMAL after a manoeuvre, or stopped."""
         ctrl = self.ctrl
         mode = ctrl.mode
-        return ((mode == 0 and len(ctrl.modes_visited) > 1)
-                or (mode in (1, 3) and self.x[3] < STOPPED_MPS))
+        return (mode == 0 and len(ctrl.modes_visited) > 1) or (
+            mode in (1, 3) and self.x[3] < STOPPED_MPS
+        )
 
     # ----------------------------------------------------------------------------- the end
     def finish(self) -> RunSummary:
@@ -409,8 +453,20 @@ class CoSimulation:
         s, d, road_yaw = self.road.project(X, Y)
         self.mu_true = self.session.friction_at_ego()
         self.meas = EgoMeasurement(
-            self.t, vx, x[4], x[5], self.ax, self.ay, s, d, yaw - road_yaw, 0.0,
-            self.mu_true, self.lane_width_m, self.left_lane)
+            self.t,
+            vx,
+            x[4],
+            x[5],
+            self.ax,
+            self.ay,
+            s,
+            d,
+            yaw - road_yaw,
+            0.0,
+            self.mu_true,
+            self.lane_width_m,
+            self.left_lane,
+        )
         for obs in self.observers:
             obs.end(self)
         self.loop_wall_s = loop_wall_s
@@ -423,29 +479,57 @@ class CoSimulation:
             return None
         opposing, limit = session.next_lane_traffic()
         return NextLaneSensing(
-            opposing=opposing, speed_limit_mps=limit, lane_width_m=self.lane_width_m,
-            radar_range_m=st.radar.range_m, radar_fov_deg=st.radar.fov_deg,
-            ego_length_m=self.params.length_m, ego_width_m=self.params.width_m, v2x=st.v2x,
-            corner=st.corner_radar, fastest_mps=st.eoam.policy.opposing_speed_mps)
+            opposing=opposing,
+            speed_limit_mps=limit,
+            lane_width_m=self.lane_width_m,
+            radar_range_m=st.radar.range_m,
+            radar_fov_deg=st.radar.fov_deg,
+            ego_length_m=self.params.length_m,
+            ego_width_m=self.params.width_m,
+            v2x=st.v2x,
+            corner=st.corner_radar,
+            fastest_mps=st.eoam.policy.opposing_speed_mps,
+        )
 
     def policy_record(self) -> dict:
         """The policy, the V2X settings and what the sight-distance gate needed."""
         st = self.settings
-        record = {"policy": st.eoam.policy.name, "v2x_range_m": st.v2x.range_m,
-                  "v2x_latency_s": st.v2x.latency_s, "v2x_loss": st.v2x.loss,
-                  "v2x_penetration": st.v2x.penetration}
+        record = {
+            "policy": st.eoam.policy.name,
+            "v2x_range_m": st.v2x.range_m,
+            "v2x_latency_s": st.v2x.latency_s,
+            "v2x_loss": st.v2x.loss,
+            "v2x_penetration": st.v2x.penetration,
+        }
         if self.ctrl.policy is not None:
             return {**record, **self.ctrl.policy.summary()}
-        return {**record, "sight_gate": "", "sight_needed_m": None, "sight_known_free_m": None,
-                "sight_time_s": None, "tie_break": ""}
+        return {
+            **record,
+            "sight_gate": "",
+            "sight_needed_m": None,
+            "sight_known_free_m": None,
+            "sight_time_s": None,
+            "tie_break": "",
+        }
 
-def policy_settings(settings: RunSettings, policy: str, v2x_range_m: float = 0.0,
-                    v2x_latency_s: float = 0.1, v2x_loss: float = 0.0,
-                    v2x_penetration: float = 1.0) -> RunSettings:
+
+def policy_settings(
+    settings: RunSettings,
+    policy: str,
+    v2x_range_m: float = 0.0,
+    v2x_latency_s: float = 0.1,
+    v2x_loss: float = 0.0,
+    v2x_penetration: float = 1.0,
+) -> RunSettings:
     """``settings`` with the decision policy and the V2X link set."""
     eoam = replace(settings.eoam, policy=replace(settings.eoam.policy, name=policy))
-    v2x = replace(settings.v2x, range_m=v2x_range_m, latency_s=v2x_latency_s, loss=v2x_loss,
-                  penetration=v2x_penetration)
+    v2x = replace(
+        settings.v2x,
+        range_m=v2x_range_m,
+        latency_s=v2x_latency_s,
+        loss=v2x_loss,
+        penetration=v2x_penetration,
+    )
     return replace(settings, eoam=eoam, v2x=v2x)
 
 
@@ -478,17 +562,24 @@ def _perception(report: RadarReport) -> Perception:
     det = report.in_path
     oncoming = _nearest_oncoming(report) if report.oncoming_detected else None
     if det is None:
-        perception = (_NOTHING if oncoming is None
-                      else Perception(None, None, True, oncoming_object=oncoming))
+        perception = (
+            _NOTHING if oncoming is None else Perception(None, None, True, oncoming_object=oncoming)
+        )
     else:
-        obstacle = ObjectState(det.s_m, det.d_m, det.road_speed_mps, det.length_m,
-                               det.width_m)
-        perception = Perception(det.range_m, det.range_rate_mps, report.oncoming_detected,
-                                obstacle, report.next_lane_range_m, oncoming_object=oncoming)
+        obstacle = ObjectState(det.s_m, det.d_m, det.road_speed_mps, det.length_m, det.width_m)
+        perception = Perception(
+            det.range_m,
+            det.range_rate_mps,
+            report.oncoming_detected,
+            obstacle,
+            report.next_lane_range_m,
+            oncoming_object=oncoming,
+        )
     if report.coasted is None:
         return perception
-    return perception._replace(coasted_range_m=report.coasted.range_m,
-                               coasted_range_rate_mps=report.coasted.range_rate_mps)
+    return perception._replace(
+        coasted_range_m=report.coasted.range_m, coasted_range_rate_mps=report.coasted.range_rate_mps
+    )
 
 
 def _nearest_oncoming(report: RadarReport) -> ObjectState | None:

@@ -81,8 +81,13 @@ class OrientedBox(_BoxFields):
 
     def __new__(cls, x_m: float, y_m: float, yaw_rad: float, length_m: float, width_m: float):
         isfinite = math.isfinite
-        if not (isfinite(x_m) and isfinite(y_m) and isfinite(yaw_rad) and isfinite(length_m)
-                and isfinite(width_m)):
+        if not (
+            isfinite(x_m)
+            and isfinite(y_m)
+            and isfinite(yaw_rad)
+            and isfinite(length_m)
+            and isfinite(width_m)
+        ):
             for name, v in zip(_BoxFields._fields, (x_m, y_m, yaw_rad, length_m, width_m)):
                 if not isfinite(v):
                     raise ValueError(f"OrientedBox.{name}={v!r} must be finite")
@@ -91,19 +96,39 @@ class OrientedBox(_BoxFields):
                 f"OrientedBox needs length_m > 0 and width_m > 0, got {length_m}, {width_m}"
             )
         hl, hw = 0.5 * length_m, 0.5 * width_m
-        return tuple.__new__(cls, (x_m, y_m, yaw_rad, length_m, width_m, math.cos(yaw_rad),
-                                   math.sin(yaw_rad), hl, hw, math.hypot(hl, hw)))
+        return tuple.__new__(
+            cls,
+            (
+                x_m,
+                y_m,
+                yaw_rad,
+                length_m,
+                width_m,
+                math.cos(yaw_rad),
+                math.sin(yaw_rad),
+                hl,
+                hw,
+                math.hypot(hl, hw),
+            ),
+        )
 
     def __getnewargs__(self):
         return self[:5]
 
     def __repr__(self) -> str:
-        return (f"OrientedBox(x_m={self.x_m!r}, y_m={self.y_m!r}, yaw_rad={self.yaw_rad!r}, "
-                f"length_m={self.length_m!r}, width_m={self.width_m!r})")
+        return (
+            f"OrientedBox(x_m={self.x_m!r}, y_m={self.y_m!r}, yaw_rad={self.yaw_rad!r}, "
+            f"length_m={self.length_m!r}, width_m={self.width_m!r})"
+        )
 
     @classmethod
     def from_axis_point(
-        cls, x_m: float, y_m: float, yaw_rad: float, length_m: float, width_m: float,
+        cls,
+        x_m: float,
+        y_m: float,
+        yaw_rad: float,
+        length_m: float,
+        width_m: float,
         to_front_m: float,
     ) -> OrientedBox:
         """Box of a body given a point on its centre line ``to_front_m`` behind its front face.
@@ -113,8 +138,11 @@ class OrientedBox(_BoxFields):
         """
         back = to_front_m - 0.5 * length_m
         return cls(
-            x_m + back * math.cos(yaw_rad), y_m + back * math.sin(yaw_rad), yaw_rad,
-            length_m, width_m,
+            x_m + back * math.cos(yaw_rad),
+            y_m + back * math.sin(yaw_rad),
+            yaw_rad,
+            length_m,
+            width_m,
         )
 
     def corners(self) -> tuple[tuple[float, float], ...]:
@@ -170,8 +198,10 @@ class Contact:
 
 def _axes(a: OrientedBox, b: OrientedBox) -> tuple[tuple[float, float], ...]:
     return (
-        (a.cos_yaw, a.sin_yaw), (-a.sin_yaw, a.cos_yaw),
-        (b.cos_yaw, b.sin_yaw), (-b.sin_yaw, b.cos_yaw),
+        (a.cos_yaw, a.sin_yaw),
+        (-a.sin_yaw, a.cos_yaw),
+        (b.cos_yaw, b.sin_yaw),
+        (-b.sin_yaw, b.cos_yaw),
     )
 
 
@@ -203,10 +233,12 @@ def gap_lower_bound(a: OrientedBox, b: OrientedBox) -> float:
     ac, asin, bc, bsin = a.cos_yaw, a.sin_yaw, b.cos_yaw, b.sin_yaw
     ahl, ahw, bhl, bhw = a.half_length_m, a.half_width_m, b.half_length_m, b.half_width_m
     c, s = abs(ac * bc + asin * bsin), abs(ac * bsin - asin * bc)  # b's yaw relative to a's
-    return max(abs(dx * ac + dy * asin) - ahl - bhl * c - bhw * s,
-               abs(dy * ac - dx * asin) - ahw - bhl * s - bhw * c,
-               abs(dx * bc + dy * bsin) - bhl - ahl * c - ahw * s,
-               abs(dy * bc - dx * bsin) - bhw - ahl * s - ahw * c)
+    return max(
+        abs(dx * ac + dy * asin) - ahl - bhl * c - bhw * s,
+        abs(dy * ac - dx * asin) - ahw - bhl * s - bhw * c,
+        abs(dx * bc + dy * bsin) - bhl - ahl * c - ahw * s,
+        abs(dy * bc - dx * bsin) - bhw - ahl * s - ahw * c,
+    )
 
 
 def _nearest_point(box: OrientedBox, x_m: float, y_m: float) -> tuple[float, float]:
@@ -226,8 +258,7 @@ def _nearest_point(box: OrientedBox, x_m: float, y_m: float) -> tuple[float, flo
     return box.x_m + c * lx - s * ly, box.y_m + s * lx + c * ly
 
 
-def _nearest_corner(src: OrientedBox, dst: OrientedBox) -> tuple[float, float, float, float,
-                                                                  float]:
+def _nearest_corner(src: OrientedBox, dst: OrientedBox) -> tuple[float, float, float, float, float]:
     """(distance, x, y of the corner, x, y of its nearest point of dst) of the first corner of
     ``src`` nearest to ``dst`` (distance inf, zeros if none is finite)."""
     best = (math.inf, 0.0, 0.0, 0.0, 0.0)
@@ -398,7 +429,10 @@ def face_overlap(a: OrientedBox, b: OrientedBox, face_a: str) -> float:
 
 
 def time_to_contact(
-    a: OrientedBox, b: OrientedBox, va: tuple[float, float], vb: tuple[float, float],
+    a: OrientedBox,
+    b: OrientedBox,
+    va: tuple[float, float],
+    vb: tuple[float, float],
     horizon_s: float = math.inf,
 ) -> float:
     """Time [s] until the boxes touch (within ``CONTACT_TOLERANCE_M``, as ``boxes_overlap``)
@@ -411,9 +445,14 @@ def time_to_contact(
     rvx, rvy = vb[0] - va[0], vb[1] - va[1]
     # b's centre on each axis relative to a's, its rate, and the pair's reach on that axis
     return slab_entry(
-        [(dx * nx + dy * ny, rvx * nx + rvy * ny,
-          _half_extent(a, nx, ny) + _half_extent(b, nx, ny) + CONTACT_TOLERANCE_M)
-         for nx, ny in _axes(a, b)],
+        [
+            (
+                dx * nx + dy * ny,
+                rvx * nx + rvy * ny,
+                _half_extent(a, nx, ny) + _half_extent(b, nx, ny) + CONTACT_TOLERANCE_M,
+            )
+            for nx, ny in _axes(a, b)
+        ],
         horizon_s,
     )
 

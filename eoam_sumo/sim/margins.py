@@ -80,13 +80,17 @@ class Margins(StepObserver):
         road_yaw = sim.road.project(X, Y)[2]
         cr, sr = math.cos(road_yaw), math.sin(road_yaw)
         ego = OrientedBox.from_axis_point(X, Y, yaw, self.length_m, self.width_m, self.front_m)
-        return min((box_distance(ego, b.box) for b in sim.session.road_users()
-                    if not b.parked and b.box.cos_yaw * cr + b.box.sin_yaw * sr < 0.0),
-                   default=math.inf)
+        return min(
+            (
+                box_distance(ego, b.box)
+                for b in sim.session.road_users()
+                if not b.parked and b.box.cos_yaw * cr + b.box.sin_yaw * sr < 0.0
+            ),
+            default=math.inf,
+        )
 
     def near_miss(self) -> bool:
-        return (self.closest_gap_m <= NEAR_MISS_GAP_M
-                or self.min_ttc_oncoming_s < NEAR_MISS_TTC_S)
+        return self.closest_gap_m <= NEAR_MISS_GAP_M or self.min_ttc_oncoming_s < NEAR_MISS_TTC_S
 
     def after_step(self, sim: RunView) -> None:
         meas = sim.meas
@@ -100,8 +104,9 @@ class Margins(StepObserver):
         ego_box = None
         for b in sim.bodies:
             box = b.box
-            bound = (math.hypot(box.x_m - ex, box.y_m - ey) - self._radius_m - box.radius_m
-                     - _ROUNDING_M)
+            bound = (
+                math.hypot(box.x_m - ex, box.y_m - ey) - self._radius_m - box.radius_m - _ROUNDING_M
+            )
             opposite = not b.parked and box.cos_yaw * cr + box.sin_yaw * sr < 0.0
             near = bound < NEAR_MISS_GAP_M
             if not (opposite or near):
@@ -126,8 +131,14 @@ class Margins(StepObserver):
                     self.closest_gap_m, self.closest_id = gap, b.vid
 
 
-def road_user_close_ahead(x: Sequence[float], cg_to_front_m: float, road: RoadProjection,
-                          lane_width_m: float, mu: float, bodies: Sequence[Body]) -> bool:
+def road_user_close_ahead(
+    x: Sequence[float],
+    cg_to_front_m: float,
+    road: RoadProjection,
+    lane_width_m: float,
+    mu: float,
+    bodies: Sequence[Body],
+) -> bool:
     """Whether the ego (plant state ``x``) is moving and a road user's centre is in the ego's
     lane (the one its centre is in; band as the radar's) ahead of its front bumper, with a gap
     along the road within what the ego needs to stop behind where that road user would stop

@@ -25,7 +25,9 @@ class RunView(Protocol):
 
     @property
     def PHASES(self) -> tuple[str, ...]: ...
+
     phase_calls: tuple[Callable[..., Any], ...]  # what the step calls for each phase (with
+
     # the simulation first)
     @property
     def max_steps(self) -> int: ...  # the time limit in steps
@@ -122,8 +124,8 @@ class Extremes(StepObserver):
         self.min_d_m, self.max_d_m = min(min_d, meas.d_m), max(max_d, meas.d_m)
         self.min_vx_mps = min(self.min_vx_mps, meas.vx_mps)
         self.max_abs_heading_error_rad = max(
-            self.max_abs_heading_error_rad,
-            abs((meas.e_yaw_rad + math.pi) % math.tau - math.pi))
+            self.max_abs_heading_error_rad, abs((meas.e_yaw_rad + math.pi) % math.tau - math.pi)
+        )
 
 
 class PhaseTimer(StepObserver):

@@ -192,8 +192,10 @@ def _manoeuvre_phrase(modes: set[int], lane_change: bool) -> str:
     if lane_change:
         return "lane change"
     if 3 in modes:
-        return ("limit braking chosen (next lane not free before the point of no return: "
-                "oncoming traffic or a standing car)")
+        return (
+            "limit braking chosen (next lane not free before the point of no return: "
+            "oncoming traffic or a standing car)"
+        )
     if 1 in modes:
         return "limit braking chosen by the DMM"
     if modes & {2, 4, 5}:
@@ -273,11 +275,16 @@ def classify_outcome(
     modes = set(modes_visited)
     if not modes <= {0, 1, 2, 3, 4, 5}:
         raise ValueError(f"modes_visited={list(modes_visited)} must hold mode numbers 0-5")
-    for name, v in (("max_lateral_offset_m", max_lateral_offset_m),
-                    ("final_offset_m", final_offset_m), ("final_speed_mps", final_speed_mps),
-                    ("max_abs_heading_error_rad", max_abs_heading_error_rad),
-                    ("min_speed_mps", min_speed_mps), ("min_offset_m", min_offset_m),
-                    ("max_offset_m", max_offset_m), ("left_width_m", left_width_m)):
+    for name, v in (
+        ("max_lateral_offset_m", max_lateral_offset_m),
+        ("final_offset_m", final_offset_m),
+        ("final_speed_mps", final_speed_mps),
+        ("max_abs_heading_error_rad", max_abs_heading_error_rad),
+        ("min_speed_mps", min_speed_mps),
+        ("min_offset_m", min_offset_m),
+        ("max_offset_m", max_offset_m),
+        ("left_width_m", left_width_m),
+    ):
         if not math.isfinite(v):
             raise ValueError(f"{name}={v!r} must be finite")
     if not lane_width_m > 0.0:
@@ -291,15 +298,25 @@ def classify_outcome(
     )
     if contact is None:
         lost = _loss_of_control(
-            max_abs_heading_error_rad, min_speed_mps,
-            road_departure(min_offset_m, max_offset_m, lane_width_m, left_width_m), settings,
+            max_abs_heading_error_rad,
+            min_speed_mps,
+            road_departure(min_offset_m, max_offset_m, lane_width_m, left_width_m),
+            settings,
         )
         if lost:
             # an offset past the point of no return is a lane change only if the EOAM steered
             done = _manoeuvre_phrase(modes, lane_change and bool(modes & {2, 4, 5}))
             return Outcome("orange", "none", 0.0, f"{done}, no contact; {'; '.join(lost)}")
-        return _no_contact(modes, lane_change, final_offset_m, final_speed_mps, settings,
-                           cut_off, manoeuvre_running, passed_obstacle)
+        return _no_contact(
+            modes,
+            lane_change,
+            final_offset_m,
+            final_speed_mps,
+            settings,
+            cut_off,
+            manoeuvre_running,
+            passed_obstacle,
+        )
     if role not in ROLES:
         raise ValueError(f"role={role!r} of the body hit must be one of {ROLES}")
     what = _ROLE_NAMES[role]
@@ -310,14 +327,21 @@ def classify_outcome(
         how = "head-on" if contact.kind == "head_on" else "offset/oblique head-on"
         colour, reason = "red", f"{done}, {how} with the oncoming vehicle at {v:.1f} m/s"
     elif (
-        not lane_change and role != "oncoming" and contact.face_a == "front"
-        and contact.kind != "side" and direct_overlap >= DIRECT_HIT_MIN_OVERLAP
+        not lane_change
+        and role != "oncoming"
+        and contact.face_a == "front"
+        and contact.kind != "side"
+        and direct_overlap >= DIRECT_HIT_MIN_OVERLAP
     ):
         colour, reason = "yellow", f"{done}, front hit {what} at {v:.1f} m/s"
     elif contact.face_a == "front" and contact.kind != "side" and role != "oncoming":
-        colour, reason = "orange", (
-            f"{done}, offset front hit {what} ({100 * direct_overlap:.0f} % of the narrower "
-            f"width in line) at {v:.1f} m/s")
+        colour, reason = (
+            "orange",
+            (
+                f"{done}, offset front hit {what} ({100 * direct_overlap:.0f} % of the narrower "
+                f"width in line) at {v:.1f} m/s"
+            ),
+        )
     else:
         how = contact.kind.replace("_", "-")
         part = f"ego {contact.face_a} against its {contact.face_b}"
@@ -326,7 +350,9 @@ def classify_outcome(
 
 
 def _loss_of_control(
-    max_abs_heading_error_rad: float, min_speed_mps: float, departure: tuple[str, float],
+    max_abs_heading_error_rad: float,
+    min_speed_mps: float,
+    departure: tuple[str, float],
     settings: OutcomeSettings,
 ) -> list[str]:
     """What went wrong, one phrase per trigger (empty when the ego stayed in control)."""
@@ -346,8 +372,13 @@ def _loss_of_control(
 
 
 def _no_contact(
-    modes: set[int], lane_change: bool, final_offset_m: float, final_speed_mps: float,
-    settings: OutcomeSettings, cut_off: str | None = None, manoeuvre_running: bool = False,
+    modes: set[int],
+    lane_change: bool,
+    final_offset_m: float,
+    final_speed_mps: float,
+    settings: OutcomeSettings,
+    cut_off: str | None = None,
+    manoeuvre_running: bool = False,
     passed_obstacle: bool | None = None,
 ) -> Outcome:
     if not modes - {0}:
@@ -355,17 +386,27 @@ def _no_contact(
     in_lane = abs(final_offset_m) <= settings.in_lane_tolerance_m
     stopped = final_speed_mps <= settings.stopped_speed_mps
     if cut_off is not None and (manoeuvre_running or not in_lane):
-        where = ("a manoeuvre still running" if in_lane else
-                 f"the ego {final_offset_m:+.1f} m from its lane centre"
-                 + (" and a manoeuvre still running" if manoeuvre_running else ""))
-        return Outcome("unfinished", "none", 0.0,
-                       f"no contact, but the run was cut off at its {cut_off} with {where}")
+        where = (
+            "a manoeuvre still running"
+            if in_lane
+            else f"the ego {final_offset_m:+.1f} m from its lane centre"
+            + (" and a manoeuvre still running" if manoeuvre_running else "")
+        )
+        return Outcome(
+            "unfinished",
+            "none",
+            0.0,
+            f"no contact, but the run was cut off at its {cut_off} with {where}",
+        )
     if lane_change and passed_obstacle is False:
-        reason = ("lane change not completed: returned to its lane behind the obstacle it was "
-                  "avoiding, no contact")
+        reason = (
+            "lane change not completed: returned to its lane behind the obstacle it was "
+            "avoiding, no contact"
+        )
     elif lane_change:
         reason = (
-            "lane change completed, returned to lane, no contact" if in_lane
+            "lane change completed, returned to lane, no contact"
+            if in_lane
             else "lane change completed, no contact, not back in lane when the run ended"
         )
     elif stopped:

@@ -91,8 +91,15 @@ class RadarSettings:
     near_fov_deg: float = 90.0  # its full horizontal field of view [deg]
 
     def __post_init__(self) -> None:
-        for name in ("range_m", "fov_deg", "stationary_speed_mps", "oncoming_speed_mps",
-                     "lane_margin_m", "near_range_m", "near_fov_deg"):
+        for name in (
+            "range_m",
+            "fov_deg",
+            "stationary_speed_mps",
+            "oncoming_speed_mps",
+            "lane_margin_m",
+            "near_range_m",
+            "near_fov_deg",
+        ):
             v = getattr(self, name)
             if not math.isfinite(v) or v < 0.0:
                 raise ValueError(f"RadarSettings.{name}={v!r} must be finite and >= 0")
@@ -101,8 +108,10 @@ class RadarSettings:
         if not 0.0 < self.fov_deg < 180.0:
             raise ValueError(f"RadarSettings.fov_deg={self.fov_deg} must be in (0, 180)")
         if self.near_range_m > self.range_m or not 0.0 < self.near_fov_deg < 180.0:
-            raise ValueError(f"RadarSettings.near_range_m={self.near_range_m} must be <= "
-                             f"range_m and near_fov_deg={self.near_fov_deg} in (0, 180)")
+            raise ValueError(
+                f"RadarSettings.near_range_m={self.near_range_m} must be <= "
+                f"range_m and near_fov_deg={self.near_fov_deg} in (0, 180)"
+            )
         if self.oncoming_speed_mps < self.stationary_speed_mps:
             raise ValueError(
                 f"RadarSettings.oncoming_speed_mps={self.oncoming_speed_mps} must be >= "
@@ -167,8 +176,15 @@ def report_of(detections: list[Detection]) -> RadarReport:
             next_lane = det.range_m
     if in_path is None:
         return RadarReport(None, None, oncoming, tuple(detections), next_lane_range_m=next_lane)
-    return RadarReport(in_path.range_m, in_path.range_rate_mps, oncoming, tuple(detections),
-                       in_path.target_index, in_path, next_lane)
+    return RadarReport(
+        in_path.range_m,
+        in_path.range_rate_mps,
+        oncoming,
+        tuple(detections),
+        in_path.target_index,
+        in_path,
+        next_lane,
+    )
 
 
 class Radar:
@@ -182,11 +198,18 @@ class Radar:
         self._near = None  # the near-range beam, as a radar of its own
         self._coaster = Coaster()
         if settings.near_range_m > 0.0:
-            self._near = Radar(replace(settings, range_m=settings.near_range_m,
-                                       fov_deg=settings.near_fov_deg, near_range_m=0.0))
+            self._near = Radar(
+                replace(
+                    settings,
+                    range_m=settings.near_range_m,
+                    fov_deg=settings.near_fov_deg,
+                    near_range_m=0.0,
+                )
+            )
 
-    def seen_point(self, ox: float, oy: float, yaw_rad: float, cos_yaw: float, sin_yaw: float,
-                   box: OrientedBox) -> tuple[float, float, float]:
+    def seen_point(
+        self, ox: float, oy: float, yaw_rad: float, cos_yaw: float, sin_yaw: float, box: OrientedBox
+    ) -> tuple[float, float, float]:
         """(distance, x, y) of the nearest point of ``box`` the radar covers (the far beam
         within ``range_m``, the near beam within ``near_range_m``); distance inf if none."""
         rng, px, py = self.visible_point(ox, oy, yaw_rad, cos_yaw, sin_yaw, box)
@@ -216,7 +239,12 @@ class Radar:
         )[0]
 
     def visible_point(
-        self, ox: float, oy: float, yaw_rad: float, cos_yaw: float, sin_yaw: float,
+        self,
+        ox: float,
+        oy: float,
+        yaw_rad: float,
+        cos_yaw: float,
+        sin_yaw: float,
         box: OrientedBox,
     ) -> tuple[float, float, float]:
         """(distance, x, y) of the point of ``box`` inside the cone nearest to the radar."""
@@ -285,11 +313,20 @@ class Radar:
             bearing = math.atan2(bx * ly - by * lx, bx * lx + by * ly)
             s, d, road_yaw = road_frame.project(box.x_m, box.y_m)
             road_speed = tgt.speed_mps * math.cos(box.yaw_rad - road_yaw)
-            category = self.classify(s > ego_s, d, tgt.speed_mps, road_speed, band_m,
-                                      lane_width_m)
+            category = self.classify(s > ego_s, d, tgt.speed_mps, road_speed, band_m, lane_width_m)
             detections.append(
-                Detection(index, rng, range_rate, bearing, s, d, road_speed, category,
-                          tgt.length_m, tgt.width_m)
+                Detection(
+                    index,
+                    rng,
+                    range_rate,
+                    bearing,
+                    s,
+                    d,
+                    road_speed,
+                    category,
+                    tgt.length_m,
+                    tgt.width_m,
+                )
             )
         report = report_of(detections)
         coaster = self._coaster
@@ -304,13 +341,30 @@ class Radar:
                 return report
         seen = None if report.in_path is None else targets[report.in_path.target_index]
         coasted = coaster.coast(
-            self, range_m, seen, [targets[det.target_index] for det in report.detections],
-            ox, oy, ego_yaw_rad, evx, evy, ego_s, road_frame.project, band_m, lane_width_m,
-            time_s)
+            self,
+            range_m,
+            seen,
+            [targets[det.target_index] for det in report.detections],
+            ox,
+            oy,
+            ego_yaw_rad,
+            evx,
+            evy,
+            ego_s,
+            road_frame.project,
+            band_m,
+            lane_width_m,
+            time_s,
+        )
         return report if coasted is None else report._replace(coasted=Detection(*coasted))
 
     def classify(
-        self, ahead: bool, d_m: float, speed_mps: float, road_speed_mps: float, band_m: float,
+        self,
+        ahead: bool,
+        d_m: float,
+        speed_mps: float,
+        road_speed_mps: float,
+        band_m: float,
         lane_width_m: float,
     ) -> str:
         st = self.settings

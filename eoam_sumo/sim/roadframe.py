@@ -149,8 +149,10 @@ def _smooth_heading(points: list, stations: list) -> tuple[list, list, list]:
     length."""
     kept, kept_s = [points[0]], [0.0]
     for p, s_m in zip(points[1:-1], stations[1:-1]):
-        if s_m - kept_s[-1] >= HEADING_MIN_SEGMENT_M and stations[-1] - s_m >= \
-                HEADING_MIN_SEGMENT_M:
+        if (
+            s_m - kept_s[-1] >= HEADING_MIN_SEGMENT_M
+            and stations[-1] - s_m >= HEADING_MIN_SEGMENT_M
+        ):
             kept.append(p)
             kept_s.append(s_m)
     kept.append(points[-1])
@@ -174,8 +176,9 @@ def _smooth_heading(points: list, stations: list) -> tuple[list, list, list]:
     if stations[-1] > breaks[-1]:
         breaks.append(stations[-1])
         values.append(yaws[-1])
-    slopes = [(y1 - y0) / (b1 - b0) for (y0, y1), (b0, b1) in zip(pairwise(values),
-                                                                   pairwise(breaks))]
+    slopes = [
+        (y1 - y0) / (b1 - b0) for (y0, y1), (b0, b1) in zip(pairwise(values), pairwise(breaks))
+    ]
     return breaks, values, [*slopes, 0.0]
 
 

@@ -19,13 +19,40 @@ from eoam_sumo.fileio import write_atomic
 
 #: timeseries.csv columns (the paper's signals first, then the rest), SI units in the names.
 COLUMNS = (
-    "time_s", "mode", "fcw", "x_m", "y_m", "yaw_rad", "vx_mps", "vy_mps", "yaw_rate_radps",
-    "ax_mps2", "ay_mps2", "steer_rad", "ax_target_mps2", "y_target_m", "aro_range_m",
+    "time_s",
+    "mode",
+    "fcw",
+    "x_m",
+    "y_m",
+    "yaw_rad",
+    "vx_mps",
+    "vy_mps",
+    "yaw_rate_radps",
+    "ax_mps2",
+    "ay_mps2",
+    "steer_rad",
+    "ax_target_mps2",
+    "y_target_m",
+    "aro_range_m",
     "aro_range_rate_mps",
-    "s_m", "lateral_offset_m", "heading_error_rad", "dx_m", "lateral_error_m",
-    "lookahead_error_m", "steer_cmd_rad", "steer_ff_rad", "steer_fb_rad", "steer_yd_rad",
-    "drive_force_n", "brake_force_n", "drive_force_cmd_n", "brake_force_cmd_n",
-    "speed_target_mps", "mu", "oncoming_detected", "sector",
+    "s_m",
+    "lateral_offset_m",
+    "heading_error_rad",
+    "dx_m",
+    "lateral_error_m",
+    "lookahead_error_m",
+    "steer_cmd_rad",
+    "steer_ff_rad",
+    "steer_fb_rad",
+    "steer_yd_rad",
+    "drive_force_n",
+    "brake_force_n",
+    "drive_force_cmd_n",
+    "brake_force_cmd_n",
+    "speed_target_mps",
+    "mu",
+    "oncoming_detected",
+    "sector",
 )
 _INT_COLUMNS = ("mode", "fcw", "oncoming_detected")
 _NAN = math.nan
@@ -99,23 +126,43 @@ class RunLog:
 #: ``Perception`` (the radar's view: empty at the end, ranges empty when nothing is in path);
 #: ``mu`` is the road's friction under the ego (the EOAM may believe another).
 _FROM_STATE = {
-    "x_m": 0, "y_m": 1, "yaw_rad": 2, "vx_mps": 3, "vy_mps": 4, "yaw_rate_radps": 5,
-    "steer_rad": 6, "drive_force_n": 7, "brake_force_n": 8,
+    "x_m": 0,
+    "y_m": 1,
+    "yaw_rad": 2,
+    "vx_mps": 3,
+    "vy_mps": 4,
+    "yaw_rate_radps": 5,
+    "steer_rad": 6,
+    "drive_force_n": 7,
+    "brake_force_n": 8,
 }
 _FROM_MEAS = {
-    "time_s": "time_s", "ax_mps2": "ax_mps2", "ay_mps2": "ay_mps2", "s_m": "s_m",
-    "lateral_offset_m": "d_m", "heading_error_rad": "e_yaw_rad",
+    "time_s": "time_s",
+    "ax_mps2": "ax_mps2",
+    "ay_mps2": "ay_mps2",
+    "s_m": "s_m",
+    "lateral_offset_m": "d_m",
+    "heading_error_rad": "e_yaw_rad",
 }
 _FROM_CMD = {
-    "mode": "mode", "fcw": "fcw", "ax_target_mps2": "ax_target_mps2",
-    "y_target_m": "y_target_m", "dx_m": "dx_m", "lateral_error_m": "lateral_error_m",
-    "lookahead_error_m": "lookahead_error_m", "steer_cmd_rad": "steer_cmd_rad",
-    "steer_ff_rad": "steer_ff_rad", "steer_fb_rad": "steer_fb_rad",
-    "steer_yd_rad": "steer_yd_rad", "drive_force_cmd_n": "drive_force_cmd_n",
-    "brake_force_cmd_n": "brake_force_cmd_n", "speed_target_mps": "speed_target_mps",
+    "mode": "mode",
+    "fcw": "fcw",
+    "ax_target_mps2": "ax_target_mps2",
+    "y_target_m": "y_target_m",
+    "dx_m": "dx_m",
+    "lateral_error_m": "lateral_error_m",
+    "lookahead_error_m": "lookahead_error_m",
+    "steer_cmd_rad": "steer_cmd_rad",
+    "steer_ff_rad": "steer_ff_rad",
+    "steer_fb_rad": "steer_fb_rad",
+    "steer_yd_rad": "steer_yd_rad",
+    "drive_force_cmd_n": "drive_force_cmd_n",
+    "brake_force_cmd_n": "brake_force_cmd_n",
+    "speed_target_mps": "speed_target_mps",
 }
 _FROM_PERCEPTION = {
-    "aro_range_m": "aro_range_m", "aro_range_rate_mps": "aro_range_rate_mps",
+    "aro_range_m": "aro_range_m",
+    "aro_range_rate_mps": "aro_range_rate_mps",
     "oncoming_detected": "oncoming_detected",
 }
 _SECTOR = "sector"  # the command's DMM sector letter, stored as its character code
@@ -143,13 +190,20 @@ def _column(rows: list, name: str) -> np.ndarray:
         get = attrgetter(_FROM_CMD[name])
         return np.array([_NAN if r[2] is None else get(r[2]) for r in rows], dtype=float)
     if name == _SECTOR:
-        return np.array([float(ord(r[2].sector)) if r[2] is not None and r[2].sector
-                         else _NAN for r in rows], dtype=float)
+        return np.array(
+            [float(ord(r[2].sector)) if r[2] is not None and r[2].sector else _NAN for r in rows],
+            dtype=float,
+        )
     if name == _ROAD_MU:
         return np.array([r[4] for r in rows], dtype=float)
     field = _FROM_PERCEPTION[name]
-    return np.array([_NAN if r[3] is None or getattr(r[3], field) is None
-                     else getattr(r[3], field) for r in rows], dtype=float)
+    return np.array(
+        [
+            _NAN if r[3] is None or getattr(r[3], field) is None else getattr(r[3], field)
+            for r in rows
+        ],
+        dtype=float,
+    )
 
 
 def read_timeseries(path: Path, columns: list[str] | None = None):
@@ -163,13 +217,15 @@ def read_timeseries(path: Path, columns: list[str] | None = None):
         raise InputError(f"{path}: cannot be read as a run's time series: {exc}") from exc
     numeric = [c for c in frame.columns if c != "sector"]
     if frame.empty or not all(pd.api.types.is_numeric_dtype(frame[c]) for c in numeric):
-        raise InputError(f"{path}: cannot be read as a run's time series: no rows, or a row "
-                         "cut short")
+        raise InputError(
+            f"{path}: cannot be read as a run's time series: no rows, or a row cut short"
+        )
     return frame
 
 
-def write_run(out_dir: Path, summary: dict, log: RunLog, timeseries: str = "csv",
-              traffic=None) -> None:
+def write_run(
+    out_dir: Path, summary: dict, log: RunLog, timeseries: str = "csv", traffic=None
+) -> None:
     """Write the time series (``timeseries.csv``, ``timeseries.parquet`` through pyarrow, or
     none), the traffic log (a ``TrafficLog``, if given, in the same format: ``traffic.csv``
     or ``traffic.parquet``) then ``summary.json`` (each atomically) into ``out_dir``."""

@@ -86,8 +86,9 @@ class Severity:
     delta_v_ego_mps: float
 
 
-def contact_severity(record: ContactRecord, ego_mass_kg: float,
-                     other_sumo_mass_kg: float) -> Severity:
+def contact_severity(
+    record: ContactRecord, ego_mass_kg: float, other_sumo_mass_kg: float
+) -> Severity:
     """The severity of a contact, the other's mass from SUMO (``road_user_mass_kg``)."""
     hit, ego, other = record.contact, record.ego_box, record.other_box
     overlap = face_overlap(ego, other, hit.face_a)
@@ -97,13 +98,24 @@ def contact_severity(record: ContactRecord, ego_mass_kg: float,
     else:
         direct = overlap
     mass = road_user_mass_kg(other_sumo_mass_kg, record.body.vclass)
-    return Severity(overlap, direct, impact_angle_rad(ego.yaw_rad, other.yaw_rad), mass,
-                    delta_v_mps(ego_mass_kg, mass, hit.closing_speed_mps))
+    return Severity(
+        overlap,
+        direct,
+        impact_angle_rad(ego.yaw_rad, other.yaw_rad),
+        mass,
+        delta_v_mps(ego_mass_kg, mass, hit.closing_speed_mps),
+    )
 
 
 def substep_contact(
-    x_prev, x_next, body: Body, b0: Body, length_m: float, width_m: float,
-    cg_to_front_m: float, substeps: int,
+    x_prev,
+    x_next,
+    body: Body,
+    b0: Body,
+    length_m: float,
+    width_m: float,
+    cg_to_front_m: float,
+    substeps: int,
 ) -> tuple[Contact, OrientedBox, OrientedBox] | None:
     """First contact at any plant sub-step between the ego (plant states ``x_prev`` and
     ``x_next``, its box ``length_m`` x ``width_m`` with the CG ``cg_to_front_m`` behind the

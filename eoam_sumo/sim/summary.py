@@ -27,13 +27,15 @@ class RunSummary:
     impact_speed_mps: float = _doc("relative speed of the box centres at the first contact")
     contact_kind: str = _doc("none, head_on, oblique, rear_end or side")
     contact_time_s: float | None = _doc("SUMO time of the first contact (empty: none)")
-    contact_x_m: float | None = _doc("where the first contact was: the centroid of the boxes'"
-                                     " overlap, network x (empty: none)")
+    contact_x_m: float | None = _doc(
+        "where the first contact was: the centroid of the boxes' overlap, network x (empty: none)"
+    )
     contact_y_m: float | None = _doc("and its network y (empty: none)")
     collision_with_id: str | None = _doc("SUMO id of the road user hit")
     collision_with_class: str | None = _doc("its SUMO vClass (pedestrian for a person)")
     contact_overlap: float | None = _doc(
-        "share of the ego's face hit that the other covers (front/rear: of its width)")
+        "share of the ego's face hit that the other covers (front/rear: of its width)"
+    )
     impact_angle_rad: float | None = _doc("angle between the headings: 0 same way, pi head-on")
     delta_v_ego_mps: float | None = _doc("the ego's change of velocity (plastic impact)")
     collision_with_mass_kg: float | None = _doc("mass of the road user hit, as used")
@@ -58,15 +60,19 @@ class RunSummary:
     radar_model: str = _doc("the radar model: ideal or automotive")
     seed: int = _doc("the seed of every random model of the run")
     min_gap_aro_m: float | None = _doc(
-        "smallest box-to-box gap to the in-lane obstacle within 20 m (empty: never that close)")
+        "smallest box-to-box gap to the in-lane obstacle within 20 m (empty: never that close)"
+    )
     min_gap_oncoming_m: float | None = _doc(
-        "smallest box gap to an opposite-direction road user in reach (empty: none)")
+        "smallest box gap to an opposite-direction road user in reach (empty: none)"
+    )
     min_ttc_oncoming_s: float | None = _doc(
-        "smallest time to collision with one (empty: never on a collision course)")
+        "smallest time to collision with one (empty: never on a collision course)"
+    )
     time_in_opposite_lane_s: float = _doc("time with the ego's centre left of its lane")
     near_miss: bool = _doc("no contact, but within 0.5 m of a road user or TTC below 1.5 s")
     passed_obstacle: bool | None = _doc(
-        "a lane change ended ahead of the obstacle it avoided (empty: no lane change)")
+        "a lane change ended ahead of the obstacle it avoided (empty: no lane change)"
+    )
     end_cause: str = _doc("contact, settled, road_end or time_limit")
     max_abs_lat_accel_mps2: float = _doc("largest |lateral acceleration| of the ego")
     max_lateral_offset_m: float = _doc("largest |lateral offset| from the original lane centre")
@@ -78,7 +84,8 @@ class RunSummary:
     ego_initial_speed_mps: float = _doc("ego speed at its departure")
     lane_width_m: float = _doc("width of the ego's start lane (the lane change's height)")
     oncoming_traffic: bool = _doc(
-        "a road user within 250 m moved against the ego's lane direction (traffic.csv role)")
+        "a road user within 250 m moved against the ego's lane direction (traffic.csv role)"
+    )
     net_file: str = _doc("the scenario's network file (for eoam-sumo animate)")
     radar_range_m: float = _doc("the radar's range")
     radar_fov_deg: float = _doc("the radar's full horizontal field of view")
@@ -88,7 +95,8 @@ class RunSummary:
     # mypy takes the _doc(...) calls above for defaults, and then this field() without one
     # for an error; neither has a default at run time
     sumo_overrides: dict = field(  # type: ignore[misc]
-        metadata={"doc": "SUMO options the run set over the sumocfg, option -> value"})
+        metadata={"doc": "SUMO options the run set over the sumocfg, option -> value"}
+    )
 
     def as_dict(self) -> dict:
         """The summary as summary.json writes it (lists for tuples)."""
@@ -115,7 +123,8 @@ def _is_number(tp) -> bool:
 
 #: Fields that are numbers (or empty).
 NUMERIC_FIELDS: tuple[str, ...] = tuple(
-    name for name, tp in typing.get_type_hints(RunSummary).items() if _is_number(tp))
+    name for name, tp in typing.get_type_hints(RunSummary).items() if _is_number(tp)
+)
 
 
 def rounded(value: float, digits: int = 6) -> float:

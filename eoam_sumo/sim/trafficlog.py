@@ -43,15 +43,32 @@ from eoam_sumo.sim.roadframe import RoadFrame
 
 TRAFFIC_FILE = "traffic.csv"
 #: traffic.csv columns, SI units in the names.
-TRAFFIC_COLUMNS = ("time_s", "id", "vclass", "role", "x_m", "y_m", "heading_rad", "speed_mps",
-                   "length_m", "width_m")
+TRAFFIC_COLUMNS = (
+    "time_s",
+    "id",
+    "vclass",
+    "role",
+    "x_m",
+    "y_m",
+    "heading_rad",
+    "speed_mps",
+    "length_m",
+    "width_m",
+)
 ROLES = ("ego", "aro", "oncoming", "parked", "other")
 #: Road users whose centre is within this distance of the ego's centre of gravity are logged:
 #: twice the view of ``eoam-sumo animate`` and beyond any radar range used here, so a car
 #: closing at 60 m/s is in the log 4 s before it reaches the ego [m].
 TRAFFIC_RADIUS_M = 250.0
-_DECIMALS = {"time_s": 6, "x_m": 4, "y_m": 4, "heading_rad": 6, "speed_mps": 4,
-             "length_m": 4, "width_m": 4}
+_DECIMALS = {
+    "time_s": 6,
+    "x_m": 4,
+    "y_m": 4,
+    "heading_rad": 6,
+    "speed_mps": 4,
+    "length_m": 4,
+    "width_m": 4,
+}
 
 
 class TrafficLog(StepObserver):
@@ -61,9 +78,17 @@ class TrafficLog(StepObserver):
     ``cg_to_centre_m`` is the distance from its centre of gravity forward to the box's centre;
     ``centreline`` and ``lane_width_m`` give the ego's original lane for the roles."""
 
-    def __init__(self, ego_id: str, ego_vclass: str, ego_length_m: float, ego_width_m: float,
-                 cg_to_centre_m: float, centreline: Iterable[Sequence[float]],
-                 lane_width_m: float, radius_m: float = TRAFFIC_RADIUS_M):
+    def __init__(
+        self,
+        ego_id: str,
+        ego_vclass: str,
+        ego_length_m: float,
+        ego_width_m: float,
+        cg_to_centre_m: float,
+        centreline: Iterable[Sequence[float]],
+        lane_width_m: float,
+        radius_m: float = TRAFFIC_RADIUS_M,
+    ):
         if not (math.isfinite(radius_m) and radius_m > 0.0):
             raise ValueError(f"radius_m={radius_m!r} must be a finite number > 0")
         if not lane_width_m > 0.0:
@@ -111,8 +136,7 @@ class TrafficLog(StepObserver):
         rows: dict[str, list] = {}
         for _ti, ex, ey, _yaw, _vx, bodies in self._steps:
             for b in bodies:
-                if ((b.x_m - ex) * (b.x_m - ex) + (b.y_m - ey) * (b.y_m - ey) <= r2
-                        and not b.parked):
+                if (b.x_m - ex) * (b.x_m - ex) + (b.y_m - ey) * (b.y_m - ey) <= r2 and not b.parked:
                     rows.setdefault(b.vid, []).append(b)
         if not rows:
             return False
@@ -140,25 +164,70 @@ class TrafficLog(StepObserver):
         length, width = self._ego_size
         rows = []
         for i, (ti, ex, ey, yaw, vx, bodies) in enumerate(self._steps):
-            rows.append((ti, i, self.ego_id, self.ego_vclass, ex + to_centre * math.cos(yaw),
-                         ey + to_centre * math.sin(yaw), math.remainder(yaw, math.tau), vx,
-                         length, width, False))
-            rows += [(ti, i, b.vid, b.vclass, b.x_m, b.y_m, b.yaw_rad, b.speed_mps, b.length_m,
-                      b.width_m, b.parked) for b in bodies
-                     if (b.x_m - ex) * (b.x_m - ex) + (b.y_m - ey) * (b.y_m - ey) <= r2]
+            rows.append(
+                (
+                    ti,
+                    i,
+                    self.ego_id,
+                    self.ego_vclass,
+                    ex + to_centre * math.cos(yaw),
+                    ey + to_centre * math.sin(yaw),
+                    math.remainder(yaw, math.tau),
+                    vx,
+                    length,
+                    width,
+                    False,
+                )
+            )
+            rows += [
+                (
+                    ti,
+                    i,
+                    b.vid,
+                    b.vclass,
+                    b.x_m,
+                    b.y_m,
+                    b.yaw_rad,
+                    b.speed_mps,
+                    b.length_m,
+                    b.width_m,
+                    b.parked,
+                )
+                for b in bodies
+                if (b.x_m - ex) * (b.x_m - ex) + (b.y_m - ey) * (b.y_m - ey) <= r2
+            ]
         rows_t = list(zip(*rows)) if rows else [()] * 11
         t, step_of, ids, vclasses, *nums, parked = rows_t
         num = np.array(nums, dtype=float).reshape(6, -1).T  # x, y, heading, speed, L, W
         ego_rows = np.flatnonzero(np.diff(np.asarray(step_of, dtype=np.int64), prepend=-1))
-        roles = self._roles(list(ids), num, np.array(parked, dtype=bool), ego_rows,
-                            np.asarray(step_of, dtype=np.int64))
-        return {"time_s": np.array(t, dtype=float), "id": list(ids),
-                "vclass": list(vclasses), "role": roles,
-                "x_m": num[:, 0], "y_m": num[:, 1], "heading_rad": num[:, 2],
-                "speed_mps": num[:, 3], "length_m": num[:, 4], "width_m": num[:, 5]}
+        roles = self._roles(
+            list(ids),
+            num,
+            np.array(parked, dtype=bool),
+            ego_rows,
+            np.asarray(step_of, dtype=np.int64),
+        )
+        return {
+            "time_s": np.array(t, dtype=float),
+            "id": list(ids),
+            "vclass": list(vclasses),
+            "role": roles,
+            "x_m": num[:, 0],
+            "y_m": num[:, 1],
+            "heading_rad": num[:, 2],
+            "speed_mps": num[:, 3],
+            "length_m": num[:, 4],
+            "width_m": num[:, 5],
+        }
 
-    def _roles(self, ids: list, num: np.ndarray, parked: np.ndarray, ego_rows: np.ndarray,
-               step_of: np.ndarray) -> list[str]:
+    def _roles(
+        self,
+        ids: list,
+        num: np.ndarray,
+        parked: np.ndarray,
+        ego_rows: np.ndarray,
+        step_of: np.ndarray,
+    ) -> list[str]:
         """Role of every row (module doc): the ego's station at each step first, then each
         road user's rows in time order, so the road frame's walk moves a little at a time."""
         roles = ["other"] * len(ids)
@@ -200,8 +269,14 @@ class TrafficLog(StepObserver):
 
         path = Path(path)
         cols = self.columns()
-        table = pa.table({name: np.round(cols[name], _DECIMALS[name]) + 0.0
-                          if name in _DECIMALS else cols[name] for name in TRAFFIC_COLUMNS})
+        table = pa.table(
+            {
+                name: np.round(cols[name], _DECIMALS[name]) + 0.0
+                if name in _DECIMALS
+                else cols[name]
+                for name in TRAFFIC_COLUMNS
+            }
+        )
         sink = pa.BufferOutputStream()
         if path.suffix == ".parquet":
             pa_parquet.write_table(table, sink, compression="zstd")
@@ -223,14 +298,15 @@ def read_traffic(path: Path):
     from eoam_sumo.errors import InputError
 
     try:
-        frame = pd.read_csv(path, dtype={"id": str, "vclass": str, "role": str,
-                                         **dict.fromkeys(_DECIMALS, float)},
-                            keep_default_na=False, na_values={c: ["", "nan"] for c in
-                                                              _DECIMALS})
+        frame = pd.read_csv(
+            path,
+            dtype={"id": str, "vclass": str, "role": str, **dict.fromkeys(_DECIMALS, float)},
+            keep_default_na=False,
+            na_values={c: ["", "nan"] for c in _DECIMALS},
+        )
     except (OSError, ValueError, pd.errors.EmptyDataError, pd.errors.ParserError) as exc:
         raise InputError(f"{path}: cannot be read as a run's traffic log: {exc}") from exc
     missing = [c for c in TRAFFIC_COLUMNS if c not in frame.columns]
     if missing:
-        raise InputError(f"{path}: cannot be read as a run's traffic log: no column "
-                         f"{missing[0]}")
+        raise InputError(f"{path}: cannot be read as a run's traffic log: no column {missing[0]}")
     return frame

@@ -42,6 +42,7 @@ class EndedRun(RunView, Protocol):
     def min_gap_aro_m(self) -> float: ...
     @property
     def belief(self) -> FrictionBelief: ...
+
     # the co-simulation's parts: settings, parameters, session, road, controller, observers
     settings: Any
     params: Any
@@ -102,8 +103,9 @@ def summarise(sim: EndedRun, loop_wall_s: float) -> RunSummary:
     record = sim.first_contact
     severity = None
     if record is not None:
-        severity = contact_severity(record, sim.params.mass_kg,
-                                    sim.session.mass_kg(record.body.vid))
+        severity = contact_severity(
+            record, sim.params.mass_kg, sim.session.mass_kg(record.body.vid)
+        )
     passed = passed_obstacle(sim, sim.avoided.vid)
     outcome = classify_outcome(
         modes_visited=sim.ctrl.modes_visited,
@@ -185,6 +187,8 @@ def _trigger(log: RunLog, belief: FrictionBelief) -> dict:
     k = int(acting[0])
     t = float(log.column("time_s")[k])
     rng = float(log.column("aro_range_m")[k])
-    return {"trigger_time_s": round(t, 6),
-            "trigger_range_m": round(rng, 6) if math.isfinite(rng) else None,
-            "mu_believed_at_trigger": belief.at(t)}
+    return {
+        "trigger_time_s": round(t, 6),
+        "trigger_range_m": round(rng, 6) if math.isfinite(rng) else None,
+        "mu_believed_at_trigger": belief.at(t),
+    }

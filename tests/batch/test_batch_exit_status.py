@@ -26,12 +26,13 @@ pytestmark = pytest.mark.sumo
         ("[5000]", EXIT_CASES_FAILED, 1),  # every case failed
     ],
 )
-def test_exit_status_counts_failed_cases(capsys, tmp_path, monkeypatch, oncoming, status,
-                                         failed):
+def test_exit_status_counts_failed_cases(capsys, tmp_path, monkeypatch, oncoming, status, failed):
     monkeypatch.delenv("EOAM_TABLES_DIR", raising=False)  # the repository's tables
-    matrix = write_matrix(tmp_path / "m.toml",
-                          f"ego_speed_kmh = [90]\nmu = [1.0]\noncoming_start_m = {oncoming}\n",
-                          scenario="max_time_s = 5.0\n")
+    matrix = write_matrix(
+        tmp_path / "m.toml",
+        f"ego_speed_kmh = [90]\nmu = [1.0]\noncoming_start_m = {oncoming}\n",
+        scenario="max_time_s = 5.0\n",
+    )
     out = tmp_path / "out"
     got = main(["batch", str(matrix), "--out", str(out), "--no-progress"])
     captured = capsys.readouterr()
@@ -51,8 +52,10 @@ def test_exit_status_counts_failed_cases(capsys, tmp_path, monkeypatch, oncoming
         bad = results[results["status"] == "failed"]
         assert bad["error"].str.contains("oncoming_start_m=5000").all()
         lines = captured.err.splitlines()
-        assert lines[-1] == (f"eoam-sumo: {failed} of {cases} cases failed; their errors are in "
-                             f"the 'error' column of {out / RESULTS_FILE}")
+        assert lines[-1] == (
+            f"eoam-sumo: {failed} of {cases} cases failed; their errors are in "
+            f"the 'error' column of {out / RESULTS_FILE}"
+        )
         assert f"failed: {bad['case_id'].iloc[0]}: InputError" in captured.err
     else:
         assert captured.err == ""

@@ -56,8 +56,13 @@ def test_every_task_once_in_long_lived_workers():
 
 def test_crash_exception_and_stdout_noise_cost_only_their_task():
     tasks = [
-        ("a", ("ok", 1)), ("segv", ("segfault", 0)), ("b", ("ok", 2)), ("exit", ("exit", 0)),
-        ("raise", ("raise", 7)), ("noise", ("print", 3)), ("c", ("ok", 4)),
+        ("a", ("ok", 1)),
+        ("segv", ("segfault", 0)),
+        ("b", ("ok", 2)),
+        ("exit", ("exit", 0)),
+        ("raise", ("raise", 7)),
+        ("noise", ("print", 3)),
+        ("c", ("ok", 4)),
     ]
     results = _by_key(run_local(misbehave, tasks, jobs=1, timeout_s=120))
     assert set(results) == {k for k, _ in tasks}

@@ -48,8 +48,12 @@ def corrupt_one(task):
 
 
 def _write_matrix(folder: Path) -> Path:
-    return write_matrix(folder / "small.toml", "ego_speed_kmh = [120, 90]\nmu = [1.0, 0.3]\n",
-                        scenario="max_time_s = 25.0\n", paper_table=True)
+    return write_matrix(
+        folder / "small.toml",
+        "ego_speed_kmh = [120, 90]\nmu = [1.0, 0.3]\n",
+        scenario="max_time_s = 25.0\n",
+        paper_table=True,
+    )
 
 
 def _stable(results_csv: Path) -> pd.DataFrame:
@@ -61,8 +65,9 @@ def _stable(results_csv: Path) -> pd.DataFrame:
 def reference(tmp_path_factory):
     """The matrix run once with one job: (matrix path, batch folder, results frame)."""
     root = tmp_path_factory.mktemp("reference")
-    tables = build_tables(root / "tables", speeds_kmh=[80, 100, 130], mus=[0.3, 1.0],
-                          progress=False)
+    tables = build_tables(
+        root / "tables", speeds_kmh=[80, 100, 130], mus=[0.3, 1.0], progress=False
+    )
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("EOAM_TABLES_DIR", str(tables))
         matrix = _write_matrix(root)
@@ -115,10 +120,21 @@ def _rows(results_csv: Path) -> int:
 def test_killed_batch_resumes_to_the_same_results(reference, tmp_path, how):
     matrix, out, _ = reference
     batch = tmp_path / "batch"
-    cmd = [sys.executable, "-m", "eoam_sumo", "batch", str(matrix), "--out", str(batch),
-           "--jobs", "1", "--no-progress"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                            start_new_session=True)
+    cmd = [
+        sys.executable,
+        "-m",
+        "eoam_sumo",
+        "batch",
+        str(matrix),
+        "--out",
+        str(batch),
+        "--jobs",
+        "1",
+        "--no-progress",
+    ]
+    proc = subprocess.Popen(
+        cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True
+    )
     started = time.monotonic()
     while _rows(batch / "results.csv") < 1 and proc.poll() is None:
         assert time.monotonic() - started < POLL_LIMIT_S, "no row was ever written"
@@ -152,12 +168,19 @@ def test_plots_of_a_run_folder_and_a_batch_folder(reference, tmp_path):
     _, out, results = reference
     case_dir = out / results["case_dir"].iloc[0]
     run_pngs = plot_folder(case_dir, tmp_path / "run")
-    assert sorted(p.name for p in run_pngs) == ["dynamics.png", "gg.png", "phase_trace.png",
-                                                "steering.png"]
+    assert sorted(p.name for p in run_pngs) == [
+        "dynamics.png",
+        "gg.png",
+        "phase_trace.png",
+        "steering.png",
+    ]
     batch_pngs = plot_folder(out, tmp_path / "batch")
-    assert sorted(p.name for p in batch_pngs) == ["lateral_offsets_120kmh.png",
-                                                  "lateral_offsets_90kmh.png", "margins.png",
-                                                  "table2.png"]
+    assert sorted(p.name for p in batch_pngs) == [
+        "lateral_offsets_120kmh.png",
+        "lateral_offsets_90kmh.png",
+        "margins.png",
+        "table2.png",
+    ]
     tables_pngs = plot_folder(out.parent / "tables", tmp_path / "tables")
     assert tables_pngs
     for png in run_pngs + batch_pngs + tables_pngs:

@@ -21,10 +21,16 @@ FLIP = {"green": "orange", "yellow": "red", "orange": "green", "red": "yellow"}
 def _summary(case, colour):
     hit = colour != "green"
     return {
-        "outcome": colour, "collision_with": "oncoming" if hit else "none",
-        "impact_speed_mps": 12.5 if hit else 0.0, "contact_kind": "side" if hit else "none",
-        "reason": f"why {case.case_id}, with a comma", "modes_visited": [0, 1, 2, 5],
-        "fcw_raised": True, "mu": case.mu, "sim_time_s": 10.0, "wall_time_s": 0.5,
+        "outcome": colour,
+        "collision_with": "oncoming" if hit else "none",
+        "impact_speed_mps": 12.5 if hit else 0.0,
+        "contact_kind": "side" if hit else "none",
+        "reason": f"why {case.case_id}, with a comma",
+        "modes_visited": [0, 1, 2, 5],
+        "fcw_raised": True,
+        "mu": case.mu,
+        "sim_time_s": 10.0,
+        "wall_time_s": 0.5,
         "realtime_factor": 20.0,
     }
 
@@ -58,8 +64,9 @@ def test_table2_counts_agreement_and_links_each_difference(tmp_path):
     md = table2_markdown(outcome_grid(results))
     assert "**59/64 cells agree.**" in md
     # the paper's layout: 16 rows (traffic x speed), friction columns 1.0 .. 0.1
-    table = [ln for ln in md.split("## Margins")[0].splitlines()
-             if ln.startswith("| ") and "km/h" in ln]
+    table = [
+        ln for ln in md.split("## Margins")[0].splitlines() if ln.startswith("| ") and "km/h" in ln
+    ]
     assert len(table) == 16
     assert "| 1.0 surface mu | 0.7 surface mu | 0.3 surface mu | 0.1 surface mu |" in md
     assert table[0].startswith("| No oncoming | 165 km/h |")
@@ -94,12 +101,14 @@ def test_own_sweep_gets_a_plain_pivot(tmp_path):
     matrix_path = tmp_path / "own.toml"
     matrix_path.write_text(
         f'[scenario]\nsumocfg = "{cfg}"\n[sweep]\nego_speed_kmh = [100, 70]\n'
-        'mu = [0.9, 0.5, 0.2]\noncoming_start_m = [250]\naro_decel_mps2 = [6.0, 9.0]\n')
+        "mu = [0.9, 0.5, 0.2]\noncoming_start_m = [250]\naro_decel_mps2 = [6.0, 9.0]\n"
+    )
     _, results = _results(tmp_path, matrix_path, differ=(1,))
     md = table2_markdown(outcome_grid(results))
     assert "agree" not in md and " / " not in md
-    table = [ln for ln in md.split("## Margins")[0].splitlines()
-             if ln.startswith("| ") and "km/h" in ln]
+    table = [
+        ln for ln in md.split("## Margins")[0].splitlines() if ln.startswith("| ") and "km/h" in ln
+    ]
     # the varying ARO deceleration is part of the row label: 2 speeds x 2 decelerations
     assert len(table) == 4 and "100 km/h, ARO decel 6 m/s²" in table[0]
     assert "| 0.9 surface mu | 0.5 surface mu | 0.2 surface mu |" in md
@@ -108,8 +117,7 @@ def test_own_sweep_gets_a_plain_pivot(tmp_path):
 
 
 def test_write_report_writes_markdown_and_a_png(tmp_path):
-    _, results = _results(tmp_path, REPO / "scenarios" / "table2.toml", differ=(5,),
-                          failed=(6,))
+    _, results = _results(tmp_path, REPO / "scenarios" / "table2.toml", differ=(5,), failed=(6,))
     md, png, margins = write_report(tmp_path, results)
     head, _, rest = table2_markdown(outcome_grid(results)).partition("\n\n")
     text = md.read_text(encoding="utf-8")  # the grid, with the policy's line below the title

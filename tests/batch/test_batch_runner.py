@@ -23,19 +23,28 @@ def _fake_summary(case) -> dict:
     """A deterministic summary from the case's parameters."""
     colour = "green" if case.mu >= 0.5 else "yellow"
     return {
-        "outcome": colour, "collision_with": "none" if colour == "green" else "aro",
+        "outcome": colour,
+        "collision_with": "none" if colour == "green" else "aro",
         "impact_speed_mps": 0.0 if colour == "green" else round(case.ego_speed_kmh / 10, 3),
-        "contact_kind": "none", "reason": f"fake run, mu {case.mu}", "modes_visited": [0, 1],
-        "fcw_raised": True, "mu": case.mu, "min_gap_aro_m": None, "sim_time_s": 12.0,
-        "wall_time_s": time.perf_counter() % 1.0, "realtime_factor": 1.0 + time.time() % 1.0,
+        "contact_kind": "none",
+        "reason": f"fake run, mu {case.mu}",
+        "modes_visited": [0, 1],
+        "fcw_raised": True,
+        "mu": case.mu,
+        "min_gap_aro_m": None,
+        "sim_time_s": 12.0,
+        "wall_time_s": time.perf_counter() % 1.0,
+        "realtime_factor": 1.0 + time.time() % 1.0,
     }
 
 
 def fake_case(task):
     """Writes its files like the real case function (direct or returned) and counts calls."""
     summary = _fake_summary(task.case)
-    files = {"summary.json": json.dumps(summary).encode(),
-             "timeseries.csv": b"time_s,lateral_offset_m,mode\n0.0,0.0,0\n"}
+    files = {
+        "summary.json": json.dumps(summary).encode(),
+        "timeseries.csv": b"time_s,lateral_offset_m,mode\n0.0,0.0,0\n",
+    }
     if task.case_dir is None:
         return {"summary": summary, "files": files}
     task.case_dir.mkdir(parents=True, exist_ok=True)
@@ -67,8 +76,11 @@ def raise_one(task):
 
 @pytest.fixture
 def matrix(tmp_path):
-    return write_matrix(tmp_path / "m.toml", "ego_speed_kmh = [120, 90]\nmu = [1.0, 0.3]\n"
-                        'oncoming_start_m = ["none", 400]\n', paper_table=True)
+    return write_matrix(
+        tmp_path / "m.toml",
+        'ego_speed_kmh = [120, 90]\nmu = [1.0, 0.3]\noncoming_start_m = ["none", 400]\n',
+        paper_table=True,
+    )
 
 
 def _stable(path: Path) -> pd.DataFrame:
@@ -80,9 +92,15 @@ def test_rows_in_matrix_order_whatever_the_jobs(tmp_path, matrix):
     one = run_batch(matrix, tmp_path / "j1", jobs=1, progress=False, case_func=fake_case)
     run_batch(matrix, tmp_path / "j2", jobs=2, progress=False, case_func=fake_case)
     assert list(one["case_id"]) == [
-        "onc-none_v120_mu1.0", "onc-none_v120_mu0.3", "onc-none_v90_mu1.0",
-        "onc-none_v90_mu0.3", "onc-400_v120_mu1.0", "onc-400_v120_mu0.3",
-        "onc-400_v90_mu1.0", "onc-400_v90_mu0.3"]
+        "onc-none_v120_mu1.0",
+        "onc-none_v120_mu0.3",
+        "onc-none_v90_mu1.0",
+        "onc-none_v90_mu0.3",
+        "onc-400_v120_mu1.0",
+        "onc-400_v120_mu0.3",
+        "onc-400_v90_mu1.0",
+        "onc-400_v90_mu0.3",
+    ]
     a, b = _stable(tmp_path / "j1" / "results.csv"), _stable(tmp_path / "j2" / "results.csv")
     pd.testing.assert_frame_equal(a, b)
     assert tuple(pd.read_csv(tmp_path / "j1" / "results.csv").columns) == COLUMNS
@@ -90,8 +108,16 @@ def test_rows_in_matrix_order_whatever_the_jobs(tmp_path, matrix):
     assert (row["oncoming_start_m"], row["modes_visited"], row["status"]) == ("400.0", "0-1", "ok")
     assert a.iloc[0]["oncoming_start_m"] == ""  # no oncoming car: empty
     # the paper's colours from the matrix's [paper] table
-    assert list(a["paper_outcome"]) == ["green", "green", "green", "green",
-                                        "green", "orange", "orange", "yellow"]
+    assert list(a["paper_outcome"]) == [
+        "green",
+        "green",
+        "green",
+        "green",
+        "green",
+        "orange",
+        "orange",
+        "yellow",
+    ]
     assert (tmp_path / "j2" / "cases" / "onc-400_v90_mu0.3" / "summary.json").is_file()
     assert (tmp_path / "j2" / "table2.md").is_file() and (tmp_path / "j2" / "table2.png").is_file()
 
@@ -112,11 +138,13 @@ def test_crash_and_exception_are_failed_rows_and_the_rest_complete(tmp_path, mat
 
 
 def test_a_case_past_its_timeout_is_killed_and_recorded(tmp_path, matrix):
-    res = run_batch(matrix, tmp_path / "t", jobs=2, timeout_s=10.0, progress=False,
-                    case_func=hang_one)
+    res = run_batch(
+        matrix, tmp_path / "t", jobs=2, timeout_s=10.0, progress=False, case_func=hang_one
+    )
     failed = res[res["status"] == "failed"].set_index("case_id")["error"]
-    assert dict(failed) == dict.fromkeys(("onc-none_v120_mu1.0", "onc-400_v120_mu1.0"),
-                                         "timed out after 10 s (worker killed)")
+    assert dict(failed) == dict.fromkeys(
+        ("onc-none_v120_mu1.0", "onc-400_v120_mu1.0"), "timed out after 10 s (worker killed)"
+    )
     assert (res["status"] == "ok").sum() == 6
 
 
@@ -130,11 +158,13 @@ def test_resume_reruns_only_failed_and_missing_cases(tmp_path, matrix):
     kept = [rows[5], rows[0], rows[3], rows[2], rows[1][: len(rows[1]) // 2]]
     (out / "results.csv").write_text(header + "".join(kept))
     res = run_batch(matrix, out, jobs=2, resume=True, progress=False, case_func=fake_case)
-    pd.testing.assert_frame_equal(_stable(out / "results.csv"),
-                                  _stable(tmp_path / "ref" / "results.csv"))
+    pd.testing.assert_frame_equal(
+        _stable(out / "results.csv"), _stable(tmp_path / "ref" / "results.csv")
+    )
     assert (res["status"] == "ok").all()
-    calls = {cid: (out / "cases" / cid / "calls.txt").read_text().count("call")
-             for cid in ref["case_id"]}
+    calls = {
+        cid: (out / "cases" / cid / "calls.txt").read_text().count("call") for cid in ref["case_id"]
+    }
     # rows 0, 2, 5 were kept: one call. Rows 1 (cut short), 4, 6 (missing) ran again: two.
     # Rows 3 and 7 had crashed before counting their first call: one, from the resume.
     ids = list(ref["case_id"])
@@ -143,8 +173,9 @@ def test_resume_reruns_only_failed_and_missing_cases(tmp_path, matrix):
 
 def test_dask_local_cluster_gives_the_same_results(tmp_path, matrix):
     run_batch(matrix, tmp_path / "j1", jobs=1, progress=False, case_func=fake_case)
-    run_batch(matrix, tmp_path / "dask", jobs=2, scheduler="local", progress=False,
-              case_func=crash_one)
+    run_batch(
+        matrix, tmp_path / "dask", jobs=2, scheduler="local", progress=False, case_func=crash_one
+    )
     a = _stable(tmp_path / "j1" / "results.csv")
     b = _stable(tmp_path / "dask" / "results.csv")
     crashed = b["status"] == "failed"
@@ -155,10 +186,14 @@ def test_dask_local_cluster_gives_the_same_results(tmp_path, matrix):
     assert json.loads((case_dir / "summary.json").read_text())["outcome"] == "green"
 
 
-@pytest.mark.parametrize("kwargs, message", [
-    ({"jobs": 0}, "--jobs"), ({"timeout_s": 0.0}, "--timeout-s"),
-    ({"scheduler": "tcp://127.0.0.1:9"}, "cannot connect to the Dask scheduler"),
-])
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"jobs": 0}, "--jobs"),
+        ({"timeout_s": 0.0}, "--timeout-s"),
+        ({"scheduler": "tcp://127.0.0.1:9"}, "cannot connect to the Dask scheduler"),
+    ],
+)
 def test_bad_settings_are_input_errors(tmp_path, matrix, kwargs, message, monkeypatch):
     monkeypatch.setattr(runner, "DASK_CONNECT_TIMEOUT_S", 1.0)
     with pytest.raises(InputError, match=message):
@@ -173,11 +208,13 @@ def test_resume_reruns_cases_whose_scenario_settings_changed(tmp_path, matrix, c
     changed = tmp_path / "changed.toml"
     changed.write_text(matrix.read_text().replace("[sweep]\n", change + "[sweep]\n", 1))
     run_batch(changed, out, jobs=1, resume=True, progress=False, case_func=fake_case)
-    calls = [len((p / "calls.txt").read_text().splitlines())
-             for p in sorted((out / "cases").iterdir())]
+    calls = [
+        len((p / "calls.txt").read_text().splitlines()) for p in sorted((out / "cases").iterdir())
+    ]
     assert calls == [2] * 8  # every case ran again
     key, value = change.strip().split(" = ")
     assert set(pd.read_csv(out / "results.csv")[key]) == {float(value)}
     run_batch(changed, out, jobs=1, resume=True, progress=False, case_func=fake_case)
-    assert [len((p / "calls.txt").read_text().splitlines())
-            for p in sorted((out / "cases").iterdir())] == [2] * 8  # now all kept
+    assert [
+        len((p / "calls.txt").read_text().splitlines()) for p in sorted((out / "cases").iterdir())
+    ] == [2] * 8  # now all kept

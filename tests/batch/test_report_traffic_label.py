@@ -13,10 +13,20 @@ def _results(oncoming_start_m: list, oncoming_traffic: list) -> pd.DataFrame:
     rows = []
     for k, (start, seen) in enumerate(zip(oncoming_start_m, oncoming_traffic)):
         row = dict.fromkeys(COLUMNS)
-        row.update(case_id=f"c{k}", ego_speed_kmh=90.0 + 30.0 * (k % 2), mu=1.0,
-                   oncoming_start_m=start, status="ok", outcome="green", paper_outcome="",
-                   case_dir=f"cases/c{k}", reason="r", modes_visited="[0]",
-                   collision_with="none", oncoming_traffic=str(seen))
+        row.update(
+            case_id=f"c{k}",
+            ego_speed_kmh=90.0 + 30.0 * (k % 2),
+            mu=1.0,
+            oncoming_start_m=start,
+            status="ok",
+            outcome="green",
+            paper_outcome="",
+            case_dir=f"cases/c{k}",
+            reason="r",
+            modes_visited="[0]",
+            collision_with="none",
+            oncoming_traffic=str(seen),
+        )
         rows.append(row)
     return pd.DataFrame(rows, columns=list(COLUMNS))
 
@@ -30,8 +40,11 @@ def test_labels():
 def test_a_row_whose_runs_met_oncoming_traffic_is_named_so():
     grid = outcome_grid(_results([None, None, 400.0, 400.0], [False, True, True, True]))
     assert [traffic for traffic, _ in grid.rows] == [
-        "Scenario's oncoming traffic", "Scenario's oncoming traffic", "Oncoming, 400 m",
-        "Oncoming, 400 m"]
+        "Scenario's oncoming traffic",
+        "Scenario's oncoming traffic",
+        "Oncoming, 400 m",
+        "Oncoming, 400 m",
+    ]
 
 
 def test_a_row_without_any_stays_no_oncoming():

@@ -18,7 +18,7 @@ pytestmark = pytest.mark.sumo
 REPO = Path(__file__).resolve().parents[2]
 MATRIX = f"""
 [scenario]
-sumocfg = "{REPO / 'scenarios' / 'baseline.sumocfg'}"
+sumocfg = "{REPO / "scenarios" / "baseline.sumocfg"}"
 max_time_s = 20.0
 radar_model = "automotive"
 
@@ -38,8 +38,9 @@ def _run(tmp_path: Path, name: str, timeseries: str, scheduler: str | None = Non
     matrix = tmp_path / "sampled.toml"
     matrix.write_text(MATRIX)
     out = tmp_path / name
-    results = run_batch(matrix, out, jobs=2, progress=False, timeseries=timeseries,
-                        scheduler=scheduler)
+    results = run_batch(
+        matrix, out, jobs=2, progress=False, timeseries=timeseries, scheduler=scheduler
+    )
     return results, out
 
 
@@ -53,8 +54,12 @@ def test_sampled_matrix_is_reproducible_and_its_probabilities_are_consistent(tmp
     assert first["oncoming_start_m"].between(250, 450).all()
     assert set(first["mu_belief"]) <= {"known", "1.0"}
     assert first["seed"].nunique() == 6 and (first["radar_model"] == "automotive").all()
-    a, b = (pd.read_csv(out / "results.csv", dtype=str, keep_default_na=False)
-            .drop(columns=list(TIMING_COLUMNS)) for out in (out1, out2))
+    a, b = (
+        pd.read_csv(out / "results.csv", dtype=str, keep_default_na=False).drop(
+            columns=list(TIMING_COLUMNS)
+        )
+        for out in (out1, out2)
+    )
     pd.testing.assert_frame_equal(a, b)
     # --timeseries none: summaries only
     for case_dir in first["case_dir"]:
@@ -79,8 +84,9 @@ def test_sampled_matrix_is_reproducible_and_its_probabilities_are_consistent(tmp
 def test_parquet_time_series_equal_the_csv_ones(tmp_path):
     pytest.importorskip("pyarrow")
     matrix = tmp_path / "one.toml"
-    matrix.write_text(MATRIX.replace("draws = 3", "draws = 1").replace("mu = [0.7, 0.3]",
-                                                                         "mu = [0.3]"))
+    matrix.write_text(
+        MATRIX.replace("draws = 3", "draws = 1").replace("mu = [0.7, 0.3]", "mu = [0.3]")
+    )
     csv_out, pq_out = tmp_path / "csv", tmp_path / "pq"
     run_batch(matrix, csv_out, progress=False, timeseries="csv")
     results = run_batch(matrix, pq_out, progress=False, timeseries="parquet")
@@ -92,6 +98,7 @@ def test_parquet_time_series_equal_the_csv_ones(tmp_path):
         if column == "sector":
             assert from_pq[column].fillna("").tolist() == from_csv[column].fillna("").tolist()
         else:  # the csv keeps 9 significant digits
-            np.testing.assert_allclose(from_pq[column].astype(float), from_csv[column],
-                                       rtol=1e-8, atol=1e-12)
+            np.testing.assert_allclose(
+                from_pq[column].astype(float), from_csv[column], rtol=1e-8, atol=1e-12
+            )
     assert not (pq_out / case_dir / "timeseries.csv").exists()

@@ -22,10 +22,26 @@ import pandas as pd
 REPO = Path(__file__).resolve().parents[2]
 MATRIX = REPO / "scenarios" / "table2.toml"
 EXPECTED = Path(__file__).with_name("table2_expected.csv")
-FIGURES = ("impact_speed_mps", "min_gap_aro_m", "max_lateral_offset_m", "sim_time_s",
-           "contact_overlap", "delta_v_ego_mps", "min_gap_oncoming_m", "min_ttc_oncoming_s")
-COLUMNS = ("case_id", "outcome", "collision_with", "collision_with_id", *FIGURES, "near_miss",
-           "modes_visited", "timeseries_sha256")
+FIGURES = (
+    "impact_speed_mps",
+    "min_gap_aro_m",
+    "max_lateral_offset_m",
+    "sim_time_s",
+    "contact_overlap",
+    "delta_v_ego_mps",
+    "min_gap_oncoming_m",
+    "min_ttc_oncoming_s",
+)
+COLUMNS = (
+    "case_id",
+    "outcome",
+    "collision_with",
+    "collision_with_id",
+    *FIGURES,
+    "near_miss",
+    "modes_visited",
+    "timeseries_sha256",
+)
 
 
 def _figure(value) -> str:
@@ -44,16 +60,18 @@ def observed(out_dir: Path, jobs: int = 2) -> pd.DataFrame:
         case = out_dir / r["case_dir"]
         summary = json.loads((case / "summary.json").read_text())
         digest = hashlib.sha256((case / "timeseries.csv").read_bytes()).hexdigest()[:16]
-        rows.append({
-            "case_id": r["case_id"],
-            "outcome": summary["outcome"],
-            "collision_with": summary["collision_with"],
-            "collision_with_id": summary["collision_with_id"] or "",
-            **{k: _figure(summary.get(k)) for k in FIGURES},
-            "near_miss": str(summary["near_miss"]).lower(),
-            "modes_visited": " ".join(str(m) for m in summary["modes_visited"]),
-            "timeseries_sha256": digest,
-        })
+        rows.append(
+            {
+                "case_id": r["case_id"],
+                "outcome": summary["outcome"],
+                "collision_with": summary["collision_with"],
+                "collision_with_id": summary["collision_with_id"] or "",
+                **{k: _figure(summary.get(k)) for k in FIGURES},
+                "near_miss": str(summary["near_miss"]).lower(),
+                "modes_visited": " ".join(str(m) for m in summary["modes_visited"]),
+                "timeseries_sha256": digest,
+            }
+        )
     return pd.DataFrame(rows, columns=list(COLUMNS))
 
 

@@ -16,7 +16,8 @@ def test_table2_matches_the_golden_file(tmp_path):
     assert not diff, (
         "Table 2 differs from tests/golden/table2_expected.csv (update it deliberately with "
         "`python -m tests.golden.table2_golden --update` and explain each cell):\n"
-        + "\n".join(diff))
+        + "\n".join(diff)
+    )
     check_verdicts(read_results(tmp_path / RESULTS_FILE))
 
 
@@ -35,8 +36,10 @@ def check_verdicts(results) -> None:
     assert oncoming["min_gap_oncoming_m"].notna().all()
     assert results[results["oncoming_start_m"].isna()]["min_gap_oncoming_m"].isna().all()
     green = results[results["outcome"] == "green"]
-    close = green[(green["min_gap_aro_m"] <= NEAR_MISS_GAP_M)
-                  | (green["min_gap_oncoming_m"] <= NEAR_MISS_GAP_M)]
+    close = green[
+        (green["min_gap_aro_m"] <= NEAR_MISS_GAP_M)
+        | (green["min_gap_oncoming_m"] <= NEAR_MISS_GAP_M)
+    ]
     assert (close["near_miss"] == "True").all()
     # the lane changes that ended green passed the obstacle they avoided (the ARO)
     changed = green[green["time_in_opposite_lane_s"] > 0.0]

@@ -30,20 +30,19 @@ def step(ctrl: EoamController, t: float, v: float, perception: Perception):
 
 
 @pytest.mark.parametrize("v_mps", [3.0, 8.0])
-def test_normal_driving_brakes_for_a_coasted_object_within_the_stopping_distance(tables,
-                                                                                  v_mps):
+def test_normal_driving_brakes_for_a_coasted_object_within_the_stopping_distance(tables, v_mps):
     margin = EoamSettings().coasted_margin_m
-    inside, outside = (stopping_m(tables, v_mps) + margin) * 0.98, (
-        stopping_m(tables, v_mps) + margin) * 1.02
+    inside, outside = (
+        (stopping_m(tables, v_mps) + margin) * 0.98,
+        (stopping_m(tables, v_mps) + margin) * 1.02,
+    )
     far = EoamController(P, tables)
     far.reset(v_mps)
-    cmd = step(far, 0.0, v_mps, Perception(coasted_range_m=outside,
-                                           coasted_range_rate_mps=-v_mps))
+    cmd = step(far, 0.0, v_mps, Perception(coasted_range_m=outside, coasted_range_rate_mps=-v_mps))
     assert far.mode is Mode.NORMAL and cmd.brake_force_cmd_n == 0.0
     near = EoamController(P, tables)
     near.reset(v_mps)
-    cmd = step(near, 0.0, v_mps, Perception(coasted_range_m=inside,
-                                            coasted_range_rate_mps=-v_mps))
+    cmd = step(near, 0.0, v_mps, Perception(coasted_range_m=inside, coasted_range_rate_mps=-v_mps))
     assert near.mode is Mode.UPDATE_BRAKE and cmd.fcw
     assert cmd.brake_force_cmd_n > 0.0 and cmd.drive_force_cmd_n == 0.0
 
@@ -57,22 +56,27 @@ def braking_for_a_person_lost_from_view(tables) -> EoamController:
     return ctrl
 
 
-@pytest.mark.parametrize(("coasted_m", "rate_mps", "hands_back"), [
-    (None, 0.0, True),  # nothing in the path: the threat is gone
-    (2.5, 1.4, False),  # pulling away, but within the 0.9 m stopping distance + 2 m
-    (10.0, -1.0, False),  # far, but closing
-    (10.0, 0.0, False),  # far, standing
-    (10.0, 1.4, True),  # far, walking away
-])
+@pytest.mark.parametrize(
+    ("coasted_m", "rate_mps", "hands_back"),
+    [
+        (None, 0.0, True),  # nothing in the path: the threat is gone
+        (2.5, 1.4, False),  # pulling away, but within the 0.9 m stopping distance + 2 m
+        (10.0, -1.0, False),  # far, but closing
+        (10.0, 0.0, False),  # far, standing
+        (10.0, 1.4, True),  # far, walking away
+    ],
+)
 def test_no_hand_back_while_a_coasted_object_is_near_or_not_pulling_away(
-        tables, coasted_m, rate_mps, hands_back):
+    tables, coasted_m, rate_mps, hands_back
+):
     """The person is lost from view (ego at 4 m/s): without a coasted track the threat is
     gone and the EOAM hands back; with one it brakes on unless the prediction pulls away
     (faster than the release speed) beyond the stopping distance plus the margin."""
     assert stopping_m(tables, 4.0) + EoamSettings().coasted_margin_m > 2.5
     ctrl = braking_for_a_person_lost_from_view(tables)
-    cmd = step(ctrl, DT, 4.0, Perception(coasted_range_m=coasted_m,
-                                         coasted_range_rate_mps=rate_mps))
+    cmd = step(
+        ctrl, DT, 4.0, Perception(coasted_range_m=coasted_m, coasted_range_rate_mps=rate_mps)
+    )
     assert (ctrl.mode is Mode.NORMAL) is hands_back
     if not hands_back:
         assert cmd.brake_force_cmd_n > 0.0 and cmd.drive_force_cmd_n == 0.0

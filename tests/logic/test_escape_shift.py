@@ -93,8 +93,15 @@ def test_path_form_matches_the_time_profile():
 
 @pytest.mark.parametrize("bad", [{"accel_mps2": 0.0}, {"ramp_s": 0.0}, {"speed_mps": 0.0}])
 def test_bad_budget_is_refused(bad):
-    kw = {"y0_m": 0.0, "v0_mps": 0.0, "a0_mps2": 0.0, "y1_m": 1.0, "speed_mps": 20.0,
-          "accel_mps2": 5.0, "ramp_s": 0.1}
+    kw = {
+        "y0_m": 0.0,
+        "v0_mps": 0.0,
+        "a0_mps2": 0.0,
+        "y1_m": 1.0,
+        "speed_mps": 20.0,
+        "accel_mps2": 5.0,
+        "ramp_s": 0.1,
+    }
     kw.update(bad)
     with pytest.raises(ValueError):
         MinTimeShift(**kw)

@@ -33,9 +33,7 @@ class Drive:
         self.t, self.s, self.v, self.d, self.mu, self.lane = 0.0, 0.0, speed_mps, 0.0, mu, lane_m
         self.cmd = None
 
-    def step(
-        self, range_m=None, rate_mps=None, oncoming=False, d_m=None, e_yaw=0.0, n=1, obj=None
-    ):
+    def step(self, range_m=None, rate_mps=None, oncoming=False, d_m=None, e_yaw=0.0, n=1, obj=None):
         if d_m is not None:
             self.d = d_m
         for _ in range(n):
@@ -350,10 +348,12 @@ def test_step_needs_reset_and_finite_measurements(tables):
         ctrl.step(bad, Perception(), DT)
 
 
-@pytest.mark.parametrize("beyond_m,mode", [(20.0, Mode.ONCOMING_BRAKE),
-                                           (80.0, Mode.UPDATE_STEER_BRAKE)])
+@pytest.mark.parametrize(
+    "beyond_m,mode", [(20.0, Mode.ONCOMING_BRAKE), (80.0, Mode.UPDATE_STEER_BRAKE)]
+)
 def test_a_standing_car_in_the_next_lane_blocks_the_steer_like_oncoming_traffic(
-        tables, beyond_m, mode):
+    tables, beyond_m, mode
+):
     """A standing object in the next lane within the in-path obstacle's range plus
     ``next_lane_clear_m`` (50 m) turns the steer into limit braking in lane (mode 3); one
     further on leaves room to pass and return."""
@@ -362,7 +362,9 @@ def test_a_standing_car_in_the_next_lane_blocks_the_steer_like_oncoming_traffic(
     drive = Drive(tables, v)
     drive.ctrl.step(
         EgoMeasurement(0.0, v, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, LANE),
-        Perception(rng, -v, False, None, rng + beyond_m), DT)
+        Perception(rng, -v, False, None, rng + beyond_m),
+        DT,
+    )
     assert drive.mode is mode
 
 

@@ -55,7 +55,14 @@ def test_obstacle_track_from_the_sensor():
     meas = EgoMeasurement(2.0, 30.0, 0.0, 0.0, 0.0, 0.0, 50.0, 0.0, 0.0, 0.0, 1.0, 3.5)
     obj = ObjectState(90.0, 0.1, 12.0, 5.0, 2.0)
     assert ObstacleTrack.sensed(meas, 3.9, 30.0, 18.0, obj, 12.0, 1.5) == (
-        2.0, 92.5, 12.0, 1.1, 1.5, 5.0)
+        2.0,
+        92.5,
+        12.0,
+        1.1,
+        1.5,
+        5.0,
+    )
     # without an object: the range from the front bumper, an assumed length, a lane's width
     assert ObstacleTrack.sensed(meas, 3.9, 30.0, 18.0, None, 12.0, 0.0) == pytest.approx(
-        (2.0, 50.0 + 3.9 + 30.0 + 12.0, 12.0, 1.75, 0.0, 12.0))
+        (2.0, 50.0 + 3.9 + 30.0 + 12.0, 12.0, 1.75, 0.0, 12.0)
+    )

@@ -26,11 +26,22 @@ from eoam_sumo.decision.oncoming import (
 from eoam_sumo.eoam_messages import EgoMeasurement
 
 MU_G = 0.7 * 9.81
-BUDGET = Budget(lateral_mps2=0.9 * MU_G, ramp_s=0.15, lag_s=0.1, brake_mps2=0.95 * MU_G,
-                mu_g_mps2=MU_G, width_m=1.85, length_m=4.92, cg_to_front_m=3.9,
-                side_clearance_m=0.5,
-                pass_margin_m=1.0, margin_m=0.2, margin_s=0.2, return_mps2=0.6 * MU_G,
-                arrest_min_mps=0.5)
+BUDGET = Budget(
+    lateral_mps2=0.9 * MU_G,
+    ramp_s=0.15,
+    lag_s=0.1,
+    brake_mps2=0.95 * MU_G,
+    mu_g_mps2=MU_G,
+    width_m=1.85,
+    length_m=4.92,
+    cg_to_front_m=3.9,
+    side_clearance_m=0.5,
+    pass_margin_m=1.0,
+    margin_m=0.2,
+    margin_s=0.2,
+    return_mps2=0.6 * MU_G,
+    arrest_min_mps=0.5,
+)
 LINE = 3.5 - 0.91 - 0.925 - 0.2  # the ego's centre out of the oncoming path [m]
 V = 40.0  # ego speed [m/s]
 
@@ -87,8 +98,10 @@ def test_seeing_the_oncoming_car_later_never_makes_an_option_safer(d, v_lat, gap
     lat = Lateral(d, v_lat, 0.0)
     far, near = oncoming(gap), oncoming(gap - less)
     for predict in (predict_abort, predict_pass):
-        a, b = predict(lat, V, standing(30.0), far, BUDGET), predict(lat, V, standing(30.0),
-                                                                     near, BUDGET)
+        a, b = (
+            predict(lat, V, standing(30.0), far, BUDGET),
+            predict(lat, V, standing(30.0), near, BUDGET),
+        )
         assert not (a.head_on and not b.head_on)
         assert b.delta_v_mps >= a.delta_v_mps - 1e-9
 
@@ -105,8 +118,9 @@ def test_choice_is_the_lower_predicted_delta_v():
 
 
 def test_past_the_obstacle_the_escape_is_taken():
-    choice = choose(Lateral(3.6, 1.0, -2.6), V, standing(-10.0), oncoming(100.0), BUDGET,
-                    passed=True)
+    choice = choose(
+        Lateral(3.6, 1.0, -2.6), V, standing(-10.0), oncoming(100.0), BUDGET, passed=True
+    )
     assert choice.pass_on
 
 
@@ -134,8 +148,9 @@ def test_return_after_passing_waits_until_it_keeps_the_side_clear():
     assert not return_clears(_ego(1.2), obstacle(30.0), BUDGET)
     # out beside it at rest: the return takes the ego within the side clearance after
     # the time it needs to drop from 2.8 m to the side offset at the budget (jerk-limited)
-    escape_s = MinTimeShift(2.8, 0.0, 0.0, 0.0, V, BUDGET.lateral_mps2,
-                            BUDGET.ramp_s).time_within_s(side)
+    escape_s = MinTimeShift(
+        2.8, 0.0, 0.0, 0.0, V, BUDGET.lateral_mps2, BUDGET.ramp_s
+    ).time_within_s(side)
     gain = V * escape_s - BUDGET.pass_margin_m  # what the ego gains on it meanwhile
     assert not return_clears(_ego(2.8), obstacle(gain + 1.0), BUDGET)
     assert return_clears(_ego(2.8), obstacle(gain - 1.0), BUDGET)

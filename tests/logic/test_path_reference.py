@@ -136,7 +136,8 @@ def _past_target(traj, y0, y1, n=4000):
 )
 @settings(max_examples=80, deadline=None)
 def test_quintic_shift_starts_from_the_state_and_never_passes_its_target(
-        y0, slope0, kappa0, y1, speed, accel):
+    y0, slope0, kappa0, y1, speed, accel
+):
     """Starts at the ego's (offset, course slope, path curvature), ends at y1 level and
     straight, and never passes y1 (no overshoot beyond the planned offset), whatever the
     start; from rest its peak lateral acceleration is within the asked value."""
@@ -188,7 +189,8 @@ def test_quintic_shift_is_the_shortest_within_the_budget(slope0, kappa0, dy, spe
 )
 @settings(max_examples=60, deadline=None)
 def test_lateral_stop_is_no_shorter_than_physics_allows_and_does_not_pass_its_end(
-        y0, slope0, kappa0, speed, mu, reaction):
+    y0, slope0, kappa0, speed, mu, reaction
+):
     """The arrest path ends where the lateral motion stops: at least the constant-deceleration
     stop v_lat^2 / (2 a) ahead of the motion (nothing stops sooner within the budget), not
     passing that end, level and straight there."""

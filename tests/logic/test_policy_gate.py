@@ -40,12 +40,23 @@ class _Flat:
 
 
 def _need(tables, **kw):
-    args = {"speed_mps": 30.0, "mu": 1.0, "opposing_speed_mps": 20.0,
-                "trajectory": tables.trajectory(1.0, 30.0), "gap_m": 40.0,
-                "obstacle_speed_mps": 0.0,
-                "obstacle_length_m": 5.09, "ego_length_m": P.length_m, "ego_width_m": P.width_m,
-                "lane_width_m": LANE, "pass_margin_m": 1.0, "return_lateral_g": 0.3,
-                "return_min_length_m": 10.0, "margin_s": 0.5, "margin_m": 10.0}
+    args = {
+        "speed_mps": 30.0,
+        "mu": 1.0,
+        "opposing_speed_mps": 20.0,
+        "trajectory": tables.trajectory(1.0, 30.0),
+        "gap_m": 40.0,
+        "obstacle_speed_mps": 0.0,
+        "obstacle_length_m": 5.09,
+        "ego_length_m": P.length_m,
+        "ego_width_m": P.width_m,
+        "lane_width_m": LANE,
+        "pass_margin_m": 1.0,
+        "return_lateral_g": 0.3,
+        "return_min_length_m": 10.0,
+        "margin_s": 0.5,
+        "margin_m": 10.0,
+    }
     args.update(kw)
     return sight_needed(**args)
 
@@ -82,18 +93,30 @@ def test_an_obstacle_as_fast_as_the_ego_is_never_passed(tables):
 
 
 @settings(max_examples=30, deadline=None)
-@given(mu=st.sampled_from([1.0, 0.7, 0.3, 0.1]), v=st.floats(15.0, 45.0),
-       v_opp=st.floats(0.0, 50.0))
+@given(
+    mu=st.sampled_from([1.0, 0.7, 0.3, 0.1]), v=st.floats(15.0, 45.0), v_opp=st.floats(0.0, 50.0)
+)
 def test_sight_distance_grows_with_lower_friction_and_faster_opposing_traffic(mu, v, v_opp):
     tables = LookupTables.load(default_tables_dir(), params=P)
-    base = _need(tables, speed_mps=v, mu=mu, opposing_speed_mps=v_opp,
-                 trajectory=tables.trajectory(mu, v))
-    faster = _need(tables, speed_mps=v, mu=mu, opposing_speed_mps=v_opp + 5.0,
-                   trajectory=tables.trajectory(mu, v))
+    base = _need(
+        tables, speed_mps=v, mu=mu, opposing_speed_mps=v_opp, trajectory=tables.trajectory(mu, v)
+    )
+    faster = _need(
+        tables,
+        speed_mps=v,
+        mu=mu,
+        opposing_speed_mps=v_opp + 5.0,
+        trajectory=tables.trajectory(mu, v),
+    )
     assert faster.needed_m > base.needed_m
     if mu < 1.0:
-        drier = _need(tables, speed_mps=v, mu=1.0, opposing_speed_mps=v_opp,
-                      trajectory=tables.trajectory(1.0, v))
+        drier = _need(
+            tables,
+            speed_mps=v,
+            mu=1.0,
+            opposing_speed_mps=v_opp,
+            trajectory=tables.trajectory(1.0, v),
+        )
         assert base.needed_m > drier.needed_m
 
 
@@ -107,9 +130,15 @@ def _meas(v=30.0, d=0.0, t=0.0, mu=1.0):
 
 
 def _view(free, nearest=None, speed=None, opposing=True, behind=None, behind_speed=None):
-    return NextLaneView(opposing, 20.0, coverage_ahead_m=free, nearest_ahead_m=nearest,
-                        nearest_ahead_speed_mps=speed, nearest_behind_m=behind,
-                        nearest_behind_speed_mps=behind_speed)
+    return NextLaneView(
+        opposing,
+        20.0,
+        coverage_ahead_m=free,
+        nearest_ahead_m=nearest,
+        nearest_ahead_speed_mps=speed,
+        nearest_behind_m=behind,
+        nearest_behind_speed_mps=behind_speed,
+    )
 
 
 def _policy(tables):
@@ -117,8 +146,7 @@ def _policy(tables):
 
 
 def _seen(view, gap=40.0, closing=30.0):
-    return Perception(gap, -closing, False, ObjectState(150.0, 0.0, 0.0, 5.09, 1.99), None,
-                      view)
+    return Perception(gap, -closing, False, ObjectState(150.0, 0.0, 0.0, 5.09, 1.99), None, view)
 
 
 def test_the_gate_opens_exactly_when_the_known_free_length_covers_the_need(tables):

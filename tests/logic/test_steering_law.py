@@ -102,8 +102,13 @@ def test_clipped_to_the_front_slip_envelope_and_the_lock():
 
 
 @settings(max_examples=50, deadline=None)
-@given(st.floats(5.0, 50.0), st.floats(-2.0, 2.0), st.floats(-0.5, 0.5), st.floats(0.1, 1.2),
-       st.sampled_from((1.0, -1.0)))
+@given(
+    st.floats(5.0, 50.0),
+    st.floats(-2.0, 2.0),
+    st.floats(-0.5, 0.5),
+    st.floats(0.1, 1.2),
+    st.sampled_from((1.0, -1.0)),
+)
 def test_envelope_edge_is_the_front_slip_limit_the_law_clips_to(v, vy, r, mu, side):
     """The edge's front slip (delta less the front axle's course) is the envelope's, on the
     side asked for, and the law's largest error towards that side lands on it."""
@@ -136,13 +141,13 @@ def test_closed_loop_poles_are_the_designed_ones(v, mu, gains):
     # characteristic polynomials (repeated roots split under rounding); gains are blended
     # linearly between the 0.5 m/s grid speeds, exact on them
     on_grid = abs(2.0 * v - round(2.0 * v)) < 1e-9
-    assert np.poly(closed).real == pytest.approx(np.poly(want).real,
-                                                 rel=1e-4 if on_grid else 3e-2)
+    assert np.poly(closed).real == pytest.approx(np.poly(want).real, rel=1e-4 if on_grid else 3e-2)
     omega = g.natural_freq_radps * mu**g.friction_exponent
     omega *= min(1.0, v / g.full_bandwidth_speed_mps)
     assert ctrl.natural_freq(v, mu) == pytest.approx(omega, rel=1e-12)
     assert np.poly(want[:2]).real == pytest.approx(  # the path pair comes first
-        [1.0, 2.0 * g.damping_ratio * omega, omega**2], rel=1e-6)
+        [1.0, 2.0 * g.damping_ratio * omega, omega**2], rel=1e-6
+    )
     damping = -want.real / abs(want)
     assert damping.min() >= min(g.damping_ratio, g.body_damping_ratio) - 1e-9
 
@@ -151,8 +156,7 @@ def test_closed_loop_poles_are_the_designed_ones(v, mu, gains):
 @pytest.mark.parametrize("v", [4.0, 10.0, 15.3, 25.0, 33.3, 45.8])
 @pytest.mark.parametrize("mu", [1.0, 0.7, 0.3, 0.1])
 @pytest.mark.parametrize("stiffness_with_mu", [False, True])
-def test_closed_loop_with_the_steering_lag_is_stable_and_damped(v, mu, stiffness_with_mu,
-                                                                 gains):
+def test_closed_loop_with_the_steering_lag_is_stable_and_damped(v, mu, stiffness_with_mu, gains):
     """With the actuator's first-order lag every pole stays in the left half-plane with
     damping above 0.4; with tyres whose cornering stiffness falls with the friction (a
     robustness check: the plant's does not) the loop stays stable."""

@@ -17,16 +17,20 @@ class _NoSumoFinder:
     @staticmethod
     def find_spec(name, path=None, target=None):
         if name.partition(".")[0] in _MODULES:
-            raise ImportError(f"{name}: SUMO is unreachable in the fast test tier "
-                              "(mark the test with @pytest.mark.sumo)")
+            raise ImportError(
+                f"{name}: SUMO is unreachable in the fast test tier "
+                "(mark the test with @pytest.mark.sumo)"
+            )
 
 
 class _NoSumoPopen(subprocess.Popen):
     def __init__(self, args, *rest, **kwargs):
         program = os.fsdecode(args if isinstance(args, (str, bytes, os.PathLike)) else args[0])
         if os.path.basename(program.split()[0] if isinstance(args, str) else program) in _PROGRAMS:
-            raise FileNotFoundError(f"{program}: SUMO is unreachable in the fast test tier "
-                                    "(mark the test with @pytest.mark.sumo)")
+            raise FileNotFoundError(
+                f"{program}: SUMO is unreachable in the fast test tier "
+                "(mark the test with @pytest.mark.sumo)"
+            )
         super().__init__(args, *rest, **kwargs)
 
 

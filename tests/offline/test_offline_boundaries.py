@@ -27,8 +27,11 @@ def test_no_lock_deceleration_matches_brute_force_and_stays_below_mu_g(mu):
     decel = np.linspace(0.0, 15.0, 150001)
     fz_f, fz_r = axle_loads(-decel, P)
     m, phi = P.mass_kg, P.brake_front_share
-    ok = ((phi * m * decel <= mu * fz_f) & ((1 - phi) * m * decel <= mu * fz_r)
-          & (m * decel <= P.max_brake_force_n))
+    ok = (
+        (phi * m * decel <= mu * fz_f)
+        & ((1 - phi) * m * decel <= mu * fz_r)
+        & (m * decel <= P.max_brake_force_n)
+    )
     brute = decel[ok].max()
     a = max_decel_no_lock_mps2(P, mu)
     assert a == pytest.approx(brute, abs=2e-4)
@@ -84,9 +87,11 @@ def test_constant_speed_clearing_is_above_the_point_mass_bound(mu):
 
 def test_buffers_add_time_headway_and_constant():
     assert steer_buffered_m(10.0, 20.0, S) == pytest.approx(
-        10.0 + 20.0 * S.steer_buffer_time_s + S.steer_buffer_m)
+        10.0 + 20.0 * S.steer_buffer_time_s + S.steer_buffer_m
+    )
     assert stop_buffered_m(30.0, 20.0, S) == pytest.approx(
-        30.0 + 20.0 * S.brake_buffer_time_s + S.brake_buffer_m)
+        30.0 + 20.0 * S.brake_buffer_time_s + S.brake_buffer_m
+    )
 
 
 def test_ttc_per_friction_follows_the_paper_and_interpolates():

@@ -34,23 +34,33 @@ def test_subset_rebuild_reproduces_the_committed_boundaries(subset):
     for key, row in ours.items():
         for column, value in row.items():
             assert float(value) == pytest.approx(float(committed[key][column]), abs=1e-3), (
-                key, column)
+                key,
+                column,
+            )
 
 
 def test_subset_rebuild_reproduces_the_committed_lookup_rows(subset):
-    with np.load(subset / "lookup_tables.npz") as ours, \
-            np.load(COMMITTED / "lookup_tables.npz") as committed:
+    with (
+        np.load(subset / "lookup_tables.npz") as ours,
+        np.load(COMMITTED / "lookup_tables.npz") as committed,
+    ):
         assert float(ours["dx_step_m"]) == float(committed["dx_step_m"])
         for i, mu in enumerate(ours["mu_grid"]):
             ci = list(committed["mu_grid"]).index(mu)
             for j, v in enumerate(ours["speed_grid_mps"]):
                 cj = int(np.argmin(np.abs(committed["speed_grid_mps"] - v)))
                 assert committed["speed_grid_mps"][cj] == pytest.approx(v)
-                assert ours["length_m"][i, j] == pytest.approx(committed["length_m"][ci, cj],
-                                                               abs=1e-4)
+                assert ours["length_m"][i, j] == pytest.approx(
+                    committed["length_m"][ci, cj], abs=1e-4
+                )
                 n = ours["y_m"].shape[2]
-                for name, tol in (("y_m", 1e-4), ("yaw_rad", 1e-4), ("curvature_1pm", 1e-4),
-                                  ("steer_rad", 1e-4), ("ax_mps2", 1e-3)):
+                for name, tol in (
+                    ("y_m", 1e-4),
+                    ("yaw_rad", 1e-4),
+                    ("curvature_1pm", 1e-4),
+                    ("steer_rad", 1e-4),
+                    ("ax_mps2", 1e-3),
+                ):
                     diff = np.abs(ours[name][i, j] - committed[name][ci, cj, :n])
                     assert diff.max() <= tol, (mu, v, name)
 

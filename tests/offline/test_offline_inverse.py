@@ -27,8 +27,9 @@ def _arc(speed, radius, duration=2.0, n=401):
     return ArcLengthPath(speed, duration, 0.0, t, s, x, y, theta, k, np.zeros(n))
 
 
-@pytest.mark.parametrize("mu,speed,radius", [(1.0, 20.0, 150.0), (0.3, 25.0, 600.0),
-                                             (0.7, 10.0, 60.0)])
+@pytest.mark.parametrize(
+    "mu,speed,radius", [(1.0, 20.0, 150.0), (0.3, 25.0, 600.0), (0.7, 10.0, 60.0)]
+)
 def test_steady_cornering_matches_linear_bicycle_closed_form(mu, speed, radius):
     inv = inverse_dynamics(_arc(speed, radius), P, mu)
     cf, cr = mu * P.cornering_stiffness_front_npr, mu * P.cornering_stiffness_rear_npr
@@ -71,8 +72,9 @@ def test_infeasible_lateral_demand_is_flagged():
     assert gentle.feasible.all()
 
 
-@pytest.mark.parametrize("speed,duration,mu", [(27.0, 2.2, 1.0), (10.0, 2.0, 1.0),
-                                               (40.0, 5.0, 0.1), (15.0, 3.0, 0.7)])
+@pytest.mark.parametrize(
+    "speed,duration,mu", [(27.0, 2.2, 1.0), (10.0, 2.0, 1.0), (40.0, 5.0, 0.1), (15.0, 3.0, 0.7)]
+)
 def test_inverse_is_the_inverse_of_the_forward_design_model(speed, duration, mu):
     """At the inverse-dynamics state and steering, the forward model (model.dynamics) gives
     the path's lateral acceleration V^2 K and yaw acceleration d(V K)/dt."""
@@ -83,8 +85,15 @@ def test_inverse_is_the_inverse_of_the_forward_design_model(speed, duration, mu)
     yaw_acc = np.gradient(v * path.curvature_1pm, path.t_s)
     ay_model, yaw_acc_model = [], []
     for i, th in enumerate(path.theta_rad):
-        x = [0.0, v[i] * math.cos(th), 0.0, v[i] * math.sin(th), inv.yaw_rad[i],
-             inv.yaw_rate_radps[i], inv.steer_rad[i]]
+        x = [
+            0.0,
+            v[i] * math.cos(th),
+            0.0,
+            v[i] * math.sin(th),
+            inv.yaw_rad[i],
+            inv.yaw_rate_radps[i],
+            inv.steer_rad[i],
+        ]
         xdot, out = dynamics(x, (0.0, 0.0), mu, P, math)
         ay_model.append(out.ay_body_mps2)
         yaw_acc_model.append(xdot[5])

@@ -42,8 +42,9 @@ def test_solution_meets_its_conditions_in_an_independent_resimulation(solution):
     assert abs(end[3]) < 1e-3 and abs(end[4]) < 1e-4 and abs(end[5]) < 1e-3
     assert resim.distance_m == pytest.approx(solution.distance_m, abs=1e-3)
     # the re-simulation passes through every optimiser node
-    nodes = np.interp(np.linspace(0, solution.duration_s, S.ocp_intervals + 1), resim.t_s,
-                      resim.states[:, 2])
+    nodes = np.interp(
+        np.linspace(0, solution.duration_s, S.ocp_intervals + 1), resim.t_s, resim.states[:, 2]
+    )
     assert nodes == pytest.approx(solution.states[:, 2], abs=2e-3)
     assert max(resim.ellipse_front.max(), resim.ellipse_rear.max()) <= 1.0 + S.verify_ellipse_tol
     # the total acceleration never beats the friction (the ellipses per axle imply it)
@@ -53,8 +54,9 @@ def test_solution_meets_its_conditions_in_an_independent_resimulation(solution):
 
 def test_optimised_clearing_beats_constant_speed_and_respects_point_mass_floor(solution):
     resim = resimulate(solution, P, 0.25)
-    clear = clearing_distance_m(resim.states[:, 0], resim.states[:, 2], resim.states[:, 4], P,
-                                S.obstacle_width_m)
+    clear = clearing_distance_m(
+        resim.states[:, 0], resim.states[:, 2], resim.states[:, 4], P, S.obstacle_width_m
+    )
     w = 0.5 * (P.width_m + S.obstacle_width_m)
     floor = V * math.sqrt(2 * w / (S.friction_use * MU * G_MPS2))  # the plan's friction share
     assert floor - w <= clear <= constant_speed_clearing_distance_m(V, MU, P, S)
@@ -91,8 +93,11 @@ def test_non_convergence_is_reported_with_speed_and_friction():
 
 def test_audit_reports_a_tampered_solution(solution):
     bad = dataclasses.replace(solution, controls=solution.controls * np.array([1.3, 1.0]))
-    with pytest.raises(OcpError, match=r"mu=0\.7, 100 km/h fails its re-simulation check: "
-                                       r".*final y"):
+    with pytest.raises(
+        OcpError,
+        match=r"mu=0\.7, 100 km/h fails its re-simulation check: "
+        r".*final y",
+    ):
         audit(bad, resimulate(bad, P, 0.25), P, S)
 
 

@@ -50,8 +50,17 @@ def test_plan_accelerations_are_the_plants_at_the_planned_state(speed_kmh, mu):
         xdot, out = dynamics(x, u, mu, P, math, 1.0)
         c, s = math.cos(x[4]), math.sin(x[4])
         brake, drive = split_force(u[1])
-        state = [0.0, 0.0, 0.0, x[1] * c + x[3] * s, -x[1] * s + x[3] * c, x[5], x[6],
-                 float(drive), float(-brake)]
+        state = [
+            0.0,
+            0.0,
+            0.0,
+            x[1] * c + x[3] * s,
+            -x[1] * s + x[3] * c,
+            x[5],
+            x[6],
+            float(drive),
+            float(-brake),
+        ]
         f = plant_model.rhs(state, [x[6], float(drive), float(-brake)], mu, P, FloatOps())
         ay_plant = f[4] + state[3] * x[5]  # eq. 5: vy' + vx r
         ay_err.append(abs(ay_plant - out.ay_body_mps2))

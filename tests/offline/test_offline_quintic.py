@@ -17,12 +17,14 @@ def test_peak_lateral_acceleration_is_5_77_h_over_t_squared():
     for duration in (1.5, 2.5, 5.0):
         t = np.linspace(0.0, duration, 200001)
         ddy = quintic_lateral(t, duration, H)[2]
-        assert np.abs(ddy).max() == pytest.approx(10.0 * math.sqrt(3.0) / 3.0 * H / duration**2,
-                                                  rel=1e-8)
+        assert np.abs(ddy).max() == pytest.approx(
+            10.0 * math.sqrt(3.0) / 3.0 * H / duration**2, rel=1e-8
+        )
         # the peak sits at tau = (3 - sqrt 3) / 6 (closed form)
         t_peak = (3.0 - math.sqrt(3.0)) / 6.0 * duration
         assert quintic_lateral(t_peak, duration, H)[2] == pytest.approx(
-            QUINTIC_PEAK_COEFF * H / duration**2, rel=1e-12)
+            QUINTIC_PEAK_COEFF * H / duration**2, rel=1e-12
+        )
 
 
 def test_boundary_conditions_of_the_quintic():
@@ -38,8 +40,9 @@ def test_derivatives_match_finite_differences():
     for k in range(3):
         hi = quintic_lateral(t + e, 2.0, H)[k]
         lo = quintic_lateral(t - e, 2.0, H)[k]
-        assert quintic_lateral(t, 2.0, H)[k + 1] == pytest.approx((hi - lo) / (2 * e), rel=1e-5,
-                                                                    abs=1e-6)
+        assert quintic_lateral(t, 2.0, H)[k + 1] == pytest.approx(
+            (hi - lo) / (2 * e), rel=1e-5, abs=1e-6
+        )
 
 
 def test_time_rule_ties_peak_lateral_acceleration_to_friction():

@@ -21,8 +21,13 @@ P = ego_e_class_sedan()
 S = DesignSettings()
 W = 0.5 * (P.width_m + S.obstacle_width_m)
 DIR = default_tables_dir()
-COLS = ("stop_distance_m", "stop_distance_buffered_m", "clear_distance_const_m",
-        "clear_distance_opt_m", "clear_distance_buffered_m")
+COLS = (
+    "stop_distance_m",
+    "stop_distance_buffered_m",
+    "clear_distance_const_m",
+    "clear_distance_opt_m",
+    "clear_distance_buffered_m",
+)
 
 
 def _rows():
@@ -50,7 +55,8 @@ def test_committed_grid_is_the_default_grid():
     meta = json.loads((DIR / "metadata.json").read_text())
     assert meta["package_version"] == __version__
     assert {k: v["value"] for k, v in meta["vehicle"].items()} == {
-        k: v["value"] for k, v in describe(P).items()}
+        k: v["value"] for k, v in describe(P).items()
+    }
     assert meta["solver"]["options"]["ipopt.print_level"] == 0
 
 
@@ -76,9 +82,11 @@ def test_clearing_distances_respect_the_point_mass_floors():
 
 
 def test_optimised_clearing_is_within_1_3_of_the_point_mass_bound_from_60_kmh():
-    ratios = [r["clear_distance_opt_m"]
-              / (kmh / 3.6 * math.sqrt(2 * W / (S.friction_use * mu * G_MPS2)))
-              for (mu, kmh), r in ROWS.items() if kmh >= 60]
+    ratios = [
+        r["clear_distance_opt_m"] / (kmh / 3.6 * math.sqrt(2 * W / (S.friction_use * mu * G_MPS2)))
+        for (mu, kmh), r in ROWS.items()
+        if kmh >= 60
+    ]
     assert max(ratios) <= 1.3
     assert min(ratios) >= 1.0
 
@@ -104,9 +112,11 @@ def test_buffers_and_ttc_follow_the_design_settings():
     for (mu, kmh), r in ROWS.items():
         v = kmh / 3.6
         assert r["stop_distance_buffered_m"] == pytest.approx(
-            r["stop_distance_m"] + S.brake_buffer_time_s * v + S.brake_buffer_m, abs=2e-4)
+            r["stop_distance_m"] + S.brake_buffer_time_s * v + S.brake_buffer_m, abs=2e-4
+        )
         assert r["clear_distance_buffered_m"] == pytest.approx(
-            r["clear_distance_opt_m"] + S.steer_buffer_time_s * v + S.steer_buffer_m, abs=2e-4)
+            r["clear_distance_opt_m"] + S.steer_buffer_time_s * v + S.steer_buffer_m, abs=2e-4
+        )
         assert r["ttc_s"] == {1.0: 2.5, 0.7: 2.5, 0.3: 5.0, 0.1: 20.0}[mu]
 
 

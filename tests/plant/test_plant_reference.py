@@ -150,8 +150,11 @@ finite = st.floats(-1e4, 1e4, allow_nan=False)
 
 
 @settings(max_examples=300, deadline=None)
-@given(x=st.lists(finite, min_size=9, max_size=9), u=st.tuples(finite, finite, finite),
-       mu=st.floats(0.01, 1.5))
+@given(
+    x=st.lists(finite, min_size=9, max_size=9),
+    u=st.tuples(finite, finite, finite),
+    mu=st.floats(0.01, 1.5),
+)
 def test_the_extension_module_steps_as_the_ctypes_call_does(plant, x, u, mu):
     """Where Python's headers are installed, ``advance`` is the extension module's: the same
     C step, so the same numbers to the last bit as through ctypes, NaNs in the same places."""
@@ -164,8 +167,9 @@ def test_the_extension_module_steps_as_the_ctypes_call_does(plant, x, u, mu):
     assert all(type(v) is float for v in got[0] + got[1])
 
 
-def test_without_python_headers_the_plant_steps_through_ctypes(params, plant_cache_dir,
-                                                                monkeypatch):
+def test_without_python_headers_the_plant_steps_through_ctypes(
+    params, plant_cache_dir, monkeypatch
+):
     from eoam_sumo.plant import compiled
 
     monkeypatch.setattr(compiled, "python_include", lambda: None)

@@ -21,16 +21,16 @@ from eoam_sumo.sim.trafficlog import TRAFFIC_COLUMNS, read_traffic
 pytestmark = pytest.mark.sumo
 ROOT = Path(__file__).resolve().parents[2]
 STEP_S = 0.01
-WALKER = ('<person id="walker" depart="1.00" departPos="260"><walk edges="E0" '
-          'arrivalPos="400"/></person>')
+WALKER = (
+    '<person id="walker" depart="1.00" departPos="260"><walk edges="E0" arrivalPos="400"/></person>'
+)
 
 
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory) -> Path:
     folder = tmp_path_factory.mktemp("walker")
     scenarios = ROOT / "scenarios"
-    routes = (scenarios / "baseline.rou.xml").read_text().replace("</routes>",
-                                                                 WALKER + "</routes>")
+    routes = (scenarios / "baseline.rou.xml").read_text().replace("</routes>", WALKER + "</routes>")
     (folder / "walker.rou.xml").write_text(routes)
     (folder / "walker.sumocfg").write_text(
         f'<configuration><input><net-file value="{ROOT / "networks" / "highway.net.xml"}"/>'
@@ -38,10 +38,14 @@ def run_dir(tmp_path_factory) -> Path:
         f'<additional-files value="{scenarios / "vtypes.add.xml"},'
         f'{ROOT / "networks" / "highway_parking.add.xml"}"/></input>'
         f'<output><fcd-output value="fcd.xml"/><precision value="6"/></output>'
-        '</configuration>')
-    run_case(folder / "walker.sumocfg",
-             ScenarioOverrides(ego_speed_mps=90 / 3.6, oncoming_start_m=300.0),
-             folder / "run", RunSettings(max_time_s=3.0))
+        "</configuration>"
+    )
+    run_case(
+        folder / "walker.sumocfg",
+        ScenarioOverrides(ego_speed_mps=90 / 3.6, oncoming_start_m=300.0),
+        folder / "run",
+        RunSettings(max_time_s=3.0),
+    )
     return folder / "run"
 
 
@@ -66,9 +70,16 @@ def test_traffic_csv_holds_the_ego_the_parked_cars_and_the_walker(run_dir):
 
 
 def _fcd(path: Path) -> pd.DataFrame:
-    rows = [(round(float(step.get("time")), 3), user.get("id"), float(user.get("x")),
-             float(user.get("y"))) for step in ET.parse(path).getroot().iter("timestep")
-            for user in step]
+    rows = [
+        (
+            round(float(step.get("time")), 3),
+            user.get("id"),
+            float(user.get("x")),
+            float(user.get("y")),
+        )
+        for step in ET.parse(path).getroot().iter("timestep")
+        for user in step
+    ]
     return pd.DataFrame(rows, columns=["time_s", "id", "fx", "fy"])
 
 
@@ -100,7 +111,7 @@ def test_animate_writes_a_gif_that_follows_the_ego(run_dir, tmp_path):
         first = np.asarray(gif.convert("RGB"))
         gif.seek(gif.n_frames - 1)
         last = np.asarray(gif.convert("RGB"))
-    blue = np.array([int(ROLE_COLOURS["ego"][k:k + 2], 16) for k in (1, 3, 5)])
+    blue = np.array([int(ROLE_COLOURS["ego"][k : k + 2], 16) for k in (1, 3, 5)])
     for image in (first, last):  # the ego's box is in every frame
         assert (np.abs(image.astype(int) - blue).sum(axis=2) < 40).sum() > 20
     assert not np.array_equal(first, last)
@@ -110,5 +121,7 @@ def test_animate_cli_bad_run_dir_is_one_line_and_exit_2(tmp_path, capsys):
     assert main(["animate", str(tmp_path / "nowhere")]) == 2
     assert main(["animate", str(tmp_path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == [f"eoam-sumo: error: {tmp_path / 'nowhere'}: no such run folder",
-                   f"eoam-sumo: error: {tmp_path}: not a run folder (no summary.json)"]
+    assert err == [
+        f"eoam-sumo: error: {tmp_path / 'nowhere'}: no such run folder",
+        f"eoam-sumo: error: {tmp_path}: not a run folder (no summary.json)",
+    ]

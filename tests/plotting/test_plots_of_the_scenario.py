@@ -26,15 +26,18 @@ LANE_M, PATCH_MU = 3.0, 0.2
 def _patch_scenario(folder: Path) -> Path:
     (folder / "patch.nod.xml").write_text(
         '<nodes><node id="w" x="0" y="0"/><node id="m" x="150" y="0"/>'
-        '<node id="e" x="3000" y="0"/></nodes>')
+        '<node id="e" x="3000" y="0"/></nodes>'
+    )
     edges = []
     for eid, frm, to, mu in (("E0a", "w", "m", 1.0), ("E0b", "m", "e", PATCH_MU)):
-        edges.append(f'<edge id="{eid}" from="{frm}" to="{to}" numLanes="1" speed="50" '
-                     f'width="{LANE_M}"><lane index="0" friction="{mu}">'
-                     f'<neigh lane="-{eid}_0"/></lane></edge>'
-                     f'<edge id="-{eid}" from="{to}" to="{frm}" numLanes="1" speed="50" '
-                     f'width="{LANE_M}"><lane index="0" friction="{mu}">'
-                     f'<neigh lane="{eid}_0"/></lane></edge>')
+        edges.append(
+            f'<edge id="{eid}" from="{frm}" to="{to}" numLanes="1" speed="50" '
+            f'width="{LANE_M}"><lane index="0" friction="{mu}">'
+            f'<neigh lane="-{eid}_0"/></lane></edge>'
+            f'<edge id="-{eid}" from="{to}" to="{frm}" numLanes="1" speed="50" '
+            f'width="{LANE_M}"><lane index="0" friction="{mu}">'
+            f'<neigh lane="{eid}_0"/></lane></edge>'
+        )
     (folder / "patch.edg.xml").write_text(f"<edges>{''.join(edges)}</edges>")
     netbuild.build_all(folder)
     (folder / "patch.rou.xml").write_text(
@@ -46,12 +49,14 @@ def _patch_scenario(folder: Path) -> Path:
         '<param key="eoam.aro_decel_mps2" value="8.0"/></vehicle>'
         '<vehicle id="westbound" type="oncoming" depart="0" departLane="0" departPos="2500" '
         'departSpeed="20" insertionChecks="none"><route edges="-E0b -E0a"/></vehicle>'
-        '</routes>')
+        "</routes>"
+    )
     cfg = folder / "patch.sumocfg"
     cfg.write_text(
         f'<configuration><input><net-file value="patch.net.xml"/>'
         f'<route-files value="patch.rou.xml"/><additional-files value="'
-        f'{SCENARIOS / "vtypes.add.xml"}"/></input></configuration>')
+        f'{SCENARIOS / "vtypes.add.xml"}"/></input></configuration>'
+    )
     return cfg
 
 
@@ -70,10 +75,8 @@ def test_the_contact_point_lies_between_the_ego_and_the_obstacle(patch_run):
     at = traffic[traffic["time_s"] == traffic["time_s"].max()].set_index("id")
     ego, aro = at.loc["ego"], at.loc["aro"]
     # a rear-end hit: the point is at the ego's front and the obstacle's back
-    assert summary["contact_x_m"] == pytest.approx(ego["x_m"] + 0.5 * ego["length_m"],
-                                                   abs=0.2)
-    assert summary["contact_x_m"] == pytest.approx(aro["x_m"] - 0.5 * aro["length_m"],
-                                                   abs=0.2)
+    assert summary["contact_x_m"] == pytest.approx(ego["x_m"] + 0.5 * ego["length_m"], abs=0.2)
+    assert summary["contact_x_m"] == pytest.approx(aro["x_m"] - 0.5 * aro["length_m"], abs=0.2)
     assert abs(summary["contact_y_m"] - ego["y_m"]) < 0.5 * ego["width_m"]
 
 
@@ -84,8 +87,12 @@ def test_plots_use_the_friction_the_manoeuvre_ran_on(patch_run, tmp_path):
     title = run_title(summary, ts, patch_run)
     assert title.startswith(f"90 km/h, μ = {PATCH_MU}, oncoming traffic:")
     pngs = plot_run(patch_run, tmp_path)
-    assert sorted(p.name for p in pngs) == ["dynamics.png", "gg.png", "phase_trace.png",
-                                            "steering.png"]
+    assert sorted(p.name for p in pngs) == [
+        "dynamics.png",
+        "gg.png",
+        "phase_trace.png",
+        "steering.png",
+    ]
 
 
 def test_lateral_offset_lines_are_those_of_the_run_lanes(patch_run):

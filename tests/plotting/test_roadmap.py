@@ -35,7 +35,8 @@ def test_dashed_lines_between_lanes_and_a_pavement(tmp_path):
         '<lane id="A_0" index="0" width="2.0" allow="pedestrian" shape="0,-7 100,-7"/>'
         '<lane id="A_1" index="1" width="3.0" shape="0,-4.5 100,-4.5"/>'
         '<lane id="A_2" index="2" width="3.0" shape="0,-1.5 100,-1.5"/>'
-        '</edge></net>')
+        "</edge></net>"
+    )
     road = read_road_map(net, (0.0, -10.0, 100.0, 0.0))
     assert len(road.pavement) == 1 and len(road.road) == 2
     # index 0 is the rightmost lane: the pavement, then the road's right edge, the dashed line

@@ -55,7 +55,8 @@ def test_oncoming_seen_reads_traffic_csv_else_the_radar_flag(tmp_path):
     pd.DataFrame({"time_s": [1.0], "oncoming_detected": [0]}).to_csv(run / "timeseries.csv")
     assert not oncoming_seen(run)
     pd.DataFrame({"time_s": [1.0, 1.01], "oncoming_detected": [0, 1]}).to_csv(
-        run / "timeseries.csv")
+        run / "timeseries.csv"
+    )
     assert oncoming_seen(run)
     (run / "traffic.csv").write_text("time_s,id,role\n1.0,ego,ego\n1.0,car,other\n")
     assert not oncoming_seen(run)  # traffic.csv, the ground truth, wins over the radar

@@ -24,8 +24,9 @@ from eoam_sumo.sim.roadframe import RoadFrame
 LANE_M = 3.5
 CAR = (4.70, 1.82)
 ROAD = RoadFrame([(-1000.0, 0.0), (5000.0, 0.0)])
-EXACT = AutomotiveRadarSettings(range_sd_m=0.0, azimuth_sd_deg=0.0, range_rate_sd_mps=0.0,
-                                detection_probability=1.0)
+EXACT = AutomotiveRadarSettings(
+    range_sd_m=0.0, azimuth_sd_deg=0.0, range_rate_sd_mps=0.0, detection_probability=1.0
+)
 
 
 def _car(rear_x_m, y_m=0.0, speed_mps=0.0, dims=CAR, vid="car"):
@@ -37,8 +38,9 @@ def _drive(radar, targets_at, seconds, ego_speed=30.0, dt=0.01):
     out = []
     for k in range(round(seconds / dt)):
         t = k * dt
-        out.append((t, radar.scan((ego_speed * t, 0.0), 0.0, ego_speed, ROAD, targets_at(t),
-                                  LANE_M, t)))
+        out.append(
+            (t, radar.scan((ego_speed * t, 0.0), 0.0, ego_speed, ROAD, targets_at(t), LANE_M, t))
+        )
     return out
 
 
@@ -132,15 +134,22 @@ def test_tracker_follows_a_braking_car_and_gates_out_a_far_detection():
     for k in range(60):
         t = 0.072 * k
         v = max(16.7 - 8.0 * max(t - 1.0, 0.0), 0.0)
-        x = 60.0 + 16.7 * min(t, 1.0) + (16.7 * (t - 1) - 4.0 * (t - 1) ** 2
-                                          if 1.0 < t <= 1.0 + 16.7 / 8 else 0.0)
+        x = (
+            60.0
+            + 16.7 * min(t, 1.0)
+            + (16.7 * (t - 1) - 4.0 * (t - 1) ** 2 if 1.0 < t <= 1.0 + 16.7 / 8 else 0.0)
+        )
         if t > 1.0 + 16.7 / 8:
-            x = 60.0 + 16.7 + 16.7 ** 2 / 16.0
+            x = 60.0 + 16.7 + 16.7**2 / 16.0
         r = x + 0.4 * rng.standard_normal()
         az = math.radians(0.1) * rng.standard_normal()
         rr = v + 0.1 * rng.standard_normal()  # the radar stands still
-        tracker.update(t, [Measurement(r, az, rr, 0.4, math.radians(0.1), 0.1, 2.35, 0, *CAR)],
-                       (0.0, 0.0), (0.0, 0.0))
+        tracker.update(
+            t,
+            [Measurement(r, az, rr, 0.4, math.radians(0.1), 0.1, 2.35, 0, *CAR)],
+            (0.0, 0.0),
+            (0.0, 0.0),
+        )
         if k >= 5:
             (track,) = tracker.confirmed()
             worst = max(worst, abs(track.vx_mps - v))
@@ -166,11 +175,17 @@ def test_make_radar_and_settings_checks():
         TrackerSettings(confirm_hits=4, confirm_window=3)
 
 
-@pytest.mark.parametrize(("option", "value", "named"), [
-    ("--radar-model", "sonar", "radar_model 'sonar'"), ("--seed", "-1", "seed -1"),
-    ("--seed", "x", "seed 'x'")])
-def test_run_refuses_a_bad_radar_model_or_seed_with_one_line(option, value, named, capsys,
-                                                              tmp_path):
+@pytest.mark.parametrize(
+    ("option", "value", "named"),
+    [
+        ("--radar-model", "sonar", "radar_model 'sonar'"),
+        ("--seed", "-1", "seed -1"),
+        ("--seed", "x", "seed 'x'"),
+    ],
+)
+def test_run_refuses_a_bad_radar_model_or_seed_with_one_line(
+    option, value, named, capsys, tmp_path
+):
     from pathlib import Path
 
     from eoam_sumo.cli import main

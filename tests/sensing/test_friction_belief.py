@@ -19,8 +19,7 @@ def _drive(belief, true_mu, seconds, accel_mps2, t0=0.0):
     out = []
     for k in range(round(seconds / DT)):
         t = t0 + k * DT
-        out.append((t, belief.mu(true_mu(t) if callable(true_mu) else true_mu, t, accel_mps2,
-                                 0.0)))
+        out.append((t, belief.mu(true_mu(t) if callable(true_mu) else true_mu, t, accel_mps2, 0.0)))
     return out
 
 
@@ -66,8 +65,9 @@ def test_estimate_converges_to_the_delayed_true_friction_when_excited():
 
 
 def test_estimate_bias_and_clip():
-    est = FrictionBelief("estimate", settings=EstimatorSettings(noise_sd=0.0, bias=-0.4),
-                         mu_min=0.1)
+    est = FrictionBelief(
+        "estimate", settings=EstimatorSettings(noise_sd=0.0, bias=-0.4), mu_min=0.1
+    )
     cruising = _drive(est, 0.3, 0.5, 0.0)
     assert all(mu == pytest.approx(0.6) for _, mu in cruising)  # prior plus bias
     trace = _drive(est, 0.3, 5.0, 0.8 * 0.3 * G_MPS2, t0=0.5)

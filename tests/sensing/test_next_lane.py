@@ -62,9 +62,16 @@ def test_a_box_hides_only_what_lies_behind_it():
 
 
 def _sensing(v2x=None, radar_range_m=100.0):
-    return NextLaneSensing(opposing=True, speed_limit_mps=25.0, lane_width_m=LANE,
-                           radar_range_m=radar_range_m, radar_fov_deg=18.0, ego_length_m=4.92,
-                           ego_width_m=1.85, v2x=v2x)
+    return NextLaneSensing(
+        opposing=True,
+        speed_limit_mps=25.0,
+        lane_width_m=LANE,
+        radar_range_m=radar_range_m,
+        radar_fov_deg=18.0,
+        ego_length_m=4.92,
+        ego_width_m=1.85,
+        v2x=v2x,
+    )
 
 
 def _view(sensing, bodies, t=0.0, road=None):
@@ -77,8 +84,7 @@ def _view(sensing, bodies, t=0.0, road=None):
 def test_an_empty_road_is_known_free_to_the_radar_range_on_the_far_line():
     view = _view(_sensing(), [])
     far = 1.5 * LANE - 0.25
-    assert view.coverage_ahead_m == pytest.approx(math.sqrt(100.0**2 - far**2),
-                                                  abs=COVERAGE_STEP_M)
+    assert view.coverage_ahead_m == pytest.approx(math.sqrt(100.0**2 - far**2), abs=COVERAGE_STEP_M)
     assert view.known_free_ahead_m == view.coverage_ahead_m
     assert view.nearest_ahead_m is None
 
@@ -120,8 +126,9 @@ def test_a_car_closing_from_behind_is_found_by_the_rear_corner_radar():
     view = _view(_sensing(), [car])
     assert view.nearest_behind_m == pytest.approx(40.0 - 4.92 - 2.35)
     assert view.nearest_behind_speed_mps == pytest.approx(40.0)
-    assert _view(_sensing(), [Body("c", -90.0, LANE, 0.0, 40.0, 4.7, 1.8)]
-                 ).nearest_behind_m is None  # beyond the corner radar's 80 m
+    assert (
+        _view(_sensing(), [Body("c", -90.0, LANE, 0.0, 40.0, 4.7, 1.8)]).nearest_behind_m is None
+    )  # beyond the corner radar's 80 m
 
 
 def test_full_penetration_v2x_proves_the_range_free_less_its_blind_distance():

@@ -37,7 +37,8 @@ def variant(tmp_path: Path, edits: dict[str, str], vtypes: str = "") -> Path:
     cfg.write_text(
         f'<configuration><input><net-file value="{ROOT / "networks" / "highway.net.xml"}"/>'
         f'<route-files value="r.rou.xml"/><additional-files value="'
-        f'{ROOT / "scenarios" / "vtypes.add.xml"}{extra}"/></input></configuration>')
+        f'{ROOT / "scenarios" / "vtypes.add.xml"}{extra}"/></input></configuration>'
+    )
     return cfg
 
 
@@ -64,12 +65,18 @@ def test_believing_a_dry_road_on_snow_acts_later_than_knowing(tmp_path):
 
 
 VEHICLES = {  # vType, length [m]: the longest SUMO default vehicle and a short, narrow one
-    "truck": ('<vType id="lead" vClass="truck" length="16.50" width="2.55" minGap="2.50" '
-              'maxSpeed="30.00" accel="1.00" decel="6.00" emergencyDecel="9.00" sigma="0" '
-              'speedDev="0"/>', 16.5),
-    "motorcycle": ('<vType id="lead" vClass="motorcycle" length="2.20" width="0.90" '
-                   'minGap="2.50" maxSpeed="30.00" accel="1.00" decel="6.00" '
-                   'emergencyDecel="9.00" sigma="0" speedDev="0"/>', 2.2),
+    "truck": (
+        '<vType id="lead" vClass="truck" length="16.50" width="2.55" minGap="2.50" '
+        'maxSpeed="30.00" accel="1.00" decel="6.00" emergencyDecel="9.00" sigma="0" '
+        'speedDev="0"/>',
+        16.5,
+    ),
+    "motorcycle": (
+        '<vType id="lead" vClass="motorcycle" length="2.20" width="0.90" '
+        'minGap="2.50" maxSpeed="30.00" accel="1.00" decel="6.00" '
+        'emergencyDecel="9.00" sigma="0" speedDev="0"/>',
+        2.2,
+    ),
 }
 
 
@@ -81,12 +88,18 @@ def test_any_length_of_vehicle_is_first_seen_at_the_radars_range(tmp_path, range
     radar's range (the truck was first seen at 93.5 m for 100 m, the motorcycle at 99.9 m,
     when sensing looked for front bumpers within range + 10 m)."""
     vtype, length_m = VEHICLES[vehicle]
-    cfg = variant(tmp_path, {
-        'type="aro" route="eastbound" depart="1.00" departLane="0" departPos="225.09"':
-        'type="lead" route="eastbound" depart="1.00" departLane="0" '
-        f'departPos="{400.0 + length_m:.2f}"',
-        '<param key="eoam.aro_hold_s" value="2.0"/>': '<param key="eoam.aro_hold_s" '
-        'value="100.0"/>'}, vtype)
+    cfg = variant(
+        tmp_path,
+        {
+            ('type="aro" route="eastbound" depart="1.00" departLane="0" departPos="225.09"'): (
+                'type="lead" route="eastbound" depart="1.00" departLane="0" '
+                f'departPos="{400.0 + length_m:.2f}"'
+            ),
+            '<param key="eoam.aro_hold_s" value="2.0"/>': '<param key="eoam.aro_hold_s" '
+            'value="100.0"/>',
+        },
+        vtype,
+    )
     settings = RunSettings(max_time_s=14.0, radar=RadarSettings(range_m=range_m))
     out = tmp_path / "run"
     run_case(cfg, ScenarioOverrides(ego_speed_mps=120 / 3.6), out, settings)
@@ -97,10 +110,10 @@ def test_any_length_of_vehicle_is_first_seen_at_the_radars_range(tmp_path, range
 
 
 STALLED = {  # the ARO stands in the ego lane, its rear 200 m ahead of the ego's front
-    'departPos="225.09"\n             departSpeed="16.666667"':
-    'departPos="305.09"\n             departSpeed="0"',
-    '<param key="eoam.aro_hold_s" value="2.0"/>': '<param key="eoam.aro_hold_s" '
-    'value="100.0"/>',
+    'departPos="225.09"\n             departSpeed="16.666667"': (
+        'departPos="305.09"\n             departSpeed="0"'
+    ),
+    '<param key="eoam.aro_hold_s" value="2.0"/>': '<param key="eoam.aro_hold_s" value="100.0"/>',
 }
 TIMING = ("wall_time_s", "realtime_factor")
 
@@ -138,10 +151,12 @@ EGO = ego_e_class_sedan()
 
 
 @pytest.mark.parametrize("radar", RADARS)
-@pytest.mark.parametrize(("depart", "arrival"), [(300.0, 3000.0), (300.0, 10.0)],
-                         ids=["walking-away", "walking-towards"])
+@pytest.mark.parametrize(
+    ("depart", "arrival"), [(300.0, 3000.0), (300.0, 10.0)], ids=["walking-away", "walking-towards"]
+)
 def test_a_person_walking_in_the_lane_ahead_raises_the_fcw_and_is_not_driven_through(
-        tmp_path, depart, arrival, radar):
+    tmp_path, depart, arrival, radar
+):
     """A person walking 1.13 m right of the lane centre: first seen at the radar's range, the
     FCW raised, the ego brakes and follows at walking pace or stops behind them; a moving ego
     never reaches them. With the paper's 18 deg beam alone they leave the beam about 5 m
@@ -149,8 +164,9 @@ def test_a_person_walking_in_the_lane_ahead_raises_the_fcw_and_is_not_driven_thr
     end while the ego moves close behind them."""
     cfg = _walker_scenario(tmp_path, depart, arrival)
     out = tmp_path / "run"
-    summary = run_case(cfg, ScenarioOverrides(mu=1.0), out,
-                       RunSettings(max_time_s=30.0, **RADARS[radar]))
+    summary = run_case(
+        cfg, ScenarioOverrides(mu=1.0), out, RunSettings(max_time_s=30.0, **RADARS[radar])
+    )
     assert summary["fcw_raised"] is True
     assert summary["collision_with"] == "none", summary["reason"]
     assert summary["modes_visited"][:2] == [0, 1]
@@ -162,7 +178,7 @@ def test_a_person_walking_in_the_lane_ahead_raises_the_fcw_and_is_not_driven_thr
     assert 100.0 - late_m <= seen.iloc[0] <= 100.0
     # the FCW is raised while the person is still further than the stopping distance
     fcw_range = ts.loc[ts["fcw"].astype(bool), "aro_range_m"].iloc[0]
-    assert fcw_range > 25.0 ** 2 / (2 * 9.81) + 5.0
+    assert fcw_range > 25.0**2 / (2 * 9.81) + 5.0
     if radar != "ideal":
         assert np.isfinite(ts["aro_range_m"].iloc[-2])  # still seen at the last step
     # ground truth: the ego's front never reaches the person while it moves
@@ -180,5 +196,5 @@ def test_a_person_walking_in_the_lane_ahead_raises_the_fcw_and_is_not_driven_thr
     # "settled" with the ego moving within its stopping distance of them
     v_end = summary["final_speed_mps"]
     if summary["end_cause"] == "settled" and v_end > 0.05:
-        assert gap.iloc[-1] > v_end ** 2 / (2 * 9.81) + 5.0
+        assert gap.iloc[-1] > v_end**2 / (2 * 9.81) + 5.0
     assert summary["end_cause"] in ("settled", "time_limit")

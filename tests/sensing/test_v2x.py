@@ -23,6 +23,7 @@ def _run(settings, bodies_at, t_end_s, dt=0.01):
 def test_a_message_arrives_after_the_latency_and_is_dead_reckoned_to_now():
     def car(t):
         return [B("c", 300.0 - 20.0 * t, 1.75, math.pi, 20.0, 4.7, 1.8)]
+
     _, seen = _run(V2XSettings(range_m=500.0, latency_s=0.1), car, 1.0)
     first = next(t for t, objs in seen if objs)
     assert first == pytest.approx(0.1, abs=1e-9)
@@ -34,6 +35,7 @@ def test_a_message_arrives_after_the_latency_and_is_dead_reckoned_to_now():
 def test_nothing_is_heard_beyond_the_range_or_with_v2x_off():
     def far(t):
         return [B("c", 600.0, 1.75, math.pi, 0.0, 4.7, 1.8)]
+
     assert not _run(V2XSettings(range_m=500.0), far, 0.5)[1][-1][1]
     assert not _run(V2XSettings(range_m=0.0), far, 0.5)[1][-1][1]
 
@@ -41,6 +43,7 @@ def test_nothing_is_heard_beyond_the_range_or_with_v2x_off():
 def test_packet_loss_drops_about_its_share_and_is_the_same_for_the_same_seed():
     def car(t):
         return [B("c", 100.0, 1.75, 0.0, 0.0, 4.7, 1.8)]
+
     counts = []
     for seed in (1, 1, 2):
         rx = V2XReceiver(V2XSettings(range_m=500.0, loss=0.3, seed=seed))
@@ -72,8 +75,16 @@ def test_blind_time_allows_for_a_run_of_losses():
     assert lossy.blind_time_s() == pytest.approx(0.1 + 0.1 * 7)
 
 
-@pytest.mark.parametrize("kwargs", [{"loss": 1.0}, {"penetration": 1.5}, {"range_m": -1.0},
-                                    {"period_s": 0.0}, {"latency_s": math.nan}])
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"loss": 1.0},
+        {"penetration": 1.5},
+        {"range_m": -1.0},
+        {"period_s": 0.0},
+        {"latency_s": math.nan},
+    ],
+)
 def test_bad_v2x_settings_are_refused(kwargs):
     with pytest.raises(ValueError):
         V2XSettings(**kwargs)

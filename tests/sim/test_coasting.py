@@ -20,8 +20,9 @@ WALK_MPS = 1.4
 HALF_FOV = math.radians(9.0)
 
 
-def walker_at(t_s: float, x0_m: float = 60.0, d_m: float = WALKER_D_M,
-              speed_mps: float = WALK_MPS) -> Body:
+def walker_at(
+    t_s: float, x0_m: float = 60.0, d_m: float = WALKER_D_M, speed_mps: float = WALK_MPS
+) -> Body:
     """A person walking along the lane (eastbound), centre at x0 + speed t."""
     return Body("walker", "pedestrian", x0_m + speed_mps * t_s, d_m, 0.0, speed_mps, *WALKER)
 
@@ -112,8 +113,15 @@ def braking_phases(person) -> list[tuple[bool, bool]]:
         t = 0.01 * k
         front = 5.0 if t >= 1.0 else 10.0 * t - 5.0 * t * t
         body = person(t)
-        rep = radar.scan((front, 0.0), 0.0, max(10.0 - 10.0 * t, 0.0), ROAD,
-                         [] if body is None else [body], LANE_M, t)
+        rep = radar.scan(
+            (front, 0.0),
+            0.0,
+            max(10.0 - 10.0 * t, 0.0),
+            ROAD,
+            [] if body is None else [body],
+            LANE_M,
+            t,
+        )
         states.append((rep.in_path is not None, rep.coasted is not None))
     return [s for i, s in enumerate(states) if i == 0 or s != states[i - 1]]
 

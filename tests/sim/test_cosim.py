@@ -27,13 +27,34 @@ from tests.builders import (
 )
 
 CONTRACT_COLUMNS = [
-    "time_s", "mode", "fcw", "x_m", "y_m", "yaw_rad", "vx_mps", "vy_mps", "yaw_rate_radps",
-    "ax_mps2", "ay_mps2", "steer_rad", "ax_target_mps2", "y_target_m", "aro_range_m",
+    "time_s",
+    "mode",
+    "fcw",
+    "x_m",
+    "y_m",
+    "yaw_rad",
+    "vx_mps",
+    "vy_mps",
+    "yaw_rate_radps",
+    "ax_mps2",
+    "ay_mps2",
+    "steer_rad",
+    "ax_target_mps2",
+    "y_target_m",
+    "aro_range_m",
     "aro_range_rate_mps",
 ]
 SUMMARY_KEYS = [
-    "outcome", "collision_with", "impact_speed_mps", "modes_visited", "fcw_raised", "mu",
-    "min_gap_aro_m", "max_abs_lat_accel_mps2", "sim_time_s", "wall_time_s",
+    "outcome",
+    "collision_with",
+    "impact_speed_mps",
+    "modes_visited",
+    "fcw_raised",
+    "mu",
+    "min_gap_aro_m",
+    "max_abs_lat_accel_mps2",
+    "sim_time_s",
+    "wall_time_s",
 ]
 
 
@@ -97,7 +118,8 @@ def test_120_kmh_dry_oncoming_300_m_is_not_red(tmp_path):
 def _write_user_scenario(folder: Path) -> Path:
     """A scenario unlike ours: other ids, 3.2 m lanes, friction in the net, a halted car."""
     netconvert(
-        folder, "road",
+        folder,
+        "road",
         textwrap.dedent("""\
             <nodes>
               <node id="west" x="0" y="50"/>
@@ -110,9 +132,13 @@ def _write_user_scenario(folder: Path) -> Path:
               <edge id="main_back" from="east" to="west" numLanes="1" speed="40" width="3.2"
                     spreadType="right"/>
             </edges>"""),
-        "--opposites.guess", "true", "--no-turnarounds", "true",
+        "--opposites.guess",
+        "true",
+        "--no-turnarounds",
+        "true",
     )
-    (folder / "cars.rou.xml").write_text(textwrap.dedent("""\
+    (folder / "cars.rou.xml").write_text(
+        textwrap.dedent("""\
         <routes>
           <vType id="sedan" length="4.8" width="1.8" accel="3" decel="9" sigma="0"/>
           <vType id="truck" length="8.0" width="2.4" accel="1" decel="6" sigma="0"/>
@@ -123,9 +149,11 @@ def _write_user_scenario(folder: Path) -> Path:
           </vehicle>
           <vehicle id="ego" type="sedan" route="r" depart="0" departPos="150"
                    departSpeed="25"/>
-        </routes>"""))
-    return write_sumocfg(folder / "user.sumocfg", "road.net.xml", "cars.rou.xml",
-                         step_length_s=0.01)
+        </routes>""")
+    )
+    return write_sumocfg(
+        folder / "user.sumocfg", "road.net.xml", "cars.rou.xml", step_length_s=0.01
+    )
 
 
 @pytest.mark.sumo
@@ -149,8 +177,14 @@ def test_oncoming_seen_past_the_point_of_no_return_passes_the_aro_and_returns(tm
     follows its lane-change plan closely, is seen further out and ends in a side contact with
     the oncoming car, docs/manoeuvre.md; by default the EOAM compares passing with aborting:
     tests/sim/test_oncoming_choice_runs.py.)"""
-    summary, out = _run(BASELINE, tmp_path, EoamSettings(compare_outcomes=False),
-                        ego_speed_mps=120 / 3.6, mu=0.3, oncoming_start_m=420.0)
+    summary, out = _run(
+        BASELINE,
+        tmp_path,
+        EoamSettings(compare_outcomes=False),
+        ego_speed_mps=120 / 3.6,
+        mu=0.3,
+        oncoming_start_m=420.0,
+    )
     assert summary["modes_visited"] == [0, 1, 2, 4, 5], summary["reason"]
     assert summary["outcome"] == "green", summary["reason"]
     ts = pd.read_csv(out / "timeseries.csv")
@@ -166,10 +200,27 @@ def test_radar_range_option_limits_what_is_sensed(tmp_path):
     for rng in (60.0, 100.0):
         out = tmp_path / f"r{rng:.0f}"
         proc = subprocess.run(
-            [sys.executable, "-m", "eoam_sumo", "run", str(BASELINE), "--speed-kmh", "90",
-             "--mu", "1.0", "--out", str(out), "--max-time-s", "6", "--radar-range-m",
-             str(rng)],
-            check=False, capture_output=True, text=True, timeout=300,
+            [
+                sys.executable,
+                "-m",
+                "eoam_sumo",
+                "run",
+                str(BASELINE),
+                "--speed-kmh",
+                "90",
+                "--mu",
+                "1.0",
+                "--out",
+                str(out),
+                "--max-time-s",
+                "6",
+                "--radar-range-m",
+                str(rng),
+            ],
+            check=False,
+            capture_output=True,
+            text=True,
+            timeout=300,
         )
         assert proc.returncode == 0, proc.stderr
         ts = pd.read_csv(out / "timeseries.csv")
@@ -182,9 +233,25 @@ def test_radar_range_option_limits_what_is_sensed(tmp_path):
 def test_cli_run_prints_one_line_and_writes_files(tmp_path):
     out = tmp_path / "cli"
     proc = subprocess.run(
-        [sys.executable, "-m", "eoam_sumo", "run", str(BASELINE), "--speed-kmh", "90",
-         "--mu", "1.0", "--out", str(out), "--max-time-s", "25"],
-        check=False, capture_output=True, text=True, timeout=300,
+        [
+            sys.executable,
+            "-m",
+            "eoam_sumo",
+            "run",
+            str(BASELINE),
+            "--speed-kmh",
+            "90",
+            "--mu",
+            "1.0",
+            "--out",
+            str(out),
+            "--max-time-s",
+            "25",
+        ],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=300,
     )
     assert proc.returncode == 0, proc.stderr
     assert len(proc.stdout.strip().splitlines()) == 1
@@ -208,7 +275,11 @@ def test_cli_run_prints_one_line_and_writes_files(tmp_path):
 def test_cli_bad_input_is_one_line_and_status_2(tmp_path, args, needle):
     proc = subprocess.run(
         [sys.executable, "-m", "eoam_sumo", *args, "--out", str(tmp_path / "o")],
-        check=False, capture_output=True, text=True, timeout=120, cwd=tmp_path,
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=tmp_path,
     )
     assert proc.returncode == 2
     lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
@@ -271,7 +342,9 @@ def test_curved_two_way_road(tmp_path):
         f'<edges><edge id="fwd" from="a" to="b" numLanes="1" speed="40" spreadType="right" '
         f'shape="{shape}"/><edge id="back" from="b" to="a" numLanes="1" speed="40" '
         f'spreadType="right" shape="{" ".join(reversed(shape.split()))}"/></edges>',
-        250.0, "--opposites.guess", "true",
+        250.0,
+        "--opposites.guess",
+        "true",
     )
     summary, out = _run(cfg, tmp_path, mu=1.0, max_time_s=25.0)
     assert summary["fcw_raised"] is True
@@ -283,8 +356,10 @@ def test_curved_two_way_road(tmp_path):
 
 
 # a 120 m left curve from (200, 0) to (320, 120), a point every 10 degrees
-ICE_CURVE = " ".join(f"{200 + 120 * math.sin(math.radians(a)):.2f},"
-                     f"{120 * (1 - math.cos(math.radians(a))):.2f}" for a in range(0, 91, 10))
+ICE_CURVE = " ".join(
+    f"{200 + 120 * math.sin(math.radians(a)):.2f},{120 * (1 - math.cos(math.radians(a))):.2f}"
+    for a in range(0, 91, 10)
+)
 
 
 @pytest.mark.sumo
@@ -292,21 +367,25 @@ def test_ice_patch_road_departure_is_orange_not_green(tmp_path):
     """Dry road, then mu 0.05 on a 120 m left curve from x = 200 m: at 30 m/s (7.5 m/s^2 asked,
     0.5 given) the ego slides off the road to the right: orange, not green."""
     netconvert(
-        tmp_path, "n",
+        tmp_path,
+        "n",
         '<nodes><node id="a" x="0" y="0"/><node id="b" x="200" y="0"/>'
         '<node id="c" x="320" y="120"/><node id="d" x="320" y="1500"/></nodes>',
         '<edges><edge id="dry" from="a" to="b" numLanes="2" speed="40"/>'
         '<edge id="ice" from="b" to="c" numLanes="2" speed="40" friction="0.05" '
         f'shape="{ICE_CURVE}"/>'
         '<edge id="end" from="c" to="d" numLanes="2" speed="40"/></edges>',
-        "--no-turnarounds", "true",
+        "--no-turnarounds",
+        "true",
     )
-    (tmp_path / "r.rou.xml").write_text(textwrap.dedent("""\
+    (tmp_path / "r.rou.xml").write_text(
+        textwrap.dedent("""\
         <routes>
           <vType id="car" length="4.6" width="1.8" decel="9" sigma="0"/>
           <route id="r" edges="dry ice end"/>
           <vehicle id="ego" type="car" route="r" depart="0" departPos="20" departSpeed="30"/>
-        </routes>"""))
+        </routes>""")
+    )
     cfg = write_sumocfg(tmp_path / "s.sumocfg", "n.net.xml", "r.rou.xml")
     summary, out = _run(cfg, tmp_path, max_time_s=20.0)
     assert summary["mu"] == pytest.approx(1.0)  # dry where the ego starts
@@ -322,7 +401,8 @@ def test_ice_patch_road_departure_is_orange_not_green(tmp_path):
     assert summary["max_abs_heading_error_rad"] == pytest.approx(e.abs().max(), abs=1e-6)
     assert summary["min_speed_mps"] == pytest.approx(ts["vx_mps"].min(), abs=1e-6)
     assert summary["max_lateral_offset_m"] == pytest.approx(
-        ts["lateral_offset_m"].iloc[:-1].abs().max(), abs=1e-6)
+        ts["lateral_offset_m"].iloc[:-1].abs().max(), abs=1e-6
+    )
 
 
 def test_the_run_log_grows_to_its_limit_and_no_further():
@@ -349,17 +429,26 @@ def test_the_run_log_grows_to_its_limit_and_no_further():
 def test_a_car_standing_in_the_next_lane_turns_the_steer_into_braking(tmp_path):
     """Cars parked in the opposite lane just beyond the ARO: the lane change would end against
     them, so the EOAM brakes in lane (mode 3) instead of hitting them (orange)."""
-    spaces = "".join(f'<space x="{x:.2f}" y="2.60" angle="270.00" length="4.30" width="1.80"/>'
-                     for x in (250.0, 262.0, 274.0))
+    spaces = "".join(
+        f'<space x="{x:.2f}" y="2.60" angle="270.00" length="4.30" width="1.80"/>'
+        for x in (250.0, 262.0, 274.0)
+    )
     (tmp_path / "park.add.xml").write_text(
         '<additional><parkingArea id="pa" lane="-E0_0" startPos="3500" endPos="3900" '
-        f'roadsideCapacity="0" friendlyPos="true">{spaces}</parkingArea></additional>')
+        f'roadsideCapacity="0" friendlyPos="true">{spaces}</parkingArea></additional>'
+    )
     parked = "".join(
         f'<vehicle id="p{k}" type="parked" route="w" depart="0" departPos="stop" '
         'insertionChecks="none"><stop parkingArea="pa" parking="true" until="1000000"/>'
-        "</vehicle>" for k in range(3))
-    cfg = baseline_variant(tmp_path, "<routes>", f'<routes><route id="w" edges="-E0"/>{parked}',
-                           extra_additional="park.add.xml")
+        "</vehicle>"
+        for k in range(3)
+    )
+    cfg = baseline_variant(
+        tmp_path,
+        "<routes>",
+        f'<routes><route id="w" edges="-E0"/>{parked}',
+        extra_additional="park.add.xml",
+    )
     summary, _ = _run(cfg, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0)
     assert 3 in summary["modes_visited"] and 2 not in summary["modes_visited"]
     assert summary["collision_with"] in ("none", "aro")
@@ -371,8 +460,12 @@ def test_the_ego_may_be_a_vehicle_with_a_scripted_stop(tmp_path):
     """`--ego aro`: its stop parameters are ignored (the plant drives it), so it stays in the
     simulation."""
     out = tmp_path / "aro-ego"
-    summary = run_case(BASELINE, ScenarioOverrides(ego_speed_mps=20.0, mu=1.0), out,
-                       RunSettings(max_time_s=3.0, ego_id="aro"))
+    summary = run_case(
+        BASELINE,
+        ScenarioOverrides(ego_speed_mps=20.0, mu=1.0),
+        out,
+        RunSettings(max_time_s=3.0, ego_id="aro"),
+    )
     assert summary["ego_initial_speed_mps"] == pytest.approx(20.0)
     assert summary["sim_time_s"] > 0.0
 
@@ -381,8 +474,11 @@ def test_the_ego_may_be_a_vehicle_with_a_scripted_stop(tmp_path):
 def test_a_second_manoeuvre_soon_after_a_hand_back_runs_to_its_end(tmp_path):
     """An ARO braking gently: the EOAM brakes, hands back, then has to change lanes; the run
     must not stop 2 s after the first hand-back, in the middle of the lane change."""
-    cfg = baseline_variant(tmp_path, '<param key="eoam.aro_decel_mps2" value="8.0"/>',
-                           '<param key="eoam.aro_decel_mps2" value="1.0"/>')
+    cfg = baseline_variant(
+        tmp_path,
+        '<param key="eoam.aro_decel_mps2" value="8.0"/>',
+        '<param key="eoam.aro_decel_mps2" value="1.0"/>',
+    )
     summary, _ = _run(cfg, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0, max_time_s=40.0)
     assert summary["modes_visited"][:3] == [0, 1, 2]
     assert abs(summary["final_lateral_offset_m"]) < 0.5

@@ -21,8 +21,7 @@ CHORD_M = 25.0
 def _shape(s0: float, s1: float, reverse: bool = False) -> str:
     n = math.ceil((s1 - s0) / CHORD_M)
     pts = [s0 + (s1 - s0) * k / n for k in range(n + 1)]
-    xy = [(RADIUS_M * math.sin(s / RADIUS_M), RADIUS_M * (1 - math.cos(s / RADIUS_M)))
-          for s in pts]
+    xy = [(RADIUS_M * math.sin(s / RADIUS_M), RADIUS_M * (1 - math.cos(s / RADIUS_M))) for s in pts]
     if reverse:
         xy.reverse()
     return " ".join(f"{x:.3f},{y:.3f}" for x, y in xy)
@@ -35,8 +34,10 @@ def curve_scenario(tmp_path):
     nodes, edges = [], []
     for k in range(4):
         s = k * EDGE_M
-        nodes.append(f'<node id="n{k}" x="{RADIUS_M * math.sin(s / RADIUS_M):.3f}" '
-                     f'y="{RADIUS_M * (1 - math.cos(s / RADIUS_M)):.3f}" type="priority"/>')
+        nodes.append(
+            f'<node id="n{k}" x="{RADIUS_M * math.sin(s / RADIUS_M):.3f}" '
+            f'y="{RADIUS_M * (1 - math.cos(s / RADIUS_M)):.3f}" type="priority"/>'
+        )
     for k in range(3):
         s0, s1 = k * EDGE_M, (k + 1) * EDGE_M
         edges.append(
@@ -46,8 +47,9 @@ def curve_scenario(tmp_path):
             f'shape="{_shape(s0, s1, True)}"><lane index="0"><neigh lane="c{k}_0"/></lane>'
             "</edge>"
         )
-    network(tmp_path, "curve", f"<nodes>{''.join(nodes)}</nodes>",
-            f"<edges>{''.join(edges)}</edges>")
+    network(
+        tmp_path, "curve", f"<nodes>{''.join(nodes)}</nodes>", f"<edges>{''.join(edges)}</edges>"
+    )
     (tmp_path / "curve.rou.xml").write_text(
         '<routes><vType id="car" length="4.9" width="1.85" sigma="0"/>'
         '<vehicle id="ego" type="car" depart="0" departPos="50" departSpeed="30">'
@@ -57,13 +59,16 @@ def curve_scenario(tmp_path):
 
 
 @pytest.mark.parametrize("speed_kmh", [120.0, 165.0])
-def test_the_ego_keeps_the_lane_centre_on_a_curve_across_edges(curve_scenario, tmp_path,
-                                                               speed_kmh):
+def test_the_ego_keeps_the_lane_centre_on_a_curve_across_edges(curve_scenario, tmp_path, speed_kmh):
     """1.4 m/s^2 of cornering at 165 km/h: no steady offset from the body's sideslip, no
     steps at the junctions between edges (the road heading and curvature are smooth)."""
     out = tmp_path / "run"
-    summary = run_case(curve_scenario, ScenarioOverrides(ego_speed_mps=speed_kmh / 3.6, mu=1.0),
-                       out, RunSettings(max_time_s=40.0))
+    summary = run_case(
+        curve_scenario,
+        ScenarioOverrides(ego_speed_mps=speed_kmh / 3.6, mu=1.0),
+        out,
+        RunSettings(max_time_s=40.0),
+    )
     assert summary["outcome"] == "none"
     ts = pd.read_csv(out / "timeseries.csv")
     assert ts["s_m"].iloc[-1] > 1.5 * EDGE_M  # through at least one junction
@@ -75,13 +80,15 @@ def _straight_edges(tmp_path, name: str, widths: list[float], lanes: list[int]) 
     nodes = "".join(f'<node id="n{k}" x="{500.0 * k}" y="0"/>' for k in range(len(widths) + 1))
     edges = "".join(
         f'<edge id="e{k}" from="n{k}" to="n{k + 1}" numLanes="{n}" speed="50" width="{w}"/>'
-        for k, (w, n) in enumerate(zip(widths, lanes)))
+        for k, (w, n) in enumerate(zip(widths, lanes))
+    )
     network(tmp_path, name, f"<nodes>{nodes}</nodes>", f"<edges>{edges}</edges>")
     route = " ".join(f"e{k}" for k in range(len(widths)))
     (tmp_path / f"{name}.rou.xml").write_text(
         '<routes><vType id="car" length="4.9" width="1.85" sigma="0"/>'
         '<vehicle id="ego" type="car" depart="0" departPos="50" departLane="0" '
-        f'departSpeed="30"><route edges="{route}"/></vehicle></routes>')
+        f'departSpeed="30"><route edges="{route}"/></vehicle></routes>'
+    )
     write_sumocfg(tmp_path / f"{name}.sumocfg", f"{name}.net.xml", f"{name}.rou.xml")
 
 
@@ -90,9 +97,12 @@ def test_lane_width_changes_along_the_route_do_not_throw_the_ego_off(tmp_path):
     (not swerving into the next lane at the heading step seen 30 m ahead)."""
     _straight_edges(tmp_path, "widths", [3.5, 3.0, 4.0, 2.8, 3.5], [1] * 5)
     out = tmp_path / "run"
-    summary = run_case(tmp_path / "widths.sumocfg",
-                       ScenarioOverrides(ego_speed_mps=120 / 3.6, mu=1.0), out,
-                       RunSettings(max_time_s=60.0))
+    summary = run_case(
+        tmp_path / "widths.sumocfg",
+        ScenarioOverrides(ego_speed_mps=120 / 3.6, mu=1.0),
+        out,
+        RunSettings(max_time_s=60.0),
+    )
     assert summary["outcome"] == "none"
     ts = pd.read_csv(out / "timeseries.csv")
     assert ts["s_m"].iloc[-1] > 2000.0
@@ -112,13 +122,19 @@ def test_a_straight_edge_then_a_curve_keeps_the_lane_centre(tmp_path):
     """A 1000 m straight edge, then a 500 m curve of 25 m chords (the heading of a straight
     edge must not lean towards the curve it meets, or the ego drifts 0.9 m on the straight)."""
     radius = 500.0
-    curve = [(1000.0 + radius * math.sin(k * CHORD_M / radius),
-              radius * (1 - math.cos(k * CHORD_M / radius))) for k in range(33)]
+    curve = [
+        (
+            1000.0 + radius * math.sin(k * CHORD_M / radius),
+            radius * (1 - math.cos(k * CHORD_M / radius)),
+        )
+        for k in range(33)
+    ]
     end = curve[-1]
     shape = " ".join(f"{x:.3f},{y:.3f}" for x, y in curve)
     back = " ".join(f"{x:.3f},{y:.3f}" for x, y in reversed(curve))
     network(
-        tmp_path, "bend",
+        tmp_path,
+        "bend",
         '<nodes><node id="a" x="0" y="0"/><node id="b" x="1000" y="0"/>'
         f'<node id="c" x="{end[0]:.3f}" y="{end[1]:.3f}"/></nodes>',
         '<edges><edge id="s" from="a" to="b" numLanes="1" speed="50" width="3.5">'
@@ -128,15 +144,18 @@ def test_a_straight_edge_then_a_curve_keeps_the_lane_centre(tmp_path):
         f'<edge id="c" from="b" to="c" numLanes="1" speed="50" width="3.5" shape="{shape}">'
         '<lane index="0"><neigh lane="-c_0"/></lane></edge>'
         f'<edge id="-c" from="c" to="b" numLanes="1" speed="50" width="3.5" shape="{back}">'
-        '<lane index="0"><neigh lane="c_0"/></lane></edge></edges>')
+        '<lane index="0"><neigh lane="c_0"/></lane></edge></edges>',
+    )
     (tmp_path / "bend.rou.xml").write_text(
         '<routes><vType id="car" length="4.9" width="1.85" sigma="0"/>'
         '<vehicle id="ego" type="car" depart="0" departPos="50" departSpeed="30">'
-        '<route edges="s c"/></vehicle></routes>')
+        '<route edges="s c"/></vehicle></routes>'
+    )
     cfg = write_sumocfg(tmp_path / "bend.sumocfg", "bend.net.xml", "bend.rou.xml")
     out = tmp_path / "run"
-    summary = run_case(cfg, ScenarioOverrides(ego_speed_mps=100 / 3.6, mu=1.0), out,
-                       RunSettings(max_time_s=60.0))
+    summary = run_case(
+        cfg, ScenarioOverrides(ego_speed_mps=100 / 3.6, mu=1.0), out, RunSettings(max_time_s=60.0)
+    )
     assert summary["outcome"] == "none"
     ts = pd.read_csv(out / "timeseries.csv")
     assert ts["s_m"].iloc[-1] > 1300.0  # well into the curve

@@ -27,7 +27,8 @@ def test_gentler_obstacle_stop_never_ends_with_a_higher_impact_speed(tmp_path):
         f'[scenario]\nsumocfg = "{REPO / "scenarios" / "baseline.sumocfg"}"\n'
         "max_time_s = 20.0\n"
         "[sweep]\nego_speed_kmh = [100, 130]\nmu = [1.0, 0.7]\noncoming_start_m = [300]\n"
-        f"aro_decel_mps2 = {list(DECELS)}\n")
+        f"aro_decel_mps2 = {list(DECELS)}\n"
+    )
     results = run_batch(matrix, tmp_path / "out", jobs=2, progress=False)
     assert (results["status"] == "ok").all()
     for (speed, mu), group in results.groupby(["ego_speed_kmh", "mu"]):
@@ -36,4 +37,5 @@ def test_gentler_obstacle_stop_never_ends_with_a_higher_impact_speed(tmp_path):
         for harder, gentler, a_hard, a_gentle in zip(impact, impact[1:], DECELS, DECELS[1:]):
             assert gentler <= harder + 0.05, (
                 f"{speed:g} km/h, mu {mu:g}: a {a_gentle:g} m/s^2 stop hit at {gentler:.2f} m/s, "
-                f"a {a_hard:g} m/s^2 one at {harder:.2f} m/s")
+                f"a {a_hard:g} m/s^2 one at {harder:.2f} m/s"
+            )

@@ -210,8 +210,11 @@ boxes = st.tuples(coord, coord, yaw, length, width).map(lambda a: OrientedBox(*a
 def _moved(box: OrientedBox, rot: float, tx: float, ty: float) -> OrientedBox:
     c, s = math.cos(rot), math.sin(rot)
     return OrientedBox(
-        c * box.x_m - s * box.y_m + tx, s * box.x_m + c * box.y_m + ty, box.yaw_rad + rot,
-        box.length_m, box.width_m,
+        c * box.x_m - s * box.y_m + tx,
+        s * box.x_m + c * box.y_m + ty,
+        box.yaw_rad + rot,
+        box.length_m,
+        box.width_m,
     )
 
 
@@ -242,9 +245,12 @@ def test_distance_is_the_nearest_corner_bit_for_bit(a, b):
     """The inlined corner search gives exactly (same floating-point value) the least distance
     from a corner of either box to its nearest point of the other (``nearest_point``)."""
     assume(not boxes_overlap(a, b))
-    corner_gaps = [math.hypot(cx - px, cy - py)
-                   for src, dst in ((a, b), (b, a)) for cx, cy in src.corners()
-                   for px, py in [dst.nearest_point(cx, cy)]]
+    corner_gaps = [
+        math.hypot(cx - px, cy - py)
+        for src, dst in ((a, b), (b, a))
+        for cx, cy in src.corners()
+        for px, py in [dst.nearest_point(cx, cy)]
+    ]
     assert box_distance(a, b) == min(corner_gaps)
 
 
@@ -363,5 +369,8 @@ def test_placed_overlapping_without_motion_uses_least_penetration():
     b = OrientedBox(3.9, 0.5, 0.0, 4.0, 2.0)  # 0.1 m deep along x, 1.5 m along y
     hit = contact(a, b, (0.0, 0.0), (0.0, 0.0))
     assert (hit.kind, hit.face_a, hit.face_b, hit.impact_speed_mps) == (
-        "rear_end", "front", "rear", 0.0,
+        "rear_end",
+        "front",
+        "rear",
+        0.0,
     )

@@ -29,11 +29,16 @@ def display():
         return
     xvfb = shutil.which("Xvfb")
     if xvfb is None:
-        pytest.skip("no display: DISPLAY is not set and Xvfb is not installed, so sumo-gui "
-                    "is NOT tested here")
+        pytest.skip(
+            "no display: DISPLAY is not set and Xvfb is not installed, so sumo-gui "
+            "is NOT tested here"
+        )
     name = f":{100 + os.getpid() % 800}"
-    proc = subprocess.Popen([xvfb, name, "-screen", "0", "1280x1024x24", "-nolisten", "tcp"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(
+        [xvfb, name, "-screen", "0", "1280x1024x24", "-nolisten", "tcp"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     time.sleep(1.0)
     if proc.poll() is not None:
         pytest.skip(f"Xvfb could not start display {name}, so sumo-gui is NOT tested here")
@@ -52,10 +57,13 @@ def _pixels_like(png, rgb) -> int:
 
 
 def test_a_screenshot_mid_manoeuvre_shows_the_ego_and_the_obstacle(display, tmp_path):
-    gui = GuiSettings(delay_ms=0.0, screenshots_s=(6.0,), screenshot_dir=tmp_path,
-                      keep_open=False)
-    summary = run_case(BASELINE, ScenarioOverrides(ego_speed_mps=165 / 3.6, mu=1.0), tmp_path,
-                       RunSettings(gui=True, use_traci=True, gui_settings=gui))
+    gui = GuiSettings(delay_ms=0.0, screenshots_s=(6.0,), screenshot_dir=tmp_path, keep_open=False)
+    summary = run_case(
+        BASELINE,
+        ScenarioOverrides(ego_speed_mps=165 / 3.6, mu=1.0),
+        tmp_path,
+        RunSettings(gui=True, use_traci=True, gui_settings=gui),
+    )
     assert 2 in summary["modes_visited"]  # the lane change ran (at 6 s the ego is beside the ARO)
     png = tmp_path / "screenshot_6.00s.png"
     assert png.is_file()
@@ -64,8 +72,9 @@ def test_a_screenshot_mid_manoeuvre_shows_the_ego_and_the_obstacle(display, tmp_
 
 
 def test_the_run_is_paced_and_the_window_stays_open(display, tmp_path):
-    s = SumoSession.start(BASELINE, ScenarioOverrides(), gui=True,
-                          gui_settings=GuiSettings(delay_ms=20.0))
+    s = SumoSession.start(
+        BASELINE, ScenarioOverrides(), gui=True, gui_settings=GuiSettings(delay_ms=20.0)
+    )
     process = s._process
     try:
         s.step()

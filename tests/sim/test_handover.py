@@ -21,14 +21,23 @@ DEPART_S = 30.0
 def _snapshot(api) -> dict:
     """Every vehicle's position, speed, angle, lane and lane position."""
     veh = api.vehicle
-    return {vid: (veh.getPosition(vid), veh.getSpeed(vid), veh.getAngle(vid),
-                  veh.getLaneID(vid), veh.getLanePosition(vid)) for vid in veh.getIDList()}
+    return {
+        vid: (
+            veh.getPosition(vid),
+            veh.getSpeed(vid),
+            veh.getAngle(vid),
+            veh.getLaneID(vid),
+            veh.getLanePosition(vid),
+        )
+        for vid in veh.getIDList()
+    }
 
 
 @pytest.fixture(scope="module")
 def traffic_cfg(tmp_path_factory):
-    return write_traffic_scenario(tmp_path_factory.mktemp("traffic"), ego_depart_s=DEPART_S,
-                                  step_length_s=0.5)
+    return write_traffic_scenario(
+        tmp_path_factory.mktemp("traffic"), ego_depart_s=DEPART_S, step_length_s=0.5
+    )
 
 
 def test_handed_over_state_is_the_sumocfg_steps_state(traffic_cfg, tmp_path):
@@ -37,10 +46,8 @@ def test_handed_over_state_is_the_sumocfg_steps_state(traffic_cfg, tmp_path):
     files = check_scenario(traffic_cfg)
     assert handover_plan(files, "ego", 0.01, {}, (), False) == (0.5, DEPART_S)
     binary = sumolib.checkBinary("sumo")
-    coarse, _ = sumo_command(binary, traffic_cfg, files.options, 0.5, tmp_path / "e.log", (),
-                             False)
-    fine, _ = sumo_command(binary, traffic_cfg, files.options, 0.01, tmp_path / "e.log", (),
-                           False)
+    coarse, _ = sumo_command(binary, traffic_cfg, files.options, 0.5, tmp_path / "e.log", (), False)
+    fine, _ = sumo_command(binary, traffic_cfg, files.options, 0.01, tmp_path / "e.log", (), False)
     libsumo.start(coarse)  # plain SUMO at the sumocfg's step
     try:
         while libsumo.simulation.getTime() < DEPART_S - 0.25:
@@ -81,10 +88,13 @@ def test_no_handover_where_the_scenario_does_not_ask_for_a_longer_step(traffic_c
     assert handover_plan(files, "ego", 0.01, {"broken": (0.0, 5.0)}, (), False) is None
     text = traffic_cfg.read_text()
     with_output = tmp_path / "o.sumocfg"
-    with_output.write_text(text.replace(
-        'net-file value="', f'net-file value="{traffic_cfg.parent}/').replace(
-        'route-files value="', f'route-files value="{traffic_cfg.parent}/').replace(
-        "</configuration>", '<output><fcd-output value="fcd.xml"/></output></configuration>'))
+    with_output.write_text(
+        text.replace('net-file value="', f'net-file value="{traffic_cfg.parent}/')
+        .replace('route-files value="', f'route-files value="{traffic_cfg.parent}/')
+        .replace(
+            "</configuration>", '<output><fcd-output value="fcd.xml"/></output></configuration>'
+        )
+    )
     assert handover_plan(check_scenario(with_output), "ego", 0.01, {}, (), False) is None
     baseline = check_scenario(BASELINE)  # its own step is 10 ms: Table 2 is unchanged
     assert handover_plan(baseline, "ego", 0.01, {}, (), False) is None

@@ -28,7 +28,8 @@ def test_lane_change_follows_its_plan(tmp_path):
     matrix.write_text(
         f'[scenario]\nsumocfg = "{REPO / "scenarios" / "baseline.sumocfg"}"\n'
         "max_time_s = 30.0\n"
-        '[sweep]\nego_speed_kmh = [55, 165]\nmu = [1.0, 0.3]\noncoming_start_m = ["none"]\n')
+        '[sweep]\nego_speed_kmh = [55, 165]\nmu = [1.0, 0.3]\noncoming_start_m = ["none"]\n'
+    )
     results = run_batch(matrix, tmp_path / "out", jobs=2, progress=False)
     assert (results["status"] == "ok").all()
     cells = results.set_index(["ego_speed_kmh", "mu"])
@@ -36,7 +37,9 @@ def test_lane_change_follows_its_plan(tmp_path):
         row = cells.loc[cell]
         assert "2" in str(row["modes_visited"]).split("-"), (cell, row["modes_visited"])
         assert row["outcome"] == "green", (cell, row["reason"])
-        ts = pd.read_csv(tmp_path / "out" / row["case_dir"] / "timeseries.csv",
-                         usecols=["mode", "lateral_error_m"])
+        ts = pd.read_csv(
+            tmp_path / "out" / row["case_dir"] / "timeseries.csv",
+            usecols=["mode", "lateral_error_m"],
+        )
         worst = ts.loc[ts["mode"] == 2, "lateral_error_m"].abs().max()
         assert worst <= LIMIT_M, f"{cell}: lane change {worst:.3f} m off its plan"

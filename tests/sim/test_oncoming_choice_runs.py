@@ -41,8 +41,20 @@ def _open_loop_growth(row: dict, steer_rad: float) -> float:
     """Lateral growth of the plant stepped from a logged state, steering held at
     ``steer_rad`` and no brake, until its lateral motion turns."""
     plant = Plant(ego_e_class_sedan())
-    x = [row[k] for k in ("x_m", "y_m", "yaw_rad", "vx_mps", "vy_mps", "yaw_rate_radps",
-                          "steer_rad", "drive_force_n", "brake_force_n")]
+    x = [
+        row[k]
+        for k in (
+            "x_m",
+            "y_m",
+            "yaw_rad",
+            "vx_mps",
+            "vy_mps",
+            "yaw_rate_radps",
+            "steer_rad",
+            "drive_force_n",
+            "brake_force_n",
+        )
+    ]
     y0 = y_max = x[1]
     for _ in range(500):
         x, _ = plant.advance(x, [steer_rad, 0.0, 0.0], row["mu"])
@@ -86,9 +98,10 @@ def test_the_abort_arrests_the_lateral_motion_as_fast_as_the_plant_can():
         row = frame.iloc[i3].to_dict()
         growths[arrest] = frame["lateral_offset_m"].iloc[i3:].max() - row["lateral_offset_m"]
         if arrest:
-            v_lat = (row["vx_mps"] * math.sin(row["yaw_rad"])
-                     + row["vy_mps"] * math.cos(row["yaw_rad"]))
-            point_mass = v_lat ** 2 / (2.0 * row["mu"] * G_MPS2)
+            v_lat = row["vx_mps"] * math.sin(row["yaw_rad"]) + row["vy_mps"] * math.cos(
+                row["yaw_rad"]
+            )
+            point_mass = v_lat**2 / (2.0 * row["mu"] * G_MPS2)
             full_lock = _open_loop_growth(row, -ego_e_class_sedan().max_steer_rad)
     assert point_mass < growths[True] <= full_lock + 0.1
     assert growths[False] > growths[True] + 0.3

@@ -43,8 +43,13 @@ def _hit(kind, face_a="front", face_b="rear", speed=7.2):
 
 def _classify(modes, max_offset, contact_=None, role="none", final_offset=0.0, final_speed=0.0):
     return classify_outcome(
-        modes_visited=modes, max_lateral_offset_m=max_offset, lane_width_m=LANE_M,
-        contact=contact_, role=role, final_offset_m=final_offset, final_speed_mps=final_speed,
+        modes_visited=modes,
+        max_lateral_offset_m=max_offset,
+        lane_width_m=LANE_M,
+        contact=contact_,
+        role=role,
+        final_offset_m=final_offset,
+        final_speed_mps=final_speed,
     )
 
 
@@ -167,7 +172,9 @@ def test_red_frontal_hit_on_oncoming_without_lane_change():
 def test_orange_any_other_contact_after_a_lane_change(hit, role, collision_with):
     out = _classify(LANE_CHANGE, 3.4, hit, role)
     assert (out.colour, out.collision_with, out.impact_speed_mps) == (
-        "orange", collision_with, hit.impact_speed_mps,
+        "orange",
+        collision_with,
+        hit.impact_speed_mps,
     )
     assert out.reason.startswith("lane change, ")
 
@@ -185,9 +192,9 @@ def test_point_of_no_return_threshold_separates_yellow_from_orange():
     assert _classify(PONR_PASSED, PONR_M, hit, "aro").colour == "orange"
     assert _classify(PONR_PASSED, -PONR_M, hit, "aro").colour == "orange"  # |d| counts
     loose = OutcomeSettings(point_of_no_return_fraction=0.5)
-    assert classify_outcome(
-        ONCOMING_ABORT, 1.5, LANE_M, hit, "aro", settings=loose
-    ).colour == "yellow"
+    assert (
+        classify_outcome(ONCOMING_ABORT, 1.5, LANE_M, hit, "aro", settings=loose).colour == "yellow"
+    )
 
 
 # --- from real box geometry to a colour ---------------------------------------------------
@@ -271,7 +278,6 @@ def test_aborted_steer_that_drifts_past_the_ponr_is_still_limit_braking():
     assert out.colour == "yellow" and "limit braking" in out.reason
 
 
-
 # --- loss of control and road departure without contact (rule 1) ---------------------------
 
 RIGHT_EDGE_M = -0.5 * LANE_M  # road frame of the ego lane: its right marker
@@ -279,12 +285,33 @@ LEFT_EDGE_M = 1.5 * LANE_M  # with one lane to the left
 DEFAULTS = OutcomeSettings()
 
 
-def _motion(modes=LANE_CHANGE, max_offset=3.6, hit=None, role="none", final_offset=0.0,
-            final_speed=25.0, heading=0.1, min_speed=20.0, min_offset=-0.2, max_offset_d=None,
-            left_width=LANE_M, lane_width=LANE_M, settings=DEFAULTS):
+def _motion(
+    modes=LANE_CHANGE,
+    max_offset=3.6,
+    hit=None,
+    role="none",
+    final_offset=0.0,
+    final_speed=25.0,
+    heading=0.1,
+    min_speed=20.0,
+    min_offset=-0.2,
+    max_offset_d=None,
+    left_width=LANE_M,
+    lane_width=LANE_M,
+    settings=DEFAULTS,
+):
     return classify_outcome(
-        modes, max_offset, lane_width, hit, role, final_offset, final_speed, settings,
-        max_abs_heading_error_rad=heading, min_speed_mps=min_speed, min_offset_m=min_offset,
+        modes,
+        max_offset,
+        lane_width,
+        hit,
+        role,
+        final_offset,
+        final_speed,
+        settings,
+        max_abs_heading_error_rad=heading,
+        min_speed_mps=min_speed,
+        min_offset_m=min_offset,
         max_offset_m=max_offset if max_offset_d is None else max_offset_d,
         left_width_m=left_width,
     )
@@ -293,8 +320,14 @@ def _motion(modes=LANE_CHANGE, max_offset=3.6, hit=None, role="none", final_offs
 def test_orange_spin_on_ice_without_contact():
     """A spin on a 0.05 ice patch, heading 2.2 rad off, vx -8 m/s, d 6.4 m on a two-lane
     road: orange, not green "lane change completed, returned to lane"."""
-    out = _motion(max_offset=6.4, final_offset=0.2, final_speed=-8.0, heading=2.2,
-                  min_speed=-8.0, min_offset=-0.3)
+    out = _motion(
+        max_offset=6.4,
+        final_offset=0.2,
+        final_speed=-8.0,
+        heading=2.2,
+        min_speed=-8.0,
+        min_offset=-0.3,
+    )
     assert (out.colour, out.collision_with, out.impact_speed_mps) == ("orange", "none", 0.0)
     assert out.reason == (
         "lane change, no contact; lost control: heading 2.20 rad (126 deg) off the road; "
@@ -305,8 +338,9 @@ def test_orange_spin_on_ice_without_contact():
 def test_orange_heading_alone():
     out = _motion(heading=1.3)
     assert (out.colour, out.collision_with) == ("orange", "none")
-    assert out.reason == ("lane change, no contact; lost control: heading 1.30 rad (74 deg) off "
-                          "the road")
+    assert out.reason == (
+        "lane change, no contact; lost control: heading 1.30 rad (74 deg) off the road"
+    )
     assert _motion(heading=-1.3) == out  # |heading| counts
     assert _motion(heading=LOST_CONTROL_HEADING_RAD).colour == "green"
     assert _motion(heading=LOST_CONTROL_HEADING_RAD + 1e-9).colour == "orange"
@@ -327,16 +361,24 @@ def test_orange_going_backwards_alone():
 def test_orange_left_the_road_to_the_right():
     out = _motion(min_offset=RIGHT_EDGE_M - 4.1)
     assert (out.colour, out.collision_with) == ("orange", "none")
-    assert out.reason == ("lane change, no contact; left the road: centre 4.1 m beyond its right "
-                          "edge")
+    assert out.reason == (
+        "lane change, no contact; left the road: centre 4.1 m beyond its right edge"
+    )
     assert _motion(min_offset=RIGHT_EDGE_M - ROAD_EDGE_MARGIN_M).colour == "green"
     assert _motion(min_offset=RIGHT_EDGE_M - ROAD_EDGE_MARGIN_M - 1e-9).colour == "orange"
 
 
 def test_orange_not_none_for_a_car_that_left_the_road_without_any_manoeuvre():
     """43 m off the road with the EOAM never triggered: orange, not ``none``."""
-    out = _motion([0], 44.75, final_offset=-44.75, heading=0.4, min_speed=25.0,
-                  min_offset=RIGHT_EDGE_M - 43.0, max_offset_d=0.0)
+    out = _motion(
+        [0],
+        44.75,
+        final_offset=-44.75,
+        heading=0.4,
+        min_speed=25.0,
+        min_offset=RIGHT_EDGE_M - 43.0,
+        max_offset_d=0.0,
+    )
     assert (out.colour, out.collision_with) == ("orange", "none")
     assert out.reason == (
         "no EOAM intervention, no contact; left the road: centre 43.0 m beyond its right edge"
@@ -370,14 +412,22 @@ def test_orange_left_the_road_to_the_left_depends_on_the_lane_there():
         (5.0, LANE_CHANGE, 5.0, -0.1, 0.70, 3.1, 5.5),
     ],
 )
-def test_normal_runs_stay_green(lane_width, modes, max_offset, min_offset, heading, min_speed,
-                                final_speed):
+def test_normal_runs_stay_green(
+    lane_width, modes, max_offset, min_offset, heading, min_speed, final_speed
+):
     final_offset = 0.05
-    old = classify_outcome(modes, max_offset, lane_width, None, "none", final_offset,
-                           final_speed)
-    new = _motion(modes, max_offset, final_offset=final_offset, final_speed=final_speed,
-                  heading=heading, min_speed=min_speed, min_offset=min_offset,
-                  left_width=lane_width, lane_width=lane_width)
+    old = classify_outcome(modes, max_offset, lane_width, None, "none", final_offset, final_speed)
+    new = _motion(
+        modes,
+        max_offset,
+        final_offset=final_offset,
+        final_speed=final_speed,
+        heading=heading,
+        min_speed=min_speed,
+        min_offset=min_offset,
+        left_width=lane_width,
+        lane_width=lane_width,
+    )
     assert new == old and new.colour == "green"
 
 
@@ -392,19 +442,28 @@ def test_contact_keeps_the_contact_rules_after_a_loss_of_control():
 
 
 def test_settings_move_the_thresholds():
-    loose = OutcomeSettings(lost_control_heading_rad=3.0, reversing_speed_mps=-10.0,
-                            road_edge_margin_m=50.0)
+    loose = OutcomeSettings(
+        lost_control_heading_rad=3.0, reversing_speed_mps=-10.0, road_edge_margin_m=50.0
+    )
     out = _motion(heading=2.2, min_speed=-8.0, min_offset=RIGHT_EDGE_M - 43.0, settings=loose)
     assert out.colour == "green"
-    for bad in ({"lost_control_heading_rad": 0.0}, {"reversing_speed_mps": 0.0},
-                {"road_edge_margin_m": -0.1}, {"lost_control_heading_rad": math.inf}):
+    for bad in (
+        {"lost_control_heading_rad": 0.0},
+        {"reversing_speed_mps": 0.0},
+        {"road_edge_margin_m": -0.1},
+        {"lost_control_heading_rad": math.inf},
+    ):
         with pytest.raises(ValueError, match=next(iter(bad))):
             OutcomeSettings(**bad)
 
 
 def test_motion_inputs_are_checked():
-    for kwargs in ({"heading": math.nan}, {"min_speed": -math.inf}, {"min_offset": math.nan},
-                   {"max_offset_d": math.inf}):
+    for kwargs in (
+        {"heading": math.nan},
+        {"min_speed": -math.inf},
+        {"min_offset": math.nan},
+        {"max_offset_d": math.inf},
+    ):
         with pytest.raises(ValueError, match="must be finite"):
             _motion(**kwargs)
     with pytest.raises(ValueError, match="left_width_m"):
@@ -434,18 +493,30 @@ def test_road_departure_and_left_road():
     st.floats(-10.0, 50.0),
     st.sampled_from((0.0, LANE_M)),
 )
-def test_motion_rule_invariants(modes, hit, role, min_offset, max_offset, heading, min_speed,
-                                left_width):
+def test_motion_rule_invariants(
+    modes, hit, role, min_offset, max_offset, heading, min_speed, left_width
+):
     role = role if hit else "none"
     max_abs = max(max_offset, -min_offset)
     old = classify_outcome(modes, max_abs, LANE_M, hit, role, 0.0, max(min_speed, 0.0))
     new = classify_outcome(
-        modes, max_abs, LANE_M, hit, role, 0.0, max(min_speed, 0.0),
-        max_abs_heading_error_rad=heading, min_speed_mps=min_speed, min_offset_m=min_offset,
-        max_offset_m=max_offset, left_width_m=left_width,
+        modes,
+        max_abs,
+        LANE_M,
+        hit,
+        role,
+        0.0,
+        max(min_speed, 0.0),
+        max_abs_heading_error_rad=heading,
+        min_speed_mps=min_speed,
+        min_offset_m=min_offset,
+        max_offset_m=max_offset,
+        left_width_m=left_width,
     )
-    off_road = (min_offset < RIGHT_EDGE_M - ROAD_EDGE_MARGIN_M
-                or max_offset > 0.5 * LANE_M + left_width + ROAD_EDGE_MARGIN_M)
+    off_road = (
+        min_offset < RIGHT_EDGE_M - ROAD_EDGE_MARGIN_M
+        or max_offset > 0.5 * LANE_M + left_width + ROAD_EDGE_MARGIN_M
+    )
     lost = abs(heading) > LOST_CONTROL_HEADING_RAD or min_speed < REVERSING_SPEED_MPS
     assert off_road == left_road(min_offset, max_offset, LANE_M, left_width)
     if hit is not None or not (off_road or lost):

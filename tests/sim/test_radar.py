@@ -111,7 +111,8 @@ def test_parked_cars_never_in_path_during_the_manoeuvre(ego_d_m, ego_yaw_deg, re
     """Whatever the ego's lateral position and heading while it steers, parked cars stay parked."""
     rep = _scan(
         [_ahead(s, PARKED_D_M, PARKED) for s in rear_s],
-        front=(0.0, ego_d_m), yaw=math.radians(ego_yaw_deg),
+        front=(0.0, ego_d_m),
+        yaw=math.radians(ego_yaw_deg),
     )
     assert rep.in_path_range_m is None and not rep.oncoming_detected
     assert all(det.category == "stationary_side" for det in rep.detections)
@@ -195,9 +196,7 @@ def test_field_of_view_edges(side, fov_deg):
 def test_box_spanning_the_field_of_view_with_all_corners_outside():
     truck = Body("t", "truck", 30.0, 0.0, math.pi / 2, 5.0, 12.0, 2.0)  # crossing ahead, 12 m
     radar = Radar()
-    assert all(
-        abs(math.atan2(y, x)) > HALF_FOV for x, y in truck.box.corners()
-    )
+    assert all(abs(math.atan2(y, x)) > HALF_FOV for x, y in truck.box.corners())
     rep = _scan([truck], radar=radar)
     assert rep.in_path_range_m == pytest.approx(29.0)
     assert rep.detections[0].road_speed_mps == pytest.approx(0.0, abs=1e-12)
@@ -306,8 +305,15 @@ def test_scene_rotated_and_moved_gives_the_same_report():
         return c * x - s * y + tx, s * x + c * y + ty
 
     def moved(t: Body) -> Body:
-        return Body(t.vid, t.vclass, *move(t.x_m, t.y_m), t.yaw_rad + rot, t.speed_mps,
-                    t.length_m, t.width_m)
+        return Body(
+            t.vid,
+            t.vclass,
+            *move(t.x_m, t.y_m),
+            t.yaw_rad + rot,
+            t.speed_mps,
+            t.length_m,
+            t.width_m,
+        )
 
     scene = [
         _ahead(70.0, 0.2, ARO, 9.0),
@@ -323,8 +329,9 @@ def test_scene_rotated_and_moved_gives_the_same_report():
     for d0, d1 in zip(base.detections, turned.detections, strict=True):
         assert d0.target_index == d1.target_index and d0.category == d1.category
         assert (d1.range_m, d1.range_rate_mps, d1.bearing_rad, d1.d_m, d1.road_speed_mps) == (
-            pytest.approx((d0.range_m, d0.range_rate_mps, d0.bearing_rad, d0.d_m,
-                           d0.road_speed_mps), abs=1e-8)
+            pytest.approx(
+                (d0.range_m, d0.range_rate_mps, d0.bearing_rad, d0.d_m, d0.road_speed_mps), abs=1e-8
+            )
         )
     assert turned.in_path_range_m == pytest.approx(base.in_path_range_m)
     assert turned.oncoming_detected and base.oncoming_detected
@@ -363,7 +370,8 @@ def test_the_nearest_standing_car_in_the_next_lane_is_reported():
     near, far = _ahead(50.0, LANE_M, CAR, 0.0), _ahead(70.0, LANE_M, CAR, 0.0)
     rep = _scan([far, _ahead(30.0, 0.0, ARO, 0.0), near], speed=30.0)
     assert rep.in_path_range_m == pytest.approx(30.0)
-    assert rep.next_lane_range_m == min(d.range_m for d in rep.detections
-                                        if d.category == "in_next_lane")
+    assert rep.next_lane_range_m == min(
+        d.range_m for d in rep.detections if d.category == "in_next_lane"
+    )
     assert 50.0 <= rep.next_lane_range_m < 51.0
     assert _scan([_ahead(40.0, LANE_M, CAR, 25.0)]).next_lane_range_m is None  # moving

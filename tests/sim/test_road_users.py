@@ -94,11 +94,13 @@ def test_every_road_user_with_its_class_wherever_it_is(session):
 def test_a_person_who_arrives_is_dropped(tmp_path, monkeypatch):
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
     cfg = on_highway(
-        tmp_path, '<routes><route id="east" edges="E0"/>'
+        tmp_path,
+        '<routes><route id="east" edges="E0"/>'
         '<vehicle id="ego" type="ego" route="east" depart="0" departPos="100" '
         'departSpeed="0"/>'
         '<person id="p" depart="0" departPos="120"><walk edges="E0" arrivalPos="121.5"/>'
-        "</person></routes>")
+        "</person></routes>",
+    )
     with SumoSession.start(cfg, ScenarioOverrides()) as s:
         assert [b.vid for b in s.nearby(50.0)] == ["p"]
         for _ in range(500):  # 1.5 m at up to 1.39 m/s: arrived within 5 s
@@ -112,12 +114,14 @@ def test_a_long_vehicle_that_departs_later_is_found_by_its_reach(tmp_path, monke
     car's diagonal, within its own), is nearby at its first step, as SUMO's getters say."""
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
     cfg = on_highway(
-        tmp_path, '<routes><vType id="train" vClass="truck" length="60" width="2.5"/>'
+        tmp_path,
+        '<routes><vType id="train" vClass="truck" length="60" width="2.5"/>'
         '<route id="east" edges="E0"/>'
         '<vehicle id="ego" type="ego" route="east" depart="0" departPos="100" '
         'departSpeed="0"/>'
         '<vehicle id="long" type="train" route="east" depart="2" departLane="0" '
-        'departPos="175" departSpeed="0"/></routes>')
+        'departPos="175" departSpeed="0"/></routes>',
+    )
     with SumoSession.start(cfg, ScenarioOverrides()) as s:
         assert s.nearby(20.0) == []
         while "long" not in s.vehicle_ids():

@@ -10,8 +10,9 @@ from hypothesis import strategies as st
 
 from eoam_sumo.sim.roadframe import RoadFrame
 
-ARC_POINTS = [(200 * math.sin(a), 200 * (1 - math.cos(a))) for a in
-              [i * 0.01 for i in range(101)]]  # left-hand arc, radius 200 m, ~200 m long
+ARC_POINTS = [
+    (200 * math.sin(a), 200 * (1 - math.cos(a))) for a in [i * 0.01 for i in range(101)]
+]  # left-hand arc, radius 200 m, ~200 m long
 ARC = RoadFrame(ARC_POINTS)
 
 
@@ -92,8 +93,13 @@ def test_a_straight_edge_stays_straight_up_to_the_curve_it_meets():
     no curvature along the straight until 12.5 m before the curve, the curve's own after."""
     radius, chord = 500.0, 25.0
     pts = [(0.0, 0.0), (1000.0, 0.0)]
-    pts += [(1000.0 + radius * math.sin(k * chord / radius),
-             radius * (1 - math.cos(k * chord / radius))) for k in range(1, 25)]
+    pts += [
+        (
+            1000.0 + radius * math.sin(k * chord / radius),
+            radius * (1 - math.cos(k * chord / radius)),
+        )
+        for k in range(1, 25)
+    ]
     road = RoadFrame(pts)
     for x in [1.0, 100.0, 500.0, 900.0, 985.0]:
         s_m, _, yaw = road.project(x, 0.0)
@@ -110,8 +116,10 @@ def test_locate_starts_the_walk_on_the_return_leg_of_a_hairpin():
     point on the return leg lies level with the first straight; ``locate`` finds its own."""
     radius = 300.0
     pts = [(0.0, 0.0), (1000.0, 0.0)]
-    pts += [(1000.0 + radius * math.sin(a), radius * (1 - math.cos(a)))
-            for a in [k * math.pi / 60 for k in range(1, 60)]]
+    pts += [
+        (1000.0 + radius * math.sin(a), radius * (1 - math.cos(a)))
+        for a in [k * math.pi / 60 for k in range(1, 60)]
+    ]
     pts += [(1000.0, 2 * radius), (0.0, 2 * radius)]
     road = RoadFrame(pts)
     assert road.project(500.0, 2 * radius)[1] == pytest.approx(2 * radius)  # the first leg's

@@ -27,7 +27,7 @@ def person(gap_m: float, d_m: float = -1.13, speed_mps: float = 0.0) -> Body:
 
 @pytest.mark.parametrize(("v_mps", "mu"), [(20.0, 1.0), (10.0, 0.3), (3.0, 0.1)])
 def test_a_standing_person_counts_within_the_stopping_distance_plus_the_margin(v_mps, mu):
-    need = v_mps ** 2 / (2 * mu * G) + CLOSE_AHEAD_MARGIN_M
+    need = v_mps**2 / (2 * mu * G) + CLOSE_AHEAD_MARGIN_M
     assert close(v_mps, person(need - 0.05), mu)
     assert not close(v_mps, person(need + 0.05), mu)
 
@@ -47,9 +47,10 @@ def test_only_ahead_and_in_the_lane_the_ego_is_in():
 def test_a_road_user_driving_away_needs_only_the_difference_of_the_stopping_distances():
     """Both braking at the road's friction, the ego stops behind where a car doing u stops
     when the gap exceeds (v^2 - u^2) / (2 mu g)."""
+
     def car(gap_m, u):
         return Body("c", "passenger", FRONT_M + gap_m + 2.3, 0.0, 0.0, u, 4.6, 1.8)
 
-    need = (20.0 ** 2 - 15.0 ** 2) / (2 * G) + CLOSE_AHEAD_MARGIN_M
+    need = (20.0**2 - 15.0**2) / (2 * G) + CLOSE_AHEAD_MARGIN_M
     assert close(20.0, car(need - 0.05, 15.0)) and not close(20.0, car(need + 0.05, 15.0))
     assert not close(20.0, car(CLOSE_AHEAD_MARGIN_M + 0.05, 25.0))  # faster than the ego

@@ -25,21 +25,32 @@ SAFE_OUTCOMES = ("green", "yellow")
 #: Road users in the opposite lane beside where the ARO stops: a van creeping west at
 #: 1.5 m/s, a cyclist riding west at 5 m/s, a person walking west on the carriageway.
 USERS = {
-    "van": ('<vType id="van" vClass="delivery" length="5.50" width="2.00" maxSpeed="1.50" '
-            'sigma="0" speedDev="0"/><route id="west" edges="-E0"/>'
-            '<vehicle id="van" type="van" route="west" depart="1.00" departPos="{pos}" '
-            'departSpeed="1.50" insertionChecks="none"/>'),
-    "bicycle": ('<vType id="bike" vClass="bicycle" length="1.80" width="0.65" maxSpeed="5.00" '
-                'sigma="0" speedDev="0"/><route id="west" edges="-E0"/>'
-                '<vehicle id="bike" type="bike" route="west" depart="1.00" departPos="{pos}" '
-                'departSpeed="5.00" insertionChecks="none"/>'),
-    "person": ('<person id="walker" depart="1.00" departPos="{pos}">'
-               '<walk edges="-E0" arrivalPos="3990"/></person>'),
+    "van": (
+        '<vType id="van" vClass="delivery" length="5.50" width="2.00" maxSpeed="1.50" '
+        'sigma="0" speedDev="0"/><route id="west" edges="-E0"/>'
+        '<vehicle id="van" type="van" route="west" depart="1.00" departPos="{pos}" '
+        'departSpeed="1.50" insertionChecks="none"/>'
+    ),
+    "bicycle": (
+        '<vType id="bike" vClass="bicycle" length="1.80" width="0.65" maxSpeed="5.00" '
+        'sigma="0" speedDev="0"/><route id="west" edges="-E0"/>'
+        '<vehicle id="bike" type="bike" route="west" depart="1.00" departPos="{pos}" '
+        'departSpeed="5.00" insertionChecks="none"/>'
+    ),
+    "person": (
+        '<person id="walker" depart="1.00" departPos="{pos}">'
+        '<walk edges="-E0" arrivalPos="3990"/></person>'
+    ),
 }
 
 
-def _scenario(tmp_path: Path, *, van_x_m: float | None = None,
-              speed_limit_mps: float | None = None, user: str = "van") -> Path:
+def _scenario(
+    tmp_path: Path,
+    *,
+    van_x_m: float | None = None,
+    speed_limit_mps: float | None = None,
+    user: str = "van",
+) -> Path:
     """The baseline scenario, optionally with a road user of ``USERS`` (front at x =
     ``van_x_m``) and the road's speed limit changed."""
     net = ROOT / "networks" / "highway.net.xml"
@@ -49,19 +60,21 @@ def _scenario(tmp_path: Path, *, van_x_m: float | None = None,
         net.write_text(text)
     routes = (SCENARIOS / "baseline.rou.xml").read_text()
     if van_x_m is not None:
-        routes = routes.replace("<routes>",
-                                "<routes>" + USERS[user].format(pos=4000.0 - van_x_m), 1)
+        routes = routes.replace(
+            "<routes>", "<routes>" + USERS[user].format(pos=4000.0 - van_x_m), 1
+        )
         if user == "person":  # persons come after the vehicles departing with them
-            routes = routes.replace("<routes>" + USERS[user].format(pos=4000.0 - van_x_m),
-                                    "<routes>", 1).replace(
-                "</routes>", USERS[user].format(pos=4000.0 - van_x_m) + "</routes>")
+            routes = routes.replace(
+                "<routes>" + USERS[user].format(pos=4000.0 - van_x_m), "<routes>", 1
+            ).replace("</routes>", USERS[user].format(pos=4000.0 - van_x_m) + "</routes>")
     (tmp_path / "r.rou.xml").write_text(routes)
     cfg = tmp_path / "s.sumocfg"
     cfg.write_text(
         f'<configuration><input><net-file value="{net}"/><route-files value="'
         f'{SCENARIOS / "parked.rou.xml"},r.rou.xml"/><additional-files value="'
         f'{SCENARIOS / "vtypes.add.xml"},{ROOT / "networks" / "highway_parking.add.xml"}"/>'
-        '</input></configuration>')
+        "</input></configuration>"
+    )
     return cfg
 
 
@@ -69,8 +82,9 @@ def _run(cfg, tmp_path, name, policy="paper", v2x_range_m=0.0, radar_model="idea
     # the DMM judges the ARO by its closing speed alone (the paper's rule), so that the ego at
     # 120 km/h changes lanes (judged where the ARO will stop, it brakes to a stop in lane)
     eoam = EoamSettings(obstacle_decel_in_dmm=False)
-    settings = policy_settings(RunSettings(max_time_s=30.0, radar_model=radar_model, eoam=eoam),
-                               policy, v2x_range_m)
+    settings = policy_settings(
+        RunSettings(max_time_s=30.0, radar_model=radar_model, eoam=eoam), policy, v2x_range_m
+    )
     out = tmp_path / name
     summary = run_case(cfg, ScenarioOverrides(**over), out, settings)
     return summary, pd.read_csv(out / "timeseries.csv")
@@ -96,8 +110,17 @@ def test_an_oncoming_car_first_seen_past_the_point_of_no_return_on_mu_03(tmp_pat
 def test_the_safe_policy_with_the_automotive_radar_and_its_tracker(tmp_path, v2x):
     """The same late oncoming car seen through the noisy, tracked automotive radar: the gate
     refuses, the EOAM brakes in lane."""
-    safe, _ = _run(BASELINE, tmp_path, "auto", "safe", v2x, radar_model="automotive",
-                   ego_speed_mps=165 / 3.6, mu=0.3, oncoming_start_m=400.0)
+    safe, _ = _run(
+        BASELINE,
+        tmp_path,
+        "auto",
+        "safe",
+        v2x,
+        radar_model="automotive",
+        ego_speed_mps=165 / 3.6,
+        mu=0.3,
+        oncoming_start_m=400.0,
+    )
     assert safe["outcome"] in SAFE_OUTCOMES, safe["reason"]
     assert 2 not in safe["modes_visited"] and safe["sight_gate"] == "refused"
 
@@ -118,8 +141,15 @@ def test_a_van_creeping_in_the_opposite_lane_beside_the_obstacle_is_not_hit(tmp_
 def test_v2x_opens_the_gate_on_a_free_road(tmp_path):
     """A 90 km/h road (25 m/s limit), the ego at 120 km/h: with every road user equipped and
     a 1000 m range the lane is known free far enough for the lane change."""
-    free, _ = _run(_scenario(tmp_path, speed_limit_mps=25.0), tmp_path, "free", "safe",
-                   1000.0, ego_speed_mps=120 / 3.6, mu=1.0)
+    free, _ = _run(
+        _scenario(tmp_path, speed_limit_mps=25.0),
+        tmp_path,
+        "free",
+        "safe",
+        1000.0,
+        ego_speed_mps=120 / 3.6,
+        mu=1.0,
+    )
     assert free["sight_gate"] == "passed"
     assert free["sight_known_free_m"] >= free["sight_needed_m"]
     assert 2 in free["modes_visited"] and free["outcome"] == "green"
@@ -130,8 +160,7 @@ def test_any_road_user_in_the_opposite_lane_closes_the_gate(tmp_path, user):
     """The same road with a slow road user in the opposite lane 260 m ahead of the ego:
     the gate refuses by the length it leaves free, whatever its kind."""
     cfg = _scenario(tmp_path, van_x_m=360.0, speed_limit_mps=25.0, user=user)
-    blocked, _ = _run(cfg, tmp_path, "blocked", "safe", 1000.0, ego_speed_mps=120 / 3.6,
-                      mu=1.0)
+    blocked, _ = _run(cfg, tmp_path, "blocked", "safe", 1000.0, ego_speed_mps=120 / 3.6, mu=1.0)
     assert blocked["sight_gate"] == "refused"
     assert blocked["sight_known_free_m"] < blocked["sight_needed_m"]
     assert blocked["sight_known_free_m"] < 260.0  # limited by the road user, not by the range
@@ -139,25 +168,36 @@ def test_any_road_user_in_the_opposite_lane_closes_the_gate(tmp_path, user):
     assert blocked["collision_with"] in ("none", "aro")
 
 
-TWO_LANES_NODES = ('<nodes><node id="a" x="0" y="0"/><node id="b" x="3000" y="0"/></nodes>')
-TWO_LANES_EDGES = ('<edges><edge id="fwd" from="a" to="b" numLanes="2" speed="50.0" '
-                   'width="3.5"/></edges>')
+TWO_LANES_NODES = '<nodes><node id="a" x="0" y="0"/><node id="b" x="3000" y="0"/></nodes>'
+TWO_LANES_EDGES = (
+    '<edges><edge id="fwd" from="a" to="b" numLanes="2" speed="50.0" width="3.5"/></edges>'
+)
 
 
 def _two_lane_road(tmp_path: Path, fast_car: bool) -> Path:
     """A one-way road of two lanes with the baseline's ego (120 km/h) and braking ARO in the
     right lane; optionally a car at 45 m/s in the left lane, 60 m behind the ego."""
     netconvert(tmp_path, "n", TWO_LANES_NODES, TWO_LANES_EDGES, "--no-turnarounds", "true")
-    fast = ('<vType id="fast" length="4.7" width="1.8" sigma="0" maxSpeed="45" '
+    fast = (
+        (
+            '<vType id="fast" length="4.7" width="1.8" sigma="0" maxSpeed="45" '
             'lcStrategic="-1" lcKeepRight="0" lcSpeedGain="0" lcCooperative="-1"/>'
             '<vehicle id="fast" type="fast" route="r" depart="1.00" departLane="1" '
-            'departPos="40" departSpeed="45" insertionChecks="none"/>') if fast_car else ""
+            'departPos="40" departSpeed="45" insertionChecks="none"/>'
+        )
+        if fast_car
+        else ""
+    )
     routes = (SCENARIOS / "baseline.rou.xml").read_text().replace('edges="E0"', 'edges="fwd"')
-    (tmp_path / "r.rou.xml").write_text(routes.replace(
-        '<route id="eastbound" edges="fwd"/>',
-        '<route id="eastbound" edges="fwd"/><route id="r" edges="fwd"/>' + fast))
-    return write_sumocfg(tmp_path / "s.sumocfg", "n.net.xml", "r.rou.xml",
-                         [SCENARIOS / "vtypes.add.xml"])
+    (tmp_path / "r.rou.xml").write_text(
+        routes.replace(
+            '<route id="eastbound" edges="fwd"/>',
+            '<route id="eastbound" edges="fwd"/><route id="r" edges="fwd"/>' + fast,
+        )
+    )
+    return write_sumocfg(
+        tmp_path / "s.sumocfg", "n.net.xml", "r.rou.xml", [SCENARIOS / "vtypes.add.xml"]
+    )
 
 
 def test_a_car_closing_from_behind_in_the_next_lane_of_the_same_direction_blocks(tmp_path):
@@ -179,8 +219,17 @@ def test_a_speeder_heard_after_the_commit_is_met_by_the_tie_breaker(tmp_path):
     the point of no return; passing on is predicted to end head-on, braking back into the
     lane softer: the EOAM brakes in lane and nothing is hit."""
     cfg = _scenario(tmp_path, speed_limit_mps=25.0)
-    safe, ts = _run(cfg, tmp_path, "speeder", "safe", 1000.0, ego_speed_mps=120 / 3.6, mu=1.0,
-                    oncoming_start_m=800.0, oncoming_speed_mps=70.0)
+    safe, ts = _run(
+        cfg,
+        tmp_path,
+        "speeder",
+        "safe",
+        1000.0,
+        ego_speed_mps=120 / 3.6,
+        mu=1.0,
+        oncoming_start_m=800.0,
+        oncoming_speed_mps=70.0,
+    )
     assert safe["sight_gate"] == "passed" and safe["tie_break"] == "brake"
     assert safe["modes_visited"][-2:] == [2, 3]
     assert ts[ts["mode"] == 3]["lateral_offset_m"].iloc[0] > PONR_M
@@ -188,8 +237,7 @@ def test_a_speeder_heard_after_the_commit_is_met_by_the_tie_breaker(tmp_path):
 
 
 #: Table 2 cells where the paper policy ends in a head-on (red) with its 100 m radar.
-PAPER_RED_CELLS = ("oncoming_start_m = [500, 400]\nego_speed_kmh = [165, 120]\n"
-                   "mu = [0.3, 0.1]\n")
+PAPER_RED_CELLS = "oncoming_start_m = [500, 400]\nego_speed_kmh = [165, 120]\nmu = [0.3, 0.1]\n"
 
 
 @pytest.mark.parametrize("v2x", [0.0, 1000.0])
@@ -198,8 +246,9 @@ def test_a_safe_batch_over_the_papers_red_cells_has_no_red_or_orange(tmp_path, v
     no red, no orange; results.csv carries the policy, the V2X link and the sight figures,
     table2.md names the policy and lists every cell's sight distance."""
     scenario = 'policy = "safe"\n' + (f"v2x_range_m = {v2x}\n" if v2x else "")
-    matrix = write_matrix(tmp_path / "red.toml", PAPER_RED_CELLS, scenario=scenario,
-                          paper_table=True)
+    matrix = write_matrix(
+        tmp_path / "red.toml", PAPER_RED_CELLS, scenario=scenario, paper_table=True
+    )
     results = run_batch(matrix, tmp_path / "out", jobs=2, progress=False)
     assert len(results) == 8 and (results["status"] == "ok").all()
     assert not results["outcome"].isin(["red", "orange"]).any(), results["reason"].tolist()

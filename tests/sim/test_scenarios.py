@@ -277,13 +277,15 @@ def test_nearby_agrees_with_sumo_at_every_step(open_session):
 
     def reach(vid):
         t = libsumo.vehicle.getTypeID(vid)
-        return radius + math.hypot(libsumo.vehicletype.getLength(t),
-                                   libsumo.vehicletype.getWidth(t))
+        return radius + math.hypot(
+            libsumo.vehicletype.getLength(t), libsumo.vehicletype.getWidth(t)
+        )
 
     for k in range(600):
         ego_front = libsumo.vehicle.getPosition(s.ego_id)
         want = sorted(
-            vid for vid in s.vehicle_ids()
+            vid
+            for vid in s.vehicle_ids()
             if vid != s.ego_id
             and math.dist(libsumo.vehicle.getPosition(vid), ego_front) <= reach(vid)
         )
@@ -484,12 +486,15 @@ def test_an_ego_alone_in_the_simulation_is_sensed_and_stepped(tmp_path, open_ses
 
 @pytest.mark.sumo
 @pytest.mark.parametrize("ego_first", [True, False])
-def test_the_ego_may_be_listed_after_a_vehicle_departing_with_it(tmp_path, open_session,
-                                                                 ego_first):
-    ego = ('<vehicle id="ego" type="ego" route="r" depart="1.00" departPos="100" '
-           'departSpeed="30" insertionChecks="none"/>')
-    aro = ('<vehicle id="aro" type="aro" route="r" depart="1.00" departPos="225" '
-           'departSpeed="16" insertionChecks="none"/>')
+def test_the_ego_may_be_listed_after_a_vehicle_departing_with_it(tmp_path, open_session, ego_first):
+    ego = (
+        '<vehicle id="ego" type="ego" route="r" depart="1.00" departPos="100" '
+        'departSpeed="30" insertionChecks="none"/>'
+    )
+    aro = (
+        '<vehicle id="aro" type="aro" route="r" depart="1.00" departPos="225" '
+        'departSpeed="16" insertionChecks="none"/>'
+    )
     pair = ego + aro if ego_first else aro + ego
     s = open_session(on_highway(tmp_path, f'<routes><route id="r" edges="E0"/>{pair}</routes>'))
     assert s.time_s == pytest.approx(1.01)
@@ -515,19 +520,28 @@ def test_a_trip_ego_gets_the_route_sumo_finds(open_session, user_scenario):
 @pytest.mark.sumo
 def test_an_ego_faster_than_the_lane_limit_starts_at_its_speed(open_session):
     limit = EGO_LANE.getSpeed()
-    s = open_session(BASELINE, ScenarioOverrides(ego_speed_mps=limit + 10.0,
-                                                 oncoming_start_m=500.0,
-                                                 oncoming_speed_mps=limit + 5.0))
+    s = open_session(
+        BASELINE,
+        ScenarioOverrides(
+            ego_speed_mps=limit + 10.0, oncoming_start_m=500.0, oncoming_speed_mps=limit + 5.0
+        ),
+    )
     assert s.ego_body().speed_mps == pytest.approx(limit + 10.0)
     s.step()
     assert s.vehicle_speed(s.oncoming_id) == pytest.approx(limit + 5.0)
 
 
-@pytest.mark.parametrize("old,new", [
-    ('friction="1.00"', 'friction="2.00"'), ('friction="1.00"', 'friction="abc"'),
-    ('friction="1.00"', 'friction="0.00"'), ('width="3.50"', 'width="abc"'),
-    ('index="0"', 'index="x"'), ('speed="50.00"', 'speed="-1"'),
-])
+@pytest.mark.parametrize(
+    "old,new",
+    [
+        ('friction="1.00"', 'friction="2.00"'),
+        ('friction="1.00"', 'friction="abc"'),
+        ('friction="1.00"', 'friction="0.00"'),
+        ('width="3.50"', 'width="abc"'),
+        ('index="0"', 'index="x"'),
+        ('speed="50.00"', 'speed="-1"'),
+    ],
+)
 def test_bad_lane_numbers_in_the_network_name_the_file(tmp_path, old, new):
     """SUMO segfaults on some of these (friction or width "abc"), or tracebacks followed."""
     net = tmp_path / "bad.net.xml"
@@ -541,11 +555,12 @@ def test_bad_lane_numbers_in_the_network_name_the_file(tmp_path, old, new):
 
 
 @pytest.mark.sumo
-def test_an_ego_type_slower_than_the_requested_speed_still_starts_at_it(tmp_path,
-                                                                       open_session):
-    routes = ('<routes><vType id="slow" maxSpeed="25" speedDev="0" length="4.9" width="1.85"/>'
-              '<route id="r" edges="E0"/><vehicle id="ego" type="slow" route="r" depart="1.00" '
-              'departPos="100" departSpeed="20" insertionChecks="none"/></routes>')
+def test_an_ego_type_slower_than_the_requested_speed_still_starts_at_it(tmp_path, open_session):
+    routes = (
+        '<routes><vType id="slow" maxSpeed="25" speedDev="0" length="4.9" width="1.85"/>'
+        '<route id="r" edges="E0"/><vehicle id="ego" type="slow" route="r" depart="1.00" '
+        'departPos="100" departSpeed="20" insertionChecks="none"/></routes>'
+    )
     s = open_session(on_highway(tmp_path, routes), ScenarioOverrides(ego_speed_mps=100 / 3.6))
     assert s.ego_body().speed_mps == pytest.approx(100 / 3.6)
 
@@ -555,10 +570,12 @@ def test_a_two_way_road_without_neigh_elements_has_its_opposite_lane(tmp_path, o
     """netconvert's default two-way road (no <neigh>): the reverse edge's lane beside the ego's
     is its opposite lane, for the lane change and for the oncoming car."""
     net = network(
-        tmp_path, "plain",
+        tmp_path,
+        "plain",
         '<nodes><node id="w" x="0" y="0"/><node id="e" x="3000" y="0"/></nodes>',
         '<edges><edge id="E0" from="w" to="e" numLanes="1" speed="50" width="3.5"/>'
-        '<edge id="-E0" from="e" to="w" numLanes="1" speed="50" width="3.5"/></edges>')
+        '<edge id="-E0" from="e" to="w" numLanes="1" speed="50" width="3.5"/></edges>',
+    )
     assert "<neigh" not in net.read_text()
     cfg = on_highway(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(), net)
     s = open_session(cfg, ScenarioOverrides(oncoming_start_m=400.0))
@@ -571,12 +588,14 @@ def test_a_two_way_road_without_neigh_elements_has_its_opposite_lane(tmp_path, o
 @pytest.mark.sumo
 def test_a_one_way_road_has_no_opposite_lane(tmp_path, open_session):
     net = network(  # a reverse edge elsewhere is not beside it
-        tmp_path, "oneway",
+        tmp_path,
+        "oneway",
         '<nodes><node id="w" x="0" y="0"/><node id="e" x="3000" y="0"/>'
         '<node id="far" x="3000" y="500"/></nodes>',
         '<edges><edge id="E0" from="w" to="e" numLanes="1" speed="50" width="3.5"/>'
         '<edge id="back" from="e" to="w" numLanes="1" speed="50" width="3.5" '
-        'shape="3000,500 0,500"/></edges>')
+        'shape="3000,500 0,500"/></edges>',
+    )
     cfg = on_highway(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(), net)
     s = open_session(cfg)
     assert not s.left_lane_exists

@@ -22,8 +22,16 @@ ROUTES = """<routes><route id="east" edges="E0"/>
 
 
 def _command(cfg_options: dict, extra=(), gui=False, keep=False):
-    return sumo_command("sumo", Path("s.sumocfg"), cfg_options, 0.01, Path("err.log"),
-                        tuple(extra), gui, keep_gui_open=keep)
+    return sumo_command(
+        "sumo",
+        Path("s.sumocfg"),
+        cfg_options,
+        0.01,
+        Path("err.log"),
+        tuple(extra),
+        gui,
+        keep_gui_open=keep,
+    )
 
 
 def _with_options(cfg: Path, xml: str) -> Path:
@@ -34,15 +42,32 @@ def _with_options(cfg: Path, xml: str) -> Path:
 
 # --------------------------------------------------------------------------- the command line
 def test_options_the_sumocfg_sets_otherwise_are_named_as_overrides():
-    cmd, over = _command({"collision.action": "warn", "step-length": "0.1",
-                          "time-to-teleport": "-1", "no-step-log": "1"})
-    assert over == {"step-length": "0.010", "collision.action": "none",
-                    "no-warnings": "true", "route-steps": "0"}
+    cmd, over = _command(
+        {
+            "collision.action": "warn",
+            "step-length": "0.1",
+            "time-to-teleport": "-1",
+            "no-step-log": "1",
+        }
+    )
+    assert over == {
+        "step-length": "0.010",
+        "collision.action": "none",
+        "no-warnings": "true",
+        "route-steps": "0",
+    }
     # same meaning, other spelling: not an override (numbers by value, SUMO's booleans)
     assert cmd[cmd.index("--time-to-teleport") + 1] == "-1"
-    _, over = _command({"step-length": "0.010", "collision.action": "none",
-                        "time-to-teleport": "-1.0", "no-warnings": "yes", "no-step-log": "on",
-                        "route-steps": "0"})
+    _, over = _command(
+        {
+            "step-length": "0.010",
+            "collision.action": "none",
+            "time-to-teleport": "-1.0",
+            "no-warnings": "yes",
+            "no-step-log": "on",
+            "route-steps": "0",
+        }
+    )
     assert over == {}
 
 
@@ -82,9 +107,11 @@ def test_the_users_error_log_is_kept():
 def test_sumo_runs_with_the_overrides_the_session_names(tmp_path):
     import libsumo
 
-    cfg = _with_options(on_highway(tmp_path, ROUTES),
-                        '<processing><collision.action value="warn"/></processing>'
-                        '<report><no-warnings value="false"/></report>')
+    cfg = _with_options(
+        on_highway(tmp_path, ROUTES),
+        '<processing><collision.action value="warn"/></processing>'
+        '<report><no-warnings value="false"/></report>',
+    )
     with SumoSession.start(cfg, ScenarioOverrides()) as s:
         assert s.sumo_overrides["collision.action"] == "none"
         assert "no-warnings" not in s.sumo_overrides
@@ -98,8 +125,9 @@ def test_sumo_runs_with_the_overrides_the_session_names(tmp_path):
 def test_fcd_output_is_labelled_one_step_before_the_session_time(tmp_path):
     """SUMO labels a step's outputs with its start: the ego the session has at t is in
     fcd-output at t - 0.01 s."""
-    cfg = _with_options(on_highway(tmp_path, ROUTES),
-                        '<output><fcd-output value="fcd.xml"/></output>')
+    cfg = _with_options(
+        on_highway(tmp_path, ROUTES), '<output><fcd-output value="fcd.xml"/></output>'
+    )
     seen = {}
     with SumoSession.start(cfg, ScenarioOverrides()) as s:
         for k in range(5):
@@ -107,17 +135,21 @@ def test_fcd_output_is_labelled_one_step_before_the_session_time(tmp_path):
             s.move_ego(x, -1.75, 90.0, 30.0)
             s.step()
             seen[round(s.time_s, 2)] = x
-    fcd = {round(float(step.get("time")), 2): float(v.get("x"))
-           for step in ET.parse(tmp_path / "fcd.xml").getroot().iter("timestep")
-           for v in step.iter("vehicle") if v.get("id") == "ego"}
+    fcd = {
+        round(float(step.get("time")), 2): float(v.get("x"))
+        for step in ET.parse(tmp_path / "fcd.xml").getroot().iter("timestep")
+        for v in step.iter("vehicle")
+        if v.get("id") == "ego"
+    }
     for t, x in seen.items():
         assert fcd[round(t - 0.01, 2)] == pytest.approx(x, abs=0.006)  # fcd: 2 decimals
 
 
 @pytest.mark.sumo
 def test_recorded_contacts_go_to_the_sumocfg_collision_output(tmp_path):
-    cfg = _with_options(on_highway(tmp_path, ROUTES),
-                        '<output><collision-output value="out/coll.xml"/></output>')
+    cfg = _with_options(
+        on_highway(tmp_path, ROUTES), '<output><collision-output value="out/coll.xml"/></output>'
+    )
     (tmp_path / "out").mkdir()
     with SumoSession.start(cfg, ScenarioOverrides()) as s:
         assert s.collision_output == tmp_path / "out" / "coll.xml"
@@ -132,7 +164,8 @@ def test_recorded_contacts_go_to_the_sumocfg_collision_output(tmp_path):
     assert rec.get("colliderType") == "ego" and rec.get("victimType") == "aro"
     assert float(rec.get("time")) == pytest.approx(t - 0.01)
     assert rec.get("lane") == "E0_0" and float(rec.get("colliderSpeed")) == pytest.approx(
-        ego.speed_mps, abs=0.005)
+        ego.speed_mps, abs=0.005
+    )
     back = [float(v) for v in rec.get("victimBack").split(",")]
     assert back == pytest.approx([halted.x_m - 0.5 * halted.length_m, halted.y_m], abs=0.006)
 
@@ -148,27 +181,33 @@ def test_no_collision_output_asked_for_none_written(tmp_path):
 
 def test_sumos_own_records_are_kept_in_time_order(tmp_path):
     path = tmp_path / "c.xml"
-    path.write_text('<?xml version="1.0"?><!-- by SUMO --><collisions>'
-                    '<collision time="3.00" type="collision" lane="a_0" collider="x" '
-                    'victim="y" colliderType="t" victimType="t" colliderSpeed="1" '
-                    'victimSpeed="0"/></collisions>')
+    path.write_text(
+        '<?xml version="1.0"?><!-- by SUMO --><collisions>'
+        '<collision time="3.00" type="collision" lane="a_0" collider="x" '
+        'victim="y" colliderType="t" victimType="t" colliderSpeed="1" '
+        'victimSpeed="0"/></collisions>'
+    )
     a = Body("ego", "passenger", 10.0, 0.0, 0.0, 20.0, 4.0, 2.0)
     b = Body("p", "pedestrian", 12.0, 0.5, 1.0, 1.0, 0.3, 0.5)
     write_collision_output(path, [CollisionRecord(2.5, "E0_0", 12.0, a, b, "ego", "walker")])
     recs = ET.parse(path).getroot().findall("collision")
     assert [r.get("time") for r in recs] == ["2.50", "3.00"]
-    assert recs[0].get("colliderFront") == "12.00,0.00" and recs[0].get("colliderBack") == \
-        "8.00,0.00"
+    assert (
+        recs[0].get("colliderFront") == "12.00,0.00" and recs[0].get("colliderBack") == "8.00,0.00"
+    )
     write_collision_output(tmp_path / "new.xml", [])  # missing file: written anew, empty
     assert ET.parse(tmp_path / "new.xml").getroot().tag == "collisions"
 
 
-@pytest.mark.parametrize("args,message", [
-    (["--gui-screenshot", "5"], "need --gui"),
-    (["--gui-delay-ms", "20"], "need --gui"),
-    (["--gui", "--gui-screenshot", "5,x"], "not a list of seconds"),
-    (["--gui", "--gui-screenshot", "-1"], "must be numbers >= 0"),
-])
+@pytest.mark.parametrize(
+    "args,message",
+    [
+        (["--gui-screenshot", "5"], "need --gui"),
+        (["--gui-delay-ms", "20"], "need --gui"),
+        (["--gui", "--gui-screenshot", "5,x"], "not a list of seconds"),
+        (["--gui", "--gui-screenshot", "-1"], "must be numbers >= 0"),
+    ],
+)
 def test_gui_options_are_checked_before_sumo_starts(tmp_path, capsys, args, message):
     from eoam_sumo.cli import EXIT_BAD_INPUT, main
 

@@ -47,8 +47,7 @@ def test_ego_row_is_its_box_centre_heading_wrapped_and_vx():
     assert c["y_m"][0] == pytest.approx(5.0 + TO_CENTRE * math.sin(0.3))
     assert c["heading_rad"][0] == pytest.approx(0.3)
     assert c["speed_mps"][0] == -1.5
-    assert (c["length_m"][0], c["width_m"][0], c["vclass"][0]) == (EGO_LEN, EGO_WID,
-                                                                    "passenger")
+    assert (c["length_m"][0], c["width_m"][0], c["vclass"][0]) == (EGO_LEN, EGO_WID, "passenger")
 
 
 def test_roles_relative_to_the_ego_lane():
@@ -67,10 +66,18 @@ def test_roles_relative_to_the_ego_lane():
     log.add(1.0, _ego(100.0), users)
     c = log.columns()
     roles = dict(zip(c["id"], c["role"]))
-    assert roles == {"ego": "ego", "ahead_car": "aro", "behind_car": "other",
-                     "walker": "aro", "pavement": "other", "oncoming": "oncoming",
-                     "parked": "parked", "slow_west": "other", "east_left": "other",
-                     "west_right": "other"}
+    assert roles == {
+        "ego": "ego",
+        "ahead_car": "aro",
+        "behind_car": "other",
+        "walker": "aro",
+        "pavement": "other",
+        "oncoming": "oncoming",
+        "parked": "parked",
+        "slow_west": "other",
+        "east_left": "other",
+        "west_right": "other",
+    }
 
 
 def test_role_follows_the_ego_station_step_by_step():
@@ -81,8 +88,7 @@ def test_role_follows_the_ego_station_step_by_step():
     for k, x in enumerate((150.0, 199.0, 201.0, 250.0)):
         log.add(k * 0.01, _ego(x, 1.75), [aro])
     c = log.columns()
-    assert [r for i, r in zip(c["id"], c["role"]) if i == "aro"] == ["aro", "aro", "other",
-                                                                     "other"]
+    assert [r for i, r in zip(c["id"], c["role"]) if i == "aro"] == ["aro", "aro", "other", "other"]
 
 
 def test_written_file_has_the_columns_and_reads_back(tmp_path):
@@ -102,8 +108,9 @@ def test_written_file_has_the_columns_and_reads_back(tmp_path):
 
 def test_an_id_with_a_comma_is_quoted_and_reads_back(tmp_path):
     log = _log()
-    log.add(1.0, _ego(100.0), [User('car,"7"', "passenger", 150.0, 1.75, 0.0, 5.0, 4.0, 1.8,
-                                    False)])
+    log.add(
+        1.0, _ego(100.0), [User('car,"7"', "passenger", 150.0, 1.75, 0.0, 5.0, 4.0, 1.8, False)]
+    )
     path = tmp_path / "traffic.csv"
     log.write(path)
     assert list(read_traffic(path)["id"]) == ["ego", 'car,"7"']
@@ -113,12 +120,12 @@ def test_parquet_holds_the_same_table(tmp_path):
     import pandas as pd
 
     log = _log()
-    log.add(1.0, _ego(100.0), [User("p", "pedestrian", 120.0, -1.0, 1.0, 1.3, 0.2, 0.5,
-                                    False)])
+    log.add(1.0, _ego(100.0), [User("p", "pedestrian", 120.0, -1.0, 1.0, 1.3, 0.2, 0.5, False)])
     log.write(tmp_path / "traffic.csv")
     log.write(tmp_path / "traffic.parquet")
-    pd.testing.assert_frame_equal(read_traffic(tmp_path / "traffic.csv"),
-                                  pd.read_parquet(tmp_path / "traffic.parquet"))
+    pd.testing.assert_frame_equal(
+        read_traffic(tmp_path / "traffic.csv"), pd.read_parquet(tmp_path / "traffic.parquet")
+    )
 
 
 def test_read_traffic_names_a_damaged_file(tmp_path):
@@ -138,20 +145,32 @@ def test_bad_radius_is_refused():
 
 CURVE = [(200.0 * math.sin(a / 20), 200.0 * (1 - math.cos(a / 20)) - 1.75) for a in range(40)]
 coord = st.floats(-250.0, 250.0, allow_nan=False)
-users = st.lists(st.builds(
-    User, vid=st.sampled_from(["a", "b", "c", "z"]), vclass=st.just("passenger"), x_m=coord,
-    y_m=coord, yaw_rad=st.floats(-4.0, 4.0), speed_mps=st.floats(0.0, 40.0), length_m=st.just(4.5),
-    width_m=st.just(1.8), parked=st.booleans()), max_size=4, unique_by=lambda u: u.vid)
+users = st.lists(
+    st.builds(
+        User,
+        vid=st.sampled_from(["a", "b", "c", "z"]),
+        vclass=st.just("passenger"),
+        x_m=coord,
+        y_m=coord,
+        yaw_rad=st.floats(-4.0, 4.0),
+        speed_mps=st.floats(0.0, 40.0),
+        length_m=st.just(4.5),
+        width_m=st.just(1.8),
+        parked=st.booleans(),
+    ),
+    max_size=4,
+    unique_by=lambda u: u.vid,
+)
 
 
 @settings(max_examples=200, deadline=None)
-@given(steps=st.lists(st.tuples(coord, coord, users), min_size=1, max_size=6),
-       curved=st.booleans())
+@given(steps=st.lists(st.tuples(coord, coord, users), min_size=1, max_size=6), curved=st.booleans())
 def test_had_oncoming_without_the_layout_is_the_layout_s_answer(steps, curved):
     """The summary's shortcut (no rows laid out) answers as the roles column does, on a
     straight and a curved lane (where a road-frame walk depends on where it starts)."""
-    log = TrafficLog("ego", "passenger", EGO_LEN, EGO_WID, TO_CENTRE, CURVE if curved else LANE,
-                     3.5, 150.0)
+    log = TrafficLog(
+        "ego", "passenger", EGO_LEN, EGO_WID, TO_CENTRE, CURVE if curved else LANE, 3.5, 150.0
+    )
     for k, (x, y, near) in enumerate(steps):
         log.add(0.01 * k, _ego(x, y), near)
     fast = log.had_role("oncoming")

@@ -24,24 +24,33 @@ BRAKED = [0, 1, 3]
 
 
 def test_a_direct_rear_hit_after_limit_braking_is_yellow_an_offset_one_orange():
-    direct = classify_outcome(BRAKED, 0.4, LANE_M, REAR_HIT, "aro",
-                              direct_overlap=DIRECT_HIT_MIN_OVERLAP)
+    direct = classify_outcome(
+        BRAKED, 0.4, LANE_M, REAR_HIT, "aro", direct_overlap=DIRECT_HIT_MIN_OVERLAP
+    )
     offset = classify_outcome(BRAKED, 0.4, LANE_M, REAR_HIT, "aro", direct_overlap=0.32)
     assert direct.colour == "yellow"
     assert offset.colour == "orange" and "offset front hit" in offset.reason
     assert "32 %" in offset.reason
 
 
-@pytest.mark.parametrize(("final_offset_m", "running", "colour"), [
-    (2.4, False, "unfinished"),  # cut off 2.4 m into the opposite lane
-    (0.1, True, "unfinished"),  # in lane, but the manoeuvre still under way
-    (0.1, False, "green"),  # back in lane and done: the cut-off changed nothing
-])
-def test_a_run_cut_off_mid_manoeuvre_is_unfinished_never_green(final_offset_m, running,
-                                                                colour):
-    out = classify_outcome([0, 1, 2], 3.6, LANE_M, final_offset_m=final_offset_m,
-                           final_speed_mps=30.0, cut_off="time limit",
-                           manoeuvre_running=running)
+@pytest.mark.parametrize(
+    ("final_offset_m", "running", "colour"),
+    [
+        (2.4, False, "unfinished"),  # cut off 2.4 m into the opposite lane
+        (0.1, True, "unfinished"),  # in lane, but the manoeuvre still under way
+        (0.1, False, "green"),  # back in lane and done: the cut-off changed nothing
+    ],
+)
+def test_a_run_cut_off_mid_manoeuvre_is_unfinished_never_green(final_offset_m, running, colour):
+    out = classify_outcome(
+        [0, 1, 2],
+        3.6,
+        LANE_M,
+        final_offset_m=final_offset_m,
+        final_speed_mps=30.0,
+        cut_off="time limit",
+        manoeuvre_running=running,
+    )
     assert out.colour == colour
     if colour == "unfinished":
         assert "time limit" in out.reason and out.collision_with == "none"
@@ -50,15 +59,19 @@ def test_a_run_cut_off_mid_manoeuvre_is_unfinished_never_green(final_offset_m, r
 def test_unfinished_needs_a_cut_off_and_a_manoeuvre():
     # the loop's own end (settled) is never unfinished; a run without any manoeuvre is none
     assert classify_outcome([0, 1, 2], 3.6, LANE_M, final_offset_m=2.4).colour == "green"
-    assert classify_outcome([0], 0.0, LANE_M, cut_off="time limit",
-                            manoeuvre_running=False).colour == "none"
+    assert (
+        classify_outcome([0], 0.0, LANE_M, cut_off="time limit", manoeuvre_running=False).colour
+        == "none"
+    )
 
 
 def test_returning_behind_the_obstacle_is_not_a_completed_lane_change():
-    behind = classify_outcome([0, 1, 2, 5], 3.6, LANE_M, final_offset_m=0.1,
-                              final_speed_mps=20.0, passed_obstacle=False)
-    ahead = classify_outcome([0, 1, 2, 5], 3.6, LANE_M, final_offset_m=0.1,
-                             final_speed_mps=20.0, passed_obstacle=True)
+    behind = classify_outcome(
+        [0, 1, 2, 5], 3.6, LANE_M, final_offset_m=0.1, final_speed_mps=20.0, passed_obstacle=False
+    )
+    ahead = classify_outcome(
+        [0, 1, 2, 5], 3.6, LANE_M, final_offset_m=0.1, final_speed_mps=20.0, passed_obstacle=True
+    )
     assert behind.colour == "green" and "not completed" in behind.reason
     assert "behind the obstacle" in behind.reason
     assert ahead.reason == "lane change completed, returned to lane, no contact"
@@ -68,10 +81,16 @@ def _box(x, y, yaw=0.0, length=4.9, width=1.85):
     return OrientedBox(x, y, yaw, length, width)
 
 
-@pytest.mark.parametrize(("offset_m", "share"), [
-    (0.0, 1.0), (0.925, 0.5), (0.5, (1.85 - 0.5) / 1.85), (-0.5, (1.85 - 0.5) / 1.85),
-    (1.85, 0.0),
-])
+@pytest.mark.parametrize(
+    ("offset_m", "share"),
+    [
+        (0.0, 1.0),
+        (0.925, 0.5),
+        (0.5, (1.85 - 0.5) / 1.85),
+        (-0.5, (1.85 - 0.5) / 1.85),
+        (1.85, 0.0),
+    ],
+)
 def test_front_overlap_is_the_share_of_the_ego_width_in_line(offset_m, share):
     ego = _box(0.0, 0.0)
     ahead = _box(4.9, offset_m)  # same width, rear touching the ego's front
@@ -106,8 +125,14 @@ def test_time_to_contact_matches_stepping_the_boxes(closing, lateral_speed, offs
     other = _box(30.0, offset_m, math.pi)
     va, vb = (closing, lateral_speed * 0.1), (0.0, 0.0)
     ttc = time_to_contact(ego, other, va, vb)
-    hit = next((k * 1e-3 for k in range(4000) if boxes_overlap(
-        _box(va[0] * k * 1e-3, va[1] * k * 1e-3), other)), math.inf)
+    hit = next(
+        (
+            k * 1e-3
+            for k in range(4000)
+            if boxes_overlap(_box(va[0] * k * 1e-3, va[1] * k * 1e-3), other)
+        ),
+        math.inf,
+    )
     if math.isinf(hit):
         assert ttc > 3.999 or math.isinf(ttc)
     else:

@@ -33,20 +33,25 @@ def _walker(folder: Path, ahead_m: float, speed_kmh: float = 100.0) -> Path:
 def test_a_pedestrian_hit_in_the_lane_is_named_by_id_and_class(tmp_path):
     """12 m ahead at 100 km/h: too close to stop (47 m on a dry road) or to steer around.
     It used to be 'none': contact was tested against vehicles only."""
-    s = run_case(_walker(tmp_path, 12.0), ScenarioOverrides(mu=1.0), None,
-                 RunSettings(max_time_s=10.0))
+    s = run_case(
+        _walker(tmp_path, 12.0), ScenarioOverrides(mu=1.0), None, RunSettings(max_time_s=10.0)
+    )
     assert s["outcome"] not in ("none", "green"), s["reason"]
     assert (s["collision_with_id"], s["collision_with_class"]) == ("walker", "pedestrian")
     assert 0.0 < s["contact_overlap"] <= 1.0
     # a 70 kg person takes almost nothing of the ego's speed: m / (m + M) of the closing speed
     assert s["collision_with_mass_kg"] == WALKER_KG
-    assert 0.0 < s["delta_v_ego_mps"] <= WALKER_KG / (WALKER_KG + EGO_KG) * s[
-        "impact_speed_mps"] * (1.0 + 1e-9)
+    assert (
+        0.0
+        < s["delta_v_ego_mps"]
+        <= WALKER_KG / (WALKER_KG + EGO_KG) * s["impact_speed_mps"] * (1.0 + 1e-9)
+    )
 
 
 def test_a_pedestrian_walking_in_the_lane_ahead_is_never_none(tmp_path):
-    s = run_case(_walker(tmp_path, 250.0), ScenarioOverrides(mu=1.0), None,
-                 RunSettings(max_time_s=30.0))
+    s = run_case(
+        _walker(tmp_path, 250.0), ScenarioOverrides(mu=1.0), None, RunSettings(max_time_s=30.0)
+    )
     assert s["outcome"] != "none", s["reason"]
     assert s["fcw_raised"] is True
     if s["collision_with"] != "none":
@@ -60,7 +65,10 @@ def test_a_head_on_with_a_van_creeping_at_1_5_mps_is_red_and_names_the_van(tmp_p
     s = run_case(cfg, ScenarioOverrides(ego_speed_mps=165 / 3.6, mu=1.0), None, RunSettings())
     assert s["outcome"] == "red", s["reason"]
     assert (s["collision_with"], s["collision_with_id"], s["collision_with_class"]) == (
-        "oncoming", "van", "delivery")
+        "oncoming",
+        "van",
+        "delivery",
+    )
     assert s["contact_kind"] in ("head_on", "oblique")
     assert s["collision_with_mass_kg"] == VAN_KG
     ratio = s["delta_v_ego_mps"] / s["impact_speed_mps"]
@@ -70,8 +78,12 @@ def test_a_head_on_with_a_van_creeping_at_1_5_mps_is_red_and_names_the_van(tmp_p
 def test_a_head_on_between_two_cars_shares_the_closing_speed_by_mass():
     """Table 2's 400 m, 165 km/h, mu 0.1 case: the oncoming car is hit head-on. Plastic impact
     of 1723 kg and 1500 kg: the ego's delta-v is 1500 / 3223 = 0.47 of the closing speed."""
-    s = run_case(BASELINE, ScenarioOverrides(ego_speed_mps=165 / 3.6, mu=0.1,
-                                             oncoming_start_m=400.0), None, RunSettings())
+    s = run_case(
+        BASELINE,
+        ScenarioOverrides(ego_speed_mps=165 / 3.6, mu=0.1, oncoming_start_m=400.0),
+        None,
+        RunSettings(),
+    )
     assert s["outcome"] == "red" and s["contact_kind"] == "head_on"
     assert (s["collision_with_id"], s["collision_with_class"]) == ("oncoming", "passenger")
     ratio = s["delta_v_ego_mps"] / s["impact_speed_mps"]

@@ -11,6 +11,12 @@ from eoam_sumo.sim.scenario.overrides import ScenarioOverrides
 from eoam_sumo.sim.scenario.stops import DECEL_KEY, HOLD_KEY, ROLE_KEY, scripted_stops
 
 __all__ = [
-    "DECEL_KEY", "HOLD_KEY", "ROLE_KEY", "ScenarioFiles", "ScenarioOverrides", "VehicleSpec",
-    "check_scenario", "scripted_stops",
+    "DECEL_KEY",
+    "HOLD_KEY",
+    "ROLE_KEY",
+    "ScenarioFiles",
+    "ScenarioOverrides",
+    "VehicleSpec",
+    "check_scenario",
+    "scripted_stops",
 ]

@@ -56,8 +56,11 @@ def read_net(path: Path) -> dict:
                     frm, to, left = edges[edge_id]
                     index = int(elem.get("index", "0"))
                     if left is None or index > left[0]:
-                        edges[edge_id] = (frm, to, (index, lane_id, elem.get("width", "3.2"),
-                                                    elem.get("shape", "")))
+                        edges[edge_id] = (
+                            frm,
+                            to,
+                            (index, lane_id, elem.get("width", "3.2"), elem.get("shape", "")),
+                        )
             elif event == "start" and elem.tag == "neigh" and lane_id is not None:
                 opposite[lane_id] = elem.get("lane")
             elif event == "end" and elem.tag in ("edge", "junction", "connection", "tlLogic"):
@@ -98,8 +101,13 @@ def _check_lane_numbers(path: Path, lane_id: str | None, lane: ET.Element) -> No
     """A lane's numbers, where given, must be numbers in range (SUMO itself crashes on some
     that are not): ``friction`` in (0, MU_MAX], ``width``, ``length`` and ``speed`` > 0,
     ``index`` a whole number >= 0."""
-    for key, top in (("friction", MU_MAX), ("width", math.inf), ("length", math.inf),
-                     ("speed", math.inf), ("index", math.inf)):
+    for key, top in (
+        ("friction", MU_MAX),
+        ("width", math.inf),
+        ("length", math.inf),
+        ("speed", math.inf),
+        ("index", math.inf),
+    ):
         text = lane.get(key)
         if text is None:
             continue
@@ -109,6 +117,9 @@ def _check_lane_numbers(path: Path, lane_id: str | None, lane: ET.Element) -> No
             value = math.nan
         low_ok = value >= 0 if key == "index" else value > 0.0
         if not (low_ok and value <= top and math.isfinite(value)):
-            bound = "a whole number >= 0" if key == "index" else (
-                f"a number in (0, {top:g}]" if math.isfinite(top) else "a number > 0")
+            bound = (
+                "a whole number >= 0"
+                if key == "index"
+                else (f"a number in (0, {top:g}]" if math.isfinite(top) else "a number > 0")
+            )
             raise InputError(f"{path}: lane '{lane_id}' {key}={text!r} must be {bound}")

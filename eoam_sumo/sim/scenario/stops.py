@@ -19,8 +19,9 @@ HOLD_KEY = "eoam.aro_hold_s"
 DECEL_KEY = "eoam.aro_decel_mps2"
 
 
-def scripted_stops(files: ScenarioFiles, overrides: ScenarioOverrides,
-                   ego_id: str | None = None) -> dict:
+def scripted_stops(
+    files: ScenarioFiles, overrides: ScenarioOverrides, ego_id: str | None = None
+) -> dict:
     """Vehicle id -> (hold_s, decel_mps2) for every vehicle whose stop is scripted (not the
     ego's: the plant drives it, whatever its parameters say)."""
     stops, aro_seen = {}, False

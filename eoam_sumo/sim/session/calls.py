@@ -34,14 +34,13 @@ class StepCalls:
 
         #: one SUMO step, called with 0.0 (libsumo's ``simulation_step`` is its
         #: ``simulationStep`` less the step listeners)
-        self.step: Callable[..., Any] = getattr(native, "simulation_step", None) \
-            or api.simulationStep
+        self.step: Callable[..., Any] = (
+            getattr(native, "simulation_step", None) or api.simulationStep
+        )
         self.time: Callable[..., Any] = bind("simulation", "getTime")
         self.departed_ids: Callable[..., Any] = bind("simulation", "getDepartedIDList")
-        self.departed_person_ids: Callable[..., Any] = bind("simulation",
-                                                            "getDepartedPersonIDList")
-        self.arrived_person_ids: Callable[..., Any] = bind("simulation",
-                                                           "getArrivedPersonIDList")
+        self.departed_person_ids: Callable[..., Any] = bind("simulation", "getDepartedPersonIDList")
+        self.arrived_person_ids: Callable[..., Any] = bind("simulation", "getArrivedPersonIDList")
         self.move_to_xy: Callable[..., Any] = bind("vehicle", "moveToXY")
         self.set_speed: Callable[..., Any] = bind("vehicle", "setSpeed")
         self.angle: Callable[..., Any] = bind("vehicle", "getAngle")
@@ -49,6 +48,5 @@ class StepCalls:
         self.stop_state: Callable[..., Any] = bind("vehicle", "getStopState")
         self.type_id: Callable[..., Any] = bind("vehicle", "getTypeID")
         self.vehicle_results: Callable[..., Any] = bind("vehicle", "getAllSubscriptionResults")
-        self.context_results: Callable[..., Any] = bind("vehicle",
-                                                        "getContextSubscriptionResults")
+        self.context_results: Callable[..., Any] = bind("vehicle", "getContextSubscriptionResults")
         self.person_results: Callable[..., Any] = bind("person", "getAllSubscriptionResults")

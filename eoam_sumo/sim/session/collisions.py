@@ -37,10 +37,15 @@ class CollisionRecord:
     def attributes(self) -> dict:
         """The ``<collision>`` element's attributes, formatted as SUMO writes them."""
         return {
-            "time": f"{self.time_s:.2f}", "type": self.kind, "lane": self.lane,
-            "pos": f"{self.pos_m:.2f}", "collider": self.collider.vid,
-            "victim": self.victim.vid, "colliderType": self.collider_type,
-            "victimType": self.victim_type, "colliderSpeed": f"{self.collider.speed_mps:.2f}",
+            "time": f"{self.time_s:.2f}",
+            "type": self.kind,
+            "lane": self.lane,
+            "pos": f"{self.pos_m:.2f}",
+            "collider": self.collider.vid,
+            "victim": self.victim.vid,
+            "colliderType": self.collider_type,
+            "victimType": self.victim_type,
+            "colliderSpeed": f"{self.collider.speed_mps:.2f}",
             "victimSpeed": f"{self.victim.speed_mps:.2f}",
             "colliderFront": _bumper(self.collider, 0.5),
             "colliderBack": _bumper(self.collider, -0.5),
@@ -52,8 +57,10 @@ class CollisionRecord:
 def _bumper(body: Body, along: float) -> str:
     """'x,y' of the centre of a body's front (along 0.5) or rear (-0.5) bumper."""
     reach = along * body.length_m
-    return (f"{body.x_m + reach * math.cos(body.yaw_rad):.2f},"
-            f"{body.y_m + reach * math.sin(body.yaw_rad):.2f}")
+    return (
+        f"{body.x_m + reach * math.cos(body.yaw_rad):.2f},"
+        f"{body.y_m + reach * math.sin(body.yaw_rad):.2f}"
+    )
 
 
 def write_collision_output(path: Path, records: list[CollisionRecord]) -> None:

@@ -37,8 +37,9 @@ class GuiSettings:
     keep_open: bool = True  # the window stays until closed; False: it closes with the run
 
     def __post_init__(self) -> None:
-        if self.delay_ms is not None and not (math.isfinite(self.delay_ms)
-                                              and self.delay_ms >= 0.0):
+        if self.delay_ms is not None and not (
+            math.isfinite(self.delay_ms) and self.delay_ms >= 0.0
+        ):
             raise InputError(f"gui delay {self.delay_ms!r} ms must be a number >= 0")
         if any(not (math.isfinite(t) and t >= 0.0) for t in self.screenshots_s):
             raise InputError(f"screenshot times {self.screenshots_s!r} must be numbers >= 0 s")
@@ -51,8 +52,14 @@ class GuiSettings:
 class GuiView:
     """The running side of :class:`GuiSettings` for one session."""
 
-    def __init__(self, api, settings: GuiSettings, step_s: float,
-                 cfg_delay_ms: float | None = None, cfg_gui_settings: bool = False) -> None:
+    def __init__(
+        self,
+        api,
+        settings: GuiSettings,
+        step_s: float,
+        cfg_delay_ms: float | None = None,
+        cfg_gui_settings: bool = False,
+    ) -> None:
         self._gui, self.settings = api.gui, settings
         self._scheme = None if cfg_gui_settings else SCHEME
         delay_ms = settings.delay_ms if settings.delay_ms is not None else cfg_delay_ms

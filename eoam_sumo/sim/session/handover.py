@@ -24,12 +24,27 @@ from pathlib import Path
 from eoam_sumo.sim.scenario import ScenarioFiles
 
 #: Options naming files SUMO writes during the run (besides those ending in "output"/"dump").
-_WRITING_OPTIONS = ("summary", "tripinfo", "vehroute", "log", "message-log", "error-log",
-                    "save-state.times", "save-state.period", "save-state.files",
-                    "output-prefix")
+_WRITING_OPTIONS = (
+    "summary",
+    "tripinfo",
+    "vehroute",
+    "log",
+    "message-log",
+    "error-log",
+    "save-state.times",
+    "save-state.period",
+    "save-state.files",
+    "output-prefix",
+)
 #: Options of the coarse run: the state written at full precision, with what a restart needs.
-SAVE_STATE_OPTIONS = ("--save-state.precision", "17", "--save-state.rng", "true",
-                      "--save-state.transportables", "true")
+SAVE_STATE_OPTIONS = (
+    "--save-state.precision",
+    "17",
+    "--save-state.rng",
+    "true",
+    "--save-state.transportables",
+    "true",
+)
 STATE_FILE = "handover.state.xml"
 
 
@@ -44,23 +59,36 @@ def _number(text) -> float | None:
 def _writes_files(options: dict) -> bool:
     return any(
         key.endswith(("output", "dump")) or key in _WRITING_OPTIONS
-        for key, value in options.items() if value
+        for key, value in options.items()
+        if value
     )
 
 
-def handover_plan(files: ScenarioFiles, ego_id: str, step_s: float, scripted: dict,
-                  extra: tuple[str, ...], gui: bool) -> tuple[float, float] | None:
+def handover_plan(
+    files: ScenarioFiles,
+    ego_id: str,
+    step_s: float,
+    scripted: dict,
+    extra: tuple[str, ...],
+    gui: bool,
+) -> tuple[float, float] | None:
     """(the sumocfg's step [s], handover time [s]) when the time before the ego's departure
     is to be run at the sumocfg's step, else None."""
     options = files.options
     coarse = _number(options.get("step-length"))
     given = {a.split("=", 1)[0].lstrip("-") for a in extra if a.startswith("-")}
-    if (coarse is None or coarse <= step_s + 1e-9 or gui or "step-length" in given
-            or "load-state" in given or "load-state" in options or _writes_files(options)):
+    if (
+        coarse is None
+        or coarse <= step_s + 1e-9
+        or gui
+        or "step-length" in given
+        or "load-state" in given
+        or "load-state" in options
+        or _writes_files(options)
+    ):
         return None
     begin = _number(options.get("begin", "0"))
-    departs = [_number(files.vehicles[vid].attrs.get("depart", "0"))
-               for vid in (ego_id, *scripted)]
+    departs = [_number(files.vehicles[vid].attrs.get("depart", "0")) for vid in (ego_id, *scripted)]
     if begin is None or any(d is None for d in departs):
         return None
     until = min(d for d in departs if d is not None)

@@ -59,8 +59,14 @@ def lane_point(lane_api, lane_id: str, pos_m: float) -> tuple[float, float, floa
     return point_at(shape, pos_m * scale)
 
 
-def place_ego(api, errors: tuple, files: ScenarioFiles, overrides: ScenarioOverrides,
-              ego_id: str, over_limit: dict) -> EgoStart:
+def place_ego(
+    api,
+    errors: tuple,
+    files: ScenarioFiles,
+    overrides: ScenarioOverrides,
+    ego_id: str,
+    over_limit: dict,
+) -> EgoStart:
     """Remove the ego SUMO loaded and insert it anew at its route file's lane and position
     with the requested speed (``over_limit`` as for :func:`insert`)."""
     veh, lanes = api.vehicle, api.lane
@@ -78,13 +84,30 @@ def place_ego(api, errors: tuple, files: ScenarioFiles, overrides: ScenarioOverr
     pos = _ego_depart_pos(api, spec, lane_len, type_id)
     speed = _ego_speed(api, spec, lane_id, type_id, overrides)
     veh.remove(ego_id)
-    insert(api, errors, ego_id, type_id, edges, lane_index, pos, speed, EGO_SPEED_MODE,
-           spec.params, over_limit)
-    left_lane = (lane_index < api.edge.getLaneNumber(edges[0]) - 1
-                 or lane_id in files.opposite_lanes)
-    return EgoStart(type_id, edges, lane_index, lane_id, float(lanes.getWidth(lane_id)),
-                    left_lane, lane_point(lanes, lane_id, pos)[:2],
-                    route_centreline(lanes, files, lane_id, edges, lane_index))
+    insert(
+        api,
+        errors,
+        ego_id,
+        type_id,
+        edges,
+        lane_index,
+        pos,
+        speed,
+        EGO_SPEED_MODE,
+        spec.params,
+        over_limit,
+    )
+    left_lane = lane_index < api.edge.getLaneNumber(edges[0]) - 1 or lane_id in files.opposite_lanes
+    return EgoStart(
+        type_id,
+        edges,
+        lane_index,
+        lane_id,
+        float(lanes.getWidth(lane_id)),
+        left_lane,
+        lane_point(lanes, lane_id, pos)[:2],
+        route_centreline(lanes, files, lane_id, edges, lane_index),
+    )
 
 
 def _ego_lane_index(api, spec: VehicleSpec, edge: str, type_id: str) -> int:
@@ -121,8 +144,9 @@ def _ego_depart_pos(api, spec: VehicleSpec, lane_len: float, type_id: str) -> fl
     return pos
 
 
-def _ego_speed(api, spec: VehicleSpec, lane_id: str, type_id: str,
-               overrides: ScenarioOverrides) -> float:
+def _ego_speed(
+    api, spec: VehicleSpec, lane_id: str, type_id: str, overrides: ScenarioOverrides
+) -> float:
     if overrides.ego_speed_mps is not None:
         return overrides.ego_speed_mps
     text = spec.attrs.get("departSpeed", "0")
@@ -132,8 +156,9 @@ def _ego_speed(api, spec: VehicleSpec, lane_id: str, type_id: str,
     return number(f"{spec.source}: vehicle '{spec.vid}' departSpeed", speed, minimum=0.0)
 
 
-def route_centreline(lanes, files: ScenarioFiles, start_lane_id: str, route_edges: list,
-                     lane_index: int) -> np.ndarray:
+def route_centreline(
+    lanes, files: ScenarioFiles, start_lane_id: str, route_edges: list, lane_index: int
+) -> np.ndarray:
     """Centre line of the ego's start lane followed along its route: from each lane over its
     connection (and the junction's internal lanes) to the lane it leads to on the next
     route edge, the one with the same index when there are several."""
@@ -164,8 +189,14 @@ def route_centreline(lanes, files: ScenarioFiles, start_lane_id: str, route_edge
     return np.array(line, dtype=float)
 
 
-def add_oncoming(api, errors: tuple, files: ScenarioFiles, overrides: ScenarioOverrides,
-                 ego: EgoStart, over_limit: dict) -> str:
+def add_oncoming(
+    api,
+    errors: tuple,
+    files: ScenarioFiles,
+    overrides: ScenarioOverrides,
+    ego: EgoStart,
+    over_limit: dict,
+) -> str:
     """Insert the oncoming car of ``overrides.oncoming_start_m`` in the lane opposite the
     ego's, its front bumper that far ahead of the ego's along the road; its id."""
     lanes = api.lane
@@ -212,13 +243,35 @@ def add_oncoming(api, errors: tuple, files: ScenarioFiles, overrides: ScenarioOv
         n += 1
         vid = f"oncoming.{n}"
     index = int(lane_id.rsplit("_", 1)[1])  # SUMO lane ids are <edge>_<index>
-    insert(api, errors, vid, "oncoming", edges, index, pos, overrides.oncoming_speed_mps,
-           ONCOMING_SPEED_MODE, {ROLE_KEY: "oncoming"}, over_limit)
+    insert(
+        api,
+        errors,
+        vid,
+        "oncoming",
+        edges,
+        index,
+        pos,
+        overrides.oncoming_speed_mps,
+        ONCOMING_SPEED_MODE,
+        {ROLE_KEY: "oncoming"},
+        over_limit,
+    )
     return vid
 
 
-def insert(api, errors: tuple, vid: str, type_id: str, edges: list, lane_index: int,
-           pos: float, speed: float, speed_mode: int, params: dict, over_limit: dict) -> None:
+def insert(
+    api,
+    errors: tuple,
+    vid: str,
+    type_id: str,
+    edges: list,
+    lane_index: int,
+    pos: float,
+    speed: float,
+    speed_mode: int,
+    params: dict,
+    over_limit: dict,
+) -> None:
     """Add ``vid`` on a fresh route over ``edges`` at ``pos`` of its first lane, placed there
     exactly with ``moveToXY`` and moving at ``speed`` from the insertion step on. A vehicle
     SUMO lets depart only at rest (above its lane's or type's limit) is entered in
@@ -227,16 +280,30 @@ def insert(api, errors: tuple, vid: str, type_id: str, edges: list, lane_index: 
     route_id = f"eoam.route.{vid}.{uuid.uuid4().hex[:8]}"
     api.route.add(route_id, edges)
     try:
-        veh.add(vid, route_id, type_id, depart="now", departLane=str(lane_index),
-                departPos=repr(float(pos)), departSpeed=repr(float(speed)))
+        veh.add(
+            vid,
+            route_id,
+            type_id,
+            depart="now",
+            departLane=str(lane_index),
+            departPos=repr(float(pos)),
+            departSpeed=repr(float(speed)),
+        )
     except errors as exc:
         if "too high" not in str(exc):
             raise
         # SUMO refuses a departure above the lane's limit times the vehicle's speed factor,
         # or above its type's maximum: depart at rest, with room to go faster; the speed
         # set below applies from the insertion step on (speed modes without limits)
-        veh.add(vid, route_id, type_id, depart="now", departLane=str(lane_index),
-                departPos=repr(float(pos)), departSpeed="0")
+        veh.add(
+            vid,
+            route_id,
+            type_id,
+            depart="now",
+            departLane=str(lane_index),
+            departPos=repr(float(pos)),
+            departSpeed="0",
+        )
         limit = api.lane.getMaxSpeed(f"{edges[0]}_{lane_index}")
         veh.setSpeedFactor(vid, max(veh.getSpeedFactor(vid), speed / limit * (1.0 + 1e-6)))
         veh.setMaxSpeed(vid, max(veh.getMaxSpeed(vid), speed * (1.0 + 1e-6)))

@@ -45,9 +45,16 @@ def _same_value(a: str | None, b: str) -> bool:
         return False
 
 
-def sumo_command(binary: str, cfg: Path, cfg_options: dict, step_s: float, error_log: Path,
-                 extra: tuple[str, ...], gui: bool,
-                 keep_gui_open: bool = False) -> tuple[list[str], dict]:
+def sumo_command(
+    binary: str,
+    cfg: Path,
+    cfg_options: dict,
+    step_s: float,
+    error_log: Path,
+    extra: tuple[str, ...],
+    gui: bool,
+    keep_gui_open: bool = False,
+) -> tuple[list[str], dict]:
     """(command line, overrides): SUMO started on ``cfg`` with the co-simulation's options,
     and option -> value of every one of them that changes what the sumocfg (``cfg_options``,
     its option elements) or SUMO's default gives. Options in ``extra`` win over both. sumo-gui

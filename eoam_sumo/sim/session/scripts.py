@@ -39,8 +39,9 @@ class StopScripts:
         """``vid`` departed: its stop runs from now on (``watch(vid)`` subscribes it)."""
         hold, decel = self._stops[vid]
         self.pending.discard(vid)
-        self.running[vid] = _Script(self._veh.getDeparture(vid) + hold, decel,
-                                    self._veh.getSpeed(vid))
+        self.running[vid] = _Script(
+            self._veh.getDeparture(vid) + hold, decel, self._veh.getSpeed(vid)
+        )
         self._veh.setSpeedMode(vid, SCRIPTED_SPEED_MODE)
         watch(vid)
 

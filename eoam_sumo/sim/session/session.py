@@ -82,17 +82,35 @@ class SumoSession:
 
     _ego: EgoStart  # the ego's start, placed by start() before any query
 
-    def __init__(self, api, constants, errors: tuple, files: ScenarioFiles,
-                 overrides: ScenarioOverrides, ego_id: str, step_length_s: float,
-                 workdir: Path, process=None, sumo_overrides: dict | None = None,
-                 gui: GuiSettings | None = None) -> None:
+    def __init__(
+        self,
+        api,
+        constants,
+        errors: tuple,
+        files: ScenarioFiles,
+        overrides: ScenarioOverrides,
+        ego_id: str,
+        step_length_s: float,
+        workdir: Path,
+        process=None,
+        sumo_overrides: dict | None = None,
+        gui: GuiSettings | None = None,
+    ) -> None:
         self._api, self._tc, self._errors, self._files = api, constants, errors, files
         self._overrides, self.ego_id, self._dt = overrides, ego_id, step_length_s
         self._workdir, self._process = workdir, process
         self.sumo_overrides = dict(sumo_overrides or {})
-        self.gui = None if gui is None else GuiView(
-            api, gui, step_length_s, _delay_ms(files.options.get("delay")),
-            "gui-settings-file" in files.options)
+        self.gui = (
+            None
+            if gui is None
+            else GuiView(
+                api,
+                gui,
+                step_length_s,
+                _delay_ms(files.options.get("delay")),
+                "gui-settings-file" in files.options,
+            )
+        )
         self._collisions: list[CollisionRecord] = []
         output = files.options.get("collision-output")
         self.collision_output = files.cfg.parent / output if output else None
@@ -101,8 +119,7 @@ class SumoSession:
         self._closed = False
         self._time_s = self._sim.getTime()
         self._mu_cache: dict[str, float] = {}
-        self._scripts = StopScripts(api, calls, constants,
-                                    scripted_stops(files, overrides, ego_id))
+        self._scripts = StopScripts(api, calls, constants, scripted_stops(files, overrides, ego_id))
         self._users = RoadUsers(api, calls, constants, ego_id, self._scripts.running)
         self._radius_m: float | None = None
         self._ego_mu = 1.0
@@ -150,22 +167,37 @@ class SumoSession:
 
         os.environ.setdefault("SUMO_HOME", sumo.SUMO_HOME)
         via_traci = gui or use_traci
-        if gui and sys.platform.startswith("linux") and not (
-                os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-            raise InputError("--gui needs a display, and DISPLAY is not set (sumo-gui would "
-                             "fail to connect after 30 s)")
+        if (
+            gui
+            and sys.platform.startswith("linux")
+            and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+        ):
+            raise InputError(
+                "--gui needs a display, and DISPLAY is not set (sumo-gui would "
+                "fail to connect after 30 s)"
+            )
         if not via_traci and _open_libsumo:
             raise RuntimeError("a libsumo session is already open in this process; close it first")
         workdir = Path(tempfile.mkdtemp(prefix="eoam-sumo-"))
         error_log = workdir / "sumo-errors.log"
         binary = sumolib.checkBinary("sumo-gui" if gui else "sumo")
-        cmd, sumo_overrides = sumo_command(binary, files.cfg, files.options, step, error_log,
-                                           extra, gui, keep_gui_open=gui_settings.keep_open)
+        cmd, sumo_overrides = sumo_command(
+            binary,
+            files.cfg,
+            files.options,
+            step,
+            error_log,
+            extra,
+            gui,
+            keep_gui_open=gui_settings.keep_open,
+        )
         plan = handover_plan(files, ego_id, step, scripted, extra, gui)
         first_cmd = cmd
         if plan is not None:
-            first_cmd = [*sumo_command(binary, files.cfg, files.options, plan[0], error_log,
-                                       extra, gui)[0], *SAVE_STATE_OPTIONS]
+            first_cmd = [
+                *sumo_command(binary, files.cfg, files.options, plan[0], error_log, extra, gui)[0],
+                *SAVE_STATE_OPTIONS,
+            ]
         try:
             if via_traci:
                 import traci
@@ -198,8 +230,19 @@ class SumoSession:
             raise
         session = None
         try:
-            session = cls(api, constants, errors, files, overrides, ego_id, step, workdir,
-                          process, sumo_overrides, gui_settings if gui else None)
+            session = cls(
+                api,
+                constants,
+                errors,
+                files,
+                overrides,
+                ego_id,
+                step,
+                workdir,
+                process,
+                sumo_overrides,
+                gui_settings if gui else None,
+            )
             if not via_traci:
                 _open_libsumo.append(session)
             session._set_up()
@@ -236,14 +279,16 @@ class SumoSession:
         while self._time_s < depart - 0.5 * self._dt:
             self._sumo_step()
         self.ego_depart_time_s = self._time_s
-        ego = self._ego = place_ego(self._api, self._errors, self._files, self._overrides,
-                                    self.ego_id, self._over_limit)
+        ego = self._ego = place_ego(
+            self._api, self._errors, self._files, self._overrides, self.ego_id, self._over_limit
+        )
         self.lane_width_m = ego.lane_width_m
         self.left_lane_exists = ego.left_lane_exists
         self._ego_mu = self._friction(ego.lane_id)
         if self._overrides.oncoming_start_m is not None:
-            self.oncoming_id = add_oncoming(self._api, self._errors, self._files,
-                                            self._overrides, ego, self._over_limit)
+            self.oncoming_id = add_oncoming(
+                self._api, self._errors, self._files, self._overrides, ego, self._over_limit
+            )
             self.roles[self.oncoming_id] = "oncoming"
         self._veh.subscribe(self.ego_id, self._users.ego_vars)
         self._sumo_step()
@@ -258,8 +303,9 @@ class SumoSession:
     def _sumo_step(self) -> None:
         scripts, users = self._scripts, self._users
         if scripts.running:
-            scripts.apply(self._time_s + self._dt, self._dt, users.step_results(),
-                          self._friction, users.watch)
+            scripts.apply(
+                self._time_s + self._dt, self._dt, users.step_results(), self._friction, users.watch
+            )
         calls = self._calls
         calls.step(0.0)
         users.new_step()
@@ -389,8 +435,9 @@ class SumoSession:
         """The ego as SUMO sees it."""
         self._ego_results()  # fails when the ego has left
         veh, ego, start = self._veh, self.ego_id, self._ego
-        return self._users.vehicle_body(ego, veh.getPosition(ego), veh.getAngle(ego),
-                                        veh.getSpeed(ego), start.type_id, 0)
+        return self._users.vehicle_body(
+            ego, veh.getPosition(ego), veh.getAngle(ego), veh.getSpeed(ego), start.type_id, 0
+        )
 
     def body(self, vid: str) -> Body:
         """Any road user by id, a vehicle or a person (getters; for checks, not for the step
@@ -398,12 +445,22 @@ class SumoSession:
         self._check_open()
         if vid not in self._veh.getIDList() and vid in self._api.person.getIDList():
             person = self._api.person
-            return self._users.person_body(vid, person.getPosition(vid), person.getAngle(vid),
-                                           person.getSpeed(vid), person.getTypeID(vid))
+            return self._users.person_body(
+                vid,
+                person.getPosition(vid),
+                person.getAngle(vid),
+                person.getSpeed(vid),
+                person.getTypeID(vid),
+            )
         veh = self._veh
-        return self._users.vehicle_body(vid, veh.getPosition(vid), veh.getAngle(vid),
-                                        veh.getSpeed(vid), veh.getTypeID(vid),
-                                        veh.getStopState(vid))
+        return self._users.vehicle_body(
+            vid,
+            veh.getPosition(vid),
+            veh.getAngle(vid),
+            veh.getSpeed(vid),
+            veh.getTypeID(vid),
+            veh.getStopState(vid),
+        )
 
     def mass_kg(self, vid: str) -> float:
         """A road user's mass as SUMO has it (``getMass``: its vType's ``mass``, or SUMO's
@@ -436,8 +493,9 @@ class SumoSession:
             types.append(domain.getTypeID(body.vid))
         lane = self._veh.getLaneID(collider.vid) if collider.vclass != PEDESTRIAN else ""
         pos = self._veh.getLanePosition(collider.vid) if lane else 0.0
-        self._collisions.append(CollisionRecord(time_s - self._dt, lane, pos, collider, victim,
-                                                *types))
+        self._collisions.append(
+            CollisionRecord(time_s - self._dt, lane, pos, collider, victim, *types)
+        )
 
     # ----------------------------------------------------------------------------- life cycle
     def _check_open(self) -> None:

@@ -51,8 +51,7 @@ def _reach2(radius_m: float, body: Body) -> float:
 class RoadUsers:
     """The road users other than the ego, followed through SUMO's subscriptions."""
 
-    def __init__(self, api, calls: StepCalls, constants, ego_id: str,
-                 scripted: Mapping) -> None:
+    def __init__(self, api, calls: StepCalls, constants, ego_id: str, scripted: Mapping) -> None:
         self._api, self._calls, self._tc, self.ego_id = api, calls, constants, ego_id
         self._veh, self._person = api.vehicle, api.person
         self._scripted = scripted  # vid -> its running scripted stop (needs speed and lane)
@@ -69,8 +68,13 @@ class RoadUsers:
         self._sense_vars = [tc.VAR_POSITION]
         if not self._getters:
             self._sense_vars += [tc.VAR_TYPE, tc.VAR_ANGLE, tc.VAR_SPEED, tc.VAR_STOPSTATE]
-        self._person_vars = [tc.VAR_POSITION, tc.VAR_ANGLE, tc.VAR_SPEED, tc.VAR_TYPE,
-                             tc.VAR_VEHICLE]
+        self._person_vars = [
+            tc.VAR_POSITION,
+            tc.VAR_ANGLE,
+            tc.VAR_SPEED,
+            tc.VAR_TYPE,
+            tc.VAR_VEHICLE,
+        ]
         self.ego_vars = [tc.VAR_LANE_ID]  # every step (friction); the pose once tracking
         self._results: dict | None = None  # vehicle subscription results of this step, once read
         self._person_results: dict | None = None
@@ -137,10 +141,10 @@ class RoadUsers:
         if radius_m != self._context_radius_m or diagonal != self._context_diagonal_m:
             range_m = radius_m + diagonal + RANGE_MARGIN_M
             if self._context_radius_m is not None:
-                self._veh.unsubscribeContext(self.ego_id, self._tc.CMD_GET_VEHICLE_VARIABLE,
-                                             0.0)
-            self._veh.subscribeContext(self.ego_id, self._tc.CMD_GET_VEHICLE_VARIABLE,
-                                       range_m, self._sense_vars)
+                self._veh.unsubscribeContext(self.ego_id, self._tc.CMD_GET_VEHICLE_VARIABLE, 0.0)
+            self._veh.subscribeContext(
+                self.ego_id, self._tc.CMD_GET_VEHICLE_VARIABLE, range_m, self._sense_vars
+            )
             self._context_radius_m, self._context_diagonal_m = radius_m, diagonal
         return self._calls.context_results(self.ego_id)
 
@@ -153,23 +157,36 @@ class RoadUsers:
             types = self._api.vehicletype
             length, width = types.getLength(type_id), types.getWidth(type_id)
             known = self._types[type_id] = (
-                length, width, types.getVehicleClass(type_id),
-                2.0 * math.hypot(0.5 * length, 0.5 * width))
+                length,
+                width,
+                types.getVehicleClass(type_id),
+                2.0 * math.hypot(0.5 * length, 0.5 * width),
+            )
         return known
 
-    def vehicle_body(self, vid: str, front: tuple, angle_deg: float, speed: float,
-                     type_id: str, stop_state: int) -> Body:
+    def vehicle_body(
+        self, vid: str, front: tuple, angle_deg: float, speed: float, type_id: str, stop_state: int
+    ) -> Body:
         """Body of a vehicle from SUMO's front position, angle, speed, type and stop state."""
         length, width, vclass, _ = self.type_of(type_id)
-        return Body.from_front(vid, vclass, front[0], front[1], angle_deg, speed, length,
-                               width, bool(stop_state & PARKING_BIT))
+        return Body.from_front(
+            vid,
+            vclass,
+            front[0],
+            front[1],
+            angle_deg,
+            speed,
+            length,
+            width,
+            bool(stop_state & PARKING_BIT),
+        )
 
-    def person_body(self, pid: str, front: tuple, angle_deg: float, speed: float,
-                    type_id: str) -> Body:
+    def person_body(
+        self, pid: str, front: tuple, angle_deg: float, speed: float, type_id: str
+    ) -> Body:
         """Body of a person (vClass ``pedestrian``; SUMO's position is its front too)."""
         length, width, _, _ = self.type_of(type_id)
-        return Body.from_front(pid, PEDESTRIAN, front[0], front[1], angle_deg, speed, length,
-                               width)
+        return Body.from_front(pid, PEDESTRIAN, front[0], front[1], angle_deg, speed, length, width)
 
     def near(self, ex: float, ey: float, radius_m: float) -> list:
         """Bodies of the road users some part of which may be within ``radius_m`` of
@@ -184,13 +201,23 @@ class RoadUsers:
     def everyone(self) -> list:
         """Bodies of all road users, wherever they are (getters: not for the step loop)."""
         veh = self._veh
-        bodies = [self.vehicle_body(vid, veh.getPosition(vid), veh.getAngle(vid),
-                                    veh.getSpeed(vid), veh.getTypeID(vid), veh.getStopState(vid))
-                  for vid in veh.getIDList() if vid != self.ego_id]
+        bodies = [
+            self.vehicle_body(
+                vid,
+                veh.getPosition(vid),
+                veh.getAngle(vid),
+                veh.getSpeed(vid),
+                veh.getTypeID(vid),
+                veh.getStopState(vid),
+            )
+            for vid in veh.getIDList()
+            if vid != self.ego_id
+        ]
         return bodies + self._persons_near(0.0, 0.0, math.inf)
 
-    def _vehicles_near(self, results: dict[str, dict[int, Any]], ex: float, ey: float,
-                       radius_m: float) -> list:
+    def _vehicles_near(
+        self, results: dict[str, dict[int, Any]], ex: float, ey: float, radius_m: float
+    ) -> list:
         """Bodies of the vehicles of ``results`` (this step's context) within reach of
         (ex, ey); a vehicle whose values did not change keeps its body. (The values are typed
         so that the compiled module works out the reach in floats.)"""
@@ -212,8 +239,7 @@ class RoadUsers:
             if (fx - ex) * (fx - ex) + (fy - ey) * (fy - ey) > reach_m * reach_m:
                 continue
             if getters:
-                values = (front, calls.angle(vid), calls.speed(vid), type_id,
-                          calls.stop_state(vid))
+                values = (front, calls.angle(vid), calls.speed(vid), type_id, calls.stop_state(vid))
             else:
                 values = (front, r[angle_k], r[speed_k], type_id, r[stop_k])
             known = bodies.get(vid)
@@ -235,8 +261,9 @@ class RoadUsers:
             if not r or r[tc.VAR_VEHICLE]:  # gone, or riding in a vehicle
                 continue
             if known is None or known[0] != r:
-                body = self.person_body(pid, r[tc.VAR_POSITION], r[tc.VAR_ANGLE],
-                                        r[tc.VAR_SPEED], r[tc.VAR_TYPE])
+                body = self.person_body(
+                    pid, r[tc.VAR_POSITION], r[tc.VAR_ANGLE], r[tc.VAR_SPEED], r[tc.VAR_TYPE]
+                )
                 known = self._persons[pid] = (r, r[tc.VAR_POSITION], body)  # noqa: PLW2901
             (fx, fy), body = known[1], known[2]
             if (fx - ex) * (fx - ex) + (fy - ey) * (fy - ey) <= _reach2(radius_m, body):
