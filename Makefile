@@ -4,26 +4,39 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 OUT    ?= out
-# the modules compiled at install (setup.py): a change to one installs (compiles) again
-COMPILED_SOURCES := $(shell sed -n 's/^ *"\(eoam_sumo\/[a-z0-9_/]*\.py\)",$$/\1/p' setup.py)
+# every direct and transitive dependency, build requirements and pip included, pinned
+# (`make lock` refreshes it; README "Installs")
+LOCK   := constraints.txt
+PIP    := $(BIN)/python -m pip install --quiet --constraint $(LOCK) --build-constraint $(LOCK)
+# the compiled build: a copy of the working tree with the step loop compiled in place by mypyc
+# (setup.py, EOAM_SUMO_COMPILE=1); `make run` and `make bench` run it, `make test` the sources
+COMPILED_TREE := build/compiled
+COMPILED_STAMP := $(COMPILED_TREE)/.built
+TREE_FILES = git ls-files --cached --others --exclude-standard -- \
+	eoam_sumo tables scenarios networks tests/golden setup.py pyproject.toml README.md \
+	| while read -r f; do [ -e "$$f" ] && echo "$$f"; done
+RUN_COMPILED := PYTHONPATH=$(CURDIR)/$(COMPILED_TREE)
 
-.PHONY: run test test-fast tables bench lint network clean
+.PHONY: run test test-fast test-compiled golden-strict golden-update tables bench lint network \
+	lock compiled clean
 
-$(STAMP): pyproject.toml setup.py $(COMPILED_SOURCES)
+$(STAMP): pyproject.toml setup.py $(LOCK)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[test]'
+	$(BIN)/python -m pip install --quiet --constraint $(LOCK) --upgrade pip
+	$(PIP) -e '.[test]'
 	touch $(STAMP)
 
 ## The main job: the paper's Table 2 (64 co-simulations), printed beside the paper's; then
 ## the same 64 cases under the safe policy with V2X, also beside the paper's.
-run: $(STAMP)
-	$(BIN)/eoam-sumo batch scenarios/table2.toml --out $(OUT)/table2 --jobs 2
+run: $(COMPILED_STAMP)
+	$(RUN_COMPILED) $(BIN)/eoam-sumo batch scenarios/table2.toml --out $(OUT)/table2 --jobs 2
 	cat $(OUT)/table2/table2.md
-	$(BIN)/eoam-sumo batch scenarios/table2_safe_v2x.toml --out $(OUT)/table2_safe_v2x --jobs 2
+	$(RUN_COMPILED) $(BIN)/eoam-sumo batch scenarios/table2_safe_v2x.toml \
+		--out $(OUT)/table2_safe_v2x --jobs 2
 	cat $(OUT)/table2_safe_v2x/table2.md
 
-## Every test, the SUMO co-simulations included (what CI runs).
+## Every test on the Python sources, the SUMO co-simulations and the golden Table 2 within its
+## tolerances included (what CI runs, with test-compiled).
 test: $(STAMP)
 	$(BIN)/python -m pytest
 
@@ -32,21 +45,58 @@ test: $(STAMP)
 test-fast: $(STAMP)
 	PYTHONPATH="$(CURDIR)/tests/no_sumo$${PYTHONPATH:+:$$PYTHONPATH}" $(BIN)/python -m pytest -m "not sumo"
 
+## The golden Table 2 (within its tolerances) on the compiled build.
+test-compiled: $(COMPILED_STAMP)
+	cd $(COMPILED_TREE) && ../../$(BIN)/python -m tests.golden.table2_golden --expect-compiled
+
+## Same machine, strict: every time series byte-identical to the digests recorded on this
+## machine (`make golden-update` records them; docs/reproducibility.md).
+golden-strict: $(STAMP)
+	$(BIN)/python -m tests.golden.table2_golden --strict
+
+## Rewrite the golden files from a run of Table 2 (a change meant to alter results; explain
+## each changed cell in the commit).
+golden-update: $(STAMP)
+	$(BIN)/python -m tests.golden.table2_golden --update
+
 tables: $(STAMP)
 	$(BIN)/eoam-sumo tables --out tables --jobs 2
 
-bench: $(STAMP)
-	$(BIN)/eoam-sumo bench --out $(OUT)/bench
+bench: $(COMPILED_STAMP)
+	$(RUN_COMPILED) $(BIN)/eoam-sumo bench --out $(OUT)/bench
 
-## ruff (rules chosen in pyproject.toml) and mypy over eoam_sumo/.
+## ruff (rules chosen in pyproject.toml; formatting checked) and mypy over eoam_sumo/.
 lint: $(STAMP)
-	$(BIN)/ruff check eoam_sumo tests
+	$(BIN)/ruff check eoam_sumo tests setup.py
+	$(BIN)/ruff format --check eoam_sumo tests setup.py
 	$(BIN)/python -m mypy
 
 ## Rebuild networks/*.net.xml from the plain XML sources with netconvert.
 network: $(STAMP)
 	$(BIN)/python -m eoam_sumo.netbuild networks
 
+## Refresh constraints.txt: the newest versions pyproject.toml allows, resolved in a fresh
+## environment, every package pinned (commit it after `make test` passes with it).
+lock:
+	rm -rf build/lock-venv
+	$(PYTHON) -m venv build/lock-venv
+	build/lock-venv/bin/python -m pip install --quiet --upgrade pip setuptools wheel
+	build/lock-venv/bin/python -m pip install --quiet '.[test]'
+	{ echo "# eoam-sumo's pinned install: every package make installs (make lock refreshes it)"; \
+	  build/lock-venv/bin/python -m pip freeze --all --exclude eoam-sumo; } > $(LOCK)
+	rm -rf build/lock-venv
+
+## The compiled build: the working tree copied to build/compiled and compiled in place.
+compiled: $(COMPILED_STAMP)
+
+$(COMPILED_STAMP): $(STAMP) $(shell $(TREE_FILES))
+	rm -rf $(COMPILED_TREE)
+	mkdir -p $(COMPILED_TREE)
+	$(TREE_FILES) | tar -cf - -T - | tar -xf - -C $(COMPILED_TREE)
+	cd $(COMPILED_TREE) && EOAM_SUMO_COMPILE=1 ../../$(BIN)/python setup.py --quiet \
+		build_ext --inplace
+	touch $(COMPILED_STAMP)
+
 clean:
-	rm -rf $(VENV) $(OUT) build eoam_sumo/compiled_sources.json
+	rm -rf $(VENV) $(OUT) build
 	find eoam_sumo -name '*.so' -delete
