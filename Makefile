@@ -22,7 +22,7 @@ RUN_COMPILED := PYTHONPATH=$(CURDIR)/$(COMPILED_TREE)
 
 $(STAMP): pyproject.toml setup.py $(LOCK)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --constraint $(LOCK) --upgrade pip
+	$(BIN)/python -m pip install --quiet --constraint $(LOCK) --upgrade pip setuptools wheel
 	$(PIP) -e '.[test]'
 	touch $(STAMP)
 
