@@ -21,6 +21,7 @@ from eoam_sumo.batch.results import RESULTS_FILE, read_results
 from eoam_sumo.colours import DARK_TEXT
 from eoam_sumo.colours import HEX as OUTCOME_COLOURS
 from eoam_sumo.params import PONR_FRACTION
+from eoam_sumo.plotting.envelope_plots import plot_envelopes
 from eoam_sumo.plotting.figures import save
 from eoam_sumo.plotting.runfacts import (
     fit,
@@ -292,17 +293,28 @@ _KEY_NAMES = {
 }
 
 
-def plot_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
-    """Every batch plot of a batch folder (has results.csv): Table 2 image and Figure 25."""
-    results = read_results(Path(batch_dir) / RESULTS_FILE)
-    if results["draw"].notna().any():  # a sampled batch: its envelopes, no Table 2 grid
-        from eoam_sumo.plotting.envelope_plots import plot_envelopes
-
+def plot_batch_report(results: pd.DataFrame, out_dir: Path) -> list[Path]:
+    """The images ``eoam-sumo batch`` draws beside its report: ``table2.png`` and
+    ``margins.png``, or for a sampled batch ``envelope.png``."""
+    if is_sampled(results):
         return plot_envelopes(results, out_dir)
-    paths = [
+    return [
         plot_table2(outcome_grid(results), Path(out_dir) / TABLE_PNG),
         plot_margins(results, Path(out_dir) / MARGINS_PNG),
     ]
+
+
+def is_sampled(results: pd.DataFrame) -> bool:
+    """Whether a results frame is of a sampled batch (its cases are numbered draws)."""
+    return bool(results["draw"].notna().any())
+
+
+def plot_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
+    """Every batch plot of a batch folder (has results.csv): Table 2 image and Figure 25."""
+    results = read_results(Path(batch_dir) / RESULTS_FILE)
+    paths = plot_batch_report(results, out_dir)
+    if is_sampled(results):  # its envelopes, no Table 2 grid
+        return paths
     ok = results[results["status"] == "ok"]
     for speed_kmh in pd.unique(ok["ego_speed_kmh"]):
         fig25 = plot_lateral_offsets(batch_dir, results, out_dir, float(speed_kmh))
