@@ -49,35 +49,7 @@ def plot_table2(grid, path: Path) -> Path:
     fig = Figure(figsize=(3.2 + 1.9 * n_cols, 1.6 + 0.42 * n_rows), layout="constrained")
     ax = fig.add_subplot()
     for (i, j), cell in grid.cells.items():
-        parts = [cell.ours, cell.paper] if halves == 2 else [cell.ours]
-        for k, colour in enumerate(parts):
-            x0 = j + k / halves
-            ax.add_patch(
-                Rectangle(
-                    (x0, i),
-                    1 / halves,
-                    1,
-                    facecolor=OUTCOME_COLOURS.get(colour, _MISSING),
-                    edgecolor="white",
-                    linewidth=0.6,
-                )
-            )
-            ax.text(
-                x0 + 0.5 / halves,
-                i + 0.5,
-                colour or "—",
-                ha="center",
-                va="center",
-                fontsize=8,
-                color=_text_colour(colour),
-            )
-        ax.add_patch(Rectangle((j, i), 1, 1, fill=False, edgecolor="white", linewidth=3.5))
-        if halves == 2 and cell.compared and not cell.agrees:
-            ax.add_patch(
-                Rectangle(
-                    (j + 0.03, i + 0.06), 0.94, 0.88, fill=False, edgecolor="black", linewidth=2.2
-                )
-            )
+        _draw_cell(ax, i, j, cell, halves)
     labels = []
     previous = None
     for i, (traffic, speed) in enumerate(grid.rows):
@@ -110,6 +82,40 @@ def plot_table2(grid, path: Path) -> Path:
     ]
     fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), frameon=False)
     return save(fig, path)
+
+
+def _draw_cell(ax, i: int, j: int, cell, halves: int) -> None:
+    """Cell (row i, column j): ours (and the paper's) colour and name, framed when the two
+    differ."""
+    parts = [cell.ours, cell.paper] if halves == 2 else [cell.ours]
+    for k, colour in enumerate(parts):
+        x0 = j + k / halves
+        ax.add_patch(
+            Rectangle(
+                (x0, i),
+                1 / halves,
+                1,
+                facecolor=OUTCOME_COLOURS.get(colour, _MISSING),
+                edgecolor="white",
+                linewidth=0.6,
+            )
+        )
+        ax.text(
+            x0 + 0.5 / halves,
+            i + 0.5,
+            colour or "—",
+            ha="center",
+            va="center",
+            fontsize=8,
+            color=_text_colour(colour),
+        )
+    ax.add_patch(Rectangle((j, i), 1, 1, fill=False, edgecolor="white", linewidth=3.5))
+    if halves == 2 and cell.compared and not cell.agrees:
+        ax.add_patch(
+            Rectangle(
+                (j + 0.03, i + 0.06), 0.94, 0.88, fill=False, edgecolor="black", linewidth=2.2
+            )
+        )
 
 
 def _offsets(batch_dir: Path, case_dir: str) -> pd.DataFrame:
