@@ -7,15 +7,19 @@ library raises, only this module prints and exits.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
+import signal
 import sys
+import threading
+from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
 
 from eoam_sumo import __version__
 from eoam_sumo.errors import InputError
-from eoam_sumo.matrix import DEFAULT_MAX_TIME_S
 from eoam_sumo.params import MU_MAX
+from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S
 
 EXIT_BAD_INPUT = 2
 
@@ -91,10 +95,23 @@ def _distance_or_none(text: str) -> float | None:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``eoam-sumo`` parser: one sub-command per job, each with its own arguments."""
     parser = _Parser(prog="eoam-sumo", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"eoam-sumo {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    for add_arguments in (
+        _tables_arguments,
+        _run_arguments,
+        _batch_arguments,
+        _plot_arguments,
+        _animate_arguments,
+        _bench_arguments,
+    ):
+        add_arguments(sub)
+    return parser
 
+
+def _tables_arguments(sub) -> None:
     p = sub.add_parser("tables", help="build the lookup tables and DMM phase boundaries")
     p.add_argument("--out", type=Path, default=Path("tables"), help="output folder")
     p.add_argument("--jobs", type=_positive_int, default=1, help="parallel processes")
@@ -102,6 +119,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--mu", type=_mu, nargs="+", help="friction grid")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
+
+def _run_arguments(sub) -> None:
     p = sub.add_parser("run", help="one co-simulation of a SUMO scenario")
     p.add_argument("cfg", type=Path, help="the scenario's .sumocfg")
     p.add_argument("--speed-kmh", type=_speed_kmh, help="ego initial speed (km/h)")
@@ -133,6 +152,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--seed", type=_seed, default=0, help="seed of every random model (0)")
     p.add_argument("--gui", action="store_true", help="run in sumo-gui through TraCI")
+    _policy_arguments(p)
+    _gui_arguments(p)
+
+
+def _policy_arguments(p: argparse.ArgumentParser) -> None:
+    """``run``: the decision policy and the V2X link that informs the safe one."""
     p.add_argument(
         "--policy",
         choices=("paper", "safe"),
@@ -155,6 +180,10 @@ def build_parser() -> argparse.ArgumentParser:
         default=1.0,
         help="share of road users equipped with V2X, in [0, 1]",
     )
+
+
+def _gui_arguments(p: argparse.ArgumentParser) -> None:
+    """``run --gui``: the sumo-gui view's pace and screenshots."""
     p.add_argument(
         "--gui-delay-ms",
         type=_finite,
@@ -169,6 +198,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="with --gui: screenshots at these simulation times (s) into --out",
     )
 
+
+def _batch_arguments(sub) -> None:
     p = sub.add_parser(
         "batch",
         help="run every case of an experiment matrix",
@@ -191,10 +222,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
+
+def _plot_arguments(sub) -> None:
     p = sub.add_parser("plot", help="plots of a run, a batch or a tables folder")
     p.add_argument("folder", type=Path, help="a run, batch or tables output folder")
     p.add_argument("--out", type=Path, help="where to put the PNGs (default: the folder)")
 
+
+def _animate_arguments(sub) -> None:
     p = sub.add_parser("animate", help="animated bird's-eye view of a run folder")
     p.add_argument(
         "run_dir", type=Path, help="a run folder (summary.json, timeseries.csv, traffic.csv)"
@@ -204,10 +239,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--fps", type=_positive_int, default=10, help="frames per second of run time")
 
+
+def _bench_arguments(sub) -> None:
     p = sub.add_parser("bench", help="the performance benchmark")
     p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder")
     p.add_argument("--quick", action="store_true", help="tiny settings (for tests)")
-    return parser
 
 
 def _writable_dir(path: Path) -> Path:
@@ -233,51 +269,17 @@ def _cmd_tables(args) -> int:
 
 
 def _cmd_run(args) -> int:
-    from eoam_sumo.sensing.automotive import parse_radar_model
-    from eoam_sumo.sensing.friction import parse_mu_belief
-    from eoam_sumo.sim.cosim import RunSettings, policy_settings, run_case
-    from eoam_sumo.sim.radar import RadarSettings
+    """``eoam-sumo run``: one co-simulation into ``--out``, its outcome on one line."""
+    from eoam_sumo.sim.cosim import run_case
     from eoam_sumo.sim.scenario import ScenarioOverrides
-    from eoam_sumo.sim.session.gui import GuiSettings
 
-    if not args.cfg.is_file():
-        raise InputError(f"{args.cfg}: no such scenario file")
-    if args.max_time_s <= 0:
-        raise InputError(f"--max-time-s {args.max_time_s} must be > 0")
-    if args.radar_range_m is not None and args.radar_range_m <= 0:
-        raise InputError(f"--radar-range-m {args.radar_range_m} must be > 0")
-    _check_v2x(args)
-    if not args.gui and (args.gui_delay_ms is not None or args.gui_screenshot):
-        raise InputError("--gui-delay-ms and --gui-screenshot need --gui")
+    _check_run_args(args)
     out = _writable_dir(args.out)
-    gui = GuiSettings(
-        delay_ms=args.gui_delay_ms, screenshots_s=args.gui_screenshot, screenshot_dir=out
-    )
+    settings = _run_settings(args, out)
     overrides = ScenarioOverrides(
         ego_speed_mps=None if args.speed_kmh is None else args.speed_kmh / 3.6,
         mu=args.mu,
         oncoming_start_m=args.oncoming_m,
-    )
-    settings = RunSettings(
-        max_time_s=args.max_time_s,
-        ego_id=args.ego,
-        gui=args.gui,
-        use_traci=args.gui,
-        gui_settings=gui,
-        tables_dir=args.tables,
-        mu_belief=parse_mu_belief(args.mu_belief),
-        seed=args.seed,
-        radar_model=parse_radar_model(args.radar_model),
-    )
-    if args.radar_range_m is not None:
-        settings = replace(settings, radar=RadarSettings(range_m=args.radar_range_m))
-    settings = policy_settings(
-        settings,
-        args.policy,
-        args.v2x_range_m,
-        args.v2x_latency_s,
-        args.v2x_loss,
-        args.v2x_penetration,
     )
     s = run_case(args.cfg, overrides, out, settings)
     print(
@@ -293,6 +295,53 @@ def _cmd_run(args) -> int:
     if args.gui:
         print("eoam-sumo: the sumo-gui window stays open until you close it", file=sys.stderr)
     return 0
+
+
+def _check_run_args(args) -> None:
+    """InputError for a ``run`` option out of its range, before anything is written."""
+    if not args.cfg.is_file():
+        raise InputError(f"{args.cfg}: no such scenario file")
+    if args.max_time_s <= 0:
+        raise InputError(f"--max-time-s {args.max_time_s} must be > 0")
+    if args.radar_range_m is not None and args.radar_range_m <= 0:
+        raise InputError(f"--radar-range-m {args.radar_range_m} must be > 0")
+    _check_v2x(args)
+    if not args.gui and (args.gui_delay_ms is not None or args.gui_screenshot):
+        raise InputError("--gui-delay-ms and --gui-screenshot need --gui")
+
+
+def _run_settings(args, out: Path):
+    """The run's ``RunSettings`` from the ``run`` options (screenshots go to ``out``)."""
+    from eoam_sumo.sensing.automotive import parse_radar_model
+    from eoam_sumo.sensing.friction import parse_mu_belief
+    from eoam_sumo.sim.cosim import RunSettings, policy_settings
+    from eoam_sumo.sim.radar import RadarSettings
+    from eoam_sumo.sim.session.gui import GuiSettings
+
+    gui = GuiSettings(
+        delay_ms=args.gui_delay_ms, screenshots_s=args.gui_screenshot, screenshot_dir=out
+    )
+    settings = RunSettings(
+        max_time_s=args.max_time_s,
+        ego_id=args.ego,
+        gui=args.gui,
+        use_traci=args.gui,
+        gui_settings=gui,
+        tables_dir=args.tables,
+        mu_belief=parse_mu_belief(args.mu_belief),
+        seed=args.seed,
+        radar_model=parse_radar_model(args.radar_model),
+    )
+    if args.radar_range_m is not None:
+        settings = replace(settings, radar=RadarSettings(range_m=args.radar_range_m))
+    return policy_settings(
+        settings,
+        args.policy,
+        args.v2x_range_m,
+        args.v2x_latency_s,
+        args.v2x_loss,
+        args.v2x_penetration,
+    )
 
 
 def _check_v2x(args) -> None:
@@ -322,9 +371,78 @@ def _sight_text(summary: dict) -> str:
 
 
 def _cmd_batch(args) -> int:
-    from eoam_sumo.batch.runner import run_batch_cli
+    """``eoam-sumo batch``: run the batch, draw its images; SIGTERM stops it like Ctrl-C
+    (rows kept).
 
-    return run_batch_cli(args)
+    Returns 0 when every case ran, ``EXIT_CASES_FAILED`` when at least one failed (after
+    results.csv and the report are written; each failed case and then the count on stderr).
+    Bad input raises InputError before any case runs (exit status 2 in :func:`main`).
+    """
+    from eoam_sumo.batch.runner import run_batch
+
+    with _sigterm_interrupts():
+        results = run_batch(
+            args.matrix,
+            args.out,
+            jobs=args.jobs,
+            scheduler=args.scheduler,
+            resume=args.resume,
+            timeout_s=args.timeout_s,
+            progress=not args.no_progress,
+            timeseries=args.timeseries,
+        )
+        # matplotlib is imported once the cases have run, in this process only
+        from eoam_sumo.plotting.batch_plots import plot_batch_report
+
+        plot_batch_report(results, args.out)
+    return _batch_status(results, Path(args.out))
+
+
+def _raise_interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def _sigterm_interrupts() -> Iterator[None]:
+    """SIGTERM raises KeyboardInterrupt inside the block (in the main thread only)."""
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _raise_interrupt)
+    try:
+        yield
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _batch_status(results, out: Path) -> int:
+    """Print the batch's counts (stdout) and its failed cases (stderr); the exit status."""
+    from eoam_sumo.batch.probabilities import PROBABILITIES_FILE
+    from eoam_sumo.batch.report import TABLE_MD
+    from eoam_sumo.batch.results import RESULTS_FILE
+    from eoam_sumo.batch.runner import EXIT_CASES_FAILED
+
+    failed = results[results["status"] != "ok"]
+    results_path = out / RESULTS_FILE
+    report = (
+        f"outcome probabilities in {out / PROBABILITIES_FILE}"
+        if results["draw"].notna().any()
+        else f"Table 2 in {out / TABLE_MD}"
+    )
+    print(
+        f"{len(results)} cases, {len(results) - len(failed)} ok, {len(failed)} failed; "
+        f"results in {results_path}, {report}"
+    )
+    if failed.empty:
+        return 0
+    for _, row in failed.iterrows():
+        print(f"failed: {row['case_id']}: {row['error']}", file=sys.stderr)
+    print(
+        f"eoam-sumo: {len(failed)} of {len(results)} cases failed; their errors are in the "
+        f"'error' column of {results_path}",
+        file=sys.stderr,
+    )
+    return EXIT_CASES_FAILED
 
 
 def _cmd_plot(args) -> int:

@@ -29,10 +29,8 @@ from eoam_sumo.sampling import Sample, parse_sample
 from eoam_sumo.sensing.automotive import parse_radar_model
 from eoam_sumo.sensing.friction import parse_mu_belief
 from eoam_sumo.sim.scenario import ScenarioOverrides, check_scenario, scripted_stops
+from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S
 
-#: Simulated time limit of a run [s]: every Table 2 case ends well before it (the slowest,
-#: 55 km/h on mu 0.1, settles after 33.7 s), so none is cut off by it.
-DEFAULT_MAX_TIME_S = 60.0
 NO_ONCOMING = "none"
 SCHEMA = {
     "scenario": (
@@ -330,15 +328,54 @@ SAMPLED = {
 def load_matrix(path: Path) -> Matrix:
     """Read and check an experiment-matrix TOML file; InputError names the file and the key."""
     path = Path(path)
+    doc = _read_toml(path)
+    _check_tables(path, doc)
+    sample = parse_sample(path, doc["sample"], SAMPLED) if "sample" in doc else None
+    sampled = sample.keys if sample else ()
+    _check_required(path, doc, sampled)
+    scenario = doc["scenario"]
+    _check_sampled_once(path, doc, sample, sampled)
+    sumocfg = _existing_file(path, "[scenario] sumocfg", scenario["sumocfg"])
+    max_time, radar_range = _run_limits(path, scenario)
+    policy = _scenario_policy(path, scenario)
+    v2x = _v2x_link(path, scenario, policy)
+    paper = None
+    if "table" in doc.get("paper", {}):
+        paper = _existing_file(path, "[paper] table", doc["paper"]["table"])
+    settings = _sensing_settings(path, scenario)
+    seed = scenario.get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise InputError(f"{path}: [scenario] seed = {seed!r} must be an integer >= 0")
+    return Matrix(
+        path=path,
+        sumocfg=sumocfg,
+        max_time_s=max_time,
+        radar_range_m=radar_range,
+        **settings,
+        seed=seed,
+        sample=sample,
+        **_swept_values(path, doc["sweep"], sampled),
+        paper_table=paper,
+        policy=policy,
+        v2x=v2x,
+    )
+
+
+def _read_toml(path: Path) -> dict:
+    """The matrix file's TOML document; InputError if it is missing, unreadable or malformed."""
     try:
         with path.open("rb") as fh:
-            doc = tomllib.load(fh)
+            return tomllib.load(fh)
     except FileNotFoundError as exc:
         raise InputError(f"matrix file {path} not found") from exc
     except OSError as exc:
         raise InputError(f"{path}: cannot read the matrix file: {exc}") from exc
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"{path}: malformed TOML: {exc}") from exc
+
+
+def _check_tables(path: Path, doc: dict) -> None:
+    """InputError for a table or key the schema does not know ([sample] is checked apart)."""
     for table, body in doc.items():
         if table not in SCHEMA:
             raise _unknown(path, "table", table, tuple(SCHEMA))
@@ -347,39 +384,61 @@ def load_matrix(path: Path) -> Matrix:
         for key in body:
             if key not in SCHEMA[table] and table != "sample":
                 raise _unknown(path, f"key in [{table}]", key, SCHEMA[table])
-    sample = parse_sample(path, doc["sample"], SAMPLED) if "sample" in doc else None
-    sampled = sample.keys if sample else ()
+
+
+def _check_required(path: Path, doc: dict, sampled: tuple[str, ...]) -> None:
+    """InputError for a missing required table, or a required key neither given nor sampled."""
     for table, keys in REQUIRED.items():
         if table not in doc:
             raise InputError(f"{path}: missing table [{table}]")
         for key in keys:
             if key not in doc[table] and key not in sampled:
                 raise InputError(f"{path}: [{table}] needs the key '{key}' (or sample it)")
-    scenario, sweep = doc["scenario"], doc["sweep"]
+
+
+def _check_sampled_once(
+    path: Path, doc: dict, sample: Sample | None, sampled: tuple[str, ...]
+) -> None:
+    """InputError for a key both given and sampled, or a fixed seed beside a [sample] table."""
     for key in sampled:
         for table in ("scenario", "sweep"):
             if key in doc[table]:
                 raise InputError(
                     f"{path}: '{key}' is both in [{table}] and sampled in [sample]; keep one"
                 )
-    if sample is not None and "seed" in scenario:
+    if sample is not None and "seed" in doc["scenario"]:
         raise InputError(
             f"{path}: [scenario] seed with a [sample] table: the draws' seeds "
             "come from [sample] seed"
         )
-    sumocfg = _existing_file(path, "[scenario] sumocfg", scenario["sumocfg"])
+
+
+def _run_limits(path: Path, scenario: dict) -> tuple[float, float | None]:
+    """[scenario] max_time_s (default ``DEFAULT_MAX_TIME_S``) and radar_range_m (None: the
+    radar's default), each a number > 0."""
     max_time = scenario.get("max_time_s", DEFAULT_MAX_TIME_S)
     if not _is_number(max_time) or max_time <= 0:
         raise InputError(f"{path}: [scenario] max_time_s = {max_time!r} must be a number > 0")
     radar_range = scenario.get("radar_range_m")
     if radar_range is not None and (not _is_number(radar_range) or radar_range <= 0):
         raise InputError(f"{path}: [scenario] radar_range_m = {radar_range!r} must be a number > 0")
+    return float(max_time), None if radar_range is None else float(radar_range)
+
+
+def _scenario_policy(path: Path, scenario: dict) -> str:
+    """[scenario] policy, one of ``POLICIES`` (default: the paper's)."""
     policy = scenario.get("policy", "paper")
     if policy not in POLICIES:
         raise InputError(
             f"{path}: [scenario] policy = {policy!r} must be one of "
             f"{', '.join(repr(p) for p in POLICIES)}"
         )
+    return policy
+
+
+def _v2x_link(path: Path, scenario: dict, policy: str) -> tuple[float, float, float, float]:
+    """[scenario] V2X range, latency, loss and penetration, each within its ``V2X_KEYS``
+    bounds; a range > 0 needs the safe policy."""
     v2x = []
     for key, (default, low, high, high_in) in V2X_KEYS.items():
         value = scenario.get(key, default)
@@ -398,9 +457,11 @@ def load_matrix(path: Path) -> Matrix:
             f"{path}: [scenario] v2x_range_m = {v2x[0]:g} needs policy = "
             '"safe" (V2X informs the safe policy only)'
         )
-    paper = None
-    if "table" in doc.get("paper", {}):
-        paper = _existing_file(path, "[paper] table", doc["paper"]["table"])
+    return (v2x[0], v2x[1], v2x[2], v2x[3])
+
+
+def _sensing_settings(path: Path, scenario: dict) -> dict:
+    """[scenario] mu_belief and radar_model where given, checked as a sampled value is."""
     settings = {}
     for key in ("mu_belief", "radar_model"):
         if key in scenario:
@@ -408,26 +469,21 @@ def load_matrix(path: Path) -> Matrix:
                 settings[key] = SAMPLED[key](scenario[key])
             except InputError as exc:
                 raise InputError(f"{path}: [scenario] {exc}") from None
-    seed = scenario.get("seed", 0)
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise InputError(f"{path}: [scenario] seed = {seed!r} must be an integer >= 0")
-    return Matrix(
-        path=path,
-        sumocfg=sumocfg,
-        max_time_s=float(max_time),
-        radar_range_m=None if radar_range is None else float(radar_range),
-        **settings,
-        seed=seed,
-        sample=sample,
-        ego_speeds_kmh=(None,)
+    return settings
+
+
+def _swept_values(path: Path, sweep: dict, sampled: tuple[str, ...]) -> dict:
+    """The [sweep] lists as ``Matrix`` fields; a sampled key has the placeholder ``(None,)``."""
+    return {
+        "ego_speeds_kmh": (None,)
         if "ego_speed_kmh" in sampled
         else _number_list(
             path, "ego_speed_kmh", sweep["ego_speed_kmh"], minimum=0.0, inclusive=False
         ),
-        mus=(None,)
+        "mus": (None,)
         if "mu" in sampled
         else _number_list(path, "mu", sweep["mu"], minimum=0.0, inclusive=False, maximum=MU_MAX),
-        oncoming_starts_m=(None,)
+        "oncoming_starts_m": (None,)
         if "oncoming_start_m" in sampled
         else _number_list(
             path,
@@ -437,22 +493,19 @@ def load_matrix(path: Path) -> Matrix:
             inclusive=True,
             allow_none=True,
         ),
-        aro_holds_s=(
+        "aro_holds_s": (
             _number_list(path, "aro_hold_s", sweep["aro_hold_s"], minimum=0.0, inclusive=True)
             if "aro_hold_s" in sweep
             else ()
         ),
-        aro_decels_mps2=(
+        "aro_decels_mps2": (
             _number_list(
                 path, "aro_decel_mps2", sweep["aro_decel_mps2"], minimum=0.0, inclusive=False
             )
             if "aro_decel_mps2" in sweep
             else ()
         ),
-        paper_table=paper,
-        policy=policy,
-        v2x=(v2x[0], v2x[1], v2x[2], v2x[3]),
-    )
+    }
 
 
 def check_matrix(matrix: Matrix, tables_dir: Path | None = None, ego_id: str = "ego") -> None:

@@ -26,9 +26,24 @@ def write_traffic_scenario(
     """Write the network (netconvert), routes and ``traffic.sumocfg`` into ``folder``; the
     sumocfg's path. ``ego_depart_s`` whole multiples of ``step_length_s`` keep the handover
     at the departure."""
+    folder.mkdir(parents=True, exist_ok=True)
+    _write_network(folder)
+    (folder / "t.rou.xml").write_text(_routes_text(ego_depart_s))
+    cfg = folder / "traffic.sumocfg"
+    cfg.write_text(
+        '<configuration><input><net-file value="t.net.xml"/>'
+        '<route-files value="t.rou.xml"/></input>'
+        f'<time><begin value="0"/><step-length value="{step_length_s:g}"/></time>'
+        f'<random_number><seed value="{seed}"/></random_number></configuration>'
+    )
+    return cfg
+
+
+def _write_network(folder: Path) -> None:
+    """``t.net.xml``: the straight road, three lanes each way, built by netconvert from the
+    node and edge files written beside it."""
     import sumolib
 
-    folder.mkdir(parents=True, exist_ok=True)
     (folder / "t.nod.xml").write_text(
         f'<nodes><node id="a" x="0" y="0"/><node id="b" x="{ROAD_M:g}" y="0"/></nodes>'
     )
@@ -53,6 +68,11 @@ def write_traffic_scenario(
         check=True,
         capture_output=True,
     )
+
+
+def _routes_text(ego_depart_s: float) -> str:
+    """The route file: the broken-down car, the random flows (same-direction ones kept out of
+    the ego's lane) until 600 s after the ego's departure, and the ego."""
     prob = LANE_FLOW_VPH / 3600.0  # departures per second of a lane
     flows = "".join(
         f'<flow id="{edge}{lane}" type="{vtype}" route="{edge}" begin="0"'
@@ -61,7 +81,7 @@ def write_traffic_scenario(
         for edge, lanes, vtype in (("fwd", (1, 2), "keep"), ("back", (0, 1, 2), "car"))
         for lane in lanes
     )
-    (folder / "t.rou.xml").write_text(
+    return (
         "<routes>"
         '<vType id="car" length="4.6" width="1.8" decel="7.5" sigma="0.5"/>'
         '<vType id="keep" length="4.6" width="1.8" decel="7.5" sigma="0.5"'
@@ -76,11 +96,3 @@ def write_traffic_scenario(
         f' departPos="{EGO_POS_M:g}" departSpeed="{SPEED_MPS:g}"/>'
         "</routes>"
     )
-    cfg = folder / "traffic.sumocfg"
-    cfg.write_text(
-        '<configuration><input><net-file value="t.net.xml"/>'
-        '<route-files value="t.rou.xml"/></input>'
-        f'<time><begin value="0"/><step-length value="{step_length_s:g}"/></time>'
-        f'<random_number><seed value="{seed}"/></random_number></configuration>'
-    )
-    return cfg

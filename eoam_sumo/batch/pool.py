@@ -1,7 +1,7 @@
 """Run many tasks in long-lived worker processes, surviving crashes and hung tasks.
 
-libsumo holds one simulation per process and importing CasADi and libsumo costs about a
-second, so each worker is a separate Python interpreter that runs task after task. A worker
+libsumo holds one simulation per process and importing CasADi and libsumo is slow next to
+a short case, so each worker is a separate Python interpreter that runs task after task. A worker
 that dies (a segfault in native code, ``os._exit``) or runs one task past ``timeout_s`` (the
 parent kills it) costs only that task, reported as a failed ``TaskResult``; a fresh worker
 takes its place. An exception inside the task function is a failed result too, and the worker

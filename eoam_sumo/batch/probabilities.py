@@ -1,4 +1,4 @@
-"""Outcome probabilities of a sampled batch: ``outcome_probabilities.csv`` and the envelopes.
+"""Outcome probabilities of a sampled batch: ``outcome_probabilities.csv``.
 
 One group per combination of swept values (the case id without its ``_dNNN`` draw suffix);
 in each, every outcome colour seen in the batch (and ``failed`` for draws that did not run)
@@ -76,11 +76,8 @@ def outcome_probabilities(results: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def write_probabilities(out_dir: Path, results: pd.DataFrame) -> list[Path]:
-    """Write ``outcome_probabilities.csv`` (atomically) and the envelope plots."""
-    from eoam_sumo.plotting.envelope_plots import plot_envelopes
-
-    out_dir = Path(out_dir)
-    path = out_dir / PROBABILITIES_FILE
+def write_probabilities(out_dir: Path, results: pd.DataFrame) -> Path:
+    """Write ``outcome_probabilities.csv`` (atomically) into ``out_dir``; return its path."""
+    path = Path(out_dir) / PROBABILITIES_FILE
     write_atomic(path, outcome_probabilities(results).to_csv(index=False))
-    return [path, *plot_envelopes(results, out_dir)]
+    return path

@@ -170,62 +170,81 @@ def _ref(cell: Cell, n: int) -> str:
 
 def table2_markdown(grid: OutcomeGrid, title: str = "Table 2") -> str:
     """The grid as markdown: ours / paper per cell, the agreement count, the differences."""
-    listed = {c.case_id: i for i, c in enumerate(grid.differing(), start=1)}
     lines = [
         f"# {title}: EOAM outcomes" + (" — this run / the paper" if grid.has_paper else ""),
         "",
-    ]
-    ours = [c.ours for c in grid.cells.values()]
-    if grid.has_paper:
-        lines += [
-            (
-                "Each cell: **ours** / paper (Lowe & Guvenc, Table 2). "
-                f"**{grid.agreeing}/{grid.compared} cells agree.**"
-            ),
-            "",
-            f"- ours: {_counts(ours)}",
-            f"- paper: {_counts([c.paper for c in grid.cells.values() if c.paper])}",
-            "",
-        ]
-    else:
-        lines += [f"Our outcomes ({len(ours)} cases): {_counts(ours)}.", ""]
-    lines.append(
-        "| Traffic | Initial ego speed | "
-        + " | ".join(f"{mu_text(mu)} surface mu" for mu in grid.mus)
-        + " |"
-    )
-    lines.append("|---|---|" + "---|" * len(grid.mus))
-    previous = None
-    for i, (traffic, speed) in enumerate(grid.rows):
-        cols = []
-        for j in range(len(grid.mus)):
-            cell = grid.cells.get((i, j))
-            if cell is None:
-                cols.append("")
-                continue
-            text = f"**{_mark(cell.ours)}**"
-            if cell.near_miss:
-                text += f" {NEAR_MISS_MARK}"
-            if grid.has_paper:
-                text += f" / {_mark(cell.paper)}"
-            if cell.case_id in listed:
-                text += f" {'✗ ' if grid.has_paper else ''}{_ref(cell, listed[cell.case_id])}"
-            cols.append(text)
-        lines.append(
-            f"| {traffic if traffic != previous else ''} | {speed} | " + " | ".join(cols) + " |"
-        )
-        previous = traffic
-    lines += [
+        *_counts_markdown(grid),
+        *_grid_markdown(grid),
         "",
         "Legend: "
         + "; ".join(f"{MARKERS[c]} {c}: {LEGEND[c]}" for c in LEGEND)
         + f"; {NEAR_MISS_MARK} near miss: no contact, but within 0.5 m of a road user or "
         "a time to collision with oncoming traffic under 1.5 s",
         "",
+        *_differing_markdown(grid),
+        "",
+        *margins_markdown(grid),
     ]
+    return "\n".join(lines) + "\n"
+
+
+def _counts_markdown(grid: OutcomeGrid) -> list[str]:
+    """The outcome counts (ours, and the paper's with the agreement when it is compared)."""
+    ours = [c.ours for c in grid.cells.values()]
+    if not grid.has_paper:
+        return [f"Our outcomes ({len(ours)} cases): {_counts(ours)}.", ""]
+    return [
+        (
+            "Each cell: **ours** / paper (Lowe & Guvenc, Table 2). "
+            f"**{grid.agreeing}/{grid.compared} cells agree.**"
+        ),
+        "",
+        f"- ours: {_counts(ours)}",
+        f"- paper: {_counts([c.paper for c in grid.cells.values() if c.paper])}",
+        "",
+    ]
+
+
+def _grid_markdown(grid: OutcomeGrid) -> list[str]:
+    """The table: a row per traffic and speed, a column per friction; each cell ours (and the
+    paper's), a near miss marked, a listed cell with its note number."""
+    listed = {c.case_id: i for i, c in enumerate(grid.differing(), start=1)}
+    lines = [
+        "| Traffic | Initial ego speed | "
+        + " | ".join(f"{mu_text(mu)} surface mu" for mu in grid.mus)
+        + " |",
+        "|---|---|" + "---|" * len(grid.mus),
+    ]
+    previous = None
+    for i, (traffic, speed) in enumerate(grid.rows):
+        cols = [_cell_markdown(grid, grid.cells.get((i, j)), listed) for j in range(len(grid.mus))]
+        lines.append(
+            f"| {traffic if traffic != previous else ''} | {speed} | " + " | ".join(cols) + " |"
+        )
+        previous = traffic
+    return lines
+
+
+def _cell_markdown(grid: OutcomeGrid, cell: Cell | None, listed: dict[str, int]) -> str:
+    """One cell of the table (empty where the matrix has no case)."""
+    if cell is None:
+        return ""
+    text = f"**{_mark(cell.ours)}**"
+    if cell.near_miss:
+        text += f" {NEAR_MISS_MARK}"
+    if grid.has_paper:
+        text += f" / {_mark(cell.paper)}"
+    if cell.case_id in listed:
+        text += f" {'✗ ' if grid.has_paper else ''}{_ref(cell, listed[cell.case_id])}"
+    return text
+
+
+def _differing_markdown(grid: OutcomeGrid) -> list[str]:
+    """The numbered list of the cells that differ from the paper (or were not green), each
+    with why it ended so and a link to its summary.json."""
     differing = grid.differing()
     heading = "Cells that differ from the paper" if grid.has_paper else "Cases that were not green"
-    lines += [f"## {heading} ({len(differing)})", ""]
+    lines = [f"## {heading} ({len(differing)})", ""]
     where = {cell.case_id: key for key, cell in grid.cells.items()}
     for n, cell in enumerate(differing, start=1):
         (traffic, speed), mu = grid.rows[where[cell.case_id][0]], grid.mus[where[cell.case_id][1]]
@@ -240,8 +259,7 @@ def table2_markdown(grid: OutcomeGrid, title: str = "Table 2") -> str:
         )
     if not differing:
         lines.append("None.")
-    lines += ["", *margins_markdown(grid)]
-    return "\n".join(lines) + "\n"
+    return lines
 
 
 def margins_markdown(grid: OutcomeGrid) -> list[str]:

@@ -1,5 +1,9 @@
 """The batch engine: expand a matrix, run its cases in parallel, write results.csv and Table 2.
 
+The engine writes data (results.csv, the cases' folders, table2.md or
+outcome_probabilities.csv) and returns the results frame; the images are drawn from that
+frame by the command line (``eoam-sumo batch``) through :mod:`eoam_sumo.plotting`.
+
 ``results.csv`` is written row by row as cases finish (appended, flushed and synced), so an
 interrupted batch loses nothing it has finished; at the end it is rewritten atomically (temp
 file and ``os.replace``) in the matrix's order, so the final file does not depend on the
@@ -14,9 +18,7 @@ failed ones included.
 from __future__ import annotations
 
 import contextlib
-import signal
 import sys
-import threading
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -33,7 +35,7 @@ from eoam_sumo.batch.case import (
 from eoam_sumo.batch.policy_report import policy_line, policy_title, sight_markdown
 from eoam_sumo.batch.pool import TaskResult, run_dask, run_local
 from eoam_sumo.batch.probabilities import write_probabilities
-from eoam_sumo.batch.report import TABLE_MD, TABLE_PNG, outcome_grid, table2_markdown
+from eoam_sumo.batch.report import TABLE_MD, outcome_grid, table2_markdown
 from eoam_sumo.batch.results import (
     CASES_DIR,
     COLUMNS,
@@ -140,35 +142,27 @@ def run_batch(
 ) -> pd.DataFrame:
     """Run every case of the matrix; return the final results (as :func:`read_results`).
 
-    Writes ``out_dir/results.csv``, ``out_dir/cases/<case_id>/`` (time series and summary),
-    ``table2.md`` and ``table2.png``. ``scheduler``: None for local worker processes,
-    ``"local"`` for a Dask LocalCluster of ``jobs`` workers, else a Dask scheduler address.
-    ``case_func`` runs one :class:`CaseTask` and returns ``{"summary", "files"}`` like
-    :func:`run_matrix_case` (the default); it must be a module-level function.
+    Writes ``out_dir/results.csv``, ``out_dir/cases/<case_id>/`` (time series and summary)
+    and ``table2.md`` (a sampled matrix: ``outcome_probabilities.csv`` instead); the images
+    are drawn by ``eoam-sumo batch`` from the returned frame
+    (:func:`eoam_sumo.plotting.batch_plots.plot_batch_report`). ``scheduler``: None for local
+    worker processes, ``"local"`` for a Dask LocalCluster of ``jobs`` workers, else a Dask
+    scheduler address. ``case_func`` runs one :class:`CaseTask` and returns
+    ``{"summary", "files"}`` like :func:`run_matrix_case` (the default); it must be a
+    module-level function.
 
     Bad input raises InputError before anything is written or run: the matrix itself
     (:func:`~eoam_sumo.matrix.load_matrix`), its scenario files and every swept speed and
     friction against the lookup tables in ``tables_dir`` (default: the co-simulation's,
     :func:`~eoam_sumo.matrix.check_matrix`). A case that fails is a ``failed`` row.
     """
-    if not (isinstance(jobs, int) and jobs >= 1):
-        raise InputError(f"--jobs {jobs!r} must be an integer >= 1")
-    if not timeout_s > 0:
-        raise InputError(f"--timeout-s {timeout_s!r} must be > 0")
-    if timeseries not in TIMESERIES_FORMATS:
-        raise InputError(
-            f"--timeseries {timeseries!r} is not one of {', '.join(TIMESERIES_FORMATS)}"
-        )
+    _check_options(jobs, timeout_s, timeseries)
     matrix: Matrix = load_matrix(Path(matrix_path))
     check_matrix(matrix, tables_dir)
     cases = matrix.cases()
     paper = matrix.paper_outcomes()
-    out_dir = Path(out_dir)
+    out_dir = _cases_folder(Path(out_dir))
     results_path = out_dir / RESULTS_FILE
-    try:
-        (out_dir / CASES_DIR).mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"output folder {out_dir} cannot be written: {exc.strerror}") from exc
     kept = (
         kept_rows(results_path, cases)
         if resume and results_path.is_file()
@@ -177,24 +171,13 @@ def run_batch(
     done = set(kept["case_id"])
     to_run = [c for c in cases if c.case_id not in done]
     log = RowLog(results_path, kept)
-    bar = tqdm(
-        total=len(cases),
-        initial=len(done),
-        unit="case",
-        desc="cases",
-        file=sys.stderr,
-        disable=not progress,
-        dynamic_ncols=True,
-    )
+    bar = _progress_bar(len(cases), len(done), progress)
     failed = 0
     try:
         for case, result in _results(
             to_run, out_dir, jobs, scheduler, timeout_s, case_func, tables_dir, timeseries
         ):
-            row = result_row(case, result, paper.get(case.case_id))
-            _store_case_files(out_dir / case_dir_of(case.case_id), result, row["status"] == "ok")
-            log.add(row)
-            failed += row["status"] != "ok"
+            failed += _record(out_dir, log, case, result, paper.get(case.case_id))
             bar.set_postfix(failed=failed, refresh=False)
             bar.update(1)
     finally:
@@ -208,73 +191,55 @@ def run_batch(
     return results
 
 
-def write_report(out_dir: Path, results: pd.DataFrame) -> list[Path]:
-    """Write ``table2.md``, ``table2.png`` and ``margins.png`` of a results frame into
-    ``out_dir``."""
-    # matplotlib is imported only when a report is drawn: the batch's workers and its tests'
-    # case functions import this module and need none of it
-    from eoam_sumo.plotting.batch_plots import MARGINS_PNG, plot_margins, plot_table2
+def _check_options(jobs: int, timeout_s: float, timeseries: str) -> None:
+    """InputError for a job count, time limit or time-series format out of range."""
+    if not (isinstance(jobs, int) and jobs >= 1):
+        raise InputError(f"--jobs {jobs!r} must be an integer >= 1")
+    if not timeout_s > 0:
+        raise InputError(f"--timeout-s {timeout_s!r} must be > 0")
+    if timeseries not in TIMESERIES_FORMATS:
+        raise InputError(
+            f"--timeseries {timeseries!r} is not one of {', '.join(TIMESERIES_FORMATS)}"
+        )
 
-    out_dir = Path(out_dir)
+
+def _cases_folder(out_dir: Path) -> Path:
+    """``out_dir`` with its ``cases/`` folder made; InputError if it cannot be written."""
+    try:
+        (out_dir / CASES_DIR).mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"output folder {out_dir} cannot be written: {exc.strerror}") from exc
+    return out_dir
+
+
+def _progress_bar(total: int, done: int, progress: bool) -> tqdm:
+    """The cases' progress bar on stderr (disabled without ``progress``)."""
+    return tqdm(
+        total=total,
+        initial=done,
+        unit="case",
+        desc="cases",
+        file=sys.stderr,
+        disable=not progress,
+        dynamic_ncols=True,
+    )
+
+
+def _record(out_dir: Path, log: RowLog, case: Case, result: TaskResult, paper: str | None) -> bool:
+    """A finished case: its files into its folder, its row into results.csv; True if it
+    failed."""
+    row = result_row(case, result, paper)
+    ok = row["status"] == "ok"
+    _store_case_files(out_dir / case_dir_of(case.case_id), result, ok)
+    log.add(row)
+    return not ok
+
+
+def write_report(out_dir: Path, results: pd.DataFrame) -> Path:
+    """Write ``table2.md`` of a results frame into ``out_dir``; return its path."""
     grid = outcome_grid(results)
     text = table2_markdown(grid, policy_title(results))
     head, _, rest = text.partition("\n\n")
     sight = sight_markdown(results)
     text = f"{head}\n\n{policy_line(results)}\n\n{rest}" + (f"\n{sight}" if sight else "")
-    md = write_atomic(out_dir / TABLE_MD, text)
-    return [
-        md,
-        plot_table2(grid, out_dir / TABLE_PNG),
-        plot_margins(results, out_dir / MARGINS_PNG),
-    ]
-
-
-def _raise_interrupt(signum, frame):
-    raise KeyboardInterrupt
-
-
-def run_batch_cli(args) -> int:
-    """``eoam-sumo batch``: run the batch; SIGTERM stops it like Ctrl-C (rows kept).
-
-    Returns 0 when every case ran, :data:`EXIT_CASES_FAILED` when at least one failed (after
-    results.csv and the report are written; each failed case and then the count on stderr).
-    Bad input raises InputError before any case runs (exit status 2 in ``cli.main``).
-    """
-    previous = None
-    if threading.current_thread() is threading.main_thread():
-        previous = signal.signal(signal.SIGTERM, _raise_interrupt)
-    try:
-        results = run_batch(
-            args.matrix,
-            args.out,
-            jobs=args.jobs,
-            scheduler=args.scheduler,
-            resume=args.resume,
-            timeout_s=args.timeout_s,
-            progress=not args.no_progress,
-            timeseries=args.timeseries,
-        )
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
-    failed = results[results["status"] != "ok"]
-    results_path = Path(args.out) / RESULTS_FILE
-    report = (
-        "outcome probabilities in " + str(Path(args.out) / "outcome_probabilities.csv")
-        if results["draw"].notna().any()
-        else f"Table 2 in {Path(args.out) / 'table2.md'}"
-    )
-    print(
-        f"{len(results)} cases, {len(results) - len(failed)} ok, {len(failed)} failed; "
-        f"results in {results_path}, {report}"
-    )
-    if failed.empty:
-        return 0
-    for _, row in failed.iterrows():
-        print(f"failed: {row['case_id']}: {row['error']}", file=sys.stderr)
-    print(
-        f"eoam-sumo: {len(failed)} of {len(results)} cases failed; their errors are in the "
-        f"'error' column of {results_path}",
-        file=sys.stderr,
-    )
-    return EXIT_CASES_FAILED
+    return write_atomic(Path(out_dir) / TABLE_MD, text)

@@ -103,15 +103,42 @@ def audit(
     solution: OcpSolution, resim: Resimulation, params: VehicleParams, settings: DesignSettings
 ) -> None:
     """Check the re-simulation against every constraint; raise ``OcpError`` listing breaches."""
-    s, p = settings, params
+    checks = _final_checks(solution, resim, settings) + _limit_checks(
+        solution, resim, params, settings
+    )
+    breaches = [
+        f"{name} off by {value:.4g} {unit} (tolerance {tol:g})"
+        for name, value, tol, unit in checks
+        if not value <= tol
+    ]
+    if breaches:
+        raise OcpError(
+            f"optimal lane change at mu={solution.mu:g}, {solution.speed_mps * 3.6:g} km/h "
+            "fails its re-simulation check: " + "; ".join(breaches)
+        )
+
+
+def _final_checks(solution: OcpSolution, resim: Resimulation, s: DesignSettings) -> list[tuple]:
+    """(name, excess, tolerance, unit) of the imposed final conditions (eq. 23, settled in the
+    next lane) and of the distance against the optimiser's."""
     end = resim.states[-1]
-    brake, drive = split_force(resim.controls[:, 1])
-    checks = [
+    return [
         ("final y (eq. 23)", abs(end[2] - s.lane_change_m), s.verify_lateral_tol_m, "m"),
         ("x(t_f) vs optimiser", abs(end[0] - solution.distance_m), s.verify_distance_tol_m, "m"),
         ("final lateral speed", abs(end[3]), s.verify_lat_speed_tol_mps, "m/s"),
         ("final yaw", abs(end[4]), s.verify_yaw_tol_rad, "rad"),
         ("final yaw rate", abs(end[5]), s.verify_yaw_rate_tol_radps, "rad/s"),
+    ]
+
+
+def _limit_checks(
+    solution: OcpSolution, resim: Resimulation, p: VehicleParams, s: DesignSettings
+) -> list[tuple]:
+    """(name, excess, tolerance, unit) of the path constraints over the whole manoeuvre:
+    friction ellipses (eqs. 25, 28), steering (eqs. 26-27), forces and power (eq. 29), and
+    the speed floor."""
+    brake, drive = split_force(resim.controls[:, 1])
+    return [
         (
             "front friction ellipse (eqs. 25, 28)",
             resim.ellipse_front.max() - s.friction_use**2,
@@ -151,13 +178,3 @@ def audit(
             "m/s",
         ),
     ]
-    breaches = [
-        f"{name} off by {value:.4g} {unit} (tolerance {tol:g})"
-        for name, value, tol, unit in checks
-        if not value <= tol
-    ]
-    if breaches:
-        raise OcpError(
-            f"optimal lane change at mu={solution.mu:g}, {solution.speed_mps * 3.6:g} km/h "
-            "fails its re-simulation check: " + "; ".join(breaches)
-        )

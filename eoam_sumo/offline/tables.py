@@ -249,8 +249,8 @@ class LookupTables:
     @classmethod
     def cached(cls, directory=None, params: VehicleParams | None = None) -> LookupTables:
         """:meth:`load`, kept for the process while the folder's files are unchanged (their
-        size and modification time): a batch worker runs many cases on the same tables, whose
-        reading (the npz decompressed, the csv parsed) took 10 ms a case."""
+        size and modification time): a batch worker runs many cases on the same tables, and
+        reading them (the npz decompressed, the csv parsed) again for each would be waste."""
         folder = Path(directory) if directory is not None else default_tables_dir()
         params = params or ego_e_class_sedan()
         try:

@@ -9,7 +9,7 @@ written to a temporary file and renamed into place, so concurrent builders are s
 
 Where Python's headers are installed the same source is also built as a Python extension
 module (``extension_source``): ``advance(x, u, mu)`` reads the floats, calls the step and
-returns the lists in C, where the ``ctypes`` call costs ~18k instructions more (callgrind).
+returns the lists in C, with less overhead per call than the ``ctypes`` call.
 """
 
 from __future__ import annotations
@@ -43,8 +43,7 @@ C_FLAGS = (
 """``-ffp-contract=off``: no fused multiply-adds, so the C code rounds like the reference.
 ``-fno-semantic-interposition`` lets the compiler inline CasADi's helpers (``casadi_fmax``,
 ``casadi_fmin``, ...), which ``-fPIC`` otherwise calls through the PLT, and ``-fno-math-errno``
-turns ``sqrt`` into one instruction; neither changes a result (IEEE arithmetic is kept): with
-``C_PREAMBLE`` a 10-sub-step call takes ~5 us instead of ~10."""
+turns ``sqrt`` into one instruction; neither changes a result (IEEE arithmetic is kept)."""
 
 CACHE_ENV = "EOAM_SUMO_CACHE_DIR"
 EXTENSION_NAME = "eoam_plant_ext"  # the extension module's name (its ``PyInit_`` function)
@@ -59,14 +58,15 @@ static inline double eoam_fmin(double x, double y) { return x < y ? x : (y != y 
 #define fmin(x, y) eoam_fmin(x, y)
 """
 """Put before CasADi's code: its ``casadi_fmax``/``casadi_fmin`` call ``fmax``/``fmin``, which
-``-fno-math-errno`` alone does not inline (~2,300 library calls per 10-sub-step call)."""
+``-fno-math-errno`` alone does not inline (a library call each)."""
 
 
 @functools.lru_cache(maxsize=16)
 def step_function(params: VehicleParams, dt_s: float, substeps: int) -> casadi.Function:
     """``(x[9], u[3], mu) -> (x_next[9], y[len(OUTPUT_NAMES)])``: ``substeps`` calls of one
-    SX RK4 step inside an MX function, so the generated C holds the step once (a 36 kB
-    library instead of 275 kB unrolled: it stays in the instruction cache between SUMO steps)."""
+    SX RK4 step inside an MX function, so the generated C holds the step once (not unrolled
+    ``substeps`` times: the smaller library stays in the instruction cache between SUMO
+    steps)."""
     x = casadi.SX.sym("x", len(STATE_NAMES))
     u = casadi.SX.sym("u", len(INPUT_NAMES))
     mu = casadi.SX.sym("mu")

@@ -3,8 +3,8 @@
 Where Python's headers are installed, ``advance`` is the ``advance`` of the same C code built
 as a Python extension module (``codegen.extension_source``): floats in and lists out in C.
 Otherwise the compiled library (``codegen.py``) is called through ``ctypes`` with
-pre-allocated ctypes buffers: about 1 us of Python overhead per call more, against ~45 us for
-calling the same library through ``casadi.external``. Without a working C compiler the same SX
+pre-allocated ctypes buffers (more Python overhead per call than the extension, far less than
+calling the same library through ``casadi.external``). Without a working C compiler the same SX
 function runs on CasADi's virtual machine (identical arithmetic, slower) and a
 ``RuntimeWarning`` says so.
 """
@@ -58,8 +58,8 @@ def _load_library(path: str):
 
 @functools.lru_cache(maxsize=16)
 def _source(params, dt_s, substeps) -> str:
-    """The step's C source (CasADi's code generation takes about 3 ms; a batch worker builds a
-    plant for every case)."""
+    """The step's C source, generated once per process and parameter set (a batch worker
+    builds a plant for every case)."""
     return c_source(step_function(params, dt_s, substeps))
 
 

@@ -113,6 +113,27 @@ class _Scene:
 
     def __init__(self, summary: dict, ts, traffic, size_in, dpi):
         self.summary = summary
+        self._read_series(ts)
+        self._traffic_index(traffic)
+        self.radar_m = float(summary.get("radar_range_m") or 100.0)
+        self.fov_rad = math.radians(float(summary.get("radar_fov_deg") or DEFAULT_RADAR_FOV_DEG))
+        self.contact_t = summary.get("contact_time_s")
+        self.fig = Figure(figsize=size_in, dpi=dpi)
+        # fixed margins (no layout engine run for every frame) and no ticks: the
+        # view moves, its scale is in the status line
+        self.ax = ax = self.fig.add_axes((0.01, 0.01, 0.98, 0.90))
+        ax.set_xticks([])
+        ax.set_yticks([])
+        ax.set_aspect("equal", adjustable="box")
+        self.view_ratio = 0.90 * size_in[1] / (0.98 * size_in[0])  # view height / width
+        ax.set_facecolor("#a5d6a7")  # verges
+        self._draw_road(summary)
+        self._add_moving_artists(ax)
+        self._static_overlay(size_in, dpi)
+
+    def _read_series(self, ts) -> None:
+        """The time series the frames show: the ego's pose and speed, its planned path, the
+        EOAM's mode, FCW and sector."""
         self.t = ts["time_s"].to_numpy()
         self.x, self.y = ts["x_m"].to_numpy(), ts["y_m"].to_numpy()
         self.yaw = ts["yaw_rad"].to_numpy()
@@ -126,20 +147,10 @@ class _Scene:
         self.vx = ts["vx_mps"].to_numpy()
         self.fcw = ts["fcw"].to_numpy(dtype=float)
         self.sector = ts["sector"].fillna("").astype(str).to_list()
-        self._traffic_index(traffic)
-        self.radar_m = float(summary.get("radar_range_m") or 100.0)
-        self.fov_rad = math.radians(float(summary.get("radar_fov_deg") or DEFAULT_RADAR_FOV_DEG))
-        self.contact_t = summary.get("contact_time_s")
-        self.fig = Figure(figsize=size_in, dpi=dpi)
-        # fixed margins (a layout engine per frame would double the cost) and no ticks: the
-        # view moves, its scale is in the status line
-        self.ax = ax = self.fig.add_axes((0.01, 0.01, 0.98, 0.90))
-        ax.set_xticks([])
-        ax.set_yticks([])
-        ax.set_aspect("equal", adjustable="box")
-        self.view_ratio = 0.90 * size_in[1] / (0.98 * size_in[0])  # view height / width
-        ax.set_facecolor("#a5d6a7")  # verges
-        self._draw_road(summary)
+
+    def _add_moving_artists(self, ax) -> None:
+        """The artists each frame updates: radar cone, track, planned path, road users'
+        boxes, the contact mark and the status text."""
         self.cone = Polygon(
             np.zeros((3, 2)),
             closed=True,
@@ -176,11 +187,10 @@ class _Scene:
             zorder=6,
             bbox={"facecolor": "white", "alpha": 0.85, "linewidth": 0},
         )
-        self._static_overlay(size_in, dpi)
 
     def _static_overlay(self, size_in, dpi) -> None:
         """Title and legend drawn once onto a transparent image laid over every frame (their
-        text would otherwise be laid out again for each frame, a third of its cost)."""
+        text would otherwise be laid out again for each frame)."""
         over = Figure(figsize=size_in, dpi=dpi)
         over.patch.set_alpha(0.0)
         handles: list[Artist] = [

@@ -21,6 +21,7 @@ from eoam_sumo.batch.results import RESULTS_FILE, read_results
 from eoam_sumo.colours import DARK_TEXT
 from eoam_sumo.colours import HEX as OUTCOME_COLOURS
 from eoam_sumo.params import PONR_FRACTION
+from eoam_sumo.plotting.envelope_plots import plot_envelopes
 from eoam_sumo.plotting.figures import save
 from eoam_sumo.plotting.runfacts import (
     fit,
@@ -48,35 +49,7 @@ def plot_table2(grid, path: Path) -> Path:
     fig = Figure(figsize=(3.2 + 1.9 * n_cols, 1.6 + 0.42 * n_rows), layout="constrained")
     ax = fig.add_subplot()
     for (i, j), cell in grid.cells.items():
-        parts = [cell.ours, cell.paper] if halves == 2 else [cell.ours]
-        for k, colour in enumerate(parts):
-            x0 = j + k / halves
-            ax.add_patch(
-                Rectangle(
-                    (x0, i),
-                    1 / halves,
-                    1,
-                    facecolor=OUTCOME_COLOURS.get(colour, _MISSING),
-                    edgecolor="white",
-                    linewidth=0.6,
-                )
-            )
-            ax.text(
-                x0 + 0.5 / halves,
-                i + 0.5,
-                colour or "—",
-                ha="center",
-                va="center",
-                fontsize=8,
-                color=_text_colour(colour),
-            )
-        ax.add_patch(Rectangle((j, i), 1, 1, fill=False, edgecolor="white", linewidth=3.5))
-        if halves == 2 and cell.compared and not cell.agrees:
-            ax.add_patch(
-                Rectangle(
-                    (j + 0.03, i + 0.06), 0.94, 0.88, fill=False, edgecolor="black", linewidth=2.2
-                )
-            )
+        _draw_cell(ax, i, j, cell, halves)
     labels = []
     previous = None
     for i, (traffic, speed) in enumerate(grid.rows):
@@ -109,6 +82,40 @@ def plot_table2(grid, path: Path) -> Path:
     ]
     fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), frameon=False)
     return save(fig, path)
+
+
+def _draw_cell(ax, i: int, j: int, cell, halves: int) -> None:
+    """Cell (row i, column j): ours (and the paper's) colour and name, framed when the two
+    differ."""
+    parts = [cell.ours, cell.paper] if halves == 2 else [cell.ours]
+    for k, colour in enumerate(parts):
+        x0 = j + k / halves
+        ax.add_patch(
+            Rectangle(
+                (x0, i),
+                1 / halves,
+                1,
+                facecolor=OUTCOME_COLOURS.get(colour, _MISSING),
+                edgecolor="white",
+                linewidth=0.6,
+            )
+        )
+        ax.text(
+            x0 + 0.5 / halves,
+            i + 0.5,
+            colour or "—",
+            ha="center",
+            va="center",
+            fontsize=8,
+            color=_text_colour(colour),
+        )
+    ax.add_patch(Rectangle((j, i), 1, 1, fill=False, edgecolor="white", linewidth=3.5))
+    if halves == 2 and cell.compared and not cell.agrees:
+        ax.add_patch(
+            Rectangle(
+                (j + 0.03, i + 0.06), 0.94, 0.88, fill=False, edgecolor="black", linewidth=2.2
+            )
+        )
 
 
 def _offsets(batch_dir: Path, case_dir: str) -> pd.DataFrame:
@@ -292,17 +299,28 @@ _KEY_NAMES = {
 }
 
 
-def plot_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
-    """Every batch plot of a batch folder (has results.csv): Table 2 image and Figure 25."""
-    results = read_results(Path(batch_dir) / RESULTS_FILE)
-    if results["draw"].notna().any():  # a sampled batch: its envelopes, no Table 2 grid
-        from eoam_sumo.plotting.envelope_plots import plot_envelopes
-
+def plot_batch_report(results: pd.DataFrame, out_dir: Path) -> list[Path]:
+    """The images ``eoam-sumo batch`` draws beside its report: ``table2.png`` and
+    ``margins.png``, or for a sampled batch ``envelope.png``."""
+    if is_sampled(results):
         return plot_envelopes(results, out_dir)
-    paths = [
+    return [
         plot_table2(outcome_grid(results), Path(out_dir) / TABLE_PNG),
         plot_margins(results, Path(out_dir) / MARGINS_PNG),
     ]
+
+
+def is_sampled(results: pd.DataFrame) -> bool:
+    """Whether a results frame is of a sampled batch (its cases are numbered draws)."""
+    return bool(results["draw"].notna().any())
+
+
+def plot_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
+    """Every batch plot of a batch folder (has results.csv): Table 2 image and Figure 25."""
+    results = read_results(Path(batch_dir) / RESULTS_FILE)
+    paths = plot_batch_report(results, out_dir)
+    if is_sampled(results):  # its envelopes, no Table 2 grid
+        return paths
     ok = results[results["status"] == "ok"]
     for speed_kmh in pd.unique(ok["ego_speed_kmh"]):
         fig25 = plot_lateral_offsets(batch_dir, results, out_dir, float(speed_kmh))

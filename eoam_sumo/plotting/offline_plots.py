@@ -62,36 +62,8 @@ def plot_phase_diagrams(tables_dir, out_dir) -> list[Path]:
             shading="nearest",
             rasterized=True,
         )
-        for field, label, colour, style in _CURVES:
-            ax.plot(
-                [getattr(b, field) for b in rows], kmh, style, color=colour, lw=1.6, label=label
-            )
-        ax.plot(
-            [b.ttc_s * v for b, v in zip(rows, speeds)],
-            kmh,
-            "-.",
-            color="#455a64",
-            lw=1.4,
-            label=f"TTC = {top.ttc_s:g} s (eq. 34)",
-        )
-        for k, sector in enumerate(_SECTORS):
-            vi, di = np.nonzero(index == k)
-            if vi.size < 20:
-                continue
-            cv, cd = vi.mean(), di.mean()
-            best = np.argmin(
-                (vi - cv) ** 2 / index.shape[0] ** 2 + (di - cd) ** 2 / index.shape[1] ** 2
-            )
-            ax.text(
-                dist[di[best]],
-                kmh[vi[best]],
-                sector.value,
-                fontsize=15,
-                weight="bold",
-                ha="center",
-                va="center",
-                color="#212121",
-            )
+        _draw_curves(ax, rows, speeds, kmh)
+        _letter_sectors(ax, index, dist, kmh)
         ax.set_xlim(0.0, d_max)
         ax.set_ylim(0.0, kmh[-1])
         ax.set_xlabel("relative distance ARV-ARO (m)")
@@ -102,6 +74,44 @@ def plot_phase_diagrams(tables_dir, out_dir) -> list[Path]:
         fig.tight_layout()
         paths.append(_save(fig, out / f"phase_diagram_mu{mu:.2f}.png"))
     return paths
+
+
+def _draw_curves(ax, rows: list, speeds: np.ndarray, kmh: np.ndarray) -> None:
+    """The five DMM boundaries (eqs. 32-33, plain and buffered) and the TTC line (eq. 34)
+    against the relative speed."""
+    for field, label, colour, style in _CURVES:
+        ax.plot([getattr(b, field) for b in rows], kmh, style, color=colour, lw=1.6, label=label)
+    ax.plot(
+        [b.ttc_s * v for b, v in zip(rows, speeds)],
+        kmh,
+        "-.",
+        color="#455a64",
+        lw=1.4,
+        label=f"TTC = {rows[-1].ttc_s:g} s (eq. 34)",
+    )
+
+
+def _letter_sectors(ax, index: np.ndarray, dist: np.ndarray, kmh: np.ndarray) -> None:
+    """Each sector's letter at its grid point nearest the sector's centroid (sectors of fewer
+    than 20 grid points unlettered)."""
+    for k, sector in enumerate(_SECTORS):
+        vi, di = np.nonzero(index == k)
+        if vi.size < 20:
+            continue
+        cv, cd = vi.mean(), di.mean()
+        best = np.argmin(
+            (vi - cv) ** 2 / index.shape[0] ** 2 + (di - cd) ** 2 / index.shape[1] ** 2
+        )
+        ax.text(
+            dist[di[best]],
+            kmh[vi[best]],
+            sector.value,
+            fontsize=15,
+            weight="bold",
+            ha="center",
+            va="center",
+            color="#212121",
+        )
 
 
 def plot_accel_profiles(tables_dir, out_dir) -> list[Path]:

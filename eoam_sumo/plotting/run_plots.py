@@ -322,8 +322,6 @@ def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = No
     repository's ``tables/``); without readable tables the trace is drawn alone and the title
     says why.
     """
-    from eoam_sumo.decision.dmm import SECTOR_ORDER
-
     summary, ts = load_run(case_dir)
     mu, what = manoeuvre_mu(summary, ts)
     seen = ts[np.isfinite(ts["aro_range_m"]) & np.isfinite(ts["aro_range_rate_mps"])]
@@ -349,84 +347,9 @@ def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = No
     except (ImportError, OSError, ValueError) as exc:
         bounds, note = None, f"\n(phase boundaries not drawn: {exc})"
     if bounds is not None:
-        from matplotlib.colors import ListedColormap
-
-        ds = np.linspace(0.0, d_max, 300)
-        index = _sector_map(bounds, vs, ds)
-        order = [s.value for s in SECTOR_ORDER]
-        cmap = ListedColormap([SECTOR_COLOURS[s] for s in order])
-        ax.imshow(
-            index,
-            origin="lower",
-            extent=(0, v_max, 0, d_max),
-            aspect="auto",
-            cmap=cmap,
-            vmin=-0.5,
-            vmax=len(order) - 0.5,
-            alpha=0.8,
-            interpolation="nearest",
-        )
-        for k, letter in enumerate(order):
-            rr, cc = np.nonzero(index == k)
-            if len(rr) > 50:
-                ax.text(
-                    vs[int(np.median(cc))],
-                    ds[int(np.median(rr))],
-                    letter,
-                    fontsize=16,
-                    fontweight="bold",
-                    ha="center",
-                    va="center",
-                    color="0.25",
-                )
-        for field, label, style, colour in (
-            ("clear_opt_m", "S: min. clearing distance (opt. accel.)", "-", "#2e7d32"),
-            ("clear_buffered_m", "Sb: buffered clearing distance", "--", "#2e7d32"),
-            ("clear_const_m", "min. clearing distance at constant speed", ":", "#2e7d32"),
-            ("stop_m", "B0: stopping distance", "-", "#1565c0"),
-            ("stop_buffered_m", "Bb: buffered stopping distance", "--", "#1565c0"),
-        ):
-            ax.plot(
-                vs,
-                [getattr(b, field) for b in bounds],
-                linestyle=style,
-                color=colour,
-                linewidth=1.4,
-                label=label,
-            )
-        ttc = np.array([b.ttc_s for b in bounds])
-        ax.plot(
-            vs, ttc * vs, ":", color="#6d4c41", linewidth=1.4, label=f"T: TTC line ({ttc[-1]:g} s)"
-        )
-    for mode in sorted(_modes_in(seen)):
-        sel = seen[seen["mode"] == mode]
-        ax.scatter(
-            -sel["aro_range_rate_mps"],
-            sel["aro_range_m"],
-            s=9,
-            color=MODE_COLOURS[mode],
-            edgecolors="black",
-            linewidths=0.2,
-            label=f"trace, mode {MODE_NAMES[mode]}",
-            zorder=3,
-        )
-    if len(seen):
-        ax.annotate(
-            "first sensed",
-            (closing.iloc[0], seen["aro_range_m"].iloc[0]),
-            xytext=(10, 10),
-            textcoords="offset points",
-            fontsize=9,
-            arrowprops={"arrowstyle": "->"},
-        )
-        ax.annotate(
-            "last sensed",
-            (closing.iloc[-1], seen["aro_range_m"].iloc[-1]),
-            xytext=(10, -15),
-            textcoords="offset points",
-            fontsize=9,
-            arrowprops={"arrowstyle": "->"},
-        )
+        _draw_sectors(ax, bounds, vs, v_max, d_max)
+        _draw_boundaries(ax, bounds, vs)
+    _draw_trace(ax, seen, closing)
     ax.set_xlim(0, v_max)
     ax.set_ylim(0, d_max)
     ax.set_xlabel("closing speed to the ARO (-range rate) [m/s]")
@@ -443,6 +366,92 @@ def plot_phase_trace(case_dir: Path, out_dir: Path, tables_dir: Path | None = No
         fontsize=10,
     )
     return save(fig, Path(out_dir) / "phase_trace.png")
+
+
+def _draw_sectors(ax, bounds: list, vs: np.ndarray, v_max: float, d_max: float) -> None:
+    """The DMM sectors A-G shaded over (closing speed, range), each large one lettered."""
+    from matplotlib.colors import ListedColormap
+
+    from eoam_sumo.decision.dmm import SECTOR_ORDER
+
+    ds = np.linspace(0.0, d_max, 300)
+    index = _sector_map(bounds, vs, ds)
+    order = [s.value for s in SECTOR_ORDER]
+    cmap = ListedColormap([SECTOR_COLOURS[s] for s in order])
+    ax.imshow(
+        index,
+        origin="lower",
+        extent=(0, v_max, 0, d_max),
+        aspect="auto",
+        cmap=cmap,
+        vmin=-0.5,
+        vmax=len(order) - 0.5,
+        alpha=0.8,
+        interpolation="nearest",
+    )
+    for k, letter in enumerate(order):
+        rr, cc = np.nonzero(index == k)
+        if len(rr) > 50:
+            ax.text(
+                vs[int(np.median(cc))],
+                ds[int(np.median(rr))],
+                letter,
+                fontsize=16,
+                fontweight="bold",
+                ha="center",
+                va="center",
+                color="0.25",
+            )
+
+
+def _draw_boundaries(ax, bounds: list, vs: np.ndarray) -> None:
+    """The DMM boundaries against the closing speed: clearing and stopping distances (plain
+    and buffered) and the TTC line."""
+    for field, label, style, colour in (
+        ("clear_opt_m", "S: min. clearing distance (opt. accel.)", "-", "#2e7d32"),
+        ("clear_buffered_m", "Sb: buffered clearing distance", "--", "#2e7d32"),
+        ("clear_const_m", "min. clearing distance at constant speed", ":", "#2e7d32"),
+        ("stop_m", "B0: stopping distance", "-", "#1565c0"),
+        ("stop_buffered_m", "Bb: buffered stopping distance", "--", "#1565c0"),
+    ):
+        ax.plot(
+            vs,
+            [getattr(b, field) for b in bounds],
+            linestyle=style,
+            color=colour,
+            linewidth=1.4,
+            label=label,
+        )
+    ttc = np.array([b.ttc_s for b in bounds])
+    ax.plot(vs, ttc * vs, ":", color="#6d4c41", linewidth=1.4, label=f"T: TTC line ({ttc[-1]:g} s)")
+
+
+def _draw_trace(ax, seen: pd.DataFrame, closing: pd.Series) -> None:
+    """The ARO as the radar saw it (range against closing speed), coloured by EOAM mode, its
+    first and last points marked."""
+    for mode in sorted(_modes_in(seen)):
+        sel = seen[seen["mode"] == mode]
+        ax.scatter(
+            -sel["aro_range_rate_mps"],
+            sel["aro_range_m"],
+            s=9,
+            color=MODE_COLOURS[mode],
+            edgecolors="black",
+            linewidths=0.2,
+            label=f"trace, mode {MODE_NAMES[mode]}",
+            zorder=3,
+        )
+    if not len(seen):
+        return
+    for which, k, offset in (("first", 0, (10, 10)), ("last", -1, (10, -15))):
+        ax.annotate(
+            f"{which} sensed",
+            (closing.iloc[k], seen["aro_range_m"].iloc[k]),
+            xytext=offset,
+            textcoords="offset points",
+            fontsize=9,
+            arrowprops={"arrowstyle": "->"},
+        )
 
 
 def plot_run(case_dir: Path, out_dir: Path, tables_dir: Path | None = None) -> list[Path]:

@@ -1,5 +1,6 @@
 """`eoam-sumo batch` exit status on real co-simulations: 0 when every case ran, 1 when at
-least one failed (results.csv and the report still written), the failed count last on stderr.
+least one failed (results.csv and the report, images included, still written), the failed
+count last on stderr.
 
 A case fails at run time here because its oncoming car would start beyond the end of the
 ego's road (4 km): a per-case error the matrix check cannot see without starting SUMO.
@@ -42,6 +43,8 @@ def test_exit_status_counts_failed_cases(capsys, tmp_path, monkeypatch, oncoming
     assert len(results) == cases
     assert (results["status"] == "failed").sum() == failed
     assert (out / "table2.md").is_file()
+    for image in ("table2.png", "margins.png"):  # drawn by the command from the results
+        assert (out / image).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     ok = results[results["status"] == "ok"]
     assert (ok["outcome"] != "").all()
     for case_dir in ok["case_dir"]:

@@ -13,6 +13,7 @@ from eoam_sumo.batch.report import outcome_grid, table2_markdown
 from eoam_sumo.batch.results import COLUMNS, read_results, result_row
 from eoam_sumo.batch.runner import write_report
 from eoam_sumo.matrix import load_matrix
+from eoam_sumo.plotting.batch_plots import plot_batch_report
 
 REPO = Path(__file__).resolve().parents[2]
 FLIP = {"green": "orange", "yellow": "red", "orange": "green", "red": "yellow"}
@@ -116,9 +117,10 @@ def test_own_sweep_gets_a_plain_pivot(tmp_path):
     assert md.count("](cases/") == 2
 
 
-def test_write_report_writes_markdown_and_a_png(tmp_path):
+def test_write_report_writes_markdown_and_the_cli_draws_the_pngs(tmp_path):
     _, results = _results(tmp_path, REPO / "scenarios" / "table2.toml", differ=(5,), failed=(6,))
-    md, png, margins = write_report(tmp_path, results)
+    md = write_report(tmp_path, results)
+    png, margins = plot_batch_report(results, tmp_path)
     head, _, rest = table2_markdown(outcome_grid(results)).partition("\n\n")
     text = md.read_text(encoding="utf-8")  # the grid, with the policy's line below the title
     assert text.startswith(f"{head}\n\nPolicy **paper**; forward radar") and text.endswith(rest)

@@ -3,9 +3,8 @@
 libsumo's Python layer wraps each function of its C binding in a static method that passes
 the arguments on (``libsumo.vehicle.getAngle(v)`` returns ``_libsumo.vehicle_getAngle(v)``),
 and ``simulationStep`` in the step listeners of ``libsumo.addStepListener`` (eoam-sumo adds
-none). Through libsumo the step calls the binding's functions themselves: one Python frame
-less for each of the 20-30 calls of a step (5.8 % of the compiled step's instructions in the
-benchmark's case: docs/performance.md). A function this libsumo lacks, and every function
+none). Through libsumo the step calls the binding's functions themselves, one Python frame
+less for each of the step's SUMO calls. A function this libsumo lacks, and every function
 through TraCI (sumo-gui, ``use_traci``), is the client's own method.
 """
 

@@ -199,17 +199,53 @@ def add_oncoming(
 ) -> str:
     """Insert the oncoming car of ``overrides.oncoming_start_m`` in the lane opposite the
     ego's, its front bumper that far ahead of the ego's along the road; its id."""
-    lanes = api.lane
     distance = overrides.oncoming_start_m
     assert distance is not None  # called only when the overrides ask for an oncoming car
+    px, py = _ahead_of_ego(ego, distance)
+    edges, lane_id, pos = _opposite_start(api, files, ego, px, py)
+    _ensure_oncoming_type(api.vehicletype)
+    vid, n = "oncoming", 0
+    while vid in files.vehicles:
+        n += 1
+        vid = f"oncoming.{n}"
+    index = int(lane_id.rsplit("_", 1)[1])  # SUMO lane ids are <edge>_<index>
+    insert(
+        api,
+        errors,
+        vid,
+        "oncoming",
+        edges,
+        index,
+        pos,
+        overrides.oncoming_speed_mps,
+        ONCOMING_SPEED_MODE,
+        {ROLE_KEY: "oncoming"},
+        over_limit,
+    )
+    return vid
+
+
+def _ahead_of_ego(ego: EgoStart, distance_m: float) -> tuple[float, float]:
+    """The point of the ego's centre line ``distance_m`` ahead of its front bumper;
+    InputError when the route ends before it."""
     s_ego, _ = project(ego.centreline, *ego.front_xy)
     total = arclength(ego.centreline)[-1]
-    if s_ego + distance > total:
+    if s_ego + distance_m > total:
         raise InputError(
-            f"oncoming_start_m={distance:g}: the ego's route ends "
+            f"oncoming_start_m={distance_m:g}: the ego's route ends "
             f"{total - s_ego:.1f} m ahead of the ego"
         )
-    px, py, _ = point_at(ego.centreline, s_ego + distance)
+    px, py, _ = point_at(ego.centreline, s_ego + distance_m)
+    return px, py
+
+
+def _opposite_start(
+    api, files: ScenarioFiles, ego: EgoStart, px: float, py: float
+) -> tuple[list[str], str, float]:
+    """(route edges, lane id, position on the lane [m]) of the oncoming car: on the opposite
+    lane of the ego's route nearest (px, py), its route the opposite edges back from there to
+    the first route edge without an opposite lane."""
+    lanes = api.lane
     opposite = []  # per route edge: the opposite lane of its leftmost lane, or None
     for edge in ego.route_edges:
         leftmost = f"{edge}_{api.edge.getLaneNumber(edge) - 1}"
@@ -232,31 +268,16 @@ def add_oncoming(
         edges.append(lanes.getEdgeID(o))
     shape = np.asarray(lanes.getShape(lane_id), dtype=float)
     pos = s_opp * lanes.getLength(lane_id) / arclength(shape)[-1]
-    types = api.vehicletype
+    return edges, lane_id, pos
+
+
+def _ensure_oncoming_type(types) -> None:
+    """The vehicle type ``oncoming`` (the oncoming sedan's dimensions), made once."""
     if "oncoming" not in types.getIDList():
         dims = oncoming_sedan()
         types.copy("DEFAULT_VEHTYPE", "oncoming")
         types.setLength("oncoming", dims.length_m)
         types.setWidth("oncoming", dims.width_m)
-    vid, n = "oncoming", 0
-    while vid in files.vehicles:
-        n += 1
-        vid = f"oncoming.{n}"
-    index = int(lane_id.rsplit("_", 1)[1])  # SUMO lane ids are <edge>_<index>
-    insert(
-        api,
-        errors,
-        vid,
-        "oncoming",
-        edges,
-        index,
-        pos,
-        overrides.oncoming_speed_mps,
-        ONCOMING_SPEED_MODE,
-        {ROLE_KEY: "oncoming"},
-        over_limit,
-    )
-    return vid
 
 
 def insert(

@@ -29,7 +29,7 @@ import shutil
 import sys
 import tempfile
 from pathlib import Path
-from typing import Self
+from typing import Any, NamedTuple, Self
 
 import numpy as np
 
@@ -63,6 +63,7 @@ from eoam_sumo.sim.session.tracking import RoadUsers
 _open_libsumo: list[SumoSession] = []  # libsumo runs one simulation per process
 _NO_OVERRIDES = ScenarioOverrides()
 _GUI_DEFAULTS = GuiSettings()
+_ERROR_LOG = "sumo-errors.log"  # SUMO's --error-log in the session's working directory
 
 
 def _delay_ms(text: str | None) -> float | None:
@@ -72,6 +73,79 @@ def _delay_ms(text: str | None) -> float | None:
     except ValueError:
         return None
     return value if math.isfinite(value) and value >= 0.0 else None
+
+
+def _checked_step(overrides: ScenarioOverrides, step_length_s: float) -> float:
+    """The SUMO step [s]: > 0 and a whole number of milliseconds (InputError otherwise);
+    TypeError for overrides that are not a ScenarioOverrides."""
+    if not isinstance(overrides, ScenarioOverrides):
+        raise TypeError(f"overrides must be a ScenarioOverrides, not {type(overrides).__name__}")
+    step = number("step_length_s", step_length_s, minimum=0.0, inclusive=False)
+    if abs(step * 1000.0 - round(step * 1000.0)) > 1e-9:
+        raise InputError(f"step_length_s={step_length_s!r} must be a whole number of milliseconds")
+    return step
+
+
+def _check_can_start(gui: bool, via_traci: bool) -> None:
+    """InputError for sumo-gui without a display; RuntimeError for a second libsumo session."""
+    if (
+        gui
+        and sys.platform.startswith("linux")
+        and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    ):
+        raise InputError(
+            "--gui needs a display, and DISPLAY is not set (sumo-gui would "
+            "fail to connect after 30 s)"
+        )
+    if not via_traci and _open_libsumo:
+        raise RuntimeError("a libsumo session is already open in this process; close it first")
+
+
+class _Started(NamedTuple):
+    """A started SUMO: the API module (libsumo or traci), its constants, its error classes,
+    the SUMO process (TraCI only, else None) and whether it runs through TraCI."""
+
+    api: Any
+    constants: Any
+    errors: tuple
+    process: Any
+    via_traci: bool
+
+
+def _connect(cmd: list, cfg: Path, error_log: Path, workdir: Path, via_traci: bool) -> _Started:
+    """Start SUMO with ``cmd`` through TraCI or in-process libsumo; a start that fails is an
+    InputError quoting SUMO's error log."""
+    if via_traci:
+        import traci
+
+        errors = (traci.exceptions.TraCIException, traci.exceptions.FatalTraCIError)
+        try:
+            api, process = traci_connect(cmd)
+        except (*errors, OSError) as exc:
+            raise InputError(start_error(cfg, error_log, exc)) from exc
+        return _Started(api, traci.constants, errors, process, True)
+    import libsumo
+
+    errors = (libsumo.TraCIException, libsumo.FatalTraCIError)
+    try:
+        with stderr_into(workdir / ERROR_LOG_STDERR):
+            libsumo.start(cmd)
+    except errors as exc:
+        raise InputError(start_error(cfg, error_log, exc)) from exc
+    return _Started(libsumo, libsumo.constants, errors, None, False)
+
+
+def _hand_over(
+    started: _Started, cmd: list, handover_s: float, cfg: Path, error_log: Path, workdir: Path
+) -> None:
+    """Run SUMO at the sumocfg's step to ``handover_s``, then restart it with ``cmd`` from
+    the saved state (``handover.run_and_hand_over``); SUMO is shut if that fails."""
+    try:
+        with stderr_into(workdir / ERROR_LOG_STDERR):
+            run_and_hand_over(started.api, cmd, handover_s, workdir)
+    except started.errors as exc:
+        shut_down(started.api, started.process)
+        raise InputError(start_error(cfg, error_log, exc)) from exc
 
 
 class SumoSession:
@@ -149,15 +223,7 @@ class SumoSession:
         query answers. ``gui`` runs ``sumo-gui`` through TraCI (shown as ``gui_settings``
         says), ``use_traci`` plain ``sumo`` through TraCI; otherwise libsumo (in-process, one
         session per process)."""
-        if not isinstance(overrides, ScenarioOverrides):
-            raise TypeError(
-                f"overrides must be a ScenarioOverrides, not {type(overrides).__name__}"
-            )
-        step = number("step_length_s", step_length_s, minimum=0.0, inclusive=False)
-        if abs(step * 1000.0 - round(step * 1000.0)) > 1e-9:
-            raise InputError(
-                f"step_length_s={step_length_s!r} must be a whole number of milliseconds"
-            )
+        step = _checked_step(overrides, step_length_s)
         extra = tuple(str(a) for a in extra_args)
         files = check_scenario(Path(cfg), ego_id)
         scripted = scripted_stops(files, overrides, ego_id)
@@ -167,19 +233,9 @@ class SumoSession:
 
         os.environ.setdefault("SUMO_HOME", sumo.SUMO_HOME)
         via_traci = gui or use_traci
-        if (
-            gui
-            and sys.platform.startswith("linux")
-            and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
-        ):
-            raise InputError(
-                "--gui needs a display, and DISPLAY is not set (sumo-gui would "
-                "fail to connect after 30 s)"
-            )
-        if not via_traci and _open_libsumo:
-            raise RuntimeError("a libsumo session is already open in this process; close it first")
+        _check_can_start(gui, via_traci)
         workdir = Path(tempfile.mkdtemp(prefix="eoam-sumo-"))
-        error_log = workdir / "sumo-errors.log"
+        error_log = workdir / _ERROR_LOG
         binary = sumolib.checkBinary("sumo-gui" if gui else "sumo")
         cmd, sumo_overrides = sumo_command(
             binary,
@@ -199,59 +255,65 @@ class SumoSession:
                 *SAVE_STATE_OPTIONS,
             ]
         try:
-            if via_traci:
-                import traci
-
-                errors = (traci.exceptions.TraCIException, traci.exceptions.FatalTraCIError)
-                try:
-                    api, process = traci_connect(first_cmd)
-                except (*errors, OSError) as exc:
-                    raise InputError(start_error(files.cfg, error_log, exc)) from exc
-                constants = traci.constants
-            else:
-                import libsumo
-
-                errors = (libsumo.TraCIException, libsumo.FatalTraCIError)
-                try:
-                    with stderr_into(workdir / ERROR_LOG_STDERR):
-                        libsumo.start(first_cmd)
-                except errors as exc:
-                    raise InputError(start_error(files.cfg, error_log, exc)) from exc
-                api, constants, process = libsumo, libsumo.constants, None
+            started = _connect(first_cmd, files.cfg, error_log, workdir, via_traci)
             if plan is not None:
-                try:
-                    with stderr_into(workdir / ERROR_LOG_STDERR):
-                        run_and_hand_over(api, cmd, plan[1], workdir)
-                except errors as exc:
-                    shut_down(api, process)
-                    raise InputError(start_error(files.cfg, error_log, exc)) from exc
+                _hand_over(started, cmd, plan[1], files.cfg, error_log, workdir)
         except BaseException:
             shutil.rmtree(workdir, ignore_errors=True)
             raise
+        return cls._opened(
+            started,
+            files,
+            overrides,
+            ego_id,
+            step,
+            workdir,
+            sumo_overrides,
+            gui_settings if gui else None,
+        )
+
+    @classmethod
+    def _opened(
+        cls,
+        started: _Started,
+        files: ScenarioFiles,
+        overrides: ScenarioOverrides,
+        ego_id: str,
+        step: float,
+        workdir: Path,
+        sumo_overrides: dict,
+        gui_settings: GuiSettings | None,
+    ) -> SumoSession:
+        """The session on a started SUMO, set up to the ego's insertion; on failure SUMO is
+        shut and ``workdir`` removed, a TraCI error becoming an InputError that quotes SUMO's
+        error log."""
         session = None
         try:
             session = cls(
-                api,
-                constants,
-                errors,
+                started.api,
+                started.constants,
+                started.errors,
                 files,
                 overrides,
                 ego_id,
                 step,
                 workdir,
-                process,
+                started.process,
                 sumo_overrides,
-                gui_settings if gui else None,
+                gui_settings,
             )
-            if not via_traci:
+            if not started.via_traci:
                 _open_libsumo.append(session)
             session._set_up()
         except BaseException as exc:
             if session is not None:
                 session._release()
             else:
-                shut_down(api, process)
-            detail = start_error(files.cfg, error_log, exc) if isinstance(exc, errors) else None
+                shut_down(started.api, started.process)
+            error_log = workdir / _ERROR_LOG
+            detail = (
+                start_error(files.cfg, error_log, exc) if isinstance(exc, started.errors) else None
+            )
             shutil.rmtree(workdir, ignore_errors=True)
             if detail is None:
                 raise

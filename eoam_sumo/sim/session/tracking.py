@@ -5,9 +5,9 @@ subscription on the ego (SUMO collects those whose front is within the range, pa
 included; one ``getContextSubscriptionResults`` a step), its range the sensing radius plus the
 largest diagonal of the vehicles SUMO has had since (each departing vehicle's type is read),
 so that every vehicle some part of which may be within the radius is in it. (The largest
-diagonal of every type SUMO knows would count SUMO's 135 m default rail type: a range of 236
-m instead of 107 m for a 100 m radius, and as many more vehicles for SUMO to collect and the
-binding to convert each step. A vehicle switched to a longer type after it departed, through
+diagonal of every type SUMO knows would count SUMO's 135 m default rail type, widening the
+range, and with it the vehicles SUMO collects and the binding converts each step, far beyond
+the radius. A vehicle switched to a longer type after it departed, through
 TraCI's ``setType``, is counted with its departure type: it is found once its front is within
 the range.) Persons are subscribed one by one (a person riding in a vehicle is not a road user
 of its own). A road user whose values did not change since the last step is the same
@@ -16,16 +16,12 @@ of its own). A road user whose values did not change since the last step is the 
 Through libsumo the context subscription carries the position only; the type of each vehicle
 in it (its reach) and the angle, speed and stop state of those within reach are read with
 getters: a subscribed value costs SUMO's step and the binding's conversion more than a getter
-does (callgrind, the benchmark's case: the type read instead of subscribed, 352.9k -> 338.5k
-instructions a step; the traffic case unchanged), and the vehicles beyond reach are not read
-further. Through TraCI every getter is a round trip, so all five values are subscribed.
+does, and the vehicles beyond reach are not read further. Through TraCI every getter is a
+round trip, so all five values are subscribed.
 
-Measured in CPU time on the benchmark's traffic scenario (381 vehicles in SUMO, 67 within reach
-of a 255 m radius, libsumo 1.28): a variable subscription on every vehicle read with one
-``getAllSubscriptionResults`` a step, a body built for each, cost 1.5-1.8 ms a step in Python
-and 1.2-1.7 ms more in SUMO's step (about 8 us per vehicle in all); the context subscription
-with bodies only within reach costs 0.22-0.29 ms in Python and 0.1-0.18 ms in SUMO's step
-(about 1.1 us per vehicle).
+The context subscription, with bodies built only within reach, is used rather than a variable
+subscription on every vehicle because the work of a step then grows with the road users near
+the ego, not with every vehicle SUMO has (docs/performance.md).
 """
 
 from __future__ import annotations
