@@ -1,7 +1,6 @@
-"""Online controllers: steering (paper eq. 38), longitudinal PIDs (sec. 9), path references."""
+"""Online controllers: steering (paper eq. 38) and longitudinal PIDs (sec. 9)."""
 
 from eoam_sumo.control.longitudinal import LongitudinalController, LongitudinalGains, Pid
-from eoam_sumo.control.paths import PathPoint, PathReference, QuinticShift
 from eoam_sumo.control.steering import (
     SteeringCommand,
     SteeringController,
@@ -12,10 +11,7 @@ from eoam_sumo.control.steering import (
 __all__ = [
     "LongitudinalController",
     "LongitudinalGains",
-    "PathPoint",
-    "PathReference",
     "Pid",
-    "QuinticShift",
     "SteeringCommand",
     "SteeringController",
     "SteeringGains",

@@ -139,10 +139,9 @@ class LongitudinalController:
         q = self._margin * abs(lateral_accel_mps2) / mu
         ellipse = math.sqrt(1.0 - q * q) if q < 1.0 else 0.0
         drive = self._fmax
-        if speed_mps > 1.0 and self._pmax / speed_mps < drive:
-            drive = self._pmax / speed_mps  # power-limited
-        if self._rear_n < drive:
-            drive = self._rear_n  # traction-limited
+        if speed_mps > 1.0:
+            drive = min(drive, self._pmax / speed_mps)  # power-limited
+        drive = min(drive, self._rear_n)  # traction-limited
         drive = mu * drive
         return drive * ellipse, no_lock_brake_n * ellipse
 

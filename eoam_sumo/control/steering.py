@@ -83,9 +83,6 @@ class SteeringCommand(NamedTuple):
     lookahead_error_m: float  # the position feedback's error e + (k_psi / k_e) psi~
 
 
-_new = tuple.__new__  # builds the per-step SteeringCommand in half its constructor's time
-
-
 def understeer_gradient(params: VehicleParams) -> float:
     """K_us = m (b / C_f - a / C_r) / L [rad per m/s^2] (axle cornering stiffnesses)."""
     return (
@@ -240,7 +237,7 @@ class SteeringController:
         )
 
     def _place(self, i: int) -> _Gains:
-        """Row ``i`` of the gain table at the table's friction (pole placement, ~0.3 ms)."""
+        """Row ``i`` of the gain table at the table's friction (pole placement)."""
         v = self._speeds[i]
         A, B = single_track_matrices(self._params, v)
         k = place_poles(A, B, self.design_poles(v, self._table_mu))
@@ -282,31 +279,23 @@ class SteeringController:
         feedforward (its path's curvature then left out of ``preview_curvature_1pm``) and
         gives its body sideslip ``sideslip_rad`` in place of the steady-state one.
         """
-        v = speed_mps if speed_mps > 0.0 else 0.0
+        v = max(0.0, speed_mps)  # 0 for -0.0 and NaN too
         k_vy, k_r, k_psi, k_e = self.gains_at(v, mu)
-        if sideslip_rad is None:
-            beta = curvature_1pm * (self._b - self._slip_k * v * v)  # steady_sideslip, inlined
-        else:
-            beta = sideslip_rad
+        beta = self.steady_sideslip(v, curvature_1pm) if sideslip_rad is None else sideslip_rad
         psi = heading_error_rad + beta
         ff = (self._L + self._kus * v * v) * preview_curvature_1pm + planned_steer_rad
         fb = -(k_e * lateral_error_m + k_psi * psi)
         yd = -(k_vy * (lateral_speed_mps - v * beta) + k_r * (yaw_rate_radps - v * curvature_1pm))
         delta = ff + fb + yd
         # front slip envelope: the front tyre's slip stays short of where its force peaks
-        # (the clips written as comparisons: min and max cost more at every step)
         if v > 1.0:
             course_f = (lateral_speed_mps + self._a * yaw_rate_radps) / v
             slip = self._slip_frac * mu
-            if delta < course_f - slip:
-                delta = course_f - slip
-            if delta > course_f + slip:
-                delta = course_f + slip
-        if delta < -self._max:
-            delta = -self._max
-        if delta > self._max:
-            delta = self._max
-        return _new(SteeringCommand, (delta, ff, fb, yd, -fb / k_e))
+            delta = max(delta, course_f - slip)
+            delta = min(delta, course_f + slip)
+        delta = max(delta, -self._max)
+        delta = min(delta, self._max)
+        return SteeringCommand(delta, ff, fb, yd, -fb / k_e)
 
     def envelope_edge(
         self,
@@ -320,6 +309,6 @@ class SteeringController:
         ``towards`` (+1 left, -1 right), clipped to the lock: the most lateral force towards
         that side the steering law allows (front slip at ``front_slip_fraction`` of its
         peak's, where the Fiala force is 7/8 of the peak)."""
-        v = speed_mps if speed_mps > 1.0 else 1.0
+        v = max(1.0, speed_mps)  # 1 for NaN too
         delta = (lateral_speed_mps + self._a * yaw_rate_radps) / v + towards * self._slip_frac * mu
         return max(-self._max, min(self._max, delta))

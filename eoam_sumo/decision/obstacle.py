@@ -68,9 +68,6 @@ def travel_m(speed_mps: float, decel_mps2: float, dt_s: float) -> float:
     return dt_s * (speed_mps - 0.5 * decel_mps2 * dt_s)
 
 
-_new = tuple.__new__  # builds the per-step track without its Python-level constructor
-
-
 class ObstacleTrack(NamedTuple):
     """The in-path obstacle as last sensed, road frame of the ego's lane."""
 
@@ -97,33 +94,21 @@ class ObstacleTrack(NamedTuple):
         (``front_offset_m`` ahead of its centre of gravity), an assumed length and a width
         filling the ego's lane."""
         if obj is not None:
-            speed = obj.speed_mps
-            if speed < 0.0:
-                speed = 0.0
-            return _new(
-                cls,
-                (
-                    meas.time_s,
-                    obj.s_m + 0.5 * obj.length_m,
-                    speed,
-                    obj.d_m + 0.5 * obj.width_m,
-                    decel_mps2,
-                    obj.length_m,
-                ),
-            )
-        speed = meas.vx_mps - closing_mps
-        if speed < 0.0:
-            speed = 0.0
-        return _new(
-            cls,
-            (
+            return cls(
                 meas.time_s,
-                meas.s_m + front_offset_m + range_m + unknown_length_m,
-                speed,
-                0.5 * meas.lane_width_m,
+                obj.s_m + 0.5 * obj.length_m,
+                max(obj.speed_mps, 0.0),
+                obj.d_m + 0.5 * obj.width_m,
                 decel_mps2,
-                unknown_length_m,
-            ),
+                obj.length_m,
+            )
+        return cls(
+            meas.time_s,
+            meas.s_m + front_offset_m + range_m + unknown_length_m,
+            max(meas.vx_mps - closing_mps, 0.0),
+            0.5 * meas.lane_width_m,
+            decel_mps2,
+            unknown_length_m,
         )
 
     def at(self, time_s: float) -> tuple[float, float]:

@@ -8,10 +8,10 @@ taken:
 
 * **abort** (mode 3): arrest the lateral motion and steer back into the own lane at once: a
   time-optimal shift to the lane centre within the evasive budget
-  (``control.escape.MinTimeShift``) up to where the lateral motion away from it stops, and
-  from there one within the (gentler) budget of the shift back after an arrest; braking at
-  the limit with what the friction ellipse leaves during the shifts and at the full limit
-  after them;
+  (``manoeuvre.min_time_shift.MinTimeShift``) up to where the lateral motion away from it
+  stops, and from there one within the (gentler) budget of the shift back after an arrest;
+  braking at the limit with what the friction ellipse leaves during the shifts and at the
+  full limit after them;
 * **pass** (mode 4): go on to just past the obstacle's side (its left edge + half the ego +
   the side clearance), hold the speed until the ego's rear is past the obstacle's front, then
   the same time-optimal shift back from there.
@@ -33,8 +33,9 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
-from eoam_sumo.control.escape import MinTimeShift, lateral_state
 from eoam_sumo.decision.obstacle import ObstacleTrack
+from eoam_sumo.manoeuvre.lateral_state import lateral_state
+from eoam_sumo.manoeuvre.min_time_shift import MinTimeShift
 from eoam_sumo.params import G_MPS2
 
 _DT_S = 0.01  # time step of the braking prediction [s]

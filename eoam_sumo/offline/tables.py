@@ -25,7 +25,6 @@ from __future__ import annotations
 import bisect
 import csv
 import json
-import math
 import os
 from pathlib import Path
 from typing import NamedTuple, cast
@@ -33,6 +32,7 @@ from typing import NamedTuple, cast
 import numpy as np
 
 from eoam_sumo.errors import InputError
+from eoam_sumo.manoeuvre.points import TrajectoryPoint
 from eoam_sumo.offline.boundaries import max_decel_no_lock_mps2
 from eoam_sumo.params import VehicleParams, describe, ego_e_class_sedan
 
@@ -79,17 +79,6 @@ def _bracket(grid: list, value: float) -> tuple[int, int, float]:
         return n, n, 0.0
     j = bisect.bisect_right(grid, value)
     return j - 1, j, (value - grid[j - 1]) / (grid[j] - grid[j - 1])
-
-
-class TrajectoryPoint(NamedTuple):
-    """A manoeuvre trajectory at one differential x-position (the tables' columns)."""
-
-    y_m: float  # lateral position of the path
-    ax_mps2: float  # body longitudinal acceleration (the optimised profile)
-    yaw_rad: float  # path direction of travel (course)
-    curvature_1pm: float  # signed path curvature, left positive
-    steer_rad: float  # road-wheel steering angle (planned with the plant's tyre)
-    sideslip_rad: float = math.nan  # body sideslip (course less body yaw); NaN: not planned
 
 
 class PhaseBoundaries:

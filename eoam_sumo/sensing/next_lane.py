@@ -35,8 +35,8 @@ from dataclasses import dataclass
 
 from mypy_extensions import mypyc_attr
 
-from eoam_sumo.decision.policy import NextLaneView
-from eoam_sumo.sensing.v2x import V2XReceiver, V2XSettings
+from eoam_sumo.lane_messages import NextLaneView
+from eoam_sumo.sensing.v2x import V2XObject, V2XReceiver, V2XSettings
 from eoam_sumo.sim.geometry import OrientedBox, slab_entry
 
 MIN_OVERLAP_M = 0.1  # a road user reaching this far into the lane is in it [m]
@@ -141,43 +141,15 @@ class NextLaneSensing:
         w = self.lane_width_m
         lane_lo, lane_hi = 0.5 * w, 1.5 * w
         in_path = report.in_path
-        objects = []  # (s, d, road speed, length, width) of road users in the lane
-        shadows = []  # detections of road users outside the lane (they hide what is behind)
-        for det in report.detections:
-            if det is not in_path and self._in_lane(det.d_m, det.width_m, lane_lo, lane_hi):
-                objects.append((det.s_m, det.d_m, det.road_speed_mps, det.length_m, det.width_m))
-            else:
-                shadows.append(det)
+        objects, shadows = self._radar_objects(report, lane_lo, lane_hi)
         objects += self._corner_objects(
             front_xy, s_f, yaw_rad, road, bodies, lane_lo, lane_hi, objects, in_path
         )
         if self.v2x is not None:
             self.v2x.update(time_s, front_xy, bodies)
-            for o in self.v2x.objects(time_s):
-                s, d, ryaw = self._project(road, o)
-                if not self._in_lane(d, o.width_m, lane_lo, lane_hi):
-                    continue
-                if in_path is not None and _same(s, o.length_m, in_path.s_m, in_path.length_m):
-                    continue
-                if any(
-                    _same(s, o.length_m, q[0], q[3]) and abs(d - q[1]) < FUSION_GATE_M
-                    for q in objects
-                ):
-                    continue  # fused with a radar object
-                objects.append(
-                    (s, d, o.speed_mps * math.cos(o.yaw_rad - ryaw), o.length_m, o.width_m)
-                )
-        ahead = behind = None
-        s_rear = s_f - self.ego_length_m
-        for s, _d, v, length, _width in objects:
-            if s - 0.5 * length >= s_f - 1e-9 or s + 0.5 * length >= s_rear:
-                gap = max(s - 0.5 * length - s_f, 0.0)
-                if ahead is None or gap < ahead[0]:
-                    ahead = (gap, v)
-            else:
-                gap = s_rear - (s + 0.5 * length)
-                if behind is None or gap < behind[0]:
-                    behind = (gap, v)
+            received = self.v2x.objects(time_s)
+            self._add_v2x_objects(received, road, lane_lo, lane_hi, objects, in_path)
+        ahead, behind = self._nearest(objects, s_f)
 
         def coverage() -> float:
             return self._coverage(road, s_f, front_xy, yaw_rad, shadows)
@@ -193,6 +165,61 @@ class NextLaneSensing:
         )
 
     # ----------------------------------------------------------------------------- parts
+    def _radar_objects(self, report, lane_lo: float, lane_hi: float) -> tuple[list, list]:
+        """(the forward radar's road users in the lane as (s, d, road speed, length, width),
+        its detections outside the lane: they hide what is behind them)."""
+        objects = []
+        shadows = []
+        in_path = report.in_path
+        for det in report.detections:
+            if det is not in_path and self._in_lane(det.d_m, det.width_m, lane_lo, lane_hi):
+                objects.append((det.s_m, det.d_m, det.road_speed_mps, det.length_m, det.width_m))
+            else:
+                shadows.append(det)
+        return objects, shadows
+
+    def _add_v2x_objects(
+        self,
+        received: list[V2XObject],
+        road,
+        lane_lo: float,
+        lane_hi: float,
+        objects: list,
+        in_path,
+    ) -> None:
+        """Append the ``received`` V2X objects in the lane that no radar object (nor the
+        in-path obstacle) already stands for."""
+        for o in received:
+            s, d, ryaw = self._project(road, o)
+            if not self._in_lane(d, o.width_m, lane_lo, lane_hi):
+                continue
+            if in_path is not None and _same(s, o.length_m, in_path.s_m, in_path.length_m):
+                continue
+            if any(
+                _same(s, o.length_m, q[0], q[3]) and abs(d - q[1]) < FUSION_GATE_M for q in objects
+            ):
+                continue  # fused with a radar object
+            objects.append((s, d, o.speed_mps * math.cos(o.yaw_rad - ryaw), o.length_m, o.width_m))
+
+    def _nearest(
+        self, objects: list, s_f: float
+    ) -> tuple[tuple[float, float] | None, tuple[float, float] | None]:
+        """(gap, road speed) of the nearest road user ahead (overlapping the ego's length
+        counts as ahead, gap 0) and of the nearest behind the ego's rear; None: none."""
+        ahead: tuple[float, float] | None = None
+        behind: tuple[float, float] | None = None
+        s_rear = s_f - self.ego_length_m
+        for s, _d, v, length, _width in objects:
+            if s - 0.5 * length >= s_f - 1e-9 or s + 0.5 * length >= s_rear:
+                gap = max(s - 0.5 * length - s_f, 0.0)
+                if ahead is None or gap < ahead[0]:
+                    ahead = (gap, v)
+            else:
+                gap = s_rear - (s + 0.5 * length)
+                if behind is None or gap < behind[0]:
+                    behind = (gap, v)
+        return ahead, behind
+
     @staticmethod
     def _in_lane(d_m: float, width_m: float, lane_lo: float, lane_hi: float) -> bool:
         return (

@@ -1,4 +1,5 @@
-"""Time-optimal lateral escapes (``control.escape.MinTimeShift``) against closed-form kinematics.
+"""Time-optimal lateral escapes (``manoeuvre.min_time_shift.MinTimeShift``) against closed-form
+kinematics.
 
 A rest-to-rest shift of D with the lateral acceleration bounded by A and its rate by J = A / r
 is quickest as ramp r, hold h, swing 2r, hold h, ramp r, covering D = A (r + h)(2r + h): its
@@ -12,9 +13,10 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from eoam_sumo.control.escape import MinTimeShift, lateral_state
-from eoam_sumo.control.paths import QuinticShift
 from eoam_sumo.eoam_messages import EgoMeasurement
+from eoam_sumo.manoeuvre.lateral_state import lateral_state
+from eoam_sumo.manoeuvre.min_time_shift import MinTimeShift
+from eoam_sumo.manoeuvre.quintic_shift import QuinticShift
 
 SPEED = 30.0  # forward speed [m/s]
 

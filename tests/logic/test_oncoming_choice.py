@@ -11,7 +11,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from eoam_sumo.control.escape import MinTimeShift
 from eoam_sumo.decision.obstacle import ObstacleTrack
 from eoam_sumo.decision.oncoming import (
     Budget,
@@ -24,6 +23,7 @@ from eoam_sumo.decision.oncoming import (
     time_to_pass_s,
 )
 from eoam_sumo.eoam_messages import EgoMeasurement
+from eoam_sumo.manoeuvre.min_time_shift import MinTimeShift
 
 MU_G = 0.7 * 9.81
 BUDGET = Budget(

@@ -6,8 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from eoam_sumo.control import PathReference, QuinticShift
-from eoam_sumo.offline import TrajectoryPoint
+from eoam_sumo.manoeuvre import PathReference, QuinticShift, TrajectoryPoint
 
 H_TABLE = 3.5  # lane change of the tables [m]
 LENGTH = 60.0  # [m]

@@ -9,7 +9,6 @@ from hypothesis import strategies as st
 
 from eoam_sumo.decision import Mode
 from eoam_sumo.decision.policy import (
-    NextLaneView,
     PolicySettings,
     SafePolicy,
     braking_impact_speed_mps,
@@ -18,7 +17,9 @@ from eoam_sumo.decision.policy import (
     sight_needed,
 )
 from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, ObjectState, Perception
-from eoam_sumo.offline.tables import LookupTables, TrajectoryPoint, default_tables_dir
+from eoam_sumo.lane_messages import NextLaneView
+from eoam_sumo.manoeuvre.points import TrajectoryPoint
+from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import G_MPS2, ego_e_class_sedan
 
 P = ego_e_class_sedan()

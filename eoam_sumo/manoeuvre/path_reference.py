@@ -1,0 +1,121 @@
+"""Manoeuvre references sampled once, at the trigger, from a lookup-table trajectory.
+
+The lookup tables (paper sec. 8.2) give the lane-change path y, path yaw, path curvature and
+the optimised longitudinal acceleration against the differential x-position dx since the
+trigger, for the trigger speed and friction. A ``PathReference`` stores them on a uniform dx
+grid as plain floats, scaled from the table's lane-change height to the wanted one (y, yaw and
+curvature scale together), so that a lookup in the 10 ms loop is one index and one blend. The
+planned speed follows from the acceleration profile: v(dx)^2 = v0^2 + 2 int_0^dx ax.
+"""
+
+from __future__ import annotations
+
+import math
+
+from eoam_sumo.manoeuvre.points import PathPoint
+
+
+class PathReference:
+    """Lateral and longitudinal reference of one manoeuvre against dx [m]."""
+
+    __slots__ = (
+        "_ax",
+        "_beta",
+        "_inv",
+        "_k",
+        "_n",
+        "_steer",
+        "_v",
+        "_y",
+        "_yaw",
+        "length_m",
+        "planned_steering",
+        "start_offset_m",
+    )
+
+    def __init__(
+        self,
+        traj,
+        *,
+        start_offset_m: float,
+        height_m: float | None,
+        speed_mps: float,
+        step_m: float,
+    ):
+        """Sample ``traj`` (``.at(dx)``, ``.length_m``) to go from start_offset by height;
+        ``height_m=None`` takes the trajectory's own lateral positions as they are."""
+        if not step_m > 0.0:
+            raise ValueError(f"reference step_m={step_m!r} must be > 0")
+        length = float(traj.length_m)
+        if not (math.isfinite(length) and length > 0.0):
+            raise ValueError(f"trajectory length_m={length!r} must be finite and > 0")
+        n = max(math.ceil(length / step_m), 1)
+        step = length / n
+        samples = [traj.at(i * step) for i in range(n + 1)]
+        if height_m is None:
+            scale, y_first, start_offset_m = 1.0, 0.0, 0.0
+        else:
+            y_end = float(samples[-1].y_m) - float(samples[0].y_m)
+            if not (math.isfinite(y_end) and abs(y_end) > 1e-6):
+                raise ValueError(f"trajectory lateral travel {y_end!r} m is not usable")
+            scale = height_m / y_end
+            y_first = float(samples[0].y_m)
+        self._y = [start_offset_m + scale * (float(s.y_m) - y_first) for s in samples]
+        self._ax = [float(s.ax_mps2) for s in samples]
+        self._yaw = [scale * float(s.yaw_rad) for s in samples]
+        self._k = [scale * float(s.curvature_1pm) for s in samples]
+        # the planned steering and sideslip where the trajectory has them (the tables' lane
+        # changes, planned with the plant's tyre), scaled with the path like the curvature
+        self.planned_steering = not math.isnan(samples[0].sideslip_rad)
+        if self.planned_steering:
+            self._steer = [scale * float(s.steer_rad) for s in samples]
+            self._beta = [scale * float(s.sideslip_rad) for s in samples]
+        else:
+            self._steer = self._beta = [0.0] * (n + 1)
+        v2 = speed_mps * speed_mps
+        self._v = [speed_mps]
+        for i in range(n):
+            v2 += (self._ax[i] + self._ax[i + 1]) * step
+            self._v.append(math.sqrt(v2) if v2 > 0.0 else 0.0)
+        self.length_m = length
+        self.start_offset_m = self._y[0]
+        self._inv, self._n = 1.0 / step, n
+
+    def at(self, dx_m: float) -> PathPoint:
+        """The reference at ``dx_m``, held at the ends of the path."""
+        u = dx_m * self._inv
+        if u <= 0.0:
+            i = 0
+        elif u >= self._n:
+            i = self._n
+        else:
+            i = int(u)
+            w = u - i
+            j = i + 1
+            y, yaw, k, ax, v, st, beta = (
+                self._y,
+                self._yaw,
+                self._k,
+                self._ax,
+                self._v,
+                self._steer,
+                self._beta,
+            )
+            return PathPoint(
+                y[i] + w * (y[j] - y[i]),
+                yaw[i] + w * (yaw[j] - yaw[i]),
+                k[i] + w * (k[j] - k[i]),
+                ax[i] + w * (ax[j] - ax[i]),
+                v[i] + w * (v[j] - v[i]),
+                st[i] + w * (st[j] - st[i]),
+                beta[i] + w * (beta[j] - beta[i]),
+            )
+        return PathPoint(
+            self._y[i],
+            self._yaw[i],
+            self._k[i],
+            self._ax[i],
+            self._v[i],
+            self._steer[i],
+            self._beta[i],
+        )
