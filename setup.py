@@ -19,7 +19,16 @@ COMPILE_ENV = "EOAM_SUMO_COMPILE"
 #: The modules compiled: what the step loop runs at every step (sensing, decision, control,
 #: contact, observers, the SUMO exchange), none of the set-up, files or plotting.
 COMPILED = [
-    "eoam_sumo/eoam.py",
+    "eoam_sumo/eoam/controller.py",
+    "eoam_sumo/eoam/decide.py",
+    "eoam_sumo/eoam/lateral.py",
+    "eoam_sumo/eoam/longitudinal.py",
+    "eoam_sumo/eoam/parts.py",
+    "eoam_sumo/eoam/perceive.py",
+    "eoam_sumo/eoam/shifts.py",
+    "eoam_sumo/eoam/state.py",
+    "eoam_sumo/eoam/strategies.py",
+    "eoam_sumo/eoam/transitions.py",
     "eoam_sumo/eoam_messages.py",
     "eoam_sumo/lane_messages.py",
     "eoam_sumo/control/longitudinal.py",

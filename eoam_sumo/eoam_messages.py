@@ -1,7 +1,5 @@
-"""The per-step messages into and out of the EOAM module (``eoam.EoamController.step``).
-
-Named tuples: as immutable as frozen dataclasses and built in a quarter of the time.
-"""
+"""The per-step messages into and out of the EOAM module (``eoam.EoamController.step``),
+as named tuples (immutable)."""
 
 from __future__ import annotations
 

@@ -45,7 +45,7 @@ class EoamSettings:
     oncoming_margin_m: float = 0.2  # ... the ego's side this far short of the other's path
     oncoming_margin_s: float = 0.2  # ... that long before the fronts meet
     min_time_escapes: bool = True  # modes 3, 4 and the returns from oncoming traffic:
-    # jerk-limited time-optimal shifts (control.escape; False: the shortest quintics)
+    # jerk-limited time-optimal shifts (manoeuvre.min_time_shift; False: the shortest quintics)
     arrest_first: bool = True  # mode 3 from a lane change: a lateral motion away from the
     # lane centre is first arrested at the front tyre's slip envelope, then the shift back
     arrest_min_speed_mps: float = 0.5  # ... when it is at least this fast (a lane change's,

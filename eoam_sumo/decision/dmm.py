@@ -43,7 +43,7 @@ class Action(Enum):
 class Sector(Enum):
     """DMM phase-diagram sector (paper Figure 14): value the letter, ``action`` what it asks
     for, ``letter`` the value and ``warns`` whether it raises the forward-collision warning
-    (A-F): plain attributes (set below), read at every step with an obstacle in range."""
+    (A-F). These are set after the class: mypyc does not compile an enum's own ``__new__``."""
 
     action: Action
     letter: str
@@ -73,8 +73,8 @@ for _sector in Sector:
     _sector.warns = _sector.value != "G"
 
 
-# The members as module names, for the per-step code (as the modes in ``decision.modes``):
-# reading a member off an Enum class goes through the Enum metaclass's attribute hook.
+# The members as module names, as the step's code reads them (as the modes in
+# ``decision.modes``)
 NONE, FCW, BRAKE, STEER, LIMIT_BRAKE = Action
 A, B, C, D, E, F, G = Sector
 

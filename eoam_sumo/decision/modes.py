@@ -34,8 +34,7 @@ class Mode(IntEnum):
     RETURN = 5
 
 
-# The members as module names, for the per-step code: reading a member off an Enum class goes
-# through the Enum metaclass's attribute hook (about 700 instructions in CPython 3.11).
+# The members as module names, as the step's code reads them
 NORMAL, UPDATE_BRAKE, UPDATE_STEER_BRAKE, ONCOMING_BRAKE, ONCOMING_STEER_BRAKE, RETURN = Mode
 
 _BRAKING = (BRAKE, LIMIT_BRAKE)

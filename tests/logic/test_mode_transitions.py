@@ -167,7 +167,7 @@ def test_2_to_5_early_once_stable_in_the_next_lane_and_past_the_obstacle(tables)
     obj = ObjectState(drive.s + P.cg_to_front_bumper_m + rng + 2.5, 0.0, 0.0, 5.0, 1.9)
     drive.step(range_m=rng, obj=obj)
     assert drive.mode is Mode.UPDATE_STEER_BRAKE
-    length = drive.ctrl._path.length_m
+    length = drive.ctrl.state.path.length_m
     # in the next lane and straight, but the obstacle (front at obj.s + 2.5) not yet passed
     front = obj.s_m + 2.5
     while drive.s - P.cg_to_rear_bumper_m < front + 0.9:

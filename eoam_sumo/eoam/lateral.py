@@ -1,0 +1,86 @@
+"""The lateral stage: the active mode's reference (the lane centre unless a path is active)
+and the steering command, feedforward + lookahead feedback + yaw damping (paper eq. 38)."""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+from eoam_sumo.eoam.parts import Parts
+from eoam_sumo.eoam.state import ControllerState, LateralOutput
+from eoam_sumo.eoam_messages import EgoMeasurement
+from eoam_sumo.manoeuvre.angles import wrap_angle
+from eoam_sumo.manoeuvre.path_reference import PathReference
+
+
+class Reference(NamedTuple):
+    """The path's reference at the ego's dx, relative to the road."""
+
+    y_m: float
+    yaw_rad: float
+    curvature_1pm: float
+    preview_curvature_1pm: float  # a preview ahead (0 with planned steering)
+    ax_mps2: float
+    speed_mps: float
+    steer_ff_rad: float  # the plan's own road-wheel angle (planned steering)
+    sideslip_rad: float | None  # the plan's body sideslip (None: steady-state)
+    in_path: bool  # before the path's end
+    planned: bool  # steered with the plan's road-wheel angle
+
+
+_LANE_CENTRE = Reference(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, None, False, False)
+
+
+def lateral_control(parts: Parts, state: ControllerState, meas: EgoMeasurement) -> LateralOutput:
+    """The reference at the distance travelled on the active path and the steering command;
+    while mode 3 arrests a lateral motion, the envelope's edge against it (no reference)."""
+    path = state.path
+    dx = meas.s_m - state.s0_m if path is not None else 0.0
+    ref = reference(parts, path, meas, dx)
+    steer = parts.planned_steering if ref.planned else parts.steering
+    v, d, mu = meas.vx_mps, meas.d_m, meas.mu
+    if state.arrest:  # the most lateral force against the motion the envelope allows
+        delta = steer.envelope_edge(v, meas.yaw_rate_radps, meas.vy_mps, mu, -state.arrest)
+        return LateralOutput(
+            delta, d, dx, 0.0, 0.0, delta, 0.0, 0.0, ref.in_path, ref.ax_mps2, ref.speed_mps
+        )
+    road_kappa = meas.road_curvature_1pm
+    e_lat = d - ref.y_m
+    delta, ff, fb, yd, e_la = steer.command(
+        v,
+        meas.yaw_rate_radps,
+        meas.vy_mps,
+        e_lat,
+        wrap_angle(meas.e_yaw_rad - ref.yaw_rad),
+        ref.curvature_1pm + road_kappa,
+        ref.preview_curvature_1pm + road_kappa,
+        mu,
+        ref.steer_ff_rad,
+        ref.sideslip_rad,
+    )
+    return LateralOutput(
+        delta, ref.y_m, dx, e_lat, e_la, ff, fb, yd, ref.in_path, ref.ax_mps2, ref.speed_mps
+    )
+
+
+def reference(
+    parts: Parts, path: PathReference | None, meas: EgoMeasurement, dx_m: float
+) -> Reference:
+    """The path at ``dx_m``: past its end its offset and profile, straight along the road; a
+    planned lane change with its own steering taken the actuator's lag ahead, else the
+    curvature ``preview_time_s`` ahead for the feedforward."""
+    if path is None:
+        return _LANE_CENTRE
+    st = parts.settings
+    v = meas.vx_mps
+    y_ref, yaw_ref, kappa_ref, ax_ref, v_plan, _, beta_plan = path.at(dx_m)
+    if not dx_m < path.length_m:
+        return Reference(y_ref, 0.0, 0.0, 0.0, ax_ref, v_plan, 0.0, None, False, False)
+    if path.planned_steering:  # planned with the plant's tyre
+        ahead = max(0.0, st.planned_preview_time_s - st.planned_preview_slope_s2pm * v)
+        steer_ff = path.at(dx_m + v * ahead).steer_rad
+        beta_ref = beta_plan + parts.steering.steady_sideslip(v, meas.road_curvature_1pm)
+        return Reference(
+            y_ref, yaw_ref, kappa_ref, 0.0, ax_ref, v_plan, steer_ff, beta_ref, True, True
+        )
+    kappa_ff = path.at(dx_m + v * st.preview_time_s).curvature_1pm
+    return Reference(y_ref, yaw_ref, kappa_ref, kappa_ff, ax_ref, v_plan, 0.0, None, True, False)

@@ -1,0 +1,62 @@
+"""The longitudinal stage: the drive and brake force limits from the friction ellipse, then
+the active mode's loop (speed PID, limit braking, or the manoeuvre's acceleration profile)."""
+
+from __future__ import annotations
+
+from eoam_sumo.decision.modes import (
+    NORMAL,
+    ONCOMING_BRAKE,
+    ONCOMING_STEER_BRAKE,
+    UPDATE_BRAKE,
+    UPDATE_STEER_BRAKE,
+)
+from eoam_sumo.eoam.parts import Parts
+from eoam_sumo.eoam.state import ControllerState, LateralOutput, LongitudinalOutput
+from eoam_sumo.eoam_messages import EgoMeasurement
+
+_STEERING = (UPDATE_STEER_BRAKE, ONCOMING_STEER_BRAKE)
+
+
+def longitudinal_control(
+    parts: Parts,
+    state: ControllerState,
+    meas: EgoMeasurement,
+    lateral: LateralOutput,
+    dt_s: float,
+) -> LongitudinalOutput:
+    """Mode 0 holds the set speed; 1 and 3 brake at the no-lock limit to standstill; 2 and 4
+    follow the path's acceleration profile, then (like 5) hold the speed at its end."""
+    mode, v, mu = state.mode, meas.vx_mps, meas.mu
+    long = parts.longitudinal
+    tracking = lateral.in_path and mode in _STEERING  # the table's ax already fits the ellipse
+    drive_lim, brake_lim = force_limits(parts, state, meas, lateral.steer_rad, tracking)
+    if mode is NORMAL:
+        target = state.initial_speed_mps
+        drive, brake, ax_target = long.track_speed(target, v, mu, drive_lim, brake_lim, dt_s)
+        return LongitudinalOutput(drive, brake, ax_target, target)
+    if mode is UPDATE_BRAKE or mode is ONCOMING_BRAKE:  # limit braking without locking
+        return LongitudinalOutput(0.0, brake_lim, -brake_lim / parts.params.mass_kg, 0.0)
+    if tracking:
+        drive, brake = long.track_accel(
+            lateral.ax_ref_mps2, meas.ax_mps2, v, drive_lim, brake_lim, dt_s
+        )
+        return LongitudinalOutput(drive, brake, lateral.ax_ref_mps2, lateral.v_plan_mps)
+    hold = state.hold_speed_mps
+    if hold is None:  # the profile's end: hold the speed reached
+        state.hold_speed_mps = hold = v
+        long.reset()
+    drive, brake, ax_target = long.track_speed(hold, v, mu, drive_lim, brake_lim, dt_s)
+    return LongitudinalOutput(drive, brake, ax_target, hold)
+
+
+def force_limits(
+    parts: Parts, state: ControllerState, meas: EgoMeasurement, steer_rad: float, tracking: bool
+) -> tuple[float, float]:
+    """(drive, brake) limits from the friction ellipse with the lateral acceleration in use:
+    measured, and outside the table's profile also the one this steering command asks for,
+    so that the brake yields before a turning axle locks."""
+    v = meas.vx_mps
+    ay_use = abs(meas.ay_mps2)
+    if not tracking:
+        ay_use = max(ay_use, abs(parts.steering.lateral_accel(v, steer_rad)))
+    return parts.longitudinal.limits(v, meas.mu, ay_use, state.friction_now().brake_limit_n)

@@ -1,0 +1,137 @@
+"""The perceive stage: the measurement checked, the friction's limits, the in-path obstacle
+tracked, a coasted object and oncoming traffic (a ``Situation`` for the DMM stage)."""
+
+from __future__ import annotations
+
+import math
+
+from eoam_sumo.decision.dmm import BoundaryCurve
+from eoam_sumo.decision.modes import (
+    NORMAL,
+    ONCOMING_STEER_BRAKE,
+    UPDATE_BRAKE,
+    UPDATE_STEER_BRAKE,
+)
+from eoam_sumo.decision.obstacle import ObstacleTrack
+from eoam_sumo.eoam.parts import Parts
+from eoam_sumo.eoam.state import ControllerState, Friction, Situation
+from eoam_sumo.eoam_messages import EgoMeasurement, ObjectState, Perception
+
+_STEERING = (UPDATE_STEER_BRAKE, ONCOMING_STEER_BRAKE)  # a lane change follows one obstacle
+_HOLDING = (NORMAL, UPDATE_BRAKE)  # a coasted object keeps these braking (track persistence)
+
+
+def perceive(
+    parts: Parts, state: ControllerState, meas: EgoMeasurement, perception: Perception
+) -> Situation:
+    """The step's view of the obstacle and the next lane (updates the friction record, the
+    obstacle's braking estimate and its track)."""
+    check_measurement(state, meas)
+    if state.friction is None or meas.mu != state.friction.mu:
+        state.friction = friction_at(parts, meas.mu)
+    st = parts.settings
+    rng = perception.aro_range_m
+    rate = perception.aro_range_rate_mps
+    sensed: float | None = None
+    closing = decel = 0.0
+    threat_gone = True
+    if rng is not None and math.isfinite(rng):
+        sensed = rng
+        closing = -rate if rate is not None and math.isfinite(rate) else 0.0
+        decel = state.obstacle_decel.update(meas.time_s, meas.vx_mps - closing)
+        threat_gone = closing < -st.release_opening_speed_mps
+        track_obstacle(parts, state, meas, rng, closing, perception.aro_object, decel)
+    else:
+        state.obstacle_decel.reset()
+    near, holds = coasted_object(parts, state, meas, perception)
+    if holds:
+        threat_gone = False
+    return Situation(sensed, closing, decel, threat_gone, near, oncoming_seen(parts, perception))
+
+
+def check_measurement(state: ControllerState, meas: EgoMeasurement) -> None:
+    """Refuse a step before ``reset`` or with a non-finite measurement."""
+    if math.isnan(state.initial_speed_mps):
+        raise ValueError("EoamController.reset(initial_speed_mps) must be called first")
+    if not math.isfinite(sum(meas)):  # a NaN or inf field (or finite fields overflowing)
+        for name, value in zip(EgoMeasurement._fields, meas):
+            if not math.isfinite(value):
+                raise ValueError(f"ego measurement {name}={value!r} is not finite")
+    if not meas.lane_width_m > 0.0:
+        raise ValueError(f"lane_width_m={meas.lane_width_m!r} must be > 0")
+
+
+def friction_at(parts: Parts, mu: float) -> Friction:
+    """The limit braking force and the DMM boundaries at the sensed friction."""
+    if not mu > 0.0:
+        raise ValueError(f"friction mu={mu!r} must be > 0")
+    decel = float(parts.tables.max_decel_mps2(mu))
+    brake_limit = parts.settings.limit_brake_fraction * parts.params.mass_kg * decel
+    bounds = parts.tables.boundaries
+    return Friction(mu, brake_limit, BoundaryCurve(bounds, mu, bounds.speed_grid_mps))
+
+
+def track_obstacle(
+    parts: Parts,
+    state: ControllerState,
+    meas: EgoMeasurement,
+    range_m: float,
+    closing_mps: float,
+    obj: ObjectState | None,
+    decel_mps2: float,
+) -> None:
+    """Remember the in-path obstacle's front station, speed and left edge (offset).
+
+    From its object track when the sensor gives one; else from the range, an assumed
+    length (``unknown_obstacle_length_m``) and a width filling its lane. During a lane
+    change (modes 2, 4) only the obstacle being avoided is followed: one whose front is
+    more than ``track_gate_m`` off the prediction is another object."""
+    st = parts.settings
+    track = ObstacleTrack.sensed(
+        meas,
+        parts.params.cg_to_front_bumper_m,
+        range_m,
+        closing_mps,
+        obj,
+        st.unknown_obstacle_length_m,
+        parts.placement.track_decel_mps2(decel_mps2),
+    )
+    last = state.obstacle
+    if (
+        last is None
+        or state.mode not in _STEERING
+        or abs(track.front_s_m - last.at(meas.time_s)[0]) <= st.track_gate_m
+    ):
+        state.obstacle = track
+
+
+def coasted_object(
+    parts: Parts, state: ControllerState, meas: EgoMeasurement, perception: Perception
+) -> tuple[bool, bool]:
+    """(near, holds) for an object lost from view, predicted in the path, in modes 0 and 1:
+    no hand-back while it does not pull away (holds); braking while it is within the
+    stopping distance, at the ego's speed or the closing speed (the larger), plus a margin
+    (near)."""
+    coasted_m = perception.coasted_range_m
+    if coasted_m is None or state.mode not in _HOLDING:
+        return False, False
+    st = parts.settings
+    closing = -perception.coasted_range_rate_mps
+    vc = max(meas.vx_mps, closing)
+    brake_limit = state.friction_now().brake_limit_n
+    near = coasted_m <= 0.5 * vc * vc * parts.params.mass_kg / brake_limit + st.coasted_margin_m
+    return near, near or closing > -st.release_opening_speed_mps
+
+
+def oncoming_seen(parts: Parts, perception: Perception) -> bool:
+    """Oncoming traffic seen, or a standing car in the next lane within the obstacle's
+    range plus ``next_lane_clear_m``: the lane change would end against it, as deadly."""
+    block_m = perception.next_lane_obstacle_range_m
+    rng = perception.aro_range_m
+    if (
+        block_m is not None
+        and rng is not None
+        and block_m <= rng + parts.settings.next_lane_clear_m
+    ):
+        return True
+    return bool(perception.oncoming_detected)

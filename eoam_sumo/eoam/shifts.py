@@ -1,0 +1,70 @@
+"""The lateral shifts the EOAM begins from the ego's lateral state (paper sec. 4.2, eqs. 7-13).
+
+Each is a trajectory (``.at(dx)``, ``.length_m``) that ``transitions.start_path`` samples into
+the active ``PathReference``.
+"""
+
+from __future__ import annotations
+
+from eoam_sumo.decision.obstacle import ObstacleTrack
+from eoam_sumo.eoam_messages import EgoMeasurement
+from eoam_sumo.eoam_settings import EoamSettings
+from eoam_sumo.manoeuvre.lateral_state import course_state, lateral_state
+from eoam_sumo.manoeuvre.min_time_shift import MinTimeShift
+from eoam_sumo.manoeuvre.quintic_shift import QuinticShift
+from eoam_sumo.params import G_MPS2, VehicleParams
+
+
+def quintic_shift(
+    settings: EoamSettings, target_m: float, meas: EgoMeasurement, lateral_g: float
+) -> QuinticShift:
+    """The shortest quintic from the ego's lateral state (offset, course, path curvature) to
+    ``target_m`` within ``lateral_g`` mu g that does not pass it."""
+    slope, kappa, speed = course_state(meas)
+    return QuinticShift.for_lateral_accel(
+        meas.d_m,
+        slope,
+        target_m,
+        speed,
+        lateral_g * meas.mu * G_MPS2,
+        settings.return_min_length_m,
+        kappa,
+    )
+
+
+def min_time_shift(
+    settings: EoamSettings, target_m: float, meas: EgoMeasurement, lateral_g: float
+) -> MinTimeShift:
+    """The jerk-limited time-optimal shift to ``target_m`` within ``lateral_g`` mu g."""
+    v_lat, a_lat, speed = lateral_state(meas)
+    accel = lateral_g * meas.mu * G_MPS2
+    return MinTimeShift(meas.d_m, v_lat, a_lat, target_m, speed, accel, settings.escape_ramp_s)
+
+
+def lateral_stop(settings: EoamSettings, meas: EgoMeasurement) -> QuinticShift:
+    """The quintic that arrests the ego's lateral motion soonest within ``evasive_lateral_g``
+    mu g; it ends where the lateral motion stops."""
+    slope, kappa, speed = course_state(meas)
+    return QuinticShift.stopping(
+        meas.d_m,
+        slope,
+        speed,
+        settings.evasive_lateral_g * meas.mu * G_MPS2,
+        settings.return_min_length_m,
+        kappa,
+        settings.lateral_reaction_s,
+    )
+
+
+def passing_offset_m(
+    params: VehicleParams,
+    settings: EoamSettings,
+    obstacle: ObstacleTrack | None,
+    meas: EgoMeasurement,
+) -> float:
+    """Mode 4's target: just far enough left to pass the obstacle with ``side_clearance_m``
+    (less exposure to the oncoming vehicle than a whole lane), at most a lane width, and
+    never back towards the obstacle from where the ego already is."""
+    left_edge = obstacle.left_edge_m if obstacle is not None else 0.5 * meas.lane_width_m
+    need = left_edge + 0.5 * params.width_m + settings.side_clearance_m
+    return max(min(need, meas.lane_width_m), meas.d_m)
