@@ -42,7 +42,7 @@ from typing import NamedTuple
 
 from mypy_extensions import mypyc_attr
 
-from eoam_sumo.lane_messages import NextLaneView
+from eoam_sumo.eoam_messages import NextLaneView
 from eoam_sumo.manoeuvre.quintic_shift import QuinticShift
 from eoam_sumo.params import G_MPS2
 

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 from mypy_extensions import mypyc_attr
 
-from eoam_sumo.lane_messages import NextLaneView
+from eoam_sumo.eoam_messages import NextLaneView
 from eoam_sumo.sensing.v2x import V2XObject, V2XReceiver, V2XSettings
 from eoam_sumo.sim.geometry import OrientedBox, slab_entry
 

@@ -17,7 +17,7 @@ from eoam_sumo.decision.policy import (
     sight_needed,
 )
 from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, ObjectState, Perception
-from eoam_sumo.lane_messages import NextLaneView
+from eoam_sumo.eoam_messages import NextLaneView
 from eoam_sumo.manoeuvre.points import TrajectoryPoint
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import G_MPS2, ego_e_class_sedan
