@@ -87,8 +87,8 @@ class CoSimulation:
     meas: EgoMeasurement
     perception: Perception
     cmd: Command
-    bodies: list[Body]
-    bodies_before: list[Body]
+    bodies: list
+    bodies_before: list
 
     def __init__(
         self,

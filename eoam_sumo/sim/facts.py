@@ -1,5 +1,5 @@
 """What a run came to, as facts: the record the verdict (``sim/verdict.py``) is a pure function
-of, and what the summary records of the run's set-up and cost.
+of, and what the summary records of the run's set-up and wall times.
 
 :class:`RunFacts` holds what happened: the road of the ego's original lane, the EOAM's modes
 and warning, the ego's end state and running extremes, the first contact and what SUMO
