@@ -5,6 +5,11 @@ observer may read of :class:`~eoam_sumo.sim.cosim.CoSimulation`): ``start`` once
 set up (the ego placed, nothing stepped), ``after_step`` at the end of every step and ``end``
 with the ego's end state in ``meas``. Add one with ``CoSimulation(..., observers=[...])``;
 :class:`StepObserver` is a base with empty hooks.
+
+Here: the time series (:class:`TimeSeries`), the running extremes of the ego
+(:class:`Extremes`), the obstacle a lane change avoided (:class:`AvoidedObstacle`) and the
+benchmark's timer of the step's phases (:class:`PhaseTimer`); the margins are in
+``sim/margins.py``, the traffic log in ``sim/trafficlog.py``.
 """
 
 from __future__ import annotations
@@ -20,9 +25,7 @@ from eoam_sumo.eoam import Command, EgoMeasurement, Perception
 from eoam_sumo.sim.lanes import lane_band_m
 from eoam_sumo.sim.runlog import RunLog
 
-_LANE_CHANGE_MODES = (2, 4)
-
-
+_LANE_CHANGE_MODES = (2, 4)  # the EOAM's modes that begin a lane change
 #: The phases of a step, in order (``CoSimulation.step``).
 PHASES = ("sense", "decide", "actuate", "write_back", "check_contact")
 
@@ -34,8 +37,9 @@ def no_lap(phase: str) -> None:
 class RunView(Protocol):
     """What observers read of a running co-simulation."""
 
-    lap: Callable[[str], None]  # called as each phase of a step ends, with its name, and
-    # with "" as the step begins (``no_lap`` unless a PhaseTimer times the phases)
+    # called as each phase of a step ends, with its name, and with "" as the step begins
+    # (``no_lap`` unless a PhaseTimer times the phases)
+    lap: Callable[[str], None]
 
     @property
     def max_steps(self) -> int: ...  # the time limit in steps

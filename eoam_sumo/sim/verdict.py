@@ -31,10 +31,9 @@ def left_width_m(facts: RunFacts) -> float:
     return facts.lane_width_m if facts.left_lane else 0.0
 
 
-def outcome_of(facts: RunFacts, severity: Severity | None) -> Outcome:
-    """The outcome colour of a run by the rules of ``sim/outcome.py``; ``severity`` that of
-    its first contact (``severity_of``)."""
-    record = facts.contact
+def outcome_of(facts: RunFacts) -> Outcome:
+    """The outcome colour of a run by the rules of ``sim/outcome.py``."""
+    record, severity = facts.contact, severity_of(facts)
     return classify_outcome(
         modes_visited=facts.modes_visited,
         max_lateral_offset_m=facts.max_abs_offset_m,
@@ -57,10 +56,8 @@ def outcome_of(facts: RunFacts, severity: Severity | None) -> Outcome:
 
 def summarise(facts: RunFacts, info: RunInfo) -> RunSummary:
     """The outcome and summary of a run (summary.json's fields: ``sim/summary.py``)."""
-    severity = severity_of(facts)
-    outcome = outcome_of(facts, severity)
     return RunSummary(
-        **_contact_fields(facts, outcome, severity),
+        **_contact_fields(facts, outcome_of(facts), severity_of(facts)),
         **_eoam_fields(facts, info),
         **_margin_fields(facts),
         **_motion_fields(facts),

@@ -86,7 +86,7 @@ def test_a_square_hit_on_the_aro_after_limit_braking_is_yellow_with_its_delta_v(
     )
     severity = severity_of(facts)
     assert severity is not None and severity.direct_overlap == 1.0
-    assert outcome_of(facts, severity).colour == "yellow"
+    assert outcome_of(facts).colour == "yellow"
     summary = summarise(facts, INFO)
     assert (summary.outcome, summary.collision_with, summary.contact_kind) == (
         "yellow",
@@ -106,7 +106,7 @@ def test_an_offset_hit_on_the_aro_after_limit_braking_is_orange():
     severity = severity_of(facts)
     assert severity is not None
     assert severity.direct_overlap == pytest.approx(0.325 / 1.8)  # of the narrower width
-    out = outcome_of(facts, severity)
+    out = outcome_of(facts)
     assert out.colour == "orange" and "offset front hit" in out.reason
 
 
@@ -121,7 +121,7 @@ def test_a_lane_change_ending_head_on_with_oncoming_traffic_is_red():
         contact_sumo_mass_kg=1500.0,
         end_cause="contact",
     )
-    out = outcome_of(facts, severity_of(facts))
+    out = outcome_of(facts)
     assert (out.colour, out.collision_with) == ("red", "oncoming")
     assert out.impact_speed_mps == pytest.approx(45.0)
     assert summarise(facts, INFO).impact_angle_rad == pytest.approx(math.pi)
@@ -165,9 +165,9 @@ def test_a_run_cut_off_in_the_other_lane_is_unfinished():
         manoeuvre_running=True,
         end_cause="time_limit",
     )
-    out = outcome_of(facts, None)
+    out = outcome_of(facts)
     assert out.colour == "unfinished" and "time limit" in out.reason
-    assert outcome_of(replace(facts, end_cause="road_end"), None).reason.endswith(
+    assert outcome_of(replace(facts, end_cause="road_end")).reason.endswith(
         "end of the road with the ego +2.4 m from its lane centre and a manoeuvre still running"
     )
 
