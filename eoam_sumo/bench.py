@@ -69,9 +69,10 @@ def _cosim_and_sumo_only(repeats: int) -> dict:
     """The co-simulation's step-loop figures and SUMO alone on the same scenario, measured in
     pairs (one co-simulation run, then SUMO alone for as many steps) so that both see the same
     machine load; medians over the repeats, the cost ratio the median of the pairs' ratios."""
-    from eoam_sumo.sim.cosim import CoSimulation, RunSettings
+    from eoam_sumo.sim.cosim import CoSimulation
     from eoam_sumo.sim.observers import PhaseTimer
     from eoam_sumo.sim.scenario import ScenarioOverrides
+    from eoam_sumo.sim.settings import RunSettings
 
     over = ScenarioOverrides(ego_speed_mps=SPEED_MPS, mu=1.0)
     timer = PhaseTimer()
@@ -191,9 +192,10 @@ def _traffic(tmp: Path, quick: bool) -> dict:
     import libsumo
     import sumolib
 
-    from eoam_sumo.sim.cosim import CoSimulation, RunSettings
+    from eoam_sumo.sim.cosim import CoSimulation
     from eoam_sumo.sim.scenario import ScenarioOverrides, check_scenario
     from eoam_sumo.sim.session.launch import sumo_command
+    from eoam_sumo.sim.settings import RunSettings
     from eoam_sumo.traffic_scenario import write_traffic_scenario
 
     depart_s = 20.0 if quick else TRAFFIC_DEPART_S

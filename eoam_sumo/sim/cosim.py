@@ -15,88 +15,57 @@ import gc
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
-from typing import Any, ClassVar
-
-from mypy_extensions import mypyc_attr
 
 from eoam_sumo.eoam import (
     Command,
     EgoMeasurement,
     EoamController,
-    EoamSettings,
     ObjectState,
     Perception,
 )
 from eoam_sumo.errors import InputError
-from eoam_sumo.matrix import DEFAULT_MAX_TIME_S
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.plant import Plant, initial_state
 from eoam_sumo.sensing.automotive import make_radar
 from eoam_sumo.sensing.friction import FrictionBelief
-from eoam_sumo.sensing.next_lane import CornerRadarSettings, NextLaneSensing
-from eoam_sumo.sensing.v2x import V2XSettings
-from eoam_sumo.sim.bodies import nav_angle_deg
-from eoam_sumo.sim.geometry import OrientedBox, box_distance, boxes_overlap, gap_lower_bound
-from eoam_sumo.sim.margins import STOPPED_MPS, Margins, road_user_close_ahead
-from eoam_sumo.sim.observers import Extremes, StepObserver, TimeSeries
+from eoam_sumo.sensing.next_lane import NextLaneSensing
+from eoam_sumo.sim.bodies import Body, nav_angle_deg
+from eoam_sumo.sim.facts import collect_facts, collect_info
+from eoam_sumo.sim.geometry import (
+    GAP_ROUNDING_M,
+    OrientedBox,
+    box_distance,
+    boxes_overlap,
+    gap_lower_bound,
+)
+from eoam_sumo.sim.margins import EGO_STANDSTILL_MPS, Margins, road_user_close_ahead
+from eoam_sumo.sim.observers import (
+    AvoidedObstacle,
+    Extremes,
+    StepObserver,
+    TimeSeries,
+    no_lap,
+)
 from eoam_sumo.sim.outcome import role_of
-from eoam_sumo.sim.radar import RadarReport, RadarSettings
+from eoam_sumo.sim.radar import RadarReport
 from eoam_sumo.sim.roadframe import RoadFrame
 from eoam_sumo.sim.runlog import RunLog, write_run
 from eoam_sumo.sim.scenario import ScenarioOverrides
 from eoam_sumo.sim.session import SumoSession
-from eoam_sumo.sim.session.gui import GuiSettings
+from eoam_sumo.sim.settings import RunSettings
 from eoam_sumo.sim.severity import ContactRecord, substep_contact
 from eoam_sumo.sim.summary import RunSummary
 from eoam_sumo.sim.trafficlog import TrafficLog
-from eoam_sumo.sim.verdict import AvoidedObstacle, summarise
+from eoam_sumo.sim.verdict import summarise
 
-
-@mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
-@dataclass(frozen=True)
-class RunSettings:
-    """Rates, limits and sub-settings of one co-simulation run."""
-
-    step_s: float = 0.01  # SUMO and decision/control step [s]; whole milliseconds in SUMO
-    plant_dt_s: float = 0.001  # plant integration step [s]
-    max_time_s: float = DEFAULT_MAX_TIME_S  # simulated time limit [s]
-    settle_s: float = 2.0  # run on this long after the hand-back or a stop [s]
-    ego_id: str = "ego"
-    gui: bool = False
-    use_traci: bool = False
-    tables_dir: Path | None = None
-    radar: RadarSettings = field(default_factory=RadarSettings)
-    eoam: EoamSettings = field(default_factory=EoamSettings)
-    mu_belief: str | float = "known"  # sensing.friction: known, estimate or a number
-    seed: int = 0  # seeds every random model of the run (friction estimator, radar)
-    v2x: V2XSettings = field(default_factory=V2XSettings)  # used by the safe policy
-    corner_radar: CornerRadarSettings = field(default_factory=CornerRadarSettings)
-    radar_model: str = "ideal"  # sensing.automotive: ideal or automotive
-    gui_settings: GuiSettings = field(default_factory=GuiSettings)  # with gui: pacing, view
-
-    def __post_init__(self) -> None:
-        ms = self.step_s * 1000.0
-        if self.step_s <= 0 or abs(ms - round(ms)) > 1e-9:
-            raise ValueError(f"step_s={self.step_s} must be a positive whole number of ms")
-        n = self.step_s / self.plant_dt_s
-        if self.plant_dt_s <= 0 or abs(n - round(n)) > 1e-9:
-            raise ValueError(f"plant_dt_s={self.plant_dt_s} must divide step_s={self.step_s}")
-        if self.max_time_s <= 0:
-            raise ValueError(f"max_time_s={self.max_time_s} must be > 0")
-        if self.v2x.enabled and self.eoam.policy.name != "safe":
-            raise ValueError("V2X informs the safe policy only: set policy 'safe' or V2X range 0")
-
-    @property
-    def substeps(self) -> int:
-        return round(self.step_s / self.plant_dt_s)
+__all__ = ["CoSimulation", "RunSettings", "policy_settings", "run_case"]
 
 
 GAP_WATCH_M = 20.0  # centre distance under which box gaps are measured and contact checked [m]
 ROAD_END_MARGIN_M = 50.0  # a run ends when the ego is this close to the end of its road [m]
-ROUNDING_M = 1e-6  # margin for rounding when a lower bound of a gap rules the gap out [m]
 
 
 class CoSimulation:
@@ -108,20 +77,11 @@ class CoSimulation:
     (see :mod:`eoam_sumo.sim.observers`) watch every step.
     """
 
-    #: The phases of a step, in order (``step``); a PhaseTimer times each.
-    PHASES: ClassVar[tuple[str, ...]] = (
-        "sense",
-        "decide",
-        "actuate",
-        "write_back",
-        "check_contact",
-    )
-    #: What ``step`` calls for each phase, in that order, with the simulation first: the class's
-    #: methods of the same names, set by ``start`` before the observers start (an observer may
-    #: wrap them, as PhaseTimer does). Not bound methods: those would make each simulation a
-    #: reference cycle, freed only by a full garbage collection (in a batch worker, after
-    #: hundreds of runs' memory).
-    phase_calls: tuple[Callable[..., Any], ...]
+    #: Called as each phase of a step ends, with its name, and with "" as a step begins:
+    #: ``no_lap``, unless an observer times the phases (PhaseTimer). Never a bound method of
+    #: the simulation: that would make it a reference cycle, freed only by a full garbage
+    #: collection (in a batch worker, after hundreds of runs' memory).
+    lap: Callable[[str], None]
     # the run's state, set by ``start`` and the steps
     session: SumoSession
     meas: EgoMeasurement
@@ -157,6 +117,7 @@ class CoSimulation:
         if isinstance(self.belief.belief, float):
             self.tables.check_run(self.belief.belief, self.tables.speed_grid_mps[0])
         self.extra_observers = tuple(observers)
+        self.lap = no_lap
 
     def _new_belief(self) -> FrictionBelief:
         st = self.settings
@@ -168,8 +129,7 @@ class CoSimulation:
 
         The objects built before the step loop (modules, tables, SUMO's set-up) are frozen out
         of Python's garbage collector over the loop, so that its collections scan only what the
-        loop made (a full collection otherwise walks the whole heap: 4 % of the loop's
-        instructions in the benchmark's run)."""
+        loop made (a full collection otherwise walks the whole heap)."""
         wall0 = time.perf_counter()
         session = self.open_session()
         try:
@@ -202,11 +162,25 @@ class CoSimulation:
     def start(self, session: SumoSession, wall0: float | None = None) -> None:
         """Set the run up on an open session: the ego's plant state, road frame, controller
         and observers; refuses a road user overlapping the ego at its departure."""
-        st, p = self.settings, self.params
         self.session = session
         self.wall0 = time.perf_counter() if wall0 is None else wall0
-        self.step_s = st.step_s
+        self.step_s = self.settings.step_s
         ego = session.ego_body()
+        self._place_ego(session, ego)
+        self._set_up_sensing(session, ego)
+        self._set_up_geometry()
+        self._reset_run_state(session)
+        self._check_departure()
+        st = self.settings
+        self.belief = self._new_belief()
+        self.radar = make_radar(st.radar_model, st.radar, st.seed)  # fresh state per run
+        self.mu_true = self.mu_start
+        self._start_observers()
+        self._loop0 = time.perf_counter()
+
+    def _place_ego(self, session: SumoSession, ego: Body) -> None:
+        """The ego at its departure: the friction under it, the road frame of its lane, its
+        plant state and a fresh controller; refuses what the tables do not cover."""
         self.mu_start = session.friction_at_ego()
         self.tables.check_run(self.mu_start, ego.speed_mps)
         self.ego_initial_speed_mps = ego.speed_mps
@@ -217,8 +191,15 @@ class CoSimulation:
         self.x = initial_state(ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps).tolist()
         self.x_prev = self.x
         self.ax = self.ay = 0.0
-        self.ctrl = EoamController(p, self.tables, st.eoam)
+        self.ctrl = EoamController(self.params, self.tables, self.settings.eoam)
         self.ctrl.reset(ego.speed_mps)
+
+    def _set_up_sensing(self, session: SumoSession, ego: Body) -> None:
+        """The next lane's sensing (safe policy), the traffic log and how far around the ego
+        SUMO reports road users: from the front bumper, where the radar is; further for V2X
+        and the corner radars, and for the traffic log (its radius is from the centre of
+        gravity)."""
+        st, p = self.settings, self.params
         self.lane_sensing = self._next_lane_sensing(session)  # safe policy only
         self.traffic = TrafficLog(
             st.ego_id,
@@ -229,19 +210,26 @@ class CoSimulation:
             session.ego_lane_centreline(),
             self.lane_width_m,
         )
-        # from the front bumper, where the radar is; further for V2X and the corner radars,
-        # and for the traffic log (its radius is from the centre of gravity)
         self._sense_radius_m = max(
             st.radar.range_m,
             self.lane_sensing.reach_m if self.lane_sensing else 0.0,
             self.traffic.radius_m + p.cg_to_front_bumper_m,
         )
+
+    def _set_up_geometry(self) -> None:
+        """The time limit in steps, where the road ends for the run, and the ego's box seen
+        from its centre of gravity (front, box centre, the radii the contact check uses)."""
+        st, p = self.settings, self.params
         self.max_steps = round(st.max_time_s / st.step_s)
-        self._end_s_m = road.length_m - ROAD_END_MARGIN_M  # the run ends this close to the end
+        self._end_s_m = self.road.length_m - ROAD_END_MARGIN_M  # the run ends this close
         self._front = front = p.cg_to_front_bumper_m
         self._back = front - 0.5 * p.length_m  # CG to the ego box's centre, as in OrientedBox
         self._ego_box_radius = math.hypot(0.5 * p.length_m, 0.5 * p.width_m)
         self._ego_radius = 0.5 * math.hypot(p.length_m, p.width_m) + front - 0.5 * p.length_m
+
+    def _reset_run_state(self, session: SumoSession) -> None:
+        """Nothing hit, no gap measured, no end yet; SUMO's time and the road users near the
+        ego at the departure."""
         self.first_contact: ContactRecord | None = None
         self.min_gap_aro_m = math.inf
         self._gaps: dict = {}  # vid -> (box, gap) measured at the last step's ego pose
@@ -251,17 +239,25 @@ class CoSimulation:
         self._stop_at: float | None = None
         self.t = self.t_start = session.time_s
         self.bodies = session.nearby(self._sense_radius_m)  # with their boxes
-        x = self.x
-        start_box = OrientedBox.from_axis_point(x[0], x[1], x[2], p.length_m, p.width_m, front)
+
+    def _check_departure(self) -> None:
+        """Refuse a road user overlapping the ego's box at its departure."""
+        p, x = self.params, self.x
+        start_box = OrientedBox.from_axis_point(
+            x[0], x[1], x[2], p.length_m, p.width_m, self._front
+        )
         for b in self.bodies:
             if boxes_overlap(start_box, b.box):
                 raise InputError(f"{self.cfg}: vehicle '{b.vid}' overlaps the ego at its departure")
         self._cy, self._sy = math.cos(x[2]), math.sin(x[2])
-        self.belief = self._new_belief()
-        self.radar = make_radar(st.radar_model, st.radar, st.seed)  # fresh state per run
-        self.mu_true = self.mu_start
+
+    def _start_observers(self) -> None:
+        """The run's own observers (time series, extremes, traffic log, margins, the avoided
+        obstacle), then those added, all started; the step's phases untimed until one of them
+        times them."""
+        p = self.params
         self.timeseries, self.extremes = TimeSeries(), Extremes()
-        self.margins = Margins(p.length_m, p.width_m, front)
+        self.margins = Margins(p.length_m, p.width_m, self._front)
         self.avoided = AvoidedObstacle()
         self.observers = (
             self.timeseries,
@@ -271,23 +267,28 @@ class CoSimulation:
             self.avoided,
             *self.extra_observers,
         )
-        cls = type(self)
-        self.phase_calls = (cls.sense, cls.decide, cls.actuate, cls.write_back, cls.check_contact)
+        self.lap = no_lap
         for obs in self.observers:
             obs.start(self)
         self._after_step = tuple(obs.after_step for obs in self.observers)
-        self._loop0 = time.perf_counter()
 
     # ----------------------------------------------------------------------------- the step
     def step(self) -> bool:
         """One co-simulation step (as highway-env's ``AbstractEnv.step``: named phases in
-        order); True when the run is over."""
-        sense, decide, actuate, write_back, check_contact = self.phase_calls
-        self.meas, self.perception = meas, perception = sense(self)
-        self.cmd = cmd = decide(self, meas, perception)
-        actuate(self, cmd)
-        write_back(self)
-        check_contact(self)
+        order, ``observers.PHASES``, each followed by ``lap`` with its name); True when the
+        run is over."""
+        lap = self.lap
+        lap("")
+        self.meas, self.perception = meas, perception = self.sense()
+        lap("sense")
+        self.cmd = cmd = self.decide(meas, perception)
+        lap("decide")
+        self.actuate(cmd)
+        lap("actuate")
+        self.write_back()
+        lap("write_back")
+        self.check_contact()
+        lap("check_contact")
         self.n_steps += 1
         for after_step in self._after_step:
             after_step(self)
@@ -372,7 +373,7 @@ class CoSimulation:
                 continue
             reach_m = ego_move + b.speed_mps * step_s + 0.05
             # the bounding circles' gap is a lower bound of the boxes' gap
-            circles_m = centres_m - ego_box_radius - b.box.radius_m - ROUNDING_M
+            circles_m = centres_m - ego_box_radius - b.box.radius_m - GAP_ROUNDING_M
             if circles_m > reach_m and circles_m >= min_gap_aro:
                 continue  # the box gap can be neither the ARO's least nor a contact
             # a parked car cannot be the ARO: its role is worked out only if it is hit
@@ -383,7 +384,7 @@ class CoSimulation:
                 ego_box = OrientedBox.from_axis_point(
                     Xn, Yn, yawn, p.length_m, p.width_m, self._front
                 )
-            bound_m = gap_lower_bound(ego_box, b.box) - ROUNDING_M  # tighter, dearer
+            bound_m = gap_lower_bound(ego_box, b.box) - GAP_ROUNDING_M  # tighter, dearer
             if bound_m > reach_m and (role != "aro" or bound_m >= min_gap_aro):
                 continue
             known = gaps.get(b.vid)  # the same boxes as at the last step: the same gap
@@ -441,18 +442,27 @@ class CoSimulation:
         ctrl = self.ctrl
         mode = ctrl.mode
         return (mode == 0 and len(ctrl.modes_visited) > 1) or (
-            mode in (1, 3) and self.x[3] < STOPPED_MPS
+            mode in (1, 3) and self.x[3] < EGO_STANDSTILL_MPS
         )
 
     # ----------------------------------------------------------------------------- the end
     def finish(self) -> RunSummary:
         """The end state to the observers, the outcome and the run's summary."""
         loop_wall_s = time.perf_counter() - self._loop0
+        self.meas = self._end_state()
+        for obs in self.observers:
+            obs.end(self)
+        self.loop_wall_s = loop_wall_s
+        facts = collect_facts(self)
+        return summarise(facts, collect_info(self, loop_wall_s))
+
+    def _end_state(self) -> EgoMeasurement:
+        """The ego at the end of the run (no road curvature: nothing steers from it)."""
         x = self.x
         X, Y, yaw, vx = x[:4]
         s, d, road_yaw = self.road.project(X, Y)
         self.mu_true = self.session.friction_at_ego()
-        self.meas = EgoMeasurement(
+        return EgoMeasurement(
             self.t,
             vx,
             x[4],
@@ -467,10 +477,6 @@ class CoSimulation:
             self.lane_width_m,
             self.left_lane,
         )
-        for obs in self.observers:
-            obs.end(self)
-        self.loop_wall_s = loop_wall_s
-        return summarise(self, loop_wall_s)
 
     def _next_lane_sensing(self, session: SumoSession) -> NextLaneSensing | None:
         """The next lane's sensing for the safe policy (None for the paper's)."""

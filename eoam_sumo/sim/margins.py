@@ -28,9 +28,15 @@ from collections.abc import Sequence
 
 from eoam_sumo.params import G_MPS2
 from eoam_sumo.sim.bodies import Body
-from eoam_sumo.sim.geometry import OrientedBox, box_distance, gap_lower_bound, time_to_contact
+from eoam_sumo.sim.geometry import (
+    GAP_ROUNDING_M,
+    OrientedBox,
+    box_distance,
+    gap_lower_bound,
+    time_to_contact,
+)
+from eoam_sumo.sim.lanes import RoadProjection, lane_band_m
 from eoam_sumo.sim.observers import RunView, StepObserver
-from eoam_sumo.sim.radar import LANE_MARGIN_M, RoadProjection
 
 #: A run without contact that came this close to another road user is a near miss [m].
 NEAR_MISS_GAP_M = 0.5
@@ -43,8 +49,10 @@ NEAR_MISS_TTC_S = 1.5
 #: stopping distance plus this [m] (``road_user_close_ahead``): the end is then a stop behind
 #: it, passing it, or a contact.
 CLOSE_AHEAD_MARGIN_M = 5.0
-STOPPED_MPS = 0.05  # the ego counts as stopped below this speed [m/s] (as ``eoam_done``)
-_ROUNDING_M = 1e-6  # lower bounds of a gap are lowered by this before ruling a gap out
+#: The ego is at a standstill below this forward speed [m/s]: the EOAM's stop is over
+#: (``CoSimulation.eoam_done``) and no road user ahead holds the run open. Not the outcome's
+#: "stopped at the end" (``outcome.STOPPED_AT_END_MPS``, 0.1 m/s), which only words a reason.
+EGO_STANDSTILL_MPS = 0.05
 
 
 class Margins(StepObserver):
@@ -105,7 +113,10 @@ class Margins(StepObserver):
         for b in sim.bodies:
             box = b.box
             bound = (
-                math.hypot(box.x_m - ex, box.y_m - ey) - self._radius_m - box.radius_m - _ROUNDING_M
+                math.hypot(box.x_m - ex, box.y_m - ey)
+                - self._radius_m
+                - box.radius_m
+                - GAP_ROUNDING_M
             )
             opposite = not b.parked and box.cos_yaw * cr + box.sin_yaw * sr < 0.0
             near = bound < NEAR_MISS_GAP_M
@@ -125,7 +136,7 @@ class Margins(StepObserver):
             if near and bound < self.closest_gap_m:
                 # the separating-axis bound rules out most of what the circles let through
                 # (a car parked beside the ego)
-                if gap < 0.0 and gap_lower_bound(ego_box, box) - _ROUNDING_M < NEAR_MISS_GAP_M:
+                if gap < 0.0 and gap_lower_bound(ego_box, box) - GAP_ROUNDING_M < NEAR_MISS_GAP_M:
                     gap = box_distance(ego_box, box)
                 if 0.0 <= gap < self.closest_gap_m:
                     self.closest_gap_m, self.closest_id = gap, b.vid
@@ -145,12 +156,12 @@ def road_user_close_ahead(
     (both braking at the road's friction: (v^2 - u^2) / (2 mu g), u its speed along the road)
     plus ``CLOSE_AHEAD_MARGIN_M``."""
     X, Y, _, vx = x[:4]
-    if vx < STOPPED_MPS:
+    if vx < EGO_STANDSTILL_MPS:
         return False  # stopped behind it: the run's real end
     s_ego, d_ego, _ = road.project(X, Y)
     front_s = s_ego + cg_to_front_m
     lane_d = lane_width_m * round(d_ego / lane_width_m)  # centre of the lane the ego is in
-    band = 0.5 * lane_width_m + LANE_MARGIN_M
+    band = lane_band_m(lane_width_m)
     two_decel = 2.0 * mu * G_MPS2
     for b in bodies:
         s, d, road_yaw = road.project(b.x_m, b.y_m)

@@ -5,6 +5,11 @@ observer may read of :class:`~eoam_sumo.sim.cosim.CoSimulation`): ``start`` once
 set up (the ego placed, nothing stepped), ``after_step`` at the end of every step and ``end``
 with the ego's end state in ``meas``. Add one with ``CoSimulation(..., observers=[...])``;
 :class:`StepObserver` is a base with empty hooks.
+
+Here: the time series (:class:`TimeSeries`), the running extremes of the ego
+(:class:`Extremes`), the obstacle a lane change avoided (:class:`AvoidedObstacle`) and the
+benchmark's timer of the step's phases (:class:`PhaseTimer`); the margins are in
+``sim/margins.py``, the traffic log in ``sim/trafficlog.py``.
 """
 
 from __future__ import annotations
@@ -17,18 +22,25 @@ from typing import Any, Protocol
 from mypy_extensions import mypyc_attr
 
 from eoam_sumo.eoam import Command, EgoMeasurement, Perception
+from eoam_sumo.sim.lanes import lane_band_m
 from eoam_sumo.sim.runlog import RunLog
+
+_LANE_CHANGE_MODES = (2, 4)  # the EOAM's modes that begin a lane change
+#: The phases of a step, in order (``CoSimulation.step``).
+PHASES = ("sense", "decide", "actuate", "write_back", "check_contact")
+
+
+def no_lap(phase: str) -> None:
+    """The step's ``lap`` when nothing times the phases: does nothing."""
 
 
 class RunView(Protocol):
     """What observers read of a running co-simulation."""
 
-    @property
-    def PHASES(self) -> tuple[str, ...]: ...
+    # called as each phase of a step ends, with its name, and with "" as the step begins
+    # (``no_lap`` unless a PhaseTimer times the phases)
+    lap: Callable[[str], None]
 
-    phase_calls: tuple[Callable[..., Any], ...]  # what the step calls for each phase (with
-
-    # the simulation first)
     @property
     def max_steps(self) -> int: ...  # the time limit in steps
     @property
@@ -129,37 +141,76 @@ class Extremes(StepObserver):
 
 
 class PhaseTimer(StepObserver):
-    """Wall time spent in each phase of the step (``CoSimulation.PHASES``), for the benchmark.
+    """Wall time spent in each phase of the step (``PHASES``), for the benchmark.
 
-    It wraps the simulation's phase calls (``phase_calls``) when the run starts and puts them
+    It sets the simulation's ``lap`` to its own when the run starts and puts the one it found
     back at its end; ``totals`` maps each phase to its seconds, ``steps`` counts the steps.
-    Without a PhaseTimer the phases run unwrapped.
     """
 
     def __init__(self) -> None:
         self.totals: dict[str, float] = {}
         self.steps = 0
-        self._unwrapped: tuple[Callable[..., Any], ...] = ()
+        self._last_s = 0.0
+        self._untimed: Callable[[str], None] = no_lap
 
     def start(self, sim: RunView) -> None:
-        self.totals = dict.fromkeys(sim.PHASES, 0.0)
+        self.totals = dict.fromkeys(PHASES, 0.0)
         self.steps = 0
-        self._unwrapped = calls = sim.phase_calls
-        sim.phase_calls = tuple(self._timed(name, call) for name, call in zip(sim.PHASES, calls))
+        self._untimed = sim.lap
+        sim.lap = self.lap
 
-    def _timed(self, name: str, phase):
-        clock, totals = time.perf_counter, self.totals
-
-        def timed(*args):
-            t0 = clock()
-            out = phase(*args)
-            totals[name] += clock() - t0
-            return out
-
-        return timed
+    def lap(self, phase: str) -> None:
+        """The phase ``phase`` has ended ("": the step begins): its time since the last lap."""
+        now = time.perf_counter()
+        if phase:
+            self.totals[phase] += now - self._last_s
+        self._last_s = now
 
     def after_step(self, sim: RunView) -> None:
         self.steps += 1
 
     def end(self, sim: RunView) -> None:
-        sim.phase_calls = self._unwrapped
+        sim.lap = self._untimed
+
+
+class AvoidedObstacle(StepObserver):
+    """The obstacle a lane change avoided, for the verdict only (ground truth; the EOAM never
+    sees it): ``vid`` the SUMO id of the nearest road user ahead of the ego with its centre
+    in the ego's lane band when the EOAM first began a lane change (mode 2 or 4), ``passed``
+    at the end whether the ego's centre ended ahead of it along the road (None when no lane
+    change began or the obstacle has left the simulation)."""
+
+    vid: str | None
+    passed: bool | None
+
+    def start(self, sim: RunView) -> None:
+        self.vid = None
+        self.passed = None
+        self._done = False
+
+    def after_step(self, sim: RunView) -> None:
+        if self._done or sim.cmd.mode not in _LANE_CHANGE_MODES:
+            return
+        self._done = True
+        band_m = lane_band_m(sim.lane_width_m)
+        s_ego, nearest = sim.meas.s_m, math.inf
+        for b in sim.bodies_before:  # the road users at the start of that step
+            s, d, _ = sim.road.project(b.x_m, b.y_m)
+            if abs(d) < band_m and s_ego < s < s_ego + nearest:
+                self.vid, nearest = b.vid, s - s_ego
+
+    def end(self, sim: RunView) -> None:
+        self.passed = None if self.vid is None else _ended_ahead_of(sim, self.vid)
+
+
+def _ended_ahead_of(sim: RunView, vid: str) -> bool | None:
+    """Whether the ego's centre ended ahead of the road user ``vid`` along the road (None
+    when it has left the simulation)."""
+    body = next((b for b in sim.bodies if b.vid == vid), None)
+    if body is None:
+        try:
+            body = sim.session.body(vid)
+        except Exception:  # noqa: BLE001 - gone from SUMO (libsumo and TraCI raise differently)
+            return None
+    s_obstacle = sim.road.project(body.x_m, body.y_m)[0]
+    return sim.meas.s_m > s_obstacle

@@ -73,10 +73,11 @@ from eoam_sumo.colours import OUTCOMES
 from eoam_sumo.params import PONR_FRACTION
 from eoam_sumo.sim.bodies import Body
 from eoam_sumo.sim.geometry import HEAD_ON_MIN_OVERLAP, Contact
-from eoam_sumo.sim.radar import (
+from eoam_sumo.sim.lanes import (
     LANE_MARGIN_M,
     STATIONARY_SPEED_MPS,
     RoadProjection,
+    lane_band_m,
 )
 
 COLOURS = OUTCOMES
@@ -99,6 +100,11 @@ REVERSING_SPEED_MPS = -0.5
 # edge (overshoot 0.3 m at most measured) and a return overshoots the own lane centre by
 # 0.33 m at most (Table 2), half a lane inside the right edge.
 ROAD_EDGE_MARGIN_M = 0.5
+# Stopped when the run ended: final forward speed at or below this [m/s]. It only words the
+# reason of a green run ("stopped behind the obstacle" or "still moving"); the step loop's
+# own standstill, which ends the EOAM's stop, is ``margins.EGO_STANDSTILL_MPS`` (0.05 m/s,
+# strictly below), a different threshold: a run cut off at 0.07 m/s is reported stopped.
+STOPPED_AT_END_MPS = 0.1
 
 #: A front hit covering less than this share of the narrower width in line is an offset hit.
 DIRECT_HIT_MIN_OVERLAP = HEAD_ON_MIN_OVERLAP
@@ -135,7 +141,7 @@ def role_of(
     _, d, road_yaw = road_frame.project(body.x_m, body.y_m)
     if not body.parked and math.cos(body.yaw_rad - road_yaw) < 0.0:
         return "oncoming"
-    if in_lane_at_start or abs(d) < 0.5 * lane_width_m + lane_margin_m:
+    if in_lane_at_start or abs(d) < lane_band_m(lane_width_m, lane_margin_m):
         return "aro"
     if abs(body.speed_mps) < stationary_speed_mps:
         return "parked"
@@ -151,7 +157,7 @@ class OutcomeSettings:
     # ego centre within 0.5 m of the lane centre: a 1.85 m wide car keeps >= 0.3 m to the
     # markers of a 3.5 m lane
     in_lane_tolerance_m: float = 0.5
-    stopped_speed_mps: float = 0.1  # "stopped" at the end of the run
+    stopped_speed_mps: float = STOPPED_AT_END_MPS  # "stopped" at the end of the run
     lost_control_heading_rad: float = LOST_CONTROL_HEADING_RAD  # |heading error| above: lost
     reversing_speed_mps: float = REVERSING_SPEED_MPS  # vx below: going backwards, lost control
     road_edge_margin_m: float = ROAD_EDGE_MARGIN_M  # CG beyond a road edge by more: left road
@@ -273,68 +279,87 @@ def classify_outcome(
     whether the ego ended ahead of the obstacle its lane change avoided (None: unknown).
     """
     modes = set(modes_visited)
-    if not modes <= {0, 1, 2, 3, 4, 5}:
+    _check_inputs(
+        modes_visited,
+        lane_width_m,
+        left_width_m,
+        (
+            ("max_lateral_offset_m", max_lateral_offset_m),
+            ("final_offset_m", final_offset_m),
+            ("final_speed_mps", final_speed_mps),
+            ("max_abs_heading_error_rad", max_abs_heading_error_rad),
+            ("min_speed_mps", min_speed_mps),
+            ("min_offset_m", min_offset_m),
+            ("max_offset_m", max_offset_m),
+            ("left_width_m", left_width_m),
+        ),
+    )
+    # mode 3 is entered only before the point of no return: limit braking was chosen, whatever
+    # lateral drift the aborted steer leaves (paper sec. 8.1)
+    lane_change = 3 not in modes and (
+        abs(max_lateral_offset_m) >= settings.point_of_no_return_fraction * lane_width_m
+    )
+    if contact is not None:
+        return _contact_outcome(modes, lane_change, contact, role, direct_overlap)
+    lost = _loss_of_control(
+        max_abs_heading_error_rad,
+        min_speed_mps,
+        road_departure(min_offset_m, max_offset_m, lane_width_m, left_width_m),
+        settings,
+    )
+    if lost:
+        # an offset past the point of no return is a lane change only if the EOAM steered
+        done = _manoeuvre_phrase(modes, lane_change and bool(modes & {2, 4, 5}))
+        return Outcome("orange", "none", 0.0, f"{done}, no contact; {'; '.join(lost)}")
+    return _no_contact(
+        modes,
+        lane_change,
+        final_offset_m,
+        final_speed_mps,
+        settings,
+        cut_off,
+        manoeuvre_running,
+        passed_obstacle,
+    )
+
+
+def _check_inputs(
+    modes_visited: Sequence[int],
+    lane_width_m: float,
+    left_width_m: float,
+    finite: tuple[tuple[str, float], ...],
+) -> None:
+    """Refuse mode numbers outside 0-5, a non-finite motion input (``finite``: name, value),
+    a lane width not above 0 and a negative width to the left."""
+    if not set(modes_visited) <= {0, 1, 2, 3, 4, 5}:
         raise ValueError(f"modes_visited={list(modes_visited)} must hold mode numbers 0-5")
-    for name, v in (
-        ("max_lateral_offset_m", max_lateral_offset_m),
-        ("final_offset_m", final_offset_m),
-        ("final_speed_mps", final_speed_mps),
-        ("max_abs_heading_error_rad", max_abs_heading_error_rad),
-        ("min_speed_mps", min_speed_mps),
-        ("min_offset_m", min_offset_m),
-        ("max_offset_m", max_offset_m),
-        ("left_width_m", left_width_m),
-    ):
+    for name, v in finite:
         if not math.isfinite(v):
             raise ValueError(f"{name}={v!r} must be finite")
     if not lane_width_m > 0.0:
         raise ValueError(f"lane_width_m={lane_width_m} must be > 0")
     if left_width_m < 0.0:
         raise ValueError(f"left_width_m={left_width_m} must be >= 0")
-    # mode 3 is entered only before the point of no return: limit braking was chosen, whatever
-    # lateral drift the aborted steer leaves (paper sec. 8.1)
-    lane_change = 3 not in modes and (
-        abs(max_lateral_offset_m) >= settings.point_of_no_return_fraction * lane_width_m
-    )
-    if contact is None:
-        lost = _loss_of_control(
-            max_abs_heading_error_rad,
-            min_speed_mps,
-            road_departure(min_offset_m, max_offset_m, lane_width_m, left_width_m),
-            settings,
-        )
-        if lost:
-            # an offset past the point of no return is a lane change only if the EOAM steered
-            done = _manoeuvre_phrase(modes, lane_change and bool(modes & {2, 4, 5}))
-            return Outcome("orange", "none", 0.0, f"{done}, no contact; {'; '.join(lost)}")
-        return _no_contact(
-            modes,
-            lane_change,
-            final_offset_m,
-            final_speed_mps,
-            settings,
-            cut_off,
-            manoeuvre_running,
-            passed_obstacle,
-        )
+
+
+def _contact_outcome(
+    modes: set[int], lane_change: bool, contact: Contact, role: str, direct_overlap: float
+) -> Outcome:
+    """Rules 1-3 of the module docstring: red, yellow or orange by the contact's kind, the
+    faces in contact, the role of the body hit and how squarely the ego's front hit it."""
     if role not in ROLES:
         raise ValueError(f"role={role!r} of the body hit must be one of {ROLES}")
     what = _ROLE_NAMES[role]
     v = contact.impact_speed_mps
     done = _manoeuvre_phrase(modes, lane_change)
     frontal = contact.kind in ("head_on", "oblique")
+    front_hit = contact.face_a == "front" and contact.kind != "side" and role != "oncoming"
     if role == "oncoming" and frontal:
         how = "head-on" if contact.kind == "head_on" else "offset/oblique head-on"
         colour, reason = "red", f"{done}, {how} with the oncoming vehicle at {v:.1f} m/s"
-    elif (
-        not lane_change
-        and role != "oncoming"
-        and contact.face_a == "front"
-        and contact.kind != "side"
-        and direct_overlap >= DIRECT_HIT_MIN_OVERLAP
-    ):
+    elif front_hit and not lane_change and direct_overlap >= DIRECT_HIT_MIN_OVERLAP:
         colour, reason = "yellow", f"{done}, front hit {what} at {v:.1f} m/s"
-    elif contact.face_a == "front" and contact.kind != "side" and role != "oncoming":
+    elif front_hit:
         colour, reason = (
             "orange",
             (

@@ -46,41 +46,29 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from operator import attrgetter
-from typing import NamedTuple, Protocol
+from typing import NamedTuple
 
 from mypy_extensions import mypyc_attr
 
 from eoam_sumo.sim.bodies import Body
 from eoam_sumo.sim.coasting import Coaster
 from eoam_sumo.sim.geometry import OrientedBox, slab_entry
-
-#: Below this speed a target counts as stopped [m/s]: SUMO reports exactly 0 for parked and
-#: stopped vehicles, and automotive radars resolve Doppler to about 0.1-0.3 m/s.
-STATIONARY_SPEED_MPS = 0.5
-#: Moving against the road direction faster than this is oncoming traffic [m/s] (7 km/h,
-#: well above the stationary threshold, far below the 20 m/s oncoming ARO of sec. 10.2).
-ONCOMING_SPEED_MPS = 2.0
-#: The ego lane band reaches this far beyond each lane marker [m]: a 1.8 m wide car whose
-#: centre is 0.5 m outside the marker still covers 0.4 m of the lane; a parked car 1.5 m
-#: beyond the marker (centre ~2.4 m beyond) and an oncoming car centred in the next lane
-#: (1.75 m beyond) are outside.
-LANE_MARGIN_M = 0.5
+from eoam_sumo.sim.lanes import (
+    LANE_MARGIN_M,
+    ONCOMING_SPEED_MPS,
+    STATIONARY_SPEED_MPS,
+    RoadProjection,
+    lane_band_m,
+)
 
 CATEGORIES = ("in_path", "oncoming", "in_next_lane", "stationary_side", "other")
-
-
-class RoadProjection(Protocol):
-    """Road frame of the ego's original lane (``eoam_sumo.sim.roadframe.RoadFrame``)."""
-
-    def project(self, x: float, y: float) -> tuple[float, float, float]:
-        """(s_m, d_m, road_yaw_rad) of a network point; d positive to the left."""
-        ...
 
 
 @mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
 @dataclass(frozen=True)
 class RadarSettings:
-    """Radar coverage and the classification thresholds (reasons at the module constants)."""
+    """Radar coverage and the classification thresholds (reasons at the constants of
+    :mod:`eoam_sumo.sim.lanes`)."""
 
     range_m: float = 100.0  # long-range radar; the ARO at 120 m is outside at start (Fig. 18)
     fov_deg: float = 18.0  # full horizontal field of view, narrow forward beam
@@ -121,7 +109,7 @@ class RadarSettings:
 
 class Detection(NamedTuple):
     """One detected target: measurements, road-frame position and class (a named tuple: built
-    at every scan, three times faster than a frozen dataclass)."""
+    at every scan)."""
 
     target_index: int  # position in the scanned target list (for logging only)
     range_m: float
@@ -185,6 +173,22 @@ def report_of(detections: list[Detection]) -> RadarReport:
         in_path,
         next_lane,
     )
+
+
+class _EgoView(NamedTuple):
+    """The ego as one scan sees it: the radar's position and heading (with its cosine and
+    sine), the ego's velocity, its station and the lane band of its original lane."""
+
+    x_m: float
+    y_m: float
+    yaw_rad: float
+    cos_yaw: float
+    sin_yaw: float
+    vx_mps: float
+    vy_mps: float
+    s_m: float
+    band_m: float
+    lane_width_m: float
 
 
 class Radar:
@@ -276,59 +280,95 @@ class Radar:
         doc); ``time_s`` is for radars with a cycle (the ideal one sees at every call)."""
         if not lane_width_m > 0.0:
             raise ValueError(f"lane_width_m={lane_width_m} must be > 0")
-        range_m = self.settings.range_m
-        cos_half_fov, sin_half_fov = self._cos_half_fov, self._sin_half_fov
-        near = self._near
         ox, oy = ego_front_xy
         bx, by = math.cos(ego_yaw_rad), math.sin(ego_yaw_rad)
-        evx, evy = ego_speed_mps * bx, ego_speed_mps * by
-        ego_s = road_frame.project(ox, oy)[0]
-        band_m = 0.5 * lane_width_m + self.settings.lane_margin_m
+        ego = _EgoView(
+            ox,
+            oy,
+            ego_yaw_rad,
+            bx,
+            by,
+            ego_speed_mps * bx,
+            ego_speed_mps * by,
+            road_frame.project(ox, oy)[0],
+            lane_band_m(lane_width_m, self.settings.lane_margin_m),
+            lane_width_m,
+        )
         detections = []
         for index, tgt in enumerate(targets):
-            box = tgt.box
+            seen = self._seen_by_beams(ego, tgt.box)
+            if seen is not None:
+                detections.append(self._detection(ego, index, tgt, seen, road_frame))
+        return self._coasting(ego, report_of(detections), targets, road_frame, time_s)
+
+    def _seen_by_beams(self, ego: _EgoView, box: OrientedBox) -> tuple[float, float, float] | None:
+        """(distance, x, y) of the nearest point of ``box`` in the beams, or None: the
+        bounding circle out of range or (one beam) wholly outside the cone first."""
+        range_m = self.settings.range_m
+        ox, oy, bx, by = ego.x_m, ego.y_m, ego.cos_yaw, ego.sin_yaw
+        dx, dy = box.x_m - ox, box.y_m - oy
+        reach = range_m + box.radius_m
+        if dx * dx + dy * dy > reach * reach:
+            return None
+        if self._near is not None:
+            seen = self.seen_point(ox, oy, ego.yaw_rad, bx, by, box)
+            return None if seen[0] == math.inf else seen
+        along, across = dx * bx + dy * by, abs(dy * bx - dx * by)
+        if along * self._sin_half_fov - across * self._cos_half_fov < -box.radius_m:
+            return None
+        seen = self.visible_point(ox, oy, ego.yaw_rad, bx, by, box)
+        return None if seen[0] > range_m else seen
+
+    def _detection(
+        self,
+        ego: _EgoView,
+        index: int,
+        tgt: Body,
+        seen: tuple[float, float, float],
+        road_frame: RoadProjection,
+    ) -> Detection:
+        """The measurements and class of target ``index`` seen at (distance, x, y) ``seen``."""
+        box = tgt.box
+        ox, oy, bx, by = ego.x_m, ego.y_m, ego.cos_yaw, ego.sin_yaw
+        rng, px, py = seen
+        if rng > 1e-9:
+            lx, ly = (px - ox) / rng, (py - oy) / rng
+        else:
             dx, dy = box.x_m - ox, box.y_m - oy
-            reach = range_m + box.radius_m
-            if dx * dx + dy * dy > reach * reach:
-                continue
-            if near is not None:
-                rng, px, py = self.seen_point(ox, oy, ego_yaw_rad, bx, by, box)
-                if rng == math.inf:
-                    continue
-            else:
-                # cheap rejection: the box's bounding circle lies wholly outside the cone
-                along, across = dx * bx + dy * by, abs(dy * bx - dx * by)
-                if along * sin_half_fov - across * cos_half_fov < -box.radius_m:
-                    continue
-                rng, px, py = self.visible_point(ox, oy, ego_yaw_rad, bx, by, box)
-                if rng > range_m:
-                    continue
-            if rng > 1e-9:
-                lx, ly = (px - ox) / rng, (py - oy) / rng
-            else:
-                norm = math.hypot(dx, dy)
-                lx, ly = (dx / norm, dy / norm) if norm > 1e-9 else (bx, by)
-            tvx, tvy = tgt.speed_mps * box.cos_yaw, tgt.speed_mps * box.sin_yaw
-            range_rate = (tvx - evx) * lx + (tvy - evy) * ly
-            bearing = math.atan2(bx * ly - by * lx, bx * lx + by * ly)
-            s, d, road_yaw = road_frame.project(box.x_m, box.y_m)
-            road_speed = tgt.speed_mps * math.cos(box.yaw_rad - road_yaw)
-            category = self.classify(s > ego_s, d, tgt.speed_mps, road_speed, band_m, lane_width_m)
-            detections.append(
-                Detection(
-                    index,
-                    rng,
-                    range_rate,
-                    bearing,
-                    s,
-                    d,
-                    road_speed,
-                    category,
-                    tgt.length_m,
-                    tgt.width_m,
-                )
-            )
-        report = report_of(detections)
+            norm = math.hypot(dx, dy)
+            lx, ly = (dx / norm, dy / norm) if norm > 1e-9 else (bx, by)
+        tvx, tvy = tgt.speed_mps * box.cos_yaw, tgt.speed_mps * box.sin_yaw
+        range_rate = (tvx - ego.vx_mps) * lx + (tvy - ego.vy_mps) * ly
+        bearing = math.atan2(bx * ly - by * lx, bx * lx + by * ly)
+        s, d, road_yaw = road_frame.project(box.x_m, box.y_m)
+        road_speed = tgt.speed_mps * math.cos(box.yaw_rad - road_yaw)
+        category = self.classify(
+            s > ego.s_m, d, tgt.speed_mps, road_speed, ego.band_m, ego.lane_width_m
+        )
+        return Detection(
+            index,
+            rng,
+            range_rate,
+            bearing,
+            s,
+            d,
+            road_speed,
+            category,
+            tgt.length_m,
+            tgt.width_m,
+        )
+
+    def _coasting(
+        self,
+        ego: _EgoView,
+        report: RadarReport,
+        targets: Sequence[Body],
+        road_frame: RoadProjection,
+        time_s: float | None,
+    ) -> RadarReport:
+        """``report`` with the in-path object coasted when it left the beams within range
+        (:mod:`eoam_sumo.sim.coasting`); the coaster is asked only when something may be or
+        is coasted, else it just remembers the in-path object."""
         coaster = self._coaster
         if coaster.coasted is None:  # nothing coasted: only remember the in-path object
             det, last = report.in_path, coaster.last
@@ -342,18 +382,18 @@ class Radar:
         seen = None if report.in_path is None else targets[report.in_path.target_index]
         coasted = coaster.coast(
             self,
-            range_m,
+            self.settings.range_m,
             seen,
             [targets[det.target_index] for det in report.detections],
-            ox,
-            oy,
-            ego_yaw_rad,
-            evx,
-            evy,
-            ego_s,
+            ego.x_m,
+            ego.y_m,
+            ego.yaw_rad,
+            ego.vx_mps,
+            ego.vy_mps,
+            ego.s_m,
             road_frame.project,
-            band_m,
-            lane_width_m,
+            ego.band_m,
+            ego.lane_width_m,
             time_s,
         )
         return report if coasted is None else report._replace(coasted=Detection(*coasted))

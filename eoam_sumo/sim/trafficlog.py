@@ -37,8 +37,8 @@ from pathlib import Path
 import numpy as np
 
 from eoam_sumo.fileio import write_atomic
+from eoam_sumo.sim.lanes import ONCOMING_SPEED_MPS, lane_band_m
 from eoam_sumo.sim.observers import RunView, StepObserver
-from eoam_sumo.sim.radar import LANE_MARGIN_M, ONCOMING_SPEED_MPS
 from eoam_sumo.sim.roadframe import RoadFrame
 
 TRAFFIC_FILE = "traffic.csv"
@@ -141,7 +141,7 @@ class TrafficLog(StepObserver):
         if not rows:
             return False
         road = RoadFrame(self._centreline)
-        band = 0.5 * self._lane_width + LANE_MARGIN_M
+        band = lane_band_m(self._lane_width)
         for vid in sorted(rows):
             first = rows[vid][0]
             road.locate(first.x_m, first.y_m)
@@ -239,7 +239,7 @@ class TrafficLog(StepObserver):
         for i, k in enumerate(ego_rows):
             ego_s[i] = road.project(num[k, 0], num[k, 1])[0]
             roles[k] = "ego"
-        band = 0.5 * self._lane_width + LANE_MARGIN_M
+        band = lane_band_m(self._lane_width)
         others = np.flatnonzero(~parked)
         others = others[np.isin(others, ego_rows, invert=True)]
         for k in np.flatnonzero(parked):
