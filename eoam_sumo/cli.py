@@ -314,9 +314,10 @@ def _run_settings(args, out: Path):
     """The run's ``RunSettings`` from the ``run`` options (screenshots go to ``out``)."""
     from eoam_sumo.sensing.automotive import parse_radar_model
     from eoam_sumo.sensing.friction import parse_mu_belief
-    from eoam_sumo.sim.cosim import RunSettings, policy_settings
-    from eoam_sumo.sim.radar import RadarSettings
+    from eoam_sumo.sensing.radar import RadarSettings
+    from eoam_sumo.sim.cosim import policy_settings
     from eoam_sumo.sim.session.gui import GuiSettings
+    from eoam_sumo.sim.settings import RunSettings
 
     gui = GuiSettings(
         delay_ms=args.gui_delay_ms, screenshots_s=args.gui_screenshot, screenshot_dir=out

@@ -94,8 +94,9 @@ def run_matrix_case(task: CaseTask) -> dict:
 
     Old output files of the case are removed first, so a folder never mixes runs.
     """
-    from eoam_sumo.sim.cosim import RunSettings, policy_settings, run_case
-    from eoam_sumo.sim.radar import RadarSettings
+    from eoam_sumo.sensing.radar import RadarSettings
+    from eoam_sumo.sim.cosim import policy_settings, run_case
+    from eoam_sumo.sim.settings import RunSettings
 
     case = task.case
     settings = policy_settings(

@@ -2,14 +2,14 @@
 
 Per radar cycle (``cycle_s``) the radar measures every road user of which some part is
 inside its range and field of view and not hidden behind a nearer road user (the exact box
-geometry of :class:`~eoam_sumo.sim.radar.Radar`; a target counts as hidden when the line of
+geometry of :class:`~eoam_sumo.sensing.radar.Radar`; a target counts as hidden when the line of
 sight to its nearest visible point and to each of its corners inside the cone passes
 through a nearer box, and the first free one of those points is measured otherwise). Each
 visible target is detected with probability ``detection_probability``; a detection is its
 range, azimuth and range rate with Gaussian errors. The cycle's detections reach the
 tracker ``latency_s`` later; the tracker (:mod:`eoam_sumo.sensing.tracker`) turns them into
 confirmed tracks, and the report the EOAM reads is built from those tracks, as of the scan
-they last saw (no latency compensation): the same :class:`~eoam_sumo.sim.radar.RadarReport`
+they last saw (no latency compensation): the same :class:`~eoam_sumo.sensing.radar.RadarReport`
 as the ideal radar, classified by the same rules on the tracked position and velocity.
 
 Defaults (``AutomotiveRadarSettings``) from the data sheet of the Continental ARS 408-21
@@ -41,9 +41,7 @@ import numpy as np
 from mypy_extensions import mypyc_attr
 
 from eoam_sumo.errors import InputError
-from eoam_sumo.sensing.tracker import Measurement, Tracker, TrackerSettings
-from eoam_sumo.sim.bodies import Body
-from eoam_sumo.sim.radar import (
+from eoam_sumo.sensing.radar import (
     EMPTY_REPORT,
     Detection,
     Radar,
@@ -53,6 +51,8 @@ from eoam_sumo.sim.radar import (
     ray_entry_m,
     report_of,
 )
+from eoam_sumo.sensing.tracker import Measurement, Tracker, TrackerSettings
+from eoam_sumo.world.bodies import Body
 
 RADAR_MODELS = ("ideal", "automotive")
 STREAM = 2  # random stream of the run seed (the friction estimator draws from stream 1)
@@ -105,7 +105,7 @@ class _Scan:
 
 
 class AutomotiveRadar:
-    """Drop-in for :class:`~eoam_sumo.sim.radar.Radar`: ``scan`` once per step with the time."""
+    """Drop-in for :class:`~eoam_sumo.sensing.radar.Radar`: ``scan`` once per step with the time."""
 
     def __init__(
         self,

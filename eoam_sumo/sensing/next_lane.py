@@ -37,7 +37,7 @@ from mypy_extensions import mypyc_attr
 
 from eoam_sumo.eoam_messages import NextLaneView
 from eoam_sumo.sensing.v2x import V2XObject, V2XReceiver, V2XSettings
-from eoam_sumo.sim.geometry import OrientedBox, slab_entry
+from eoam_sumo.world.geometry import OrientedBox, slab_entry
 
 MIN_OVERLAP_M = 0.1  # a road user reaching this far into the lane is in it [m]
 FUSION_GATE_M = 3.0  # radar and V2X objects closer than this (centre, plus half lengths) [m]

@@ -32,15 +32,8 @@ from eoam_sumo.plant import Plant, initial_state
 from eoam_sumo.sensing.automotive import make_radar
 from eoam_sumo.sensing.friction import FrictionBelief
 from eoam_sumo.sensing.next_lane import NextLaneSensing
-from eoam_sumo.sim.bodies import Body, nav_angle_deg
+from eoam_sumo.sensing.radar import RadarReport
 from eoam_sumo.sim.facts import collect_facts, collect_info
-from eoam_sumo.sim.geometry import (
-    GAP_ROUNDING_M,
-    OrientedBox,
-    box_distance,
-    boxes_overlap,
-    gap_lower_bound,
-)
 from eoam_sumo.sim.margins import EGO_STANDSTILL_MPS, Margins, road_user_close_ahead
 from eoam_sumo.sim.observers import (
     AvoidedObstacle,
@@ -50,7 +43,6 @@ from eoam_sumo.sim.observers import (
     no_lap,
 )
 from eoam_sumo.sim.outcome import role_of
-from eoam_sumo.sim.radar import RadarReport
 from eoam_sumo.sim.roadframe import RoadFrame
 from eoam_sumo.sim.runlog import RunLog, write_run
 from eoam_sumo.sim.scenario import ScenarioOverrides
@@ -60,8 +52,16 @@ from eoam_sumo.sim.severity import ContactRecord, substep_contact
 from eoam_sumo.sim.summary import RunSummary
 from eoam_sumo.sim.trafficlog import TrafficLog
 from eoam_sumo.sim.verdict import summarise
+from eoam_sumo.world.bodies import Body, nav_angle_deg
+from eoam_sumo.world.geometry import (
+    GAP_ROUNDING_M,
+    OrientedBox,
+    box_distance,
+    boxes_overlap,
+    gap_lower_bound,
+)
 
-__all__ = ["CoSimulation", "RunSettings", "policy_settings", "run_case"]
+__all__ = ["CoSimulation", "policy_settings", "run_case"]
 
 
 GAP_WATCH_M = 20.0  # centre distance under which box gaps are measured and contact checked [m]

@@ -27,16 +27,16 @@ import math
 from collections.abc import Sequence
 
 from eoam_sumo.params import G_MPS2
-from eoam_sumo.sim.bodies import Body
-from eoam_sumo.sim.geometry import (
+from eoam_sumo.sim.observers import RunView, StepObserver
+from eoam_sumo.world.bodies import Body
+from eoam_sumo.world.geometry import (
     GAP_ROUNDING_M,
     OrientedBox,
     box_distance,
     gap_lower_bound,
     time_to_contact,
 )
-from eoam_sumo.sim.lanes import RoadProjection, lane_band_m
-from eoam_sumo.sim.observers import RunView, StepObserver
+from eoam_sumo.world.lanes import RoadProjection, lane_band_m
 
 #: A run without contact that came this close to another road user is a near miss [m].
 NEAR_MISS_GAP_M = 0.5

@@ -22,8 +22,8 @@ from typing import Any, Protocol
 from mypy_extensions import mypyc_attr
 
 from eoam_sumo.eoam import Command, EgoMeasurement, Perception
-from eoam_sumo.sim.lanes import lane_band_m
 from eoam_sumo.sim.runlog import RunLog
+from eoam_sumo.world.lanes import lane_band_m
 
 _LANE_CHANGE_MODES = (2, 4)  # the EOAM's modes that begin a lane change
 #: The phases of a step, in order (``CoSimulation.step``).

@@ -71,9 +71,9 @@ from mypy_extensions import mypyc_attr
 
 from eoam_sumo.colours import OUTCOMES
 from eoam_sumo.params import PONR_FRACTION
-from eoam_sumo.sim.bodies import Body
-from eoam_sumo.sim.geometry import HEAD_ON_MIN_OVERLAP, Contact
-from eoam_sumo.sim.lanes import (
+from eoam_sumo.world.bodies import Body
+from eoam_sumo.world.geometry import HEAD_ON_MIN_OVERLAP, Contact
+from eoam_sumo.world.lanes import (
     LANE_MARGIN_M,
     STATIONARY_SPEED_MPS,
     RoadProjection,
@@ -294,11 +294,7 @@ def classify_outcome(
             ("left_width_m", left_width_m),
         ),
     )
-    # mode 3 is entered only before the point of no return: limit braking was chosen, whatever
-    # lateral drift the aborted steer leaves (paper sec. 8.1)
-    lane_change = 3 not in modes and (
-        abs(max_lateral_offset_m) >= settings.point_of_no_return_fraction * lane_width_m
-    )
+    lane_change = _was_lane_change(modes, max_lateral_offset_m, lane_width_m, settings)
     if contact is not None:
         return _contact_outcome(modes, lane_change, contact, role, direct_overlap)
     lost = _loss_of_control(
@@ -308,9 +304,7 @@ def classify_outcome(
         settings,
     )
     if lost:
-        # an offset past the point of no return is a lane change only if the EOAM steered
-        done = _manoeuvre_phrase(modes, lane_change and bool(modes & {2, 4, 5}))
-        return Outcome("orange", "none", 0.0, f"{done}, no contact; {'; '.join(lost)}")
+        return _lost_control(modes, lane_change, lost)
     return _no_contact(
         modes,
         lane_change,
@@ -321,6 +315,23 @@ def classify_outcome(
         manoeuvre_running,
         passed_obstacle,
     )
+
+
+def _was_lane_change(
+    modes: set[int], max_lateral_offset_m: float, lane_width_m: float, settings: OutcomeSettings
+) -> bool:
+    """Past the point of no return and never in mode 3: mode 3 is entered only before it, so
+    limit braking was chosen, whatever lateral drift the aborted steer leaves (sec. 8.1)."""
+    return 3 not in modes and (
+        abs(max_lateral_offset_m) >= settings.point_of_no_return_fraction * lane_width_m
+    )
+
+
+def _lost_control(modes: set[int], lane_change: bool, lost: list[str]) -> Outcome:
+    """Rule 4: orange without contact, saying how control was lost or the road left."""
+    # an offset past the point of no return is a lane change only if the EOAM steered
+    done = _manoeuvre_phrase(modes, lane_change and bool(modes & {2, 4, 5}))
+    return Outcome("orange", "none", 0.0, f"{done}, no contact; {'; '.join(lost)}")
 
 
 def _check_inputs(

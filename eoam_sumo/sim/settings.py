@@ -10,8 +10,8 @@ from mypy_extensions import mypyc_attr
 
 from eoam_sumo.eoam_settings import EoamSettings
 from eoam_sumo.sensing.next_lane import CornerRadarSettings
+from eoam_sumo.sensing.radar import RadarSettings
 from eoam_sumo.sensing.v2x import V2XSettings
-from eoam_sumo.sim.radar import RadarSettings
 from eoam_sumo.sim.session.gui import GuiSettings
 
 #: A run's simulated time limit unless set [s]: every Table 2 case ends well before it (the

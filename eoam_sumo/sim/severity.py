@@ -26,8 +26,8 @@ from dataclasses import dataclass
 
 from mypy_extensions import mypyc_attr
 
-from eoam_sumo.sim.bodies import Body
-from eoam_sumo.sim.geometry import Contact, OrientedBox, contact, face_overlap
+from eoam_sumo.world.bodies import Body
+from eoam_sumo.world.geometry import Contact, OrientedBox, contact, face_overlap
 
 #: SUMO's default mass of a bicycle vType without a ``mass`` attribute [kg] (SUMO 1.28).
 SUMO_BICYCLE_DEFAULT_KG = 10.0

@@ -37,9 +37,9 @@ from pathlib import Path
 import numpy as np
 
 from eoam_sumo.fileio import write_atomic
-from eoam_sumo.sim.lanes import ONCOMING_SPEED_MPS, lane_band_m
 from eoam_sumo.sim.observers import RunView, StepObserver
 from eoam_sumo.sim.roadframe import RoadFrame
+from eoam_sumo.world.lanes import ONCOMING_SPEED_MPS, lane_band_m
 
 TRAFFIC_FILE = "traffic.csv"
 #: traffic.csv columns, SI units in the names.

@@ -1,9 +1,7 @@
-"""The manoeuvre package (``eoam_sumo.manoeuvre``): angle wrapping against its definition, and
-the package's place beneath decision and control (what each side imports)."""
+"""The manoeuvre package (``eoam_sumo.manoeuvre``): angle wrapping against its definition and a
+time-optimal shift's end (its place beneath decision and control: tests/test_layers.py)."""
 
-import ast
 import math
-import sys
 from pathlib import Path
 
 from hypothesis import given
@@ -53,30 +51,3 @@ def test_min_time_shift_ends_at_rest_at_its_target_from_rest(y0, y1, accel):
     y, v, a = shift.state_at(shift.duration_s)
     assert abs(y - y1) <= 1e-6 and abs(v) <= 1e-9 and abs(a) <= 1e-9
     assert abs(shift.at(shift.length_m).yaw_rad) <= 1e-9
-
-
-def _imports(path: Path) -> set[str]:
-    """The modules ``path`` imports (absolute imports, at any depth)."""
-    found = set()
-    for node in ast.walk(ast.parse(path.read_text())):
-        if isinstance(node, ast.Import):
-            found |= {a.name for a in node.names}
-        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            found.add(node.module)
-    return found
-
-
-def test_manoeuvre_imports_only_itself_params_numpy_and_the_standard_library():
-    for path in (PACKAGE / "manoeuvre").glob("*.py"):
-        for name in _imports(path):
-            top = name.split(".")[0]
-            if top == "eoam_sumo":
-                assert name.startswith(("eoam_sumo.manoeuvre", "eoam_sumo.params")), (path, name)
-            else:
-                assert top == "numpy" or top in sys.stdlib_module_names, (path, name)
-
-
-def test_decision_does_not_import_control_and_sensing_not_decision():
-    for package, banned in (("decision", "eoam_sumo.control"), ("sensing", "eoam_sumo.decision")):
-        for path in (PACKAGE / package).glob("*.py"):
-            assert not any(n.startswith(banned) for n in _imports(path)), path

@@ -14,8 +14,9 @@ from PIL import Image
 
 from eoam_sumo.cli import main
 from eoam_sumo.plotting.animate import ROLE_COLOURS, animate_run
-from eoam_sumo.sim.cosim import RunSettings, run_case
+from eoam_sumo.sim.cosim import run_case
 from eoam_sumo.sim.scenario import ScenarioOverrides
+from eoam_sumo.sim.settings import RunSettings
 from eoam_sumo.sim.trafficlog import TRAFFIC_COLUMNS, read_traffic
 
 pytestmark = pytest.mark.sumo

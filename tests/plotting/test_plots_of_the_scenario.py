@@ -14,8 +14,9 @@ from eoam_sumo import netbuild
 from eoam_sumo.plotting.batch_plots import _CaseFacts, _panel
 from eoam_sumo.plotting.run_plots import load_run, plot_run, run_title
 from eoam_sumo.plotting.runfacts import manoeuvre_mu
-from eoam_sumo.sim.cosim import RunSettings, run_case
+from eoam_sumo.sim.cosim import run_case
 from eoam_sumo.sim.scenario import ScenarioOverrides
+from eoam_sumo.sim.settings import RunSettings
 from eoam_sumo.sim.trafficlog import read_traffic
 
 pytestmark = pytest.mark.sumo

@@ -16,10 +16,10 @@ from eoam_sumo.sensing.automotive import (
     make_radar,
     parse_radar_model,
 )
+from eoam_sumo.sensing.radar import Radar
 from eoam_sumo.sensing.tracker import Measurement, Tracker, TrackerSettings
-from eoam_sumo.sim.bodies import Body
-from eoam_sumo.sim.radar import Radar
 from eoam_sumo.sim.roadframe import RoadFrame
+from eoam_sumo.world.bodies import Body
 
 LANE_M = 3.5
 CAR = (4.70, 1.82)

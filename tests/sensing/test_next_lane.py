@@ -7,9 +7,9 @@ from collections import namedtuple
 import pytest
 
 from eoam_sumo.sensing.next_lane import COVERAGE_STEP_M, NextLaneSensing, hides, sees
+from eoam_sumo.sensing.radar import Radar, RadarSettings
 from eoam_sumo.sensing.v2x import V2XSettings
-from eoam_sumo.sim.geometry import OrientedBox
-from eoam_sumo.sim.radar import Radar, RadarSettings
+from eoam_sumo.world.geometry import OrientedBox
 
 LANE = 3.5
 HALF_FOV = math.radians(9.0)

@@ -10,9 +10,10 @@ import pandas as pd
 import pytest
 
 from eoam_sumo.params import ego_e_class_sedan
-from eoam_sumo.sim.cosim import RunSettings, run_case
-from eoam_sumo.sim.radar import RadarSettings
+from eoam_sumo.sensing.radar import RadarSettings
+from eoam_sumo.sim.cosim import run_case
 from eoam_sumo.sim.scenario import ScenarioOverrides
+from eoam_sumo.sim.settings import RunSettings
 from tests.builders import walker_on_highway
 
 pytestmark = pytest.mark.sumo

@@ -14,9 +14,10 @@ import pytest
 
 from eoam_sumo.eoam_settings import EoamSettings
 from eoam_sumo.params import G_MPS2
-from eoam_sumo.sim.cosim import RunSettings, run_case
+from eoam_sumo.sim.cosim import run_case
 from eoam_sumo.sim.runlog import COLUMNS
 from eoam_sumo.sim.scenario import ScenarioOverrides
+from eoam_sumo.sim.settings import RunSettings
 from tests.builders import (
     BASELINE,
     PARKED_ONLY,

@@ -7,8 +7,9 @@ import math
 import pandas as pd
 import pytest
 
-from eoam_sumo.sim.cosim import RunSettings, run_case
+from eoam_sumo.sim.cosim import run_case
 from eoam_sumo.sim.scenario import ScenarioOverrides
+from eoam_sumo.sim.settings import RunSettings
 from tests.builders import network, write_sumocfg
 
 pytestmark = pytest.mark.sumo

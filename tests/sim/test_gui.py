@@ -10,10 +10,11 @@ import time
 import numpy as np
 import pytest
 
-from eoam_sumo.sim.cosim import RunSettings, run_case
+from eoam_sumo.sim.cosim import run_case
 from eoam_sumo.sim.scenario import ScenarioOverrides
 from eoam_sumo.sim.session import SumoSession
 from eoam_sumo.sim.session.gui import GuiSettings
+from eoam_sumo.sim.settings import RunSettings
 from tests.builders import BASELINE
 
 pytestmark = pytest.mark.sumo

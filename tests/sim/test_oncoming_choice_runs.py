@@ -22,8 +22,9 @@ import pytest
 from eoam_sumo.eoam_settings import EoamSettings
 from eoam_sumo.params import G_MPS2, ego_e_class_sedan
 from eoam_sumo.plant.compiled import Plant
-from eoam_sumo.sim.cosim import CoSimulation, RunSettings
+from eoam_sumo.sim.cosim import CoSimulation
 from eoam_sumo.sim.scenario import ScenarioOverrides
+from eoam_sumo.sim.settings import RunSettings
 
 pytestmark = pytest.mark.sumo
 

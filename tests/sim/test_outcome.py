@@ -8,8 +8,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from eoam_sumo.sim.bodies import Body
-from eoam_sumo.sim.geometry import Contact, OrientedBox, contact
 from eoam_sumo.sim.outcome import (
     COLOURS,
     LOST_CONTROL_HEADING_RAD,
@@ -23,6 +21,8 @@ from eoam_sumo.sim.outcome import (
     role_of,
 )
 from eoam_sumo.sim.roadframe import RoadFrame
+from eoam_sumo.world.bodies import Body
+from eoam_sumo.world.geometry import Contact, OrientedBox, contact
 
 LANE_M = 3.5
 PONR_M = 0.3 * LANE_M  # 1.05 m, paper sec. 8.1

@@ -6,9 +6,9 @@ import tempfile
 
 import pytest
 
-from eoam_sumo.sim.bodies import PEDESTRIAN, Body
 from eoam_sumo.sim.scenario import ScenarioOverrides
 from eoam_sumo.sim.session import SumoSession
+from eoam_sumo.world.bodies import PEDESTRIAN, Body
 from tests.builders import on_highway  # E0 eastbound (y -3.5..0), -E0 westbound
 
 pytestmark = pytest.mark.sumo

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import pytest
 
-from eoam_sumo.sim.bodies import Body
 from eoam_sumo.sim.margins import CLOSE_AHEAD_MARGIN_M, road_user_close_ahead
 from eoam_sumo.sim.roadframe import RoadFrame
+from eoam_sumo.world.bodies import Body
 
 LANE_M = 3.5
 ROAD = RoadFrame([(-1000.0, 0.0), (5000.0, 0.0)])  # the ego's lane centre line, eastbound

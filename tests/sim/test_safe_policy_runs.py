@@ -11,8 +11,9 @@ import pytest
 from eoam_sumo.batch.runner import run_batch
 from eoam_sumo.eoam_settings import EoamSettings
 from eoam_sumo.params import LANE_CHANGE_HEIGHT_M, PONR_FRACTION
-from eoam_sumo.sim.cosim import RunSettings, policy_settings, run_case
+from eoam_sumo.sim.cosim import policy_settings, run_case
 from eoam_sumo.sim.scenario import ScenarioOverrides
+from eoam_sumo.sim.settings import RunSettings
 from tests.builders import netconvert, write_matrix, write_sumocfg
 
 pytestmark = pytest.mark.sumo

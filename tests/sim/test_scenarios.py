@@ -20,9 +20,9 @@ from eoam_sumo.params import (
     oncoming_sedan,
     parked_car,
 )
-from eoam_sumo.sim.bodies import nav_angle_deg, yaw_rad
 from eoam_sumo.sim.scenario import ScenarioOverrides
 from eoam_sumo.sim.session import SumoSession
+from eoam_sumo.world.bodies import nav_angle_deg, yaw_rad
 from tests.builders import (
     BASELINE,
     HIGHWAY_NET,

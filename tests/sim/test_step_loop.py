@@ -8,9 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from eoam_sumo.sim.cosim import CoSimulation, RunSettings
+from eoam_sumo.sim.cosim import CoSimulation
 from eoam_sumo.sim.observers import PHASES, PhaseTimer, StepObserver, no_lap
 from eoam_sumo.sim.scenario import ScenarioOverrides
+from eoam_sumo.sim.settings import RunSettings
 from eoam_sumo.sim.summary import TIMING_FIELDS
 
 pytestmark = pytest.mark.sumo

@@ -7,11 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from eoam_sumo.sim.bodies import Body
 from eoam_sumo.sim.scenario import ScenarioOverrides
 from eoam_sumo.sim.session import SumoSession
 from eoam_sumo.sim.session.collisions import CollisionRecord, write_collision_output
 from eoam_sumo.sim.session.launch import ENFORCED_OPTIONS, sumo_command
+from eoam_sumo.world.bodies import Body
 from tests.builders import on_highway
 
 ROUTES = """<routes><route id="east" edges="E0"/>

@@ -10,12 +10,12 @@ from dataclasses import replace
 
 import pytest
 
-from eoam_sumo.sim.bodies import Body
 from eoam_sumo.sim.facts import RunFacts, RunInfo
-from eoam_sumo.sim.geometry import OrientedBox, contact
 from eoam_sumo.sim.severity import ContactRecord
 from eoam_sumo.sim.summary import FIELDS
 from eoam_sumo.sim.verdict import outcome_of, severity_of, summarise
+from eoam_sumo.world.bodies import Body
+from eoam_sumo.world.geometry import OrientedBox, contact
 
 LANE_M = 3.5
 EGO_MASS_KG = 1723.0
@@ -199,7 +199,7 @@ def test_the_verdict_imports_nothing_of_sumo():
     code = (
         "import sys, eoam_sumo.sim.verdict, eoam_sumo.sim.outcome; "
         "bad = [m for m in sys.modules if m.startswith(('eoam_sumo.sim.session', 'libsumo', "
-        "'traci', 'sumolib', 'eoam_sumo.sim.radar', 'eoam_sumo.sim.cosim'))]; "
+        "'traci', 'sumolib', 'eoam_sumo.sensing.radar', 'eoam_sumo.sim.cosim'))]; "
         "assert not bad, bad"
     )
     subprocess.run([sys.executable, "-c", code], check=True)

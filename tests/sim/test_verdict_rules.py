@@ -9,7 +9,6 @@ import pytest
 from hypothesis import example, given
 from hypothesis import strategies as st
 
-from eoam_sumo.sim.geometry import Contact, OrientedBox, face_overlap, time_to_contact
 from eoam_sumo.sim.outcome import DIRECT_HIT_MIN_OVERLAP, classify_outcome
 from eoam_sumo.sim.severity import (
     BICYCLE_WITH_RIDER_KG,
@@ -17,6 +16,7 @@ from eoam_sumo.sim.severity import (
     impact_angle_rad,
     road_user_mass_kg,
 )
+from eoam_sumo.world.geometry import Contact, OrientedBox, face_overlap, time_to_contact
 
 LANE_M = 3.5
 REAR_HIT = Contact("rear_end", "front", "rear", 20.0, (0.0, 0.0), (1.0, 0.0), 20.0)
@@ -119,7 +119,7 @@ def test_time_to_contact_of_a_head_on_is_gap_over_closing_speed():
 @example(7.0, 0.0, 1.85)  # side by side, touching: within the contact tolerance on both sides
 def test_time_to_contact_matches_stepping_the_boxes(closing, lateral_speed, offset_m):
     """Step both boxes in 1 ms steps: the first overlap is within one step of the TTC."""
-    from eoam_sumo.sim.geometry import boxes_overlap
+    from eoam_sumo.world.geometry import boxes_overlap
 
     ego = _box(0.0, 0.0)
     other = _box(30.0, offset_m, math.pi)

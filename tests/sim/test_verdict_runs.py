@@ -9,8 +9,9 @@ import pandas as pd
 import pytest
 
 from eoam_sumo.params import ego_e_class_sedan
-from eoam_sumo.sim.cosim import RunSettings, run_case
+from eoam_sumo.sim.cosim import run_case
 from eoam_sumo.sim.scenario import ScenarioOverrides
+from eoam_sumo.sim.settings import RunSettings
 from tests.builders import walker_on_highway
 from tests.sim.test_safe_policy_runs import _scenario as beside_the_obstacle
 

@@ -16,7 +16,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
-from eoam_sumo.sim.bodies import Body
+from eoam_sumo.world.bodies import Body
 
 ROOT_TAG = "collisions"
 

@@ -16,11 +16,11 @@ import numpy as np
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import oncoming_sedan
-from eoam_sumo.sim.bodies import nav_angle_deg
 from eoam_sumo.sim.roadframe import arclength, point_at, project
 from eoam_sumo.sim.scenario import ROLE_KEY, ScenarioFiles, ScenarioOverrides, VehicleSpec
 from eoam_sumo.sim.scenario.files import float_attr
 from eoam_sumo.sim.scenario.values import number
+from eoam_sumo.world.bodies import nav_angle_deg
 
 EGO_SPEED_MODE = 32  # SUMO applies setSpeed and moveToXY without checks
 ONCOMING_SPEED_MODE = 0  # constant speed even when the ego is mapped onto its lane

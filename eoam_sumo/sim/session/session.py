@@ -5,7 +5,7 @@
 the ARO's emergency stop), advances SUMO to the ego's departure and makes the step that
 inserts the ego at the requested speed (moveToXY before the insertion step). The session then
 answers the co-simulation's queries: the ego's reference line, the road users around the ego
-(vehicles of every class and persons, as :class:`~eoam_sumo.sim.bodies.Body`), the friction
+(vehicles of every class and persons, as :class:`~eoam_sumo.world.bodies.Body`), the friction
 under the ego; :meth:`move_ego` writes the ego's pose back and :meth:`step` advances SUMO.
 
 Time: :attr:`SumoSession.time_s` is SUMO's time at the end of the last step (``getTime``
@@ -34,7 +34,6 @@ from typing import Any, NamedTuple, Self
 import numpy as np
 
 from eoam_sumo.errors import InputError
-from eoam_sumo.sim.bodies import PEDESTRIAN, Body
 from eoam_sumo.sim.scenario import (
     ROLE_KEY,
     ScenarioFiles,
@@ -59,6 +58,7 @@ from eoam_sumo.sim.session.launch import (
 )
 from eoam_sumo.sim.session.scripts import StopScripts
 from eoam_sumo.sim.session.tracking import RoadUsers
+from eoam_sumo.world.bodies import PEDESTRIAN, Body
 
 _open_libsumo: list[SumoSession] = []  # libsumo runs one simulation per process
 _NO_OVERRIDES = ScenarioOverrides()

@@ -30,8 +30,8 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from eoam_sumo.sim.bodies import PEDESTRIAN, Body
 from eoam_sumo.sim.session.calls import StepCalls
+from eoam_sumo.world.bodies import PEDESTRIAN, Body
 
 PARKING_BIT = 2  # bit of VAR_STOPSTATE set while a vehicle is parked
 RANGE_MARGIN_M = 1.0  # added to the context subscription's range (rounding in SUMO) [m]

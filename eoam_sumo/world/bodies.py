@@ -3,7 +3,7 @@
 A :class:`Body` is any road user SUMO has (a vehicle of any vClass, a bicycle, a person) or a
 test's hand-made one: its SUMO id and vClass (``pedestrian`` for persons), the centre of its
 footprint, yaw counter-clockwise from +x, speed along the yaw, size, whether it is parked, and
-its :class:`~eoam_sumo.sim.geometry.OrientedBox`. The session builds one per road user per
+its :class:`~eoam_sumo.world.geometry.OrientedBox`. The session builds one per road user per
 step that its values changed, and the radar, the contact test and the outcome read it.
 
 SUMO reports a road user's FRONT centre (for a person: the front in its walking direction;
@@ -20,7 +20,7 @@ from typing import NamedTuple
 
 from mypy_extensions import mypyc_attr
 
-from eoam_sumo.sim.geometry import OrientedBox
+from eoam_sumo.world.geometry import OrientedBox
 
 PEDESTRIAN = "pedestrian"  # SUMO's vClass of persons
 

@@ -8,9 +8,9 @@ import math
 
 import pytest
 
-from eoam_sumo.sim.bodies import Body
-from eoam_sumo.sim.radar import Radar, RadarSettings
+from eoam_sumo.sensing.radar import Radar, RadarSettings
 from eoam_sumo.sim.roadframe import RoadFrame
+from eoam_sumo.world.bodies import Body
 
 LANE_M = 3.5
 ROAD = RoadFrame([(-1000.0, 0.0), (5000.0, 0.0)])  # ego lane centre line, eastbound

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from eoam_sumo.sim.geometry import (
+from eoam_sumo.world.geometry import (
     CONTACT_TOLERANCE_M,
     OrientedBox,
     box_distance,

@@ -30,12 +30,12 @@ import math
 from collections.abc import Callable, Sequence
 from typing import Protocol
 
-from eoam_sumo.sim.bodies import Body
-from eoam_sumo.sim.geometry import OrientedBox
+from eoam_sumo.world.bodies import Body
+from eoam_sumo.world.geometry import OrientedBox
 
 
 class Beams(Protocol):
-    """What coasting asks of the radar (``eoam_sumo.sim.radar.Radar``)."""
+    """What coasting asks of the radar (``eoam_sumo.sensing.radar.Radar``)."""
 
     def classify(
         self,

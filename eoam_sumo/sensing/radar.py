@@ -14,7 +14,7 @@ reported range. Occlusion is ignored: a target hidden behind another is still se
 optional second, wide near-range beam (``near_range_m``, ``near_fov_deg``; off by default, as
 the paper's radar has one beam) covers what is close beside the boresight. An in-path target
 that leaves the beams within range is kept as a predicted object (``RadarReport.coasted``,
-:mod:`eoam_sumo.sim.coasting`).
+:mod:`eoam_sumo.sensing.coasting`).
 
 Measurements per detection: range to the nearest visible point, range rate (relative velocity
 projected on the line of sight to that point, negative when closing; ego velocity taken
@@ -50,10 +50,10 @@ from typing import NamedTuple
 
 from mypy_extensions import mypyc_attr
 
-from eoam_sumo.sim.bodies import Body
-from eoam_sumo.sim.coasting import Coaster
-from eoam_sumo.sim.geometry import OrientedBox, slab_entry
-from eoam_sumo.sim.lanes import (
+from eoam_sumo.sensing.coasting import Coaster
+from eoam_sumo.world.bodies import Body
+from eoam_sumo.world.geometry import OrientedBox, slab_entry
+from eoam_sumo.world.lanes import (
     LANE_MARGIN_M,
     ONCOMING_SPEED_MPS,
     STATIONARY_SPEED_MPS,
@@ -68,7 +68,7 @@ CATEGORIES = ("in_path", "oncoming", "in_next_lane", "stationary_side", "other")
 @dataclass(frozen=True)
 class RadarSettings:
     """Radar coverage and the classification thresholds (reasons at the constants of
-    :mod:`eoam_sumo.sim.lanes`)."""
+    :mod:`eoam_sumo.world.lanes`)."""
 
     range_m: float = 100.0  # long-range radar; the ARO at 120 m is outside at start (Fig. 18)
     fov_deg: float = 18.0  # full horizontal field of view, narrow forward beam
@@ -367,7 +367,7 @@ class Radar:
         time_s: float | None,
     ) -> RadarReport:
         """``report`` with the in-path object coasted when it left the beams within range
-        (:mod:`eoam_sumo.sim.coasting`); the coaster is asked only when something may be or
+        (:mod:`eoam_sumo.sensing.coasting`); the coaster is asked only when something may be or
         is coasted, else it just remembers the in-path object."""
         coaster = self._coaster
         if coaster.coasted is None:  # nothing coasted: only remember the in-path object

@@ -8,10 +8,10 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from eoam_sumo.sim.bodies import Body
-from eoam_sumo.sim.geometry import OrientedBox
-from eoam_sumo.sim.radar import Radar, RadarSettings
+from eoam_sumo.sensing.radar import Radar, RadarSettings
 from eoam_sumo.sim.roadframe import RoadFrame
+from eoam_sumo.world.bodies import Body
+from eoam_sumo.world.geometry import OrientedBox
 
 LANE_M = 3.5
 ARO = (5.09, 1.99)
