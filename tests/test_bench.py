@@ -1,10 +1,13 @@
-"""The benchmark runs on tiny settings and writes every key (no timing is asserted)."""
+"""The benchmark runs on tiny settings and writes every key, each one documented in
+docs/performance.md (no timing is asserted)."""
 
 from __future__ import annotations
 
 import json
 import math
+import re
 from importlib import machinery
+from pathlib import Path
 
 import pytest
 
@@ -12,6 +15,7 @@ from eoam_sumo.bench import TARGETS, run_bench
 from eoam_sumo.sim import cosim
 
 pytestmark = pytest.mark.sumo
+PERFORMANCE = Path(__file__).resolve().parents[1] / "docs" / "performance.md"
 
 KEYS = (
     "realtime_factor",
@@ -42,3 +46,12 @@ def test_quick_bench_writes_every_key(tmp_path):
     assert saved["compiled"] is isinstance(loader, machinery.ExtensionFileLoader)
     assert set(saved["targets"]) == set(TARGETS)
     assert math.isfinite(saved["traffic_us_per_user_step"])
+    assert set(saved) - {"quick", "targets"} == _documented_keys()
+
+
+def _documented_keys() -> set[str]:
+    """The keys of docs/performance.md's table under "What is measured"."""
+    text = PERFORMANCE.read_text(encoding="utf-8")
+    section = text.split("## What is measured", 1)[1].split("\n## ", 1)[0]
+    rows = [line.split("|")[1] for line in section.splitlines() if line.startswith("| `")]
+    return {key for cell in rows for key in re.findall(r"`([a-z_0-9]+)`", cell)}
