@@ -148,41 +148,61 @@ def _traffic_columns(traffic: pd.DataFrame):
     return box, traffic["id"].to_numpy(dtype=str), best, is_ego
 
 
+def _frame_scene(ts, traffic, rows, start, end, box, is_ego) -> FrameScene:
+    """What the frames of ``rows`` must show (``plotting/view.py``): the ego's box, heading
+    and radar place, and the other road users' boxes, traffic rows ``start:end`` a frame."""
+    ego_xy, yaw, length_m, width_m = _ego_pose(ts, traffic, rows)
+    front = 0.5 * length_m * np.stack((np.cos(yaw), np.sin(yaw)), axis=-1)
+    user = np.concatenate([np.arange(a, b) for a, b in zip(start, end)]).astype(int)
+    frame_of = np.repeat(np.arange(len(rows)), end - start)
+    others = ~is_ego[user]
+    return FrameScene(
+        time_s=ts["time_s"].to_numpy()[rows],
+        heading_rad=_road_heading(ts, rows),
+        ego_box=box_corners(ego_xy[:, 0], ego_xy[:, 1], yaw, length_m, width_m),
+        ego_yaw_rad=yaw,
+        radar_xy=ego_xy + front,
+        user_box=box[user[others]].reshape(-1, 4, 2),
+        user_frame=frame_of[others],
+    )
+
+
 def load_frames(run_dir: Path, fps: float, aspect: float) -> RunFrames:
     """The frames of the run in ``run_dir`` at ``fps``, their views for a picture of
     height / width ``aspect``; InputError naming a missing or damaged file."""
     if fps < 1:
         raise InputError(f"--fps {fps} must be a whole number >= 1")
     summary, ts, traffic = _read(run_dir)
-    t_all = ts["time_s"].to_numpy()
     contact_t = summary.get("contact_time_s")
-    rows = frame_rows(t_all, fps, contact_t)
-    t = t_all[rows]
+    rows = frame_rows(ts["time_s"].to_numpy(), fps, contact_t)
+    t = ts["time_s"].to_numpy()[rows]
     times = traffic["time_s"].to_numpy()
     start = np.searchsorted(times, t - SAME_TIME_S)
     end = np.searchsorted(times, t + SAME_TIME_S)
     box, ids, rank, is_ego = _traffic_columns(traffic)
-    ego_xy, yaw, length_m, width_m = _ego_pose(ts, traffic, rows)
-    front = 0.5 * length_m * np.stack((np.cos(yaw), np.sin(yaw)), axis=-1)
+    scene = _frame_scene(ts, traffic, rows, start, end, box, is_ego)
+    ego_xy = scene.ego_box.mean(axis=1)
     radar_m = float(summary.get("radar_range_m") or DEFAULT_RADAR_RANGE_M)
     fov_rad = math.radians(float(summary.get("radar_fov_deg") or DEFAULT_RADAR_FOV_DEG))
-    user = np.concatenate([np.arange(a, b) for a, b in zip(start, end)]).astype(int)
-    frame_of = np.repeat(np.arange(len(rows)), end - start)
-    frame_of, user = frame_of[~is_ego[user]], user[~is_ego[user]]
-    scene = FrameScene(
-        time_s=t,
-        heading_rad=_road_heading(ts, rows),
-        ego_box=box_corners(ego_xy[:, 0], ego_xy[:, 1], yaw, length_m, width_m),
-        ego_yaw_rad=yaw,
-        radar_xy=ego_xy + front,
-        user_box=box[user].reshape(-1, 4, 2),
-        user_frame=frame_of,
-    )
     contact = None
     if contact_t is not None:
         contact = _contact(summary, traffic, int(start[-1]), int(end[-1]), ego_xy[-1])
-    views = plan_views(scene, radar_m, fov_rad, aspect)
     return RunFrames(
-        summary, ts, rows, t, start, end, box, ids, rank, is_ego, ego_xy, yaw,
-        scene.radar_xy, radar_m, fov_rad, contact, views,
-    )  # fmt: skip
+        summary=summary,
+        series=ts,
+        rows=rows,
+        time_s=t,
+        user_start=start,
+        user_end=end,
+        box=box,
+        user_id=ids,
+        rank=rank,
+        is_ego=is_ego,
+        ego_xy=ego_xy,
+        ego_yaw_rad=scene.ego_yaw_rad,
+        radar_xy=scene.radar_xy,
+        radar_range_m=radar_m,
+        radar_fov_rad=fov_rad,
+        contact=contact,
+        views=plan_views(scene, radar_m, fov_rad, aspect),
+    )
