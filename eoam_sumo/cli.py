@@ -238,6 +238,7 @@ def _animate_arguments(sub) -> None:
         "--out", type=Path, help="GIF, or MP4 with ffmpeg (default: RUN_DIR/animation.gif)"
     )
     p.add_argument("--fps", type=_positive_int, default=10, help="frames per second of run time")
+    p.add_argument("--labels", action="store_true", help="write each road user's id beside it")
 
 
 def _bench_arguments(sub) -> None:
@@ -459,7 +460,7 @@ def _cmd_plot(args) -> int:
 def _cmd_animate(args) -> int:
     from eoam_sumo.plotting.animate import animate_cli
 
-    print(animate_cli(args.run_dir, args.out, args.fps))
+    print(animate_cli(args.run_dir, args.out, args.fps, args.labels))
     return 0
 
 

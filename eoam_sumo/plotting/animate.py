@@ -3,11 +3,15 @@
 Drawn per frame from the run folder: the road and its lane markings from the network named
 in summary.json (``net_file``), every road user of traffic.csv as its footprint box coloured
 by role (a road user keeps the colour of the most telling role it had: aro, oncoming,
-parked, other), the ego's radar cone (``radar_range_m``, ``radar_fov_deg``), the planned
-path (the lateral target ``y_target_m`` of the next ``PLAN_AHEAD_S`` as logged, placed in
-the road frame), the ego's track so far, and as text the time, EOAM mode, speed, DMM sector
-and FCW; from the contact on, the contact point is marked. Frames are taken every 1/fps
-seconds of simulated time and played at fps, so the film runs in real time.
+parked, other), with its id beside it when asked (``labels``), the ego's radar cone
+(``radar_range_m``, ``radar_fov_deg``), the planned path (the lateral target ``y_target_m``
+of the next ``PLAN_AHEAD_S`` as logged, placed in the road frame), the ego's track so far,
+and above the picture the time, EOAM mode, speed, DMM sector and FCW. The view turns with
+the road and keeps the ego, its radar cone and every road user within the radar's range in
+the picture (``plotting/view.py``); an arrow shows north. A run that ended in a contact ends
+on the frame of the contact: the contact point ringed, the road user hit outlined in red.
+Frames are taken every 1/fps seconds of simulated time and played at fps, so the film runs
+in real time (``plotting/animation_frames.py``).
 
 GIF through matplotlib's PillowWriter; MP4 through FFMpegWriter when ffmpeg is on PATH and
 the file name ends in .mp4.
@@ -27,11 +31,14 @@ from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Polygon
+from matplotlib.text import Text
+from matplotlib.transforms import Affine2D
 
 from eoam_sumo.errors import InputError
+from eoam_sumo.plotting.animation_frames import ROLE_RANK, RunFrames, load_frames
 from eoam_sumo.plotting.roadmap import read_road_map
-from eoam_sumo.plotting.run_plots import MODE_NAMES, load_run
-from eoam_sumo.sim.trafficlog import TRAFFIC_FILE, read_traffic
+from eoam_sumo.plotting.run_plots import MODE_NAMES
+from eoam_sumo.plotting.view import radar_cone
 
 ROLE_COLOURS = {
     "ego": "#1e88e5",
@@ -40,30 +47,28 @@ ROLE_COLOURS = {
     "parked": "#757575",
     "other": "#43a047",
 }
-_ROLE_RANK = {"ego": 0, "aro": 1, "oncoming": 2, "parked": 3, "other": 4}
+CONTACT_COLOUR = "#d50000"
 PLAN_AHEAD_S = 3.0  # the planned path drawn this far ahead of the frame's time [s]
-VIEW_BEHIND_M, VIEW_AHEAD_M = 40.0, 110.0  # view along the ego's heading [m]
-MIN_DRAWN_M = 1.0  # road users are drawn at least this long and wide [m]
 DEFAULT_FPS = 10
-DEFAULT_RADAR_FOV_DEG = 18.0
+AXES_BOX = (0.01, 0.09, 0.98, 0.76)  # the picture within the figure (left, bottom, w, h)
+LABEL_GAP_M = 0.5  # an id is written this far beside its road user's box [m]
+NORTH_PT = 16.0  # length of the north arrow [points]
+NORTH_AT = (0.965, 0.82)  # the north arrow's middle in the picture (axes fractions)
 
 
-def _boxes(x, y, yaw, length, width) -> np.ndarray:
-    """(n, 4, 2) corners of footprint rectangles centred at (x, y)."""
-    c, s = np.cos(yaw), np.sin(yaw)
-    hl, hw = 0.5 * length, 0.5 * width
-    corners = []
-    for fl, fw in ((1, 1), (1, -1), (-1, -1), (-1, 1)):
-        corners.append(
-            np.column_stack((x + fl * hl * c - fw * hw * s, y + fl * hl * s + fw * hw * c))
-        )
-    return np.stack(corners, axis=1)
+def picture_aspect(size_in: tuple[float, float]) -> float:
+    """Height / width of the picture in a figure of ``size_in`` inches."""
+    return AXES_BOX[3] * size_in[1] / (AXES_BOX[2] * size_in[0])
 
 
-def _frame_rows(times: np.ndarray, fps: float) -> np.ndarray:
-    """Indices of the time-series rows shown as frames: one every 1/fps s of run time."""
-    wanted = np.arange(times[0], times[-1] + 1e-9, 1.0 / fps)
-    return np.unique(np.clip(np.searchsorted(times, wanted - 1e-9), 0, len(times) - 1))
+def _check_out(out: Path) -> bool:
+    """Whether ``out`` is an MP4 (else a GIF); InputError for any other name."""
+    mp4 = out.suffix.lower() == ".mp4"
+    if mp4 and shutil.which("ffmpeg") is None:
+        raise InputError(f"{out}: an MP4 needs ffmpeg on PATH; name a .gif instead")
+    if not mp4 and out.suffix.lower() != ".gif":
+        raise InputError(f"{out}: the animation's file name must end in .gif or .mp4")
+    return mp4
 
 
 def animate_run(
@@ -72,72 +77,60 @@ def animate_run(
     fps: int = DEFAULT_FPS,
     size_in: tuple[float, float] = (9.0, 3.6),
     dpi: int = 90,
+    labels: bool = False,
 ) -> tuple[Path, int]:
     """Write the animation of ``run_dir``; (its path, the number of frames)."""
-    run_dir = Path(run_dir)
-    if not run_dir.is_dir():
-        raise InputError(f"{run_dir}: no such run folder")
-    if not (run_dir / "summary.json").is_file():
-        raise InputError(f"{run_dir}: not a run folder (no summary.json)")
-    if fps < 1:
-        raise InputError(f"--fps {fps} must be a whole number >= 1")
-    summary, ts = load_run(run_dir)
-    traffic_path = run_dir / TRAFFIC_FILE
-    if not traffic_path.is_file():
-        raise InputError(
-            f"{run_dir}: has no {TRAFFIC_FILE} (a run of an older eoam-sumo; run it again)"
-        )
-    traffic = read_traffic(traffic_path)
-    out = Path(out) if out is not None else run_dir / "animation.gif"
-    mp4 = out.suffix.lower() == ".mp4"
-    if mp4 and shutil.which("ffmpeg") is None:
-        raise InputError(f"{out}: an MP4 needs ffmpeg on PATH; name a .gif instead")
-    if not mp4 and out.suffix.lower() != ".gif":
-        raise InputError(f"{out}: the animation's file name must end in .gif or .mp4")
-    scene = _Scene(summary, ts, traffic, size_in, dpi)
-    frames = _frame_rows(ts["time_s"].to_numpy(), fps)
+    frames = load_frames(Path(run_dir), fps, picture_aspect(size_in))
+    out = Path(out) if out is not None else Path(run_dir) / "animation.gif"
+    mp4 = _check_out(out)
+    scene = Scene(frames, size_in, dpi, labels)
     writer = FFMpegWriter(fps=fps) if mp4 else PillowWriter(fps=fps)
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
         with writer.saving(scene.fig, str(out), dpi):
-            for row in frames:
-                scene.draw(int(row))
+            for k in range(len(frames.rows)):
+                scene.draw(k)
                 writer.grab_frame()
     except OSError as exc:
         raise InputError(f"{out}: cannot be written: {exc.strerror or exc}") from exc
-    return out, len(frames)
+    return out, len(frames.rows)
 
 
-class _Scene:
-    """The figure's artists, made once and updated per frame."""
+class Scene:
+    """The figure's artists, made once and updated per frame. Every artist in network
+    coordinates is drawn through ``to_view`` (the frame's turn about its centre) and the
+    axes' own transform; the axes' limits are the view's half width and height."""
 
-    def __init__(self, summary: dict, ts, traffic, size_in, dpi):
-        self.summary = summary
-        self._read_series(ts)
-        self._traffic_index(traffic)
-        self.radar_m = float(summary.get("radar_range_m") or 100.0)
-        self.fov_rad = math.radians(float(summary.get("radar_fov_deg") or DEFAULT_RADAR_FOV_DEG))
-        self.contact_t = summary.get("contact_time_s")
+    def __init__(self, frames: RunFrames, size_in=(9.0, 3.6), dpi: int = 90, labels=False):
+        self.frames = frames
+        self.summary = frames.summary
+        self._read_series(frames.series)
+        by_rank = {v: k for k, v in ROLE_RANK.items()}
+        self.colour = np.array([ROLE_COLOURS[by_rank[r]] for r in frames.rank])
+        self.roles_present = {by_rank[r] for r in set(frames.rank.tolist())}
         self.fig = Figure(figsize=size_in, dpi=dpi)
-        # fixed margins (no layout engine run for every frame) and no ticks: the
-        # view moves, its scale is in the status line
-        self.ax = ax = self.fig.add_axes((0.01, 0.01, 0.98, 0.90))
+        # fixed margins (no layout engine run for every frame) and no ticks: the view
+        # moves and turns, its scale is in the status line
+        self.ax = ax = self.fig.add_axes(AXES_BOX)
         ax.set_xticks([])
         ax.set_yticks([])
         ax.set_aspect("equal", adjustable="box")
-        self.view_ratio = 0.90 * size_in[1] / (0.98 * size_in[0])  # view height / width
         ax.set_facecolor("#a5d6a7")  # verges
-        self._draw_road(summary)
+        self.to_view = Affine2D()
+        self.data = self.to_view + ax.transData
+        self._draw_road()
         self._add_moving_artists(ax)
+        self._add_contact_artists(ax)
+        self.labels = self._add_labels(ax) if labels else []
+        self._add_north_arrow(ax)
         self._static_overlay(size_in, dpi)
 
     def _read_series(self, ts) -> None:
-        """The time series the frames show: the ego's pose and speed, its planned path, the
+        """The time series the frames show: the ego's track and speed, its planned path, the
         EOAM's mode, FCW and sector."""
         self.t = ts["time_s"].to_numpy()
         self.x, self.y = ts["x_m"].to_numpy(), ts["y_m"].to_numpy()
-        self.yaw = ts["yaw_rad"].to_numpy()
-        road_yaw = self.road_yaw = self.yaw - ts["heading_error_rad"].to_numpy()
+        road_yaw = ts["yaw_rad"].to_numpy() - ts["heading_error_rad"].to_numpy()
         # the planned path: the target offset placed beside the ego's station
         shift = ts["y_target_m"].to_numpy() - ts["lateral_offset_m"].to_numpy()
         self.plan_x = self.x - shift * np.sin(road_yaw)
@@ -150,43 +143,93 @@ class _Scene:
 
     def _add_moving_artists(self, ax) -> None:
         """The artists each frame updates: radar cone, track, planned path, road users'
-        boxes, the contact mark and the status text."""
+        boxes and the status text above the picture."""
         self.cone = Polygon(
-            np.zeros((3, 2)),
+            np.zeros((4, 2)),
             closed=True,
             facecolor="#ffee58",
             alpha=0.25,
             edgecolor="#f9a825",
             linewidth=0.6,
             zorder=2,
+            transform=self.data,
         )
         ax.add_patch(self.cone)
-        (self.track,) = ax.plot([], [], color="#1e88e5", linewidth=0.8, alpha=0.6, zorder=3)
-        (self.plan,) = ax.plot([], [], color="black", linestyle="--", linewidth=1.0, zorder=3)
-        self.bodies = PolyCollection([], edgecolors="black", linewidths=0.5, zorder=4)
-        ax.add_collection(self.bodies)
+        line = {"transform": self.data, "zorder": 3}
+        (self.track,) = ax.plot([], [], color="#1e88e5", linewidth=0.8, alpha=0.6, **line)
+        (self.plan,) = ax.plot([], [], color="black", linestyle="--", linewidth=1.0, **line)
+        self.bodies = PolyCollection(
+            [], edgecolors="black", linewidths=0.5, zorder=4, transform=self.data
+        )
+        ax.add_collection(self.bodies, autolim=False)
+        self.text = self.fig.text(
+            AXES_BOX[0], AXES_BOX[1] + AXES_BOX[3] + 0.01, "", va="bottom", fontsize=8
+        )
+        self.text.set_fontfamily("monospace")
+
+    def _add_contact_artists(self, ax) -> None:
+        """The contact ring and the outline of the road user hit, shown on the contact's
+        frame."""
         (self.contact,) = ax.plot(
             [],
             [],
             marker="o",
             markersize=18,
             markerfacecolor="none",
-            markeredgecolor="#d50000",
+            markeredgecolor=CONTACT_COLOUR,
             markeredgewidth=2.0,
             linestyle="",
-            zorder=5,
-        )
-        self.text = ax.text(
-            0.01,
-            0.97,
-            "",
-            transform=ax.transAxes,
-            va="top",
-            fontsize=8,
-            family="monospace",
             zorder=6,
-            bbox={"facecolor": "white", "alpha": 0.85, "linewidth": 0},
+            transform=self.data,
         )
+        self.hit = Polygon(
+            np.zeros((4, 2)),
+            closed=True,
+            fill=False,
+            edgecolor=CONTACT_COLOUR,
+            linewidth=2.2,
+            zorder=5,
+            transform=self.data,
+            visible=False,
+        )
+        ax.add_patch(self.hit)
+
+    def _add_labels(self, ax) -> list[Text]:
+        """Enough id texts for the busiest frame, hidden until used."""
+        most = int(np.max(self.frames.user_end - self.frames.user_start, initial=0))
+        style = {"fontsize": 6, "ha": "center", "va": "center", "clip_on": True, "zorder": 7}
+        return [
+            ax.text(0.0, 0.0, "", transform=self.data, visible=False, **style) for _ in range(most)
+        ]
+
+    def _add_north_arrow(self, ax) -> None:
+        """An arrow pointing north and an N at its tip, in the picture's top right corner."""
+        self.north = ax.annotate(
+            "",
+            xy=NORTH_AT,
+            xytext=NORTH_AT,
+            xycoords="axes fraction",
+            arrowprops={"arrowstyle": "->", "color": "black", "linewidth": 1.0},
+            zorder=8,
+        )
+        self.north_n = ax.text(
+            *NORTH_AT, "N", transform=ax.transAxes, ha="center", va="center", fontsize=7
+        )
+        width_in, height_in = self.fig.get_size_inches()
+        # an arrow NORTH_PT long in axes fractions, across and up
+        self.north_scale = (
+            NORTH_PT / (72.0 * AXES_BOX[2] * width_in),
+            NORTH_PT / (72.0 * AXES_BOX[3] * height_in),
+        )
+
+    def _point_north(self, rotation_rad: float) -> None:
+        """The north arrow for a view turned by ``rotation_rad``."""
+        north = 0.5 * math.pi - rotation_rad  # north's direction in the picture
+        dx = 0.5 * self.north_scale[0] * math.cos(north)
+        dy = 0.5 * self.north_scale[1] * math.sin(north)
+        self.north.xy = (NORTH_AT[0] + dx, NORTH_AT[1] + dy)
+        self.north.set_position((NORTH_AT[0] - dx, NORTH_AT[1] - dy))
+        self.north_n.set_position((NORTH_AT[0] + 2.0 * dx, NORTH_AT[1] + 2.0 * dy))
 
     def _static_overlay(self, size_in, dpi) -> None:
         """Title and legend drawn once onto a transparent image laid over every frame (their
@@ -199,13 +242,17 @@ class _Scene:
             if r in self.roles_present
         ]
         handles.append(Line2D([], [], color="black", linestyle="--", label="planned path"))
+        if self.frames.contact is not None:
+            handles.append(
+                Patch(facecolor="none", edgecolor=CONTACT_COLOUR, linewidth=2, label="hit")
+            )
         over.legend(
             handles=handles,
-            loc="lower right",
-            bbox_to_anchor=(0.985, 0.02),
+            loc="lower center",
+            bbox_to_anchor=(0.5, 0.0),
             fontsize=7,
-            ncols=3,
-            framealpha=0.85,
+            ncols=len(handles),
+            frameon=False,
         )
         over.suptitle(self._title(self.summary), fontsize=8, y=0.985)
         canvas = FigureCanvasAgg(over)
@@ -217,38 +264,17 @@ class _Scene:
         end = f"{s['outcome']}" + (f", hit {hit}" if hit not in (None, "none") else "")
         return f"{s.get('reason', '')} ({end})"
 
-    def _traffic_index(self, traffic) -> None:
-        """Per time-series row: the slice of traffic rows logged at the same time."""
-        traffic = traffic.sort_values("time_s", kind="stable")
-        times = traffic["time_s"].to_numpy()
-        self.tr_start = np.searchsorted(times, self.t - 5e-7)
-        self.tr_end = np.searchsorted(times, self.t + 5e-7)
-        rank = traffic["role"].map(_ROLE_RANK).fillna(4)
-        best = rank.groupby(traffic["id"]).transform("min").astype(int)
-        by_rank = {v: k for k, v in _ROLE_RANK.items()}
-        self.tr_colour = np.array([ROLE_COLOURS[by_rank[r]] for r in best])
-        self.roles_present = {by_rank[r] for r in set(best)}
-        x, y, heading, length, width = (
-            traffic[c].to_numpy() for c in ("x_m", "y_m", "heading_rad", "length_m", "width_m")
+    def _draw_road(self) -> None:
+        """The lanes of the network near any frame's view, once (the view turns them)."""
+        views = self.frames.views
+        net = self.summary.get("net_file")
+        reach = 0.5 * np.hypot(views.width_m, views.height_m)
+        bbox = (
+            float(np.min(views.centre_x_m - reach)),
+            float(np.min(views.centre_y_m - reach)),
+            float(np.max(views.centre_x_m + reach)),
+            float(np.max(views.centre_y_m + reach)),
         )
-        # a person (0.2 x 0.5 m) would be a pixel or two: small road users drawn larger
-        self.tr_boxes = _boxes(
-            x, y, heading, np.maximum(length, MIN_DRAWN_M), np.maximum(width, MIN_DRAWN_M)
-        )
-        self.tr_is_ego = (traffic["role"] == "ego").to_numpy()
-        self.tr_xy = traffic[["x_m", "y_m"]].to_numpy()
-        ego = traffic[self.tr_is_ego]
-        self.ego_front_m = float(ego["length_m"].iloc[0]) * 0.5 if len(ego) else 0.0
-        # per time-series row: the ego's box centre (its CG when traffic.csv lacks the row)
-        rows = np.searchsorted(ego["time_s"].to_numpy(), self.t - 5e-7).clip(0, len(ego) - 1)
-        found = len(ego) > 0 and np.abs(ego["time_s"].to_numpy()[rows] - self.t) < 5e-7
-        self.ego_cx = np.where(found, ego["x_m"].to_numpy()[rows] if len(ego) else 0, self.x)
-        self.ego_cy = np.where(found, ego["y_m"].to_numpy()[rows] if len(ego) else 0, self.y)
-
-    def _draw_road(self, summary: dict) -> None:
-        net = summary.get("net_file")
-        pad = VIEW_AHEAD_M + 50.0
-        bbox = (self.x.min() - pad, self.y.min() - pad, self.x.max() + pad, self.y.max() + pad)
         if not net or not Path(net).is_file():
             self.ax.text(
                 0.5,
@@ -260,84 +286,104 @@ class _Scene:
             )
             return
         road = read_road_map(Path(net), bbox)
-        self.ax.add_collection(
-            PolyCollection(road.road, facecolors="#616161", edgecolors="none", zorder=1)
+        for polygons, colour in ((road.road, "#616161"), (road.pavement, "#bdbdbd")):
+            surface = PolyCollection(polygons, facecolors=colour, edgecolors="none", zorder=1)
+            self.ax.add_collection(surface, autolim=False)
+            surface.set_transform(self.data)
+        solid = LineCollection(road.solid, colors="white", linewidths=1.0, zorder=1.5)
+        dashed = LineCollection(
+            road.dashed, colors="white", linewidths=0.8, linestyles=(0, (4, 6)), zorder=1.5
         )
-        self.ax.add_collection(
-            PolyCollection(road.pavement, facecolors="#bdbdbd", edgecolors="none", zorder=1)
-        )
-        self.ax.add_collection(
-            LineCollection(road.solid, colors="white", linewidths=1.0, zorder=1.5)
-        )
-        self.ax.add_collection(
-            LineCollection(
-                road.dashed, colors="white", linewidths=0.8, linestyles=(0, (4, 6)), zorder=1.5
-            )
-        )
+        for lines in (solid, dashed):
+            self.ax.add_collection(lines, autolim=False)
+            lines.set_transform(self.data)
 
     def draw(self, k: int) -> None:
-        """Update the artists to time-series row ``k``."""
-        x, y, yaw = self.x[k], self.y[k], self.yaw[k]
-        c, s = math.cos(yaw), math.sin(yaw)
-        a, b = self.tr_start[k], self.tr_end[k]
-        self.bodies.set_verts(list(self.tr_boxes[a:b]))
-        self.bodies.set_facecolor(self.tr_colour[a:b].tolist())
-        fx = self.ego_cx[k] + self.ego_front_m * c
-        fy = self.ego_cy[k] + self.ego_front_m * s
-        r, h = self.radar_m, 0.5 * self.fov_rad
+        """Update the artists to frame ``k``."""
+        f = self.frames
+        row = int(f.rows[k])
+        self._turn_view(k)
+        a, b = int(f.user_start[k]), int(f.user_end[k])
+        self.bodies.set_verts(list(f.box[a:b]))
+        self.bodies.set_facecolor(self.colour[a:b].tolist())
         self.cone.set_xy(
-            [
-                (fx, fy),
-                (fx + r * math.cos(yaw + h), fy + r * math.sin(yaw + h)),
-                (fx + r * math.cos(yaw - h), fy + r * math.sin(yaw - h)),
-            ]
+            radar_cone(f.radar_xy[k], f.ego_yaw_rad[k], f.radar_range_m, f.radar_fov_rad)
         )
-        self.track.set_data(self.x[: k + 1], self.y[: k + 1])
-        end = int(np.searchsorted(self.t, self.t[k] + PLAN_AHEAD_S))
-        phase = self.in_manoeuvre[k:end]  # ahead as long as the phase (manoeuvre or not) lasts
-        n = int(np.argmin(phase == phase[0])) if not phase.all() and phase.any() else len(phase)
-        self.plan.set_data(self.plan_x[k : k + n], self.plan_y[k : k + n])
-        if self.contact_t is not None and self.t[k] >= self.contact_t - 1e-9:
-            self.contact.set_data(*self._contact_point(self.contact_t))
-        else:
-            self.contact.set_data([], [])
-        mid = 0.5 * (VIEW_AHEAD_M - VIEW_BEHIND_M)  # the view looks ahead along the road
-        road_yaw = self.road_yaw[k] if np.isfinite(self.road_yaw[k]) else yaw
-        cx, cy = x + mid * math.cos(road_yaw), y + mid * math.sin(road_yaw)
-        half = 0.5 * (VIEW_AHEAD_M + VIEW_BEHIND_M)
-        self.ax.set_xlim(cx - half, cx + half)
-        self.ax.set_ylim(cy - half * self.view_ratio, cy + half * self.view_ratio)
+        self.track.set_data(self.x[: row + 1], self.y[: row + 1])
+        self.plan.set_data(*self._plan(row))
+        self._draw_contact(k)
+        self._draw_labels(k, a, b)
         self.text.set_text(self._status(k))
 
+    def _turn_view(self, k: int) -> None:
+        """Frame ``k``'s view: its centre to the origin, its heading to the right."""
+        v = self.frames.views
+        self.to_view.clear().translate(-v.centre_x_m[k], -v.centre_y_m[k])
+        self.to_view.rotate(-v.rotation_rad[k])
+        half_w, half_h = 0.5 * v.width_m[k], 0.5 * v.height_m[k]
+        self.ax.set_xlim(-half_w, half_w)
+        self.ax.set_ylim(-half_h, half_h)
+        self._point_north(float(v.rotation_rad[k]))
+
+    def _plan(self, row: int) -> tuple[np.ndarray, np.ndarray]:
+        """The planned path from ``row``: ahead as long as the phase (manoeuvre or not)
+        lasts, at most ``PLAN_AHEAD_S``."""
+        end = int(np.searchsorted(self.t, self.t[row] + PLAN_AHEAD_S))
+        phase = self.in_manoeuvre[row:end]
+        n = int(np.argmin(phase == phase[0])) if not phase.all() and phase.any() else len(phase)
+        return self.plan_x[row : row + n], self.plan_y[row : row + n]
+
+    def _draw_contact(self, k: int) -> None:
+        """The contact ring and the hit road user's outline on the contact's frame."""
+        contact = self.frames.contact
+        shown = contact is not None and k == len(self.frames.rows) - 1
+        if contact is not None and shown:
+            self.contact.set_data([contact.x_m], [contact.y_m])
+        else:
+            self.contact.set_data([], [])
+        hit = contact.hit_row if contact is not None else None
+        self.hit.set_visible(shown and hit is not None)
+        if shown and hit is not None:
+            self.hit.set_xy(self.frames.box[hit])
+
+    def _draw_labels(self, k: int, a: int, b: int) -> None:
+        """Each road user's id beside its box: above it in the picture, the ego's below it
+        (so that the ego's and the obstacle's ids do not overlap at a contact)."""
+        if not self.labels:
+            return
+        rotation = self.frames.views.rotation_rad[k]
+        up = np.array([-math.sin(rotation), math.cos(rotation)])  # up in the picture
+        across = np.where(self.frames.is_ego[a:b, None], -up, up)
+        boxes = self.frames.box[a:b]
+        centre = boxes.mean(axis=1)
+        reach = np.max(np.einsum("nij,nj->ni", boxes - centre[:, None, :], across), axis=1)
+        place = centre + (reach + LABEL_GAP_M)[:, None] * across
+        for j, label in enumerate(self.labels):
+            if j >= b - a:
+                label.set_visible(False)
+                continue
+            label.set_position(tuple(place[j]))
+            label.set_verticalalignment("top" if self.frames.is_ego[a + j] else "bottom")
+            label.set_text(str(self.frames.user_id[a + j]))
+            label.set_visible(True)
+
     def _status(self, k: int) -> str:
-        mode = self.mode[k]
+        row = int(self.frames.rows[k])
+        mode = self.mode[row]
         name = MODE_NAMES.get(int(mode), "?") if np.isfinite(mode) else "end"
-        sector = self.sector[k] or "-"
-        fcw = "  FCW" if np.isfinite(self.fcw[k]) and self.fcw[k] > 0 else ""
-        return (
-            f"t = {self.t[k]:6.2f} s   mode {name}   {3.6 * self.vx[k]:5.1f} km/h   "
-            f"DMM sector {sector}{fcw}\nview {VIEW_BEHIND_M + VIEW_AHEAD_M:g} m wide"
+        sector = self.sector[row] or "-"
+        fcw = "  FCW" if np.isfinite(self.fcw[row]) and self.fcw[row] > 0 else ""
+        line = (
+            f"t = {self.t[row]:6.2f} s   mode {name}   {3.6 * self.vx[row]:5.1f} km/h   "
+            f"DMM sector {sector}{fcw}   view {self.frames.views.width_m[k]:.0f} m wide"
         )
-
-    def _contact_point(self, contact_t: float) -> tuple[list, list]:
-        """The contact point of summary.json, else (a run of an older eoam-sumo) the midpoint
-        between the ego and the road user nearest to it when the contact was found
-        (``contact_t``)."""
-        x, y = self.summary.get("contact_x_m"), self.summary.get("contact_y_m")
-        if x is not None and y is not None:
-            return [x], [y]
-        k = min(int(np.searchsorted(self.t, contact_t - 1e-9)), len(self.t) - 1)
-        a, b = self.tr_start[k], self.tr_end[k]
-        xy, ego = self.tr_xy[a:b], self.tr_is_ego[a:b]
-        if ego.sum() != 1 or len(xy) < 2:
-            return [self.x[k]], [self.y[k]]
-        e = xy[ego][0]
-        others = xy[~ego]
-        near = others[np.argmin(np.hypot(*(others - e).T))]
-        return [0.5 * (e[0] + near[0])], [0.5 * (e[1] + near[1])]
+        if self.frames.contact is not None and k == len(self.frames.rows) - 1:
+            hit = self.summary.get("collision_with_id") or self.summary.get("collision_with")
+            line += f"   CONTACT with {hit}"
+        return line
 
 
-def animate_cli(run_dir: Path, out: Path | None, fps: int) -> str:
+def animate_cli(run_dir: Path, out: Path | None, fps: int, labels: bool = False) -> str:
     """The line ``eoam-sumo animate`` prints."""
-    path, n = animate_run(run_dir, out, fps)
+    path, n = animate_run(run_dir, out, fps, labels=labels)
     return f"{path} ({n} frames at {fps} fps)"

@@ -4,6 +4,8 @@ run is the independent record the traffic log is checked against."""
 
 from __future__ import annotations
 
+import json
+import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -13,11 +15,13 @@ import pytest
 from PIL import Image
 
 from eoam_sumo.cli import main
-from eoam_sumo.plotting.animate import ROLE_COLOURS, animate_run
+from eoam_sumo.plotting.animate import ROLE_COLOURS, Scene, animate_run, picture_aspect
+from eoam_sumo.plotting.animation_frames import load_frames
 from eoam_sumo.sim.cosim import run_case
 from eoam_sumo.sim.scenario import ScenarioOverrides
 from eoam_sumo.sim.settings import RunSettings
 from eoam_sumo.sim.trafficlog import TRAFFIC_COLUMNS, read_traffic
+from tests.builders import halted_car_scenario
 
 pytestmark = pytest.mark.sumo
 ROOT = Path(__file__).resolve().parents[2]
@@ -126,3 +130,158 @@ def test_animate_cli_bad_run_dir_is_one_line_and_exit_2(tmp_path, capsys):
         f"eoam-sumo: error: {tmp_path / 'nowhere'}: no such run folder",
         f"eoam-sumo: error: {tmp_path}: not a run folder (no summary.json)",
     ]
+
+
+# --- on any road: the view follows the ego round a curve and along roads running every way
+
+
+def _road_run(
+    folder: Path, points: list[tuple[float, float]], obstacle_m: float, speed_mps: float, mu: float
+) -> Path:
+    """A one-lane one-way road through ``points`` (no lane to escape into), a car halted on
+    it ``obstacle_m`` from its start, the ego 20 m from the start at ``speed_mps``: the run's
+    folder."""
+    shape = " ".join(f"{x:.3f},{y:.3f}" for x, y in points)
+    (x0, y0), (x1, y1) = points[0], points[-1]
+    cfg = halted_car_scenario(
+        folder,
+        f'<nodes><node id="a" x="{x0:.3f}" y="{y0:.3f}"/>'
+        f'<node id="b" x="{x1:.3f}" y="{y1:.3f}"/></nodes>',
+        f'<edges><edge id="fwd" from="a" to="b" numLanes="1" speed="40" shape="{shape}"/></edges>',
+        obstacle_m,
+    )
+    run_case(
+        cfg,
+        ScenarioOverrides(ego_speed_mps=speed_mps, mu=mu),
+        folder / "run",
+        RunSettings(max_time_s=30.0),
+    )
+    return folder / "run"
+
+
+def _left_turn(
+    lead_m: float, radius_m: float, turn_deg: float, tail_m: float
+) -> list[tuple[float, float]]:
+    """A straight ``lead_m`` east, a left arc of ``radius_m`` through ``turn_deg`` (2 m
+    chords), then a straight ``tail_m``."""
+    turn = math.radians(turn_deg)
+    n = math.ceil(radius_m * turn / 2.0)
+    points = [(0.0, 0.0)] + [
+        (lead_m + radius_m * math.sin(turn * k / n), radius_m * (1 - math.cos(turn * k / n)))
+        for k in range(n + 1)
+    ]
+    x, y = points[-1]
+    return [*points, (x + tail_m * math.cos(turn), y + tail_m * math.sin(turn))]
+
+
+CURVE = {"lead_m": 30.0, "radius_m": 40.0, "turn_deg": 100.0, "tail_m": 300.0}
+
+
+@pytest.fixture(scope="module")
+def curve_run(tmp_path_factory) -> Path:
+    """A 40 m radius left turn through 100 deg, 30 m from the road's start; a car halted just
+    past it (its tail 0.6 m beyond the curve's end, heading 100 deg); the ego at 12 m/s on
+    mu 0.6 sees it too late and hits it."""
+    return _road_run(tmp_path_factory.mktemp("curve"), _left_turn(**CURVE), 105.0, 12.0, 0.6)
+
+
+def _boxes_at(traffic: pd.DataFrame, time_s: float, user: str) -> np.ndarray:
+    """(4, 2) corners of ``user``'s box in traffic.csv at ``time_s``, worked out here."""
+    row = traffic[(np.abs(traffic["time_s"] - time_s) < 1e-6) & (traffic["id"] == user)]
+    assert len(row) == 1, (time_s, user)
+    x, y, h, length, width = row[["x_m", "y_m", "heading_rad", "length_m", "width_m"]].to_numpy()[0]
+    along, left = np.array([math.cos(h), math.sin(h)]), np.array([-math.sin(h), math.cos(h)])
+    return np.array(
+        [
+            [x, y] + a * 0.5 * length * along + b * 0.5 * width * left
+            for a, b in ((1, 1), (1, -1), (-1, -1), (-1, 1))
+        ]
+    )
+
+
+def _in_view(views, k: int, xy: np.ndarray) -> bool:
+    """Whether the points ``xy`` lie inside frame ``k``'s view (rotation matrix worked out
+    here)."""
+    c, s = math.cos(views.rotation_rad[k]), math.sin(views.rotation_rad[k])
+    d = xy - [views.centre_x_m[k], views.centre_y_m[k]]
+    u, v = d @ [c, s], d @ [-s, c]
+    return bool(
+        (np.abs(u) <= views.width_m[k] / 2).all() and (np.abs(v) <= views.height_m[k] / 2).all()
+    )
+
+
+def _check_every_frame(run_dir: Path, fps: int = 10):
+    """Every frame's view holds the ego's and the obstacle's boxes of traffic.csv; the last
+    frame is the contact's. The frames, the summary and the traffic log."""
+    summary = json.loads((run_dir / "summary.json").read_text())
+    assert summary["end_cause"] == "contact" and summary["collision_with_id"] == "stalled"
+    frames = load_frames(run_dir, fps, picture_aspect((9.0, 3.6)))
+    traffic = read_traffic(run_dir / "traffic.csv")
+    for k, t in enumerate(frames.time_s):
+        for user in ("ego", "stalled"):
+            assert _in_view(frames.views, k, _boxes_at(traffic, t, user)), (k, t, user)
+    assert abs(frames.time_s[-1] - summary["contact_time_s"]) <= STEP_S + 1e-9
+    assert len(frames.time_s) >= fps * (summary["contact_time_s"] - frames.time_s[0])
+    return frames, summary, traffic
+
+
+def test_round_a_curve_every_frame_shows_the_ego_and_the_obstacle_and_ends_on_the_contact(
+    curve_run,
+):
+    frames, summary, traffic = _check_every_frame(curve_run)
+    turn = traffic.loc[traffic["id"] == "ego", "heading_rad"]
+    assert turn.max() - turn.min() > math.radians(90.0)  # the road turned the ego round
+    obstacle = traffic.loc[traffic["id"] == "stalled", "heading_rad"].iloc[0]
+    assert obstacle > math.radians(95.0)
+    # the view turned with it: from east to the obstacle's heading
+    assert abs(frames.views.rotation_rad[0]) < math.radians(10.0)
+    assert abs(frames.views.rotation_rad[-1] - obstacle) < math.radians(10.0)
+    # the last frame shows the contact: the ring at the contact point, the obstacle outlined
+    scene = Scene(frames, labels=True)
+    scene.draw(len(frames.rows) - 1)
+    np.testing.assert_allclose(
+        np.column_stack(scene.contact.get_data()),
+        [[summary["contact_x_m"], summary["contact_y_m"]]],
+    )
+    assert scene.hit.get_visible()
+    np.testing.assert_allclose(
+        scene.hit.get_xy()[:4], _boxes_at(traffic, frames.time_s[-1], "stalled"), atol=1e-3
+    )
+    assert "CONTACT with stalled" in scene.text.get_text()
+    scene.draw(len(frames.rows) - 2)  # not before
+    assert not scene.hit.get_visible() and len(scene.contact.get_xdata()) == 0
+
+
+@pytest.mark.parametrize("heading_deg", [90.0, 180.0, -90.0, -135.0])
+def test_roads_heading_north_west_south_and_south_west_keep_both_in_view(tmp_path, heading_deg):
+    """A straight one-lane road 600 m long heading this way, the car halted 110 m along it
+    (within the radar's range of the ego from the start), the ego at 30 m/s on mu 0.3."""
+    h = math.radians(heading_deg)
+    run = _road_run(
+        tmp_path, [(0.0, 0.0), (600.0 * math.cos(h), 600.0 * math.sin(h))], 110.0, 30.0, 0.3
+    )
+    frames, _, _ = _check_every_frame(run)
+    np.testing.assert_allclose(
+        np.angle(np.exp(1j * (frames.views.rotation_rad - h))), 0.0, atol=1e-3
+    )
+
+
+def test_labels_write_each_road_users_id_beside_its_box(curve_run):
+    frames = load_frames(curve_run, 10, picture_aspect((9.0, 3.6)))
+    scene = Scene(frames, labels=True)
+    for k in (0, len(frames.rows) - 1):
+        scene.draw(k)
+        shown = {t.get_text(): t.get_position() for t in scene.labels if t.get_visible()}
+        assert set(shown) == {"ego", "stalled"}
+        a = frames.user_start[k]
+        for j, user in enumerate(frames.user_id[a : frames.user_end[k]]):
+            centre = frames.box[a + j].mean(axis=0)
+            assert 0.5 < math.dist(shown[user], centre) < 3.0  # beside its own box
+    assert Scene(frames).labels == []  # not asked: none
+
+
+def test_animate_cli_labels_writes_the_gif(curve_run, tmp_path, capsys):
+    out = tmp_path / "c.gif"
+    assert main(["animate", str(curve_run), "--out", str(out), "--fps", "4", "--labels"]) == 0
+    with Image.open(out) as gif:
+        assert gif.n_frames == int(capsys.readouterr().out.split("(")[1].split()[0])
