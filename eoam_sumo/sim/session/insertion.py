@@ -189,6 +189,49 @@ def route_centreline(
     return np.array(line, dtype=float)
 
 
+def let_fast_vehicles_depart(api, errors: tuple, files: ScenarioFiles, ego_id: str) -> None:
+    """Let every vehicle of the scenario's files that has not departed yet, the ego aside,
+    depart at a ``departSpeed`` above its departure edge's speed limit: SUMO chooses such a
+    vehicle a speed factor that allows the speed when its type has a speed deviation
+    (``speedDev`` > 0) and refuses the others ("Departure speed for vehicle ... is too high
+    for the departure edge"); those get that speed factor here (departSpeed / the edge's
+    lowest lane speed limit), so they too depart at their speed and keep it as their desired
+    speed. A speed above the vehicle type's ``maxSpeed`` stays SUMO's to refuse."""
+    veh = api.vehicle
+    try:
+        pending = set(veh.getLoadedIDList()) - set(veh.getIDList())
+    except errors:
+        return
+    for vid, spec in files.vehicles.items():
+        speed = _given_depart_speed(spec)
+        if vid == ego_id or vid not in pending or speed is None:
+            continue
+        try:
+            if api.vehicletype.getSpeedDeviation(veh.getTypeID(vid)) > 0.0:
+                continue  # SUMO chooses its speed factor itself
+            limit_mps = _edge_speed_limit(api, veh.getRoute(vid)[0])
+            if speed > limit_mps * veh.getSpeedFactor(vid):
+                veh.setSpeedFactor(vid, speed / limit_mps)
+        except errors:
+            continue  # SUMO reports what is wrong with this vehicle when it departs
+
+
+def _given_depart_speed(spec: VehicleSpec) -> float | None:
+    """A vehicle's ``departSpeed`` when it is a number > 0, else None."""
+    try:
+        speed = float(spec.attrs.get("departSpeed", ""))
+    except ValueError:
+        return None
+    return speed if math.isfinite(speed) and speed > 0.0 else None
+
+
+def _edge_speed_limit(api, edge: str) -> float:
+    """The lowest speed limit of an edge's lanes [m/s]."""
+    return min(
+        float(api.lane.getMaxSpeed(f"{edge}_{i}")) for i in range(api.edge.getLaneNumber(edge))
+    )
+
+
 def add_oncoming(
     api,
     errors: tuple,
