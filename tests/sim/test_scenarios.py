@@ -677,3 +677,50 @@ def test_a_refusal_quotes_sumos_error_not_the_warnings_before_it(tmp_path, step_
     message = str(refused.value)
     assert "Departure speed for vehicle 'lead' is too high for the vehicle type 'aro'" in message
     assert "Warning" not in message and "State was written" not in message
+
+
+# --------------------------------------------------------------------------- refusals that say why
+def test_a_flow_cannot_be_the_ego(tmp_path):
+    cfg = on_highway(
+        tmp_path,
+        '<routes><route id="r" edges="E0"/>'
+        '<flow id="ego" type="ego" route="r" begin="0" end="10" number="2"/></routes>',
+    )
+    with pytest.raises(InputError, match=r"v\.rou\.xml: 'ego' is a <flow>: a flow cannot be"):
+        SumoSession.start(cfg)
+
+
+@pytest.mark.sumo
+def test_a_route_that_skips_an_edge_is_not_connected(tmp_path):
+    net = network(
+        tmp_path,
+        "chain",
+        '<nodes><node id="n0" x="0" y="0"/><node id="n1" x="1000" y="0"/>'
+        '<node id="n2" x="2000" y="0"/><node id="n3" x="3000" y="0"/></nodes>',
+        '<edges><edge id="a" from="n0" to="n1" numLanes="2" speed="30"/>'
+        '<edge id="b" from="n1" to="n2" numLanes="2" speed="30"/>'
+        '<edge id="c" from="n2" to="n3" numLanes="2" speed="30"/></edges>',
+    )
+    routes = (
+        '<routes><vehicle id="ego" type="ego" depart="0" departPos="20" departSpeed="25">'
+        '<route edges="a c"/></vehicle></routes>'
+    )
+    with pytest.raises(
+        InputError,
+        match=r"v\.rou\.xml: the route of vehicle 'ego' is not connected: edge 'a' "
+        r"does not lead onto edge 'c'",
+    ):
+        SumoSession.start(on_highway(tmp_path, routes, net))
+
+
+@pytest.mark.sumo
+def test_an_oncoming_car_on_a_one_way_road_is_refused_as_such(tmp_path):
+    net = network(
+        tmp_path,
+        "oneway2",
+        '<nodes><node id="w" x="0" y="0"/><node id="e" x="3000" y="0"/></nodes>',
+        '<edges><edge id="E0" from="w" to="e" numLanes="2" speed="50" width="3.5"/></edges>',
+    )
+    cfg = on_highway(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(), net)
+    with pytest.raises(InputError, match=r"oneway2\.net\.xml: no oncoming car .* one-way.*'E0'"):
+        SumoSession.start(cfg, ScenarioOverrides(oncoming_start_m=400.0))
