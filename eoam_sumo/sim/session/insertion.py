@@ -320,11 +320,11 @@ def _opposite_start(
         if o is not None
     ]
     if not candidates:
-        edges = ", ".join(f"'{e}'" for e in ego.route_edges)
+        names = ", ".join(f"'{e}'" for e in ego.route_edges)
         raise InputError(
             f"{files.net_file}: no oncoming car (--oncoming-m, oncoming_start_m): the ego's "
             f"road is one-way, no lane of the other direction lies beside its route (edges "
-            f"{edges})"
+            f"{names})"
         )
     (s_opp, _), k, lane_id = min(candidates, key=lambda c: c[0][1])
     edges = []
