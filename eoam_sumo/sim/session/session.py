@@ -140,6 +140,17 @@ def _connect(cmd: list, cfg: Path, error_log: Path, workdir: Path, via_traci: bo
     return _Started(libsumo, libsumo.constants, errors, None, False)
 
 
+def _started(
+    cmd: list, files: ScenarioFiles, ego_id: str, error_log: Path, workdir: Path, via_traci: bool
+) -> _Started:
+    """SUMO started (``_connect``), the vehicles it loaded let depart above their lane's limit
+    (``insertion.let_fast_vehicles_depart``: before the first step, at a handover's longer
+    step too)."""
+    started = _connect(cmd, files.cfg, error_log, workdir, via_traci)
+    let_fast_vehicles_depart(started.api, started.errors, files, ego_id)
+    return started
+
+
 def _hand_over(
     started: _Started, cmd: list, handover_s: float, cfg: Path, error_log: Path, workdir: Path
 ) -> None:
@@ -260,8 +271,7 @@ class SumoSession:
                 *SAVE_STATE_OPTIONS,
             ]
         try:
-            started = _connect(first_cmd, files.cfg, error_log, workdir, via_traci)
-            let_fast_vehicles_depart(started.api, started.errors, files, ego_id)
+            started = _started(first_cmd, files, ego_id, error_log, workdir, via_traci)
             if plan is not None:
                 _hand_over(started, cmd, plan[1], files.cfg, error_log, workdir)
         except BaseException:
