@@ -354,7 +354,7 @@ def load_matrix(path: Path) -> Matrix:
         **settings,
         seed=seed,
         sample=sample,
-        **_swept_values(path, doc["sweep"], sampled),
+        **_swept_values(path, doc.get("sweep", {}), sampled),
         paper_table=paper,
         policy=policy,
         v2x=v2x,
@@ -387,12 +387,13 @@ def _check_tables(path: Path, doc: dict) -> None:
 
 
 def _check_required(path: Path, doc: dict, sampled: tuple[str, ...]) -> None:
-    """InputError for a missing required table, or a required key neither given nor sampled."""
+    """InputError for a missing required table (one whose every required key is sampled may
+    be left out), or a required key neither given nor sampled."""
     for table, keys in REQUIRED.items():
-        if table not in doc:
+        if table not in doc and not set(keys) <= set(sampled):
             raise InputError(f"{path}: missing table [{table}]")
         for key in keys:
-            if key not in doc[table] and key not in sampled:
+            if key not in doc.get(table, {}) and key not in sampled:
                 raise InputError(f"{path}: [{table}] needs the key '{key}' (or sample it)")
 
 
@@ -402,7 +403,7 @@ def _check_sampled_once(
     """InputError for a key both given and sampled, or a fixed seed beside a [sample] table."""
     for key in sampled:
         for table in ("scenario", "sweep"):
-            if key in doc[table]:
+            if key in doc.get(table, {}):
                 raise InputError(
                     f"{path}: '{key}' is both in [{table}] and sampled in [sample]; keep one"
                 )

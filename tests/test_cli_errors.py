@@ -73,6 +73,17 @@ def test_sumocfg_without_ego(capsys, tmp_path):
     _check(capsys, ["run", str(cfg), "--ego", "hero", "--out", str(tmp_path / "o")], "hero")
 
 
+def test_a_flow_as_the_ego_is_named_as_such(capsys, tmp_path):
+    cfg = _copy_scenario(tmp_path)
+    routes = cfg.parent / "baseline.rou.xml"
+    text = routes.read_text()
+    start = text.index('<vehicle id="ego"')
+    end = text.index("</vehicle>", start) + len("</vehicle>")
+    flow = '<flow id="ego" type="ego" route="eastbound" begin="1" end="10" number="2"/>'
+    routes.write_text(text[:start] + flow + text[end:])
+    _check(capsys, ["run", str(cfg), "--out", str(tmp_path / "o")], "a flow cannot be the ego")
+
+
 def test_unwritable_output_folder(capsys, tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("not a folder")

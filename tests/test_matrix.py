@@ -335,3 +335,25 @@ def test_speeds_below_the_tables_lowest_are_refused():
     with pytest.raises(InputError, match=r"15.0 km/h is outside the tables' range \[20, 175\]"):
         tables.check_run(1.0, 15.0 / 3.6)
     tables.check_run(1.0, 20.0 / 3.6)  # the lowest itself is covered
+
+
+def test_a_matrix_sampling_every_swept_key_needs_no_sweep_table(tmp_path):
+    """docs/monte-carlo.md: a sampled key leaves the sweep; when every required one is sampled,
+    [sweep] may be left out (as it may be left empty), and is still checked when given."""
+    sample = (
+        "[sample]\ndraws = 2\nseed = 1\nego_speed_kmh = { uniform = [60, 140] }\n"
+        "mu = { choice = [0.3, 0.7] }\n"
+    )
+    scenario = f'[scenario]\nsumocfg = "{(ROOT / "scenarios" / "baseline.sumocfg").as_posix()}"\n'
+    without = tmp_path / "without.toml"
+    without.write_text(scenario + sample)
+    empty = tmp_path / "empty.toml"
+    empty.write_text(scenario + "[sweep]\n" + sample)
+    ids = [c.case_id for c in load_matrix(without).cases()]
+    assert ids == [c.case_id for c in load_matrix(empty).cases()]
+    assert len(ids) == 2
+    # only sampling every required key leaves it out
+    half = tmp_path / "half.toml"
+    half.write_text(scenario + sample.replace("mu = { choice = [0.3, 0.7] }\n", ""))
+    with pytest.raises(InputError, match=r"half\.toml: missing table \[sweep\]"):
+        load_matrix(half)

@@ -7,6 +7,7 @@ import re
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from eoam_sumo.batch.case import PARAMETERS
 from eoam_sumo.batch.results import COLUMNS, NUMERIC_COLUMNS, RENAMED, SUMMARY_COLUMNS
@@ -84,3 +85,22 @@ def test_a_logged_step_lands_in_its_named_columns():
     assert first["mode"] == 2 and first["speed_target_mps"] == 29.0
     assert first["mu"] == 0.9  # the road's friction, not the 0.7 the EOAM believed
     assert np.isnan(end["mode"]) and np.isnan(end["aro_range_m"]) and end["mu"] == 0.9
+
+
+def test_the_end_row_carries_the_mode_and_sector_in_force_and_no_other_command():
+    log = runlog.RunLog(3)
+    meas = EgoMeasurement(1.5, 30.0, 0.1, 0.02, -1.0, 0.5, 200.0, 0.25, 0.01, 0.0, 0.7, 3.5)
+    x = [10.0, -1.75, 0.05, 30.0, 0.1, 0.02, 0.003, 100.0, 200.0]
+    cmd = Command(
+        0.004, 110.0, 0.0, 3, True, "E", -2.0, 1.0, 3.0, 0.1, 0.2, 0.001, 0.002, 0.0005, 29.0
+    )
+    log.add(meas, x, cmd, Perception(55.0, -12.0, True), 0.9)
+    log.add_end(meas, x, cmd, 0.9)
+    frame = log.frame()
+    end = frame.iloc[-1]
+    assert end["mode"] == 3 and end["sector"] == "E"
+    command_columns = set(runlog._FROM_CMD) - {"mode"}
+    assert all(pd.isna(end[c]) for c in command_columns)
+    assert pd.isna(end["aro_range_m"]) and end["x_m"] == 10.0
+    log.add_end(meas, x, None, 0.9)  # no step made: nothing in force
+    assert pd.isna(log.frame().iloc[-1]["mode"]) and log.frame().iloc[-1]["sector"] == ""

@@ -188,6 +188,7 @@ class CoSimulation:
         road.locate(ego.x_m, ego.y_m)
         self.lane_width_m = session.lane_width_m
         self.left_lane = session.left_lane_exists
+        self.next_lane_opposing = self.left_lane and session.next_lane_traffic()[0]
         self.x = initial_state(ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps).tolist()
         self.x_prev = self.x
         self.ax = self.ay = 0.0

@@ -62,11 +62,13 @@ class RunFacts:
     contact: ContactRecord | None = None
     contact_sumo_mass_kg: float = math.nan
     # the margins (``sim/margins.py``; infinite: never measured) and whether they make a
-    # near miss of a run without contact
+    # near miss of a run without contact; the time with the ego's centre left of its lane,
+    # in the next lane whatever its direction, and in it when that lane is the opposite one
     min_gap_aro_m: float = math.inf
     min_gap_oncoming_m: float = math.inf
     min_ttc_oncoming_s: float = math.inf
     time_in_opposite_lane_s: float = 0.0
+    time_in_next_lane_s: float = 0.0
     near_miss_margins: bool = False
     # around the ego: whether it ended ahead of the obstacle its lane change avoided (None:
     # no lane change, or the obstacle gone), whether oncoming traffic came within the log
@@ -112,6 +114,8 @@ class EndedRun(RunView, Protocol):
     def ego_initial_speed_mps(self) -> float: ...
     @property
     def min_gap_aro_m(self) -> float: ...
+    @property
+    def next_lane_opposing(self) -> bool: ...  # the lane left of the ego's is the opposite one
 
     # the co-simulation's parts: settings, parameters, controller, friction belief, observers
     settings: Any
@@ -155,7 +159,9 @@ def collect_facts(sim: EndedRun) -> RunFacts:
         min_gap_aro_m=sim.min_gap_aro_m,
         min_gap_oncoming_m=margins.min_gap_oncoming_m,
         min_ttc_oncoming_s=margins.min_ttc_oncoming_s,
-        time_in_opposite_lane_s=margins.time_in_opposite_lane_s,
+        # the margins count the steps left of the lane, whatever the next lane's direction
+        time_in_opposite_lane_s=margins.time_in_opposite_lane_s if sim.next_lane_opposing else 0.0,
+        time_in_next_lane_s=margins.time_in_opposite_lane_s,
         near_miss_margins=margins.near_miss(),
         passed_obstacle=sim.avoided.passed,
         oncoming_traffic=sim.traffic.had_role("oncoming"),

@@ -91,7 +91,7 @@ class StepObserver:
 
 class TimeSeries(StepObserver):
     """The run's time series (timeseries.csv): the state at each step's start with the command
-    decided from it, then the end state."""
+    decided from it, then the end state with the mode and sector in force."""
 
     log: RunLog  # set when the run starts
 
@@ -103,7 +103,8 @@ class TimeSeries(StepObserver):
         self._add(sim.meas, sim.x_prev, sim.cmd, sim.perception, sim.mu_true)
 
     def end(self, sim: RunView) -> None:
-        self._add(sim.meas, sim.x, None, None, sim.mu_true)
+        # the mode and sector in force at the end: the last command's (none without a step)
+        self.log.add_end(sim.meas, sim.x, sim.cmd if sim.n_steps else None, sim.mu_true)
 
 
 class Extremes(StepObserver):

@@ -11,6 +11,7 @@ import json
 import math
 from operator import attrgetter
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -58,6 +59,14 @@ _INT_COLUMNS = ("mode", "fcw", "oncoming_detected")
 _NAN = math.nan
 
 
+class InForce(NamedTuple):
+    """What of the last command is still in force at the end state (its row): the mode and
+    the DMM sector; the command's other columns are empty there."""
+
+    mode: int
+    sector: str
+
+
 PREALLOCATED_ROWS = 1 << 14  # 164 s of 10 ms steps; a longer run doubles the list as it goes
 
 
@@ -91,6 +100,12 @@ class RunLog:
         if self._columns:
             self._columns = {}
 
+    def add_end(self, meas, x, in_force, mu) -> None:
+        """Log the end state as ``add`` does with no command and no radar view, but with the
+        mode and DMM sector in force: those of ``in_force``, the last command (None: none)."""
+        held = None if in_force is None else InForce(in_force.mode, in_force.sector)
+        self.add(meas, x, held, None, mu)
+
     def array(self) -> np.ndarray:
         """(n, len(COLUMNS)) float array of the rows logged so far."""
         if self._array is None:
@@ -122,9 +137,10 @@ class RunLog:
 
 
 #: Where each column comes from, by name: the plant state's index, or a field of the
-#: ``EgoMeasurement``, of the ``Command`` (empty in the end state's row) or of the
-#: ``Perception`` (the radar's view: empty at the end, ranges empty when nothing is in path);
-#: ``mu`` is the road's friction under the ego (the EOAM may believe another).
+#: ``EgoMeasurement``, of the ``Command`` (in the end state's row only the mode and sector in
+#: force, an ``InForce``) or of the ``Perception`` (the radar's view: empty at the end, ranges
+#: empty when nothing is in path); ``mu`` is the road's friction under the ego (the EOAM may
+#: believe another).
 _FROM_STATE = {
     "x_m": 0,
     "y_m": 1,
@@ -187,8 +203,17 @@ def _column(rows: list, name: str) -> np.ndarray:
         get = attrgetter(_FROM_MEAS[name])
         return np.array([get(r[0]) for r in rows], dtype=float)
     if name in _FROM_CMD:
-        get = attrgetter(_FROM_CMD[name])
-        return np.array([_NAN if r[2] is None else get(r[2]) for r in rows], dtype=float)
+        field = _FROM_CMD[name]
+        if field in InForce._fields:  # the end state's row holds an InForce
+            get = attrgetter(field)
+            return np.array([_NAN if r[2] is None else get(r[2]) for r in rows], dtype=float)
+        return np.array(
+            [
+                _NAN if r[2] is None or isinstance(r[2], InForce) else getattr(r[2], field)
+                for r in rows
+            ],
+            dtype=float,
+        )
     if name == _SECTOR:
         return np.array(
             [float(ord(r[2].sector)) if r[2] is not None and r[2].sector else _NAN for r in rows],

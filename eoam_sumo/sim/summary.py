@@ -68,7 +68,10 @@ class RunSummary:
     min_ttc_oncoming_s: float | None = _doc(
         "smallest time to collision with one (empty: never on a collision course)"
     )
-    time_in_opposite_lane_s: float = _doc("time with the ego's centre left of its lane")
+    time_in_opposite_lane_s: float = _doc(
+        "time with the ego's centre in the opposite lane (left of its lane, where the lane "
+        "there carries opposing traffic; 0 on a one-way road)"
+    )
     near_miss: bool = _doc("no contact, but within 0.5 m of a road user or TTC below 1.5 s")
     passed_obstacle: bool | None = _doc(
         "a lane change ended ahead of the obstacle it avoided (empty: no lane change)"
@@ -96,6 +99,9 @@ class RunSummary:
     # for an error; neither has a default at run time
     sumo_overrides: dict = field(  # type: ignore[misc]
         metadata={"doc": "SUMO options the run set over the sumocfg, option -> value"}
+    )
+    time_in_next_lane_s: float = _doc(
+        "time with the ego's centre left of its lane (in the next lane, whatever its direction)"
     )
 
     def as_dict(self) -> dict:

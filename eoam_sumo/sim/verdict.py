@@ -136,7 +136,8 @@ def _motion_fields(facts: RunFacts) -> dict[str, Any]:
 
 
 def _run_fields(facts: RunFacts, info: RunInfo) -> dict[str, Any]:
-    """The scenario, the radar's coverage, the simulated and wall times, SUMO's options."""
+    """The scenario, the radar's coverage, the simulated and wall times, SUMO's options, the
+    time in the next lane."""
     return {
         "net_file": info.net_file,
         "radar_range_m": info.radar_range_m,
@@ -145,4 +146,5 @@ def _run_fields(facts: RunFacts, info: RunInfo) -> dict[str, Any]:
         "wall_time_s": info.wall_time_s,
         "realtime_factor": facts.sim_time_s / info.loop_wall_s,
         "sumo_overrides": info.sumo_overrides,
+        "time_in_next_lane_s": rounded(facts.time_in_next_lane_s),
     }

@@ -54,3 +54,23 @@ def test_a_road_user_driving_away_needs_only_the_difference_of_the_stopping_dist
     need = (20.0**2 - 15.0**2) / (2 * G) + CLOSE_AHEAD_MARGIN_M
     assert close(20.0, car(need - 0.05, 15.0)) and not close(20.0, car(need + 0.05, 15.0))
     assert not close(20.0, car(CLOSE_AHEAD_MARGIN_M + 0.05, 25.0))  # faster than the ego
+
+
+@pytest.mark.sumo
+def test_the_last_timeseries_row_carries_the_mode_and_sector_in_force(tmp_path):
+    """The end state's row (no command is decided from it) keeps the last step's mode and DMM
+    sector; it used to leave them empty."""
+    import pandas as pd
+
+    from eoam_sumo.sim.cosim import run_case
+    from eoam_sumo.sim.scenario import ScenarioOverrides
+    from eoam_sumo.sim.settings import RunSettings
+    from tests.builders import BASELINE
+
+    over = ScenarioOverrides(ego_speed_mps=120 / 3.6, mu=1.0)
+    run_case(BASELINE, over, tmp_path, RunSettings(max_time_s=4.0))
+    ts = pd.read_csv(tmp_path / "timeseries.csv", keep_default_na=False)
+    last, before = ts.iloc[-1], ts.iloc[-2]
+    assert last["mode"] != "" and last["sector"] != ""
+    assert (last["mode"], last["sector"]) == (before["mode"], before["sector"])
+    assert last["steer_cmd_rad"] == "" and last["fcw"] == ""  # no command of its own

@@ -29,6 +29,7 @@ from tests.builders import (
     NETWORKS,
     PARKED_ONLY,
     SCENARIOS,
+    VTYPES,
     network,
     on_highway,
     write_sumocfg,
@@ -608,3 +609,118 @@ def test_a_left_hand_traffic_network_is_refused_by_name(tmp_path):
     cfg = on_highway(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(), net)
     with pytest.raises(InputError, match=r"lh.net.xml: a left-hand-traffic network"):
         SumoSession.start(cfg)
+
+
+# --------------------------------------------------------------------------- fast departures
+SLOW_ROAD_NODES = '<nodes><node id="w" x="0" y="0"/><node id="e" x="3000" y="0"/></nodes>'
+SLOW_ROAD_EDGES = (
+    '<edges><edge id="E0" from="w" to="e" numLanes="1" speed="25" width="3.5"/>'
+    '<edge id="-E0" from="e" to="w" numLanes="1" speed="25" width="3.5"/></edges>'
+)
+
+
+def _fast_departures(folder: Path, step_length_s: float | None, lead_speed_mps: float) -> Path:
+    """A 25 m/s road: the ego departing at 120 s; "early" (at 119 s), "lead" (with the ego) and
+    "late" (at 121 s) departing at 30 m/s, "lead" at ``lead_speed_mps``; types without a
+    speed deviation (SUMO refuses their departures above the limit by itself). The sumocfg
+    gives ``begin`` and, if not None, its ``step-length``."""
+    network(folder, "slow", SLOW_ROAD_NODES, SLOW_ROAD_EDGES)
+    vehicle = (
+        '<vehicle id="{}" type="aro" route="r" depart="{}" departPos="{}" departSpeed="{}" '
+        'insertionChecks="none"/>'
+    )
+    (folder / "fast.rou.xml").write_text(
+        '<routes><route id="r" edges="E0"/>'
+        + vehicle.format("early", "119.00", 100, 30)
+        + vehicle.format("ego", "120.00", 100, 20).replace('"aro"', '"ego"')
+        + vehicle.format("lead", "120.00", 400, lead_speed_mps)
+        + vehicle.format("late", "121.00", 10, 30)
+        + "</routes>"
+    )
+    step = "" if step_length_s is None else f'<step-length value="{step_length_s}"/>'
+    cfg = folder / "fast.sumocfg"
+    cfg.write_text(
+        f'<configuration><input><net-file value="slow.net.xml"/>'
+        f'<route-files value="fast.rou.xml"/><additional-files value="{VTYPES}"/></input>'
+        f'<time><begin value="0"/>{step}</time></configuration>'
+    )
+    return cfg
+
+
+@pytest.mark.sumo
+@pytest.mark.parametrize("step_length_s", [None, 0.1])
+def test_vehicles_faster_than_the_lane_limit_depart_at_their_speed(
+    tmp_path, open_session, step_length_s
+):
+    """docs/scenarios.md: other vehicles faster than the lane's limit depart at their speed
+    (SUMO alone refuses them for a type without speedDev), before, with and after the ego,
+    whether or not the time before the ego's departure runs at a longer step."""
+    s = open_session(_fast_departures(tmp_path, step_length_s, 30.0))
+    assert s.vehicle_speed("lead") == pytest.approx(30.0)
+    assert s.vehicle_speed("early") == pytest.approx(30.0)
+    while s.time_s < 121.5:
+        s.step()
+    for vid in ("early", "lead", "late"):
+        assert s.vehicle_speed(vid) == pytest.approx(30.0), vid
+
+
+@pytest.mark.sumo
+@pytest.mark.parametrize("step_length_s", [None, 0.1])
+def test_a_refusal_quotes_sumos_error_not_the_warnings_before_it(tmp_path, step_length_s):
+    """Faster than its type's maxSpeed (50 m/s): SUMO's refusal, in SUMO's words, even when
+    the handover at the longer step leaves a warning in SUMO's error log first. (Through
+    TraCI: the message comes from the error log, and SUMO runs in a process of its own; a
+    libsumo that failed during a step may not fail the same way in its next session.)"""
+    cfg = _fast_departures(tmp_path, step_length_s, 70.0)
+    with pytest.raises(InputError) as refused:
+        SumoSession.start(cfg, use_traci=True)
+    message = str(refused.value)
+    assert "Departure speed for vehicle 'lead' is too high for the vehicle type 'aro'" in message
+    assert "Warning" not in message and "State was written" not in message
+
+
+# --------------------------------------------------------------------------- refusals that say why
+def test_a_flow_cannot_be_the_ego(tmp_path):
+    cfg = on_highway(
+        tmp_path,
+        '<routes><route id="r" edges="E0"/>'
+        '<flow id="ego" type="ego" route="r" begin="0" end="10" number="2"/></routes>',
+    )
+    with pytest.raises(InputError, match=r"v\.rou\.xml: 'ego' is a <flow>: a flow cannot be"):
+        SumoSession.start(cfg)
+
+
+@pytest.mark.sumo
+def test_a_route_that_skips_an_edge_is_not_connected(tmp_path):
+    net = network(
+        tmp_path,
+        "chain",
+        '<nodes><node id="n0" x="0" y="0"/><node id="n1" x="1000" y="0"/>'
+        '<node id="n2" x="2000" y="0"/><node id="n3" x="3000" y="0"/></nodes>',
+        '<edges><edge id="a" from="n0" to="n1" numLanes="2" speed="30"/>'
+        '<edge id="b" from="n1" to="n2" numLanes="2" speed="30"/>'
+        '<edge id="c" from="n2" to="n3" numLanes="2" speed="30"/></edges>',
+    )
+    routes = (
+        '<routes><vehicle id="ego" type="ego" depart="0" departPos="20" departSpeed="25">'
+        '<route edges="a c"/></vehicle></routes>'
+    )
+    with pytest.raises(
+        InputError,
+        match=r"v\.rou\.xml: the route of vehicle 'ego' is not connected: edge 'a' "
+        r"does not lead onto edge 'c'",
+    ):
+        SumoSession.start(on_highway(tmp_path, routes, net))
+
+
+@pytest.mark.sumo
+def test_an_oncoming_car_on_a_one_way_road_is_refused_as_such(tmp_path):
+    net = network(
+        tmp_path,
+        "oneway2",
+        '<nodes><node id="w" x="0" y="0"/><node id="e" x="3000" y="0"/></nodes>',
+        '<edges><edge id="E0" from="w" to="e" numLanes="2" speed="50" width="3.5"/></edges>',
+    )
+    cfg = on_highway(tmp_path, (SCENARIOS / "ego_only.rou.xml").read_text(), net)
+    with pytest.raises(InputError, match=r"oneway2\.net\.xml: no oncoming car .* one-way.*'E0'"):
+        SumoSession.start(cfg, ScenarioOverrides(oncoming_start_m=400.0))

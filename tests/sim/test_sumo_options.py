@@ -10,7 +10,12 @@ import pytest
 from eoam_sumo.sim.scenario import ScenarioOverrides
 from eoam_sumo.sim.session import SumoSession
 from eoam_sumo.sim.session.collisions import CollisionRecord, write_collision_output
-from eoam_sumo.sim.session.launch import ENFORCED_OPTIONS, sumo_command
+from eoam_sumo.sim.session.launch import (
+    ENFORCED_OPTIONS,
+    ERROR_LOG_STDERR,
+    start_error,
+    sumo_command,
+)
 from eoam_sumo.world.bodies import Body
 from tests.builders import on_highway
 
@@ -38,6 +43,39 @@ def _with_options(cfg: Path, xml: str) -> Path:
     """The sumocfg with these option sections added."""
     cfg.write_text(cfg.read_text().replace("</configuration>", xml + "</configuration>"))
     return cfg
+
+
+# --------------------------------------------------------------------------- SUMO's errors
+WARNING = (
+    "Warning: State was written at a different time=120.00 than the begin time 0 (set "
+    "option load-state.offset to force a different begin)!"
+)
+TOO_HIGH = (
+    "Departure speed for vehicle 'lead' is too high for the departure edge 'E0', time=120.00."
+)
+
+
+def _refusal(tmp_path: Path, error_log: str, stderr_log: str, exc_text: str) -> str:
+    log = tmp_path / "sumo-errors.log"
+    log.write_text(error_log)
+    (tmp_path / ERROR_LOG_STDERR).write_text(stderr_log)
+    return start_error(Path("s.sumocfg"), log, RuntimeError(exc_text))
+
+
+def test_a_refusal_quotes_sumos_error_and_never_a_warning(tmp_path):
+    prefix = "s.sumocfg: SUMO could not load the scenario: "
+    # only a warning logged (the handover's): the error is the exception's
+    assert _refusal(tmp_path, WARNING + "\n", WARNING + "\n", TOO_HIGH) == prefix + TOO_HIGH
+    # the error logged after the warning (TraCI: the exception says only that SUMO quit)
+    logged = f"{WARNING}\nError: {TOO_HIGH}\nQuitting (on error).\n"
+    assert _refusal(tmp_path, logged, "", "connection closed by SUMO") == prefix + TOO_HIGH
+    # a message over two lines stays whole, once though both logs hold it
+    two_lines = "Error: No connection between edge 'a'\n and edge 'c' found.\n"
+    assert (
+        _refusal(tmp_path, two_lines, two_lines, "x")
+        == prefix + "No connection between edge 'a' and edge 'c' found."
+    )
+    assert _refusal(tmp_path, "", "", "") == prefix + "RuntimeError"
 
 
 # --------------------------------------------------------------------------- the command line

@@ -53,7 +53,8 @@ def check_scenario(cfg: Path, ego_id: str = "ego") -> ScenarioFiles:
     """Check a ``.sumocfg`` and its files with ElementTree before SUMO sees them.
 
     Raises InputError naming the file for a missing or malformed file, a config without a
-    net-file, or no vehicle ``ego_id`` in its route and additional files.
+    net-file, or no vehicle ``ego_id`` in its route and additional files (a flow of that id
+    cannot be the ego).
     """
     cfg = Path(cfg)
     root = parse_xml(cfg, "sumocfg")
@@ -63,23 +64,43 @@ def check_scenario(cfg: Path, ego_id: str = "ego") -> ScenarioFiles:
     opposite = read_net(nets[0])
     routes = _option_files(root, cfg, "route-files")
     additionals = _option_files(root, cfg, "additional-files")
-    vehicles = {}
-    for path, what in [(p, "route file") for p in routes] + [
-        (p, "additional file") for p in additionals
-    ]:
-        for elem in parse_xml(path, what).iter():
-            if elem.tag in ("vehicle", "trip") and (vid := elem.get("id")) is not None:
-                params = {p.get("key"): p.get("value") for p in elem.findall("param")}
-                routed = elem.tag == "vehicle" and (
-                    "route" in elem.attrib or elem.find("route") is not None
-                )
-                vehicles[vid] = VehicleSpec(vid, path, dict(elem.attrib), params, routed)
+    vehicles, flows = _vehicles(routes, additionals)
     if ego_id not in vehicles:
+        if ego_id in flows:
+            raise InputError(
+                f"{flows[ego_id]}: '{ego_id}' is a <flow>: a flow cannot be the ego (SUMO "
+                f"makes vehicles '{ego_id}.0', '{ego_id}.1', ... of it); write the ego as one "
+                "<vehicle> or <trip>"
+            )
         searched = ", ".join(p.name for p in routes + additionals) or "no route files"
         raise InputError(
             f"{cfg}: no vehicle '{ego_id}' in its route or additional files ({searched})"
         )
     return ScenarioFiles(cfg, nets[0], routes, additionals, vehicles, opposite, _options(root))
+
+
+def _vehicles(
+    routes: tuple[Path, ...], additionals: tuple[Path, ...]
+) -> tuple[dict[str, VehicleSpec], dict[str, Path]]:
+    """(vid -> VehicleSpec of every ``<vehicle>`` and ``<trip>``, flow id -> its file) of the
+    route and additional files."""
+    vehicles, flows = {}, {}
+    for path, what in [(p, "route file") for p in routes] + [
+        (p, "additional file") for p in additionals
+    ]:
+        for elem in parse_xml(path, what).iter():
+            vid = elem.get("id")
+            if vid is None:
+                continue
+            if elem.tag == "flow":
+                flows[vid] = path
+            elif elem.tag in ("vehicle", "trip"):
+                params = {p.get("key"): p.get("value") for p in elem.findall("param")}
+                routed = elem.tag == "vehicle" and (
+                    "route" in elem.attrib or elem.find("route") is not None
+                )
+                vehicles[vid] = VehicleSpec(vid, path, dict(elem.attrib), params, routed)
+    return vehicles, flows
 
 
 def float_attr(spec: VehicleSpec, key: str, text: str) -> float:

@@ -8,6 +8,7 @@ in the insertion step.
 
 from __future__ import annotations
 
+import itertools
 import math
 import uuid
 from dataclasses import dataclass
@@ -78,6 +79,7 @@ def place_ego(
         type_id = veh.getTypeID(ego_id)
     except errors as exc:
         raise InputError(f"{spec.source}: SUMO did not load vehicle '{ego_id}': {exc}") from exc
+    check_route_connected(api, spec, edges)
     lane_index = _ego_lane_index(api, spec, edges[0], type_id)
     lane_id = f"{edges[0]}_{lane_index}"
     lane_len = lanes.getLength(lane_id)
@@ -108,6 +110,25 @@ def place_ego(
         lane_point(lanes, lane_id, pos)[:2],
         route_centreline(lanes, files, lane_id, edges, lane_index),
     )
+
+
+def check_route_connected(api, spec: VehicleSpec, edges: list[str]) -> None:
+    """InputError naming the route file and the two edges when some lane of a route edge does
+    not lead onto the next route edge at all (a route that skips an edge: SUMO checks it
+    only when the vehicle departs)."""
+    lanes = api.lane
+    for edge, following in itertools.pairwise(edges):
+        leads_on = any(
+            lanes.getEdgeID(link[0]) == following
+            for i in range(api.edge.getLaneNumber(edge))
+            for link in lanes.getLinks(f"{edge}_{i}")
+        )
+        if not leads_on:
+            raise InputError(
+                f"{spec.source}: the route of vehicle '{spec.vid}' is not connected: edge "
+                f"'{edge}' does not lead onto edge '{following}' (a route names every edge "
+                "it drives, in order)"
+            )
 
 
 def _ego_lane_index(api, spec: VehicleSpec, edge: str, type_id: str) -> int:
@@ -189,6 +210,49 @@ def route_centreline(
     return np.array(line, dtype=float)
 
 
+def let_fast_vehicles_depart(api, errors: tuple, files: ScenarioFiles, ego_id: str) -> None:
+    """Let every vehicle of the scenario's files that has not departed yet, the ego aside,
+    depart at a ``departSpeed`` above its departure edge's speed limit: SUMO chooses such a
+    vehicle a speed factor that allows the speed when its type has a speed deviation
+    (``speedDev`` > 0) and refuses the others ("Departure speed for vehicle ... is too high
+    for the departure edge"); those get that speed factor here (departSpeed / the edge's
+    lowest lane speed limit), so they too depart at their speed and keep it as their desired
+    speed. A speed above the vehicle type's ``maxSpeed`` stays SUMO's to refuse."""
+    veh = api.vehicle
+    try:
+        pending = set(veh.getLoadedIDList()) - set(veh.getIDList())
+    except errors:
+        return
+    for vid, spec in files.vehicles.items():
+        speed = _given_depart_speed(spec)
+        if vid == ego_id or vid not in pending or speed is None:
+            continue
+        try:
+            if api.vehicletype.getSpeedDeviation(veh.getTypeID(vid)) > 0.0:
+                continue  # SUMO chooses its speed factor itself
+            limit_mps = _edge_speed_limit(api, veh.getRoute(vid)[0])
+            if speed > limit_mps * veh.getSpeedFactor(vid):
+                veh.setSpeedFactor(vid, speed / limit_mps)
+        except errors:
+            continue  # SUMO reports what is wrong with this vehicle when it departs
+
+
+def _given_depart_speed(spec: VehicleSpec) -> float | None:
+    """A vehicle's ``departSpeed`` when it is a number > 0, else None."""
+    try:
+        speed = float(spec.attrs.get("departSpeed", ""))
+    except ValueError:
+        return None
+    return speed if math.isfinite(speed) and speed > 0.0 else None
+
+
+def _edge_speed_limit(api, edge: str) -> float:
+    """The lowest speed limit of an edge's lanes [m/s]."""
+    return min(
+        float(api.lane.getMaxSpeed(f"{edge}_{i}")) for i in range(api.edge.getLaneNumber(edge))
+    )
+
+
 def add_oncoming(
     api,
     errors: tuple,
@@ -256,9 +320,11 @@ def _opposite_start(
         if o is not None
     ]
     if not candidates:
+        names = ", ".join(f"'{e}'" for e in ego.route_edges)
         raise InputError(
-            f"{files.net_file}: the ego's lane {ego.lane_id} has no "
-            "opposite lane (<neigh lane=...>) for the oncoming car"
+            f"{files.net_file}: no oncoming car (--oncoming-m, oncoming_start_m): the ego's "
+            f"road is one-way, no lane of the other direction lies beside its route (edges "
+            f"{names})"
         )
     (s_opp, _), k, lane_id = min(candidates, key=lambda c: c[0][1])
     edges = []

@@ -137,12 +137,33 @@ def stderr_into(path: Path):
 
 
 def start_error(cfg: Path, error_log: Path, exc: BaseException) -> str:
-    """One line with SUMO's own error messages (its error log and what it wrote to standard
-    error while starting, else the exception's text)."""
+    """One line with SUMO's own error messages: the errors in its error log and in what it
+    wrote to standard error while starting (never its warnings: a warning logged before the
+    error is not the reason), else the exception's text."""
     text = ""
     for log in (error_log, error_log.with_name(ERROR_LOG_STDERR)):
         with contextlib.suppress(OSError):
             text += log.read_text(errors="replace")
-    lines = [ln.strip().removeprefix("Error: ") for ln in (text or str(exc)).splitlines()]
-    detail = " ".join(ln for ln in lines if ln and ln != "Quitting (on error).")
+    errors = sumo_errors(text) or sumo_errors(str(exc))
+    detail = " ".join(dict.fromkeys(errors))  # each message once (both logs may hold it)
     return f"{cfg}: SUMO could not load the scenario: {detail or type(exc).__name__}"
+
+
+def sumo_errors(text: str) -> list[str]:
+    """SUMO's error messages in ``text`` (a log), without their "Error: " prefix: each message
+    begins a line with "Error: " or "Warning: " and may run on over the lines that follow;
+    lines before the first such line are errors too (an exception's text has no prefix).
+    Warnings and SUMO's "Quitting (on error)." are left out."""
+    messages: list[list[str]] = []
+    kinds: list[str] = []
+    for raw in text.splitlines():
+        line = raw.strip()
+        if not line or line == "Quitting (on error).":
+            continue
+        kind = next((k for k in ("Error: ", "Warning: ") if line.startswith(k)), "")
+        if kind or not messages:
+            messages.append([line.removeprefix(kind)])
+            kinds.append(kind or "Error: ")
+        else:
+            messages[-1].append(line)
+    return [" ".join(m) for m, kind in zip(messages, kinds, strict=True) if kind == "Error: "]

@@ -47,7 +47,12 @@ from eoam_sumo.sim.session.calls import StepCalls
 from eoam_sumo.sim.session.collisions import CollisionRecord, write_collision_output
 from eoam_sumo.sim.session.gui import GuiSettings, GuiView
 from eoam_sumo.sim.session.handover import SAVE_STATE_OPTIONS, handover_plan, run_and_hand_over
-from eoam_sumo.sim.session.insertion import EgoStart, add_oncoming, place_ego
+from eoam_sumo.sim.session.insertion import (
+    EgoStart,
+    add_oncoming,
+    let_fast_vehicles_depart,
+    place_ego,
+)
 from eoam_sumo.sim.session.launch import (
     ERROR_LOG_STDERR,
     shut_down,
@@ -133,6 +138,17 @@ def _connect(cmd: list, cfg: Path, error_log: Path, workdir: Path, via_traci: bo
     except errors as exc:
         raise InputError(start_error(cfg, error_log, exc)) from exc
     return _Started(libsumo, libsumo.constants, errors, None, False)
+
+
+def _started(
+    cmd: list, files: ScenarioFiles, ego_id: str, error_log: Path, workdir: Path, via_traci: bool
+) -> _Started:
+    """SUMO started (``_connect``), the vehicles it loaded let depart above their lane's limit
+    (``insertion.let_fast_vehicles_depart``: before the first step, at a handover's longer
+    step too)."""
+    started = _connect(cmd, files.cfg, error_log, workdir, via_traci)
+    let_fast_vehicles_depart(started.api, started.errors, files, ego_id)
+    return started
 
 
 def _hand_over(
@@ -255,7 +271,7 @@ class SumoSession:
                 *SAVE_STATE_OPTIONS,
             ]
         try:
-            started = _connect(first_cmd, files.cfg, error_log, workdir, via_traci)
+            started = _started(first_cmd, files, ego_id, error_log, workdir, via_traci)
             if plan is not None:
                 _hand_over(started, cmd, plan[1], files.cfg, error_log, workdir)
         except BaseException:
@@ -338,6 +354,7 @@ class SumoSession:
                     except Exception:  # noqa: BLE001 - TraCI's class may come from SUMO_HOME/tools
                         # TraCI of SUMO 1.28 cannot set friction: the override lives here only
                         settable = False
+        let_fast_vehicles_depart(self._api, self._errors, self._files, self.ego_id)
         while self._time_s < depart - 0.5 * self._dt:
             self._sumo_step()
         self.ego_depart_time_s = self._time_s
