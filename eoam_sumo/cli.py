@@ -75,14 +75,18 @@ def _seed(text: str) -> int:
     return value
 
 
-def _seconds_list(text: str) -> tuple[float, ...]:
+def _screenshot_times(text: str) -> tuple[tuple[float, bool], ...]:
+    """``T[,T...]``: (seconds, absolute) pairs; T is in seconds after the ego's departure,
+    ``@T`` in SUMO's time."""
     try:
-        values = tuple(float(t) for t in text.split(","))
+        times = tuple((float(t.strip().removeprefix("@")), "@" in t) for t in text.split(","))
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a list of seconds T[,T...]") from None
-    if not all(math.isfinite(v) and v >= 0.0 for v in values):
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a list of seconds T[,T...] (@T: SUMO's time)"
+        ) from None
+    if not all(math.isfinite(t) and t >= 0.0 for t, _ in times):
         raise argparse.ArgumentTypeError(f"times {text} s must be numbers >= 0")
-    return values
+    return times
 
 
 def _distance_or_none(text: str) -> float | None:
@@ -192,10 +196,17 @@ def _gui_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--gui-screenshot",
-        type=_seconds_list,
+        type=_screenshot_times,
         metavar="T[,T...]",
         default=(),
-        help="with --gui: screenshots at these simulation times (s) into --out",
+        help="with --gui: screenshots T s after the ego's departure (@T: at SUMO's time T) "
+        "into --out, named screenshot_+Ts.png (screenshot_@Ts.png)",
+    )
+    p.add_argument(
+        "--gui-close",
+        action="store_true",
+        help="with --gui: close the window at the end (default: it stays open, except on "
+        "a virtual display, Xvfb)",
     )
 
 
@@ -293,7 +304,7 @@ def _cmd_run(args) -> int:
     if s.get("sumo_overrides"):
         options = ", ".join(f"{k}={v}" for k, v in s["sumo_overrides"].items())
         print(f"eoam-sumo: SUMO options set over the scenario's: {options}", file=sys.stderr)
-    if args.gui:
+    if args.gui and settings.gui_settings.keep_open:
         print("eoam-sumo: the sumo-gui window stays open until you close it", file=sys.stderr)
     return 0
 
@@ -307,8 +318,8 @@ def _check_run_args(args) -> None:
     if args.radar_range_m is not None and args.radar_range_m <= 0:
         raise InputError(f"--radar-range-m {args.radar_range_m} must be > 0")
     _check_v2x(args)
-    if not args.gui and (args.gui_delay_ms is not None or args.gui_screenshot):
-        raise InputError("--gui-delay-ms and --gui-screenshot need --gui")
+    if not args.gui and (args.gui_delay_ms is not None or args.gui_screenshot or args.gui_close):
+        raise InputError("--gui-delay-ms, --gui-screenshot and --gui-close need --gui")
 
 
 def _run_settings(args, out: Path):
@@ -317,11 +328,15 @@ def _run_settings(args, out: Path):
     from eoam_sumo.sensing.friction import parse_mu_belief
     from eoam_sumo.sensing.radar import RadarSettings
     from eoam_sumo.sim.cosim import policy_settings
-    from eoam_sumo.sim.session.gui import GuiSettings
+    from eoam_sumo.sim.session.gui import GuiSettings, virtual_display
     from eoam_sumo.sim.settings import RunSettings
 
     gui = GuiSettings(
-        delay_ms=args.gui_delay_ms, screenshots_s=args.gui_screenshot, screenshot_dir=out
+        delay_ms=args.gui_delay_ms,
+        screenshots_s=tuple(t for t, absolute in args.gui_screenshot if not absolute),
+        screenshots_at_s=tuple(t for t, absolute in args.gui_screenshot if absolute),
+        screenshot_dir=out,
+        keep_open=not (args.gui_close or virtual_display()),  # Xvfb: nobody sees the window
     )
     settings = RunSettings(
         max_time_s=args.max_time_s,

@@ -44,7 +44,7 @@ def test_handed_over_state_is_the_sumocfg_steps_state(traffic_cfg, tmp_path):
     import libsumo
 
     files = check_scenario(traffic_cfg)
-    assert handover_plan(files, "ego", 0.01, {}, (), False) == (0.5, DEPART_S)
+    assert handover_plan(files, "ego", 0.01, {}, ()) == (0.5, DEPART_S)
     binary = sumolib.checkBinary("sumo")
     coarse, _ = sumo_command(binary, traffic_cfg, files.options, 0.5, tmp_path / "e.log", (), False)
     fine, _ = sumo_command(binary, traffic_cfg, files.options, 0.01, tmp_path / "e.log", (), False)
@@ -82,10 +82,9 @@ def test_session_departs_the_ego_after_the_handover(traffic_cfg):
 
 def test_no_handover_where_the_scenario_does_not_ask_for_a_longer_step(traffic_cfg, tmp_path):
     files = check_scenario(traffic_cfg)
-    assert handover_plan(files, "ego", 0.5, {}, (), False) is None  # already the step
-    assert handover_plan(files, "ego", 0.01, {}, ("--step-length", "0.1"), False) is None
-    assert handover_plan(files, "ego", 0.01, {}, (), True) is None  # sumo-gui
-    assert handover_plan(files, "ego", 0.01, {"broken": (0.0, 5.0)}, (), False) is None
+    assert handover_plan(files, "ego", 0.5, {}, ()) is None  # already the step
+    assert handover_plan(files, "ego", 0.01, {}, ("--step-length", "0.1")) is None
+    assert handover_plan(files, "ego", 0.01, {"broken": (0.0, 5.0)}, ()) is None
     text = traffic_cfg.read_text()
     with_output = tmp_path / "o.sumocfg"
     with_output.write_text(
@@ -95,6 +94,6 @@ def test_no_handover_where_the_scenario_does_not_ask_for_a_longer_step(traffic_c
             "</configuration>", '<output><fcd-output value="fcd.xml"/></output></configuration>'
         )
     )
-    assert handover_plan(check_scenario(with_output), "ego", 0.01, {}, (), False) is None
+    assert handover_plan(check_scenario(with_output), "ego", 0.01, {}, ()) is None
     baseline = check_scenario(BASELINE)  # its own step is 10 ms: Table 2 is unchanged
-    assert handover_plan(baseline, "ego", 0.01, {}, (), False) is None
+    assert handover_plan(baseline, "ego", 0.01, {}, ()) is None

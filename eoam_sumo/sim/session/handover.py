@@ -8,12 +8,13 @@ there (``simulation.saveState`` at full precision, random number generators and 
 included) and loaded into SUMO restarted at the co-simulation's step (``load`` with
 ``--load-state``), which steps on to the departure. The state at the handover is the one the
 scenario's own step length produces (vehicle positions, speeds, angles and lanes equal to a
-plain SUMO run at that step, checked by the tests).
+plain SUMO run at that step, checked by the tests). sumo-gui hands over the same way (``load``
+restarts the simulation in its window), so a run watched in it is the run without it.
 
 No handover (the whole run at the co-simulation's step) when the sumocfg's step is not longer
 (or not given: SUMO's default of 1 s is not the scenario asking for it), when the user's extra
-options set the step length, under sumo-gui, or when the sumocfg writes any output file or
-log (SUMO's restart would start those files anew).
+options set the step length, or when the sumocfg writes any output file or log (SUMO's
+restart would start those files anew).
 """
 
 from __future__ import annotations
@@ -70,7 +71,6 @@ def handover_plan(
     step_s: float,
     scripted: dict,
     extra: tuple[str, ...],
-    gui: bool,
 ) -> tuple[float, float] | None:
     """(the sumocfg's step [s], handover time [s]) when the time before the ego's departure
     is to be run at the sumocfg's step, else None."""
@@ -80,7 +80,6 @@ def handover_plan(
     if (
         coarse is None
         or coarse <= step_s + 1e-9
-        or gui
         or "step-length" in given
         or "load-state" in given
         or "load-state" in options

@@ -263,13 +263,13 @@ class SumoSession:
             gui,
             keep_gui_open=gui_settings.keep_open,
         )
-        plan = handover_plan(files, ego_id, step, scripted, extra, gui)
+        plan = handover_plan(files, ego_id, step, scripted, extra)
         first_cmd = cmd
-        if plan is not None:
-            first_cmd = [
-                *sumo_command(binary, files.cfg, files.options, plan[0], error_log, extra, gui)[0],
-                *SAVE_STATE_OPTIONS,
-            ]
+        if plan is not None:  # sumo-gui too: a run watched in it is the run without it
+            coarse_cmd, _ = sumo_command(
+                binary, files.cfg, files.options, plan[0], error_log, extra, gui
+            )
+            first_cmd = [*coarse_cmd, *SAVE_STATE_OPTIONS]
         try:
             started = _started(first_cmd, files, ego_id, error_log, workdir, via_traci)
             if plan is not None:
@@ -361,6 +361,9 @@ class SumoSession:
         ego = self._ego = place_ego(
             self._api, self._errors, self._files, self._overrides, self.ego_id, self._over_limit
         )
+        if self.gui is not None:
+            self.gui.depart(self._time_s, ego.front_xy)
+            self.gui.request_screenshots(self._time_s + self._dt)
         self.lane_width_m = ego.lane_width_m
         self.left_lane_exists = ego.left_lane_exists
         self._ego_mu = self._friction(ego.lane_id)
@@ -594,6 +597,8 @@ class SumoSession:
     def close(self) -> None:
         """End SUMO (idempotent; a sumo-gui window meant to stay open is left to the user),
         then add the recorded collisions to the scenario's collision-output."""
+        if self.gui is not None:
+            self.gui.finish(self._time_s)  # warns of the screenshots the run did not reach
         self._release()
         shutil.rmtree(self._workdir, ignore_errors=True)
         if self._collisions and self.collision_output is not None:
