@@ -25,6 +25,7 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
+from eoam_sumo.errors import InputError
 from eoam_sumo.sim.roadframe import RoadFrame
 from eoam_sumo.sim.runlog import ROAD_FILE, read_road
 from eoam_sumo.world.geometry import OrientedBox, box_distance
@@ -77,7 +78,10 @@ def ego_road(run_dir: Path, ts: pd.DataFrame) -> EgoRoad:
     path = Path(run_dir) / ROAD_FILE
     if path.is_file():
         return EgoRoad(RoadFrame(read_road(path)), 0.0, f"{ROAD_FILE} (the run's centre line)")
-    points, s0 = centreline_from_ego(ts)
+    try:
+        points, s0 = centreline_from_ego(ts)
+    except ValueError as exc:
+        raise InputError(f"{Path(run_dir) / 'timeseries.csv'}: {exc}") from exc
     covered = (float(np.nanmin(ts["s_m"])), float(np.nanmax(ts["s_m"])))
     return EgoRoad(
         RoadFrame(points), s0, "the ego's samples (no road.csv): straight beyond them", covered

@@ -46,7 +46,12 @@ from eoam_sumo.plotting.roadtracks import (
 )
 from eoam_sumo.plotting.run_plots import load_run, run_title
 from eoam_sumo.plotting.runfacts import fit, lane_width_m
-from eoam_sumo.sim.trafficlog import TRAFFIC_FILE, TRAFFIC_RADIUS_M, read_traffic
+from eoam_sumo.sim.trafficlog import (
+    TRAFFIC_COLUMNS,
+    TRAFFIC_FILE,
+    TRAFFIC_RADIUS_M,
+    read_traffic,
+)
 
 TRAFFIC_PNG = "traffic.png"
 #: Road users whose centre stays farther than this many lane widths from the ego lane's
@@ -57,7 +62,6 @@ FAR_LANES = 3.0
 FALLBACK_REACH_M = 50.0
 #: A road user's rows further apart than this in time are drawn as separate pieces [s].
 TRACK_GAP_S = 0.05
-CONTACT_COLOUR = "black"
 CLOSEST_STYLE = {"aro": ("v", "obstacle"), "oncoming": ("D", "oncoming")}
 
 
@@ -102,7 +106,6 @@ def read_scene(run_dir: Path, summary: dict, ts: pd.DataFrame) -> TrafficScene:
     traffic, why = _read_traffic(run_dir)
     if why:
         notes.append(why)
-        traffic = _no_traffic()
     traffic = project_traffic(traffic, road)
     traffic, dropped = _near_the_road(traffic, road, width)
     if dropped:
@@ -120,22 +123,23 @@ def read_scene(run_dir: Path, summary: dict, ts: pd.DataFrame) -> TrafficScene:
 
 
 def _read_traffic(run_dir: Path) -> tuple[pd.DataFrame, str]:
-    """traffic.csv's rows, or none and why (missing or empty); a damaged file is an
-    InputError naming it."""
+    """traffic.csv's rows with a whole footprint (finite pose, positive size), or none and
+    why (missing or empty); a damaged file is an InputError naming it."""
     path = run_dir / TRAFFIC_FILE
     if not path.is_file():
         return _no_traffic(), f"no {TRAFFIC_FILE} in the run folder: the ego alone"
     if path.stat().st_size == 0:
         return _no_traffic(), f"{TRAFFIC_FILE} is empty: the ego alone"
     frame = read_traffic(path)
+    pose = frame[["time_s", "x_m", "y_m", "heading_rad", "speed_mps"]].to_numpy(dtype=float)
+    whole = np.isfinite(pose).all(axis=1) & (frame["length_m"] > 0) & (frame["width_m"] > 0)
+    frame = frame[whole].reset_index(drop=True)
     if frame.empty:
         return frame, f"{TRAFFIC_FILE} holds no rows: the ego alone"
-    return frame.reset_index(drop=True), ""
+    return frame, ""
 
 
 def _no_traffic() -> pd.DataFrame:
-    from eoam_sumo.sim.trafficlog import TRAFFIC_COLUMNS
-
     return pd.DataFrame({c: pd.Series(dtype=float) for c in TRAFFIC_COLUMNS}).astype(
         {"id": str, "vclass": str, "role": str}
     )

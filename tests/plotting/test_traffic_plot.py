@@ -185,3 +185,16 @@ def test_a_damaged_traffic_csv_is_one_line_and_exit_2(southbound, tmp_path, caps
     assert main(["plot", str(copy), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err.strip()
     assert "traffic.csv" in err and "\n" not in err
+
+
+def test_a_row_without_a_whole_footprint_is_left_out(southbound, tmp_path):
+    copy = tmp_path / "run"
+    shutil.copytree(southbound, copy)
+    with (copy / "traffic.csv").open("a") as f:
+        f.write(
+            "5.0,ghost,passenger,other,10,-50,nan,1,4.5,1.8\n5.0,flat,passenger,other,1,-40,0,1,0,1.8\n"
+        )
+    summary, ts = load_run(copy)
+    scene = read_scene(copy, summary, ts)
+    assert not {"ghost", "flat"} & set(scene.traffic["id"])
+    assert plot_traffic(copy, tmp_path).is_file()
