@@ -406,7 +406,7 @@ def _mark_contact_plan(ax, scene: TrafficScene) -> None:
         ax.fill(outline[:, 0], outline[:, 1], color=colour, alpha=0.3, zorder=5)
         ax.plot(outline[:, 0], outline[:, 1], color="black", linewidth=1.0, zorder=5)
     ax.plot(*point, "*", color="yellow", markeredgecolor="black", markersize=16, zorder=7)
-    _note(ax, _contact_text(scene), point)
+    _note(ax, _contact_text(scene), point, above=False)  # a braking note may be above
 
 
 def _mark_contact_time(ax, scene: TrafficScene) -> None:
