@@ -20,7 +20,9 @@ def plot_folder(folder: Path, out_dir: Path) -> list[Path]:
 
         if not (folder / "timeseries.csv").is_file():
             raise InputError(f"{folder}: has summary.json but no timeseries.csv")
-        return plot_run(folder, out_dir)
+        from eoam_sumo.plotting.traffic_plots import plot_traffic
+
+        return [*plot_run(folder, out_dir), plot_traffic(folder, out_dir)]
     if (folder / "phase_boundaries.csv").is_file():
         from eoam_sumo.offline.tables import NPZ_NAME
         from eoam_sumo.plotting.offline_plots import plot_accel_profiles, plot_phase_diagrams

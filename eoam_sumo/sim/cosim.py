@@ -555,7 +555,14 @@ def run_case(
     if extra:
         summary = {**extra, **summary}
     if out_dir is not None:
-        write_run(Path(out_dir), summary, log, timeseries, sim.traffic)
+        write_run(
+            Path(out_dir),
+            summary,
+            log,
+            timeseries,
+            sim.traffic,
+            sim.session.ego_lane_centreline(),
+        )
     return summary
 
 

@@ -1,4 +1,5 @@
-"""Preallocated per-step log of a co-simulation run and its files (timeseries.csv, summary.json).
+"""Preallocated per-step log of a co-simulation run and its files (timeseries.csv, road.csv,
+summary.json).
 
 One entry per SUMO step, the step's values kept as a tuple in a preallocated list (no row
 layout, numpy or pandas work in the loop); the rows and the float array are built once at the
@@ -249,11 +250,18 @@ def read_timeseries(path: Path, columns: list[str] | None = None):
 
 
 def write_run(
-    out_dir: Path, summary: dict, log: RunLog, timeseries: str = "csv", traffic=None
+    out_dir: Path,
+    summary: dict,
+    log: RunLog,
+    timeseries: str = "csv",
+    traffic=None,
+    centreline=None,
 ) -> None:
     """Write the time series (``timeseries.csv``, ``timeseries.parquet`` through pyarrow, or
     none), the traffic log (a ``TrafficLog``, if given, in the same format: ``traffic.csv``
-    or ``traffic.parquet``) then ``summary.json`` (each atomically) into ``out_dir``."""
+    or ``traffic.parquet``), the road frame's ``centreline`` (if given, with a time series:
+    ``road.csv``, :func:`write_road`) then ``summary.json`` (each atomically) into
+    ``out_dir``."""
     out_dir.mkdir(parents=True, exist_ok=True)
     if timeseries == "csv":
         csv = log.frame().to_csv(index=False, float_format="%.9g")
@@ -265,4 +273,42 @@ def write_run(
         raise InputError(f"time series format {timeseries!r} is not csv, parquet or none")
     if traffic is not None and timeseries != "none":
         traffic.write(out_dir / f"traffic.{timeseries}")
+    if centreline is not None and timeseries != "none":
+        write_road(out_dir / ROAD_FILE, centreline)
     write_atomic(out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
+
+
+#: The road frame's centre line: the ego's start lane followed along its route, the line the
+#: run's stations and lateral offsets (``s_m``, ``lateral_offset_m``) and traffic.csv's roles
+#: are measured from (``sim.roadframe``), so that a plot can place every road user in it.
+ROAD_FILE = "road.csv"
+ROAD_COLUMNS = ("s_m", "x_m", "y_m")
+
+
+def write_road(path: Path, centreline) -> None:
+    """The centre line's vertices (an (N, 2) sequence of x, y in network coordinates) as CSV:
+    ``s_m, x_m, y_m``, the station from the line's start (mm precision)."""
+    from eoam_sumo.sim.roadframe import arclength
+
+    xy = np.asarray(centreline, dtype=float).reshape(-1, 2)
+    rows = [",".join(ROAD_COLUMNS)]
+    rows += [f"{s:.3f},{x:.3f},{y:.3f}" for s, (x, y) in zip(arclength(xy), xy)]
+    write_atomic(Path(path), "\n".join(rows) + "\n")
+
+
+def read_road(path: Path) -> np.ndarray:
+    """The (N, 2) vertices of a run's road.csv; InputError naming the file when it cannot be
+    read, lacks a column or has fewer than two points."""
+    import pandas as pd
+
+    try:
+        frame = pd.read_csv(path, dtype=float)
+        xy = frame[["x_m", "y_m"]].to_numpy(dtype=float)
+    except (OSError, KeyError, ValueError, pd.errors.EmptyDataError, pd.errors.ParserError) as exc:
+        raise InputError(f"{path}: cannot be read as a run's road centre line: {exc}") from exc
+    if len(xy) < 2 or not np.isfinite(xy).all():
+        raise InputError(
+            f"{path}: cannot be read as a run's road centre line: fewer than two points, "
+            "or a value that is not a number"
+        )
+    return xy

@@ -173,6 +173,7 @@ def test_plots_of_a_run_folder_and_a_batch_folder(reference, tmp_path):
         "gg.png",
         "phase_trace.png",
         "steering.png",
+        "traffic.png",
     ]
     batch_pngs = plot_folder(out, tmp_path / "batch")
     assert sorted(p.name for p in batch_pngs) == [
