@@ -16,8 +16,8 @@ from eoam_sumo.matrix import Case
 #: ``--timeseries`` format.
 TIMESERIES_FORMATS = ("csv", "parquet", "none")
 CASE_FILES_OF = {
-    "csv": ("timeseries.csv", "traffic.csv", "summary.json"),
-    "parquet": ("timeseries.parquet", "traffic.parquet", "summary.json"),
+    "csv": ("timeseries.csv", "traffic.csv", "road.csv", "summary.json"),
+    "parquet": ("timeseries.parquet", "traffic.parquet", "road.csv", "summary.json"),
     "none": ("summary.json",),
 }
 ALL_CASE_FILES = (
@@ -25,6 +25,7 @@ ALL_CASE_FILES = (
     "timeseries.parquet",
     "traffic.csv",
     "traffic.parquet",
+    "road.csv",
     "summary.json",
 )
 #: Modules a worker imports before its first case, so start-up is not charged to a case.
