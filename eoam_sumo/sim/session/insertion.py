@@ -366,7 +366,8 @@ def insert(
     veh = api.vehicle
     route_id = f"eoam.route.{vid}.{uuid.uuid4().hex[:8]}"
     api.route.add(route_id, edges)
-    try:
+
+    def add(depart_speed: str) -> None:
         veh.add(
             vid,
             route_id,
@@ -374,23 +375,18 @@ def insert(
             depart="now",
             departLane=str(lane_index),
             departPos=repr(float(pos)),
-            departSpeed=repr(float(speed)),
+            departSpeed=depart_speed,
         )
+
+    try:
+        add(repr(float(speed)))
     except errors as exc:
         if "too high" not in str(exc):
             raise
         # SUMO refuses a departure above the lane's limit times the vehicle's speed factor,
         # or above its type's maximum: depart at rest, with room to go faster; the speed
         # set below applies from the insertion step on (speed modes without limits)
-        veh.add(
-            vid,
-            route_id,
-            type_id,
-            depart="now",
-            departLane=str(lane_index),
-            departPos=repr(float(pos)),
-            departSpeed="0",
-        )
+        add("0")
         limit = api.lane.getMaxSpeed(f"{edges[0]}_{lane_index}")
         veh.setSpeedFactor(vid, max(veh.getSpeedFactor(vid), speed / limit * (1.0 + 1e-6)))
         veh.setMaxSpeed(vid, max(veh.getMaxSpeed(vid), speed * (1.0 + 1e-6)))
