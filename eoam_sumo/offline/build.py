@@ -42,15 +42,11 @@ from eoam_sumo.offline.ocp import LaneChangeOcp, solve_chain, solver_options
 from eoam_sumo.offline.resim import Resimulation, audit, resimulate
 from eoam_sumo.params import VehicleParams, aro_d_class_minivan, describe, ego_e_class_sedan
 
+#: phase_boundaries.csv: the grid point, the boundaries the tables read, then the rest
 CSV_COLUMNS = (
     "mu",
     "speed_kmh",
-    "stop_distance_m",
-    "stop_distance_buffered_m",
-    "clear_distance_const_m",
-    "clear_distance_opt_m",
-    "clear_distance_buffered_m",
-    "ttc_s",
+    *tb.BOUNDARY_COLUMNS,
     "max_decel_mps2",
     "manoeuvre_length_m",
     "manoeuvre_time_s",

@@ -180,6 +180,16 @@ def plot_dynamics(case_dir: Path, out_dir: Path) -> Path:
     axes[1].set_yticks([0, 1], ["off", "on"])
     for ax in axes[-2:]:
         ax.set_xlabel("time [s]")
+    _mode_figure_legend(fig, ts)
+    fig.suptitle(
+        fit("EOAM dynamics (cf. paper Figure 22) — " + run_title(summary, ts, case_dir), 14, 11),
+        fontsize=11,
+    )
+    return save(fig, Path(out_dir) / "dynamics.png")
+
+
+def _mode_figure_legend(fig: Figure, ts) -> None:
+    """The legend of the EOAM modes shaded behind the curves, below the figure."""
     fig.legend(
         handles=_mode_legend(_modes_in(ts)),
         loc="outside lower center",
@@ -188,11 +198,6 @@ def plot_dynamics(case_dir: Path, out_dir: Path) -> Path:
         title="background: EOAM mode",
         title_fontsize=8,
     )
-    fig.suptitle(
-        fit("EOAM dynamics (cf. paper Figure 22) — " + run_title(summary, ts, case_dir), 14, 11),
-        fontsize=11,
-    )
-    return save(fig, Path(out_dir) / "dynamics.png")
 
 
 def plot_steering(case_dir: Path, out_dir: Path) -> Path:
@@ -238,14 +243,7 @@ def plot_steering(case_dir: Path, out_dir: Path) -> Path:
         ax.grid(alpha=0.3)
     for ax in axes[2:]:
         ax.set_xlabel("time [s]")
-    fig.legend(
-        handles=_mode_legend(_modes_in(ts)),
-        loc="outside lower center",
-        ncols=6,
-        fontsize=8,
-        title="background: EOAM mode",
-        title_fontsize=8,
-    )
+    _mode_figure_legend(fig, ts)
     fig.suptitle(
         fit(
             "Steering, lateral acceleration and yaw rate (cf. paper Figure 23) — "

@@ -534,15 +534,7 @@ class SumoSession:
                 person.getSpeed(vid),
                 person.getTypeID(vid),
             )
-        veh = self._veh
-        return self._users.vehicle_body(
-            vid,
-            veh.getPosition(vid),
-            veh.getAngle(vid),
-            veh.getSpeed(vid),
-            veh.getTypeID(vid),
-            veh.getStopState(vid),
-        )
+        return self._users.vehicle_now(vid)
 
     def mass_kg(self, vid: str) -> float:
         """A road user's mass as SUMO has it (``getMass``: its vType's ``mass``, or SUMO's

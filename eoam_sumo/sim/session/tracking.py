@@ -196,20 +196,20 @@ class RoadUsers:
 
     def everyone(self) -> list:
         """Bodies of all road users, wherever they are (getters: not for the step loop)."""
-        veh = self._veh
-        bodies = [
-            self.vehicle_body(
-                vid,
-                veh.getPosition(vid),
-                veh.getAngle(vid),
-                veh.getSpeed(vid),
-                veh.getTypeID(vid),
-                veh.getStopState(vid),
-            )
-            for vid in veh.getIDList()
-            if vid != self.ego_id
-        ]
+        bodies = [self.vehicle_now(vid) for vid in self._veh.getIDList() if vid != self.ego_id]
         return bodies + self._persons_near(0.0, 0.0, math.inf)
+
+    def vehicle_now(self, vid: str) -> Body:
+        """One vehicle's body read with getters (not for the step loop)."""
+        veh = self._veh
+        return self.vehicle_body(
+            vid,
+            veh.getPosition(vid),
+            veh.getAngle(vid),
+            veh.getSpeed(vid),
+            veh.getTypeID(vid),
+            veh.getStopState(vid),
+        )
 
     def _vehicles_near(
         self, results: dict[str, dict[int, Any]], ex: float, ey: float, radius_m: float
