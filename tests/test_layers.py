@@ -26,6 +26,7 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
     "colours": (set(), set()),
     "params": (set(), set()),
     "fileio": ({"errors"}, set()),
+    "vehicle_files": ({"params", "errors"}, set()),
     "sampling": ({"errors"}, {"numpy"}),
     "plant": ({"params"}, {"numpy", "casadi"}),
     "manoeuvre": ({"params"}, {"numpy"}),

@@ -1,0 +1,138 @@
+"""Vehicle files: a ``VehicleParams`` as TOML, every value with its unit and its source.
+
+A vehicle file has one table per parameter of ``params.VehicleParams``::
+
+    [mass_kg]
+    value = 1723.0
+    unit = "kg"
+    source = "CarSim E-class sedan table, Jing et al., IEEE T-ITS 2022"
+
+Every parameter must be present, with the unit the dataclass states and a non-empty source;
+unknown keys are refused (a misspelt key would otherwise fall back to the sedan's value).
+``--vehicle NAME`` looks NAME up in the catalogue (``vehicles/NAME.toml``); anything with a
+``.toml`` suffix or a path separator is read as the user's own file.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import tomllib
+from pathlib import Path
+
+from eoam_sumo.errors import InputError
+from eoam_sumo.params import VehicleParams
+
+DEFAULT_VEHICLE = "sedan"
+
+
+def default_vehicles_dir() -> Path:
+    """``$EOAM_VEHICLES_DIR`` if set, else the repository's ``vehicles/``."""
+    env = os.environ.get("EOAM_VEHICLES_DIR")
+    if env:
+        return Path(env)
+    return Path(__file__).resolve().parents[1] / "vehicles"
+
+
+def catalogue(directory: Path | None = None) -> list[str]:
+    """Names of the catalogue's vehicles (file stems), sorted."""
+    folder = directory or default_vehicles_dir()
+    return sorted(p.stem for p in folder.glob("*.toml"))
+
+
+def vehicle_path(name_or_file: str, directory: Path | None = None) -> Path:
+    """The file of a catalogue NAME, or the user's own FILE; ``InputError`` if neither."""
+    text = str(name_or_file)
+    if text.endswith(".toml") or os.sep in text or "/" in text:
+        path = Path(text)
+        if not path.is_file():
+            raise InputError(f"{path}: no such vehicle file")
+        return path
+    folder = directory or default_vehicles_dir()
+    path = folder / f"{text}.toml"
+    if not path.is_file():
+        known = ", ".join(catalogue(folder)) or "none"
+        raise InputError(f"--vehicle {text!r}: not in the catalogue ({known}) nor a .toml file")
+    return path
+
+
+def load_vehicle(name_or_file: str, directory: Path | None = None) -> VehicleParams:
+    """The ``VehicleParams`` of a catalogue NAME or a vehicle FILE (checked, see module doc)."""
+    path = vehicle_path(name_or_file, directory)
+    try:
+        with path.open("rb") as fh:
+            data = tomllib.load(fh)
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot read: {exc}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: not valid TOML: {exc}") from None
+    return params_from_tables(data, path)
+
+
+def params_from_tables(data: dict, path: Path) -> VehicleParams:
+    """``VehicleParams`` from a vehicle file's parsed tables; ``InputError`` names the key."""
+    fields = {f.name: f for f in dataclasses.fields(VehicleParams)}
+    unknown = sorted(set(data) - set(fields))
+    if unknown:
+        raise InputError(f"{path}: unknown key {unknown[0]!r} (a VehicleParams field expected)")
+    values = {name: _value(data, f, path) for name, f in fields.items()}
+    try:
+        return VehicleParams(**values)
+    except ValueError as exc:
+        raise InputError(f"{path}: {exc}") from None
+
+
+def _value(data: dict, f: dataclasses.Field, path: Path):
+    """One parameter's value, its type, unit and source checked."""
+    entry = data.get(f.name)
+    if entry is None:
+        raise InputError(f"{path}: key {f.name!r} is missing")
+    if not isinstance(entry, dict) or "value" not in entry:
+        raise InputError(f"{path}: key {f.name!r} must be a table with value, unit and source")
+    unit = f.metadata.get("unit", "")
+    if entry.get("unit") != unit:
+        raise InputError(f"{path}: key {f.name!r} has unit {entry.get('unit')!r}, not {unit!r}")
+    source = entry.get("source")
+    if not isinstance(source, str) or not source.strip():
+        raise InputError(f"{path}: key {f.name!r} has no source")
+    return _typed(entry["value"], f, path)
+
+
+def _typed(value, f: dataclasses.Field, path: Path):
+    """The value in the field's type (the default's); floats finite and >= 0."""
+    kind = type(f.default)
+    if kind is float and isinstance(value, (int, float)) and not isinstance(value, bool):
+        value = float(value)
+        if not (math.isfinite(value) and value >= 0.0):
+            raise InputError(f"{path}: key {f.name!r} = {value!r} must be finite and >= 0")
+        return value
+    if isinstance(value, kind) and not (kind is int and isinstance(value, bool)):
+        return value
+    raise InputError(f"{path}: key {f.name!r} = {value!r} must be a {kind.__name__}")
+
+
+def vehicle_toml(params: VehicleParams) -> str:
+    """The vehicle file of ``params`` (every field with its unit and its source)."""
+    blocks = []
+    for f in dataclasses.fields(params):
+        value = getattr(params, f.name)
+        lines = [
+            f"[{f.name}]",
+            f"value = {_toml_scalar(value)}",
+            f"unit = {_toml_scalar(f.metadata.get('unit', ''))}",
+            f"source = {_toml_scalar(f.metadata.get('source', ''))}",
+        ]
+        blocks.append("\n".join(lines))
+    return "\n\n".join(blocks) + "\n"
+
+
+def _toml_scalar(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, int):
+        return str(value)
+    escaped = str(value).replace("\\", "\\\\").replace('"', '\\"')
+    return f'"{escaped}"'
