@@ -17,20 +17,41 @@ of a passenger car's tyres, below the 0.5 g the slowly increasing steer reaches)
 def understeer_gradient_deg_per_g(
     ay_mps2: np.ndarray,
     steer_road_rad: np.ndarray,
-    speed_mps: float,
+    yaw_rate_radps: np.ndarray,
+    vx_mps: np.ndarray,
     wheelbase_m: float,
     ay_range_g: tuple[float, float] = LINEAR_AY_RANGE_G,
 ) -> float:
-    """Understeer gradient (ISO 4138, constant speed): the slope of the road-wheel angle over
-    the lateral acceleration less that of the Ackermann angle ``L / R = L ay / v^2``, fitted by
-    least squares over ``ay_range_g``; in deg of road-wheel angle per g."""
+    """Understeer gradient (ISO 4138): the slope over the lateral acceleration of the
+    road-wheel angle less the Ackermann angle ``L / R``, the path curvature ``1 / R = r / vx``
+    taken per sample (so a speed that drifts does not bias it), fitted by least squares over
+    ``ay_range_g``; in deg of road-wheel angle per g."""
     ay_g = np.abs(ay_mps2) / G_MPS2
     window = (ay_g >= ay_range_g[0]) & (ay_g <= ay_range_g[1])
     if np.count_nonzero(window) < 2:
         raise ValueError(f"no lateral acceleration within {ay_range_g} g to fit")
+    sign = np.sign(np.mean(ay_mps2[window]))
+    ackermann_rad = wheelbase_m * yaw_rate_radps[window] / vx_mps[window]
+    excess_rad = sign * (steer_road_rad[window] - ackermann_rad)
+    slope = np.polyfit(sign * ay_mps2[window], excess_rad, 1)[0]
+    return math.degrees(slope) * G_MPS2
+
+
+def steer_angle_gradient_deg_per_g(
+    ay_mps2: np.ndarray,
+    steer_road_rad: np.ndarray,
+    ay_range_g: tuple[float, float] = LINEAR_AY_RANGE_G,
+) -> float:
+    """Steering angle gradient (ISO 4138): the slope of the road-wheel angle over the lateral
+    acceleration, least squares over ``ay_range_g``; deg per g (times the steering ratio: the
+    steering-wheel angle gradient)."""
+    window = (np.abs(ay_mps2) >= ay_range_g[0] * G_MPS2) & (
+        np.abs(ay_mps2) <= ay_range_g[1] * G_MPS2
+    )
+    if np.count_nonzero(window) < 2:
+        raise ValueError(f"no lateral acceleration within {ay_range_g} g to fit")
     slope = np.polyfit(np.abs(ay_mps2[window]), np.abs(steer_road_rad[window]), 1)[0]
-    gradient_rad_per_mps2 = slope - wheelbase_m / (speed_mps * speed_mps)
-    return math.degrees(gradient_rad_per_mps2) * G_MPS2
+    return math.degrees(slope) * G_MPS2
 
 
 class StepResponse(NamedTuple):

@@ -22,6 +22,7 @@ from eoam_sumo.vehicle_tests.common import (
 from eoam_sumo.vehicle_tests.harness import Controls, Run, Sample, Vehicle, simulate
 from eoam_sumo.vehicle_tests.steer_figures import (
     LINEAR_AY_RANGE_G,
+    steer_angle_gradient_deg_per_g,
     step_response,
     understeer_gradient_deg_per_g,
 )
@@ -29,6 +30,20 @@ from eoam_sumo.vehicle_tests.steer_figures import (
 RAMP_END_FRACTION = 0.9
 """A ramp steer ends once the lateral acceleration has fallen below this share of its peak
 (past the limit: more steering gives no more lateral acceleration) or the speed to half."""
+
+RAMP_STEER_RATE_DEGPS = 2.0
+"""Hand-wheel rate of the ramp steer [deg/s] (ours: slow enough that the understeer gradient
+is within 2 % of the one of steady turns at constant steer; at the 13.5 deg/s of the FMVSS 126
+slowly increasing steer the yaw response's lag adds about 0.1 deg/g)."""
+
+QUASI_STEADY_TOLERANCE = 0.1
+"""A ramp steer also ends when the lateral acceleration departs from ``vx r`` by more than this
+share: the turn is no longer quasi-steady (a spin, a slide, a wheel lifting), and ISO 4138
+describes steady turns."""
+
+RAMP_MIN_PEAK_MU = 0.2
+"""... judged once the peak is above this share of ``mu g`` (any car gets there; below it,
+the first wobbles of a noisy model would end the ramp)."""
 
 STEP_RISE_S = 0.1
 """Time of the step's steering ramp [s] (ours: a steering robot's quick step)."""
@@ -41,22 +56,27 @@ STEP_ITERATIONS = 3
 
 
 def ramp_steer(params: VehicleParams, options: TestOptions, vehicle: Vehicle | None = None):
-    """ISO 4138 at constant speed: the hand wheel turned left at 13.5 deg/s (the slowly
-    increasing steer of FMVSS 126 S7.6) with the speed held, until the lateral acceleration
-    stops growing. Figures: understeer gradient (deg of road-wheel angle per g, and of
-    hand-wheel angle) fitted over ``LINEAR_AY_RANGE_G``; the peak lateral acceleration."""
+    """ISO 4138 at constant speed: the hand wheel turned left at ``RAMP_STEER_RATE_DEGPS`` with
+    the speed held, until the lateral acceleration stops growing or the turn stops being
+    quasi-steady. Figures over ``LINEAR_AY_RANGE_G``: the understeer gradient and the steering
+    angle gradient (deg of road-wheel angle per g; of hand-wheel angle: times the steering
+    ratio); the peak lateral acceleration."""
     speed_mps = options.speed_mps(c.RAMP_SPEED_KMH)
-    run = slowly_increasing_steer(params, speed_mps, options.mu, vehicle)
+    run = slowly_increasing_steer(
+        params, speed_mps, options.mu, vehicle, rate_degps=RAMP_STEER_RATE_DEGPS
+    )
     road_rad = np.radians(run["steer_wheel_deg"]) / params.steering_ratio
-    mean_speed = float(np.mean(run["vx_mps"]))
+    steer_gradient = steer_angle_gradient_deg_per_g(run["ay_mps2"], road_rad)
     gradient = understeer_gradient_deg_per_g(
-        run["ay_mps2"], road_rad, mean_speed, params.wheelbase_m
+        run["ay_mps2"], road_rad, run["yaw_rate_radps"], run["vx_mps"], params.wheelbase_m
     )
     peak_mps2 = float(np.max(np.abs(run["ay_mps2"])))
     summary = header("ramp-steer", params, options, speed_mps)
     summary["figures"] = {
         "understeer_gradient_deg_per_g": round(gradient, 4),
-        "steering_wheel_gradient_deg_per_g": round(gradient * params.steering_ratio, 3),
+        "steer_angle_gradient_deg_per_g": round(steer_gradient, 4),
+        "steering_wheel_angle_gradient_deg_per_g": round(steer_gradient * params.steering_ratio, 3),
+        "steer_rate_degps": RAMP_STEER_RATE_DEGPS,
         "fit_range_g": list(LINEAR_AY_RANGE_G),
         "peak_lateral_acceleration_mps2": round(peak_mps2, 4),
         "peak_lateral_acceleration_g": round(peak_mps2 / G_MPS2, 4),
@@ -73,12 +93,14 @@ def slowly_increasing_steer(
     mu: float,
     vehicle: Vehicle | None,
     *,
+    rate_degps: float = c.SIS_STEER_RATE_DEGPS,
     until_ay_g: float | None = None,
 ) -> Run:
-    """Hand wheel turned left at 13.5 deg/s from ``SETTLE_S`` with the speed held, until the
-    lateral acceleration reaches ``until_ay_g`` (None: until it falls past its peak)."""
+    """Hand wheel turned left at ``rate_degps`` from ``SETTLE_S`` with the speed held, until
+    the lateral acceleration reaches ``until_ay_g`` (None: until it falls past its peak or the
+    turn is no longer quasi-steady)."""
     keep = speed_keeper(params, speed_mps)
-    rate_radps = math.radians(c.SIS_STEER_RATE_DEGPS) / params.steering_ratio
+    rate_radps = math.radians(rate_degps) / params.steering_ratio
     peak = [0.0]
 
     def driver(t_s: float, s: Sample) -> Controls:
@@ -88,8 +110,12 @@ def slowly_increasing_steer(
         peak[0] = max(peak[0], abs(s.ay_mps2))
         if until_ay_g is not None:
             return abs(s.ay_mps2) >= until_ay_g * G_MPS2
+        judged = peak[0] > RAMP_MIN_PEAK_MU * mu * G_MPS2
         fell = abs(s.ay_mps2) < RAMP_END_FRACTION * peak[0]
-        return fell or s.vx_mps < 0.5 * speed_mps
+        unsteady = abs(s.ay_mps2 - s.vx_mps * s.yaw_rate_radps) > QUASI_STEADY_TOLERANCE * abs(
+            s.ay_mps2
+        )
+        return (judged and (fell or unsteady)) or s.vx_mps < 0.5 * speed_mps
 
     duration_s = SETTLE_S + params.max_steer_rad / rate_radps + 2.0
     return simulate(vehicle_for(params, vehicle), speed_mps, driver, duration_s, mu, stop=stop)
