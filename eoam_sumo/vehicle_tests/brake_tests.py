@@ -9,8 +9,8 @@ import numpy as np
 from eoam_sumo.params import G_MPS2, VehicleParams
 from eoam_sumo.vehicle_tests import clauses as c
 from eoam_sumo.vehicle_tests.common import (
-    TestOptions,
-    TestResult,
+    VehicleTestOptions,
+    VehicleTestResult,
     criterion,
     header,
     overall,
@@ -41,7 +41,7 @@ BRAKE_RAMP_G_PER_S = 0.2
 against the 0.1 s brake lag, so each braking rate is passed quasi-statically)."""
 
 
-def brake(params: VehicleParams, options: TestOptions, vehicle: Vehicle | None = None):
+def brake(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle | None = None):
     """Full brake application from the test speed to a stop, engine disconnected (R13-H Type-0):
     stopping distance against ``0.1 v + 0.0060 v^2``, the mean fully developed deceleration,
     the friction utilisation (MFDD over ``mu g``; at least 0.75 with ABS, R13-H Annex 6),
@@ -66,7 +66,7 @@ def brake(params: VehicleParams, options: TestOptions, vehicle: Vehicle | None =
     )
     summary = header("brake", params, options, v0_mps)
     summary.update(_brake_figures(run, v0_mps, options.mu, abs_fitted(params)))
-    return TestResult("brake", (run,), summary)
+    return VehicleTestResult("brake", (run,), summary)
 
 
 def _brake_figures(run: Run, v0_mps: float, mu: float, with_abs: bool) -> dict:
@@ -109,7 +109,7 @@ def _brake_figures(run: Run, v0_mps: float, mu: float, with_abs: bool) -> dict:
     return {"figures": figures, "criteria": criteria, "passed": overall(criteria)}
 
 
-def brake_ramp(params: VehicleParams, options: TestOptions, vehicle: Vehicle | None = None):
+def brake_ramp(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle | None = None):
     """A slowly increasing brake force (``BRAKE_RAMP_G_PER_S``) from the test speed, engine
     disconnected, until both axles lock or the speed falls below ``LOCK_MIN_SPEED_MPS``:
     which axle locks first and at which braking rate; R13-H Annex 5 passes when the front locks
@@ -159,4 +159,4 @@ def brake_ramp(params: VehicleParams, options: TestOptions, vehicle: Vehicle | N
         }
     ]
     summary["passed"] = passed
-    return TestResult("brake-ramp", (run,), summary)
+    return VehicleTestResult("brake-ramp", (run,), summary)

@@ -71,11 +71,11 @@ def run(args) -> int:
     from eoam_sumo.plotting.vehicle_tests import plot_vehicle_test
     from eoam_sumo.vehicle_tests.equipment import equipped
     from eoam_sumo.vehicle_tests.output import writable_dir, write_result
-    from eoam_sumo.vehicle_tests.procedures import TESTS, TestOptions
+    from eoam_sumo.vehicle_tests.procedures import TESTS, VehicleTestOptions
 
     params = equipped(vehicle(args.vehicle), args.abs == "on", args.esc == "on")
     out = writable_dir(args.out)
-    result = TESTS[args.test](params, TestOptions(speed_kmh=args.speed_kmh, mu=args.mu))
+    result = TESTS[args.test](params, VehicleTestOptions(speed_kmh=args.speed_kmh, mu=args.mu))
     summary = write_result(result, out)
     runs = [(r.label, r.columns) for r in result.runs]
     png = plot_vehicle_test(summary, runs, out / f"{args.test}.png")

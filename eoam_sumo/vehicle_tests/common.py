@@ -22,7 +22,7 @@ SETTLE_S = 1.0
 
 
 @dataclass(frozen=True)
-class TestOptions:
+class VehicleTestOptions:
     """A test's options: the speed (None: the standard's), the road's friction."""
 
     speed_kmh: float | None = None
@@ -33,7 +33,7 @@ class TestOptions:
 
 
 @dataclass(frozen=True)
-class TestResult:
+class VehicleTestResult:
     """A test's runs (one time series each) and its summary (figures, criteria, clauses)."""
 
     test: str
@@ -62,7 +62,7 @@ def overall(criteria: list[dict[str, Any]]) -> bool | None:
     return all(judged) if judged else None
 
 
-def header(test: str, params: VehicleParams, options: TestOptions, speed_mps: float) -> dict:
+def header(test: str, params: VehicleParams, options: VehicleTestOptions, speed_mps: float) -> dict:
     """The summary's first fields: what was tested, how."""
     return {
         "test": test,

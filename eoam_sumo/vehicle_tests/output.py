@@ -12,7 +12,7 @@ from pathlib import Path
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import write_atomic
-from eoam_sumo.vehicle_tests.common import TestResult
+from eoam_sumo.vehicle_tests.common import VehicleTestResult
 from eoam_sumo.vehicle_tests.harness import COLUMNS, Run
 
 
@@ -28,7 +28,7 @@ def writable_dir(path: Path) -> Path:
     return path
 
 
-def run_path(out: Path, result: TestResult, run: Run) -> Path:
+def run_path(out: Path, result: VehicleTestResult, run: Run) -> Path:
     """Where a run's time series goes."""
     if len(result.runs) == 1:
         return out / "timeseries.csv"
@@ -46,7 +46,7 @@ def timeseries_csv(run: Run) -> str:
     return buffer.getvalue()
 
 
-def write_result(result: TestResult, out: Path) -> dict:
+def write_result(result: VehicleTestResult, out: Path) -> dict:
     """Write every run's CSV and ``summary.json`` (with the runs' files) into ``out``; the
     summary as written."""
     out = writable_dir(out)

@@ -14,8 +14,8 @@ from eoam_sumo.params import G_MPS2, VehicleParams
 from eoam_sumo.vehicle_tests import clauses as c
 from eoam_sumo.vehicle_tests.common import (
     SETTLE_S,
-    TestOptions,
-    TestResult,
+    VehicleTestOptions,
+    VehicleTestResult,
     criterion,
     header,
     overall,
@@ -65,7 +65,9 @@ def run_label(amplitude_a: float) -> str:
     return f"amp_{f'{amplitude_a:.2f}'.rstrip('0').rstrip('.')}A"
 
 
-def sine_with_dwell(params: VehicleParams, options: TestOptions, vehicle: Vehicle | None = None):
+def sine_with_dwell(
+    params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle | None = None
+):
     """The whole series: the slowly increasing steer (run ``sis``), then one run per amplitude
     (``amp_<k>A``, the first half-wave to the left); figures per run and pass/fail."""
     speed_mps = options.speed_mps(c.SWD_SPEED_KMH)
@@ -78,7 +80,7 @@ def sine_with_dwell(params: VehicleParams, options: TestOptions, vehicle: Vehicl
     if a_deg is None:
         summary.update(figures={"A_deg": None}, criteria=[], passed=None)
         summary["note"] = f"the slowly increasing steer never reached {c.SIS_TARGET_AY_G} g"
-        return TestResult("sine-with-dwell", (sis,), summary)
+        return VehicleTestResult("sine-with-dwell", (sis,), summary)
     runs, per_run, criteria = [sis], [], []
     for amp_deg in amplitudes_deg(a_deg):
         label = run_label(amp_deg / a_deg)
@@ -90,7 +92,7 @@ def sine_with_dwell(params: VehicleParams, options: TestOptions, vehicle: Vehicl
     summary["figures"] = {"A_deg": round(a_deg, 3), "runs": per_run, "clause": c.CITE["swd"]}
     summary["criteria"] = criteria
     summary["passed"] = overall(criteria)
-    return TestResult("sine-with-dwell", tuple(runs), summary)
+    return VehicleTestResult("sine-with-dwell", tuple(runs), summary)
 
 
 def _swd_run(

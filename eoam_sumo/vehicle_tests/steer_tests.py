@@ -12,8 +12,8 @@ from eoam_sumo.params import G_MPS2, VehicleParams
 from eoam_sumo.vehicle_tests import clauses as c
 from eoam_sumo.vehicle_tests.common import (
     SETTLE_S,
-    TestOptions,
-    TestResult,
+    VehicleTestOptions,
+    VehicleTestResult,
     header,
     rounded,
     speed_keeper,
@@ -55,7 +55,7 @@ STEP_ITERATIONS = 3
 """Runs to scale the step to the standard's steady-state lateral acceleration."""
 
 
-def ramp_steer(params: VehicleParams, options: TestOptions, vehicle: Vehicle | None = None):
+def ramp_steer(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle | None = None):
     """ISO 4138 at constant speed: the hand wheel turned left at ``RAMP_STEER_RATE_DEGPS`` with
     the speed held, until the lateral acceleration stops growing or the turn stops being
     quasi-steady. Figures over ``LINEAR_AY_RANGE_G``: the understeer gradient and the steering
@@ -84,7 +84,7 @@ def ramp_steer(params: VehicleParams, options: TestOptions, vehicle: Vehicle | N
     }
     summary["criteria"] = []
     summary["passed"] = None
-    return TestResult("ramp-steer", (run,), summary)
+    return VehicleTestResult("ramp-steer", (run,), summary)
 
 
 def slowly_increasing_steer(
@@ -121,7 +121,7 @@ def slowly_increasing_steer(
     return simulate(vehicle_for(params, vehicle), speed_mps, driver, duration_s, mu, stop=stop)
 
 
-def step_steer(params: VehicleParams, options: TestOptions, vehicle: Vehicle | None = None):
+def step_steer(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle | None = None):
     """ISO 7401 sec. 10: a step of the hand wheel (left, ``STEP_RISE_S``) held for
     ``STEP_HOLD_S``, throttle held from the step on; the step scaled (``STEP_ITERATIONS``
     runs) to a steady-state lateral acceleration of 4 m/s^2. Figures of the yaw rate and of
@@ -150,7 +150,7 @@ def step_steer(params: VehicleParams, options: TestOptions, vehicle: Vehicle | N
     }
     summary["criteria"] = []
     summary["passed"] = None
-    return TestResult("step-steer", (run,), summary)
+    return VehicleTestResult("step-steer", (run,), summary)
 
 
 def _linear_steer_rad(params: VehicleParams, speed_mps: float, ay_mps2: float) -> float:
