@@ -13,7 +13,6 @@ front / rear, as our plant does with ``brake_front_share``.
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -22,7 +21,7 @@ from vehiclemodels.parameters_vehicle2 import parameters_vehicle2
 from vehiclemodels.utils.tire_model import formula_lateral, formula_longitudinal
 from vehiclemodels.vehicle_dynamics_mb import vehicle_dynamics_mb
 
-from eoam_sumo.params import G_MPS2, VehicleParams
+from eoam_sumo.params import VehicleParams
 from eoam_sumo.vehicle_tests.harness import STEP_S, Controls, Sample, rolling_start
 
 STEER_TAU_S = 0.02
@@ -135,7 +134,6 @@ class CommonRoadVehicle:
         x, p = self._x, self._p
         f = vehicle_dynamics_mb(list(x), u, p)
         vx, vy, r = x[3], x[10], x[5]
-        # their x, y velocity is of the path (beta + yaw): positions are theirs as given
         return Sample(
             vx_mps=float(vx),
             vy_mps=float(vy),
@@ -145,16 +143,9 @@ class CommonRoadVehicle:
             yaw_rate_radps=float(r),
             steer_road_rad=float(x[2]),
             ax_mps2=float(f[3] - r * vy),
-            ay_mps2=float(f[10] + r * vx),
+            ay_mps2=float(f[10] + r * vx),  # the sprung mass's, body frame
             wheel_speed_front_mps=float(p.R_w * 0.5 * (x[23] + x[24])),
             wheel_speed_rear_mps=float(p.R_w * 0.5 * (x[25] + x[26])),
             drive_force_n=max(controls.drive_force_cmd_n - controls.brake_force_cmd_n, 0.0),
             brake_force_n=max(controls.brake_force_cmd_n - controls.drive_force_cmd_n, 0.0),
         )
-
-
-def g_units(value_mps2: float) -> float:
-    return value_mps2 / G_MPS2
-
-
-__all__ = ["CommonRoadVehicle", "commonroad_params", "math", "ours_from_commonroad"]
