@@ -72,6 +72,7 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
         {"params", "errors", "colours", "sampling", "offline", "decision", "world", "sim", "batch"},
         {"numpy", "pandas", "matplotlib"},
     ),
+    "vehicle_tests": ({"params", "errors", "fileio", "plant", "plotting"}, {"numpy"}),
     "traffic_scenario": (set(), {"sumolib"}),
     "netbuild": ({"errors"}, {"sumolib", "sumo"}),
     "bench": (

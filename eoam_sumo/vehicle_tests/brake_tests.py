@@ -1,0 +1,162 @@
+"""The braking tests: a straight-line stop (``brake``, UN R13-H Annex 3 / FMVSS 135) and the
+lock order in a slowly increasing brake (``brake-ramp``, UN R13-H Annex 5). Clauses:
+``clauses.py``."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from eoam_sumo.params import G_MPS2, VehicleParams
+from eoam_sumo.vehicle_tests import clauses as c
+from eoam_sumo.vehicle_tests.common import (
+    VehicleTestOptions,
+    VehicleTestResult,
+    criterion,
+    header,
+    overall,
+    rounded,
+    vehicle_for,
+)
+from eoam_sumo.vehicle_tests.equipment import abs_fitted
+from eoam_sumo.vehicle_tests.figures import (
+    LOCK_MIN_SPEED_MPS,
+    LOCK_SLIP,
+    STOP_SPEED_MPS,
+    distance_between_m,
+    first_time_s,
+    lock_order,
+    locked,
+    mfdd_mps2,
+    path_length_m,
+    stop_time_s,
+    stopping_distance_limit_m,
+)
+from eoam_sumo.vehicle_tests.harness import Controls, Run, Sample, Vehicle, simulate
+
+REST_S = 1.0
+"""Time recorded after the stop, to see the vehicle stay at rest [s]."""
+
+BRAKE_RAMP_G_PER_S = 0.2
+"""Brake-ramp rate: the brake force rises by this share of the weight per second (ours: slow
+against the 0.1 s brake lag, so each braking rate is passed quasi-statically)."""
+
+
+def brake(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle | None = None):
+    """Full brake application from the test speed to a stop, engine disconnected (R13-H Type-0):
+    stopping distance against ``0.1 v + 0.0060 v^2``, the mean fully developed deceleration,
+    the friction utilisation (MFDD over ``mu g``; at least 0.75 with ABS, R13-H Annex 6),
+    which axles locked, the lowest wheel speed and the largest speed once at rest."""
+    v0_mps = options.speed_mps(c.BRAKE_SPEED_KMH)
+    full_n = params.max_brake_force_n
+    stopped_at: list[float] = []
+
+    def stop(t_s: float, s: Sample) -> bool:
+        if not stopped_at and s.vx_mps <= STOP_SPEED_MPS:
+            stopped_at.append(t_s)
+        return bool(stopped_at) and t_s >= stopped_at[0] + REST_S
+
+    duration_s = 4.0 * v0_mps / (options.mu * G_MPS2) + 10.0
+    run = simulate(
+        vehicle_for(params, vehicle),
+        v0_mps,
+        lambda t, s: Controls(0.0, 0.0, full_n),
+        duration_s,
+        options.mu,
+        stop=stop,
+    )
+    summary = header("brake", params, options, v0_mps)
+    summary.update(_brake_figures(run, v0_mps, options.mu, abs_fitted(params)))
+    return VehicleTestResult("brake", (run,), summary)
+
+
+def _brake_figures(run: Run, v0_mps: float, mu: float, with_abs: bool) -> dict:
+    time_s, vx = run["time_s"], run["vx_mps"]
+    distance = path_length_m(run["x_m"], run["y_m"])
+    t_stop = stop_time_s(time_s, vx, 0.0)
+    stopping_m = None if t_stop is None else distance_between_m(time_s, distance, 0.0, t_stop)
+    mfdd = mfdd_mps2(vx, distance, v0_mps)
+    utilisation = None if mfdd is None else mfdd / (mu * G_MPS2)
+    front = locked(run["wheel_speed_front_mps"], vx)
+    rear = locked(run["wheel_speed_rear_mps"], vx)
+    rest = time_s >= (t_stop if t_stop is not None else np.inf)
+    limit_m = stopping_distance_limit_m(v0_mps * 3.6)
+    criteria = [criterion("stopping_distance_m", stopping_m, limit_m, True, c.CITE["stop"])]
+    if with_abs:
+        criteria.append(
+            criterion(
+                "friction_utilisation",
+                utilisation,
+                c.ADHESION_UTILISATION_MIN,
+                False,
+                c.CITE["adhesion"],
+            )
+        )
+    wheel_min = min(run["wheel_speed_front_mps"].min(), run["wheel_speed_rear_mps"].min())
+    figures = {
+        "stopping_distance_m": rounded(stopping_m, 3),
+        "stopping_distance_limit_m": round(limit_m, 3),
+        "stop_time_s": rounded(t_stop, 3),
+        "mfdd_mps2": rounded(mfdd),
+        "mfdd_clause": c.CITE["mfdd"],
+        "friction_utilisation": rounded(utilisation),
+        "front_locked": bool(front.any()),
+        "rear_locked": bool(rear.any()),
+        "front_lock_time_s": rounded(first_time_s(time_s, front), 3),
+        "rear_lock_time_s": rounded(first_time_s(time_s, rear), 3),
+        "min_wheel_speed_mps": round(float(wheel_min), 6),
+        "max_speed_at_rest_mps": round(float(np.abs(vx[rest]).max()), 6) if rest.any() else None,
+    }
+    return {"figures": figures, "criteria": criteria, "passed": overall(criteria)}
+
+
+def brake_ramp(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle | None = None):
+    """A slowly increasing brake force (``BRAKE_RAMP_G_PER_S``) from the test speed, engine
+    disconnected, until both axles lock or the speed falls below ``LOCK_MIN_SPEED_MPS``:
+    which axle locks first and at which braking rate; R13-H Annex 5 passes when the front locks
+    first (or together) for every braking rate between 0.15 and 0.8."""
+    v0_mps = options.speed_mps(c.BRAKE_SPEED_KMH)
+    rate_n_per_s = BRAKE_RAMP_G_PER_S * params.mass_kg * G_MPS2
+    both_at: list[float] = []
+
+    def stop(t_s: float, s: Sample) -> bool:
+        low = (1.0 - LOCK_SLIP) * s.vx_mps
+        if not both_at and s.wheel_speed_front_mps < low and s.wheel_speed_rear_mps < low:
+            both_at.append(t_s)
+        return s.vx_mps < LOCK_MIN_SPEED_MPS or (bool(both_at) and t_s >= both_at[0] + 0.3)
+
+    duration_s = params.max_brake_force_n / rate_n_per_s + 2.0
+    run = simulate(
+        vehicle_for(params, vehicle),
+        v0_mps,
+        lambda t, s: Controls(0.0, 0.0, min(rate_n_per_s * t, params.max_brake_force_n)),
+        duration_s,
+        options.mu,
+        stop=stop,
+    )
+    vx = run["vx_mps"]
+    order = lock_order(
+        run["time_s"],
+        run["ax_mps2"],
+        locked(run["wheel_speed_front_mps"], vx),
+        locked(run["wheel_speed_rear_mps"], vx),
+    )
+    passed = order.passes(c.LOCK_ORDER_RATE_MIN, c.LOCK_ORDER_RATE_MAX)
+    summary = header("brake-ramp", params, options, v0_mps)
+    summary["figures"] = {
+        "first_locked_axle": order.first,
+        "front_lock_braking_rate": rounded(order.rate_front),
+        "rear_lock_braking_rate": rounded(order.rate_rear),
+        "brake_ramp_g_per_s": BRAKE_RAMP_G_PER_S,
+    }
+    summary["criteria"] = [
+        {
+            "name": "front_locks_first_between_braking_rates",
+            "value": order.first,
+            "limit": [c.LOCK_ORDER_RATE_MIN, c.LOCK_ORDER_RATE_MAX],
+            "comparison": "front first or together",
+            "clause": c.CITE["lock_order"],
+            "passed": passed,
+        }
+    ]
+    summary["passed"] = passed
+    return VehicleTestResult("brake-ramp", (run,), summary)

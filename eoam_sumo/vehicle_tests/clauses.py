@@ -1,0 +1,75 @@
+"""The standards' test conditions and limits, each with the clause it comes from.
+
+Sources (found in the regulations' public texts and NHTSA's papers on them):
+
+- FMVSS No. 126 (49 CFR 571.126), Electronic stability control systems for light vehicles; UN
+  Regulation No. 140 (ESC) takes over the same test (Annex 3). S7.6: slowly increasing steer at
+  80 km/h, 13.5 deg/s, to find A (the hand-wheel angle of 0.3 g). S7.9: sine with dwell, one
+  0.7 Hz sine cycle with a 500 ms pause between its third and fourth quarter; amplitudes from
+  1.5 A in steps of 0.5 A up to 6.5 A or 270 deg. S5.2.1 / S5.2.2: the yaw rate 1.0 s and
+  1.75 s after the completion of steer at most 35 % and 20 % of the first yaw-rate peak after
+  the second steering reversal. S5.2.3: from 5 A, a lateral displacement of the centre of
+  gravity of at least 1.83 m (vehicles up to 3 500 kg gross) 1.07 s after the beginning of steer.
+- UN Regulation No. 13-H (braking of passenger cars), harmonised with FMVSS No. 135. Annex 3
+  (R13 Annex 4) para. 1.1.2: the stopping distance runs from the first actuation of the control
+  to the stop; the mean fully developed deceleration is ``(vb^2 - ve^2) / (25.92 (se - sb))``
+  with ``vb = 0.8 v0``, ``ve = 0.1 v0`` (km/h, m). Annex 3 para. 2.1.1 (Type-0, engine
+  disconnected, 100 km/h): stopping distance at most ``0.1 v + 0.0060 v^2`` (70 m; FMVSS 135
+  S7.5 gives the same 70 m from 100 km/h). Annex 5 (distribution of braking among the axles,
+  Appendix 1 wheel-lock sequence): for all braking rates between 0.15 and 0.8 the front wheels
+  lock simultaneously with or before the rear wheels. Annex 6 (anti-lock systems, Appendix 2):
+  utilisation of adhesion, at least 0.75.
+- ISO 4138 (passenger cars, steady-state circular driving behaviour, open-loop): the constant
+  speed method with a slowly increasing steer; understeer gradient and the maximum lateral
+  acceleration. ISO 7401:2011 sec. 10 (lateral transient response, step input): yaw-rate gain,
+  response time (from 50 % of the steering input to 90 % of the steady-state response), peak
+  response time and overshoot. Neither ISO method sets a pass mark: their figures are reported.
+"""
+
+from __future__ import annotations
+
+FMVSS126 = "FMVSS 126 (49 CFR 571.126) / UN R140 Annex 3"
+R13H = "UN R13-H"
+
+SIS_SPEED_KMH = 80.0  # FMVSS 126 S7.6
+SIS_STEER_RATE_DEGPS = 13.5  # FMVSS 126 S7.6
+SIS_TARGET_AY_G = 0.3  # FMVSS 126 S7.6: A gives 0.3 g
+SWD_SPEED_KMH = 80.0  # FMVSS 126 S7.9
+SWD_FREQUENCY_HZ = 0.7  # FMVSS 126 S7.9
+SWD_DWELL_S = 0.5  # FMVSS 126 S7.9
+SWD_FIRST_AMPLITUDE_A = 1.5  # FMVSS 126 S7.9
+SWD_AMPLITUDE_STEP_A = 0.5  # FMVSS 126 S7.9
+SWD_LAST_AMPLITUDE_A = 6.5  # FMVSS 126 S7.9
+SWD_LAST_AMPLITUDE_DEG = 270.0  # FMVSS 126 S7.9 (the greater of 6.5 A and 270 deg)
+YAW_RATIO_1S_MAX = 0.35  # FMVSS 126 S5.2.1, 1.0 s after completion of steer
+YAW_RATIO_175S_MAX = 0.20  # FMVSS 126 S5.2.2, 1.75 s after completion of steer
+DISPLACEMENT_TIME_S = 1.07  # FMVSS 126 S5.2.3, after the beginning of steer
+DISPLACEMENT_MIN_M = 1.83  # FMVSS 126 S5.2.3, gross vehicle mass up to 3 500 kg
+DISPLACEMENT_FROM_A = 5.0  # FMVSS 126 S5.2.3, amplitudes of 5 A and more
+
+BRAKE_SPEED_KMH = 100.0  # R13-H Annex 3 para. 2.1.1 (Type-0)
+STOP_LINEAR_S = 0.1  # R13-H Annex 3 para. 2.1.1: s <= 0.1 v + 0.0060 v^2 (v km/h, s m)
+STOP_QUADRATIC_S2PM = 0.0060
+MFDD_FROM_FRACTION = 0.8  # R13-H Annex 3 para. 1.1.2: vb = 0.8 v0
+MFDD_TO_FRACTION = 0.1  # R13-H Annex 3 para. 1.1.2: ve = 0.1 v0
+ADHESION_UTILISATION_MIN = 0.75  # R13-H Annex 6 (with ABS)
+LOCK_ORDER_RATE_MIN = 0.15  # R13-H Annex 5: braking rates 0.15 ...
+LOCK_ORDER_RATE_MAX = 0.8  # ... to 0.8: front locks first or together
+
+STEP_SPEED_KMH = 80.0  # ISO 7401 sec. 10 (standard test speed)
+STEP_AY_MPS2 = 4.0  # ISO 7401 sec. 10 (steady-state lateral acceleration)
+RAMP_SPEED_KMH = 80.0  # ISO 4138 constant speed method (one of the speeds it allows)
+
+CITE = {
+    "sis": "FMVSS 126 S7.6 (slowly increasing steer)",
+    "swd": "FMVSS 126 S7.9 / UN R140 Annex 3 (sine with dwell)",
+    "yaw_1s": "FMVSS 126 S5.2.1 / UN R140 (lateral stability, 1.0 s)",
+    "yaw_175s": "FMVSS 126 S5.2.2 / UN R140 (lateral stability, 1.75 s)",
+    "displacement": "FMVSS 126 S5.2.3 / UN R140 (responsiveness)",
+    "stop": "UN R13-H Annex 3 para. 2.1.1 (Type-0) / FMVSS 135 S7.5",
+    "mfdd": "UN R13-H Annex 3 para. 1.1.2 (R13 Annex 4 para. 1.1.2)",
+    "adhesion": "UN R13-H Annex 6 Appendix 2 (utilisation of adhesion, ABS)",
+    "lock_order": "UN R13-H Annex 5 Appendix 1 (wheel-lock sequence)",
+    "ramp": "ISO 4138 (steady-state circular driving, constant speed, slowly increasing steer)",
+    "step": "ISO 7401:2011 sec. 10 (step input)",
+}

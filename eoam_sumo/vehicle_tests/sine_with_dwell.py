@@ -1,0 +1,164 @@
+"""The sine with dwell (FMVSS 126 S7.9 / UN R140 Annex 3): the slowly increasing steer finds
+A, then one 0.7 Hz sine cycle with a 500 ms dwell at its second peak, at amplitudes from 1.5 A
+in steps of 0.5 A up to the greater of 6.5 A and 270 deg. Each run is judged on the yaw-rate
+ratios (S5.2.1, S5.2.2) and, from 5 A, the lateral displacement (S5.2.3). Clauses:
+``clauses.py``."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from eoam_sumo.params import G_MPS2, VehicleParams
+from eoam_sumo.vehicle_tests import clauses as c
+from eoam_sumo.vehicle_tests.common import (
+    SETTLE_S,
+    VehicleTestOptions,
+    VehicleTestResult,
+    criterion,
+    header,
+    overall,
+    speed_keeper,
+    vehicle_for,
+)
+from eoam_sumo.vehicle_tests.figures import crossing_value
+from eoam_sumo.vehicle_tests.harness import Controls, Run, Sample, Vehicle, simulate
+from eoam_sumo.vehicle_tests.steer_figures import lateral_displacement_m, yaw_rate_ratios
+from eoam_sumo.vehicle_tests.steer_tests import slowly_increasing_steer
+
+PERIOD_S = 1.0 / c.SWD_FREQUENCY_HZ
+SECOND_REVERSAL_S = 0.75 * PERIOD_S
+"""The steering's second reversal, where the dwell begins (after the beginning of steer)."""
+COMPLETION_S = PERIOD_S + c.SWD_DWELL_S
+"""Completion of steer, after the beginning of steer."""
+SPIN_YAW_DEG = 90.0
+"""A run counts as a spin once the heading has turned this far from the start (ours)."""
+
+
+def sine_with_dwell_steer(t_s: float, amplitude: float) -> float:
+    """The steering input ``t_s`` after the beginning of steer: a sine of ``SWD_FREQUENCY_HZ``
+    held at its second peak (``-amplitude``) for ``SWD_DWELL_S``, then its last quarter."""
+    omega = 2.0 * math.pi * c.SWD_FREQUENCY_HZ
+    if t_s <= 0.0 or t_s >= COMPLETION_S:
+        return 0.0
+    if t_s < SECOND_REVERSAL_S:
+        return amplitude * math.sin(omega * t_s)
+    if t_s < SECOND_REVERSAL_S + c.SWD_DWELL_S:
+        return -amplitude
+    return amplitude * math.sin(omega * (t_s - c.SWD_DWELL_S))
+
+
+def amplitudes_deg(a_deg: float) -> list[float]:
+    """The series' hand-wheel amplitudes: 1.5 A, 2 A, ... up to the greater of 6.5 A and
+    270 deg (the last one exactly that)."""
+    last_deg = max(c.SWD_LAST_AMPLITUDE_A * a_deg, c.SWD_LAST_AMPLITUDE_DEG)
+    series, k = [], 0
+    while (amp := (c.SWD_FIRST_AMPLITUDE_A + k * c.SWD_AMPLITUDE_STEP_A) * a_deg) < last_deg:
+        series.append(amp)
+        k += 1
+    return [*series, last_deg]
+
+
+def run_label(amplitude_a: float) -> str:
+    """``amp_1.5A``, ``amp_2A``, ``amp_16.17A``: a run's label from its amplitude in A."""
+    return f"amp_{f'{amplitude_a:.2f}'.rstrip('0').rstrip('.')}A"
+
+
+def sine_with_dwell(
+    params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle | None = None
+):
+    """The whole series: the slowly increasing steer (run ``sis``), then one run per amplitude
+    (``amp_<k>A``, the first half-wave to the left); figures per run and pass/fail."""
+    speed_mps = options.speed_mps(c.SWD_SPEED_KMH)
+    sis = slowly_increasing_steer(params, speed_mps, options.mu, vehicle, until_ay_g=0.35)
+    sis = Run("sis", sis.columns)
+    a_deg = crossing_value(
+        sis["steer_wheel_deg"], np.abs(sis["ay_mps2"]), c.SIS_TARGET_AY_G * G_MPS2
+    )
+    summary = header("sine-with-dwell", params, options, speed_mps)
+    if a_deg is None:
+        summary.update(figures={"A_deg": None}, criteria=[], passed=None)
+        summary["note"] = f"the slowly increasing steer never reached {c.SIS_TARGET_AY_G} g"
+        return VehicleTestResult("sine-with-dwell", (sis,), summary)
+    runs, per_run, criteria = [sis], [], []
+    for amp_deg in amplitudes_deg(a_deg):
+        label = run_label(amp_deg / a_deg)
+        run = _swd_run(params, speed_mps, amp_deg, options.mu, vehicle, label)
+        figures, judged = _judge(run, amp_deg, a_deg)
+        runs.append(run)
+        per_run.append(figures)
+        criteria.extend(judged)
+    summary["figures"] = {"A_deg": round(a_deg, 3), "runs": per_run, "clause": c.CITE["swd"]}
+    summary["criteria"] = criteria
+    summary["passed"] = overall(criteria)
+    return VehicleTestResult("sine-with-dwell", tuple(runs), summary)
+
+
+def _swd_run(
+    params: VehicleParams,
+    speed_mps: float,
+    amp_deg: float,
+    mu: float,
+    vehicle: Vehicle | None,
+    label: str,
+) -> Run:
+    """One sine-with-dwell run: speed held, then from the beginning of steer (``SETTLE_S``) the
+    throttle released and the hand wheel through ``sine_with_dwell_steer``."""
+    keep = speed_keeper(params, speed_mps)
+    amp_rad = math.radians(amp_deg) / params.steering_ratio
+
+    def driver(t_s: float, s: Sample) -> Controls:
+        if t_s < SETTLE_S:
+            return Controls(0.0, keep(s), 0.0)
+        return Controls(sine_with_dwell_steer(t_s - SETTLE_S, amp_rad), 0.0, 0.0)
+
+    duration_s = SETTLE_S + COMPLETION_S + 1.75 + 0.25
+    return simulate(vehicle_for(params, vehicle), speed_mps, driver, duration_s, mu, label=label)
+
+
+def _judge(run: Run, amp_deg: float, a_deg: float) -> tuple[dict, list[dict]]:
+    """One run's figures and its criteria (the displacement from 5 A only)."""
+    time_s = run["time_s"]
+    ratios = yaw_rate_ratios(
+        time_s, run["yaw_rate_radps"], SETTLE_S + SECOND_REVERSAL_S, SETTLE_S + COMPLETION_S, -1.0
+    )
+    displacement = lateral_displacement_m(
+        time_s, run["x_m"], run["y_m"], run["yaw_rad"], SETTLE_S, c.DISPLACEMENT_TIME_S
+    )
+    max_yaw_deg = float(np.degrees(np.max(np.abs(run["yaw_rad"]))))
+    label = run.label
+    judged = [
+        criterion(
+            f"{label}.yaw_ratio_1s", ratios.ratio_1s, c.YAW_RATIO_1S_MAX, True, c.CITE["yaw_1s"]
+        ),
+        criterion(
+            f"{label}.yaw_ratio_1.75s",
+            ratios.ratio_175s,
+            c.YAW_RATIO_175S_MAX,
+            True,
+            c.CITE["yaw_175s"],
+        ),
+    ]
+    if amp_deg >= c.DISPLACEMENT_FROM_A * a_deg - 1e-9:
+        judged.append(
+            criterion(
+                f"{label}.lateral_displacement_m",
+                displacement,
+                c.DISPLACEMENT_MIN_M,
+                False,
+                c.CITE["displacement"],
+            )
+        )
+    figures = {
+        "run": label,
+        "amplitude_deg": round(amp_deg, 3),
+        "amplitude_A": round(amp_deg / a_deg, 3),
+        "peak_yaw_rate_degps": round(math.degrees(ratios.peak_radps), 3),
+        "yaw_ratio_1s": round(ratios.ratio_1s, 4),
+        "yaw_ratio_1.75s": round(ratios.ratio_175s, 4),
+        "lateral_displacement_m": round(displacement, 4),
+        "max_heading_change_deg": round(max_yaw_deg, 2),
+        "spun": max_yaw_deg >= SPIN_YAW_DEG,
+    }
+    return figures, judged

@@ -1,0 +1,181 @@
+"""The steering tests at constant speed: ``ramp-steer`` (ISO 4138, slowly increasing steer)
+and ``step-steer`` (ISO 7401 sec. 10). Clauses: ``clauses.py``; the sine with dwell is in
+``sine_with_dwell.py``."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from eoam_sumo.params import G_MPS2, VehicleParams
+from eoam_sumo.vehicle_tests import clauses as c
+from eoam_sumo.vehicle_tests.common import (
+    SETTLE_S,
+    VehicleTestOptions,
+    VehicleTestResult,
+    header,
+    rounded,
+    speed_keeper,
+    vehicle_for,
+)
+from eoam_sumo.vehicle_tests.harness import Controls, Run, Sample, Vehicle, simulate
+from eoam_sumo.vehicle_tests.steer_figures import (
+    LINEAR_AY_RANGE_G,
+    steer_angle_gradient_deg_per_g,
+    step_response,
+    understeer_gradient_deg_per_g,
+)
+
+RAMP_END_FRACTION = 0.9
+"""A ramp steer ends once the lateral acceleration has fallen below this share of its peak
+(past the limit: more steering gives no more lateral acceleration) or the speed to half."""
+
+RAMP_STEER_RATE_DEGPS = 2.0
+"""Hand-wheel rate of the ramp steer [deg/s] (ours: slow enough that the understeer gradient
+is within 2 % of the one of steady turns at constant steer; at the 13.5 deg/s of the FMVSS 126
+slowly increasing steer the yaw response's lag adds about 0.1 deg/g)."""
+
+QUASI_STEADY_TOLERANCE = 0.1
+"""A ramp steer also ends when the lateral acceleration departs from ``vx r`` by more than this
+share: the turn is no longer quasi-steady (a spin, a slide, a wheel lifting), and ISO 4138
+describes steady turns."""
+
+RAMP_MIN_PEAK_MU = 0.2
+"""... judged once the peak is above this share of ``mu g`` (any car gets there; below it,
+the first wobbles of a noisy model would end the ramp)."""
+
+STEP_RISE_S = 0.1
+"""Time of the step's steering ramp [s] (ours: a steering robot's quick step)."""
+
+STEP_HOLD_S = 4.0
+"""The step steer is held this long [s]; the last second gives the steady state."""
+
+STEP_ITERATIONS = 3
+"""Runs to scale the step to the standard's steady-state lateral acceleration."""
+
+
+def ramp_steer(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle | None = None):
+    """ISO 4138 at constant speed: the hand wheel turned left at ``RAMP_STEER_RATE_DEGPS`` with
+    the speed held, until the lateral acceleration stops growing or the turn stops being
+    quasi-steady. Figures over ``LINEAR_AY_RANGE_G``: the understeer gradient and the steering
+    angle gradient (deg of road-wheel angle per g; of hand-wheel angle: times the steering
+    ratio); the peak lateral acceleration."""
+    speed_mps = options.speed_mps(c.RAMP_SPEED_KMH)
+    run = slowly_increasing_steer(
+        params, speed_mps, options.mu, vehicle, rate_degps=RAMP_STEER_RATE_DEGPS
+    )
+    road_rad = np.radians(run["steer_wheel_deg"]) / params.steering_ratio
+    steer_gradient = steer_angle_gradient_deg_per_g(run["ay_mps2"], road_rad)
+    gradient = understeer_gradient_deg_per_g(
+        run["ay_mps2"], road_rad, run["yaw_rate_radps"], run["vx_mps"], params.wheelbase_m
+    )
+    peak_mps2 = float(np.max(np.abs(run["ay_mps2"])))
+    summary = header("ramp-steer", params, options, speed_mps)
+    summary["figures"] = {
+        "understeer_gradient_deg_per_g": round(gradient, 4),
+        "steer_angle_gradient_deg_per_g": round(steer_gradient, 4),
+        "steering_wheel_angle_gradient_deg_per_g": round(steer_gradient * params.steering_ratio, 3),
+        "steer_rate_degps": RAMP_STEER_RATE_DEGPS,
+        "fit_range_g": list(LINEAR_AY_RANGE_G),
+        "peak_lateral_acceleration_mps2": round(peak_mps2, 4),
+        "peak_lateral_acceleration_g": round(peak_mps2 / G_MPS2, 4),
+        "clause": c.CITE["ramp"],
+    }
+    summary["criteria"] = []
+    summary["passed"] = None
+    return VehicleTestResult("ramp-steer", (run,), summary)
+
+
+def slowly_increasing_steer(
+    params: VehicleParams,
+    speed_mps: float,
+    mu: float,
+    vehicle: Vehicle | None,
+    *,
+    rate_degps: float = c.SIS_STEER_RATE_DEGPS,
+    until_ay_g: float | None = None,
+) -> Run:
+    """Hand wheel turned left at ``rate_degps`` from ``SETTLE_S`` with the speed held, until
+    the lateral acceleration reaches ``until_ay_g`` (None: until it falls past its peak or the
+    turn is no longer quasi-steady)."""
+    keep = speed_keeper(params, speed_mps)
+    rate_radps = math.radians(rate_degps) / params.steering_ratio
+    peak = [0.0]
+
+    def driver(t_s: float, s: Sample) -> Controls:
+        return Controls(rate_radps * max(t_s - SETTLE_S, 0.0), keep(s), 0.0)
+
+    def stop(t_s: float, s: Sample) -> bool:
+        peak[0] = max(peak[0], abs(s.ay_mps2))
+        if until_ay_g is not None:
+            return abs(s.ay_mps2) >= until_ay_g * G_MPS2
+        judged = peak[0] > RAMP_MIN_PEAK_MU * mu * G_MPS2
+        fell = abs(s.ay_mps2) < RAMP_END_FRACTION * peak[0]
+        unsteady = abs(s.ay_mps2 - s.vx_mps * s.yaw_rate_radps) > QUASI_STEADY_TOLERANCE * abs(
+            s.ay_mps2
+        )
+        return (judged and (fell or unsteady)) or s.vx_mps < 0.5 * speed_mps
+
+    duration_s = SETTLE_S + params.max_steer_rad / rate_radps + 2.0
+    return simulate(vehicle_for(params, vehicle), speed_mps, driver, duration_s, mu, stop=stop)
+
+
+def step_steer(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle | None = None):
+    """ISO 7401 sec. 10: a step of the hand wheel (left, ``STEP_RISE_S``) held for
+    ``STEP_HOLD_S``, throttle held from the step on; the step scaled (``STEP_ITERATIONS``
+    runs) to a steady-state lateral acceleration of 4 m/s^2. Figures of the yaw rate and of
+    the lateral acceleration: steady-state gain, response time, peak response time, overshoot."""
+    speed_mps = options.speed_mps(c.STEP_SPEED_KMH)
+    steer_rad = _linear_steer_rad(params, speed_mps, c.STEP_AY_MPS2)
+    for _ in range(STEP_ITERATIONS):
+        run = _step_run(params, speed_mps, steer_rad, options.mu, vehicle)
+        steady_ay = step_response(run["time_s"], run["steer_wheel_deg"], run["ay_mps2"])
+        steer_rad *= c.STEP_AY_MPS2 / max(steady_ay.steady_state, 0.1)
+    yaw = step_response(run["time_s"], run["steer_wheel_deg"], run["yaw_rate_radps"])
+    ay = step_response(run["time_s"], run["steer_wheel_deg"], run["ay_mps2"])
+    summary = header("step-steer", params, options, speed_mps)
+    summary["figures"] = {
+        "steer_wheel_deg": round(float(run["steer_wheel_deg"][-1]), 3),
+        "steady_lateral_acceleration_mps2": round(ay.steady_state, 4),
+        "yaw_rate_gain_per_s": round(yaw.gain * 180.0 / math.pi * params.steering_ratio, 5),
+        "yaw_rate_gain_degps_per_deg": round(math.degrees(yaw.gain), 5),
+        "yaw_rate_response_time_s": rounded(yaw.response_time_s),
+        "yaw_rate_peak_response_time_s": rounded(yaw.peak_response_time_s),
+        "yaw_rate_overshoot": round(yaw.overshoot, 4),
+        "lateral_acceleration_response_time_s": rounded(ay.response_time_s),
+        "lateral_acceleration_peak_response_time_s": rounded(ay.peak_response_time_s),
+        "lateral_acceleration_overshoot": round(ay.overshoot, 4),
+        "clause": c.CITE["step"],
+    }
+    summary["criteria"] = []
+    summary["passed"] = None
+    return VehicleTestResult("step-steer", (run,), summary)
+
+
+def _linear_steer_rad(params: VehicleParams, speed_mps: float, ay_mps2: float) -> float:
+    """Road-wheel angle of a steady turn at ``ay_mps2`` in the linear single-track model."""
+    a, b, L = params.cg_to_front_m, params.cg_to_rear_m, params.wheelbase_m
+    k_us = (
+        params.mass_kg
+        / L
+        * (b / params.cornering_stiffness_front_npr - a / params.cornering_stiffness_rear_npr)
+    )
+    return (L / (speed_mps * speed_mps) + k_us) * ay_mps2
+
+
+def _step_run(
+    params: VehicleParams, speed_mps: float, steer_rad: float, mu: float, vehicle: Vehicle | None
+) -> Run:
+    keep = speed_keeper(params, speed_mps)
+    held_n: list[float] = []
+
+    def driver(t_s: float, s: Sample) -> Controls:
+        if t_s < SETTLE_S:
+            return Controls(0.0, keep(s), 0.0)
+        if not held_n:
+            held_n.append(keep(s))
+        return Controls(steer_rad * min((t_s - SETTLE_S) / STEP_RISE_S, 1.0), held_n[0], 0.0)
+
+    duration_s = SETTLE_S + STEP_HOLD_S
+    return simulate(vehicle_for(params, vehicle), speed_mps, driver, duration_s, mu)

@@ -1,0 +1,210 @@
+"""The standards' figures against closed-form answers on hand-made time series."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from eoam_sumo.params import G_MPS2
+from eoam_sumo.vehicle_tests.figures import (
+    LockOrder,
+    crossing_value,
+    lock_order,
+    locked,
+    mfdd_mps2,
+    path_length_m,
+    stop_time_s,
+    stopping_distance_limit_m,
+)
+from eoam_sumo.vehicle_tests.sine_with_dwell import (
+    COMPLETION_S,
+    SECOND_REVERSAL_S,
+    amplitudes_deg,
+    run_label,
+    sine_with_dwell_steer,
+)
+from eoam_sumo.vehicle_tests.steer_figures import (
+    lateral_displacement_m,
+    steer_angle_gradient_deg_per_g,
+    step_response,
+    understeer_gradient_deg_per_g,
+    yaw_rate_ratios,
+)
+
+DT = 0.001
+
+
+def test_the_stopping_distance_limit_is_70_m_from_100_kmh():
+    assert stopping_distance_limit_m(100.0) == pytest.approx(70.0)
+    assert stopping_distance_limit_m(50.0) == pytest.approx(20.0)
+
+
+def _constant_deceleration(v0_mps: float, decel_mps2: float):
+    t = np.arange(0.0, v0_mps / decel_mps2 + 1.0, DT)
+    speed = np.maximum(v0_mps - decel_mps2 * t, 0.0)
+    t_stop = v0_mps / decel_mps2
+    travelled = np.where(
+        t < t_stop, v0_mps * t - 0.5 * decel_mps2 * t * t, v0_mps**2 / 2 / decel_mps2
+    )
+    return t, speed, travelled
+
+
+def test_a_constant_deceleration_gives_the_closed_form_stop_and_mfdd():
+    v0, decel = 27.0, 8.0
+    t, speed, travelled = _constant_deceleration(v0, decel)
+    t_stop = stop_time_s(t, speed, 0.0)
+    assert t_stop == pytest.approx((v0 - 0.01) / decel, abs=2 * DT)
+    assert np.interp(t_stop, t, travelled) == pytest.approx(v0 * v0 / 2 / decel, abs=0.01)
+    assert mfdd_mps2(speed, travelled, v0) == pytest.approx(decel, rel=1e-4)
+
+
+def test_the_mfdd_is_the_regulations_km_h_formula():
+    """R13-H: dm = (vb^2 - ve^2) / (25.92 (se - sb)) with speeds in km/h."""
+    v0, decel = 25.0, 6.0
+    _t, speed, travelled = _constant_deceleration(v0, decel)
+    vb_kmh, ve_kmh = 0.8 * v0 * 3.6, 0.1 * v0 * 3.6
+    sb = (v0**2 - (0.8 * v0) ** 2) / (2 * decel)
+    se = (v0**2 - (0.1 * v0) ** 2) / (2 * decel)
+    assert mfdd_mps2(speed, travelled, v0) == pytest.approx(
+        (vb_kmh**2 - ve_kmh**2) / (25.92 * (se - sb)), rel=1e-4
+    )
+
+
+def test_no_stop_and_no_mfdd_when_the_speed_never_falls():
+    t = np.arange(0.0, 2.0, 0.01)
+    speed = np.full_like(t, 10.0)
+    assert stop_time_s(t, speed, 0.0) is None
+    assert mfdd_mps2(speed, 10.0 * t, 10.0) is None
+
+
+def test_the_path_length_of_a_circle_is_its_arc():
+    angle = np.linspace(0.0, math.pi / 2, 2001)
+    assert path_length_m(20.0 * np.sin(angle), 20.0 * (1 - np.cos(angle)))[-1] == pytest.approx(
+        10.0 * math.pi, rel=1e-6
+    )
+
+
+def test_an_axle_is_locked_when_its_wheels_turn_far_slower_than_the_body():
+    vx = np.array([20.0, 20.0, 20.0, 0.5])
+    wheels = np.array([20.0, 2.5, 0.0, 0.0])
+    assert locked(wheels, vx).tolist() == [False, False, True, False]
+
+
+@pytest.mark.parametrize(
+    ("order", "passes"),
+    [
+        (LockOrder("front", 0.6, 0.7), True),
+        (LockOrder("both", 0.5, 0.5), True),
+        (LockOrder("none", None, None), True),
+        (LockOrder("rear", 0.7, 0.5), False),  # rear locked alone from 0.5 to 0.7
+        (LockOrder("rear", None, 0.65), False),
+        (LockOrder("rear", None, 0.83), True),  # above the band
+        (LockOrder("rear", 0.12, 0.10), True),  # both below the band
+    ],
+)
+def test_the_lock_order_criterion_of_r13h_annex_5(order, passes):
+    assert order.passes(0.15, 0.8) is passes
+
+
+def test_the_lock_order_and_the_braking_rates_from_a_hand_made_ramp():
+    t = np.arange(0.0, 5.0, 0.01)
+    ax = -0.2 * G_MPS2 * t
+    rear = t >= 3.0  # rear locks at z = 0.6
+    front = t >= 4.0
+    order = lock_order(t, ax, front, rear)
+    assert order.first == "rear"
+    assert order.rate_rear == pytest.approx(0.598, abs=0.003)
+    assert order.rate_front == pytest.approx(0.798, abs=0.003)
+
+
+def test_a_crossing_is_interpolated():
+    x = np.array([0.0, 1.0, 2.0, 3.0])
+    y = np.array([0.0, 0.2, 0.4, 0.6])
+    assert crossing_value(x, y, 0.3) == pytest.approx(1.5)
+    assert crossing_value(x, y, 0.7) is None
+
+
+def test_the_understeer_gradient_of_a_linear_car():
+    """delta = L r / v + K ay: the gradient is K, whatever the speed does."""
+    wheelbase, k_rad = 2.7, math.radians(2.0) / G_MPS2  # 2 deg/g
+    ay = np.linspace(0.0, 0.6 * G_MPS2, 300)
+    vx = np.linspace(22.0, 20.0, 300)
+    r = ay / vx
+    steer = wheelbase * r / vx + k_rad * ay
+    assert understeer_gradient_deg_per_g(ay, steer, r, vx, wheelbase) == pytest.approx(2.0)
+    assert understeer_gradient_deg_per_g(-ay, -steer, -r, vx, wheelbase) == pytest.approx(2.0)
+    steady = steer_angle_gradient_deg_per_g(ay, wheelbase * ay / 22.0**2 + k_rad * ay)
+    assert steady == pytest.approx(2.0 + math.degrees(wheelbase / 22.0**2) * G_MPS2)
+
+
+def test_a_first_order_yaw_response_has_its_closed_form_response_time():
+    """An ideal step at t0 (50 % of the input at t0) and r = r_ss (1 - exp(-(t - t0) / tau)):
+    90 % after tau ln 10, no overshoot, the gain r_ss / input."""
+    tau, t0, r_ss = 0.25, 1.0, 0.2
+    t = np.arange(0.0, 6.0, DT)
+    steer = np.where(t >= t0, 30.0, 0.0)
+    yaw = np.where(t >= t0, r_ss * (1 - np.exp(-(t - t0) / tau)), 0.0)
+    response = step_response(t, steer, yaw)
+    assert response.response_time_s == pytest.approx(tau * math.log(10.0), abs=2 * DT)
+    assert response.gain == pytest.approx(r_ss / 30.0, rel=1e-4)
+    assert response.overshoot == pytest.approx(0.0, abs=1e-4)
+
+
+def test_a_second_order_yaw_response_has_its_closed_form_overshoot_and_peak_time():
+    zeta, omega_n, t0 = 0.5, 8.0, 0.5
+    omega_d = omega_n * math.sqrt(1 - zeta * zeta)
+    t = np.arange(0.0, 5.0, DT)
+    s = np.maximum(t - t0, 0.0)
+    phase = math.acos(zeta)
+    yaw = 1 - np.exp(-zeta * omega_n * s) * np.sin(omega_d * s + phase) / math.sqrt(1 - zeta**2)
+    response = step_response(t, np.where(t >= t0, 1.0, 0.0), yaw)
+    assert response.overshoot == pytest.approx(
+        math.exp(-zeta * math.pi / math.sqrt(1 - zeta**2)), abs=1e-3
+    )
+    assert response.peak_response_time_s == pytest.approx(math.pi / omega_d, abs=2 * DT)
+
+
+def test_the_sine_with_dwell_input():
+    amp = 100.0
+    quarter = SECOND_REVERSAL_S / 3
+    assert sine_with_dwell_steer(0.0, amp) == 0.0
+    assert sine_with_dwell_steer(quarter, amp) == pytest.approx(amp)
+    assert sine_with_dwell_steer(SECOND_REVERSAL_S + 0.25, amp) == -amp
+    assert sine_with_dwell_steer(SECOND_REVERSAL_S + 0.5 + 1e-9, amp) == pytest.approx(-amp)
+    assert sine_with_dwell_steer(COMPLETION_S - 1e-9, amp) == pytest.approx(0.0, abs=1e-6)
+    assert pytest.approx(1 / 0.7 + 0.5) == COMPLETION_S
+
+
+def test_the_amplitude_series_goes_to_the_greater_of_6_5_a_and_270_deg():
+    assert amplitudes_deg(20.0) == [30.0 + 10.0 * k for k in range(24)] + [270.0]
+    big = amplitudes_deg(50.0)
+    assert big[0] == 75.0
+    assert big[-1] == 325.0
+    assert run_label(1.5) == "amp_1.5A"
+    assert run_label(2.0) == "amp_2A"
+
+
+def test_the_yaw_rate_ratios_of_a_decaying_yaw_rate():
+    """Peak -P at t_p after the second reversal, then r = -P exp(-(t - t_p) / tau)."""
+    tau, peak, t_rev, t_peak, t_done = 0.8, 0.5, 1.0, 1.3, 1.9
+    t = np.arange(0.0, 5.0, DT)
+    rise = -peak * np.sin(0.5 * math.pi * np.clip((t - t_rev) / (t_peak - t_rev), 0.0, 1.0))
+    yaw = np.where(t < t_peak, rise, -peak * np.exp(-(t - t_peak) / tau))
+    ratios = yaw_rate_ratios(t, yaw, t_rev, t_done, -1.0)
+    assert ratios.peak_radps == pytest.approx(-peak, rel=1e-6)
+    assert ratios.ratio_1s == pytest.approx(math.exp(-(t_done + 1.0 - t_peak) / tau), rel=1e-3)
+    assert ratios.ratio_175s == pytest.approx(math.exp(-(t_done + 1.75 - t_peak) / tau), rel=1e-3)
+
+
+def test_the_lateral_displacement_on_a_circle():
+    """From the beginning of steer at (5, 0) heading +x, a left circle of radius R at speed v:
+    after T the displacement is R (1 - cos(v T / R))."""
+    radius, speed, begin = 40.0, 20.0, 0.5
+    t = np.arange(0.0, 3.0, DT)
+    arc = np.maximum(t - begin, 0.0) * speed / radius
+    x = 5.0 + np.where(t < begin, (t - begin) * speed, radius * np.sin(arc))
+    y = radius * (1 - np.cos(arc))
+    displacement = lateral_displacement_m(t, x, y, arc, begin, 1.07)
+    assert displacement == pytest.approx(radius * (1 - math.cos(speed * 1.07 / radius)), rel=1e-4)
