@@ -1,0 +1,85 @@
+"""``eoam-sumo protocol NAME``: every test point of a protocol as a SUMO scenario, run as one
+batch, scored into ``results.csv``, ``scorecard.md`` and ``scorecard.png``
+(docs/protocols.md)."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from eoam_sumo.errors import InputError
+from eoam_sumo.params import MU_MAX, ego_e_class_sedan
+from eoam_sumo.protocols.points import PROTOCOLS, TestPoint, protocol_points
+
+#: Runs end at this simulated time after the ego's departure [s]: the slowest approach
+#: (CCRm 30 km/h behind 20 km/h, 41.7 m at 2.8 m/s) meets the target after 15 s.
+MAX_TIME_S = 40.0
+VEHICLES = ("sedan",)
+POLICIES = ("paper", "safe")
+
+
+def vehicle_width_m(name: str) -> float:
+    """The VUT's width for the target offsets; the one lookup of ``--vehicle``."""
+    if name == "sedan":
+        return ego_e_class_sedan().width_m
+    raise InputError(f"--vehicle {name!r} is not one of {', '.join(VEHICLES)}")
+
+
+def add_arguments(subparsers) -> None:
+    """The ``protocol`` sub-command's arguments."""
+    p = subparsers.add_parser(
+        "protocol",
+        help="run a test protocol (Euro NCAP AEB C2C, UN R152) and score it",
+        description="Run every test point of a protocol as one batch and score it "
+        "(docs/protocols.md). Exit status: 0 every point ran; 1 a point failed; 2 bad input.",
+    )
+    p.add_argument("name", choices=PROTOCOLS, help="the protocol")
+    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--jobs", type=int, default=1, help="parallel processes")
+    p.add_argument("--scheduler", help="Dask scheduler address, or 'local'")
+    p.add_argument("--vehicle", default="sedan", help="the VUT (sedan)")
+    p.add_argument("--policy", choices=POLICIES, default="paper", help="decision policy")
+    p.add_argument("--mu", type=float, default=1.0, help="friction of every lane (1.0)")
+    p.add_argument("--points", help="run only the points whose id matches this regex")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def selected_points(args) -> list[TestPoint]:
+    """The protocol's points (head-on ones under both policies), filtered by ``--points``."""
+    if not 0.0 < args.mu <= MU_MAX:
+        raise InputError(f"--mu {args.mu:g} is outside (0, {MU_MAX:g}]")
+    if args.jobs < 1:
+        raise InputError(f"--jobs {args.jobs} must be >= 1")
+    points = protocol_points(args.name, vehicle_width_m(args.vehicle), POLICIES)
+    if args.points:
+        try:
+            pattern = re.compile(args.points)
+        except re.error as exc:
+            raise InputError(
+                f"--points {args.points!r} is not a regular expression: {exc}"
+            ) from None
+        points = [p for p in points if pattern.search(p.point_id)]
+        if not points:
+            raise InputError(f"--points {args.points!r} matches no test point of {args.name}")
+    return points
+
+
+def run(args) -> int:
+    """Run the protocol; 0 when every point ran, 1 when one failed."""
+    from eoam_sumo.protocols.runner import run_protocol
+
+    points = selected_points(args)
+    summary = run_protocol(
+        args.name,
+        points,
+        Path(args.out),
+        jobs=args.jobs,
+        scheduler=args.scheduler,
+        policy=args.policy,
+        mu=args.mu,
+        vehicle=args.vehicle,
+        progress=not args.no_progress,
+        max_time_s=MAX_TIME_S,
+    )
+    print(summary.line)
+    return 1 if summary.failed else 0

@@ -1,0 +1,115 @@
+"""A protocol's rows from its test points and their run summaries: colour, points, R152
+verdict, and the totals per test. Pure: plain dicts, no SUMO, no pandas."""
+
+from __future__ import annotations
+
+import math
+
+from eoam_sumo.protocols import rules
+from eoam_sumo.protocols.points import PROTOCOLS, TestPoint
+
+#: Why a point is not run: its VUT speed is below the lookup tables' speeds.
+OUTSIDE_DESIGN = (
+    "outside the design range: VUT speed {v:g} km/h is below the lookup tables' lowest "
+    "entry speed {low:g} km/h (offline/design.py speeds_kmh); the run is refused"
+)
+EDITION = {
+    PROTOCOLS[0]: "AEB C2C 2023 (4.3.1) grid; scored with the 2026 FC v1.2 sec. 5.2 bands "
+    "(the 2023 assessment protocol's bands are not held)",
+    PROTOCOLS[1]: "Crash Avoidance FC 2026 (v1.2), rating code " + rules.RATING_2026,
+    PROTOCOLS[2]: "UN R152 (M1, dry road), para. 5.2.1.4 limits not held",
+}
+
+
+def point_row(point: TestPoint, impact_speed_kmh: float | None, note: str = "") -> dict:
+    """One results row of a point: its parameters, impact speed, colour and points (R152:
+    verdict). ``impact_speed_kmh`` None: the point did not run, ``note`` says why."""
+    row = {
+        "protocol": point.protocol,
+        "test": point.test,
+        "ego_speed_kmh": point.ego_speed_kmh,
+        "target_speed_kmh": point.target_speed_kmh,
+        "overlap": point.overlap,
+        "gap_m": point.gap_m,
+        "target_decel_mps2": point.target_decel_mps2,
+        "target_offset_m": point.offset_m,
+        "range": "extended" if point.extended else "standard",
+        "policy_side": point.policy,
+        "impact_speed_kmh": impact_speed_kmh,
+    }
+    if impact_speed_kmh is None:
+        return {
+            **row,
+            "colour": rules.NOT_RUN,
+            "points": 0.0,
+            "max_points": 1.0,
+            "verdict": "",
+            "note": note,
+        }
+    if point.protocol == PROTOCOLS[2]:
+        target = point.test.removeprefix("R152-")
+        rel = point.ego_speed_kmh - point.target_speed_kmh
+        verdict, reason = rules.r152_verdict(rules.R152_LIMITS_KMH[(target, rel)], impact_speed_kmh)
+        return {
+            **row,
+            "colour": "",
+            "points": math.nan,
+            "max_points": math.nan,
+            "verdict": verdict,
+            "note": reason,
+        }
+    colour = _colour(point, impact_speed_kmh)
+    points = rules.cell_points(colour, point.extended)
+    return {
+        **row,
+        "colour": colour,
+        "points": points,
+        "max_points": 1.0,
+        "verdict": "",
+        "note": note,
+    }
+
+
+def _colour(point: TestPoint, impact_speed_kmh: float) -> str:
+    """The point's colour; a head-on point avoided altogether is green (our reading: the
+    published mitigation bands are on the speed reduction of a collision)."""
+    if point.head_on and impact_speed_kmh <= 0.0:
+        return rules.GREEN
+    if point.head_on:
+        ego_at_impact = max(impact_speed_kmh - point.target_speed_kmh, 0.0)
+        return rules.ncap_colour(point.test, point.ego_speed_kmh, ego_at_impact)
+    return rules.ncap_colour(point.test, point.ego_speed_kmh, impact_speed_kmh)
+
+
+def totals(rows: list[dict]) -> list[dict]:
+    """Points per test (per policy side) and overall: the ranges' weights times their cells'
+    mean points (``rules.test_score``); R152 rows are counted by verdict instead."""
+    groups: dict[tuple[str, str], list[dict]] = {}
+    for row in rows:
+        groups.setdefault((row["test"], row["policy_side"]), []).append(row)
+    out = []
+    for (test, side), own in groups.items():
+        if test in rules.TOTAL_SCORES:
+            score = rules.test_score(test, [(r["points"], r["range"] == "extended") for r in own])
+            out.append(
+                {
+                    "test": test,
+                    "policy_side": side,
+                    "points": score.total,
+                    "max_points": score.max_total,
+                    "rows": len(own),
+                }
+            )
+        else:
+            verdicts = [r["verdict"] or rules.NOT_RUN for r in own]
+            out.append(
+                {
+                    "test": test,
+                    "policy_side": side,
+                    "points": math.nan,
+                    "max_points": math.nan,
+                    "rows": len(own),
+                    **{v: verdicts.count(v) for v in sorted(set(verdicts))},
+                }
+            )
+    return out
