@@ -99,6 +99,7 @@ def run_protocol(
         cases, out / BATCH_DIR, jobs, scheduler, progress=progress, tables_dir=tables_dir
     )
     frame = results_frame(points, batch, low, policy)
+    frame["net_file"] = [_relative(v, out) for v in frame["net_file"]]
     write_atomic(out / RESULTS_FILE, frame.to_csv(index=False), durable=True)
     write_atomic(out / SCORECARD_MD, scorecard_markdown(name, frame, vehicle, mu, policy, low))
     from eoam_sumo.plotting.protocol_plots import plot_scorecard
@@ -111,6 +112,17 @@ def run_protocol(
         f"{out / SCORECARD_MD}",
         failed,
     )
+
+
+def _relative(path, out: Path):
+    """A file of the run relative to the output folder (results.csv then does not depend on
+    where the protocol ran)."""
+    if not isinstance(path, str) or not path:
+        return path
+    try:
+        return str(Path(path).resolve().relative_to(out.resolve()))
+    except ValueError:
+        return path
 
 
 def results_frame(
