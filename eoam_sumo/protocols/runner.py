@@ -183,6 +183,13 @@ def scorecard_markdown(
         "",
     ]
     lines += _totals_table(scoring.totals(rows))
+    unscored = [r["point_id"] for r in rows if r["colour"] == scoring.NO_BAND]
+    if unscored:
+        lines += [
+            f"Not scored (no band row for their VUT speed; run, impact speed in "
+            f"results.csv, left out of the totals): {', '.join(unscored)}.",
+            "",
+        ]
     lines += _not_run_lines(rows, low_kmh) + _failed_lines(rows)
     return "\n".join(lines) + "\n"
 

@@ -13,6 +13,8 @@ OUTSIDE_DESIGN = (
     "outside the design range: VUT speed {v:g} km/h is below the lookup tables' lowest "
     "entry speed {low:g} km/h (offline/design.py speeds_kmh); the run is refused"
 )
+#: colour of a point whose VUT speed the bands have no row for (not in the totals)
+NO_BAND = "no_band"
 EDITION = {
     PROTOCOLS[0]: "AEB C2C 2023 (4.3.1) grid; scored with the 2026 FC v1.2 sec. 5.2 bands "
     "(the 2023 assessment protocol's bands are not held)",
@@ -58,7 +60,17 @@ def point_row(point: TestPoint, impact_speed_kmh: float | None, note: str = "") 
             "verdict": verdict,
             "note": reason,
         }
-    colour = _colour(point, impact_speed_kmh)
+    try:
+        colour = _colour(point, impact_speed_kmh)
+    except ValueError as exc:  # a 2023 speed (25, 35, 45 km/h) the 2026 bands have no row for
+        return {
+            **row,
+            "colour": NO_BAND,
+            "points": math.nan,
+            "max_points": math.nan,
+            "verdict": "",
+            "note": f"not scored: {exc} (the 2026 table's rows are 10, 20, 30, 40, 50+ km/h)",
+        }
     points = rules.cell_points(colour, point.extended)
     return {
         **row,
@@ -90,7 +102,8 @@ def totals(rows: list[dict]) -> list[dict]:
     out = []
     for (test, side), own in groups.items():
         if test in rules.TOTAL_SCORES:
-            score = rules.test_score(test, [(r["points"], r["range"] == "extended") for r in own])
+            cells = [(r["points"], r["range"] == "extended") for r in own if r["colour"] != NO_BAND]
+            score = rules.test_score(test, cells)
             out.append(
                 {
                     "test": test,
