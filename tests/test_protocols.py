@@ -4,6 +4,7 @@ twice (determinism)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import subprocess
 import sys
@@ -64,6 +65,62 @@ def test_test_score_weights_the_ranges():
     assert score.max_total == pytest.approx(1.35)
 
 
+# UN R152 00 series, para. 5.2.1.4, "Maximum relative impact speed (km/h) for M1 vehicles",
+# copied by hand: relative speed -> (maximum mass / laden, mass in running order / unladen)
+R152_BY_HAND = {40: (0, 0), 42: (10, 0), 45: (15, 15), 50: (25, 25), 55: (30, 30), 60: (35, 35)}
+
+
+def test_r152_table_as_published():
+    for rel, limits in R152_BY_HAND.items():
+        assert rules.R152_M1_TABLE_KMH[float(rel)] == limits
+    assert all(rules.R152_M1_TABLE_KMH[float(v)] == (0, 0) for v in range(10, 40, 5))
+    assert rules.R152_LIMITS_KMH[("stationary", 42.0)] == 0.0  # the unladen column
+    assert ("moving", 45.0) not in rules.R152_LIMITS_KMH  # subject 65 km/h: out of range
+
+
+@pytest.mark.parametrize(
+    ("test", "ego_kmh", "impact_kmh", "verdict"),
+    [
+        ("R152-stationary", 42, 0.0, "pass"),
+        ("R152-stationary", 42, 4.0, "fail"),  # 10 allowed laden, 0 unladen
+        ("R152-stationary", 45, 15.0, "pass"),
+        ("R152-stationary", 60, 35.5, "fail"),
+        ("R152-moving", 60, 0.0, "pass"),
+        ("R152-moving", 60, 1.0, "fail"),
+    ],
+)
+def test_r152_rows_from_impact_speeds(test, ego_kmh, impact_kmh, verdict):
+    point = next(
+        p
+        for p in protocol_points(PROTOCOLS[2], SEDAN_WIDTH_M, ())
+        if p.test == test and p.ego_speed_kmh == ego_kmh
+    )
+    assert scoring.point_row(point, impact_kmh)["verdict"] == verdict
+
+
+def test_failure_cause_names_the_never_triggered_head_on():
+    row = {"status": "ok", "note": "", "modes_visited": "0", "test": "CCFhos", "reason": "x"}
+    assert scoring.failure_cause(row) == f"{scoring.NO_TRIGGER_ONCOMING}; run: x"
+    failed = {"status": "failed", "error": "boom", "test": "CCRs"}
+    assert scoring.failure_cause(failed) == "the run failed: boom"
+
+
+def test_abs_and_esc_need_the_fields():
+    from eoam_sumo.errors import InputError
+    from eoam_sumo.params import VehicleParams
+    from eoam_sumo.protocols.command import vehicle_params
+
+    assert vehicle_params("sedan").width_m == SEDAN_WIDTH_M
+    fields = {f.name for f in dataclasses.fields(VehicleParams)}
+    for option in ("abs", "esc"):
+        if f"{option}_fitted" in fields:
+            params = vehicle_params("sedan", **{f"{option}_mode": "off"})
+            assert getattr(params, f"{option}_fitted") is False
+        else:
+            with pytest.raises(InputError, match=f"this build has no {option.upper()}"):
+                vehicle_params("sedan", **{f"{option}_mode": "off"})
+
+
 def test_r152_verdicts():
     assert rules.r152_verdict(None, 0.0)[0] == "pass"
     assert rules.r152_verdict(None, 5.0)[0] == "undetermined"
@@ -90,7 +147,12 @@ def test_grids():
     assert len({p.point_id for p in p2026}) == len(p2026)
     p2023 = protocol_points(PROTOCOLS[0], SEDAN_WIDTH_M, ())
     assert sum(p.test == "CCRb" for p in p2023) == 4
-    assert len(protocol_points(PROTOCOLS[2], SEDAN_WIDTH_M, ())) == 12
+    r152 = protocol_points(PROTOCOLS[2], SEDAN_WIDTH_M, ())
+    # the M1 table's 12 relative speeds against a stationary target; against a target at
+    # 20 km/h those up to a subject speed of 60 km/h (para. 5.2.1.3): 10-40 km/h, 7 rows
+    assert sum(p.test == "R152-stationary" for p in r152) == 12
+    moving = [p.ego_speed_kmh for p in r152 if p.test == "R152-moving"]
+    assert moving == [30, 35, 40, 45, 50, 55, 60]
 
 
 def test_offsets():
@@ -100,7 +162,11 @@ def test_offsets():
     assert offset_2026_m(125, SEDAN_WIDTH_M) == pytest.approx(0.75 * SEDAN_WIDTH_M)
 
 
-def test_bad_input_is_one_line_and_status_2(tmp_path):
+@pytest.mark.parametrize(
+    ("option", "value", "named"),
+    [("--vehicle", "truck", "truck"), ("--abs", "on", "ABS"), ("--esc", "on", "ESC")],
+)
+def test_bad_input_is_one_line_and_status_2(tmp_path, option, value, named):
     done = subprocess.run(
         [
             sys.executable,
@@ -110,15 +176,15 @@ def test_bad_input_is_one_line_and_status_2(tmp_path):
             "unr152",
             "--out",
             str(tmp_path),
-            "--vehicle",
-            "truck",
+            option,
+            value,
         ],
         capture_output=True,
         text=True,
         check=False,
     )
     assert done.returncode == 2
-    assert done.stderr.count("\n") == 1 and "truck" in done.stderr
+    assert done.stderr.count("\n") == 1 and named.lower() in done.stderr.lower()
 
 
 @pytest.mark.sumo

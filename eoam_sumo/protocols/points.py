@@ -20,8 +20,9 @@ github.com/vectorgrp/OSC-NCAP-scenarios (MPL-2.0), commit ee7aa11 (``VECTOR``):
   rows from 90 km/h.
 - The initial gap of a CCR test: ``Ego_initTimeHeadway`` 5 s times the VUT speed (VECTOR
   ``CCRs.xosc``); a head-on test: 5 s times the closing speed (our choice, same margin).
-- UN R152 rows: relative speeds 10-60 km/h against a stationary target and a target at
-  20 km/h, target centred (100 % overlap).
+- UN R152 rows: the relative speeds of the M1 table of para. 5.2.1.4 (10-60 km/h, ``R152``
+  in rules.py) against a stationary target, and those a target at 20 km/h allows within the
+  subject speed range of para. 5.2.1.3 (10-40 km/h, subject 30-60 km/h); target centred.
 
 The target is the Global Vehicle Target, 4.023 m x 1.712 m (VECTOR
 ``Catalogs/Vehicles/Vehicles.xosc`` ``NCAP_GlobalVehicleTarget``).
@@ -30,6 +31,8 @@ The target is the Global Vehicle Target, 4.023 m x 1.712 m (VECTOR
 from __future__ import annotations
 
 from dataclasses import dataclass
+
+from eoam_sumo.protocols.rules import R152_LIMITS_KMH, R152_MOVING_TARGET_KMH
 
 VECTOR = "vectorgrp/OSC-NCAP-scenarios@ee7aa11"
 GVT_LENGTH_M = 4.023
@@ -194,10 +197,13 @@ def head_on_2026(width: float, policies: tuple[str, ...]) -> list[TestPoint]:
 
 
 def points_r152() -> list[TestPoint]:
-    """UN R152 M1 rows: relative speed 10-60 km/h, stationary and 20 km/h targets."""
-    p = PROTOCOLS[2]
-    out = [_ccr(p, "R152-stationary", rel, 0, 100, 0.0) for rel in range(10, 70, 10)]
-    return out + [_ccr(p, "R152-moving", rel + 20, 20, 100, 0.0) for rel in range(10, 70, 10)]
+    """UN R152 M1 rows: every relative speed of the table (``rules.R152_LIMITS_KMH``), the
+    target stationary or at ``R152_MOVING_TARGET_KMH``."""
+    out = []
+    for target, rel in R152_LIMITS_KMH:
+        tgt = 0.0 if target == "stationary" else R152_MOVING_TARGET_KMH
+        out.append(_ccr(PROTOCOLS[2], f"R152-{target}", rel + tgt, tgt, 100, 0.0))
+    return out
 
 
 def protocol_points(name: str, vut_width_m: float, policies: tuple[str, ...]) -> list[TestPoint]:

@@ -7,10 +7,12 @@ Sources (cited per rule below):
   (Apache-2.0), commit 94b1035, ``crash_avoidance/matrix_processing.py`` and
   ``crash_avoidance/data_model.py``; they cite Crash Avoidance - Frontal Collisions (FC)
   protocol v1.2 sec. 5.2 (colour bands) and sec. 4.2.4 (tolerance).
-- UN R152 (AEBS, M1): the table of the largest relative impact speed per relative speed
-  (para. 5.2.1.4 of the original series) is *not held* in this repository's sources: every
-  limit is None, and a row is judged only where no limit is needed (an avoided collision
-  passes under any limit >= 0). See docs/protocols.md.
+- ``R152``: UN Regulation No. 152 (AEBS for M1 and N1), 00 series: the original text,
+  E/ECE/TRANS/505/Rev.3/Add.151 (in force 22 Jan 2020; authentic text
+  ECE/TRANS/WP.29/2019/61), and its Supplement 1, Add.151/Amend.1 (in force 25 Sep 2020;
+  ECE/TRANS/WP.29/2020/9): para. 5.2.1.3 (speed range 10-60 km/h) and para. 5.2.1.4 (speed
+  reduction by braking demand), table "Maximum relative impact speed (km/h) for M1 vehicles"
+  (page 7 of both). The 01-03 series are not held here.
 """
 
 from __future__ import annotations
@@ -133,10 +135,40 @@ def test_score(test: str, cells: list[tuple[float, bool]]) -> TestScore:
     return TestScore(test, parts["standard"], parts["extended"], weights["standard"], max_ext)
 
 
-#: UN R152 rows: (target, relative speed [km/h]) -> largest relative impact speed allowed
-#: [km/h] for M1 on a dry road, or None where the regulation's value is not held here.
+R152 = "UN R152 00 series (Add.151 and its Supplement 1, Amend.1), para. 5.2.1.4"
+#: R152 para. 5.2.1.4, M1 table: relative speed [km/h] -> largest relative impact speed
+#: [km/h] at (maximum mass, mass in running order) ("laden", "unladen" in the original text),
+#: the same for a stationary and a moving target (Supplement 1: one "Stationary/Moving"
+#: column pair; the original's moving columns hold these values up to 40 km/h, "-" above).
+R152_M1_TABLE_KMH: dict[float, tuple[float, float]] = {
+    10.0: (0.0, 0.0),
+    15.0: (0.0, 0.0),
+    20.0: (0.0, 0.0),
+    25.0: (0.0, 0.0),
+    30.0: (0.0, 0.0),
+    35.0: (0.0, 0.0),
+    40.0: (0.0, 0.0),
+    42.0: (10.0, 0.0),
+    45.0: (15.0, 15.0),
+    50.0: (25.0, 25.0),
+    55.0: (30.0, 30.0),
+    60.0: (35.0, 35.0),
+}
+#: R152 para. 5.2.1.3: the AEBS shall be active at least from 10 to 60 km/h (subject speed)
+R152_MAX_SUBJECT_SPEED_KMH = 60.0
+#: the moving target's speed in R152's test procedure (subject at 30 and 60 km/h)
+R152_MOVING_TARGET_KMH = 20.0
+#: R152 rows: (target, relative speed [km/h]) -> the limit applied [km/h]. The plant's mass
+#: is the sedan's (params.VehicleParams.mass_kg), taken as its mass in running order, so the
+#: unladen column applies; it is never above the laden one. A moving target's rows stop at
+#: a subject speed of 60 km/h (para. 5.2.1.3).
 R152_LIMITS_KMH: dict[tuple[str, float], float | None] = {
-    (target, float(v)): None for target in ("stationary", "moving") for v in range(10, 70, 10)
+    **{("stationary", v): lim[1] for v, lim in R152_M1_TABLE_KMH.items()},
+    **{
+        ("moving", v): lim[1]
+        for v, lim in R152_M1_TABLE_KMH.items()
+        if v + R152_MOVING_TARGET_KMH <= R152_MAX_SUBJECT_SPEED_KMH
+    },
 }
 PASS, FAIL, UNDETERMINED = "pass", "fail", "undetermined"
 
@@ -146,9 +178,7 @@ def r152_verdict(limit_kmh: float | None, impact_speed_kmh: float) -> tuple[str,
     if impact_speed_kmh <= 0.0:
         return PASS, "collision avoided (passes under any limit)"
     if limit_kmh is None:
-        return UNDETERMINED, (
-            f"impact at {impact_speed_kmh:.1f} km/h; the R152 limit of this row is not held"
-        )
+        return UNDETERMINED, (f"impact at {impact_speed_kmh:.1f} km/h; no R152 limit for this row")
     if impact_speed_kmh <= limit_kmh:
         return PASS, f"impact {impact_speed_kmh:.1f} <= {limit_kmh:g} km/h allowed"
     return FAIL, f"impact {impact_speed_kmh:.1f} > {limit_kmh:g} km/h allowed"

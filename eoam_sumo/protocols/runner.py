@@ -244,12 +244,15 @@ def _failed_lines(rows: list[dict]) -> list[str]:
     lines = [
         f"## Points short of full marks ({len(bad)})",
         "",
-        "| point | impact km/h | colour / verdict | reason |",
+        "Cause: the scoring's note, why the EOAM did not do better, and the run's own account "
+        "(results.csv `reason`).",
+        "",
+        "| point | impact km/h | colour / verdict | cause |",
         "|---|---|---|---|",
     ]
-    for r in bad:
-        why = r["note"] or r.get("reason") or ""
-        lines.append(
-            f"| {r['point_id']} | {r['impact_speed_kmh']} | {r['colour'] or r['verdict']} | {why} |"
-        )
+    lines += [
+        f"| {r['point_id']} | {r['impact_speed_kmh']} | {r['colour'] or r['verdict']} "
+        f"| {scoring.failure_cause(r)} |"
+        for r in bad
+    ]
     return [*lines, ""]

@@ -19,7 +19,7 @@ EDITION = {
     PROTOCOLS[0]: "AEB C2C 2023 (4.3.1) grid; scored with the 2026 FC v1.2 sec. 5.2 bands "
     "(the 2023 assessment protocol's bands are not held)",
     PROTOCOLS[1]: "Crash Avoidance FC 2026 (v1.2), rating code " + rules.RATING_2026,
-    PROTOCOLS[2]: "UN R152 (M1, dry road), para. 5.2.1.4 limits not held",
+    PROTOCOLS[2]: rules.R152 + " (M1, dry road; the mass-in-running-order column)",
 }
 
 
@@ -49,9 +49,7 @@ def point_row(point: TestPoint, impact_speed_kmh: float | None, note: str = "") 
             "note": note,
         }
     if point.protocol == PROTOCOLS[2]:
-        target = point.test.removeprefix("R152-")
-        rel = point.ego_speed_kmh - point.target_speed_kmh
-        verdict, reason = rules.r152_verdict(rules.R152_LIMITS_KMH[(target, rel)], impact_speed_kmh)
+        verdict, reason = _r152(point, impact_speed_kmh)
         return {
             **row,
             "colour": "",
@@ -82,6 +80,18 @@ def point_row(point: TestPoint, impact_speed_kmh: float | None, note: str = "") 
     }
 
 
+def _r152(point: TestPoint, impact_speed_kmh: float) -> tuple[str, str]:
+    """(verdict, reason) of an R152 row against its limit (``rules.R152_LIMITS_KMH``); the
+    reason names the table's maximum-mass limit too."""
+    target = point.test.removeprefix("R152-")
+    rel = point.ego_speed_kmh - point.target_speed_kmh
+    verdict, reason = rules.r152_verdict(rules.R152_LIMITS_KMH.get((target, rel)), impact_speed_kmh)
+    table = rules.R152_M1_TABLE_KMH.get(rel)
+    if table is not None:
+        reason += f" (relative speed {rel:g} km/h; maximum mass: {table[0]:g} km/h allowed)"
+    return verdict, reason
+
+
 def _colour(point: TestPoint, impact_speed_kmh: float) -> str:
     """The point's colour; a head-on point avoided altogether is green (our reading: the
     published mitigation bands are on the speed reduction of a collision)."""
@@ -91,6 +101,31 @@ def _colour(point: TestPoint, impact_speed_kmh: float) -> str:
         ego_at_impact = max(impact_speed_kmh - point.target_speed_kmh, 0.0)
         return rules.ncap_colour(point.test, point.ego_speed_kmh, ego_at_impact)
     return rules.ncap_colour(point.test, point.ego_speed_kmh, impact_speed_kmh)
+
+
+#: Why a head-on point the EOAM never reacted to fails (a finding for eoam/** and sensing/**,
+#: not fixed here): the radar classes a road user driving towards the ego as ``oncoming``,
+#: never as the in-path obstacle (sensing/radar.py ``classify``), and the EOAM intervenes on
+#: an in-path obstacle only; the oncoming flag alone starts no manoeuvre.
+NO_TRIGGER_ONCOMING = (
+    "the EOAM never reacted: the radar classes a car driving towards the ego as oncoming, "
+    "never as the in-path obstacle, and the EOAM intervenes on an in-path obstacle only"
+)
+NO_TRIGGER = "the EOAM never reacted (no trigger: the obstacle was never in its path)"
+
+
+def failure_cause(row: dict) -> str:
+    """Why a point falls short of full marks, in one line: the scoring's note, then the
+    cause (a run that failed, an EOAM that never reacted), then the run's own account."""
+    if row.get("status") == "failed":
+        return "the run failed: " + str(row.get("error") or "")
+    parts = [str(row["note"])] if row.get("note") else []
+    if row.get("status") == "ok" and str(row.get("modes_visited")) == "0":
+        parts.append(NO_TRIGGER_ONCOMING if str(row["test"]).startswith("CCFho") else NO_TRIGGER)
+    reason = row.get("reason")
+    if isinstance(reason, str) and reason:
+        parts.append("run: " + reason)
+    return "; ".join(parts)
 
 
 def totals(rows: list[dict]) -> list[dict]:
