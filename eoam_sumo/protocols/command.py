@@ -20,7 +20,7 @@ VEHICLES = ("sedan",)
 POLICIES = ("paper", "safe")
 
 
-#: --abs / --esc -> the VehicleParams field each sets (the chassis branch, issue 27, adds them)
+#: --abs / --esc -> the VehicleParams field each sets (fields the chassis work adds)
 FITTED_FIELDS = {"abs": "abs_fitted", "esc": "esc_fitted"}
 ON_OFF = ("on", "off")
 
@@ -56,7 +56,7 @@ def vehicle_params(
 def check_runs_carry(params: VehicleParams) -> None:
     """InputError unless the runs would use ``params``: the batch cases build the default
     sedan (sim.cosim), so any other vehicle would be scored as the sedan. The lead removes
-    this check when a case carries its vehicle (the merge of issues 27/28)."""
+    this check when a case carries its vehicle."""
     if params != ego_e_class_sedan():
         raise InputError(
             "--vehicle/--abs/--esc: the batch engine runs the default sedan only in this "
