@@ -112,9 +112,16 @@ def build_parser() -> argparse.ArgumentParser:
         _animate_arguments,
         _bench_arguments,
         vehicle_test_command.add_arguments,
+        _protocol_arguments,
     ):
         add_arguments(sub)
     return parser
+
+
+def _protocol_arguments(sub) -> None:
+    from eoam_sumo.protocols.command import add_arguments
+
+    add_arguments(sub)
 
 
 def _tables_arguments(sub) -> None:
@@ -487,6 +494,12 @@ def _cmd_bench(args) -> int:
     return run_bench_cli(_writable_dir(args.out), quick=args.quick)
 
 
+def _cmd_protocol(args) -> int:
+    from eoam_sumo.protocols.command import run
+
+    return run(args)
+
+
 _COMMANDS = {
     "tables": _cmd_tables,
     "run": _cmd_run,
@@ -495,6 +508,7 @@ _COMMANDS = {
     "animate": _cmd_animate,
     "bench": _cmd_bench,
     "vehicle-test": vehicle_test_command.run,
+    "protocol": _cmd_protocol,
 }
 
 

@@ -79,6 +79,10 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
         {"params", "plant", "offline", "sensing", "sim", "batch", "traffic_scenario"},
         {"libsumo", "sumolib"},
     ),
+    "protocols": (
+        {"params", "errors", "fileio", "offline", "matrix", "batch", "netbuild", "plotting"},
+        {"pandas"},
+    ),
     "cli": ({EVERYTHING}, set()),
     "__main__": ({"cli"}, set()),
 }

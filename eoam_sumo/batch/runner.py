@@ -162,6 +162,45 @@ def run_batch(
     cases = matrix.cases()
     paper = matrix.paper_outcomes()
     out_dir = _cases_folder(Path(out_dir))
+    results = run_cases(
+        cases,
+        out_dir,
+        jobs,
+        scheduler,
+        resume,
+        timeout_s,
+        progress,
+        case_func=case_func,
+        tables_dir=tables_dir,
+        timeseries=timeseries,
+        paper=paper,
+    )
+    if matrix.sample is None:
+        write_report(out_dir, results)
+    else:
+        write_probabilities(out_dir, results)
+    return results
+
+
+def run_cases(
+    cases: list[Case],
+    out_dir: Path,
+    jobs: int = 1,
+    scheduler: str | None = None,
+    resume: bool = False,
+    timeout_s: float = 300.0,
+    progress: bool = True,
+    *,
+    case_func: Callable[[CaseTask], dict] = run_matrix_case,
+    tables_dir: Path | None = None,
+    timeseries: str = "csv",
+    paper: dict[str, str] | None = None,
+) -> pd.DataFrame:
+    """Run ``cases`` (each with its own scenario file) into ``out_dir``: the cases' folders
+    and ``results.csv`` in the cases' order; return the results (as ``read_results``)."""
+    _check_options(jobs, timeout_s, timeseries)
+    paper = paper or {}
+    out_dir = _cases_folder(Path(out_dir))
     results_path = out_dir / RESULTS_FILE
     kept = (
         kept_rows(results_path, cases)
@@ -183,12 +222,7 @@ def run_batch(
     finally:
         bar.close()
         log.close()
-    results = finalise(results_path, cases, paper)
-    if matrix.sample is None:
-        write_report(out_dir, results)
-    else:
-        write_probabilities(out_dir, results)
-    return results
+    return finalise(results_path, cases, paper)
 
 
 def _check_options(jobs: int, timeout_s: float, timeseries: str) -> None:

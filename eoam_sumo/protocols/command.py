@@ -1,0 +1,134 @@
+"""``eoam-sumo protocol NAME``: every test point of a protocol as a SUMO scenario, run as one
+batch, scored into ``results.csv``, ``scorecard.md`` and ``scorecard.png``
+(docs/protocols.md)."""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+from pathlib import Path
+from typing import Any
+
+from eoam_sumo.errors import InputError
+from eoam_sumo.params import MU_MAX, VehicleParams, ego_e_class_sedan
+from eoam_sumo.protocols.points import PROTOCOLS, TestPoint, protocol_points
+
+#: Runs end at this simulated time after the ego's departure [s]: the slowest approach
+#: (CCRm 30 km/h behind 20 km/h, 41.7 m at 2.8 m/s) meets the target after 15 s.
+MAX_TIME_S = 40.0
+VEHICLES = ("sedan",)
+POLICIES = ("paper", "safe")
+
+
+#: --abs / --esc -> the VehicleParams field each sets (fields the chassis work adds)
+FITTED_FIELDS = {"abs": "abs_fitted", "esc": "esc_fitted"}
+ON_OFF = ("on", "off")
+
+
+def vehicle_params(
+    name: str, abs_mode: str | None = None, esc_mode: str | None = None
+) -> VehicleParams:
+    """The VUT's ``VehicleParams``: ``--vehicle`` NAME, with ABS/ESC fitted or not as asked
+    (None: the vehicle's own). The one place a protocol builds its vehicle: at the merge with
+    main, NAME is looked up with ``vehicle_files.load_vehicle(name)`` here instead of the
+    sedan-only branch below. InputError for an unknown NAME, or ABS/ESC on a build whose
+    ``VehicleParams`` has no such field."""
+    if name != "sedan":
+        raise InputError(f"--vehicle {name!r} is not one of {', '.join(VEHICLES)}")
+    params = ego_e_class_sedan()
+    known = {f.name for f in dataclasses.fields(VehicleParams)}
+    changes: dict[str, Any] = {}
+    for option, mode in (("abs", abs_mode), ("esc", esc_mode)):
+        if mode is None:
+            continue
+        if mode not in ON_OFF:
+            raise InputError(f"--{option} {mode!r} is not one of on, off")
+        field = FITTED_FIELDS[option]
+        if field not in known:
+            raise InputError(
+                f"--{option} {mode}: this build has no {option.upper()} "
+                f"(VehicleParams has no field {field!r})"
+            )
+        changes[field] = mode == "on"
+    return dataclasses.replace(params, **changes)
+
+
+def check_runs_carry(params: VehicleParams) -> None:
+    """InputError unless the runs would use ``params``: the batch cases build the default
+    sedan (sim.cosim), so any other vehicle would be scored as the sedan. The lead removes
+    this check when a case carries its vehicle."""
+    if params != ego_e_class_sedan():
+        raise InputError(
+            "--vehicle/--abs/--esc: the batch engine runs the default sedan only in this "
+            "build; this vehicle cannot reach the runs yet"
+        )
+
+
+def vehicle_label(args) -> str:
+    """The VUT as the scorecard names it: NAME, and ABS/ESC where asked."""
+    extra = [f"{o.upper()} {getattr(args, o)}" for o in FITTED_FIELDS if getattr(args, o)]
+    return ", ".join([args.vehicle, *extra])
+
+
+def add_arguments(subparsers) -> None:
+    """The ``protocol`` sub-command's arguments."""
+    p = subparsers.add_parser(
+        "protocol",
+        help="run a test protocol (Euro NCAP AEB C2C, UN R152) and score it",
+        description="Run every test point of a protocol as one batch and score it "
+        "(docs/protocols.md). Exit status: 0 every point ran; 1 a point failed; 2 bad input.",
+    )
+    p.add_argument("name", choices=PROTOCOLS, help="the protocol")
+    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--jobs", type=int, default=1, help="parallel processes")
+    p.add_argument("--scheduler", help="Dask scheduler address, or 'local'")
+    p.add_argument("--vehicle", default="sedan", help="the VUT (sedan)")
+    p.add_argument("--policy", choices=POLICIES, default="paper", help="decision policy")
+    p.add_argument("--abs", choices=ON_OFF, help="ABS fitted or not (default: the vehicle's)")
+    p.add_argument("--esc", choices=ON_OFF, help="ESC fitted or not (default: the vehicle's)")
+    p.add_argument("--mu", type=float, default=1.0, help="friction of every lane (1.0)")
+    p.add_argument("--points", help="run only the points whose id matches this regex")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def selected_points(args) -> list[TestPoint]:
+    """The protocol's points (head-on ones under both policies), filtered by ``--points``."""
+    if not 0.0 < args.mu <= MU_MAX:
+        raise InputError(f"--mu {args.mu:g} is outside (0, {MU_MAX:g}]")
+    if args.jobs < 1:
+        raise InputError(f"--jobs {args.jobs} must be >= 1")
+    params = vehicle_params(args.vehicle, args.abs, args.esc)
+    check_runs_carry(params)
+    points = protocol_points(args.name, params.width_m, POLICIES)
+    if args.points:
+        try:
+            pattern = re.compile(args.points)
+        except re.error as exc:
+            raise InputError(
+                f"--points {args.points!r} is not a regular expression: {exc}"
+            ) from None
+        points = [p for p in points if pattern.search(p.point_id)]
+        if not points:
+            raise InputError(f"--points {args.points!r} matches no test point of {args.name}")
+    return points
+
+
+def run(args) -> int:
+    """Run the protocol; 0 when every point ran, 1 when one failed."""
+    from eoam_sumo.protocols.runner import run_protocol
+
+    points = selected_points(args)
+    summary = run_protocol(
+        args.name,
+        points,
+        Path(args.out),
+        jobs=args.jobs,
+        scheduler=args.scheduler,
+        policy=args.policy,
+        mu=args.mu,
+        vehicle=vehicle_label(args),
+        progress=not args.no_progress,
+        max_time_s=MAX_TIME_S,
+    )
+    print(summary.line)
+    return 1 if summary.failed else 0

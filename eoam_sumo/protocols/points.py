@@ -1,0 +1,217 @@
+"""The test points of each protocol: grids, target motion, lateral position and gap. Pure.
+
+Grids and set-up from Vector's OpenSCENARIO encodings of the Euro NCAP protocols,
+github.com/vectorgrp/OSC-NCAP-scenarios (MPL-2.0), commit ee7aa11 (``VECTOR``):
+
+- 2023 (AEB C2C test protocol 4.3.1): ``AEB_C2C_2023/Variations/NCAP_AEB_C2C_*_Variation_2023``:
+  CCRs 10-50 km/h in 5 km/h steps (AEB) and 55-80 km/h (``CCRs_FCW``); CCRm 30-80 km/h in
+  5 km/h steps behind a target at 20 km/h; overlaps -75, -50, 50, 75, 100 %; CCRb both at
+  50 km/h, 12 or 40 m apart, the target braking at 2 or 6 m/s^2 after 3 s
+  (``GVT_braking_delay``), 100 % overlap. The target offset for an overlap
+  (``NCAP_AEB_C2C_CCR_2023.xosc`` ``_GVT_offset``): sign(o) min(1, 100 - o)
+  (w_gvt / 2 - w_vut (|o| - 50) / 100).
+- 2026 (Crash Avoidance - Frontal Collisions): ``CA-FC_2026/Variations/{Standard,Extended}Range``:
+  impact locations 0-100 % (standard) and -25, 125 % (extended); CCRs 10-80 km/h in 10 km/h
+  steps (60-80 from ``CCRs_FCW``); CCRm 30-80 km/h behind 20 km/h and 90/30 to 130/70;
+  CCRb 30-130 km/h, both cars at one speed, 1 s headway, 4 m/s^2 after 3 s
+  (``Target_braking_delay``), 90-130 km/h extended; CCFhos 30-100 km/h. Target offset
+  (``CCRs.xosc`` ``_Target_offset``): IL / 100 w_vut - w_vut / 2. Ranges as RATING_2026
+  ``EXTENDED_RANGE_CELLS``: first and last column, CCRb rows from 90 km/h, CCFhos 100 % and
+  rows from 90 km/h.
+- The initial gap of a CCR test: ``Ego_initTimeHeadway`` 5 s times the VUT speed (VECTOR
+  ``CCRs.xosc``); a head-on test: 5 s times the closing speed (our choice, same margin).
+- UN R152 rows: the relative speeds of the M1 table of para. 5.2.1.4 (10-60 km/h, ``R152``
+  in rules.py) against a stationary target, and those a target at 20 km/h allows within the
+  subject speed range of para. 5.2.1.3 (10-40 km/h, subject 30-60 km/h); target centred.
+
+The target is the Global Vehicle Target, 4.023 m x 1.712 m (VECTOR
+``Catalogs/Vehicles/Vehicles.xosc`` ``NCAP_GlobalVehicleTarget``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from eoam_sumo.protocols.rules import R152_LIMITS_KMH, R152_MOVING_TARGET_KMH
+
+VECTOR = "vectorgrp/OSC-NCAP-scenarios@ee7aa11"
+GVT_LENGTH_M = 4.023
+GVT_WIDTH_M = 1.712
+INIT_HEADWAY_S = 5.0
+BRAKING_DELAY_S = 3.0
+#: hold time of a target that keeps its speed to the end of the run [s]
+FOREVER_S = 1.0e6
+
+PROTOCOLS = ("euroncap-aeb-c2c-2023", "euroncap-aeb-c2c-2026", "unr152")
+
+
+@dataclass(frozen=True)
+class TestPoint:
+    """One test point: the protocol's parameters and the target's scripted motion."""
+
+    protocol: str
+    test: str  # CCRs, CCRm, CCRb, CCFhos, R152-stationary, R152-moving
+    ego_speed_kmh: float
+    target_speed_kmh: float
+    overlap: float  # % (2023: overlap; 2026: impact location; R152: 100)
+    gap_m: float  # front bumper to the target's rear (head-on: front) bumper
+    target_decel_mps2: float  # 0: no braking
+    hold_s: float  # the target keeps its speed this long before braking
+    offset_m: float  # target centre left (+) of the ego lane centre
+    extended: bool = False
+    head_on: bool = False
+    policy: str = ""  # set only where the protocol runs both policies side by side
+
+    @property
+    def point_id(self) -> str:
+        parts = [
+            self.test,
+            f"v{self.ego_speed_kmh:g}",
+            f"t{self.target_speed_kmh:g}",
+            f"o{self.overlap:g}",
+            f"g{self.gap_m:.1f}",
+        ]
+        if self.target_decel_mps2:
+            parts.append(f"d{self.target_decel_mps2:g}")
+        if self.policy:
+            parts.append(self.policy)
+        return "_".join(parts).replace("-", "m").replace(".", "p")
+
+
+def offset_2023_m(overlap: float, vut_width_m: float) -> float:
+    """Target offset of a 2023 overlap (VECTOR ``_GVT_offset``)."""
+    sign = 1.0 if overlap > 0 else -1.0
+    return (
+        sign
+        * min(1.0, 100.0 - overlap)
+        * (GVT_WIDTH_M / 2 - vut_width_m * (abs(overlap) - 50) / 100)
+    )
+
+
+def offset_2026_m(impact_location: float, vut_width_m: float) -> float:
+    """Target offset of a 2026 impact location (VECTOR ``_Target_offset``)."""
+    return impact_location / 100.0 * vut_width_m - vut_width_m / 2.0
+
+
+def _ccr(
+    protocol: str, test: str, ego: float, target: float, overlap: float, width: float, **kw
+) -> TestPoint:
+    """A car-to-car rear point; the gap is 5 s at the VUT speed unless given."""
+    new = protocol.endswith("2026")
+    offset = offset_2026_m(overlap, width) if new else offset_2023_m(overlap, width)
+    gap = kw.pop("gap_m", INIT_HEADWAY_S * ego / 3.6)
+    return TestPoint(
+        protocol,
+        test,
+        float(ego),
+        float(target),
+        float(overlap),
+        round(gap, 3),
+        kw.pop("decel", 0.0),
+        kw.pop("hold_s", FOREVER_S),
+        round(offset, 4),
+        **kw,
+    )
+
+
+def points_2023(width: float) -> list[TestPoint]:
+    """AEB C2C 2023 (protocol 4.3.1): CCRs, CCRm, CCRb as VECTOR encodes them."""
+    p, overlaps = PROTOCOLS[0], (-75, -50, 50, 75, 100)
+    out = [_ccr(p, "CCRs", v, 0, o, width) for v in range(10, 85, 5) for o in overlaps]
+    out += [_ccr(p, "CCRm", v, 20, o, width) for v in range(30, 85, 5) for o in overlaps]
+    out += [
+        _ccr(p, "CCRb", 50, 50, 100, width, gap_m=g, decel=d, hold_s=BRAKING_DELAY_S)
+        for g in (12.0, 40.0)
+        for d in (2.0, 6.0)
+    ]
+    return out
+
+
+IL_2026 = (-25, 0, 25, 50, 75, 100, 125)
+CCRM_2026: tuple[tuple[int, int], ...] = (
+    *((v, 20) for v in range(30, 90, 10)),
+    *((90, 30), (100, 40), (110, 50), (120, 60), (130, 70)),
+)
+CCFHOS_2026 = ((30, 50), (40, 50), (50, 50), (60, 70), (70, 70), (80, 70), (90, 90), (100, 100))
+
+
+def points_2026(width: float, policies: tuple[str, ...]) -> list[TestPoint]:
+    """Crash Avoidance FC 2026: CCRs, CCRm, CCRb standard and extended grids, CCFhos (once per
+    policy in ``policies``)."""
+    p = PROTOCOLS[1]
+
+    def edge(il: float) -> bool:
+        return il in (-25, 125)
+
+    out = [
+        _ccr(p, "CCRs", v, 0, il, width, extended=edge(il))
+        for v in range(10, 90, 10)
+        for il in IL_2026
+    ]
+    out += [
+        _ccr(p, "CCRm", v, t, il, width, extended=edge(il)) for v, t in CCRM_2026 for il in IL_2026
+    ]
+    out += [
+        _ccr(
+            p,
+            "CCRb",
+            v,
+            v,
+            il,
+            width,
+            gap_m=1.0 * v / 3.6,
+            decel=4.0,
+            hold_s=BRAKING_DELAY_S,
+            extended=edge(il) or v >= 90,
+        )
+        for v in range(30, 140, 10)
+        for il in IL_2026
+    ]
+    return out + head_on_2026(width, policies)
+
+
+def head_on_2026(width: float, policies: tuple[str, ...]) -> list[TestPoint]:
+    """CCFhos: the target drives towards the VUT in its lane (impact locations 25-100 %)."""
+    out = []
+    for policy in policies:
+        for v, t in CCFHOS_2026:
+            for il in (100, 75, 50, 25):
+                gap = INIT_HEADWAY_S * (v + t) / 3.6
+                out.append(
+                    TestPoint(
+                        PROTOCOLS[1],
+                        "CCFhos",
+                        float(v),
+                        float(t),
+                        float(il),
+                        round(gap, 3),
+                        0.0,
+                        FOREVER_S,
+                        round(offset_2026_m(il, width), 4),
+                        extended=il == 100 or v >= 90,
+                        head_on=True,
+                        policy=policy,
+                    )
+                )
+    return out
+
+
+def points_r152() -> list[TestPoint]:
+    """UN R152 M1 rows: every relative speed of the table (``rules.R152_LIMITS_KMH``), the
+    target stationary or at ``R152_MOVING_TARGET_KMH``."""
+    out = []
+    for target, rel in R152_LIMITS_KMH:
+        tgt = 0.0 if target == "stationary" else R152_MOVING_TARGET_KMH
+        out.append(_ccr(PROTOCOLS[2], f"R152-{target}", rel + tgt, tgt, 100, 0.0))
+    return out
+
+
+def protocol_points(name: str, vut_width_m: float, policies: tuple[str, ...]) -> list[TestPoint]:
+    """Every test point of a protocol, in grid order; ValueError for an unknown name."""
+    if name == PROTOCOLS[0]:
+        return points_2023(vut_width_m)
+    if name == PROTOCOLS[1]:
+        return points_2026(vut_width_m, policies)
+    if name == PROTOCOLS[2]:
+        return points_r152()
+    raise ValueError(f"unknown protocol {name!r}; one of {', '.join(PROTOCOLS)}")

@@ -1,0 +1,184 @@
+"""Scoring rules of the protocols: colour bands, points, weights, pass/fail. Pure: no SUMO,
+no pandas.
+
+Sources (cited per rule below):
+
+- ``RATING_2026``: Euro NCAP's published rating code, github.com/Euro-NCAP/euroncap_rating_2026
+  (Apache-2.0), commit 94b1035, ``crash_avoidance/matrix_processing.py`` and
+  ``crash_avoidance/data_model.py``; they cite Crash Avoidance - Frontal Collisions (FC)
+  protocol v1.2 sec. 5.2 (colour bands) and sec. 4.2.4 (tolerance).
+- ``R152``: UN Regulation No. 152 (AEBS for M1 and N1), 00 series: the original text,
+  E/ECE/TRANS/505/Rev.3/Add.151 (in force 22 Jan 2020; authentic text
+  ECE/TRANS/WP.29/2019/61), and its Supplement 1, Add.151/Amend.1 (in force 25 Sep 2020;
+  ECE/TRANS/WP.29/2020/9): para. 5.2.1.3 (speed range 10-60 km/h) and para. 5.2.1.4 (speed
+  reduction by braking demand), table "Maximum relative impact speed (km/h) for M1 vehicles"
+  (page 7 of both). The 01-03 series are not held here.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+RATING_2026 = "Euro-NCAP/euroncap_rating_2026@94b1035"
+
+GREEN, YELLOW, ORANGE, BROWN, RED = "green", "yellow", "orange", "brown", "red"
+#: colour of a point not scored, and why (the scorecard names the reason)
+NOT_RUN = "not_run"
+COLOURS = (GREEN, YELLOW, ORANGE, BROWN, RED)
+
+#: Colour bands of the "mitigation or avoidance" tests (CCRs, CCRm, CCRb) by VUT speed
+#: [km/h] (VUT speeds of 50 and above use the 50 row): (colour, highest relative impact
+#: speed [km/h] of the band), bands (-inf, t0], (t0, t1], ... . RATING_2026
+#: matrix_processing.py ``ComputedTestPoint._compute_color_logic``
+#: (``mitigation_or_avoidance_thresholds``), FC v1.2 sec. 5.2.
+MITIGATION_OR_AVOIDANCE_BANDS: dict[float, tuple[tuple[str, float], ...]] = {
+    10.0: ((GREEN, 0.0), (RED, math.inf)),
+    20.0: ((GREEN, 0.0), (RED, math.inf)),
+    30.0: ((GREEN, 0.0), (BROWN, 10.0), (RED, math.inf)),
+    40.0: ((GREEN, 0.0), (ORANGE, 10.0), (BROWN, 20.0), (RED, math.inf)),
+    50.0: ((GREEN, 0.0), (YELLOW, 10.0), (ORANGE, 20.0), (BROWN, 30.0), (RED, math.inf)),
+}
+#: Bands of the "mitigation" tests (CCFhos, CCFhol) on the speed *reduction* [km/h]:
+#: RATING_2026 ``mitigation_scenarios_thresholds`` (FC v1.2 Figure 5-2), ascending upper
+#: bounds: reduction <= 10 red, <= 20 orange, <= 30 green, above 30 red (as published).
+MITIGATION_BANDS: tuple[tuple[str, float], ...] = (
+    (RED, 10.0),
+    (ORANGE, 20.0),
+    (GREEN, 30.0),
+    (RED, math.inf),
+)
+#: Points of one standard-range cell by colour: RATING_2026 matrix_processing.py
+#: ``TestPoint.predicted_score``; an extended-range cell scores 1 unless red.
+STANDARD_POINTS = {GREEN: 1.0, YELLOW: 0.75, ORANGE: 0.5, BROWN: 0.25, RED: 0.0}
+#: Weight of each test's standard and extended range [points]: RATING_2026 data_model.py
+#: ``TOTAL_SCORES`` (the robustness layer, a further 1/8 of each, is not assessed here).
+TOTAL_SCORES = {
+    "CCRs": {"standard": 1.2, "extended": 0.15},
+    "CCRm": {"standard": 2.4, "extended": 0.3},
+    "CCRb": {"standard": 1.6, "extended": 0.2},
+    "CCFhos": {"standard": 2.0, "extended": 0.25},
+    "CCFhol": {"standard": 2.0, "extended": 0.25},
+}
+#: FC v1.2 sec. 4.2.4: 2 km/h on the impact speed, applied only when a *predicted* colour is
+#: verified (RATING_2026 ``NCAP_TEST_CRITERIA_TO_TOLERANCE``). We predict nothing and measure
+#: every point, so the colour is the band the impact speed falls in, no tolerance.
+IMPACT_SPEED_TOLERANCE_KMH = 2.0
+
+
+def band_colour(bands: tuple[tuple[str, float], ...], value: float) -> str:
+    """The band ``value`` falls in: (-inf, t0] the first, (t0, t1] the next, ...
+    (RATING_2026 ``get_band_color``)."""
+    lower = -math.inf
+    for colour, upper in sorted(bands, key=lambda b: b[1]):
+        if lower < value <= upper:
+            return colour
+        lower = upper
+    return bands[-1][0]
+
+
+def bands_for_speed(ego_speed_kmh: float) -> tuple[tuple[str, float], ...]:
+    """The mitigation-or-avoidance bands of a VUT speed (50 and above: the 50 row);
+    ValueError for a speed the published table has no row for."""
+    key = 50.0 if ego_speed_kmh >= 50.0 else float(ego_speed_kmh)
+    if key not in MITIGATION_OR_AVOIDANCE_BANDS:
+        raise ValueError(f"no colour bands for a VUT speed of {ego_speed_kmh:g} km/h")
+    return MITIGATION_OR_AVOIDANCE_BANDS[key]
+
+
+def ncap_colour(test: str, ego_speed_kmh: float, impact_speed_kmh: float) -> str:
+    """Colour of a measured point: CCR tests by their relative impact speed, head-on tests by
+    the speed reduction (their score parameter, RATING_2026
+    ``NCAP_TEST_CRITERIA_TO_SCORE_PARAMETER``)."""
+    if test in ("CCFhos", "CCFhol"):
+        return band_colour(MITIGATION_BANDS, ego_speed_kmh - impact_speed_kmh)
+    return band_colour(bands_for_speed(ego_speed_kmh), impact_speed_kmh)
+
+
+def cell_points(colour: str, extended: bool) -> float:
+    """Points of one cell: standard range by colour, extended range 1 unless red."""
+    if colour == NOT_RUN:
+        return 0.0
+    if extended:
+        return 0.0 if colour == RED else 1.0
+    return STANDARD_POINTS[colour]
+
+
+@dataclass(frozen=True)
+class TestScore:
+    """A test's points: each range's weight times its cells' mean points."""
+
+    test: str
+    standard: float
+    extended: float
+    max_standard: float
+    max_extended: float
+
+    @property
+    def total(self) -> float:
+        return self.standard + self.extended
+
+    @property
+    def max_total(self) -> float:
+        return self.max_standard + self.max_extended
+
+
+def test_score(test: str, cells: list[tuple[float, bool]]) -> TestScore:
+    """``cells``: (cell points, extended) of every point of a test. Each range scores its
+    ``TOTAL_SCORES`` weight times the mean of its cells' points (a point not run scores 0)."""
+    weights = TOTAL_SCORES[test]
+    parts = {}
+    for name, extended in (("standard", False), ("extended", True)):
+        own = [p for p, ext in cells if ext == extended]
+        parts[name] = weights[name] * sum(own) / len(own) if own else 0.0
+    max_ext = weights["extended"] if any(ext for _, ext in cells) else 0.0
+    return TestScore(test, parts["standard"], parts["extended"], weights["standard"], max_ext)
+
+
+R152 = "UN R152 00 series (Add.151 and its Supplement 1, Amend.1), para. 5.2.1.4"
+#: R152 para. 5.2.1.4, M1 table: relative speed [km/h] -> largest relative impact speed
+#: [km/h] at (maximum mass, mass in running order) ("laden", "unladen" in the original text),
+#: the same for a stationary and a moving target (Supplement 1: one "Stationary/Moving"
+#: column pair; the original's moving columns hold these values up to 40 km/h, "-" above).
+R152_M1_TABLE_KMH: dict[float, tuple[float, float]] = {
+    10.0: (0.0, 0.0),
+    15.0: (0.0, 0.0),
+    20.0: (0.0, 0.0),
+    25.0: (0.0, 0.0),
+    30.0: (0.0, 0.0),
+    35.0: (0.0, 0.0),
+    40.0: (0.0, 0.0),
+    42.0: (10.0, 0.0),
+    45.0: (15.0, 15.0),
+    50.0: (25.0, 25.0),
+    55.0: (30.0, 30.0),
+    60.0: (35.0, 35.0),
+}
+#: R152 para. 5.2.1.3: the AEBS shall be active at least from 10 to 60 km/h (subject speed)
+R152_MAX_SUBJECT_SPEED_KMH = 60.0
+#: the moving target's speed in R152's test procedure (subject at 30 and 60 km/h)
+R152_MOVING_TARGET_KMH = 20.0
+#: R152 rows: (target, relative speed [km/h]) -> the limit applied [km/h]. The plant's mass
+#: is the sedan's (params.VehicleParams.mass_kg), taken as its mass in running order, so the
+#: unladen column applies; it is never above the laden one. A moving target's rows stop at
+#: a subject speed of 60 km/h (para. 5.2.1.3).
+R152_LIMITS_KMH: dict[tuple[str, float], float | None] = {
+    **{("stationary", v): lim[1] for v, lim in R152_M1_TABLE_KMH.items()},
+    **{
+        ("moving", v): lim[1]
+        for v, lim in R152_M1_TABLE_KMH.items()
+        if v + R152_MOVING_TARGET_KMH <= R152_MAX_SUBJECT_SPEED_KMH
+    },
+}
+PASS, FAIL, UNDETERMINED = "pass", "fail", "undetermined"
+
+
+def r152_verdict(limit_kmh: float | None, impact_speed_kmh: float) -> tuple[str, str]:
+    """(verdict, reason) of one R152 row from its relative impact speed and its limit."""
+    if impact_speed_kmh <= 0.0:
+        return PASS, "collision avoided (passes under any limit)"
+    if limit_kmh is None:
+        return UNDETERMINED, (f"impact at {impact_speed_kmh:.1f} km/h; no R152 limit for this row")
+    if impact_speed_kmh <= limit_kmh:
+        return PASS, f"impact {impact_speed_kmh:.1f} <= {limit_kmh:g} km/h allowed"
+    return FAIL, f"impact {impact_speed_kmh:.1f} > {limit_kmh:g} km/h allowed"
