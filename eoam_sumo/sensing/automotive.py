@@ -243,8 +243,9 @@ class AutomotiveRadar:
             road_speed = tr.vx_mps * math.cos(road_yaw) + tr.vy_mps * math.sin(road_yaw)
             # the lateral velocity of a track far ahead is poorly observed: stopped or not
             # is judged on the speed along the road
+            ahead = s > scan.ego_s
             category = self._geometry.classify(
-                s > scan.ego_s, d, abs(road_speed), road_speed, band_m, lane_width_m
+                ahead, d, abs(road_speed), road_speed, band_m, lane_width_m
             )
             detections.append(
                 Detection(
@@ -258,6 +259,7 @@ class AutomotiveRadar:
                     category,
                     tr.length_m,
                     tr.width_m,
+                    self._geometry.head_on(category, ahead, d, band_m),
                 )
             )
         return report_of(detections)

@@ -15,7 +15,8 @@ maintenance by missed-detection logic). Here:
   it is coasted: its box moved at its last velocity, measured from the radar as a detection
   would be, classified by the radar's rules;
 * the coasted object is reported (``RadarReport.coasted``) while that prediction is in path
-  (centre in the lane band and ahead of the ego's front bumper) and outside the beams; it
+  (centre in the lane band and ahead of the ego's front bumper; classed ``in_path``, or
+  oncoming and so head-on, as the radar's in-path obstacle is) and outside the beams; it
   ends when it is predicted out of the path or behind the ego, when the radar sees the
   object again, or when the prediction lies in a beam and nothing is seen there (the object
   did not go where it was predicted to go).
@@ -47,6 +48,10 @@ class Beams(Protocol):
         lane_width_m: float,
     ) -> str:
         """The radar's class of a target."""
+        ...
+
+    def head_on(self, category: str, ahead: bool, d_m: float, band_m: float) -> bool:
+        """Whether a target of ``category`` is oncoming ahead in the lane band (in path)."""
         ...
 
     def covers(self, ox: float, oy: float, yaw_rad: float, px: float, py: float) -> bool:
@@ -146,9 +151,11 @@ class Coaster:
         box = _predicted(body, time_s - self.coasted_t)
         s, d, road_yaw = project(box.x_m, box.y_m)
         road_speed = body.speed_mps * math.cos(box.yaw_rad - road_yaw)
-        category = radar.classify(s > ego_s, d, body.speed_mps, road_speed, band_m, lane_width_m)
+        ahead = s > ego_s
+        category = radar.classify(ahead, d, body.speed_mps, road_speed, band_m, lane_width_m)
+        head_on = radar.head_on(category, ahead, d, band_m)
         px, py = box.nearest_point(ox, oy)
-        if category != "in_path" or radar.covers(ox, oy, yaw_rad, px, py):
+        if not (category == "in_path" or head_on) or radar.covers(ox, oy, yaw_rad, px, py):
             return None
         rng = math.hypot(px - ox, py - oy)
         lx, ly = (
@@ -169,6 +176,7 @@ class Coaster:
             category,
             body.length_m,
             body.width_m,
+            head_on,
         )
 
 

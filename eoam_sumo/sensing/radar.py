@@ -38,6 +38,13 @@ road speed = target speed times the cosine of its heading relative to the road):
 * ``stationary_side``: speed below stationary_speed_mps and the centre outside the lane band
   otherwise (parked cars; never in path, never oncoming);
 * ``other``: everything else (e.g. traffic in another lane moving with the ego).
+
+An oncoming target whose centre is ahead inside the lane band is also the in-path obstacle
+(``Detection.head_on``; Euro NCAP's CCFhos, a car driving straight at the ego in its lane):
+the nearest in-path target is the nearest one classed ``in_path`` or head-on, so the EOAM
+sees its range and range rate (the closing speed, ego + target) while the ``oncoming`` flag
+stays raised, and with it the paper's rule for oncoming traffic, braking in the lane (mode 3,
+sec. 3.2) rather than steering into the next lane.
 """
 
 from __future__ import annotations
@@ -121,6 +128,7 @@ class Detection(NamedTuple):
     category: str
     length_m: float  # object size, as a tracking sensor reports it
     width_m: float
+    head_on: bool = False  # oncoming, centre ahead in the lane band: in the path as well
 
 
 class RadarReport(NamedTuple):
@@ -149,18 +157,20 @@ def ray_entry_m(box: OrientedBox, ox: float, oy: float, ux: float, uy: float) ->
 
 
 def report_of(detections: list[Detection]) -> RadarReport:
-    """The report of a scan's detections: sorted by range, the nearest in-path one, the
-    oncoming flag and the nearest standing object in the next lane."""
+    """The report of a scan's detections: sorted by range, the nearest in-path one (classed
+    ``in_path`` or head-on), the oncoming flag and the nearest standing object in the next
+    lane."""
     if not detections:
         return EMPTY_REPORT
     detections.sort(key=_range_of)
     in_path, oncoming, next_lane = None, False, None
     for det in detections:
-        if det.category == "in_path" and in_path is None:
+        category = det.category
+        if in_path is None and (category == "in_path" or det.head_on):
             in_path = det
-        elif det.category == "oncoming":
+        if category == "oncoming":
             oncoming = True
-        elif det.category == "in_next_lane" and next_lane is None:
+        elif category == "in_next_lane" and next_lane is None:
             next_lane = det.range_m
     if in_path is None:
         return RadarReport(None, None, oncoming, tuple(detections), next_lane_range_m=next_lane)
@@ -342,9 +352,8 @@ class Radar:
         bearing = math.atan2(bx * ly - by * lx, bx * lx + by * ly)
         s, d, road_yaw = road_frame.project(box.x_m, box.y_m)
         road_speed = tgt.speed_mps * math.cos(box.yaw_rad - road_yaw)
-        category = self.classify(
-            s > ego.s_m, d, tgt.speed_mps, road_speed, ego.band_m, ego.lane_width_m
-        )
+        ahead = s > ego.s_m
+        category = self.classify(ahead, d, tgt.speed_mps, road_speed, ego.band_m, ego.lane_width_m)
         return Detection(
             index,
             rng,
@@ -356,6 +365,7 @@ class Radar:
             category,
             tgt.length_m,
             tgt.width_m,
+            self.head_on(category, ahead, d, ego.band_m),
         )
 
     def _coasting(
@@ -407,6 +417,7 @@ class Radar:
         band_m: float,
         lane_width_m: float,
     ) -> str:
+        """The class of a target (rules: module doc)."""
         st = self.settings
         if road_speed_mps < -st.oncoming_speed_mps and d_m > -band_m:
             return "oncoming"
@@ -419,3 +430,8 @@ class Radar:
                 return "in_next_lane"
             return "stationary_side"
         return "other"
+
+    def head_on(self, category: str, ahead: bool, d_m: float, band_m: float) -> bool:
+        """Whether a target of ``category`` is oncoming with its centre ahead inside the lane
+        band: a wrong-way road user in the ego's lane, the in-path obstacle as well."""
+        return category == "oncoming" and ahead and abs(d_m) < band_m

@@ -194,3 +194,23 @@ def test_run_refuses_a_bad_radar_model_or_seed_with_one_line(
     assert main(["run", str(cfg), option, value, "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and named in err[0]
+
+
+def test_a_tracked_wrong_way_car_in_the_lane_is_the_in_path_obstacle():
+    """The automotive radar classifies its tracks as the ideal radar does: a wrong-way car
+    half an ego width off the lane centre is reported in path, at the closing speed (ego +
+    target, exact model), and as oncoming traffic."""
+    ego_mps, tgt_mps = 80 / 3.6, 50 / 3.6
+    radar = AutomotiveRadar(model=EXACT)
+
+    def world(t):
+        centre = 90.0 + 0.5 * CAR[0] - tgt_mps * t
+        return [Body("wrong_way", "passenger", centre, 0.925, math.pi, tgt_mps, *CAR)]
+
+    reports = [rep for _, rep in _drive(radar, world, 1.0, ego_speed=ego_mps)]
+    seen = [rep for rep in reports if rep.in_path is not None]
+    assert seen, "never in path"
+    for rep in seen:
+        assert rep.oncoming_detected and rep.in_path.head_on
+        assert rep.in_path.category == "oncoming"
+        assert rep.in_path_range_rate_mps == pytest.approx(-(ego_mps + tgt_mps), abs=0.05)

@@ -148,3 +148,34 @@ def test_without_a_time_nothing_is_coasted():
         body = walker_at(t, x0_m=8.0)
         rep = radar.scan((10.0 * t, 0.0), 0.0, 10.0, ROAD, [body], LANE_M)
         assert rep.coasted is None
+
+
+def test_a_wrong_way_car_leaving_the_beam_beside_the_lane_centre_is_coasted_head_on():
+    """A wrong-way car (50 km/h against the ego's 80), its centre 2.0 m left of the lane
+    centre (inside the lane band): in path while seen, then coasted, still head-on and
+    oncoming, at the range of its predicted box (closed form), until its centre passes the
+    radar."""
+    ego_mps, tgt_mps, d_m, dims = 80 / 3.6, 50 / 3.6, 2.0, (4.70, 1.82)
+
+    def car(t):  # front face 30 m ahead of the ego's front at t = 0, driving west
+        return Body(
+            "car", "passenger", 30.0 + 0.5 * dims[0] - tgt_mps * t, d_m, math.pi, tgt_mps, *dims
+        )
+
+    phases, coasted = [], 0
+    for _t, front, body, rep in drive(Radar(), ego_mps, 1.0, walker=car):
+        phases.append("seen" if rep.in_path is not None else "coasted" if rep.coasted else "-")
+        if rep.in_path is not None:
+            assert rep.in_path.head_on and rep.oncoming_detected
+        if rep.coasted is not None:
+            coasted += 1
+            det = rep.coasted
+            assert det.head_on and det.category == "oncoming"
+            front_face = body.x_m - 0.5 * dims[0]
+            near_side = d_m - 0.5 * dims[1]
+            assert det.range_m == pytest.approx(
+                math.hypot(max(front_face - front, 0.0), near_side), abs=1e-9
+            )
+            assert det.range_rate_mps <= 1e-9  # closing (0 once beside the radar)
+    runs = [p for i, p in enumerate(phases) if i == 0 or p != phases[i - 1]]
+    assert runs == ["seen", "coasted", "-"] and coasted >= 3

@@ -154,6 +154,49 @@ def test_classification(target, category):
     assert det.category == category
 
 
+# --- head-on: a wrong-way car in the ego's lane (Euro NCAP CCFhos) ----------------------------
+
+EGO_W_M = 1.85  # the ego's width: a 50 % offset puts the other car's centre half of it aside
+
+
+@pytest.mark.parametrize("offset_m", [0.0, 0.5 * EGO_W_M, -0.5 * EGO_W_M, 2.2])
+def test_a_wrong_way_car_in_the_lane_is_the_in_path_obstacle_and_oncoming(offset_m):
+    """Its front 60 m ahead, 50 km/h against the ego's 80: the in-path range is the distance
+    to its front face (closed form), the range rate minus the closing speed projected on the
+    line of sight, and the oncoming flag stays raised."""
+    ego_mps, tgt_mps = 80 / 3.6, 50 / 3.6
+    rep = _scan([_ahead(60.0, offset_m, CAR, tgt_mps, reverse=True)], speed=ego_mps)
+    (det,) = rep.detections
+    lateral = max(abs(offset_m) - 0.5 * CAR[1], 0.0)  # nearest point of its front face
+    r = math.hypot(60.0, lateral)
+    assert det.category == "oncoming" and det.head_on
+    assert rep.oncoming_detected and rep.in_path is det and rep.in_path_index == 0
+    assert rep.in_path_range_m == pytest.approx(r, abs=1e-9)
+    assert rep.in_path_range_rate_mps == pytest.approx(-(ego_mps + tgt_mps) * 60.0 / r, abs=1e-9)
+
+
+def test_head_on_nearest_in_path_target_wins():
+    """The nearer of a wrong-way car and a stopped ARO in the lane is the in-path obstacle; a
+    wrong-way car in the next lane or behind the ego's front is never in the path."""
+    wrong_way = _ahead(40.0, 0.0, CAR, 14.0, reverse=True)
+    far_aro, near_aro = _ahead(70.0, 0.0, ARO), _ahead(25.0, 0.0, ARO)
+    rep = _scan([far_aro, wrong_way])
+    assert rep.in_path_range_m == pytest.approx(40.0) and rep.in_path_index == 1
+    rep = _scan([near_aro, wrong_way])
+    assert rep.in_path_range_m == pytest.approx(25.0) and rep.oncoming_detected
+    next_lane = _ahead(40.0, LANE_M, CAR, 14.0, reverse=True)
+    rep = _scan([next_lane])
+    assert rep.oncoming_detected and rep.in_path is None
+    assert not rep.detections[0].head_on
+    right_of_band = _ahead(40.0, -LANE_M, CAR, 14.0, reverse=True)  # wrong way on the right
+    assert all(not d.head_on for d in _scan([right_of_band]).detections)
+    radar = Radar()
+    assert radar.head_on("oncoming", True, 0.0, 2.25)
+    assert not radar.head_on("oncoming", False, 0.0, 2.25)  # its centre behind the bumper
+    assert not radar.head_on("oncoming", True, 2.25, 2.25)
+    assert not radar.head_on("in_path", True, 0.0, 2.25)
+
+
 def test_in_path_is_relative_to_the_original_lane():
     """In the left lane after the lane change, the ARO in the original lane is still in path."""
     aro = _ahead(30.0, 0.0, ARO, 0.0)
