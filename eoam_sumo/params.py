@@ -42,7 +42,7 @@ PAC2002 = (
     "MSC Adams PAC2002 sample tyre 235/60R16 (FNOMIN 4850 N, R0 0.344 m), the set "
     "CommonRoad vehicle models ship (Althoff & Wuersching 2020, Tab. 7)"
 )
-CHASSIS = "docs/chassis.md (issue 27)"
+CHASSIS = "docs/chassis.md"
 DRIVETRAINS = ("fwd", "rwd", "awd", "eawd")
 
 

@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 
 pytest.importorskip("vehiclemodels")
-from vehiclemodels.utils import tire_model as cr  # noqa: E402
-from vehiclemodels.utils.tireParameters import TireParameters  # noqa: E402
+from vehiclemodels.utils import tire_model as cr
+from vehiclemodels.utils.tireParameters import TireParameters
 
-from eoam_sumo.plant.magic_formula import (  # noqa: E402
+from eoam_sumo.plant.magic_formula import (
     PAC2002_235_60R16,
     axle_forces,
     combined_fx,
@@ -29,7 +29,7 @@ from eoam_sumo.plant.magic_formula import (  # noqa: E402
     pure_fx,
     pure_fy,
 )
-from eoam_sumo.plant.ops import FLOAT_OPS  # noqa: E402
+from eoam_sumo.plant.ops import FLOAT_OPS
 
 NO_LOAD_VARIATION = dict.fromkeys(
     (

@@ -41,13 +41,6 @@ def test_fiala_slope_at_zero_is_the_cornering_stiffness_and_it_saturates_at_the_
     assert all(b >= a for a, b in itertools.pairwise(forces))  # monotone up to full sliding
 
 
-def axle(brake_n, steer_rad=0.0, vy_mps=0.0, drive_n=0.0, mu=0.8, fz_n=9000.0):
-    return axle_force(
-        20.0, vy_mps, math.cos(steer_rad), math.sin(steer_rad), brake_n, drive_n, fz_n, mu,
-        C_NPR, 0.012, 0.8, FLOAT_OPS,
-    )  # fmt: skip
-
-
 @pytest.mark.parametrize("esc", [False, True])
 def test_casadi_form_of_the_model_equals_the_float_form(params, esc):
     params = dataclasses.replace(params, esc_fitted=esc, abs_fitted=esc, drivetrain="eawd")
