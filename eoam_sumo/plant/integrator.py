@@ -1,5 +1,5 @@
-"""Fixed-step integration of the plant, for any arithmetic: classical Runge-Kutta (RK4) for
-the smooth dynamics, then the wheels' Coulomb torques (brakes, rolling resistance) applied
+"""Fixed-step integration of the plant, for any arithmetic: the explicit midpoint rule (RK2)
+for the smooth dynamics, then the wheels' Coulomb torques (brakes, rolling resistance) applied
 exactly for the step (``resist``), a splitting that keeps the stiff stick-slip of a braked
 wheel out of the explicit step."""
 
@@ -39,11 +39,10 @@ def resist(x, params: VehicleParams, dt_s: float, ops) -> list:
     return out
 
 
-def rk4_step(x, u, mu, params: VehicleParams, dt_s: float, ops) -> list:
-    """One step of ``dt_s`` with inputs and friction held: the explicit midpoint rule (RK2),
-    then ``resist``. (The name is kept for its callers: the relaxed slips make every remaining
-    mode slow against the 1 ms step, where the second-order rule is as accurate as RK4's
-    needs, at half the tyre evaluations.)"""
+def sub_step(x, u, mu, params: VehicleParams, dt_s: float, ops) -> list:
+    """One step of ``dt_s`` with inputs and friction held: the explicit midpoint rule, then
+    ``resist``. The relaxed slips leave no mode fast against a 1 ms step (``MAX_DT_S``), so
+    the second-order rule needs half the tyre evaluations of RK4."""
     k1 = rhs(x, u, mu, params, ops)
     k2 = rhs([xi + 0.5 * dt_s * ki for xi, ki in zip(x, k1)], u, mu, params, ops)
     x = [xi + dt_s * ki for xi, ki in zip(x, k2)]
@@ -53,5 +52,5 @@ def rk4_step(x, u, mu, params: VehicleParams, dt_s: float, ops) -> list:
 def advance(x, u, mu, params: VehicleParams, dt_s: float, substeps: int, ops):
     """``substeps`` steps; returns ``(x_next, y)`` with ``y`` the outputs at ``x_next``."""
     for _ in range(substeps):
-        x = rk4_step(x, u, mu, params, dt_s, ops)
+        x = sub_step(x, u, mu, params, dt_s, ops)
     return x, outputs(x, mu, params, ops)
