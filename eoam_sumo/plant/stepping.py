@@ -30,7 +30,7 @@ region (|lambda dt| < 0.35)."""
 
 def validate_step(params: VehicleParams, dt_s: float, substeps: int) -> None:
     """Raise ``ValueError`` unless ``0 < dt_s <= MAX_DT_S``, ``substeps >= 1`` and every
-    actuator lag is at least ``dt_s`` (a shorter lag would make the fixed-step integration unstable)."""
+    actuator lag is at least ``dt_s`` (a shorter lag would make the fixed step unstable)."""
     if isinstance(substeps, bool) or not isinstance(substeps, int) or substeps < 1:
         raise ValueError(f"substeps={substeps!r} must be an int >= 1")
     if not (isinstance(dt_s, (int, float)) and 0.0 < dt_s <= MAX_DT_S):
