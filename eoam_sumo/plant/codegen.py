@@ -1,7 +1,8 @@
 """Build the plant's step as one CasADi SX function and compile it to a cached C library.
 
 One integration sub-step of ``model.rhs`` (``integrator.sub_step``) is an SX function; an MX
-function calls it ``substeps`` times, so one call of the compiled function advances a whole co-simulation step.
+function calls it ``substeps`` times, so one call of the compiled function advances a whole
+co-simulation step.
 The C source comes from ``casadi.CodeGenerator``; it is compiled with the system C compiler
 (``$CC``, else ``gcc``, else ``cc``) into a cache directory, keyed by a hash of the source and
 the compiler command, so a changed model or parameter set gets a new library. The library is

@@ -118,9 +118,9 @@ class Plant:
     (``OUTPUT_NAMES``, evaluated at ``x_next``) are 1-D float arrays (``advance``: lists of
     floats, for loops that keep the state in plain floats); ``mu`` is the peak surface
     friction under the vehicle for this step. The model is ``model.rhs`` integrated by the
-    midpoint rule (``integrator.py``). The C library is built on first construction (a few seconds) and
-    cached in ``cache_dir`` (default ``codegen.default_cache_dir()``). Instances hold their
-    own buffers: one instance must not be stepped from two threads at once.
+    midpoint rule (``integrator.py``). The C library is built on first construction (a few
+    seconds) and cached in ``cache_dir`` (default ``codegen.default_cache_dir()``). Instances
+    hold their own buffers: one instance must not be stepped from two threads at once.
     """
 
     def __init__(
