@@ -138,7 +138,7 @@ def _floor_over_sumo(repeats: int, steps: int = 903) -> float:
     import libsumo
 
     from eoam_sumo.params import ego_e_class_sedan
-    from eoam_sumo.plant import Plant
+    from eoam_sumo.plant import Plant, initial_state
     from eoam_sumo.sim.scenario import ScenarioOverrides
     from eoam_sumo.sim.session import SumoSession
     from eoam_sumo.sim.session.calls import StepCalls
@@ -153,7 +153,7 @@ def _floor_over_sumo(repeats: int, steps: int = 903) -> float:
             ego = session.ego_id
             session.nearby(100.0)  # the step's subscriptions, as the co-simulation sets them
             body = session.ego_body()  # heading east (nav angle 90)
-            x = [body.x_m, body.y_m, 0.0, SPEED_MPS, 0.0, 0.0, 0.0, 300.0, 0.0]
+            x = initial_state(body.x_m, body.y_m, 0.0, SPEED_MPS, drive_force_n=300.0).tolist()
             t0 = time.perf_counter()
             for _k in range(steps):
                 x, _y = advance(x, u, 1.0)

@@ -30,6 +30,20 @@ W213 = "Mercedes-Benz E-Class (W213) sedan dimensions, manufacturer data sheet"
 GILLESPIE = "Gillespie, Fundamentals of Vehicle Dynamics (1992), typical passenger-car value"
 PAPER = "Lowe & Guvenc 2022 (the paper)"
 ASSUMED = "assumed: typical value for the class, documented in README"
+NHTSA_INERTIA = (
+    "Heydinger et al., Measured vehicle inertial parameters - NHTSA's data through November "
+    "1998, SAE 1999-01-1336 (passenger cars: dynamic index k^2/(a b) close to 1)"
+)
+R13H = (
+    "UN R13-H Annex 5 para. 3.1.1 (as Directive 71/320/EEC Annex II Appendix 3.1.1): "
+    "front axle's adhesion utilisation above the rear's for braking rates 0.15-0.8"
+)
+PAC2002 = (
+    "MSC Adams PAC2002 sample tyre 235/60R16 (FNOMIN 4850 N, R0 0.344 m), the set "
+    "CommonRoad vehicle models ship (Althoff & Wuersching 2020, Tab. 7)"
+)
+CHASSIS = "docs/chassis.md"
+DRIVETRAINS = ("fwd", "rwd", "awd", "eawd")
 
 
 @dataclass(frozen=True)
@@ -38,7 +52,9 @@ class VehicleParams:
 
     name: str = _p("E-class sedan", "-", PAPER + ", sec. 4.1")
     mass_kg: float = _p(1723.0, "kg", JING)
-    yaw_inertia_kgm2: float = _p(4175.0, "kg m^2", JI)
+    yaw_inertia_kgm2: float = _p(
+        3116.0, "kg m^2", NHTSA_INERTIA + ": k^2/(a b) = 1.0 with this mass and CG"
+    )
     cg_to_front_m: float = _p(1.232, "m", JING)
     cg_to_rear_m: float = _p(1.468, "m", JING)
     cg_height_m: float = _p(0.54, "m", ASSUMED + " (sedan CG height 0.5-0.6 m, Gillespie)")
@@ -52,7 +68,10 @@ class VehicleParams:
         math.radians(50.0), "rad/s", ASSUMED + " (800 deg/s hand wheel / 16)"
     )
     cornering_stiffness_front_npr: float = _p(
-        2 * 66900.0, "N/rad", JI + " (per tyre x 2, per axle)"
+        0.75 * 2 * 66900.0,
+        "N/rad",
+        JI + " (per tyre x 2, per axle) x 0.75 steering-compliance factor (effective axle "
+        "stiffness, Gillespie ch. 6: understeer gradient 1.7 deg/g)",
     )
     cornering_stiffness_rear_npr: float = _p(2 * 62700.0, "N/rad", JI + " (per tyre x 2, per axle)")
     slip_angle_sat_rad: float = _p(math.radians(5.0), "rad", PAPER + ", eq. 6 (alpha* = 5 deg)")
@@ -62,12 +81,42 @@ class VehicleParams:
     max_brake_force_n: float = _p(
         22000.0, "N", ASSUMED + " (brakes able to lock all wheels on dry)"
     )
-    brake_front_share: float = _p(0.65, "-", GILLESPIE + " (fixed front brake proportion)")
+    brake_front_share: float = _p(0.73, "-", R13H + "; front first up to 0.93 g")
     rolling_resistance_coeff: float = _p(0.012, "-", GILLESPIE)
     drag_area_m2: float = _p(0.62, "m^2", ASSUMED + " (Cd 0.27 x 2.3 m^2 frontal area)")
     steer_lag_s: float = _p(0.05, "s", ASSUMED + " (electric power steering actuator)")
     drive_lag_s: float = _p(0.20, "s", ASSUMED + " (engine torque build-up)")
     brake_lag_s: float = _p(0.10, "s", ASSUMED + " (hydraulic brake build-up)")
+    # --- the chassis (plant only; the offline design does not use these, DESIGN_FIELDS) ---
+    wheel_radius_m: float = _p(0.334, "m", PAC2002 + ": R0 less 3 % deflection")
+    wheel_inertia_kgm2: float = _p(1.7, "kg m^2", "CommonRoad vehicle 2 (BMW 320i), I_y_w")
+    tyre_nominal_load_n: float = _p(4850.0, "N", PAC2002 + " (FNOMIN)")
+    relaxation_length_long_m: float = _p(
+        0.25, "m", PAC2002 + ": K_x/C_x at FNOMIN (Pacejka 2012 sec. 7.2)"
+    )
+    relaxation_length_lat_m: float = _p(
+        0.60, "m", PAC2002 + ": PTY1 sin(2 atan(1/PTY2)) R0 (Pacejka 2012 sec. 7.2)"
+    )
+    roll_stiffness_front_share: float = _p(
+        0.60, "-", GILLESPIE + " (front-biased roll stiffness of a sedan)"
+    )
+    max_brake_pressure_bar: float = _p(150.0, "bar", ASSUMED + " (ABS modulator range)")
+    brake_build_rate_barps: float = _p(1500.0, "bar/s", ASSUMED + " (booster + ABS pump)")
+    brake_dump_rate_barps: float = _p(3000.0, "bar/s", ASSUMED + " (ABS outlet valve)")
+    abs_fitted: bool = _p(False, "-", PAPER + ", sec. 4.1 (no ABS)")
+    esc_fitted: bool = _p(False, "-", PAPER + ", sec. 4.1 (no ESC)")
+    drivetrain: str = _p("rwd", "-", PAPER + ", sec. 4.1 (rear drive); fwd|rwd|awd|eawd")
+    awd_front_share: float = _p(0.40, "-", ASSUMED + " (fixed AWD torque split to the front)")
+    eawd_gain_per_slip: float = _p(
+        10.0, "-", CHASSIS + ": front share moved per unit slip difference (eAWD)"
+    )
+    esc_yaw_gain: float = _p(15.0, "1/s", CHASSIS + ": moment / (Iz yaw-rate error), tuned SWD")
+    esc_yaw_deadband_radps: float = _p(0.03, "rad/s", CHASSIS + " (tuned on SWD)")
+    esc_sideslip_threshold_rad: float = _p(
+        math.radians(4.0), "rad", CHASSIS + " (sideslip beyond which ESC acts)"
+    )
+    esc_sideslip_gain_nmprad: float = _p(60000.0, "N m/rad", CHASSIS + " (tuned on SWD)")
+    esc_lag_s: float = _p(0.08, "s", ASSUMED + " (ESC hydraulic build-up)")
 
     @property
     def wheelbase_m(self) -> float:
@@ -89,6 +138,13 @@ class VehicleParams:
                 raise ValueError(f"vehicle parameter {f.name}={v!r} must be finite and >= 0")
         if not 0.0 < self.brake_front_share < 1.0:
             raise ValueError(f"brake_front_share={self.brake_front_share} must be in (0, 1)")
+        if self.drivetrain not in DRIVETRAINS:
+            raise ValueError(f"drivetrain={self.drivetrain!r} must be one of {DRIVETRAINS}")
+        for name in ("abs_fitted", "esc_fitted"):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(f"vehicle parameter {name}={getattr(self, name)!r} must be a bool")
+        if not 0.0 <= self.awd_front_share <= 1.0:
+            raise ValueError(f"awd_front_share={self.awd_front_share} must be in [0, 1]")
 
 
 @dataclass(frozen=True)

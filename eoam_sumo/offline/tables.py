@@ -325,6 +325,29 @@ def _same(grid, values: list[float], tol: float) -> bool:
     return len(grid) == len(values) and bool(np.allclose(sorted(grid), values, atol=tol))
 
 
+DESIGN_FIELDS = (
+    "mass_kg",
+    "yaw_inertia_kgm2",
+    "cg_to_front_m",
+    "cg_to_rear_m",
+    "cg_height_m",
+    "width_m",
+    "front_overhang_m",
+    "max_steer_rad",
+    "max_steer_rate_radps",
+    "cornering_stiffness_front_npr",
+    "cornering_stiffness_rear_npr",
+    "slip_angle_sat_rad",
+    "max_drive_force_n",
+    "max_drive_power_w",
+    "max_brake_force_n",
+    "brake_front_share",
+)
+"""The vehicle parameters the offline design uses (``offline/``: the design model, the
+inverse dynamics, the boundaries): the tables are valid for a vehicle that matches them; the
+chassis-only fields (tyre, wheels, ABS/ESC, drivetrain) do not change them."""
+
+
 def _check_metadata(path: Path, metadata: dict, params: VehicleParams) -> None:
     if metadata.get("format") != FORMAT_VERSION:
         raise InputError(
@@ -335,10 +358,10 @@ def _check_metadata(path: Path, metadata: dict, params: VehicleParams) -> None:
     wanted = describe(params)
     diffs = [
         name
-        for name, rec in wanted.items()
-        if not isinstance(stored.get(name), dict) or stored[name].get("value") != rec["value"]
+        for name in DESIGN_FIELDS
+        if not isinstance(stored.get(name), dict)
+        or stored[name].get("value") != wanted[name]["value"]
     ]
-    diffs += [name for name in stored if name not in wanted]
     if diffs:
         shown = ", ".join(
             f"{n} (tables {stored.get(n, {}).get('value')!r}, in use "

@@ -1,5 +1,6 @@
-"""The ego vehicle plant: a nonlinear single-track model with Fiala tyres, load transfer,
-wheel lock (no ABS), drag and actuator lags, integrated by fixed-step RK4.
+"""The ego vehicle plant: a nonlinear single-track model with wheel spin, Magic Formula tyres
+per wheel with load transfer, hydraulic brakes, ABS, ESC, drivetrains, drag and actuator lags
+(docs/chassis.md), integrated by a fixed-step explicit midpoint rule.
 
 ``Plant`` is the fast online path (compiled C, one call per co-simulation step);
 ``ReferencePlant`` evaluates the same model with Python floats; ``rhs`` / ``outputs`` with

@@ -1,7 +1,8 @@
 """Build the plant's step as one CasADi SX function and compile it to a cached C library.
 
-One RK4 step of ``model.rhs`` is an SX function; an MX function calls it ``substeps`` times,
-so one call of the compiled function advances a whole co-simulation step.
+One integration sub-step of ``model.rhs`` (``integrator.sub_step``) is an SX function; an MX
+function calls it ``substeps`` times, so one call of the compiled function advances a whole
+co-simulation step.
 The C source comes from ``casadi.CodeGenerator``; it is compiled with the system C compiler
 (``$CC``, else ``gcc``, else ``cc``) into a cache directory, keyed by a hash of the source and
 the compiler command, so a changed model or parameter set gets a new library. The library is
@@ -27,7 +28,7 @@ from pathlib import Path
 import casadi
 
 from eoam_sumo.params import VehicleParams
-from eoam_sumo.plant.integrator import rk4_step
+from eoam_sumo.plant.integrator import sub_step
 from eoam_sumo.plant.model import INPUT_NAMES, STATE_NAMES, outputs
 from eoam_sumo.plant.ops import CASADI_OPS
 
@@ -64,7 +65,7 @@ static inline double eoam_fmin(double x, double y) { return x < y ? x : (y != y 
 @functools.lru_cache(maxsize=16)
 def step_function(params: VehicleParams, dt_s: float, substeps: int) -> casadi.Function:
     """``(x[9], u[3], mu) -> (x_next[9], y[len(OUTPUT_NAMES)])``: ``substeps`` calls of one
-    SX RK4 step inside an MX function, so the generated C holds the step once (not unrolled
+    SX sub-step inside an MX function, so the generated C holds the step once (not unrolled
     ``substeps`` times: the smaller library stays in the instruction cache between SUMO
     steps)."""
     x = casadi.SX.sym("x", len(STATE_NAMES))
@@ -72,11 +73,11 @@ def step_function(params: VehicleParams, dt_s: float, substeps: int) -> casadi.F
     mu = casadi.SX.sym("mu")
     xs = [x[i] for i in range(x.numel())]
     one_step = casadi.Function(
-        f"{FUNCTION_NAME}_rk4",
+        f"{FUNCTION_NAME}_sub",
         [x, u, mu],
         [
             casadi.vertcat(
-                *rk4_step(xs, [u[i] for i in range(u.numel())], mu, params, dt_s, CASADI_OPS)
+                *sub_step(xs, [u[i] for i in range(u.numel())], mu, params, dt_s, CASADI_OPS)
             )
         ],
     )

@@ -117,10 +117,10 @@ class Plant:
     ``x`` (``STATE_NAMES``), ``u`` (``INPUT_NAMES``) and the returned ``x_next``, ``y``
     (``OUTPUT_NAMES``, evaluated at ``x_next``) are 1-D float arrays (``advance``: lists of
     floats, for loops that keep the state in plain floats); ``mu`` is the peak surface
-    friction under the vehicle for this step. The model is ``model.rhs`` integrated by RK4
-    (``integrator.py``). The C library is built on first construction (a few seconds) and
-    cached in ``cache_dir`` (default ``codegen.default_cache_dir()``). Instances hold their
-    own buffers: one instance must not be stepped from two threads at once.
+    friction under the vehicle for this step. The model is ``model.rhs`` integrated by the
+    midpoint rule (``integrator.py``). The C library is built on first construction (a few
+    seconds) and cached in ``cache_dir`` (default ``codegen.default_cache_dir()``). Instances
+    hold their own buffers: one instance must not be stepped from two threads at once.
     """
 
     def __init__(
@@ -175,7 +175,7 @@ class Plant:
         return self.dt_s * self.substeps
 
     def step(self, x, u, mu: float) -> tuple[np.ndarray, np.ndarray]:
-        """Advance ``substeps`` RK4 steps with ``u`` and ``mu`` held; return new arrays."""
+        """Advance ``substeps`` sub-steps with ``u`` and ``mu`` held; return new arrays."""
         x_next, y = self.advance(x, u, mu)
         return np.array(x_next), np.array(y)
 

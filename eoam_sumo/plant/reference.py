@@ -1,4 +1,4 @@
-"""Plain-Python reference plant: the same model and RK4, evaluated with Python floats.
+"""Plain-Python reference plant: the same model and integrator, evaluated with Python floats.
 
 Slow (pure Python) but independent of CasADi's code generation and of the C compiler; the
 tests hold the compiled ``Plant`` to it.

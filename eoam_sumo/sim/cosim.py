@@ -189,7 +189,9 @@ class CoSimulation:
         self.lane_width_m = session.lane_width_m
         self.left_lane = session.left_lane_exists
         self.next_lane_opposing = self.left_lane and session.next_lane_traffic()[0]
-        self.x = initial_state(ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps).tolist()
+        self.x = initial_state(
+            ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps, params=self.params
+        ).tolist()
         self.x_prev = self.x
         self.ax = self.ay = 0.0
         self.ctrl = EoamController(self.params, self.tables, self.settings.eoam)

@@ -1,123 +1,120 @@
-"""Straight-line braking from 100 km/h against closed-form stopping distances."""
+"""Braking: the standards' figures (UN R13-H / FMVSS 135 stop, R13-H Annex 5 lock order) and
+the wheels at standstill.
+
+Independent truths: the regulations' limits (stopping distance 0.1 v + 0.0060 v^2, v in km/h,
+FMVSS 135 S7.5; front axle locking first between 0.15 and 0.8 g, R13-H Annex 5 3.1.1), the
+closed-form lock deceleration of a fixed brake split with load transfer
+``z = mu b / (phi L - mu h)``, and ``v^2 / (2 d)`` for the friction utilisation.
+"""
 
 import dataclasses
-import math
 
 import numpy as np
 import pytest
 
-from eoam_sumo.params import AIR_DENSITY_KGPM3, G_MPS2
+from eoam_sumo.params import G_MPS2
 from eoam_sumo.plant import OUTPUT_NAMES, STATE_NAMES, Plant, initial_state
+from eoam_sumo.plant.magic_formula import PAC2002_235_60R16
 
-V0_MPS = 100.0 / 3.6
-MUS = (1.0, 0.7, 0.3, 0.1)
-VX = STATE_NAMES.index("vx_mps")
-YOUT = {name: i for i, name in enumerate(OUTPUT_NAMES)}
-
-
-def brake_to_rest(plant, mu, brake_n, max_time_s=60.0):
-    """Brake with the brake actuator already at ``brake_n`` (no lag); return the final state and
-    the lock flags of every step while faster than 0.5 m/s."""
-    x = initial_state(0.0, 0.0, 0.0, V0_MPS, brake_force_n=brake_n)
-    u = np.array([0.0, 0.0, brake_n])
-    locks = []
-    for _ in range(int(max_time_s / plant.step_s)):
-        x, y = plant.step(x, u, mu)
-        if x[VX] > 0.5:
-            locks.append((y[YOUT["front_locked"]], y[YOUT["rear_locked"]]))
-        if x[VX] < 1e-4:
-            return x, locks
-    raise AssertionError(f"not at rest after {max_time_s} s: {x}")
-
-
-def drag_distance_m(params, decel_mps2):
-    """Exact distance of m v' = -m decel - k v^2 from V0: (m / 2k) ln(1 + k V0^2 / (m decel))."""
-    k = 0.5 * AIR_DENSITY_KGPM3 * params.drag_area_m2
-    return params.mass_kg / (2 * k) * math.log1p(k * V0_MPS**2 / (params.mass_kg * decel_mps2))
-
-
-@pytest.mark.parametrize("mu", MUS)
-def test_locked_wheels_slide_to_the_closed_form_distance(plant, params, mu):
-    x, locks = brake_to_rest(plant, mu, params.max_brake_force_n)
-    assert set(locks) == {(1.0, 1.0)}, "full brake demand must lock both axles"
-    # Both axles sliding: m v' = -mu_slide m g - k v^2 (no rolling resistance while sliding).
-    expected_m = drag_distance_m(params, params.sliding_friction_ratio * mu * G_MPS2)
-    assert x[0] == pytest.approx(expected_m, rel=0.01)
-    assert x[0] >= V0_MPS**2 / (2 * mu * G_MPS2)
+S = {name: i for i, name in enumerate(STATE_NAMES)}
+Y = {name: i for i, name in enumerate(OUTPUT_NAMES)}
+V100_MPS = 100.0 / 3.6
 
 
 @pytest.fixture(scope="module")
-def plant_no_drag(params, plant_cache_dir):
-    return Plant(dataclasses.replace(params, drag_area_m2=0.0), cache_dir=plant_cache_dir)
+def abs_plant(params, plant_cache_dir):
+    return Plant(dataclasses.replace(params, abs_fitted=True), cache_dir=plant_cache_dir)
 
 
-@pytest.mark.parametrize("mu", MUS)
-@pytest.mark.parametrize("brake_n", [1000.0, 3000.0, 6000.0, 9000.0, 12000.0, 16000.0, 22000.0])
-def test_no_brake_demand_beats_the_friction_limit(plant, plant_no_drag, params, mu, brake_n):
-    # Without drag only the tyres decelerate: at most mu g, so at least v^2 / (2 mu g).
-    x, _ = brake_to_rest(plant_no_drag, mu, brake_n, max_time_s=120.0)
-    assert x[0] >= V0_MPS**2 / (2 * mu * G_MPS2)
-    # With drag the honest floor is tyres at mu g plus the drag, integrated exactly.
-    x, _ = brake_to_rest(plant, mu, brake_n, max_time_s=120.0)
-    assert x[0] >= drag_distance_m(params, mu * G_MPS2)
+def stop(plant, mu, brake_n=22000.0, seconds=20.0):
+    """Full brake demand from 100 km/h; returns (states, outputs) every 10 ms."""
+    x = initial_state(0.0, 0.0, 0.0, V100_MPS, params=plant.params).tolist()
+    xs, ys = [], []
+    for _ in range(round(seconds / 0.01)):
+        x, y = plant.advance(x, (0.0, 0.0, brake_n), mu)
+        xs.append(x)
+        ys.append(y)
+    return np.array(xs), np.array(ys)
 
 
-def test_partial_brake_without_lock_matches_constant_deceleration(plant_no_drag, params):
-    # Dry road, 6 kN: neither axle locks; the only forces are the brake and rolling resistance.
-    brake_n = 6000.0
-    x, locks = brake_to_rest(plant_no_drag, 1.0, brake_n)
-    assert set(locks) == {(0.0, 0.0)}
-    decel = brake_n / params.mass_kg + params.rolling_resistance_coeff * G_MPS2
-    assert x[0] == pytest.approx(V0_MPS**2 / (2 * decel), rel=0.005)
+def stopping(xs):
+    """Index of the first step at rest and the distance to it."""
+    i = int(np.argmax(xs[:, S["vx_mps"]] < 0.01))
+    assert i > 0, "the car did not stop"
+    return i, xs[i, S["x_m"]]
 
 
-@pytest.mark.parametrize(("mu", "brake_n"), [(1.0, 6000.0), (0.1, 1800.0), (0.1, 22000.0)])
-def test_normal_loads_carry_the_longitudinal_load_transfer(plant, params, mu, brake_n):
-    # Quasi-static pitch balance: Fz_f = (m g b - h Fx) / L with Fx the tyre force sum, here
-    # solved in closed form for each lock state (rolling axles deliver brake + rolling
-    # resistance; a locked axle slides at mu_slide Fz).
-    p, m_g = params, params.mass_kg * G_MPS2
-    x = initial_state(0.0, 0.0, 0.0, 80.0 / 3.6, brake_force_n=brake_n)
-    _, y = plant.step(x, np.array([0.0, 0.0, brake_n]), mu)
-    front_locked, rear_locked = y[YOUT["front_locked"]], y[YOUT["rear_locked"]]
-    slide, rr, h, length = (
-        p.sliding_friction_ratio * mu,
-        p.rolling_resistance_coeff,
-        p.cg_height_m,
-        p.wheelbase_m,
-    )
-    # -Fx = k_f Fz_f + k_r Fz_r + c with Fz_r = m g - Fz_f.
-    k_f = slide if front_locked else rr
-    k_r = slide if rear_locked else rr
-    c = (0.0 if front_locked else p.brake_front_share * brake_n) + (
-        0.0 if rear_locked else (1 - p.brake_front_share) * brake_n
-    )
-    fz_front = (m_g * p.cg_to_rear_m + h * (k_r * m_g + c)) / (length - h * (k_f - k_r))
-    assert (front_locked, rear_locked) == {6000.0: (0, 0), 1800.0: (1, 0), 22000.0: (1, 1)}[brake_n]
-    assert y[YOUT["fz_front_n"]] == pytest.approx(fz_front, rel=2e-4)
-    assert y[YOUT["fz_rear_n"]] == pytest.approx(m_g - fz_front, rel=2e-4)
+def test_abs_stop_from_100_kmh_on_dry_meets_the_regulation(abs_plant):
+    xs, ys = stop(abs_plant, 1.0)
+    i, distance = stopping(xs)
+    assert distance <= 0.1 * 100.0 + 0.0060 * 100.0**2  # 70 m
+    assert not ys[:i, Y["front_locked"]].any() and not ys[:i, Y["rear_locked"]].any()
 
 
-def test_vehicle_stays_at_rest_under_brake_and_never_reverses(plant, params):
-    x, _ = brake_to_rest(plant, 0.7, params.max_brake_force_n)
-    resting = x.copy()
-    u = np.array([0.3, 0.0, params.max_brake_force_n])  # steering at rest moves nothing
-    for _ in range(300):
-        x, y = plant.step(x, u, 0.7)
-        assert np.all(np.isfinite(x)) and np.all(np.isfinite(y))
-        assert x[VX] >= 0.0
-    assert x[VX] < 1e-6
-    assert np.hypot(x[0] - resting[0], x[1] - resting[1]) < 1e-5
-    assert abs(x[2] - resting[2]) < 1e-6
+def test_abs_on_snow_uses_the_friction_and_locks_no_axle(abs_plant):
+    xs, ys = stop(abs_plant, 0.3, seconds=25.0)
+    i, distance = stopping(xs)
+    utilisation = V100_MPS**2 / (2.0 * distance) / (0.3 * G_MPS2)
+    assert utilisation >= 0.75
+    assert not ys[:i, Y["front_locked"]].any() and not ys[:i, Y["rear_locked"]].any()
+
+
+def lock_ramp(plant, mu, rate_n_per_s=4000.0):
+    """A slowly rising brake demand from 120 km/h: for each axle, (time, the largest
+    deceleration [g] before the first lock) when it locks."""
+    x = initial_state(0.0, 0.0, 0.0, 120.0 / 3.6, params=plant.params).tolist()
+    first, peak_g = {}, 0.0
+    for k in range(1, 1200):
+        x, y = plant.advance(x, (0.0, 0.0, rate_n_per_s * k * 0.01), mu)
+        if not first:
+            peak_g = max(peak_g, -y[Y["ax_mps2"]] / G_MPS2)
+        for axle in ("front", "rear"):
+            if y[Y[f"{axle}_locked"]] > 0.5 and axle not in first:
+                first[axle] = (k, peak_g)
+        if len(first) == 2 or x[S["vx_mps"]] < 3.0:
+            break
+    return first
+
+
+@pytest.mark.parametrize("mu", [1.0, 0.7, 0.3])
+def test_without_abs_the_front_axle_locks_first(plant, params, mu):
+    first = lock_ramp(plant, mu)
+    assert "front" in first
+    if "rear" in first:
+        assert first["front"][0] < first["rear"][0]
+    assert first["front"][1] == pytest.approx(front_lock_g(params, mu), abs=0.03)
+
+
+def front_lock_g(p, mu):
+    """``z = mu_f b / (phi L - mu_f h)``, the front tyres' friction ``mu_f`` at their load
+    ``m g (b + z h) / (2 L)`` by the published load sensitivity PDX2 (fixed point)."""
+    tyre = PAC2002_235_60R16
+    z = mu
+    for _ in range(50):
+        fz = p.mass_kg * G_MPS2 * (p.cg_to_rear_m + z * p.cg_height_m) / (2 * p.wheelbase_m)
+        mu_f = mu * (1.0 + tyre.pdx2 / tyre.pdx1 * (fz - tyre.fz0) / tyre.fz0)
+        z = mu_f * p.cg_to_rear_m / (p.brake_front_share * p.wheelbase_m - mu_f * p.cg_height_m)
+    return z
+
+
+@pytest.mark.parametrize("mu", [1.0, 0.3])
+def test_braking_to_standstill_wheels_never_negative_and_no_ringing(plant, abs_plant, mu):
+    for car in (plant, abs_plant):
+        xs, ys = stop(car, mu, seconds=20.0)
+        i, _ = stopping(xs)
+        assert ys[:, Y["wheel_speed_front_mps"]].min() >= 0.0
+        assert ys[:, Y["wheel_speed_rear_mps"]].min() >= 0.0
+        rest = xs[i + 50 :]  # 0.5 s after the stop
+        assert np.abs(rest[:, S["vx_mps"]]).max() < 1e-3
+        assert np.ptp(xs[i:, S["x_m"]]) < 0.01
+        assert np.abs(ys[i + 50 :, Y["ax_mps2"]]).max() < 0.01
 
 
 def test_rest_without_brake_stays_put_and_drive_moves_forward(plant):
     x = initial_state(5.0, 2.0, 0.3, 0.0)
     for _ in range(100):
-        x, _ = plant.step(x, np.zeros(3), 0.5)
-    assert np.array_equal(x[:6], np.array([5.0, 2.0, 0.3, 0.0, 0.0, 0.0]))
+        x, _ = plant.step(x, np.zeros(3), 0.8)
+    assert np.allclose(x[:6], [5.0, 2.0, 0.3, 0.0, 0.0, 0.0])
     for _ in range(100):
-        x, _ = plant.step(x, np.array([0.0, 3000.0, 0.0]), 0.5)
-    heading = np.array([math.cos(0.3), math.sin(0.3)])
-    assert x[VX] > 0.5
-    assert np.dot(x[:2] - np.array([5.0, 2.0]), heading) > 0.2
+        x, _ = plant.step(x, np.array([0.0, 3000.0, 0.0]), 0.8)
+    assert x[S["vx_mps"]] > 0.5 and x[S["x_m"]] > 5.0

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from eoam_sumo.plant import OUTPUT_NAMES, Plant, ReferencePlant, initial_state
+from eoam_sumo.plant import OUTPUT_NAMES, STATE_NAMES, Plant, ReferencePlant, initial_state
 from eoam_sumo.plant.codegen import build_library, find_compiler, python_include
 
 FRONT_LOCKED = OUTPUT_NAMES.index("front_locked")
@@ -57,7 +57,7 @@ def test_virtual_machine_fallback_gives_the_same_numbers(compiled_run, params):
     np.testing.assert_allclose(outs, compiled_run[1], rtol=1e-12, atol=1e-12)
 
 
-def test_rk4_converges_when_the_step_is_halved(params):
+def test_the_integration_converges_when_the_step_is_halved(params):
     coarse, fine = ReferencePlant(params, 1e-3, 10), ReferencePlant(params, 5e-4, 20)
     xc = xf = initial_state(0.0, 0.0, 0.0, 25.0)
     for k in range(100):
@@ -65,7 +65,9 @@ def test_rk4_converges_when_the_step_is_halved(params):
         xc, _ = coarse.step(xc, u, 0.9)
         xf, _ = fine.step(xf, u, 0.9)
     assert abs(xf[1]) > 0.1  # the manoeuvre moved the car sideways
-    np.testing.assert_allclose(xc, xf, rtol=1e-7, atol=1e-7)
+    # second order in the body's motion; the wheels' Coulomb torques are split off (first order)
+    np.testing.assert_allclose(xc[:6], xf[:6], rtol=1e-5, atol=1e-5)
+    np.testing.assert_allclose(xc, xf, rtol=1e-4, atol=5e-3)
 
 
 def test_second_plant_reuses_the_cached_library(plant, params, plant_cache_dir):
@@ -151,7 +153,7 @@ finite = st.floats(-1e4, 1e4, allow_nan=False)
 
 @settings(max_examples=300, deadline=None)
 @given(
-    x=st.lists(finite, min_size=9, max_size=9),
+    x=st.lists(finite, min_size=len(STATE_NAMES), max_size=len(STATE_NAMES)),
     u=st.tuples(finite, finite, finite),
     mu=st.floats(0.01, 1.5),
 )

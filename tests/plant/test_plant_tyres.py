@@ -1,5 +1,7 @@
-"""Tyre model against the textbook Fiala formula, and the CasADi form of the model."""
+"""The tyres: Fiala (the design's) against the textbook, the Magic Formula against CommonRoad's
+formulas point by point on their tyre set, the friction ellipse; the CasADi form of the model."""
 
+import dataclasses
 import itertools
 import math
 
@@ -8,7 +10,7 @@ import numpy as np
 import pytest
 
 from eoam_sumo.plant import CASADI_OPS, FLOAT_OPS, INPUT_NAMES, STATE_NAMES, outputs, rhs
-from eoam_sumo.plant.tyres import axle_force, fiala_lateral_force_n
+from eoam_sumo.plant.tyres import fiala_lateral_force_n
 
 C_NPR = 133800.0
 PEAK_N = 9000.0
@@ -39,41 +41,9 @@ def test_fiala_slope_at_zero_is_the_cornering_stiffness_and_it_saturates_at_the_
     assert all(b >= a for a, b in itertools.pairwise(forces))  # monotone up to full sliding
 
 
-def axle(brake_n, steer_rad=0.0, vy_mps=0.0, drive_n=0.0, mu=0.8, fz_n=9000.0):
-    return axle_force(
-        20.0, vy_mps, math.cos(steer_rad), math.sin(steer_rad), brake_n, drive_n, fz_n, mu,
-        C_NPR, 0.012, 0.8, FLOAT_OPS,
-    )  # fmt: skip
-
-
-def test_rolling_axle_delivers_the_brake_and_keeps_within_the_friction_ellipse():
-    f = axle(4000.0, vy_mps=0.5)
-    assert not f.locked
-    assert f.fx_n == pytest.approx(-(4000.0 + 0.012 * 9000.0))
-    reduced_peak = math.sqrt((0.8 * 9000.0) ** 2 - f.fx_n**2)
-    assert f.fy_n == pytest.approx(textbook_fiala(math.atan(0.5 / 20.0), C_NPR, reduced_peak))
-    assert math.hypot(f.fx_n, f.fy_n) <= 0.8 * 9000.0
-
-
-@pytest.mark.parametrize("steer_deg", [0.0, 5.0, -12.0])
-def test_over_braked_axle_locks_and_slides_against_its_velocity(steer_deg):
-    f = axle(7300.0, steer_rad=math.radians(steer_deg), vy_mps=1.0)
-    assert f.locked
-    sliding = 0.8 * 0.8 * 9000.0
-    speed = math.sqrt(20.0**2 + 1.0**2 + 0.1**2)
-    assert f.fx_n == pytest.approx(-sliding * 20.0 / speed, rel=1e-12)
-    assert f.fy_n == pytest.approx(-sliding * 1.0 / speed, rel=1e-12)
-
-
-def test_lock_threshold_falls_with_the_slip_angle():
-    # mu Fz = 7200 N; at 5.7 deg slip the brush tyre slides at 7200 cos(5.7 deg) = 7164 N.
-    assert not axle(7180.0).locked
-    assert axle(7180.0, vy_mps=2.0).locked
-    assert not axle(7150.0, vy_mps=2.0).locked
-    assert not axle(9000.0, drive_n=2000.0).locked  # the engine holds the wheel turning
-
-
-def test_casadi_form_of_the_model_equals_the_float_form(params):
+@pytest.mark.parametrize("esc", [False, True])
+def test_casadi_form_of_the_model_equals_the_float_form(params, esc):
+    params = dataclasses.replace(params, esc_fitted=esc, abs_fitted=esc, drivetrain="eawd")
     x = casadi.MX.sym("x", len(STATE_NAMES))
     u = casadi.MX.sym("u", len(INPUT_NAMES))
     mu = casadi.MX.sym("mu")
@@ -86,9 +56,9 @@ def test_casadi_form_of_the_model_equals_the_float_form(params):
     )  # fmt: skip
     rng = np.random.default_rng(3)
     for _ in range(30):
-        xv = rng.uniform(
-            [-50, -50, -3, 0, -2, -0.8, -0.6, 0, 0], [50, 50, 3, 45, 2, 0.8, 0.6, 7000, 22000]
-        )
+        lo = [-50, -50, -3, 0, -2, -0.8, -0.6, 0, 0, 0, 0, 0, -1, -1, -0.5, -0.5, -9, -9, -5e3]
+        hi = [50, 50, 3, 45, 2, 0.8, 0.6, 7000, 150, 150, 140, 140, 1, 1, 0.5, 0.5, 9, 9, 5e3]
+        xv = rng.uniform(lo, hi)
         uv = rng.uniform([-0.7, 0, 0], [0.7, 7000, 22000])
         muv = rng.uniform(0.1, 1.2)
         dx, y = fn(xv, uv, muv)
