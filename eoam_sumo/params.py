@@ -68,10 +68,7 @@ class VehicleParams:
         math.radians(50.0), "rad/s", ASSUMED + " (800 deg/s hand wheel / 16)"
     )
     cornering_stiffness_front_npr: float = _p(
-        0.75 * 2 * 66900.0,
-        "N/rad",
-        JI + " (per tyre x 2, per axle) x 0.75 steering-compliance factor (effective axle "
-        "stiffness, Gillespie ch. 6: understeer gradient 1.7 deg/g)",
+        2 * 66900.0, "N/rad", JI + " (per tyre x 2, per axle)"
     )
     cornering_stiffness_rear_npr: float = _p(2 * 62700.0, "N/rad", JI + " (per tyre x 2, per axle)")
     slip_angle_sat_rad: float = _p(math.radians(5.0), "rad", PAPER + ", eq. 6 (alpha* = 5 deg)")
@@ -97,6 +94,13 @@ class VehicleParams:
     relaxation_length_lat_m: float = _p(
         0.60, "m", PAC2002 + ": PTY1 sin(2 atan(1/PTY2)) R0 (Pacejka 2012 sec. 7.2)"
     )
+    front_steer_compliance: float = _p(
+        0.75,
+        "-",
+        GILLESPIE
+        + " ch. 6: the front axle's effective cornering stiffness over its tyres' (steering "
+        "compliance; understeer gradient 1.7 deg/g)",
+    )
     roll_stiffness_front_share: float = _p(
         0.60, "-", GILLESPIE + " (front-biased roll stiffness of a sedan)"
     )
@@ -121,6 +125,12 @@ class VehicleParams:
     @property
     def wheelbase_m(self) -> float:
         return self.cg_to_front_m + self.cg_to_rear_m
+
+    @property
+    def front_axle_stiffness_npr(self) -> float:
+        """The front axle's effective cornering stiffness in the plant: its tyres' times the
+        steering compliance (Gillespie ch. 6)."""
+        return self.front_steer_compliance * self.cornering_stiffness_front_npr
 
     @property
     def cg_to_front_bumper_m(self) -> float:

@@ -73,16 +73,16 @@ def constants(p: VehicleParams) -> Chassis:
     k_f = cornering_stiffness_npr(fz_f, tyre, FLOAT_OPS)
     k_r = cornering_stiffness_npr(fz_r, tyre, FLOAT_OPS)
     k_long = 2.0 * (fz_f + fz_r) * tyre.pkx1  # all four tyres' slip stiffness, about
-    k_lat = p.cornering_stiffness_front_npr + p.cornering_stiffness_rear_npr
+    c_front = p.front_axle_stiffness_npr
+    k_lat = c_front + p.cornering_stiffness_rear_npr
     zeta2 = 2.0 * LOW_SPEED_DAMPING_RATIO
     understeer = p.mass_kg * (
-        p.cg_to_rear_m / p.cornering_stiffness_front_npr
-        - p.cg_to_front_m / p.cornering_stiffness_rear_npr
+        p.cg_to_rear_m / c_front - p.cg_to_front_m / p.cornering_stiffness_rear_npr
     )
     share = {"fwd": 1.0, "rwd": 0.0}.get(p.drivetrain, p.awd_front_share)
     return Chassis(
         tyre=tyre,
-        lky_front=p.cornering_stiffness_front_npr / (2.0 * k_f),
+        lky_front=c_front / (2.0 * k_f),
         lky_rear=p.cornering_stiffness_rear_npr / (2.0 * k_r),
         brake_n_per_bar=p.max_brake_force_n / p.max_brake_pressure_bar,
         axle_inertia_kgm2=2.0 * p.wheel_inertia_kgm2,

@@ -18,6 +18,7 @@ import numpy as np
 
 from eoam_sumo.params import VehicleParams
 from eoam_sumo.plant import OUTPUT_NAMES, STATE_NAMES, Plant, initial_state
+from eoam_sumo.plant.chassis import constants
 from eoam_sumo.vehicle_tests.equipment import wheel_speeds
 
 COLUMNS = (
@@ -88,7 +89,7 @@ _OUTPUT = {name: i for i, name in enumerate(OUTPUT_NAMES)}
 
 
 class PlantVehicle:
-    """Our plant (compiled RK4, 1 ms sub-steps) behind the ``Vehicle`` interface."""
+    """Our plant (compiled, 1 ms sub-steps) behind the ``Vehicle`` interface."""
 
     def __init__(self, params: VehicleParams):
         self.params = params
@@ -96,7 +97,7 @@ class PlantVehicle:
         self._x: list[float] = []
 
     def start(self, speed_mps: float) -> Sample:
-        self._x = [float(v) for v in initial_state(0.0, 0.0, 0.0, speed_mps)]
+        self._x = [float(v) for v in initial_state(0.0, 0.0, 0.0, speed_mps, params=self.params)]
         return rolling_start(speed_mps)
 
     def advance(self, controls: Controls, mu: float) -> Sample:
@@ -119,8 +120,17 @@ class PlantVehicle:
             wheel_speed_front_mps=front_mps,
             wheel_speed_rear_mps=rear_mps,
             drive_force_n=x[_STATE["drive_force_n"]],
-            brake_force_n=x[_STATE["brake_force_n"]],
+            brake_force_n=self._brake_force_n(x),
         )
+
+    def _brake_force_n(self, x: list[float]) -> float:
+        """The brake force the line pressures apply at the road (both axles)."""
+        share = self.params.brake_front_share
+        pressure_bar = (
+            share * x[_STATE["brake_pressure_front_bar"]]
+            + (1.0 - share) * x[_STATE["brake_pressure_rear_bar"]]
+        )
+        return constants(self.params).brake_n_per_bar * pressure_bar
 
 
 def rolling_start(speed_mps: float) -> Sample:

@@ -159,7 +159,7 @@ def _linear_steer_rad(params: VehicleParams, speed_mps: float, ay_mps2: float) -
     k_us = (
         params.mass_kg
         / L
-        * (b / params.cornering_stiffness_front_npr - a / params.cornering_stiffness_rear_npr)
+        * (b / params.front_axle_stiffness_npr - a / params.cornering_stiffness_rear_npr)
     )
     return (L / (speed_mps * speed_mps) + k_us) * ay_mps2
 

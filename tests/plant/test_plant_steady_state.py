@@ -20,7 +20,7 @@ def linear_yaw_gain(params, speed_mps):
         p.mass_kg
         / length
         * (
-            p.cg_to_rear_m / p.cornering_stiffness_front_npr
+            p.cg_to_rear_m / p.front_axle_stiffness_npr
             - p.cg_to_front_m / p.cornering_stiffness_rear_npr
         )
     )

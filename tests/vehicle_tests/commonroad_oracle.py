@@ -88,6 +88,7 @@ def ours_from_commonroad(p) -> VehicleParams:
         max_steer_rate_radps=float(p.steering.v_max),
         cornering_stiffness_front_npr=-float(p.tire.p_ky1) * front_n,
         cornering_stiffness_rear_npr=-float(p.tire.p_ky1) * rear_n,
+        front_steer_compliance=1.0,
         sliding_friction_ratio=sliding_friction_ratio(p),
         max_drive_force_n=float(p.m * lon.a_max),
         max_drive_power_w=float(p.m * lon.a_max * lon.v_switch),

@@ -3,12 +3,12 @@ and the adapter to the chassis features the plant may lack."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 
-from eoam_sumo.errors import InputError
 from eoam_sumo.params import G_MPS2, ego_e_class_sedan
 from eoam_sumo.plant import OUTPUT_NAMES
 from eoam_sumo.vehicle_tests.common import VehicleTestOptions
@@ -37,7 +37,7 @@ def test_braking_to_standstill_keeps_the_wheels_at_or_above_zero_and_the_car_at_
         assert figures["min_wheel_speed_mps"] >= 0.0
         assert figures["max_speed_at_rest_mps"] < 0.01
         run = result.runs[0]
-        assert run["vx_mps"].min() > -1e-3
+        assert run["vx_mps"].min() > -0.01  # the tyres' relaxed slip springs back a few mm/s
 
 
 def test_the_stop_is_longer_on_a_slippery_road_and_no_shorter_than_friction_allows():
@@ -50,34 +50,35 @@ def test_the_stop_is_longer_on_a_slippery_road_and_no_shorter_than_friction_allo
     assert wet["stopping_distance_m"] > 2.5 * dry["stopping_distance_m"]
 
 
-def test_the_brake_ramp_finds_todays_rear_first_lock():
-    """Today's 65/35 split locks the rear first (0.83 g on mu 1.0 measured by the review):
-    above R13-H's band on mu 1.0, inside it on mu 0.7."""
-    dry = TESTS["brake-ramp"](SEDAN, VehicleTestOptions(mu=1.0)).summary
-    assert dry["figures"]["first_locked_axle"] == "rear"
-    assert dry["figures"]["rear_lock_braking_rate"] == pytest.approx(0.83, abs=0.02)
-    wet = TESTS["brake-ramp"](SEDAN, VehicleTestOptions(mu=0.7)).summary
-    assert wet["figures"]["first_locked_axle"] == "rear"
-    assert wet["passed"] is False
+def test_the_brake_ramp_locks_the_sedans_front_axle_first():
+    """The sedan's 73/27 split locks the front first on every friction (UN R13-H Annex 5),
+    below the friction's braking rate: the loaded front tyres lose friction (load
+    sensitivity)."""
+    for mu in (1.0, 0.7, 0.3):
+        summary = TESTS["brake-ramp"](SEDAN, VehicleTestOptions(mu=mu)).summary
+        assert summary["figures"]["first_locked_axle"] == "front"
+        assert 0.8 * mu < summary["figures"]["front_lock_braking_rate"] <= 1.05 * mu
+        assert summary["passed"] is True
 
 
 def test_the_ramp_steer_gradient_is_the_steady_state_one():
-    """Against the linear single-track gradient m/L (b/Cf - a/Cr), which the Fiala tyres raise
-    over 0.1-0.4 g (the same normalised slip on both axles): within 0.2 deg/g above it."""
+    """Against the linear single-track gradient m/L (b/Cf - a/Cr), which the tyres' lateral
+    load transfer raises over 0.1-0.4 g (a front roll-stiffness share above the front's
+    static load share): within 0.5 deg/g above it."""
     p = SEDAN
     linear = (
         math.degrees(
             p.mass_kg
             / p.wheelbase_m
             * (
-                p.cg_to_rear_m / p.cornering_stiffness_front_npr
+                p.cg_to_rear_m / p.front_axle_stiffness_npr
                 - p.cg_to_front_m / p.cornering_stiffness_rear_npr
             )
         )
         * G_MPS2
     )
     figures = TESTS["ramp-steer"](p, VehicleTestOptions()).summary["figures"]
-    assert linear <= figures["understeer_gradient_deg_per_g"] <= linear + 0.2
+    assert linear <= figures["understeer_gradient_deg_per_g"] <= linear + 0.5
     assert 0.8 < figures["peak_lateral_acceleration_g"] <= 1.0
 
 
@@ -101,22 +102,15 @@ def test_the_sine_with_dwell_judges_each_amplitude():
     assert judged == {r["run"] for r in runs if r["amplitude_A"] >= 5.0}
 
 
-def test_abs_and_esc_on_need_a_plant_that_has_them():
-    params = equipped(SEDAN, False, False)
-    assert params == SEDAN
-    if not hasattr(SEDAN, "abs_fitted"):
-        with pytest.raises(InputError, match="no ABS"):
-            equipped(SEDAN, True, False)
-    if not hasattr(SEDAN, "esc_fitted"):
-        with pytest.raises(InputError, match="no ESC"):
-            equipped(SEDAN, False, True)
+def test_abs_and_esc_are_switched_per_run():
+    assert equipped(SEDAN, False, False) == SEDAN
+    both = equipped(SEDAN, True, True)
+    assert both.abs_fitted and both.esc_fitted
+    assert dataclasses.replace(both, abs_fitted=False, esc_fitted=False) == SEDAN
 
 
-def test_wheel_speeds_fall_back_to_the_body_speed_and_zero_when_locked():
-    if "wheel_speed_front_mps" in OUTPUT_NAMES:
-        pytest.skip("the plant gives wheel speeds")
+def test_wheel_speeds_are_the_plants_outputs():
     outputs = [0.0] * len(OUTPUT_NAMES)
-    assert wheel_speeds(outputs, 20.0) == (20.0, 20.0)
-    outputs[OUTPUT_NAMES.index("rear_locked")] = 1.0
-    assert wheel_speeds(outputs, 20.0) == (20.0, 0.0)
-    assert wheel_speeds([0.0] * len(OUTPUT_NAMES), -1.0) == (0.0, 0.0)
+    outputs[OUTPUT_NAMES.index("wheel_speed_front_mps")] = 12.5
+    outputs[OUTPUT_NAMES.index("wheel_speed_rear_mps")] = 3.0
+    assert wheel_speeds(outputs, 20.0) == (12.5, 3.0)
