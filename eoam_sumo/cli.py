@@ -20,6 +20,7 @@ from eoam_sumo import __version__
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import MU_MAX
 from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S
+from eoam_sumo.traffic_levels.command import add_scenario_arguments, cmd_scenario
 
 EXIT_BAD_INPUT = 2
 
@@ -110,6 +111,7 @@ def build_parser() -> argparse.ArgumentParser:
         _plot_arguments,
         _animate_arguments,
         _bench_arguments,
+        add_scenario_arguments,
     ):
         add_arguments(sub)
     return parser
@@ -492,6 +494,7 @@ _COMMANDS = {
     "plot": _cmd_plot,
     "animate": _cmd_animate,
     "bench": _cmd_bench,
+    "scenario": cmd_scenario,
 }
 
 
