@@ -209,7 +209,13 @@ class Margins(StepObserver):
             behind_m = ego.x_m - box.x_m
             if behind_m < 0.0 and abs(box.y_m) < self._band_m:
                 continue  # the obstacle ahead in the ego's lane: its margin is the gap
-            ttc = time_to_contact(ego, box, ego_v, v, min(self.min_ttc_s, TTC_HORIZON_S))
+            horizon = min(self.min_ttc_s, TTC_HORIZON_S)
+            if behind_m > 0.0:
+                horizon = max(horizon, min(self.min_ttc_rear_s, TTC_HORIZON_S))
+            if _apart(ego, box, ego_v, v, horizon):
+                ttc = math.inf
+            else:
+                ttc = time_to_contact(ego, box, ego_v, v, horizon)
             self.min_ttc_s = min(self.min_ttc_s, ttc)
             if behind_m <= 0.0:
                 continue
@@ -272,6 +278,19 @@ class Margins(StepObserver):
                 self.max_follower_decel_mps2, self.follower_decel_id = decel, b.vid
 
 
+def _apart(
+    a: OrientedBox, b: OrientedBox, va: tuple[float, float], vb: tuple[float, float], t_s: float
+) -> bool:
+    """Whether two boxes moving at these rates cannot touch within ``t_s``: along either
+    axis of the frame their centres are farther apart than their bounding circles plus what
+    the rate between them closes in that time."""
+    reach = a.radius_m + b.radius_m + GAP_ROUNDING_M
+    return (
+        abs(b.x_m - a.x_m) - reach > abs(vb[0] - va[0]) * t_s
+        or abs(b.y_m - a.y_m) - reach > abs(vb[1] - va[1]) * t_s
+    )
+
+
 def road_user_close_ahead(
     x: Sequence[float],
     cg_to_front_m: float,
@@ -300,5 +319,32 @@ def road_user_close_ahead(
         u = max(b.speed_mps * math.cos(b.yaw_rad - road_yaw), 0.0)
         need = max(vx * vx - u * u, 0.0) / two_decel + CLOSE_AHEAD_MARGIN_M
         if s - 0.5 * b.length_m - front_s <= need:
+            return True
+    return False
+
+
+def follower_arriving(
+    x: Sequence[float],
+    cg_to_rear_m: float,
+    road: RoadProjection,
+    lane_width_m: float,
+    bodies: Sequence[Body],
+) -> bool:
+    """Whether a road user has its centre in the ego's lane behind the ego's rear bumper
+    (``cg_to_rear_m`` ahead of the CG: negative), within ``FOLLOWER_REACH_M``, still moving
+    towards it: it has not yet stopped behind the ego, and may hit it. The run of a stopped
+    ego waits for it (``RunSettings.after_stop_s`` None)."""
+    X, Y = x[0], x[1]
+    s_ego, d_ego, _ = road.project(X, Y)
+    rear_s = s_ego + cg_to_rear_m
+    lane_d = lane_width_m * round(d_ego / lane_width_m)
+    band = lane_band_m(lane_width_m)
+    for b in bodies:
+        if b.parked:
+            continue
+        s, d, road_yaw = road.project(b.x_m, b.y_m)
+        if not rear_s - FOLLOWER_REACH_M < s < rear_s or abs(d - lane_d) >= band:
+            continue
+        if b.speed_mps * math.cos(b.yaw_rad - road_yaw) > EGO_STANDSTILL_MPS:
             return True
     return False
