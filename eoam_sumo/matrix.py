@@ -130,7 +130,7 @@ class Case:
             return None
         return TrafficSpec(
             self.road,
-            self.los or "A",
+            self.los or "",
             self.lanes,
             self.speed_limit_kmh,
             self.curve_radius_m,
@@ -494,8 +494,10 @@ def _scenario_file(path: Path, scenario: dict, traffic_axes: tuple) -> Path | No
         return _existing_file(path, "[scenario] sumocfg", scenario["sumocfg"])
     if not traffic_axes:
         raise InputError(f"{path}: [scenario] needs the key 'sumocfg' (or a generated 'road')")
-    if traffic_axes[0][0] != "road":
-        raise InputError(f"{path}: '{traffic_axes[0][0]}' needs the key 'road'")
+    keys = [key for key, _ in traffic_axes]
+    for need in ("road", "los"):
+        if need not in keys:
+            raise InputError(f"{path}: '{keys[0]}' needs the key '{need}'")
     return None
 
 

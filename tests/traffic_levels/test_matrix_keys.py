@@ -70,20 +70,28 @@ mu = { uniform = [0.3, 1.0] }
 @pytest.mark.parametrize(
     "text, message",
     [
-        ('[scenario]\nroad = "city"\n[sweep]\nego_speed_kmh=[90]\nmu=[1.0]', "road 'city'"),
         (
-            '[scenario]\nroad = "motorway"\ncurve_radius_m = 400\n'
+            '[scenario]\nroad = "city"\nlos = "A"\n[sweep]\nego_speed_kmh=[90]\nmu=[1.0]',
+            "road 'city'",
+        ),
+        (
+            '[scenario]\nroad = "motorway"\nlos = "A"\ncurve_radius_m = 400\n'
             "[sweep]\nego_speed_kmh=[90]\nmu=[1.0]",
             "rural road only",
         ),
         ('[scenario]\nlos = "A"\n[sweep]\nego_speed_kmh=[90]\nmu=[1.0]', "needs the key 'road'"),
         ("[sweep]\nego_speed_kmh=[90]\nmu=[1.0]", "needs the key 'sumocfg'"),
         (
+            '[scenario]\nroad = "rural"\n[sweep]\nego_speed_kmh=[90]\nmu=[1.0]',
+            "needs the key 'los'",
+        ),
+        (
             '[scenario]\nroad = "rural"\n[sweep]\nlos = ["G"]\nego_speed_kmh=[90]\nmu=[1.0]',
             "level of service 'G'",
         ),
         (
-            '[scenario]\nroad = "rural"\nafter_stop_s = -1\n[sweep]\nego_speed_kmh=[90]\nmu=[1.0]',
+            '[scenario]\nroad = "rural"\nlos = "A"\nafter_stop_s = -1\n'
+            "[sweep]\nego_speed_kmh=[90]\nmu=[1.0]",
             "after_stop_s",
         ),
     ],
