@@ -97,10 +97,11 @@ def plot_envelopes(results: pd.DataFrame, out_dir: Path) -> list[Path]:
     the two per level of service."""
     if not (results["status"] == "ok").any():
         return []
-    if "road" in results and results["road"].notna().any():
+    roads = results["road"].fillna("").astype(str) if "road" in results else pd.Series()
+    if (roads != "").any():
         return [
-            _road_envelopes(results[results["road"] == road], str(road), out_dir)
-            for road in sorted(results["road"].dropna().unique())
+            _road_envelopes(results[roads == road], road, out_dir)
+            for road in sorted(set(roads) - {""})
         ]
     fig = Figure(figsize=(12, 5.5), layout="constrained")
     axes = fig.subplots(1, 2)
@@ -112,7 +113,7 @@ def plot_envelopes(results: pd.DataFrame, out_dir: Path) -> list[Path]:
 
 def _road_envelopes(results: pd.DataFrame, road: str, out_dir: Path) -> Path:
     """``envelope_<road>.png``: per level of service (rows), P(contact) and P(red)."""
-    levels = sorted(results["los"].dropna().unique()) or [None]
+    levels = sorted(set(results["los"].fillna("").astype(str)) - {""}) or [None]
     fig = Figure(figsize=(12, 4.8 * len(levels)), layout="constrained")
     axes = fig.subplots(len(levels), 2, squeeze=False)
     for row, level in zip(axes, levels):
