@@ -21,6 +21,7 @@ from eoam_sumo.errors import InputError
 from eoam_sumo.params import MU_MAX
 from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S
 from eoam_sumo.vehicle_tests import command as vehicle_test_command
+from eoam_sumo.traffic_levels.command import add_scenario_arguments, cmd_scenario
 
 EXIT_BAD_INPUT = 2
 
@@ -113,6 +114,7 @@ def build_parser() -> argparse.ArgumentParser:
         _bench_arguments,
         vehicle_test_command.add_arguments,
         _protocol_arguments,
+        add_scenario_arguments,
     ):
         add_arguments(sub)
     return parser
@@ -164,9 +166,21 @@ def _run_arguments(sub) -> None:
         "occlusion, tracker; docs/sensing.md)",
     )
     p.add_argument("--seed", type=_seed, default=0, help="seed of every random model (0)")
+    _after_stop_argument(p)
     p.add_argument("--gui", action="store_true", help="run in sumo-gui through TraCI")
     _policy_arguments(p)
     _gui_arguments(p)
+
+
+def _after_stop_argument(p: argparse.ArgumentParser) -> None:
+    """``run`` and ``batch``: how long a run goes on after the ego stops."""
+    p.add_argument(
+        "--after-stop-s",
+        type=_finite,
+        metavar="S",
+        help="simulate S s after the ego stops (default: 2 s, then as long as a road user "
+        "behind it in its lane, within 150 m, still moves towards it)",
+    )
 
 
 def _policy_arguments(p: argparse.ArgumentParser) -> None:
@@ -241,6 +255,7 @@ def _batch_arguments(sub) -> None:
         help="per-case time series format, or none (summary.json only)",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _after_stop_argument(p)
 
 
 def _plot_arguments(sub) -> None:
@@ -326,6 +341,8 @@ def _check_run_args(args) -> None:
         raise InputError(f"--max-time-s {args.max_time_s} must be > 0")
     if args.radar_range_m is not None and args.radar_range_m <= 0:
         raise InputError(f"--radar-range-m {args.radar_range_m} must be > 0")
+    if args.after_stop_s is not None and args.after_stop_s < 0:
+        raise InputError(f"--after-stop-s {args.after_stop_s:g} must be >= 0")
     _check_v2x(args)
     if not args.gui and (args.gui_delay_ms is not None or args.gui_screenshot or args.gui_close):
         raise InputError("--gui-delay-ms, --gui-screenshot and --gui-close need --gui")
@@ -357,6 +374,7 @@ def _run_settings(args, out: Path):
         mu_belief=parse_mu_belief(args.mu_belief),
         seed=args.seed,
         radar_model=parse_radar_model(args.radar_model),
+        after_stop_s=args.after_stop_s,
     )
     if args.radar_range_m is not None:
         settings = replace(settings, radar=RadarSettings(range_m=args.radar_range_m))
@@ -416,6 +434,7 @@ def _cmd_batch(args) -> int:
             timeout_s=args.timeout_s,
             progress=not args.no_progress,
             timeseries=args.timeseries,
+            after_stop_s=args.after_stop_s,
         )
         # matplotlib is imported once the cases have run, in this process only
         from eoam_sumo.plotting.batch_plots import plot_batch_report
@@ -509,6 +528,7 @@ _COMMANDS = {
     "bench": _cmd_bench,
     "vehicle-test": vehicle_test_command.run,
     "protocol": _cmd_protocol,
+    "scenario": cmd_scenario,
 }
 
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import csv
 import difflib
+import itertools
 import math
 import tomllib
 from dataclasses import dataclass, replace
@@ -30,8 +31,20 @@ from eoam_sumo.sensing.automotive import parse_radar_model
 from eoam_sumo.sensing.friction import parse_mu_belief
 from eoam_sumo.sim.scenario import ScenarioOverrides, check_scenario, scripted_stops
 from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S
+from eoam_sumo.traffic_levels.hcm import LEVELS
+from eoam_sumo.traffic_levels.spec import (
+    MIN_CURVE_RADIUS_M,
+    ROADS,
+    SPEED_LIMIT_RANGE_KMH,
+    TrafficSpec,
+)
 
 NO_ONCOMING = "none"
+#: The keys of a generated scenario (``eoam_sumo.traffic_levels``), in [scenario] one value
+#: each, in [sweep] lists; a case folder's ``GENERATED`` is its scenario then.
+TRAFFIC_KEYS = ("road", "los", "lanes", "speed_limit_kmh", "curve_radius_m")
+STRAIGHT = "none"  # curve_radius_m: a straight road
+GENERATED = Path("scenario") / "scenario.sumocfg"
 SCHEMA = {
     "scenario": (
         "sumocfg",
@@ -45,12 +58,21 @@ SCHEMA = {
         "mu_belief",
         "radar_model",
         "seed",
+        "after_stop_s",
+        *TRAFFIC_KEYS,
     ),
-    "sweep": ("ego_speed_kmh", "mu", "oncoming_start_m", "aro_hold_s", "aro_decel_mps2"),
+    "sweep": (
+        "ego_speed_kmh",
+        "mu",
+        "oncoming_start_m",
+        "aro_hold_s",
+        "aro_decel_mps2",
+        *TRAFFIC_KEYS,
+    ),
     "paper": ("table",),
     "sample": (),  # draws, seed and the sampled keys: checked by sampling.parse_sample
 }
-REQUIRED = {"scenario": ("sumocfg",), "sweep": ("ego_speed_kmh", "mu")}  # unless sampled
+REQUIRED = {"scenario": (), "sweep": ("ego_speed_kmh", "mu")}  # unless sampled
 PAPER_COLUMNS = ("oncoming_start_m", "ego_speed_kmh", "mu", "outcome")
 POLICIES = ("paper", "safe")
 #: [scenario] V2X keys: (default, lowest, highest or None, highest included)
@@ -92,8 +114,28 @@ class Case:
     mu_belief: str | float = "known"
     radar_model: str = "ideal"
     seed: int = 0
+    after_stop_s: float | None = None  # None: the run's default (RunSettings.after_stop_s)
+    # a generated scenario (None: the sumocfg's); its traffic seeded with ``seed``
+    road: str | None = None
+    los: str | None = None
+    lanes: int | None = None
+    speed_limit_kmh: float | None = None
+    curve_radius_m: float | None = None
     draw: int | None = None  # the draw's number within its group (sampled matrices)
     group_id: str | None = None  # the case id of its group of swept values (sampled)
+
+    def traffic(self) -> TrafficSpec | None:
+        """The generated scenario's spec (None: the case runs its sumocfg)."""
+        if self.road is None:
+            return None
+        return TrafficSpec(
+            self.road,
+            self.los or "",
+            self.lanes,
+            self.speed_limit_kmh,
+            self.curve_radius_m,
+            self.seed,
+        )
 
     def overrides(self) -> ScenarioOverrides:
         return ScenarioOverrides(
@@ -110,7 +152,7 @@ class Matrix:
     """A checked experiment matrix (see :func:`load_matrix`)."""
 
     path: Path
-    sumocfg: Path
+    sumocfg: Path | None  # None: a generated scenario (``traffic_axes``)
     max_time_s: float
     ego_speeds_kmh: tuple[float, ...]
     mus: tuple[float, ...]
@@ -125,47 +167,48 @@ class Matrix:
     radar_model: str = "ideal"
     seed: int = 0
     sample: Sample | None = None
+    after_stop_s: float | None = None
+    # the generated scenario's keys given, swept or sampled: (key, values), ``TRAFFIC_KEYS``
+    # order; a sampled key's values are (None,)
+    traffic_axes: tuple[tuple[str, tuple], ...] = ()
 
     def cases(self) -> list[Case]:
-        """Every case, in the paper's Table 2 order (traffic, speed, friction, ARO stop); with
-        a ``[sample]`` table, each combination's draws in turn (``<combination id>_dNNNN``)."""
+        """Every case, in the paper's Table 2 order (traffic, speed, friction, ARO stop),
+        after a generated scenario's keys (road, level, lanes, speed limit, curve); with a
+        ``[sample]`` table, each combination's draws in turn (``<combination id>_dNNNN``)."""
         sampled = self.sample.keys if self.sample else ()
-        traffic = sorted(self.oncoming_starts_m, key=lambda d: d is not None)  # stable: none first
-        holds = self.aro_holds_s or (None,)
-        decels = self.aro_decels_mps2 or (None,)
+        axes = (
+            *self.traffic_axes,
+            (
+                "oncoming_start_m",
+                tuple(sorted(self.oncoming_starts_m, key=lambda d: d is not None)),
+            ),
+            ("ego_speed_kmh", self.ego_speeds_kmh),
+            ("mu", self.mus),
+            ("aro_hold_s", self.aro_holds_s or (None,)),
+            ("aro_decel_mps2", self.aro_decels_mps2 or (None,)),
+        )
         cases = []
-        for onc in traffic:
-            for speed in self.ego_speeds_kmh:
-                for mu in self.mus:
-                    for hold in holds:
-                        for decel in decels:
-                            parts = [
-                                ""
-                                if "oncoming_start_m" in sampled
-                                else f"onc-{NO_ONCOMING if onc is None else _id_number(onc)}",
-                                "" if speed is None else f"v{_id_number(speed)}",
-                                "" if mu is None else f"mu{_mu_text(mu)}",
-                                "" if hold is None else f"hold{_id_number(hold)}",
-                                "" if decel is None else f"dec{_id_number(decel)}",
-                            ]
-                            cases.append(
-                                Case(
-                                    "_".join(p for p in parts if p) or "all",
-                                    self.sumocfg,
-                                    speed,
-                                    mu,
-                                    onc,
-                                    hold,
-                                    decel,
-                                    self.max_time_s,
-                                    self.radar_range_m,
-                                    self.policy,
-                                    *self.v2x,
-                                    mu_belief=self.mu_belief,
-                                    radar_model=self.radar_model,
-                                    seed=self.seed,
-                                )
-                            )
+        for combo in itertools.product(*(values for _, values in axes)):
+            values = dict(zip((key for key, _ in axes), combo))
+            cases.append(
+                Case(
+                    _case_id(values, sampled),
+                    self.sumocfg or GENERATED,
+                    max_time_s=self.max_time_s,
+                    radar_range_m=self.radar_range_m,
+                    policy=self.policy,
+                    v2x_range_m=self.v2x[0],
+                    v2x_latency_s=self.v2x[1],
+                    v2x_loss=self.v2x[2],
+                    v2x_penetration=self.v2x[3],
+                    mu_belief=self.mu_belief,
+                    radar_model=self.radar_model,
+                    seed=self.seed,
+                    after_stop_s=self.after_stop_s,
+                    **values,
+                )
+            )
         return cases if self.sample is None else self._draws(cases, self.sample)
 
     @staticmethod
@@ -197,6 +240,39 @@ class Matrix:
             for c in self.cases()
             if (key := (c.oncoming_start_m, c.ego_speed_kmh, c.mu)) in published
         }
+
+
+def _case_id(values: dict, sampled: tuple[str, ...]) -> str:
+    """A case's id from its values: the generated scenario's keys given (road, ``losC``,
+    ``l3`` lanes, ``lim100`` speed limit, ``R400`` or ``straight``), ``onc-...`` unless
+    sampled, ``v...``, ``mu...``, ``hold...``, ``dec...``; "all" when nothing is left."""
+    road_parts = {
+        "road": lambda v: v,
+        "los": lambda v: f"los{v}",
+        "lanes": lambda v: f"l{v}",
+        "speed_limit_kmh": lambda v: f"lim{_id_number(v)}",
+        "curve_radius_m": lambda v: f"R{_id_number(v)}",
+    }
+    parts = [
+        road_parts[k](values[k])
+        if values[k] is not None
+        else ("straight" if k == "curve_radius_m" else "")
+        for k in TRAFFIC_KEYS
+        if k in values and k not in sampled
+    ]
+    onc = values["oncoming_start_m"]
+    speed, mu = values["ego_speed_kmh"], values["mu"]
+    hold, decel = values["aro_hold_s"], values["aro_decel_mps2"]
+    parts += [
+        ""
+        if "oncoming_start_m" in sampled
+        else f"onc-{NO_ONCOMING if onc is None else _id_number(onc)}",
+        "" if speed is None else f"v{_id_number(speed)}",
+        "" if mu is None else f"mu{_mu_text(mu)}",
+        "" if hold is None else f"hold{_id_number(hold)}",
+        "" if decel is None else f"dec{_id_number(decel)}",
+    ]
+    return "_".join(p for p in parts if p) or "all"
 
 
 def load_paper_table(path: Path) -> dict[tuple[float | None, float, float], str]:
@@ -306,6 +382,39 @@ def _policy(value) -> str:
     return value
 
 
+def _road(value) -> str:
+    if value not in ROADS:
+        raise InputError(f"road {value!r} is not one of {', '.join(ROADS)}")
+    return value
+
+
+def _los(value) -> str:
+    if value not in LEVELS:
+        raise InputError(f"level of service {value!r} is not one of {', '.join(LEVELS)}")
+    return value
+
+
+def _lanes(value) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 6:
+        raise InputError(f"lanes {value!r} is not a whole number 1-6")
+    return value
+
+
+def _curve_radius(value) -> float | None:
+    if value == STRAIGHT:
+        return None
+    return _checked(MIN_CURVE_RADIUS_M, True)(value)
+
+
+#: The generated scenario's keys, with the check of one value of each.
+TRAFFIC_CHECKS = {
+    "road": _road,
+    "los": _los,
+    "lanes": _lanes,
+    "speed_limit_kmh": _checked(SPEED_LIMIT_RANGE_KMH[0], True, SPEED_LIMIT_RANGE_KMH[1]),
+    "curve_radius_m": _curve_radius,
+}
+
 #: The keys a [sample] table may draw, with the check of one value of each.
 SAMPLED = {
     "ego_speed_kmh": _checked(0.0, False),
@@ -322,6 +431,8 @@ SAMPLED = {
         key: _checked(low, True, high, max_inclusive=high_in)
         for key, (_, low, high, high_in) in V2X_KEYS.items()
     },
+    "after_stop_s": _checked(0.0, True),
+    **TRAFFIC_CHECKS,
 }
 
 
@@ -333,9 +444,10 @@ def load_matrix(path: Path) -> Matrix:
     sample = parse_sample(path, doc["sample"], SAMPLED) if "sample" in doc else None
     sampled = sample.keys if sample else ()
     _check_required(path, doc, sampled)
-    scenario = doc["scenario"]
+    scenario = doc.get("scenario", {})
     _check_sampled_once(path, doc, sample, sampled)
-    sumocfg = _existing_file(path, "[scenario] sumocfg", scenario["sumocfg"])
+    traffic_axes = _traffic_axes(path, doc, sampled)
+    sumocfg = _scenario_file(path, scenario, traffic_axes)
     max_time, radar_range = _run_limits(path, scenario)
     policy = _scenario_policy(path, scenario)
     v2x = _v2x_link(path, scenario, policy)
@@ -354,11 +466,81 @@ def load_matrix(path: Path) -> Matrix:
         **settings,
         seed=seed,
         sample=sample,
+        after_stop_s=_after_stop(path, scenario),
+        traffic_axes=traffic_axes,
         **_swept_values(path, doc.get("sweep", {}), sampled),
         paper_table=paper,
         policy=policy,
         v2x=v2x,
     )
+
+
+def _after_stop(path: Path, scenario: dict) -> float | None:
+    """[scenario] after_stop_s (None: the run's default), a number >= 0."""
+    value = scenario.get("after_stop_s")
+    if value is not None and (not _is_number(value) or value < 0):
+        raise InputError(f"{path}: [scenario] after_stop_s = {value!r} must be a number >= 0")
+    return None if value is None else float(value)
+
+
+def _scenario_file(path: Path, scenario: dict, traffic_axes: tuple) -> Path | None:
+    """[scenario] sumocfg, or None for a generated scenario; exactly one of the two."""
+    if "sumocfg" in scenario:
+        if traffic_axes:
+            raise InputError(
+                f"{path}: [scenario] sumocfg with the generated scenario's "
+                f"'{traffic_axes[0][0]}': keep one"
+            )
+        return _existing_file(path, "[scenario] sumocfg", scenario["sumocfg"])
+    if not traffic_axes:
+        raise InputError(f"{path}: [scenario] needs the key 'sumocfg' (or a generated 'road')")
+    keys = [key for key, _ in traffic_axes]
+    for need in ("road", "los"):
+        if need not in keys:
+            raise InputError(f"{path}: '{keys[0]}' needs the key '{need}'")
+    return None
+
+
+def _traffic_axes(path: Path, doc: dict, sampled: tuple[str, ...]) -> tuple:
+    """The generated scenario's keys as (key, values): [scenario] one value, [sweep] a list,
+    sampled (None,); every swept combination checked as a scenario spec."""
+    axes = []
+    for key in TRAFFIC_KEYS:
+        where = [t for t in ("scenario", "sweep") if key in doc.get(t, {})]
+        if len(where) > 1:
+            raise InputError(f"{path}: '{key}' is in [scenario] and [sweep]; keep one")
+        if key in sampled:
+            axes.append((key, (None,)))
+        elif where:
+            raw = doc[where[0]][key]
+            listed = raw if where[0] == "sweep" else [raw]
+            if not isinstance(listed, list) or not listed:
+                raise InputError(f"{path}: [sweep] {key} must be a non-empty list")
+            try:
+                axes.append((key, tuple(TRAFFIC_CHECKS[key](v) for v in listed)))
+            except InputError as exc:
+                raise InputError(f"{path}: [{where[0]}] {key}: {exc}") from None
+    _check_specs(path, axes)
+    return tuple(axes)
+
+
+def _check_specs(path: Path, axes: list) -> None:
+    """InputError for a swept combination that is not a scenario (a curved motorway)."""
+    keys = [key for key, _ in axes]
+    for combo in itertools.product(*(values for _, values in axes)):
+        values = dict(zip(keys, combo))
+        if values.get("road") is None:
+            continue
+        try:
+            TrafficSpec(
+                values["road"],
+                values.get("los") or "A",
+                values.get("lanes"),
+                values.get("speed_limit_kmh"),
+                values.get("curve_radius_m"),
+            ).checked()
+        except InputError as exc:
+            raise InputError(f"{path}: {', '.join(keys)}: {exc}") from None
 
 
 def _read_toml(path: Path) -> dict:
@@ -407,7 +589,7 @@ def _check_sampled_once(
                 raise InputError(
                     f"{path}: '{key}' is both in [{table}] and sampled in [sample]; keep one"
                 )
-    if sample is not None and "seed" in doc["scenario"]:
+    if sample is not None and "seed" in doc.get("scenario", {}):
         raise InputError(
             f"{path}: [scenario] seed with a [sample] table: the draws' seeds "
             "come from [sample] seed"
@@ -521,6 +703,10 @@ def check_matrix(matrix: Matrix, tables_dir: Path | None = None, ego_id: str = "
     """
     from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 
+    folder = Path(tables_dir) if tables_dir is not None else default_tables_dir()
+    if matrix.sumocfg is None:  # generated per case: nothing to read yet
+        check_within_tables(matrix, LookupTables.load(folder), folder)
+        return
     try:
         files = check_scenario(matrix.sumocfg, ego_id)
         holds = matrix.aro_holds_s or _extremes(matrix, "aro_hold_s") or (None,)
@@ -531,7 +717,6 @@ def check_matrix(matrix: Matrix, tables_dir: Path | None = None, ego_id: str = "
                 scripted_stops(files, over, ego_id)
     except InputError as exc:
         raise InputError(f"{matrix.path}: [scenario] sumocfg: {exc}") from exc
-    folder = Path(tables_dir) if tables_dir is not None else default_tables_dir()
     check_within_tables(matrix, LookupTables.load(folder), folder)
 
 

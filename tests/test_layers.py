@@ -63,9 +63,22 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
         },
         {"numpy", "pandas", "pyarrow", "libsumo", "traci", "sumolib", "sumo", "mypy_extensions"},
     ),
-    "matrix": ({"params", "errors", "colours", "sampling", "offline", "sensing", "sim"}, set()),
+    "matrix": (
+        {"params", "errors", "colours", "sampling", "offline", "sensing", "sim", "traffic_levels"},
+        set(),
+    ),
     "batch": (
-        {"params", "errors", "colours", "fileio", "sampling", "sensing", "sim", "matrix"},
+        {
+            "params",
+            "errors",
+            "colours",
+            "fileio",
+            "sampling",
+            "sensing",
+            "sim",
+            "matrix",
+            "traffic_levels",
+        },
         {"pandas", "dask", "distributed", "tqdm", "pyarrow"},
     ),
     "plotting": (
@@ -75,6 +88,7 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
     "vehicle_tests": ({"params", "errors", "fileio", "plant", "plotting"}, {"numpy"}),
     "traffic_scenario": (set(), {"sumolib"}),
     "netbuild": ({"errors"}, {"sumolib", "sumo"}),
+    "traffic_levels": ({"errors", "netbuild"}, {"numpy", "libsumo"}),
     "bench": (
         {"params", "plant", "offline", "sensing", "sim", "batch", "traffic_scenario"},
         {"libsumo", "sumolib"},

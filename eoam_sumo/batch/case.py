@@ -64,8 +64,14 @@ class CaseParameters:
     mu_belief: str | float  # known, estimate or a number
     radar_model: str  # ideal or automotive
     seed: int
+    after_stop_s: float | None  # None: the run's default
+    road: str | None  # a generated scenario (None: the sumocfg's): rural or motorway
+    los: str | None  # its level of service
+    lanes: int | None
+    speed_limit_kmh: float | None
+    curve_radius_m: float | None
     draw: int | None  # the sample's number in a sampled matrix
-    sumocfg: str
+    sumocfg: str  # a generated scenario's: relative to the case folder
 
     @classmethod
     def of(cls, case: Case) -> CaseParameters:
@@ -107,6 +113,7 @@ def run_matrix_case(task: CaseTask) -> dict:
             mu_belief=case.mu_belief,
             radar_model=case.radar_model,
             seed=case.seed,
+            after_stop_s=case.after_stop_s,
         ),
         case.policy,
         case.v2x_range_m,
@@ -123,7 +130,7 @@ def run_matrix_case(task: CaseTask) -> dict:
         for name in ALL_CASE_FILES:
             (case_dir / name).unlink(missing_ok=True)
         summary = run_case(
-            case.sumocfg,
+            _scenario(case, case_dir),
             case.overrides(),
             case_dir,
             settings,
@@ -133,7 +140,7 @@ def run_matrix_case(task: CaseTask) -> dict:
         return {"summary": summary, "files": None}
     with tempfile.TemporaryDirectory(prefix="eoam-case-") as scratch:
         summary = run_case(
-            case.sumocfg,
+            _scenario(case, Path(scratch)),
             case.overrides(),
             Path(scratch),
             settings,
@@ -144,3 +151,14 @@ def run_matrix_case(task: CaseTask) -> dict:
             name: (Path(scratch) / name).read_bytes() for name in CASE_FILES_OF[task.timeseries]
         }
     return {"summary": summary, "files": files}
+
+
+def _scenario(case: Case, case_dir: Path) -> Path:
+    """The case's sumocfg; a generated scenario written first into ``case_dir`` (its
+    ``case.sumocfg`` there, the traffic seeded with the case's seed)."""
+    spec = case.traffic()
+    if spec is None:
+        return case.sumocfg
+    from eoam_sumo.traffic_levels.build import write_scenario
+
+    return write_scenario(spec, case_dir / case.sumocfg.parent)

@@ -21,6 +21,11 @@ OUTCOME_ORDER = ("none", "green", "unfinished", "yellow", "orange", "red")
 FAILED = "failed"
 #: Parameter columns that may identify a group (those constant within every group are kept).
 GROUP_COLUMNS = (
+    "road",
+    "los",
+    "lanes",
+    "speed_limit_kmh",
+    "curve_radius_m",
     "ego_speed_kmh",
     "mu",
     "oncoming_start_m",
@@ -30,6 +35,7 @@ GROUP_COLUMNS = (
     "radar_range_m",
     "mu_belief",
     "radar_model",
+    "after_stop_s",
 )
 _DRAW_SUFFIX = re.compile(r"_d\d+$")
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 import contextlib
 import sys
 from collections.abc import Callable, Iterator
+from dataclasses import replace
 from pathlib import Path
 
 import pandas as pd
@@ -139,6 +140,7 @@ def run_batch(
     case_func: Callable[[CaseTask], dict] = run_matrix_case,
     tables_dir: Path | None = None,
     timeseries: str = "csv",
+    after_stop_s: float | None = None,
 ) -> pd.DataFrame:
     """Run every case of the matrix; return the final results (as :func:`read_results`).
 
@@ -155,11 +157,16 @@ def run_batch(
     (:func:`~eoam_sumo.matrix.load_matrix`), its scenario files and every swept speed and
     friction against the lookup tables in ``tables_dir`` (default: the co-simulation's,
     :func:`~eoam_sumo.matrix.check_matrix`). A case that fails is a ``failed`` row.
+    ``after_stop_s`` sets every case's (over the matrix's ``[scenario] after_stop_s``).
     """
     _check_options(jobs, timeout_s, timeseries)
+    if after_stop_s is not None and not after_stop_s >= 0.0:
+        raise InputError(f"--after-stop-s {after_stop_s:g} must be >= 0")
     matrix: Matrix = load_matrix(Path(matrix_path))
     check_matrix(matrix, tables_dir)
     cases = matrix.cases()
+    if after_stop_s is not None:
+        cases = [replace(c, after_stop_s=after_stop_s) for c in cases]
     paper = matrix.paper_outcomes()
     out_dir = _cases_folder(Path(out_dir))
     results = run_cases(

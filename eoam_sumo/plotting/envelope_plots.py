@@ -46,46 +46,79 @@ def envelope_table(results: pd.DataFrame, event: pd.Series) -> tuple:
     return count, n, speeds, mus
 
 
-def plot_envelopes(results: pd.DataFrame, out_dir: Path) -> list[Path]:
-    """``envelope.png``: P(contact) and P(red) over initial speed x friction."""
-    if not (results["status"] == "ok").any():
-        return []
-    events = {
+def _events(results: pd.DataFrame) -> dict[str, pd.Series]:
+    return {
         "P(contact with any road user)": results["collision_with"].fillna("none") != "none",
         "P(red: head-on after a lane change)": results["outcome"] == "red",
     }
-    fig = Figure(figsize=(12, 5.5), layout="constrained")
-    axes = fig.subplots(1, 2)
-    for ax, (title, event) in zip(axes, events.items()):
-        count, n, speeds, mus = envelope_table(results, event)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            p = np.where(n > 0, count / np.maximum(n, 1), np.nan)
-        image = ax.imshow(p, cmap="Reds", vmin=0.0, vmax=1.0, aspect="auto")
-        for i in range(len(speeds)):
-            for j in range(len(mus)):
-                if n[i, j] == 0:
-                    continue
-                low, high = wilson_interval(int(count[i, j]), int(n[i, j]))
-                ax.text(
-                    j,
-                    i,
-                    f"{p[i, j]:.2f}\n[{low:.2f}, {high:.2f}]\nn={n[i, j]}",
-                    ha="center",
-                    va="center",
-                    fontsize=8,
-                    color="white" if p[i, j] > 0.6 else "black",
-                )
-        ax.set_xticks(range(len(mus)), mus)
-        ax.set_yticks(range(len(speeds)), speeds)
-        ax.invert_yaxis()  # the highest speed on top
-        ax.set_xlabel("surface friction mu")
-        ax.set_ylabel("initial ego speed [km/h]")
-        ax.set_title(title)
-        fig.colorbar(image, ax=ax, shrink=0.8, label="probability")
+
+
+def _panel(ax, results: pd.DataFrame, event: pd.Series, title: str, fig: Figure) -> None:
+    """One envelope: ``event``'s probability over speed x friction, each cell annotated."""
+    count, n, speeds, mus = envelope_table(results, event)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        p = np.where(n > 0, count / np.maximum(n, 1), np.nan)
+    image = ax.imshow(p, cmap="Reds", vmin=0.0, vmax=1.0, aspect="auto")
+    for i in range(len(speeds)):
+        for j in range(len(mus)):
+            if n[i, j] == 0:
+                continue
+            low, high = wilson_interval(int(count[i, j]), int(n[i, j]))
+            ax.text(
+                j,
+                i,
+                f"{p[i, j]:.2f}\n[{low:.2f}, {high:.2f}]\nn={n[i, j]}",
+                ha="center",
+                va="center",
+                fontsize=8,
+                color="white" if p[i, j] > 0.6 else "black",
+            )
+    ax.set_xticks(range(len(mus)), mus)
+    ax.set_yticks(range(len(speeds)), speeds)
+    ax.invert_yaxis()  # the highest speed on top
+    ax.set_xlabel("surface friction mu")
+    ax.set_ylabel("initial ego speed [km/h]")
+    ax.set_title(title)
+    fig.colorbar(image, ax=ax, shrink=0.8, label="probability")
+
+
+def _title(results: pd.DataFrame, what: str) -> str:
     failed = int((results["status"] != "ok").sum())
-    fig.suptitle(
-        f"Outcome envelopes: {int((results['status'] == 'ok').sum())} draws"
+    return (
+        f"{what}: {int((results['status'] == 'ok').sum())} draws"
         + (f" ({failed} failed, left out)" if failed else "")
         + "; each cell p [Wilson 95 %] and n"
     )
+
+
+def plot_envelopes(results: pd.DataFrame, out_dir: Path) -> list[Path]:
+    """``envelope.png``: P(contact) and P(red) over initial speed x friction; for generated
+    scenarios (a ``road`` column) one ``envelope_<road>.png`` per road instead, a row of
+    the two per level of service."""
+    if not (results["status"] == "ok").any():
+        return []
+    roads = results["road"].fillna("").astype(str) if "road" in results else pd.Series()
+    if (roads != "").any():
+        return [
+            _road_envelopes(results[roads == road], road, out_dir)
+            for road in sorted(set(roads) - {""})
+        ]
+    fig = Figure(figsize=(12, 5.5), layout="constrained")
+    axes = fig.subplots(1, 2)
+    for ax, (title, event) in zip(axes, _events(results).items()):
+        _panel(ax, results, event, title, fig)
+    fig.suptitle(_title(results, "Outcome envelopes"))
     return [save(fig, Path(out_dir) / ENVELOPE_PNG)]
+
+
+def _road_envelopes(results: pd.DataFrame, road: str, out_dir: Path) -> Path:
+    """``envelope_<road>.png``: per level of service (rows), P(contact) and P(red)."""
+    levels = sorted(set(results["los"].fillna("").astype(str)) - {""}) or [None]
+    fig = Figure(figsize=(12, 4.8 * len(levels)), layout="constrained")
+    axes = fig.subplots(len(levels), 2, squeeze=False)
+    for row, level in zip(axes, levels):
+        subset = results if level is None else results[results["los"] == level]
+        for ax, (title, event) in zip(row, _events(subset).items()):
+            _panel(ax, subset, event, f"LoS {level}: {title}", fig)
+    fig.suptitle(_title(results, f"Outcome envelopes, {road} road"))
+    return save(fig, Path(out_dir) / f"envelope_{road}.png")

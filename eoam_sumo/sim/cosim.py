@@ -34,7 +34,12 @@ from eoam_sumo.sensing.friction import FrictionBelief
 from eoam_sumo.sensing.next_lane import NextLaneSensing
 from eoam_sumo.sensing.radar import RadarReport
 from eoam_sumo.sim.facts import collect_facts, collect_info
-from eoam_sumo.sim.margins import EGO_STANDSTILL_MPS, Margins, road_user_close_ahead
+from eoam_sumo.sim.margins import (
+    EGO_STANDSTILL_MPS,
+    Margins,
+    follower_arriving,
+    road_user_close_ahead,
+)
 from eoam_sumo.sim.observers import (
     AvoidedObstacle,
     Extremes,
@@ -423,13 +428,14 @@ class CoSimulation:
         if not self.eoam_done():
             self._stop_at = None  # (again) a manoeuvre under way: run on to its end
         elif self._stop_at is None:
-            self._stop_at = self.t + self.settings.settle_s
+            self._stop_at = self.t + self._run_on_s()
         if (
             self._stop_at is not None
             and self.t >= self._stop_at - 1e-9
             and not road_user_close_ahead(
                 self.x, self._front, self.road, self.lane_width_m, self.mu_true, self.bodies
             )
+            and not self._waiting_for_follower()
         ):
             self.end_cause = "settled"
         elif self.meas.s_m > self._end_s_m:
@@ -439,6 +445,24 @@ class CoSimulation:
         else:
             return False
         return True
+
+    def _run_on_s(self) -> float:
+        """How long the run goes on once the EOAM is done: ``after_stop_s`` after a stop
+        when set, else ``settle_s``."""
+        st = self.settings
+        if st.after_stop_s is not None and self.x[3] < EGO_STANDSTILL_MPS:
+            return st.after_stop_s
+        return st.settle_s
+
+    def _waiting_for_follower(self) -> bool:
+        """By default (no ``after_stop_s``), a stopped ego waits for a road user behind it
+        moving towards it (``margins.follower_arriving``): it stops behind the ego, or hits
+        it."""
+        if self.settings.after_stop_s is not None or self.x[3] >= EGO_STANDSTILL_MPS:
+            return False
+        return follower_arriving(
+            self.x, self._front - self.params.length_m, self.road, self.lane_width_m, self.bodies
+        )
 
     def eoam_done(self) -> bool:
         """The EOAM is over: handed back to NORMAL after a manoeuvre, or stopped."""

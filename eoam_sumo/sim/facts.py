@@ -70,6 +70,14 @@ class RunFacts:
     time_in_opposite_lane_s: float = 0.0
     time_in_next_lane_s: float = 0.0
     near_miss_margins: bool = False
+    # along the lanes: the smallest time to collision with any moving road user and with
+    # those behind; the ego's follower: smallest gap, largest DRAC and deceleration, who
+    min_ttc_s: float = math.inf
+    min_ttc_rear_s: float = math.inf
+    min_gap_rear_m: float = math.inf
+    max_drac_rear_mps2: float = 0.0
+    max_follower_decel_mps2: float = 0.0
+    follower_decel_id: str | None = None
     # around the ego: whether it ended ahead of the obstacle its lane change avoided (None:
     # no lane change, or the obstacle gone), whether oncoming traffic came within the log
     passed_obstacle: bool | None = None
@@ -163,6 +171,12 @@ def collect_facts(sim: EndedRun) -> RunFacts:
         time_in_opposite_lane_s=margins.time_in_opposite_lane_s if sim.next_lane_opposing else 0.0,
         time_in_next_lane_s=margins.time_in_opposite_lane_s,
         near_miss_margins=margins.near_miss(),
+        min_ttc_s=margins.min_ttc_s,
+        min_ttc_rear_s=margins.min_ttc_rear_s,
+        min_gap_rear_m=margins.min_gap_rear_m,
+        max_drac_rear_mps2=margins.max_drac_rear_mps2,
+        max_follower_decel_mps2=margins.max_follower_decel_mps2,
+        follower_decel_id=margins.follower_decel_id,
         passed_obstacle=sim.avoided.passed,
         oncoming_traffic=sim.traffic.had_role("oncoming"),
         end_cause=sim.end_cause or "",

@@ -8,14 +8,31 @@ left of its lane, and whether a run without contact was a near miss.
   simulation at the start and at the end of the run (one never within reach has neither met
   nor passed the ego, so the smaller of those two gaps is its smallest); infinite (empty in
   the summary) when there is none;
-* ``min_ttc_oncoming_s``: the smallest time to collision with such a road user, both keeping
-  their velocities (``geometry.time_to_contact``); infinite when never on a collision course;
+* ``min_ttc_oncoming_s``: the smallest time to collision with such a road user, both moving
+  on along their lanes at their present rates (below); infinite when never on a collision
+  course;
+* ``min_ttc_s``: the smallest time to collision along the lanes with any moving road user
+  (opposite direction, or the same direction within ``TTC_HORIZON_S``), the obstacle ahead
+  in the ego's lane aside (its margin is ``min_gap_aro_m``); ``min_ttc_rear_s`` the same for
+  those behind the ego;
+* the ego's follower (the nearest road user behind it overlapping its width, within
+  ``FOLLOWER_REACH_M``): the smallest gap along the road ``min_gap_rear_m``, and while it
+  closes in on the ego the largest DRAC ``max_drac_rear_mps2`` (deceleration rate to avoid
+  the crash, (v_f - v_ego)^2 / (2 gap)) and the largest deceleration it made,
+  ``max_follower_decel_mps2`` (``follower_decel_id`` who);
 * ``time_in_opposite_lane_s``: steps with the ego's centre left of its lane (in the next lane
   to the left, the opposite lane on a two-way road) times the step;
 * ``closest_gap_m`` and ``closest_id``: the smallest gap to any road user once within
   ``NEAR_MISS_GAP_M`` (gaps farther out are not measured);
 * a run without contact is a **near miss** when it came within ``NEAR_MISS_GAP_M`` of any
-  road user or its ``min_ttc_oncoming_s`` fell below ``NEAR_MISS_TTC_S``.
+  road user, its ``min_ttc_s`` fell below ``NEAR_MISS_TTC_S``, or a follower was forced to
+  brake at ``EMERGENCY_DECEL_MPS2`` or harder.
+
+Along the lanes: every road user and the ego move on in the road frame of the ego's original
+lane (station ``s``, offset ``d``) at their present rates, ``s' = v cos(psi - psi_road) /
+(1 - kappa d)`` and ``d' = v sin(psi - psi_road)``: on a curve each keeps to its lane, where a
+straight line would cross the bend into the other. On a straight road it is the straight
+line.
 
 ``road_user_close_ahead`` is the ground truth the step loop asks before it ends a run as
 settled: a run does not end while the ego moves towards a road user close ahead in its lane.
@@ -28,6 +45,7 @@ from collections.abc import Sequence
 
 from eoam_sumo.params import G_MPS2
 from eoam_sumo.sim.observers import RunView, StepObserver
+from eoam_sumo.sim.roadframe import RoadFrame
 from eoam_sumo.world.bodies import Body
 from eoam_sumo.world.geometry import (
     GAP_ROUNDING_M,
@@ -53,6 +71,15 @@ CLOSE_AHEAD_MARGIN_M = 5.0
 #: (``CoSimulation.eoam_done``) and no road user ahead holds the run open. Not the outcome's
 #: "stopped at the end" (``outcome.STOPPED_AT_END_MPS``, 0.1 m/s), which only words a reason.
 EGO_STANDSTILL_MPS = 0.05
+#: Times to collision with same-direction road users are looked for this far ahead [s].
+TTC_HORIZON_S = 10.0
+#: The ego's follower is the nearest road user behind it, overlapping its width, within [m].
+FOLLOWER_REACH_M = 150.0
+#: A follower forced to brake this hard or harder makes a near miss [m/s^2]: "emergency
+#: braking" on the scale of the deceleration needed to stay clear of a leader (Hupfer 1997,
+#: as tabulated for the DST/a_long,req metrics by Westhofen et al., "Criticality metrics for
+#: automated driving: a review", 2023: < 4 considerable, < 6 heavy reaction, >= 6 emergency).
+EMERGENCY_DECEL_MPS2 = 6.0
 
 
 class Margins(StepObserver):
@@ -72,7 +99,17 @@ class Margins(StepObserver):
         self._opposite_steps = 0
         self._step_s = sim.step_s
         self._half_lane_m = 0.5 * sim.lane_width_m
+        self._band_m = lane_band_m(sim.lane_width_m)
         self._left_lane = sim.left_lane
+        # along the lanes: the road frame of the ego's original lane (its own walk)
+        self._frame = RoadFrame(sim.session.ego_lane_centreline())
+        self._frame.locate(sim.x[0], sim.x[1])
+        self.min_ttc_s = math.inf
+        self.min_ttc_rear_s = math.inf
+        self.min_gap_rear_m = math.inf
+        self.max_drac_rear_mps2 = 0.0
+        self.max_follower_decel_mps2 = 0.0
+        self.follower_decel_id: str | None = None
 
     @property
     def time_in_opposite_lane_s(self) -> float:
@@ -98,16 +135,29 @@ class Margins(StepObserver):
         )
 
     def near_miss(self) -> bool:
-        return self.closest_gap_m <= NEAR_MISS_GAP_M or self.min_ttc_oncoming_s < NEAR_MISS_TTC_S
+        """Within ``NEAR_MISS_GAP_M`` of any road user, a time to collision along the lanes
+        below ``NEAR_MISS_TTC_S`` with any moving one (the obstacle ahead in the ego's lane
+        aside), or a follower forced to brake at ``EMERGENCY_DECEL_MPS2`` or harder."""
+        return (
+            self.closest_gap_m <= NEAR_MISS_GAP_M
+            or self.min_ttc_s < NEAR_MISS_TTC_S
+            or self.max_follower_decel_mps2 >= EMERGENCY_DECEL_MPS2
+        )
 
     def after_step(self, sim: RunView) -> None:
         meas = sim.meas
         if self._left_lane and meas.d_m > self._half_lane_m:
             self._opposite_steps += 1
-        X, Y, yaw, vx, vy = sim.x[:5]
+        self._gaps(sim)
+        self._along_lanes(sim)
+
+    def _gaps(self, sim: RunView) -> None:
+        """The box gaps: to opposite-direction road users, and the closest within
+        ``NEAR_MISS_GAP_M``."""
+        X, Y, yaw = sim.x[0], sim.x[1], sim.x[2]
         c, s = math.cos(yaw), math.sin(yaw)
         ex, ey = X + self._back_m * c, Y + self._back_m * s
-        road_yaw = sim.x_prev[2] - meas.e_yaw_rad  # the road's heading at the ego
+        road_yaw = sim.x_prev[2] - sim.meas.e_yaw_rad  # the road's heading at the ego
         cr, sr = math.cos(road_yaw), math.sin(road_yaw)
         ego_box = None
         for b in sim.bodies:
@@ -120,19 +170,14 @@ class Margins(StepObserver):
             )
             opposite = not b.parked and box.cos_yaw * cr + box.sin_yaw * sr < 0.0
             near = bound < NEAR_MISS_GAP_M
-            if not (opposite or near):
+            if not (near or (opposite and bound < self.min_gap_oncoming_m)):
                 continue
             if ego_box is None:
                 ego_box = OrientedBox(ex, ey, yaw, self.length_m, self.width_m)
-                ve = (vx * c - vy * s, vx * s + vy * c)
             gap = -1.0
-            if opposite:
-                if bound < self.min_gap_oncoming_m:
-                    gap = box_distance(ego_box, box)
-                    self.min_gap_oncoming_m = min(self.min_gap_oncoming_m, gap)
-                vb = (b.speed_mps * box.cos_yaw, b.speed_mps * box.sin_yaw)
-                ttc = time_to_contact(ego_box, box, ve, vb, self.min_ttc_oncoming_s)
-                self.min_ttc_oncoming_s = min(self.min_ttc_oncoming_s, ttc)
+            if opposite and bound < self.min_gap_oncoming_m:
+                gap = box_distance(ego_box, box)
+                self.min_gap_oncoming_m = min(self.min_gap_oncoming_m, gap)
             if near and bound < self.closest_gap_m:
                 # the separating-axis bound rules out most of what the circles let through
                 # (a car parked beside the ego)
@@ -140,6 +185,110 @@ class Margins(StepObserver):
                     gap = box_distance(ego_box, box)
                 if 0.0 <= gap < self.closest_gap_m:
                     self.closest_gap_m, self.closest_id = gap, b.vid
+
+    def _along_lanes(self, sim: RunView) -> None:
+        """Times to collision along the lanes, and the follower's measures.
+
+        Every road user and the ego move on in the road frame (station along the ego's
+        original lane, offset from it) at their present rates: ``s' = v cos(psi - psi_road)
+        / (1 - kappa d)``, ``d' = v sin(psi - psi_road)``, so that on a curve each keeps to
+        its lane instead of leaving it on a straight line. Their boxes in that frame, turned
+        by the heading relative to the road, give the time to contact
+        (``geometry.time_to_contact``)."""
+        ego, ego_v = self._ego_in_frame(sim)
+        follower: tuple[float, Body, OrientedBox, tuple[float, float]] | None = None
+        for b in sim.bodies:
+            if b.parked:
+                continue
+            box, v = self._in_frame(b)
+            if box.cos_yaw < 0.0:  # opposite direction
+                ttc = time_to_contact(ego, box, ego_v, v, self.min_ttc_oncoming_s)
+                self.min_ttc_oncoming_s = min(self.min_ttc_oncoming_s, ttc)
+                self.min_ttc_s = min(self.min_ttc_s, ttc)
+                continue
+            behind_m = ego.x_m - box.x_m
+            if behind_m < 0.0 and abs(box.y_m) < self._band_m:
+                continue  # the obstacle ahead in the ego's lane: its margin is the gap
+            horizon = min(self.min_ttc_s, TTC_HORIZON_S)
+            if behind_m > 0.0:
+                horizon = max(horizon, min(self.min_ttc_rear_s, TTC_HORIZON_S))
+            if _apart(ego, box, ego_v, v, horizon):
+                ttc = math.inf
+            else:
+                ttc = time_to_contact(ego, box, ego_v, v, horizon)
+            self.min_ttc_s = min(self.min_ttc_s, ttc)
+            if behind_m <= 0.0:
+                continue
+            self.min_ttc_rear_s = min(self.min_ttc_rear_s, ttc)
+            overlap = abs(box.y_m - ego.y_m) < 0.5 * (self.width_m + b.width_m)
+            if (
+                overlap
+                and behind_m < FOLLOWER_REACH_M
+                and (follower is None or behind_m < follower[0])
+            ):
+                follower = (behind_m, b, box, v)
+        if follower is not None:
+            self._follower(sim, ego, ego_v, follower[1], follower[2], follower[3])
+
+    def _ego_in_frame(self, sim: RunView) -> tuple[OrientedBox, tuple[float, float]]:
+        """The ego's box in the road frame, and its rates (s', d')."""
+        X, Y, yaw, vx, vy = sim.x[:5]
+        c, s = math.cos(yaw), math.sin(yaw)
+        ex, ey = X + self._back_m * c, Y + self._back_m * s
+        st, d, road_yaw = self._frame.project(ex, ey)
+        rel = yaw - road_yaw
+        cr, sr = math.cos(rel), math.sin(rel)
+        stretch = 1.0 - self._frame.curvature_at(st) * d
+        v = ((vx * cr - vy * sr) / stretch, vx * sr + vy * cr)
+        return OrientedBox(st, d, rel, self.length_m, self.width_m), v
+
+    def _in_frame(self, b: Body) -> tuple[OrientedBox, tuple[float, float]]:
+        """A road user's box in the road frame, and its rates (s', d')."""
+        st, d, road_yaw = self._frame.project(b.x_m, b.y_m)
+        rel = b.yaw_rad - road_yaw
+        stretch = 1.0 - self._frame.curvature_at(st) * d
+        v = (b.speed_mps * math.cos(rel) / stretch, b.speed_mps * math.sin(rel))
+        return OrientedBox(st, d, rel, b.length_m, b.width_m), v
+
+    def _follower(
+        self,
+        sim: RunView,
+        ego: OrientedBox,
+        ego_v: tuple[float, float],
+        b: Body,
+        box: OrientedBox,
+        v: tuple[float, float],
+    ) -> None:
+        """The nearest road user behind the ego overlapping its width (the ego is its
+        leader): the gap between them along the road, and while it closes in on the ego its
+        DRAC ((v_f - v_ego)^2 / (2 gap)) and its deceleration over the step (forced by the
+        ego; a follower falling back, such as an obstacle the ego passed stopping behind it,
+        is not)."""
+        gap = ego.x_m - 0.5 * ego.length_m - (box.x_m + 0.5 * b.length_m)
+        self.min_gap_rear_m = min(self.min_gap_rear_m, max(gap, 0.0))
+        closing = v[0] - ego_v[0]
+        if closing <= 0.0:
+            return
+        if gap > 0.0:
+            self.max_drac_rear_mps2 = max(self.max_drac_rear_mps2, closing * closing / (2.0 * gap))
+        before = next((o for o in sim.bodies_before if o.vid == b.vid), None)
+        if before is not None:
+            decel = (before.speed_mps - b.speed_mps) / self._step_s
+            if decel > self.max_follower_decel_mps2:
+                self.max_follower_decel_mps2, self.follower_decel_id = decel, b.vid
+
+
+def _apart(
+    a: OrientedBox, b: OrientedBox, va: tuple[float, float], vb: tuple[float, float], t_s: float
+) -> bool:
+    """Whether two boxes moving at these rates cannot touch within ``t_s``: along either
+    axis of the frame their centres are farther apart than their bounding circles plus what
+    the rate between them closes in that time."""
+    reach = a.radius_m + b.radius_m + GAP_ROUNDING_M
+    return (
+        abs(b.x_m - a.x_m) - reach > abs(vb[0] - va[0]) * t_s
+        or abs(b.y_m - a.y_m) - reach > abs(vb[1] - va[1]) * t_s
+    )
 
 
 def road_user_close_ahead(
@@ -170,5 +319,32 @@ def road_user_close_ahead(
         u = max(b.speed_mps * math.cos(b.yaw_rad - road_yaw), 0.0)
         need = max(vx * vx - u * u, 0.0) / two_decel + CLOSE_AHEAD_MARGIN_M
         if s - 0.5 * b.length_m - front_s <= need:
+            return True
+    return False
+
+
+def follower_arriving(
+    x: Sequence[float],
+    cg_to_rear_m: float,
+    road: RoadProjection,
+    lane_width_m: float,
+    bodies: Sequence[Body],
+) -> bool:
+    """Whether a road user has its centre in the ego's lane behind the ego's rear bumper
+    (``cg_to_rear_m`` ahead of the CG: negative), within ``FOLLOWER_REACH_M``, still moving
+    towards it: it has not yet stopped behind the ego, and may hit it. The run of a stopped
+    ego waits for it (``RunSettings.after_stop_s`` None)."""
+    X, Y = x[0], x[1]
+    s_ego, d_ego, _ = road.project(X, Y)
+    rear_s = s_ego + cg_to_rear_m
+    lane_d = lane_width_m * round(d_ego / lane_width_m)
+    band = lane_band_m(lane_width_m)
+    for b in bodies:
+        if b.parked:
+            continue
+        s, d, road_yaw = road.project(b.x_m, b.y_m)
+        if not rear_s - FOLLOWER_REACH_M < s < rear_s or abs(d - lane_d) >= band:
+            continue
+        if b.speed_mps * math.cos(b.yaw_rad - road_yaw) > EGO_STANDSTILL_MPS:
             return True
     return False

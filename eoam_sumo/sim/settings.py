@@ -28,6 +28,9 @@ class RunSettings:
     plant_dt_s: float = 0.001  # plant integration step [s]
     max_time_s: float = DEFAULT_MAX_TIME_S  # simulated time limit [s]
     settle_s: float = 2.0  # run on this long after the hand-back or a stop [s]
+    # after the ego stops: run on this long [s]; None: ``settle_s`` and then for as long as
+    # a road user behind it in its lane (150 m) moves towards it (``margins.follower_arriving``)
+    after_stop_s: float | None = None
     ego_id: str = "ego"
     gui: bool = False
     use_traci: bool = False
@@ -50,6 +53,8 @@ class RunSettings:
             raise ValueError(f"plant_dt_s={self.plant_dt_s} must divide step_s={self.step_s}")
         if self.max_time_s <= 0:
             raise ValueError(f"max_time_s={self.max_time_s} must be > 0")
+        if self.after_stop_s is not None and not self.after_stop_s >= 0.0:
+            raise ValueError(f"after_stop_s={self.after_stop_s} must be >= 0")
         if self.v2x.enabled and self.eoam.policy.name != "safe":
             raise ValueError("V2X informs the safe policy only: set policy 'safe' or V2X range 0")
 

@@ -66,13 +66,17 @@ class RunSummary:
         "smallest box gap to an opposite-direction road user in reach (empty: none)"
     )
     min_ttc_oncoming_s: float | None = _doc(
-        "smallest time to collision with one (empty: never on a collision course)"
+        "smallest time to collision with one, each moving on along its lane (empty: never "
+        "on a collision course)"
     )
     time_in_opposite_lane_s: float = _doc(
         "time with the ego's centre in the opposite lane (left of its lane, where the lane "
         "there carries opposing traffic; 0 on a one-way road)"
     )
-    near_miss: bool = _doc("no contact, but within 0.5 m of a road user or TTC below 1.5 s")
+    near_miss: bool = _doc(
+        "no contact, but within 0.5 m of a road user, a TTC along the lanes below 1.5 s "
+        "(min_ttc_s), or a follower forced to brake at 6 m/s2 or more"
+    )
     passed_obstacle: bool | None = _doc(
         "a lane change ended ahead of the obstacle it avoided (empty: no lane change)"
     )
@@ -103,6 +107,25 @@ class RunSummary:
     time_in_next_lane_s: float = _doc(
         "time with the ego's centre left of its lane (in the next lane, whatever its direction)"
     )
+    min_ttc_s: float | None = _doc(
+        "smallest time to collision along the lanes with any moving road user but the "
+        "obstacle ahead in the ego's lane (same direction: within 10 s; empty: none)"
+    )
+    min_ttc_rear_s: float | None = _doc(
+        "the same with road users behind the ego (empty: none within 10 s)"
+    )
+    min_gap_rear_m: float | None = _doc(
+        "smallest gap along the road from the ego's follower (the nearest road user behind "
+        "it overlapping its width, within 150 m) to the ego (empty: none)"
+    )
+    max_drac_rear_mps2: float = _doc(
+        "largest deceleration the follower needed to avoid the ego while closing in, "
+        "(v_f - v_ego)^2 / (2 gap) (DRAC)"
+    )
+    max_follower_decel_mps2: float = _doc(
+        "largest deceleration the follower made while closing in on the ego"
+    )
+    follower_decel_id: str | None = _doc("SUMO id of that follower (empty: none)")
 
     def as_dict(self) -> dict:
         """The summary as summary.json writes it (lists for tuples)."""

@@ -147,4 +147,17 @@ def _run_fields(facts: RunFacts, info: RunInfo) -> dict[str, Any]:
         "realtime_factor": facts.sim_time_s / info.loop_wall_s,
         "sumo_overrides": info.sumo_overrides,
         "time_in_next_lane_s": rounded(facts.time_in_next_lane_s),
+        **_traffic_margin_fields(facts),
+    }
+
+
+def _traffic_margin_fields(facts: RunFacts) -> dict[str, Any]:
+    """The margins along the lanes and to the traffic behind (``sim/margins.py``)."""
+    return {
+        "min_ttc_s": finite_or_none(facts.min_ttc_s),
+        "min_ttc_rear_s": finite_or_none(facts.min_ttc_rear_s),
+        "min_gap_rear_m": finite_or_none(facts.min_gap_rear_m),
+        "max_drac_rear_mps2": rounded(facts.max_drac_rear_mps2),
+        "max_follower_decel_mps2": rounded(facts.max_follower_decel_mps2),
+        "follower_decel_id": facts.follower_decel_id,
     }

@@ -48,4 +48,5 @@ def test_time_in_the_opposite_lane_counts_only_an_opposite_lane(tmp_path, edges,
     assert left_s > 1.0
     assert s["time_in_next_lane_s"] == pytest.approx(left_s, abs=0.015)
     assert s["time_in_opposite_lane_s"] == (s["time_in_next_lane_s"] if opposing else 0.0)
-    assert list(s)[-1] == "time_in_next_lane_s"  # the last field: the older ones keep their place
+    # added after the older fields (they keep their place), before the margins along the lanes
+    assert list(s)[list(s).index("time_in_next_lane_s") + 1 :][0] == "min_ttc_s"

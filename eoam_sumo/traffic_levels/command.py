@@ -1,0 +1,47 @@
+"""``eoam-sumo scenario ROAD --los L ... --out DIR``: write a generated traffic scenario."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from eoam_sumo.errors import InputError
+from eoam_sumo.traffic_levels.hcm import LEVELS
+from eoam_sumo.traffic_levels.spec import ROADS, TrafficSpec
+
+
+def add_scenario_arguments(sub) -> None:
+    """The ``scenario`` sub-command's arguments."""
+    p = sub.add_parser(
+        "scenario",
+        help="write a road with traffic at a level of service, an obstacle and the ego",
+        description="Write DIR/scenario.sumocfg and its files: a rural two-lane road or a "
+        "motorway, traffic at a Highway Capacity Manual level of service settled by a "
+        "warm-up run, the ego placed in a gap of it behind an obstacle that brakes to a stop.",
+    )
+    p.add_argument("road", choices=ROADS, help="rural (two lanes, two-way) or motorway")
+    p.add_argument("--los", required=True, choices=LEVELS, help="level of service A-E")
+    p.add_argument("--lanes", type=int, help="motorway: lanes of the carriageway (3)")
+    p.add_argument("--speed-limit-kmh", type=float, help="speed limit (rural 100, motorway 120)")
+    p.add_argument("--curve-radius-m", type=float, help="rural: a left-hand curve of this radius")
+    p.add_argument("--seed", type=int, default=0, help="seed of the traffic (0)")
+    p.add_argument("--out", type=Path, default=Path("out/scenario"), help="output folder")
+
+
+def cmd_scenario(args: argparse.Namespace) -> int:
+    """Write the scenario; one line with its level as measured."""
+    spec = TrafficSpec(
+        args.road, args.los, args.lanes, args.speed_limit_kmh, args.curve_radius_m, args.seed
+    ).checked()
+    if args.out.exists() and not args.out.is_dir():
+        raise InputError(f"--out {args.out}: not a folder")
+    from eoam_sumo.traffic_levels.build import write_scenario
+
+    cfg = write_scenario(spec, args.out)
+    measured = json.loads((args.out / "scenario.json").read_text(encoding="utf-8"))["measured"]
+    print(
+        f"{spec.road} LoS {spec.los}: measured {measured['measure']} = {measured['value']:g} "
+        f"(level {measured['level']}) -> {cfg}"
+    )
+    return 0
