@@ -73,8 +73,9 @@ class Command(NamedTuple):
 
 
 class NextLaneView:
-    """What the sensors know of the lane left of the ego's original lane (road frame of that
-    lane; distances along the road from the ego's front bumper, or from its rear behind it).
+    """What the sensors know of a lane beside the ego's original lane, the target of a lane
+    change (road frame of the original lane; distances along the road from the ego's front
+    bumper, or from its rear behind it).
 
     The covered length is worked out only when read (``coverage`` a function returning it):
     the policy needs it at a commit, and its geometry is the costly part."""
@@ -82,11 +83,15 @@ class NextLaneView:
     __slots__ = (
         "_coverage",
         "_coverage_m",
+        "ahead",
+        "coverage_behind_m",
+        "lane_width_m",
         "nearest_ahead_m",
         "nearest_ahead_speed_mps",
         "nearest_behind_m",
         "nearest_behind_speed_mps",
         "opposing",
+        "side",
         "speed_limit_mps",
     )
 
@@ -101,6 +106,10 @@ class NextLaneView:
         nearest_ahead_speed_mps: float | None = None,
         nearest_behind_m: float | None = None,
         nearest_behind_speed_mps: float | None = None,
+        ahead: tuple[tuple[float, float], ...] | None = None,
+        coverage_behind_m: float | None = None,
+        side: int = 1,
+        lane_width_m: float = 0.0,
     ):
         self.opposing = opposing  # the lane carries opposing traffic
         self.speed_limit_mps = speed_limit_mps  # its speed limit (net file)
@@ -110,6 +119,10 @@ class NextLaneView:
         self.nearest_ahead_speed_mps = nearest_ahead_speed_mps  # its road speed (< 0: towards)
         self.nearest_behind_m = nearest_behind_m  # gap to the nearest road user in it behind
         self.nearest_behind_speed_mps = nearest_behind_speed_mps
+        self.ahead = ahead  # (gap, road speed) of every road user in it ahead, nearest first
+        self.coverage_behind_m = coverage_behind_m  # length behind the rear seen (None: unknown)
+        self.side = side  # +1: the lane left of the ego's, -1: the lane right of it
+        self.lane_width_m = lane_width_m  # its width (0: as the ego's lane)
 
     @property
     def coverage_ahead_m(self) -> float:
@@ -123,3 +136,11 @@ class NextLaneView:
         """Covered and empty: the covered length or the gap to the nearest road user ahead."""
         cover = self.coverage_ahead_m
         return cover if self.nearest_ahead_m is None else min(cover, self.nearest_ahead_m)
+
+    def users_ahead(self) -> tuple[tuple[float, float], ...]:
+        """(gap, road speed) of the road users ahead in the lane, nearest first."""
+        if self.ahead is not None:
+            return self.ahead
+        if self.nearest_ahead_m is None:
+            return ()
+        return ((self.nearest_ahead_m, self.nearest_ahead_speed_mps or 0.0),)

@@ -158,10 +158,13 @@ class NextLaneSensing:
             self.opposing,
             self.speed_limit_mps,
             coverage=coverage,
-            nearest_ahead_m=None if ahead is None else ahead[0],
-            nearest_ahead_speed_mps=None if ahead is None else ahead[1],
+            nearest_ahead_m=ahead[0][0] if ahead else None,
+            nearest_ahead_speed_mps=ahead[0][1] if ahead else None,
             nearest_behind_m=None if behind is None else behind[0],
             nearest_behind_speed_mps=None if behind is None else behind[1],
+            ahead=tuple(ahead),
+            coverage_behind_m=max(self.corner.range_m, self._v2x_free_m),
+            lane_width_m=w,
         )
 
     # ----------------------------------------------------------------------------- parts
@@ -203,21 +206,21 @@ class NextLaneSensing:
 
     def _nearest(
         self, objects: list, s_f: float
-    ) -> tuple[tuple[float, float] | None, tuple[float, float] | None]:
-        """(gap, road speed) of the nearest road user ahead (overlapping the ego's length
-        counts as ahead, gap 0) and of the nearest behind the ego's rear; None: none."""
-        ahead: tuple[float, float] | None = None
+    ) -> tuple[list[tuple[float, float]], tuple[float, float] | None]:
+        """(gap, road speed) of every road user ahead, nearest first (overlapping the ego's
+        length counts as ahead, gap 0), and of the nearest behind the ego's rear (None:
+        none)."""
+        ahead: list[tuple[float, float]] = []
         behind: tuple[float, float] | None = None
         s_rear = s_f - self.ego_length_m
         for s, _d, v, length, _width in objects:
             if s - 0.5 * length >= s_f - 1e-9 or s + 0.5 * length >= s_rear:
-                gap = max(s - 0.5 * length - s_f, 0.0)
-                if ahead is None or gap < ahead[0]:
-                    ahead = (gap, v)
+                ahead.append((max(s - 0.5 * length - s_f, 0.0), v))
             else:
                 gap = s_rear - (s + 0.5 * length)
                 if behind is None or gap < behind[0]:
                     behind = (gap, v)
+        ahead.sort()
         return ahead, behind
 
     @staticmethod

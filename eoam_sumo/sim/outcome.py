@@ -194,13 +194,17 @@ class Outcome:
     reason: str
 
 
+#: Why mode 3 found the next lane closed, unless the decision policy names the cause.
+NEXT_LANE_CLOSED = "oncoming traffic or a standing car"
+
+
 def _manoeuvre_phrase(modes: set[int], lane_change: bool) -> str:
     if lane_change:
         return "lane change"
     if 3 in modes:
         return (
             "limit braking chosen (next lane not free before the point of no return: "
-            "oncoming traffic or a standing car)"
+            f"{NEXT_LANE_CLOSED})"
         )
     if 1 in modes:
         return "limit braking chosen by the DMM"
