@@ -50,6 +50,9 @@ class Perception(NamedTuple):
     coasted_range_m: float | None = None
     coasted_range_rate_mps: float = 0.0
     oncoming_object: ObjectState | None = None  # the nearest oncoming road user, when tracked
+    # what is known of the lane right of the ego's, when it has one its class may use (the
+    # EOAM may then evade right: ``next_lane`` is the left one)
+    right_lane: NextLaneView | None = None
 
 
 class Command(NamedTuple):

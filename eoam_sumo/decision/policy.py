@@ -222,10 +222,13 @@ def sight_needed(
     margin_s: float,
     margin_m: float,
     obstacle_decel_mps2: float = 0.0,
+    offset_m: float | None = None,
 ) -> SightNeed:
     """Passing sight distance of a lane change begun now (module doc): ``gap_m`` from the ego's
     front bumper to the obstacle's rear, the obstacle at ``obstacle_speed_mps`` braking at
-    ``obstacle_decel_mps2`` (its estimate), the ego on its planned speed profile."""
+    ``obstacle_decel_mps2`` (its estimate), the ego on its planned speed profile;
+    ``offset_m`` the target lane's centre from the ego's lane's (None: a lane width)."""
+    travel_m = lane_width_m if offset_m is None else offset_m
     t_lc, v_end = lane_change_time_s(trajectory, speed_mps)
     # ego rear past the obstacle's front: relative travel gap + both lengths + the margin
     to_pass_m = gap_m + obstacle_length_m + ego_length_m + pass_margin_m
@@ -234,10 +237,12 @@ def sight_needed(
     moved = road_user_travel_m(obstacle_speed_mps, -decel, t_lc)
     t_beside = beside_time_s(to_pass_m - (trajectory.length_m - moved), v_end, obstacle_end, decel)
     back = QuinticShift.for_lateral_accel(
-        lane_width_m, 0.0, 0.0, v_end, return_lateral_g * mu * G_MPS2, return_min_length_m
+        travel_m, 0.0, 0.0, v_end, return_lateral_g * mu * G_MPS2, return_min_length_m
     )
     t_out = out_of_lane_time_s(back, lane_width_m, ego_width_m, v_end)
-    t_escape = escape_time_s(0.5 * (lane_width_m + ego_width_m), mu)
+    # from the target lane's centre until the body is out of it (past the ego's lane marker)
+    out_m = 0.5 * (lane_width_m + ego_width_m) + (travel_m - lane_width_m)
+    t_escape = escape_time_s(out_m, mu)
     need = SightNeed(
         math.inf,
         speed_mps + opposing_speed_mps,
@@ -314,7 +319,11 @@ class SafePolicy:
     ) -> SightNeed:
         gap, speed, length = self._obstacle(meas, perception)
         st, p = self.settings, self.params
-        lane_w = view.lane_width_m if view is not None and view.lane_width_m else meas.lane_width_m
+        own_w = meas.lane_width_m
+        target_w = view.lane_width_m if view is not None and view.lane_width_m else own_w
+        lane_w, offset = (
+            (target_w, None) if target_w == own_w else (own_w, 0.5 * (own_w + target_w))
+        )
         return sight_needed(
             speed_mps=meas.vx_mps,
             mu=meas.mu,
@@ -332,18 +341,21 @@ class SafePolicy:
             margin_s=st.margin_s,
             margin_m=st.margin_m,
             obstacle_decel_mps2=obstacle_decel_mps2,
+            offset_m=offset,
         )
 
-    def _behind_reason(self, view: NextLaneView, need: SightNeed, t_s: float) -> str:
-        """A road user behind in the target lane (at its own speed), or one unseen beyond the
-        rear coverage at the speed limit, that could not keep its distance to the ego
-        (:func:`follower_keeps_distance`) within ``t_s``."""
+    def _behind_reason(
+        self, view: NextLaneView, need: SightNeed, t_s: float, unseen: bool = True
+    ) -> str:
+        """A road user behind in the target lane (at its own speed), or (``unseen``) one
+        unseen beyond the rear coverage at the speed limit, that could not keep its distance
+        to the ego (:func:`follower_keeps_distance`) within ``t_s``."""
         gap_m = self.settings.rear_gap_m
         if view.nearest_behind_m is not None:
             v_b = view.nearest_behind_speed_mps or 0.0
             if not follower_keeps_distance(need, view.nearest_behind_m, v_b, t_s, gap_m):
                 return "a road user behind in the target lane would catch the ego up"
-        cover = view.coverage_behind_m
+        cover = view.coverage_behind_m if unseen else None
         v_lim = self._opposing_speed(view)
         if cover is not None and not follower_keeps_distance(need, cover, v_lim, t_s, gap_m):
             return "unseen road behind: a road user at the speed limit could catch the ego up"
@@ -396,6 +408,29 @@ class SafePolicy:
         return self._behind_reason(view, now, t) or self._ahead_reason(view, now, t)
 
     # ----------------------------------------------------------------------------- checks
+    def lane_reason(
+        self,
+        meas,
+        perception,
+        view: NextLaneView | None,
+        obstacle_decel_mps2: float = 0.0,
+        traffic_only: bool = False,
+    ) -> tuple[SightNeed, str]:
+        """The plan of a lane change into ``view``'s lane begun now, and why it may not begin
+        ("": it may; module doc). ``traffic_only``: the road users in the lane alone (the
+        paper's policy choosing a side), not the unseen road."""
+        need = self.sight_need(meas, perception, view, obstacle_decel_mps2)
+        if view is not None and not view.opposing:  # seen as far as it drives in it
+            drive_m = need.ego_travel_m(need.t_lane_change_s + need.t_beside_s)
+            need = need._replace(needed_m=drive_m + need.margin_m)
+        if traffic_only:
+            if view is None or not math.isfinite(need.t_total_s):
+                return need, ""
+            t = need.t_total_s + need.margin_s
+            reason = self._behind_reason(view, need, t, unseen=False)
+            return need, reason or self._ahead_reason(view, need, t)
+        return need, self._commit_reason(meas, view, need)
+
     def blocks(
         self,
         meas,
@@ -409,11 +444,7 @@ class SafePolicy:
         and the return (``manoeuvring``) any road user that would meet the ego in it."""
         view = perception.next_lane
         if committing:
-            need = self.sight_need(meas, perception, view, obstacle_decel_mps2)
-            if view is not None and not view.opposing:  # seen as far as it drives in it
-                drive_m = need.ego_travel_m(need.t_lane_change_s + need.t_beside_s)
-                need = need._replace(needed_m=drive_m + need.margin_m)
-            reason = self._commit_reason(meas, view, need)
+            need, reason = self.lane_reason(meas, perception, view, obstacle_decel_mps2)
             if not self.gate:
                 self.gate = "refused" if reason else "passed"
                 self.known_free_m = view.known_free_ahead_m if view is not None else 0.0

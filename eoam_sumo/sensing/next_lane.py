@@ -101,8 +101,11 @@ class NextLaneSensing:
         v2x: V2XSettings | None = None,
         corner: CornerRadarSettings | None = None,
         fastest_mps: float | None = None,
+        side: int = 1,
+        target_width_m: float | None = None,
     ):
         self.opposing = opposing
+        self.side = 1 if side >= 0 else -1  # +1: the lane left of the ego's, -1: right of it
         self.speed_limit_mps = speed_limit_mps
         self.lane_width_m = lane_width_m
         self.radar_range_m = radar_range_m
@@ -114,7 +117,15 @@ class NextLaneSensing:
         fastest = speed_limit_mps if fastest_mps is None else fastest_mps
         self._v2x_free_m = v2x.range_m - fastest * v2x.blind_time_s() if v2x.covers_all else 0.0
         w = lane_width_m
-        self.lines_m = (0.5 * w + LINE_INSET_M, w, 1.5 * w - LINE_INSET_M)
+        wt = self.target_width_m = w if target_width_m is None else target_width_m
+        inner, outer = 0.5 * w, (1.5 * w if wt == w else 0.5 * w + wt)
+        centre = w if wt == w else 0.5 * (inner + outer)
+        sgn = self.side
+        # the lane's band in the ego's road frame (d_lo, d_hi) and its three coverage lines
+        self.band_m = (inner, outer) if sgn > 0 else (-outer, -inner)
+        self.lines_m = tuple(
+            sgn * line for line in (inner + LINE_INSET_M, centre, outer - LINE_INSET_M)
+        )
         self._standing: dict[tuple[float, float], tuple[float, float, float]] = {}
 
     @property
@@ -138,8 +149,7 @@ class NextLaneSensing:
         ``bodies`` the ground truth of the road users around (for the corner radars and V2X),
         ``road`` the original lane's frame (``project(x, y) -> (s, d, road_yaw)``)."""
         s_f = road.project(*front_xy)[0]
-        w = self.lane_width_m
-        lane_lo, lane_hi = 0.5 * w, 1.5 * w
+        lane_lo, lane_hi = self.band_m
         in_path = report.in_path
         objects, shadows = self._radar_objects(report, lane_lo, lane_hi)
         objects += self._corner_objects(
@@ -164,7 +174,8 @@ class NextLaneSensing:
             nearest_behind_speed_mps=None if behind is None else behind[1],
             ahead=tuple(ahead),
             coverage_behind_m=max(self.corner.range_m, self._v2x_free_m),
-            lane_width_m=w,
+            side=self.side,
+            lane_width_m=self.target_width_m,
         )
 
     # ----------------------------------------------------------------------------- parts
@@ -284,13 +295,15 @@ class NextLaneSensing:
         return hit
 
     def _sensors(self, front_xy, yaw_rad: float) -> tuple[Sensor, Sensor, Sensor]:
-        """(x, y, look, half field of view, range) of the forward and the two corner radars."""
+        """(x, y, look, half field of view, range) of the forward and the two corner radars
+        (on the lane's side: front-left and rear-left for the left lane)."""
         c = self.corner
         cy, sy = math.cos(yaw_rad), math.sin(yaw_rad)
-        half_w = 0.5 * self.ego_width_m
-        fx, fy = front_xy[0] - half_w * sy, front_xy[1] + half_w * cy  # front-left corner
-        rx, ry = fx - self.ego_length_m * cy, fy - self.ego_length_m * sy  # rear-left corner
-        half, bore = math.radians(0.5 * c.fov_deg), math.radians(c.boresight_deg)
+        half_w = 0.5 * self.ego_width_m * self.side
+        fx, fy = front_xy[0] - half_w * sy, front_xy[1] + half_w * cy  # front corner
+        rx, ry = fx - self.ego_length_m * cy, fy - self.ego_length_m * sy  # rear corner
+        half = math.radians(0.5 * c.fov_deg)
+        bore = math.radians(c.boresight_deg) * self.side
         return (
             (front_xy[0], front_xy[1], yaw_rad, self._radar_half_fov, self.radar_range_m),
             (fx, fy, yaw_rad + bore, half, c.range_m),

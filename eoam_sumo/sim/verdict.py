@@ -48,6 +48,7 @@ def outcome_of(facts: RunFacts) -> Outcome:
         min_offset_m=facts.min_offset_m,
         max_offset_m=facts.max_offset_m,
         left_width_m=left_width_m(facts),
+        right_width_m=facts.right_width_m,
         direct_overlap=severity.direct_overlap if severity else 1.0,
         cut_off=CUT_OFF.get(facts.end_cause),
         manoeuvre_running=facts.manoeuvre_running,
@@ -136,7 +137,11 @@ def _motion_fields(facts: RunFacts) -> dict[str, Any]:
         "min_speed_mps": rounded(facts.min_speed_mps),
         "max_abs_heading_error_rad": rounded(facts.max_abs_heading_error_rad),
         "left_road": left_road(
-            facts.min_offset_m, facts.max_offset_m, facts.lane_width_m, left_width_m(facts)
+            facts.min_offset_m,
+            facts.max_offset_m,
+            facts.lane_width_m,
+            left_width_m(facts),
+            right_width_m=facts.right_width_m,
         ),
         "ego_initial_speed_mps": rounded(facts.ego_initial_speed_mps),
         "lane_width_m": rounded(facts.lane_width_m),

@@ -1,4 +1,4 @@
-"""The EOAM on a 3-lane one-way motorway at 130 km/h (issue 29), real SUMO runs: a car 20 m
+"""The EOAM on a 3-lane one-way motorway at 130 km/h, real SUMO runs: a car 20 m
 ahead brakes at 10 m/s^2; the safe policy passes it when the left lane is known free, and
 keeps out of the way of a faster car coming up the left lane from behind."""
 
@@ -78,9 +78,10 @@ def test_the_safe_policy_passes_a_car_braking_hard_20_m_ahead(tmp_path, v2x_m):
 
 
 def test_a_faster_car_coming_up_the_left_lane_is_never_touched_and_named(tmp_path):
-    # its front 11 m behind the ego's rear, at 40 m/s
-    behind = car("fast", 2, 100.0 - 4.92 - 11.0, 40.0)
-    cfg = motorway(tmp_path / "road", others=behind)
+    # its front 11 m behind the ego's rear, at 40 m/s; the ego in the right lane (no lane on
+    # its right to evade into)
+    behind = car("fast", 1, 100.0 - 4.92 - 11.0, 40.0)
+    cfg = motorway(tmp_path / "road", ego_lane=0, others=behind)
     for v2x_m in (0.0, 1000.0):
         safe, _ = run(cfg, tmp_path / f"safe{v2x_m:g}", "safe", v2x_m)
         assert safe["collision_with"] in ("none", "aro"), safe["reason"]
@@ -88,3 +89,22 @@ def test_a_faster_car_coming_up_the_left_lane_is_never_touched_and_named(tmp_pat
         # the ego braking in mode 1, the car has come alongside by the commit
         assert "a road user beside the ego in the target lane" in safe["reason"]
         assert "oncoming" not in safe["reason"]
+
+
+LEFT_CARS = {
+    "alongside": car("left", 2, 100.0, SPEED_MPS),  # its front beside the ego's, as fast
+    "coming up": car("left", 2, 100.0 - 4.92 - 11.0, 40.0),  # 11 m behind, faster
+}
+
+
+@pytest.mark.parametrize("left", sorted(LEFT_CARS))
+@pytest.mark.parametrize(("policy", "v2x_m"), [("paper", 0.0), ("safe", 0.0), ("safe", 1000.0)])
+def test_with_the_left_lane_taken_the_eoam_evades_right_and_passes(tmp_path, policy, v2x_m, left):
+    cfg = motorway(tmp_path / "road", others=LEFT_CARS[left])
+    summary, ts = run(cfg, tmp_path / policy, policy, v2x_m)
+    assert summary["collision_with"] == "none", summary["reason"]
+    assert summary["outcome"] == "green", summary["reason"]
+    assert 2 in summary["modes_visited"] and 3 not in summary["modes_visited"]
+    assert ts["lateral_offset_m"].min() < -2.5  # into the right lane and past
+    assert ts["lateral_offset_m"].max() < 0.5  # never towards the car on the left
+    assert not summary["left_road"]
