@@ -23,13 +23,13 @@ NODES = '<nodes><node id="a" x="0" y="0"/><node id="b" x="3000" y="0"/></nodes>'
 EDGES = '<edges><edge id="mw" from="a" to="b" numLanes="3" speed="36.12" width="3.5"/></edges>'
 
 
-def motorway(folder: Path, ego_lane: int = 1, others: str = "") -> Path:
+def motorway(folder: Path, ego_lane: int = 1, others: str = "", edges: str = EDGES) -> Path:
     """The motorway (built by netbuild), the ego at 130 km/h in lane ``ego_lane``, 100 m from
     the start; the ARO 20 m ahead at the same speed, braking at 10 m/s^2 after 0.5 s;
     ``others``: more vehicles (route ``r``)."""
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "m.nod.xml").write_text(NODES)
-    (folder / "m.edg.xml").write_text(EDGES)
+    (folder / "m.edg.xml").write_text(edges)
     netbuild.build_network(folder / "m.nod.xml")
     v = f"{SPEED_MPS:.4f}"
     (folder / "r.rou.xml").write_text(
@@ -108,3 +108,14 @@ def test_with_the_left_lane_taken_the_eoam_evades_right_and_passes(tmp_path, pol
     assert ts["lateral_offset_m"].min() < -2.5  # into the right lane and past
     assert ts["lateral_offset_m"].max() < 0.5  # never towards the car on the left
     assert not summary["left_road"]
+
+
+def test_a_right_lane_the_ego_may_not_use_is_never_chosen(tmp_path):
+    closed = EDGES.replace(
+        'width="3.5"/>', 'width="3.5"><lane index="0" disallow="passenger"/></edge>'
+    )
+    cfg = motorway(tmp_path / "road", others=LEFT_CARS["alongside"], edges=closed)
+    summary, ts = run(cfg, tmp_path / "safe", "safe", 1000.0)
+    assert ts["lateral_offset_m"].min() > -0.5  # not into the right lane
+    assert summary["sight_gate"] == "refused"
+    assert "a road user" in summary["reason"] and "in the target lane" in summary["reason"]
