@@ -86,11 +86,13 @@ class NextLaneView:
     __slots__ = (
         "_coverage",
         "_coverage_m",
+        "accel_ahead_mps2",
         "ahead",
         "coverage_behind_m",
         "lane_width_m",
         "nearest_ahead_m",
         "nearest_ahead_speed_mps",
+        "nearest_behind_accel_mps2",
         "nearest_behind_m",
         "nearest_behind_speed_mps",
         "opposing",
@@ -113,6 +115,8 @@ class NextLaneView:
         coverage_behind_m: float | None = None,
         side: int = 1,
         lane_width_m: float = 0.0,
+        accel_ahead_mps2: tuple[float, ...] | None = None,
+        nearest_behind_accel_mps2: float = 0.0,
     ):
         self.opposing = opposing  # the lane carries opposing traffic
         self.speed_limit_mps = speed_limit_mps  # its speed limit (net file)
@@ -126,6 +130,10 @@ class NextLaneView:
         self.coverage_behind_m = coverage_behind_m  # length behind the rear seen (None: unknown)
         self.side = side  # +1: the lane left of the ego's, -1: the lane right of it
         self.lane_width_m = lane_width_m  # its width (0: as the ego's lane)
+        # the road users' accelerations along the road where known (0: taken as constant
+        # speed): of each one in ``ahead``, in its order, and of the nearest behind
+        self.accel_ahead_mps2 = accel_ahead_mps2
+        self.nearest_behind_accel_mps2 = nearest_behind_accel_mps2
 
     @property
     def coverage_ahead_m(self) -> float:
@@ -147,3 +155,12 @@ class NextLaneView:
         if self.nearest_ahead_m is None:
             return ()
         return ((self.nearest_ahead_m, self.nearest_ahead_speed_mps or 0.0),)
+
+    def users_ahead_accel(self) -> tuple[tuple[float, float, float], ...]:
+        """(gap, road speed, acceleration along the road; 0 where unknown) of the road users
+        ahead in the lane, nearest first."""
+        users = self.users_ahead()
+        accel = self.accel_ahead_mps2
+        if accel is None or len(accel) != len(users):
+            return tuple((gap, speed, 0.0) for gap, speed in users)
+        return tuple((gap, speed, a) for (gap, speed), a in zip(users, accel))

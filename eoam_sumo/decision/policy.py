@@ -48,9 +48,11 @@ from eoam_sumo.params import G_MPS2
 
 POLICIES = ("paper", "safe")
 ONCOMING_MPS = 0.5  # a road user moving towards the ego faster than this is oncoming [m/s]
-#: A road user behind in the target lane (UN Regulation No. 157, ALKS, para. 5.2.6.2): it
-#: may brake at 3 m/s^2 from 0.4 s after the lane change begins; it keeps 1 s of its own
-#: travel as the gap.
+#: A road user behind in the target lane: it may brake at 3 m/s^2 from 0.4 s after the lane
+#: change begins, and keeps 1 s of its own travel as the gap. The project's
+#: assumption, modelled on the "critical situation" of a lane change in UN Regulation No. 79
+#: (ACSF of Category C, para. 5.6.4.7) as recalled; the values were not found in the text
+#: of R79 or of UN R157 (ALKS), and are not cited as either's (docs/policy.md).
 FOLLOWER_REACTION_S = 0.4
 FOLLOWER_DECEL_MPS2 = 3.0
 FOLLOWER_HEADWAY_S = 1.0
@@ -182,13 +184,19 @@ def remaining_plan(need: SightNeed, elapsed_s: float) -> SightNeed:
 
 
 def follower_keeps_distance(
-    need: SightNeed, gap_m: float, speed_mps: float, t_s: float, min_gap_m: float
+    need: SightNeed,
+    gap_m: float,
+    speed_mps: float,
+    t_s: float,
+    min_gap_m: float,
+    accel_mps2: float = 0.0,
 ) -> bool:
     """A road user ``gap_m`` behind the ego's rear in the target lane at ``speed_mps`` keeps
     its distance while the ego drives its planned profile for ``t_s``: it may brake at
-    ``FOLLOWER_DECEL_MPS2`` from ``FOLLOWER_REACTION_S`` after the lane change begins (UN
-    Regulation No. 157, ALKS, lane change, para. 5.2.6.2), and the gap stays at least its
-    own ``FOLLOWER_HEADWAY_S`` of travel (and ``min_gap_m``)."""
+    ``FOLLOWER_DECEL_MPS2`` from ``FOLLOWER_REACTION_S`` after the lane change begins, and
+    the gap stays at least its own ``FOLLOWER_HEADWAY_S`` of travel (and ``min_gap_m``): the
+    project's assumption (see ``FOLLOWER_REACTION_S``). Until it reacts it keeps its own
+    ``accel_mps2`` (where known; 0: its speed)."""
     t, step = 0.0, 0.05
     ego_x, x_b, v_b = 0.0, 0.0, speed_mps
     v0 = need.lane_change_m / need.t_lane_change_s if need.t_lane_change_s > 0.0 else 0.0
@@ -196,6 +204,8 @@ def follower_keeps_distance(
         v_e = v0 if t < need.t_lane_change_s else need.end_speed_mps
         if t >= FOLLOWER_REACTION_S:
             v_b = max(v_b - FOLLOWER_DECEL_MPS2 * step, min(v_e, v_b))
+        elif accel_mps2 != 0.0:
+            v_b = max(v_b + accel_mps2 * step, 0.0)
         ego_x += v_e * step
         x_b += v_b * step
         t += step
@@ -353,7 +363,8 @@ class SafePolicy:
         gap_m = self.settings.rear_gap_m
         if view.nearest_behind_m is not None:
             v_b = view.nearest_behind_speed_mps or 0.0
-            if not follower_keeps_distance(need, view.nearest_behind_m, v_b, t_s, gap_m):
+            a_b = view.nearest_behind_accel_mps2
+            if not follower_keeps_distance(need, view.nearest_behind_m, v_b, t_s, gap_m, a_b):
                 return "a road user behind in the target lane would catch the ego up"
         cover = view.coverage_behind_m if unseen else None
         v_lim = self._opposing_speed(view)
@@ -367,11 +378,11 @@ class SafePolicy:
         beside the ego always closes the lane."""
         margin = self.settings.margin_m
         times = (0.0, min(need.t_lane_change_s, t_s), t_s)
-        for gap, speed in view.users_ahead():
+        for gap, speed, accel in view.users_ahead_accel():
             if gap <= 0.0:
                 return "a road user beside the ego in the target lane"
             if any(
-                gap + road_user_travel_m(speed, 0.0, t) - need.ego_travel_m(t) <= margin
+                gap + road_user_travel_m(speed, accel, t) - need.ego_travel_m(t) <= margin
                 for t in times
             ):
                 if speed < -ONCOMING_MPS:

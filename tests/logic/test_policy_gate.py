@@ -14,6 +14,7 @@ from eoam_sumo.decision.policy import (
     beside_time_s,
     braking_impact_speed_mps,
     escape_time_s,
+    follower_keeps_distance,
     lane_change_time_s,
     road_user_travel_m,
     sight_needed,
@@ -263,3 +264,32 @@ def test_mode_3_in_lane_keeps_braking_while_it_corrects_an_offset(tables):
     assert braking
     limit = ctrl.state.friction_now().brake_limit_n
     assert min(braking) >= floor * limit - 1e-6
+
+
+def test_a_car_ahead_in_the_target_lane_braking_hard_closes_it_at_constant_speed_it_does_not(
+    tables,
+):
+    meas = _meas()
+    need = _policy(tables).sight_need(meas, _seen(None), _view(0.0))
+    t = need.t_total_s + need.margin_s
+    # just far enough ahead, as fast as the ego will be, not to be caught up at its speed
+    margin = _policy(tables).settings.margin_m
+    gap = max(need.ego_travel_m(x) - 30.0 * x for x in (0.0, need.t_lane_change_s, t)) + margin + 5
+    steady = NextLaneView(False, 36.0, coverage_ahead_m=5000.0, ahead=((gap, 30.0),))
+    braking = NextLaneView(
+        False, 36.0, coverage_ahead_m=5000.0, ahead=((gap, 30.0),), accel_ahead_mps2=(-8.0,)
+    )
+    pol = _policy(tables)
+    assert not pol.blocks(meas, _seen(steady), True, False), pol.reason
+    pol = _policy(tables)
+    assert pol.blocks(meas, _seen(braking), True, False)
+    assert pol.reason == "a road user ahead in the target lane"
+
+
+def test_a_follower_accelerating_until_it_reacts_needs_a_larger_gap(tables):
+    need = _policy(tables).sight_need(_meas(), _seen(None), _view(0.0))
+    t = need.t_total_s + need.margin_s
+    gaps = [g * 0.5 for g in range(200)]
+    steady = next(g for g in gaps if follower_keeps_distance(need, g, 32.0, t, 2.0))
+    pushing = next(g for g in gaps if follower_keeps_distance(need, g, 32.0, t, 2.0, 3.0))
+    assert pushing > steady

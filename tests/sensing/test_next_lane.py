@@ -185,3 +185,16 @@ def test_a_wider_right_lane_reaches_further_out():
     view = _view(sensing, [van])
     assert view.nearest_ahead_m == pytest.approx(60.0)
     assert view.lane_width_m == 4.0
+
+
+def test_a_road_users_acceleration_is_its_speed_change_over_the_baseline():
+    sensing = _sensing()
+    speeds = [30.0 - 4.0 * 0.1 * k for k in range(8)]  # braking at 4 m/s^2, every 0.1 s
+    x = 60.0
+    views = []
+    for k, v in enumerate(speeds):
+        car = Body("c", x, LANE, 0.0, v, 4.7, 1.8)
+        views.append(_view(sensing, [car], t=0.1 * k))
+        x += v * 0.1
+    assert views[0].users_ahead_accel()[0][2] == 0.0  # not followed long enough yet
+    assert views[-1].users_ahead_accel()[0][2] == pytest.approx(-4.0)
