@@ -50,6 +50,9 @@ class Perception(NamedTuple):
     coasted_range_m: float | None = None
     coasted_range_rate_mps: float = 0.0
     oncoming_object: ObjectState | None = None  # the nearest oncoming road user, when tracked
+    # what is known of the lane right of the ego's, when it has one its class may use (the
+    # EOAM may then evade right: ``next_lane`` is the left one)
+    right_lane: NextLaneView | None = None
 
 
 class Command(NamedTuple):
@@ -73,8 +76,9 @@ class Command(NamedTuple):
 
 
 class NextLaneView:
-    """What the sensors know of the lane left of the ego's original lane (road frame of that
-    lane; distances along the road from the ego's front bumper, or from its rear behind it).
+    """What the sensors know of a lane beside the ego's original lane, the target of a lane
+    change (road frame of the original lane; distances along the road from the ego's front
+    bumper, or from its rear behind it).
 
     The covered length is worked out only when read (``coverage`` a function returning it):
     the policy needs it at a commit, and its geometry is the costly part."""
@@ -82,11 +86,17 @@ class NextLaneView:
     __slots__ = (
         "_coverage",
         "_coverage_m",
+        "accel_ahead_mps2",
+        "ahead",
+        "coverage_behind_m",
+        "lane_width_m",
         "nearest_ahead_m",
         "nearest_ahead_speed_mps",
+        "nearest_behind_accel_mps2",
         "nearest_behind_m",
         "nearest_behind_speed_mps",
         "opposing",
+        "side",
         "speed_limit_mps",
     )
 
@@ -101,6 +111,12 @@ class NextLaneView:
         nearest_ahead_speed_mps: float | None = None,
         nearest_behind_m: float | None = None,
         nearest_behind_speed_mps: float | None = None,
+        ahead: tuple[tuple[float, float], ...] | None = None,
+        coverage_behind_m: float | None = None,
+        side: int = 1,
+        lane_width_m: float = 0.0,
+        accel_ahead_mps2: tuple[float, ...] | None = None,
+        nearest_behind_accel_mps2: float = 0.0,
     ):
         self.opposing = opposing  # the lane carries opposing traffic
         self.speed_limit_mps = speed_limit_mps  # its speed limit (net file)
@@ -110,6 +126,14 @@ class NextLaneView:
         self.nearest_ahead_speed_mps = nearest_ahead_speed_mps  # its road speed (< 0: towards)
         self.nearest_behind_m = nearest_behind_m  # gap to the nearest road user in it behind
         self.nearest_behind_speed_mps = nearest_behind_speed_mps
+        self.ahead = ahead  # (gap, road speed) of every road user in it ahead, nearest first
+        self.coverage_behind_m = coverage_behind_m  # length behind the rear seen (None: unknown)
+        self.side = side  # +1: the lane left of the ego's, -1: the lane right of it
+        self.lane_width_m = lane_width_m  # its width (0: as the ego's lane)
+        # the road users' accelerations along the road where known (0: taken as constant
+        # speed): of each one in ``ahead``, in its order, and of the nearest behind
+        self.accel_ahead_mps2 = accel_ahead_mps2
+        self.nearest_behind_accel_mps2 = nearest_behind_accel_mps2
 
     @property
     def coverage_ahead_m(self) -> float:
@@ -123,3 +147,20 @@ class NextLaneView:
         """Covered and empty: the covered length or the gap to the nearest road user ahead."""
         cover = self.coverage_ahead_m
         return cover if self.nearest_ahead_m is None else min(cover, self.nearest_ahead_m)
+
+    def users_ahead(self) -> tuple[tuple[float, float], ...]:
+        """(gap, road speed) of the road users ahead in the lane, nearest first."""
+        if self.ahead is not None:
+            return self.ahead
+        if self.nearest_ahead_m is None:
+            return ()
+        return ((self.nearest_ahead_m, self.nearest_ahead_speed_mps or 0.0),)
+
+    def users_ahead_accel(self) -> tuple[tuple[float, float, float], ...]:
+        """(gap, road speed, acceleration along the road; 0 where unknown) of the road users
+        ahead in the lane, nearest first."""
+        users = self.users_ahead()
+        accel = self.accel_ahead_mps2
+        if accel is None or len(accel) != len(users):
+            return tuple((gap, speed, 0.0) for gap, speed in users)
+        return tuple((gap, speed, a) for (gap, speed), a in zip(users, accel))

@@ -30,6 +30,9 @@ class EoamSettings:
     # plus this brakes (a standstill gap, as adaptive cruise keeps)
     min_steer_speed_mps: float = 20.0 / 3.6  # below it a STEER sector brakes instead
     limit_brake_fraction: float = 0.95  # share of the no-lock brake force used as limit braking
+    limit_brake_floor: float = 0.5  # mode 3 (not arresting): the brake keeps at least this share
+    # of the limit, the steering the rest of the friction ellipse (eqs. 25, 28); 0: none
+    limit_brake_floor_speed_mps: float = 2.0  # ... above walking speed
     reference_step_m: float = 0.25  # dx spacing of the sampled manoeuvre reference
     return_when_stable: bool = True  # ... heading within settle_heading_rad and clear of the
     # obstacle: 2 -> 5 before the timer (False: the timer alone, as in the paper's runs)

@@ -255,6 +255,14 @@ class SteeringController:
         """Steady-state lateral acceleration v^2 delta / (L + K_us v^2) a steer angle asks for."""
         return speed_mps * speed_mps * steer_rad / (self._L + self._kus * speed_mps * speed_mps)
 
+    def steer_for_lateral_accel(self, speed_mps: float, lateral_accel_mps2: float) -> float:
+        """The steady-state steer angle asking for ``lateral_accel_mps2`` (the inverse of
+        :meth:`lateral_accel`; the lock when standing)."""
+        v2 = speed_mps * speed_mps
+        if v2 <= 1e-9:
+            return self._max
+        return lateral_accel_mps2 * (self._L + self._kus * v2) / v2
+
     def command(
         self,
         speed_mps: float,

@@ -47,6 +47,15 @@ from eoam_sumo.manoeuvre.quintic_shift import QuinticShift
 from eoam_sumo.params import G_MPS2
 
 POLICIES = ("paper", "safe")
+ONCOMING_MPS = 0.5  # a road user moving towards the ego faster than this is oncoming [m/s]
+#: A road user behind in the target lane: it may brake at 3 m/s^2 from 0.4 s after the lane
+#: change begins, and keeps 1 s of its own travel as the gap. The project's
+#: assumption, modelled on the "critical situation" of a lane change in UN Regulation No. 79
+#: (ACSF of Category C, para. 5.6.4.7) as recalled; the values were not found in the text
+#: of R79 or of UN R157 (ALKS), and are not cited as either's (docs/policy.md).
+FOLLOWER_REACTION_S = 0.4
+FOLLOWER_DECEL_MPS2 = 3.0
+FOLLOWER_HEADWAY_S = 1.0
 
 
 @mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
@@ -75,18 +84,29 @@ class PolicySettings:
 class SightNeed(NamedTuple):
     """The passing sight distance of one lane change and its terms."""
 
-    needed_m: float
+    needed_m: float  # unseen road ahead must be covered this far (module doc)
     closing_speed_mps: float  # v_ego + v_opposing_max
     t_lane_change_s: float
     t_beside_s: float  # inf: the ego never gets past (the obstacle is as fast)
-    t_return_s: float
-    t_escape_s: float
+    t_return_s: float  # the return until the ego's body has left the target lane
+    t_escape_s: float  # leaving the target lane from its centre at the limit (not added)
     margin_s: float
     margin_m: float
+    lane_change_m: float = 0.0  # length of the table lane change
+    end_speed_mps: float = 0.0  # the ego's speed at its end, held until it is back
 
     @property
     def t_total_s(self) -> float:
+        """Time from the commit until the ego's body has left the target lane."""
         return self.t_lane_change_s + self.t_beside_s + self.t_return_s
+
+    def ego_travel_m(self, t_s: float) -> float:
+        """Distance the ego drives in ``t_s`` on its planned speed profile: the table lane
+        change (at its mean speed), then the speed at its end held."""
+        t_lc = self.t_lane_change_s
+        if t_s <= t_lc:
+            return self.lane_change_m * t_s / t_lc if t_lc > 0.0 else 0.0
+        return self.lane_change_m + self.end_speed_mps * (t_s - t_lc)
 
 
 def escape_time_s(lateral_m: float, mu: float) -> float:
@@ -109,6 +129,91 @@ def lane_change_time_s(trajectory, speed_mps: float, step_m: float = 1.0) -> tup
     return t, v
 
 
+def road_user_travel_m(speed_mps: float, accel_mps2: float, t_s: float) -> float:
+    """Distance along the road a road user covers in ``t_s`` at constant acceleration, a
+    braking one (acceleration against its speed) until it stands."""
+    if speed_mps * accel_mps2 < 0.0:
+        t_stop = -speed_mps / accel_mps2
+        if t_s >= t_stop:
+            return 0.5 * speed_mps * t_stop
+    return speed_mps * t_s + 0.5 * accel_mps2 * t_s * t_s
+
+
+def beside_time_s(left_m: float, ego_mps: float, obstacle_mps: float, decel_mps2: float) -> float:
+    """Time for the ego at constant ``ego_mps`` to gain ``left_m`` on an obstacle at
+    ``obstacle_mps`` braking at ``decel_mps2`` to a stop (inf: never)."""
+    if left_m <= 0.0:
+        return 0.0
+    rel = ego_mps - obstacle_mps
+    if decel_mps2 <= 1e-9 or obstacle_mps <= 0.0:
+        return left_m / rel if rel > 1e-6 else math.inf
+    t_stop = obstacle_mps / decel_mps2
+    # 0.5 a t^2 + rel t - left = 0 while it brakes
+    t = (-rel + math.sqrt(rel * rel + 2.0 * decel_mps2 * left_m)) / decel_mps2
+    if t <= t_stop:
+        return t
+    if ego_mps <= 1e-6:
+        return math.inf
+    return (left_m + 0.5 * obstacle_mps * t_stop) / ego_mps
+
+
+def out_of_lane_time_s(back: QuinticShift, lane_width_m: float, ego_width_m: float, v: float):
+    """Time along the return ``back`` (from the target lane's centre to 0, at speed ``v``)
+    until the ego's body has left the target lane: |y| <= (w - ego width) / 2."""
+    inside = 0.5 * (lane_width_m - ego_width_m)
+    lo, hi = 0.0, back.length_m
+    if abs(back.at(hi).y_m) > inside:
+        return hi / max(v, 0.1)
+    for _ in range(40):  # bisection on the monotone shift
+        mid = 0.5 * (lo + hi)
+        if abs(back.at(mid).y_m) > inside:
+            lo = mid
+        else:
+            hi = mid
+    return hi / max(v, 0.1)
+
+
+def remaining_plan(need: SightNeed, elapsed_s: float) -> SightNeed:
+    """The plan of ``need`` from ``elapsed_s`` after its commit on (the same speed profile,
+    so that the checks during the manoeuvre agree with the gate's)."""
+    t_lc = need.t_lane_change_s
+    if elapsed_s < t_lc:
+        left = t_lc - elapsed_s
+        return need._replace(t_lane_change_s=left, lane_change_m=need.lane_change_m * left / t_lc)
+    return need._replace(t_lane_change_s=0.0, lane_change_m=0.0)
+
+
+def follower_keeps_distance(
+    need: SightNeed,
+    gap_m: float,
+    speed_mps: float,
+    t_s: float,
+    min_gap_m: float,
+    accel_mps2: float = 0.0,
+) -> bool:
+    """A road user ``gap_m`` behind the ego's rear in the target lane at ``speed_mps`` keeps
+    its distance while the ego drives its planned profile for ``t_s``: it may brake at
+    ``FOLLOWER_DECEL_MPS2`` from ``FOLLOWER_REACTION_S`` after the lane change begins, and
+    the gap stays at least its own ``FOLLOWER_HEADWAY_S`` of travel (and ``min_gap_m``): the
+    project's assumption (see ``FOLLOWER_REACTION_S``). Until it reacts it keeps its own
+    ``accel_mps2`` (where known; 0: its speed)."""
+    t, step = 0.0, 0.05
+    ego_x, x_b, v_b = 0.0, 0.0, speed_mps
+    v0 = need.lane_change_m / need.t_lane_change_s if need.t_lane_change_s > 0.0 else 0.0
+    while t < t_s:
+        v_e = v0 if t < need.t_lane_change_s else need.end_speed_mps
+        if t >= FOLLOWER_REACTION_S:
+            v_b = max(v_b - FOLLOWER_DECEL_MPS2 * step, min(v_e, v_b))
+        elif accel_mps2 != 0.0:
+            v_b = max(v_b + accel_mps2 * step, 0.0)
+        ego_x += v_e * step
+        x_b += v_b * step
+        t += step
+        if gap_m + ego_x - x_b < max(min_gap_m, v_b * FOLLOWER_HEADWAY_S):
+            return False
+    return True
+
+
 def sight_needed(
     *,
     speed_mps: float,
@@ -126,27 +231,44 @@ def sight_needed(
     return_min_length_m: float,
     margin_s: float,
     margin_m: float,
+    obstacle_decel_mps2: float = 0.0,
+    offset_m: float | None = None,
 ) -> SightNeed:
     """Passing sight distance of a lane change begun now (module doc): ``gap_m`` from the ego's
-    front bumper to the obstacle's rear, the obstacle at ``obstacle_speed_mps``."""
+    front bumper to the obstacle's rear, the obstacle at ``obstacle_speed_mps`` braking at
+    ``obstacle_decel_mps2`` (its estimate), the ego on its planned speed profile;
+    ``offset_m`` the target lane's centre from the ego's lane's (None: a lane width)."""
+    travel_m = lane_width_m if offset_m is None else offset_m
     t_lc, v_end = lane_change_time_s(trajectory, speed_mps)
     # ego rear past the obstacle's front: relative travel gap + both lengths + the margin
     to_pass_m = gap_m + obstacle_length_m + ego_length_m + pass_margin_m
-    left_m = to_pass_m - (trajectory.length_m - obstacle_speed_mps * t_lc)
-    if left_m <= 0.0:
-        t_beside = 0.0
-    elif v_end > obstacle_speed_mps + 1e-6:
-        t_beside = left_m / (v_end - obstacle_speed_mps)
-    else:
-        t_beside = math.inf
+    decel = max(obstacle_decel_mps2, 0.0)
+    obstacle_end = max(obstacle_speed_mps - decel * t_lc, 0.0)
+    moved = road_user_travel_m(obstacle_speed_mps, -decel, t_lc)
+    t_beside = beside_time_s(to_pass_m - (trajectory.length_m - moved), v_end, obstacle_end, decel)
     back = QuinticShift.for_lateral_accel(
-        lane_width_m, 0.0, 0.0, v_end, return_lateral_g * mu * G_MPS2, return_min_length_m
+        travel_m, 0.0, 0.0, v_end, return_lateral_g * mu * G_MPS2, return_min_length_m
     )
-    t_return = back.length_m / max(v_end, 0.1)
-    t_escape = escape_time_s(0.5 * (lane_width_m + ego_width_m), mu)
-    closing = speed_mps + opposing_speed_mps
-    needed = closing * (t_lc + t_beside + t_return + t_escape + margin_s) + margin_m
-    return SightNeed(needed, closing, t_lc, t_beside, t_return, t_escape, margin_s, margin_m)
+    t_out = out_of_lane_time_s(back, lane_width_m, ego_width_m, v_end)
+    # from the target lane's centre until the body is out of it (past the ego's lane marker)
+    out_m = 0.5 * (lane_width_m + ego_width_m) + (travel_m - lane_width_m)
+    t_escape = escape_time_s(out_m, mu)
+    need = SightNeed(
+        math.inf,
+        speed_mps + opposing_speed_mps,
+        t_lc,
+        t_beside,
+        t_out,
+        t_escape,
+        margin_s,
+        margin_m,
+        trajectory.length_m,
+        v_end,
+    )
+    t = need.t_total_s + margin_s
+    if math.isfinite(t):
+        need = need._replace(needed_m=need.ego_travel_m(t) + opposing_speed_mps * t + margin_m)
+    return need
 
 
 def head_on_delta_v_mps(closing_speed_mps: float) -> float:
@@ -181,6 +303,7 @@ class SafePolicy:
         self.need: SightNeed | None = None
         self.known_free_m: float | None = None
         self.gate: str = ""  # "" not asked, "passed", "refused" (at the first commit)
+        self.reason: str = ""  # why the next lane was closed (the first time it was)
         self.tie_break: str = ""  # "" not needed, "continue" or "brake"
         self._commit_s = 0.0
 
@@ -201,9 +324,16 @@ class SafePolicy:
         length = obj.length_m if obj is not None else self.eoam.unknown_obstacle_length_m
         return (gap if gap is not None else 0.0), max(meas.vx_mps - closing, 0.0), length
 
-    def sight_need(self, meas, perception, view: NextLaneView | None) -> SightNeed:
+    def sight_need(
+        self, meas, perception, view: NextLaneView | None, obstacle_decel_mps2: float = 0.0
+    ) -> SightNeed:
         gap, speed, length = self._obstacle(meas, perception)
         st, p = self.settings, self.params
+        own_w = meas.lane_width_m
+        target_w = view.lane_width_m if view is not None and view.lane_width_m else own_w
+        lane_w, offset = (
+            (target_w, None) if target_w == own_w else (own_w, 0.5 * (own_w + target_w))
+        )
         return sight_needed(
             speed_mps=meas.vx_mps,
             mu=meas.mu,
@@ -214,69 +344,133 @@ class SafePolicy:
             obstacle_length_m=length,
             ego_length_m=p.length_m,
             ego_width_m=p.width_m,
-            lane_width_m=meas.lane_width_m,
+            lane_width_m=lane_w,
             pass_margin_m=self.eoam.pass_margin_m,
             return_lateral_g=self.eoam.return_lateral_g,
             return_min_length_m=self.eoam.return_min_length_m,
             margin_s=st.margin_s,
             margin_m=st.margin_m,
+            obstacle_decel_mps2=obstacle_decel_mps2,
+            offset_m=offset,
         )
 
-    def _lane_free(
-        self, view: NextLaneView, speed_mps: float, t_left_s: float, need_m: float, committing: bool
-    ) -> bool:
-        """The next lane is free for ``t_left_s`` more seconds of manoeuvre; at a commit it
-        must be seen ``need_m`` ahead (free of road users too, if it carries opposing
-        traffic). In either kind of lane a road user behind must not catch the ego up (one
-        overtaking in the opposite lane, or a faster car of the own direction)."""
-        st = self.settings
-        t = t_left_s + st.margin_s
+    def _behind_reason(
+        self, view: NextLaneView, need: SightNeed, t_s: float, unseen: bool = True
+    ) -> str:
+        """A road user behind in the target lane (at its own speed), or (``unseen``) one
+        unseen beyond the rear coverage at the speed limit, that could not keep its distance
+        to the ego (:func:`follower_keeps_distance`) within ``t_s``."""
+        gap_m = self.settings.rear_gap_m
         if view.nearest_behind_m is not None:
-            behind_speed = view.nearest_behind_speed_mps or 0.0
-            if view.nearest_behind_m <= max(behind_speed - speed_mps, 0.0) * t + st.rear_gap_m:
-                return False
-        if view.opposing:
-            if committing:
-                return view.known_free_ahead_m >= need_m
-            return view.nearest_ahead_m is None or view.nearest_ahead_m > need_m
-        if view.nearest_ahead_m is not None:  # the ego must not catch it up
-            ahead_speed = view.nearest_ahead_speed_mps or 0.0
-            if view.nearest_ahead_m <= max(speed_mps - ahead_speed, 0.0) * t + st.margin_m:
-                return False
-        # the lane must be seen as far as the ego goes in it before it is past the obstacle
-        return not committing or view.coverage_ahead_m >= need_m
+            v_b = view.nearest_behind_speed_mps or 0.0
+            a_b = view.nearest_behind_accel_mps2
+            if not follower_keeps_distance(need, view.nearest_behind_m, v_b, t_s, gap_m, a_b):
+                return "a road user behind in the target lane would catch the ego up"
+        cover = view.coverage_behind_m if unseen else None
+        v_lim = self._opposing_speed(view)
+        if cover is not None and not follower_keeps_distance(need, cover, v_lim, t_s, gap_m):
+            return "unseen road behind: a road user at the speed limit could catch the ego up"
+        return ""
+
+    def _ahead_reason(self, view: NextLaneView, need: SightNeed, t_s: float) -> str:
+        """A road user ahead in the target lane (at its own speed) that the ego would come
+        within ``margin_m`` of during ``t_s``, or that would reach the ego (oncoming); one
+        beside the ego always closes the lane."""
+        margin = self.settings.margin_m
+        times = (0.0, min(need.t_lane_change_s, t_s), t_s)
+        for gap, speed, accel in view.users_ahead_accel():
+            if gap <= 0.0:
+                return "a road user beside the ego in the target lane"
+            if any(
+                gap + road_user_travel_m(speed, accel, t) - need.ego_travel_m(t) <= margin
+                for t in times
+            ):
+                if speed < -ONCOMING_MPS:
+                    return "an oncoming road user in the target lane"
+                return "a road user ahead in the target lane"
+        return ""
+
+    def _commit_reason(self, meas, view: NextLaneView | None, need: SightNeed) -> str:
+        """Why the lane change may not begin now ("" : it may): module doc."""
+        if not math.isfinite(need.t_total_s):
+            return "the obstacle would never be passed"
+        if view is None:
+            return "nothing is known of the target lane"
+        t = need.t_total_s + need.margin_s
+        reason = self._behind_reason(view, need, t) or self._ahead_reason(view, need, t)
+        if reason:
+            return reason
+        if view.coverage_ahead_m < need.needed_m:
+            return "unseen road ahead in the target lane"
+        return ""
+
+    def _watch_reason(self, meas, view: NextLaneView) -> str:
+        """During the lane change and the return: a road user that would meet the ego before
+        its body has left the target lane (the time left on the plan, at least the escape
+        from where it is now)."""
+        need = self.need
+        if need is None:
+            return ""
+        elapsed = meas.time_s - self._commit_s
+        t_left = max(need.t_total_s - elapsed, 0.0)
+        into_m = abs(meas.d_m) + 0.5 * (self.params.width_m - meas.lane_width_m)
+        t = max(t_left, escape_time_s(into_m, meas.mu)) + need.margin_s
+        now = remaining_plan(need, elapsed)
+        return self._behind_reason(view, now, t) or self._ahead_reason(view, now, t)
 
     # ----------------------------------------------------------------------------- checks
-    def blocks(self, meas, perception, committing: bool, manoeuvring: bool) -> bool:
+    def lane_reason(
+        self,
+        meas,
+        perception,
+        view: NextLaneView | None,
+        obstacle_decel_mps2: float = 0.0,
+        traffic_only: bool = False,
+    ) -> tuple[SightNeed, str]:
+        """The plan of a lane change into ``view``'s lane begun now, and why it may not begin
+        ("": it may; module doc). ``traffic_only``: the road users in the lane alone (the
+        paper's policy choosing a side), not the unseen road."""
+        need = self.sight_need(meas, perception, view, obstacle_decel_mps2)
+        if view is not None and not view.opposing:  # seen as far as it drives in it
+            drive_m = need.ego_travel_m(need.t_lane_change_s + need.t_beside_s)
+            need = need._replace(needed_m=drive_m + need.margin_m)
+        if traffic_only:
+            if view is None or not math.isfinite(need.t_total_s):
+                return need, ""
+            t = need.t_total_s + need.margin_s
+            reason = self._behind_reason(view, need, t, unseen=False)
+            return need, reason or self._ahead_reason(view, need, t)
+        return need, self._commit_reason(meas, view, need)
+
+    def blocks(
+        self,
+        meas,
+        perception,
+        committing: bool,
+        manoeuvring: bool,
+        obstacle_decel_mps2: float = 0.0,
+    ) -> bool:
         """True when the next lane is closed: at a commit (``committing``: a lane change is
         about to begin) the sight-distance gate and every road user; during the lane change
-        and the return (``manoeuvring``) any road user within the distance still needed."""
+        and the return (``manoeuvring``) any road user that would meet the ego in it."""
         view = perception.next_lane
         if committing:
-            need = self.sight_need(meas, perception, view)
-            if view is not None and not view.opposing:  # seen as far as it drives in it
-                need = need._replace(
-                    needed_m=meas.vx_mps * (need.t_lane_change_s + need.t_beside_s) + need.margin_m
-                )
-            free = (
-                view is not None
-                and math.isfinite(need.needed_m)
-                and self._lane_free(view, meas.vx_mps, need.t_total_s, need.needed_m, True)
-            )
+            need, reason = self.lane_reason(meas, perception, view, obstacle_decel_mps2)
             if not self.gate:
-                self.gate = "passed" if free else "refused"
+                self.gate = "refused" if reason else "passed"
                 self.known_free_m = view.known_free_ahead_m if view is not None else 0.0
                 self.need = need
+                self.reason = reason
             self._commit_s = meas.time_s
-            if free:
+            if not reason:
                 self.need = need
-            return not free
+            return bool(reason)
         if not manoeuvring or self.need is None or view is None:
             return False
-        need = self.need
-        t_left = max(need.t_total_s - (meas.time_s - self._commit_s), 0.0)
-        left_m = need.closing_speed_mps * (t_left + need.t_escape_s + need.margin_s)
-        return not self._lane_free(view, meas.vx_mps, t_left, left_m + need.margin_m, False)
+        reason = self._watch_reason(meas, view)
+        if reason and not self.reason:
+            self.reason = reason
+        return bool(reason)
 
     def prefer_braking(self, meas, perception) -> bool:
         """Past the point of no return with the next lane closed: True when braking in lane
@@ -319,8 +513,7 @@ class SafePolicy:
             "sight_known_free_m": (
                 None if self.known_free_m is None else round(self.known_free_m, 3)
             ),
-            "sight_time_s": (
-                round(need.t_total_s + need.t_escape_s, 3) if need is not None else None
-            ),
+            "sight_time_s": round(need.t_total_s, 3) if need is not None else None,
+            "sight_reason": self.reason,
             "tie_break": self.tie_break,
         }

@@ -25,6 +25,13 @@ from eoam_sumo.eoam.lateral import lateral_control
 from eoam_sumo.eoam.longitudinal import longitudinal_control
 from eoam_sumo.eoam.parts import Parts, build_parts
 from eoam_sumo.eoam.perceive import perceive
+from eoam_sumo.eoam.sides import (
+    RIGHT,
+    choose_side,
+    mirrored_command,
+    mirrored_measurement,
+    mirrored_perception,
+)
 from eoam_sumo.eoam.state import ControllerState, LateralOutput, LongitudinalOutput
 from eoam_sumo.eoam.transitions import advance_mode
 from eoam_sumo.eoam_messages import Command, EgoMeasurement, Perception
@@ -59,7 +66,15 @@ class EoamController:
         self.state = self._fresh_state(v)
 
     def step(self, meas: EgoMeasurement, perception: Perception, dt_s: float) -> Command:
-        """One decision + control step; commands hold until the next call."""
+        """One decision + control step; commands hold until the next call (evading right,
+        in the mirrored road frame: ``sides``)."""
+        parts, state = self.parts, self.state
+        if choose_side(parts, state, meas, perception) == RIGHT:
+            meas, perception = mirrored_measurement(meas), mirrored_perception(perception)
+            return mirrored_command(self._step(meas, perception, dt_s))
+        return self._step(meas, perception, dt_s)
+
+    def _step(self, meas: EgoMeasurement, perception: Perception, dt_s: float) -> Command:
         parts, state = self.parts, self.state
         situation = perceive(parts, state, meas, perception)
         decision = decide(parts, state, meas, perception, situation)

@@ -27,7 +27,9 @@ def decide(
         action = BRAKE
     mode = state.mode
     committing = action is STEER and mode in _COMMITTING
-    blocked = parts.gate.blocks(meas, perception, committing, mode in _WATCHING)
+    blocked = parts.gate.blocks(
+        meas, perception, committing, mode in _WATCHING, situation.obstacle_decel_mps2
+    )
     return Decision(sector, action, situation.oncoming or blocked)
 
 

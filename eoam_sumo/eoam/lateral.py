@@ -3,13 +3,17 @@ and the steering command, feedforward + lookahead feedback + yaw damping (paper 
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
+from eoam_sumo.decision.modes import ONCOMING_BRAKE
+from eoam_sumo.eoam.longitudinal import shares_ellipse
 from eoam_sumo.eoam.parts import Parts
 from eoam_sumo.eoam.state import ControllerState, LateralOutput
 from eoam_sumo.eoam_messages import EgoMeasurement
 from eoam_sumo.manoeuvre.angles import wrap_angle
 from eoam_sumo.manoeuvre.path_reference import PathReference
+from eoam_sumo.params import G_MPS2
 
 
 class Reference(NamedTuple):
@@ -57,9 +61,21 @@ def lateral_control(parts: Parts, state: ControllerState, meas: EgoMeasurement) 
         ref.steer_ff_rad,
         ref.sideslip_rad,
     )
+    if state.mode is ONCOMING_BRAKE and shares_ellipse(parts, state, meas):
+        delta = steering_share(parts, steer, v, mu, delta)
     return LateralOutput(
         delta, ref.y_m, dx, e_lat, e_la, ff, fb, yd, ref.in_path, ref.ax_mps2, ref.speed_mps
     )
+
+
+def steering_share(parts: Parts, steer, speed_mps: float, mu: float, delta_rad: float) -> float:
+    """``delta_rad`` within the lateral share of the friction ellipse the brake's floor
+    leaves: |a_y| <= sqrt(1 - floor^2) mu g / ellipse margin (eqs. 25, 28)."""
+    st = parts.settings
+    share = math.sqrt(max(1.0 - st.limit_brake_floor * st.limit_brake_floor, 0.0))
+    ay_cap = share * mu * G_MPS2 / st.longitudinal.ellipse_margin
+    cap = steer.steer_for_lateral_accel(speed_mps, ay_cap)
+    return max(-cap, min(cap, delta_rad))
 
 
 def reference(

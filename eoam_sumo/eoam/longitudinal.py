@@ -35,6 +35,9 @@ def longitudinal_control(
         drive, brake, ax_target = long.track_speed(target, v, mu, drive_lim, brake_lim, dt_s)
         return LongitudinalOutput(drive, brake, ax_target, target)
     if mode is UPDATE_BRAKE or mode is ONCOMING_BRAKE:  # limit braking without locking
+        if mode is ONCOMING_BRAKE and shares_ellipse(parts, state, meas):
+            floor = parts.settings.limit_brake_floor * state.friction_now().brake_limit_n
+            brake_lim = max(brake_lim, floor)
         return LongitudinalOutput(0.0, brake_lim, -brake_lim / parts.params.mass_kg, 0.0)
     if tracking:
         drive, brake = long.track_accel(
@@ -47,6 +50,20 @@ def longitudinal_control(
         long.reset()
     drive, brake, ax_target = long.track_speed(hold, v, mu, drive_lim, brake_lim, dt_s)
     return LongitudinalOutput(drive, brake, ax_target, hold)
+
+
+def shares_ellipse(parts: Parts, state: ControllerState, meas: EgoMeasurement) -> bool:
+    """Mode 3 above ``limit_brake_floor_speed_mps`` with the ego's body inside its own lane
+    (a lateral correction, not an escape from the next lane, nor an arrest): the brake keeps
+    ``limit_brake_floor`` of the limit, the steering the rest of the friction ellipse (paper
+    eqs. 25, 28: (Fx / mu Fz)^2 + (Fy / mu Fz)^2 <= 1)."""
+    st = parts.settings
+    return (
+        st.limit_brake_floor > 0.0
+        and not state.arrest
+        and meas.vx_mps > st.limit_brake_floor_speed_mps
+        and abs(meas.d_m) + 0.5 * parts.params.width_m <= 0.5 * meas.lane_width_m
+    )
 
 
 def force_limits(

@@ -41,6 +41,7 @@ class Parts(NamedTuple):
     escapes: QuinticEscapes  # the shifts of modes 3, 4 and the urgent return
     return_rule: TimerReturn  # when mode 2 returns
     gate: NextLaneGate  # the decision policy's checks of the next lane
+    side_judge: SafePolicy  # the checks of a lane on either side (``sides.open_side``)
 
 
 def build_parts(params: VehicleParams, tables: Any, settings: EoamSettings) -> Parts:
@@ -68,4 +69,5 @@ def build_parts(params: VehicleParams, tables: Any, settings: EoamSettings) -> P
         SafeGate(SafePolicy(params, tables, st, st.policy))
         if st.policy.name == "safe"
         else NextLaneGate(),
+        SafePolicy(params, tables, st, st.policy),
     )

@@ -61,10 +61,12 @@ def passing_offset_m(
     settings: EoamSettings,
     obstacle: ObstacleTrack | None,
     meas: EgoMeasurement,
+    target_offset_m: float = 0.0,
 ) -> float:
     """Mode 4's target: just far enough left to pass the obstacle with ``side_clearance_m``
-    (less exposure to the oncoming vehicle than a whole lane), at most a lane width, and
-    never back towards the obstacle from where the ego already is."""
+    (less exposure to the oncoming vehicle than a whole lane), at most to the target lane's
+    centre (``target_offset_m``; 0: a lane width), and never back towards the obstacle from
+    where the ego already is."""
     left_edge = obstacle.left_edge_m if obstacle is not None else 0.5 * meas.lane_width_m
     need = left_edge + 0.5 * params.width_m + settings.side_clearance_m
-    return max(min(need, meas.lane_width_m), meas.d_m)
+    return max(min(need, target_offset_m or meas.lane_width_m), meas.d_m)

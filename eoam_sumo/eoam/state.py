@@ -50,6 +50,8 @@ class ControllerState:
     arrest: float = 0.0  # mode 3: sign of the lateral motion being arrested (0: none)
     obstacle: ObstacleTrack | None = None  # the in-path obstacle as last sensed
     oncoming_choice: Choice | None = None  # the commit/abort decision, when made
+    side: int = 1  # the side of the lane change: +1 left, -1 right (the step mirrored)
+    target_offset_m: float = 0.0  # the target lane's centre from the ego's (0: a lane width)
 
     def friction_now(self) -> Friction:
         """The friction record of this step (the perceive stage refreshes it first)."""

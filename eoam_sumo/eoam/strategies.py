@@ -284,7 +284,12 @@ class NextLaneGate:
     policy: SafePolicy | None = None
 
     def blocks(
-        self, meas: EgoMeasurement, perception: Perception, committing: bool, watching: bool
+        self,
+        meas: EgoMeasurement,
+        perception: Perception,
+        committing: bool,
+        watching: bool,
+        obstacle_decel_mps2: float = 0.0,
     ) -> bool:
         """The next lane is closed to the lane change (treated as oncoming traffic)."""
         return False
@@ -306,9 +311,14 @@ class SafeGate(NextLaneGate):
         self._policy = policy
 
     def blocks(
-        self, meas: EgoMeasurement, perception: Perception, committing: bool, watching: bool
+        self,
+        meas: EgoMeasurement,
+        perception: Perception,
+        committing: bool,
+        watching: bool,
+        obstacle_decel_mps2: float = 0.0,
     ) -> bool:
-        return self._policy.blocks(meas, perception, committing, watching)
+        return self._policy.blocks(meas, perception, committing, watching, obstacle_decel_mps2)
 
     def prefer_braking(self, meas: EgoMeasurement, perception: Perception) -> bool:
         return self._policy.prefer_braking(meas, perception)

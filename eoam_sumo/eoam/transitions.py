@@ -119,15 +119,18 @@ def enter(parts: Parts, state: ControllerState, mode: Mode, meas: EgoMeasurement
     state.arrest = 0.0
     if mode is UPDATE_STEER_BRAKE:  # the table lane change for the trigger speed and friction
         state.hold_speed_mps = None
-        state.height_m = meas.lane_width_m
+        # to the target lane's centre: one lane width, or centre to centre
+        state.height_m = height = state.target_offset_m or meas.lane_width_m
         state.t_steer_s = meas.time_s
         traj = parts.tables.trajectory(meas.mu, meas.vx_mps)  # clamped to the speed grid
-        start_path(parts, state, meas, traj, meas.lane_width_m)
+        start_path(parts, state, meas, traj, height)
     elif mode is RETURN:
         state.hold_speed_mps = meas.vx_mps
         start_return(parts, state, meas, urgent=previous is ONCOMING_STEER_BRAKE)
     elif mode is ONCOMING_STEER_BRAKE:
-        target = passing_offset_m(parts.params, parts.settings, state.obstacle, meas)
+        target = passing_offset_m(
+            parts.params, parts.settings, state.obstacle, meas, state.target_offset_m
+        )
         shift = parts.escapes.shift(target, meas, parts.settings.evasive_lateral_g)
         start_path(parts, state, meas, shift, None)
     elif mode is ONCOMING_BRAKE:

@@ -47,6 +47,7 @@ BESIDE_M = 2.0  # a road user within this of the ego's body along the road is be
 #: A sensor: position (x, y), look direction, half field of view [rad], range [m].
 Sensor = tuple[float, float, float, float, float]
 COVERAGE_STEP_M = 1.0  # spacing of the points at which coverage is tested [m]
+ACCEL_BASELINE_S = 0.5  # a road user's acceleration: its speed change over this long [s]
 
 
 @mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
@@ -101,8 +102,11 @@ class NextLaneSensing:
         v2x: V2XSettings | None = None,
         corner: CornerRadarSettings | None = None,
         fastest_mps: float | None = None,
+        side: int = 1,
+        target_width_m: float | None = None,
     ):
         self.opposing = opposing
+        self.side = 1 if side >= 0 else -1  # +1: the lane left of the ego's, -1: right of it
         self.speed_limit_mps = speed_limit_mps
         self.lane_width_m = lane_width_m
         self.radar_range_m = radar_range_m
@@ -114,8 +118,19 @@ class NextLaneSensing:
         fastest = speed_limit_mps if fastest_mps is None else fastest_mps
         self._v2x_free_m = v2x.range_m - fastest * v2x.blind_time_s() if v2x.covers_all else 0.0
         w = lane_width_m
-        self.lines_m = (0.5 * w + LINE_INSET_M, w, 1.5 * w - LINE_INSET_M)
+        wt = self.target_width_m = w if target_width_m is None else target_width_m
+        inner, outer = 0.5 * w, (1.5 * w if wt == w else 0.5 * w + wt)
+        centre = w if wt == w else 0.5 * (inner + outer)
+        sgn = self.side
+        # the lane's band in the ego's road frame (d_lo, d_hi) and its three coverage lines
+        self.band_m = (inner, outer) if sgn > 0 else (-outer, -inner)
+        self.lines_m = tuple(
+            sgn * line for line in (inner + LINE_INSET_M, centre, outer - LINE_INSET_M)
+        )
         self._standing: dict[tuple[float, float], tuple[float, float, float]] = {}
+        # the road users in the lane at the last steps: (time, station, speed, the speed
+        # history (time, speed) over the last ACCEL_BASELINE_S)
+        self._tracks: list[tuple[float, float, float, list[tuple[float, float]]]] = []
 
     @property
     def reach_m(self) -> float:
@@ -138,8 +153,7 @@ class NextLaneSensing:
         ``bodies`` the ground truth of the road users around (for the corner radars and V2X),
         ``road`` the original lane's frame (``project(x, y) -> (s, d, road_yaw)``)."""
         s_f = road.project(*front_xy)[0]
-        w = self.lane_width_m
-        lane_lo, lane_hi = 0.5 * w, 1.5 * w
+        lane_lo, lane_hi = self.band_m
         in_path = report.in_path
         objects, shadows = self._radar_objects(report, lane_lo, lane_hi)
         objects += self._corner_objects(
@@ -149,7 +163,8 @@ class NextLaneSensing:
             self.v2x.update(time_s, front_xy, bodies)
             received = self.v2x.objects(time_s)
             self._add_v2x_objects(received, road, lane_lo, lane_hi, objects, in_path)
-        ahead, behind = self._nearest(objects, s_f)
+        accel = self._accelerations(time_s, objects)
+        ahead, behind = self._nearest(objects, accel, s_f)
 
         def coverage() -> float:
             return self._coverage(road, s_f, front_xy, yaw_rad, shadows)
@@ -158,10 +173,16 @@ class NextLaneSensing:
             self.opposing,
             self.speed_limit_mps,
             coverage=coverage,
-            nearest_ahead_m=None if ahead is None else ahead[0],
-            nearest_ahead_speed_mps=None if ahead is None else ahead[1],
+            nearest_ahead_m=ahead[0][0] if ahead else None,
+            nearest_ahead_speed_mps=ahead[0][1] if ahead else None,
             nearest_behind_m=None if behind is None else behind[0],
             nearest_behind_speed_mps=None if behind is None else behind[1],
+            ahead=tuple((gap, v) for gap, v, _a in ahead),
+            accel_ahead_mps2=tuple(a for _gap, _v, a in ahead),
+            nearest_behind_accel_mps2=0.0 if behind is None else behind[2],
+            coverage_behind_m=max(self.corner.range_m, self._v2x_free_m),
+            side=self.side,
+            lane_width_m=self.target_width_m,
         )
 
     # ----------------------------------------------------------------------------- parts
@@ -202,23 +223,51 @@ class NextLaneSensing:
             objects.append((s, d, o.speed_mps * math.cos(o.yaw_rad - ryaw), o.length_m, o.width_m))
 
     def _nearest(
-        self, objects: list, s_f: float
-    ) -> tuple[tuple[float, float] | None, tuple[float, float] | None]:
-        """(gap, road speed) of the nearest road user ahead (overlapping the ego's length
-        counts as ahead, gap 0) and of the nearest behind the ego's rear; None: none."""
-        ahead: tuple[float, float] | None = None
-        behind: tuple[float, float] | None = None
+        self, objects: list, accel: list[float], s_f: float
+    ) -> tuple[list[tuple[float, float, float]], tuple[float, float, float] | None]:
+        """(gap, road speed, acceleration) of every road user ahead, nearest first
+        (overlapping the ego's length counts as ahead, gap 0), and of the nearest behind the
+        ego's rear (None: none)."""
+        ahead: list[tuple[float, float, float]] = []
+        behind: tuple[float, float, float] | None = None
         s_rear = s_f - self.ego_length_m
-        for s, _d, v, length, _width in objects:
+        for (s, _d, v, length, _width), a in zip(objects, accel):
             if s - 0.5 * length >= s_f - 1e-9 or s + 0.5 * length >= s_rear:
-                gap = max(s - 0.5 * length - s_f, 0.0)
-                if ahead is None or gap < ahead[0]:
-                    ahead = (gap, v)
+                ahead.append((max(s - 0.5 * length - s_f, 0.0), v, a))
             else:
                 gap = s_rear - (s + 0.5 * length)
                 if behind is None or gap < behind[0]:
-                    behind = (gap, v)
+                    behind = (gap, v, a)
+        ahead.sort()
         return ahead, behind
+
+    def _accelerations(self, time_s: float, objects: list) -> list[float]:
+        """The acceleration along the road of each road user in the lane: its speed change
+        over the last ``ACCEL_BASELINE_S`` (0 until it has been followed that long). A road
+        user is the one of the last step whose predicted station lies within the fusion gate
+        (the nearest)."""
+        tracks = []
+        accel: list[float] = []
+        for s, _d, v, length, _width in objects:
+            history = self._history(time_s, s, length)
+            history.append((time_s, v))
+            while len(history) > 1 and time_s - history[1][0] >= ACCEL_BASELINE_S - 1e-9:
+                history.pop(0)
+            t0, v0 = history[0]
+            span = time_s - t0
+            accel.append((v - v0) / span if span >= ACCEL_BASELINE_S - 1e-9 else 0.0)
+            tracks.append((time_s, s, v, history))
+        self._tracks = tracks
+        return accel
+
+    def _history(self, time_s: float, s_m: float, length_m: float) -> list[tuple[float, float]]:
+        """The speed history of the road user of the last step at ``s_m`` (a new one: [])."""
+        best, best_err = None, FUSION_GATE_M + 0.5 * length_m
+        for t, s, v, history in self._tracks:
+            err = abs(s + v * (time_s - t) - s_m)
+            if err <= best_err:
+                best, best_err = history, err
+        return list(best) if best is not None else []
 
     @staticmethod
     def _in_lane(d_m: float, width_m: float, lane_lo: float, lane_hi: float) -> bool:
@@ -281,13 +330,15 @@ class NextLaneSensing:
         return hit
 
     def _sensors(self, front_xy, yaw_rad: float) -> tuple[Sensor, Sensor, Sensor]:
-        """(x, y, look, half field of view, range) of the forward and the two corner radars."""
+        """(x, y, look, half field of view, range) of the forward and the two corner radars
+        (on the lane's side: front-left and rear-left for the left lane)."""
         c = self.corner
         cy, sy = math.cos(yaw_rad), math.sin(yaw_rad)
-        half_w = 0.5 * self.ego_width_m
-        fx, fy = front_xy[0] - half_w * sy, front_xy[1] + half_w * cy  # front-left corner
-        rx, ry = fx - self.ego_length_m * cy, fy - self.ego_length_m * sy  # rear-left corner
-        half, bore = math.radians(0.5 * c.fov_deg), math.radians(c.boresight_deg)
+        half_w = 0.5 * self.ego_width_m * self.side
+        fx, fy = front_xy[0] - half_w * sy, front_xy[1] + half_w * cy  # front corner
+        rx, ry = fx - self.ego_length_m * cy, fy - self.ego_length_m * sy  # rear corner
+        half = math.radians(0.5 * c.fov_deg)
+        bore = math.radians(c.boresight_deg) * self.side
         return (
             (front_xy[0], front_xy[1], yaw_rad, self._radar_half_fov, self.radar_range_m),
             (fx, fy, yaw_rad + bore, half, c.range_m),

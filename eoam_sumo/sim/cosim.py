@@ -52,6 +52,7 @@ from eoam_sumo.sim.roadframe import RoadFrame
 from eoam_sumo.sim.runlog import RunLog, write_run
 from eoam_sumo.sim.scenario import ScenarioOverrides
 from eoam_sumo.sim.session import SumoSession
+from eoam_sumo.sim.session.session import SideLane
 from eoam_sumo.sim.settings import RunSettings
 from eoam_sumo.sim.severity import ContactRecord, substep_contact
 from eoam_sumo.sim.summary import RunSummary
@@ -194,6 +195,13 @@ class CoSimulation:
         self.lane_width_m = session.lane_width_m
         self.left_lane = session.left_lane_exists
         self.next_lane_opposing = self.left_lane and session.next_lane_traffic()[0]
+        # the lanes beside the ego's its class may use (the EOAM may evade into either)
+        self.side_lanes = (session.side_lane(1), session.side_lane(-1))
+        if self.side_lanes[0] is None:  # the safe policy still senses the left side
+            opposing, limit = session.next_lane_traffic()
+            self._left_fallback = SideLane("", self.lane_width_m, limit, opposing)
+        self.left_usable = self.side_lanes[0] is not None
+        self.right_width_m = self.side_lanes[1].width_m if self.side_lanes[1] else 0.0
         self.x = initial_state(
             ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps, params=self.params
         ).tolist()
@@ -208,7 +216,8 @@ class CoSimulation:
         and the corner radars, and for the traffic log (its radius is from the centre of
         gravity)."""
         st, p = self.settings, self.params
-        self.lane_sensing = self._next_lane_sensing(session)  # safe policy only
+        self.lane_sensing = self._next_lane_sensing(1)  # safe policy, or a right lane
+        self.right_sensing = self._next_lane_sensing(-1)  # a usable right lane only
         self.traffic = TrafficLog(
             st.ego_id,
             ego.vclass,
@@ -221,6 +230,7 @@ class CoSimulation:
         self._sense_radius_m = max(
             st.radar.range_m,
             self.lane_sensing.reach_m if self.lane_sensing else 0.0,
+            self.right_sensing.reach_m if self.right_sensing else 0.0,
             self.traffic.radius_m + p.cg_to_front_bumper_m,
         )
 
@@ -317,6 +327,12 @@ class CoSimulation:
             perception = perception._replace(
                 next_lane=self.lane_sensing.update(self.t, front_xy, yaw, road, report, self.bodies)
             )
+        if self.right_sensing is not None:
+            perception = perception._replace(
+                right_lane=self.right_sensing.update(
+                    self.t, front_xy, yaw, road, report, self.bodies
+                )
+            )
         meas = EgoMeasurement(
             self.t,
             vx,
@@ -330,7 +346,7 @@ class CoSimulation:
             road.curvature_at(s),
             mu,
             self.lane_width_m,
-            self.left_lane,  # yaw is continuous
+            self.left_usable,  # yaw is continuous
         )
         return meas, perception
 
@@ -502,18 +518,25 @@ class CoSimulation:
             0.0,
             self.mu_true,
             self.lane_width_m,
-            self.left_lane,
+            self.left_usable,
         )
 
-    def _next_lane_sensing(self, session: SumoSession) -> NextLaneSensing | None:
-        """The next lane's sensing for the safe policy (None for the paper's)."""
+    def _next_lane_sensing(self, side: int) -> NextLaneSensing | None:
+        """The sensing of the lane on ``side`` (+1 left, -1 right): the left one for the safe
+        policy, both when the ego's class may use the right one (the EOAM then chooses its
+        side); None: not needed, or no usable lane there."""
         st = self.settings
-        if st.eoam.policy.name != "safe":
+        left, right = self.side_lanes
+        if right is None and (side < 0 or st.eoam.policy.name != "safe"):
             return None
-        opposing, limit = session.next_lane_traffic()
+        lane = left if side > 0 else right
+        if lane is None:
+            if side < 0:
+                return None
+            lane = self._left_fallback
         return NextLaneSensing(
-            opposing=opposing,
-            speed_limit_mps=limit,
+            opposing=lane.opposing,
+            speed_limit_mps=lane.speed_limit_mps,
             lane_width_m=self.lane_width_m,
             radar_range_m=st.radar.range_m,
             radar_fov_deg=st.radar.fov_deg,
@@ -522,6 +545,8 @@ class CoSimulation:
             v2x=st.v2x,
             corner=st.corner_radar,
             fastest_mps=st.eoam.policy.opposing_speed_mps,
+            side=side,
+            target_width_m=lane.width_m,
         )
 
     def policy_record(self) -> dict:

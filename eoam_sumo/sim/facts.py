@@ -85,6 +85,8 @@ class RunFacts:
     # the end: contact, settled, road_end or time_limit; simulated time since the departure
     end_cause: str = "settled"
     sim_time_s: float = 0.0
+    # the road's width right of the original lane: a lane there the ego may evade into
+    right_width_m: float = 0.0
 
 
 @mypyc_attr(native_class=False)  # a Python dataclass: built by hand in tests
@@ -124,6 +126,8 @@ class EndedRun(RunView, Protocol):
     def min_gap_aro_m(self) -> float: ...
     @property
     def next_lane_opposing(self) -> bool: ...  # the lane left of the ego's is the opposite one
+    @property
+    def right_width_m(self) -> float: ...  # a usable lane's width right of the ego's (0: none)
 
     # the co-simulation's parts: settings, parameters, controller, friction belief, observers
     settings: Any
@@ -181,6 +185,7 @@ def collect_facts(sim: EndedRun) -> RunFacts:
         oncoming_traffic=sim.traffic.had_role("oncoming"),
         end_cause=sim.end_cause or "",
         sim_time_s=sim.t - sim.t_start,
+        right_width_m=sim.right_width_m,
     )
 
 

@@ -194,13 +194,17 @@ class Outcome:
     reason: str
 
 
+#: Why mode 3 found the next lane closed, unless the decision policy names the cause.
+NEXT_LANE_CLOSED = "oncoming traffic or a standing car"
+
+
 def _manoeuvre_phrase(modes: set[int], lane_change: bool) -> str:
     if lane_change:
         return "lane change"
     if 3 in modes:
         return (
             "limit braking chosen (next lane not free before the point of no return: "
-            "oncoming traffic or a standing car)"
+            f"{NEXT_LANE_CLOSED})"
         )
     if 1 in modes:
         return "limit braking chosen by the DMM"
@@ -214,15 +218,16 @@ def road_departure(
     max_offset_m: float,
     lane_width_m: float,
     left_width_m: float = 0.0,
+    right_width_m: float = 0.0,
 ) -> tuple[str, float]:
     """The side and distance [m] by which the ego's centre went farthest beyond a road edge.
 
     ``min_offset_m``/``max_offset_m``: the smallest and largest signed lateral offset d of the
     ego's centre in the road frame of its original lane (left positive); the road spans
-    d in [-lane_width_m / 2, lane_width_m / 2 + left_width_m]. The distance is <= 0 while the
-    centre stayed on the road (then it is minus the least clearance to an edge).
+    d in [-lane_width_m / 2 - right_width_m, lane_width_m / 2 + left_width_m]. The distance is
+    <= 0 while the centre stayed on the road (then it is minus the least clearance to an edge).
     """
-    right = -0.5 * lane_width_m - min_offset_m
+    right = -0.5 * lane_width_m - right_width_m - min_offset_m
     left = max_offset_m - 0.5 * lane_width_m - left_width_m
     return ("left", left) if left > right else ("right", right)
 
@@ -233,9 +238,12 @@ def left_road(
     lane_width_m: float,
     left_width_m: float = 0.0,
     settings: OutcomeSettings = OutcomeSettings(),
+    right_width_m: float = 0.0,
 ) -> bool:
     """Whether the ego's centre went more than ``settings.road_edge_margin_m`` off the road."""
-    _, beyond_m = road_departure(min_offset_m, max_offset_m, lane_width_m, left_width_m)
+    _, beyond_m = road_departure(
+        min_offset_m, max_offset_m, lane_width_m, left_width_m, right_width_m
+    )
     return beyond_m > settings.road_edge_margin_m
 
 
@@ -254,6 +262,7 @@ def classify_outcome(
     min_offset_m: float = 0.0,
     max_offset_m: float = 0.0,
     left_width_m: float = 0.0,
+    right_width_m: float = 0.0,
     direct_overlap: float = 1.0,
     cut_off: str | None = None,
     manoeuvre_running: bool = False,
@@ -270,7 +279,8 @@ def classify_outcome(
     ``max_abs_heading_error_rad`` the largest |heading - road heading| (wrapped to [-pi, pi))
     and ``min_speed_mps`` the lowest forward speed vx (signed) during the run;
     ``min_offset_m``/``max_offset_m`` the signed extremes of d and ``left_width_m`` the road
-    width to the left of the original lane (``road_departure``).
+    width to the left of the original lane, ``right_width_m`` to its right (a usable lane
+    there; ``road_departure``).
 
     Contact and end of the run (keyword-only): ``direct_overlap`` the share of the narrower
     width in line covered at the contact (direct or offset hit); ``cut_off`` what cut the run
@@ -300,7 +310,7 @@ def classify_outcome(
     lost = _loss_of_control(
         max_abs_heading_error_rad,
         min_speed_mps,
-        road_departure(min_offset_m, max_offset_m, lane_width_m, left_width_m),
+        road_departure(min_offset_m, max_offset_m, lane_width_m, left_width_m, right_width_m),
         settings,
     )
     if lost:

@@ -6,10 +6,11 @@ margins, the obstacle a lane change avoided) and, for the summary, its set-up an
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Any
 
 from eoam_sumo.sim.facts import RunFacts, RunInfo
-from eoam_sumo.sim.outcome import Outcome, classify_outcome, left_road
+from eoam_sumo.sim.outcome import NEXT_LANE_CLOSED, Outcome, classify_outcome, left_road
 from eoam_sumo.sim.severity import Severity, contact_severity
 from eoam_sumo.sim.summary import RunSummary, finite_or_none, rounded
 
@@ -47,6 +48,7 @@ def outcome_of(facts: RunFacts) -> Outcome:
         min_offset_m=facts.min_offset_m,
         max_offset_m=facts.max_offset_m,
         left_width_m=left_width_m(facts),
+        right_width_m=facts.right_width_m,
         direct_overlap=severity.direct_overlap if severity else 1.0,
         cut_off=CUT_OFF.get(facts.end_cause),
         manoeuvre_running=facts.manoeuvre_running,
@@ -57,12 +59,20 @@ def outcome_of(facts: RunFacts) -> Outcome:
 def summarise(facts: RunFacts, info: RunInfo) -> RunSummary:
     """The outcome and summary of a run (summary.json's fields: ``sim/summary.py``)."""
     return RunSummary(
-        **_contact_fields(facts, outcome_of(facts), severity_of(facts)),
+        **_contact_fields(facts, named_cause(outcome_of(facts), info), severity_of(facts)),
         **_eoam_fields(facts, info),
         **_margin_fields(facts),
         **_motion_fields(facts),
         **_run_fields(facts, info),
     )
+
+
+def named_cause(outcome: Outcome, info: RunInfo) -> Outcome:
+    """The outcome with the decision policy's cause of a closed next lane, when it gave one."""
+    why = info.policy_record.get("sight_reason")
+    if not why or NEXT_LANE_CLOSED not in outcome.reason:
+        return outcome
+    return replace(outcome, reason=outcome.reason.replace(NEXT_LANE_CLOSED, why))
 
 
 def _contact_fields(facts: RunFacts, outcome: Outcome, severity: Severity | None) -> dict[str, Any]:
@@ -97,7 +107,7 @@ def _eoam_fields(facts: RunFacts, info: RunInfo) -> dict[str, Any]:
         "trigger_time_s": None if t is None else round(t, 6),
         "trigger_range_m": round(rng, 6) if t is not None and math.isfinite(rng) else None,
         "mu_believed_at_trigger": facts.mu_believed_at_trigger,
-        **info.policy_record,
+        **{k: v for k, v in info.policy_record.items() if k != "sight_reason"},
         "radar_model": info.radar_model,
         "seed": info.seed,
     }
@@ -127,7 +137,11 @@ def _motion_fields(facts: RunFacts) -> dict[str, Any]:
         "min_speed_mps": rounded(facts.min_speed_mps),
         "max_abs_heading_error_rad": rounded(facts.max_abs_heading_error_rad),
         "left_road": left_road(
-            facts.min_offset_m, facts.max_offset_m, facts.lane_width_m, left_width_m(facts)
+            facts.min_offset_m,
+            facts.max_offset_m,
+            facts.lane_width_m,
+            left_width_m(facts),
+            right_width_m=facts.right_width_m,
         ),
         "ego_initial_speed_mps": rounded(facts.ego_initial_speed_mps),
         "lane_width_m": rounded(facts.lane_width_m),

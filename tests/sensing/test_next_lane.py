@@ -148,3 +148,53 @@ def test_a_v2x_car_beyond_the_radar_limits_the_free_length_and_is_fused_when_see
     near = Body("c", 52.35, LANE, math.pi, 20.0, 4.7, 1.8)  # seen by radar and V2X: one
     view = _view(sensing, [near], t=0.1)
     assert view.nearest_ahead_m == pytest.approx(50.0)
+
+
+def _right_sensing(target_width_m=LANE):
+    return NextLaneSensing(
+        opposing=False,
+        speed_limit_mps=36.0,
+        lane_width_m=LANE,
+        radar_range_m=100.0,
+        radar_fov_deg=18.0,
+        ego_length_m=4.92,
+        ego_width_m=1.85,
+        side=-1,
+        target_width_m=target_width_m,
+    )
+
+
+def test_the_right_lane_is_sensed_as_the_left_one_mirrored():
+    car = Body("c", -40.0, -LANE, 0.0, 40.0, 4.7, 1.8)  # behind, in the right lane
+    view = _view(_right_sensing(), [car])
+    assert view.side == -1
+    assert view.nearest_behind_m == pytest.approx(40.0 - 4.92 - 2.35)
+    assert (
+        _view(_right_sensing(), [Body("c", -40.0, LANE, 0.0, 40.0, 4.7, 1.8)]).nearest_behind_m
+        is None
+    )
+    left = _view(_sensing(), [])
+    right = _view(_right_sensing(), [])
+    assert right.coverage_ahead_m == pytest.approx(left.coverage_ahead_m)
+
+
+def test_a_wider_right_lane_reaches_further_out():
+    sensing = _right_sensing(target_width_m=4.0)
+    assert sensing.band_m == pytest.approx((-(0.5 * LANE + 4.0), -0.5 * LANE))
+    van = Body("van", 62.5, -(0.5 * LANE + 3.7), 0.0, 10.0, 5.0, 1.0)  # in its outer half
+    view = _view(sensing, [van])
+    assert view.nearest_ahead_m == pytest.approx(60.0)
+    assert view.lane_width_m == 4.0
+
+
+def test_a_road_users_acceleration_is_its_speed_change_over_the_baseline():
+    sensing = _sensing()
+    speeds = [30.0 - 4.0 * 0.1 * k for k in range(8)]  # braking at 4 m/s^2, every 0.1 s
+    x = 60.0
+    views = []
+    for k, v in enumerate(speeds):
+        car = Body("c", x, LANE, 0.0, v, 4.7, 1.8)
+        views.append(_view(sensing, [car], t=0.1 * k))
+        x += v * 0.1
+    assert views[0].users_ahead_accel()[0][2] == 0.0  # not followed long enough yet
+    assert views[-1].users_ahead_accel()[0][2] == pytest.approx(-4.0)

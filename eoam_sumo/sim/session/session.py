@@ -106,6 +106,15 @@ def _check_can_start(gui: bool, via_traci: bool) -> None:
         raise RuntimeError("a libsumo session is already open in this process; close it first")
 
 
+class SideLane(NamedTuple):
+    """A lane beside the ego's start lane that its vehicle class may use."""
+
+    lane_id: str
+    width_m: float
+    speed_limit_mps: float
+    opposing: bool  # it carries opposing traffic
+
+
 class _Started(NamedTuple):
     """A started SUMO: the API module (libsumo or traci), its constants, its error classes,
     the SUMO process (TraCI only, else None) and whether it runs through TraCI."""
@@ -461,6 +470,46 @@ class SumoSession:
                 opposing = opposing or edge == ego.route_edges[0]
             limit = max(limit, float(self._lane.getMaxSpeed(lane)))
         return opposing, limit
+
+    def side_lane(self, side: int) -> SideLane | None:
+        """The lane beside the ego's start lane on ``side`` (+1 left, -1 right) on its start
+        edge, if the ego's vehicle class may use it (SUMO lane permissions): its width, its
+        speed limit (the highest along the route) and whether it carries opposing traffic
+        (left only: ``next_lane_traffic``). None: no such lane, or a forbidden one."""
+        ego = self._ego
+        index = ego.lane_index + side
+        if index < 0:
+            return None
+        start = ego.route_edges[0]
+        if index < self._api.edge.getLaneNumber(start):
+            lane_id = f"{start}_{index}"
+        elif side > 0:
+            lane_id = self._files.opposite_lanes.get(ego.lane_id, "")
+        else:
+            lane_id = ""
+        if not lane_id or not self._permits(lane_id):
+            return None
+        if side > 0:
+            opposing, limit = self.next_lane_traffic()
+        else:
+            opposing, limit = False, self._side_limit(index)
+        return SideLane(lane_id, float(self._lane.getWidth(lane_id)), limit, opposing)
+
+    def _permits(self, lane_id: str) -> bool:
+        """The ego's vehicle class may drive on ``lane_id`` (allowed list empty: all)."""
+        vclass = self._api.vehicletype.getVehicleClass(self._ego.type_id)
+        allowed = self._lane.getAllowed(lane_id)
+        if allowed:
+            return vclass in allowed
+        return vclass not in self._lane.getDisallowed(lane_id)
+
+    def _side_limit(self, index: int) -> float:
+        """The highest speed limit of lane ``index`` along the ego's route (0: none)."""
+        limit = 0.0
+        for edge in self._ego.route_edges:
+            if index < self._api.edge.getLaneNumber(edge):
+                limit = max(limit, float(self._lane.getMaxSpeed(f"{edge}_{index}")))
+        return limit
 
     def lane_ids(self) -> list[str]:
         return list(self._lane.getIDList())
