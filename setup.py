@@ -26,6 +26,7 @@ COMPILED = [
     "eoam_sumo/eoam/parts.py",
     "eoam_sumo/eoam/perceive.py",
     "eoam_sumo/eoam/shifts.py",
+    "eoam_sumo/eoam/sides.py",
     "eoam_sumo/eoam/state.py",
     "eoam_sumo/eoam/strategies.py",
     "eoam_sumo/eoam/transitions.py",
