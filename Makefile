@@ -13,7 +13,7 @@ PIP    := $(BIN)/python -m pip install --quiet --constraint $(LOCK) --build-cons
 COMPILED_TREE := build/compiled
 COMPILED_STAMP := $(COMPILED_TREE)/.built
 TREE_FILES = git ls-files --cached --others --exclude-standard -- \
-	eoam_sumo tables scenarios networks tests/golden setup.py pyproject.toml README.md \
+	eoam_sumo tables vehicles scenarios networks tests/golden setup.py pyproject.toml README.md \
 	| while read -r f; do [ -e "$$f" ] && echo "$$f"; done
 RUN_COMPILED := PYTHONPATH=$(CURDIR)/$(COMPILED_TREE)
 

@@ -20,8 +20,8 @@ from eoam_sumo import __version__
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import MU_MAX
 from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S
-from eoam_sumo.vehicle_tests import command as vehicle_test_command
 from eoam_sumo.traffic_levels.command import add_scenario_arguments, cmd_scenario
+from eoam_sumo.vehicle_tests import command as vehicle_test_command
 
 EXIT_BAD_INPUT = 2
 

@@ -121,6 +121,8 @@ class Case:
     lanes: int | None = None
     speed_limit_kmh: float | None = None
     curve_radius_m: float | None = None
+    abs_fitted: bool | None = None  # None: the vehicle's own (the sedan's: off)
+    esc_fitted: bool | None = None  # None: the vehicle's own (the sedan's: off)
     draw: int | None = None  # the draw's number within its group (sampled matrices)
     group_id: str | None = None  # the case id of its group of swept values (sampled)
 

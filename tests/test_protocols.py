@@ -4,7 +4,6 @@ twice (determinism)."""
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import subprocess
 import sys
@@ -105,20 +104,17 @@ def test_failure_cause_names_the_never_triggered_head_on():
     assert scoring.failure_cause(failed) == "the run failed: boom"
 
 
-def test_abs_and_esc_need_the_fields():
-    from eoam_sumo.errors import InputError
-    from eoam_sumo.params import VehicleParams
+def test_abs_and_esc_are_switched_on_the_vehicle_and_carried_by_every_case(tmp_path):
+    from eoam_sumo.batch.case import case_vehicle
     from eoam_sumo.protocols.command import vehicle_params
+    from eoam_sumo.protocols.runner import _case
 
     assert vehicle_params("sedan").width_m == SEDAN_WIDTH_M
-    fields = {f.name for f in dataclasses.fields(VehicleParams)}
-    for option in ("abs", "esc"):
-        if f"{option}_fitted" in fields:
-            params = vehicle_params("sedan", **{f"{option}_mode": "off"})
-            assert getattr(params, f"{option}_fitted") is False
-        else:
-            with pytest.raises(InputError, match=f"this build has no {option.upper()}"):
-                vehicle_params("sedan", **{f"{option}_mode": "off"})
+    params = vehicle_params("sedan", abs_mode="on", esc_mode="off")
+    assert params.abs_fitted is True and params.esc_fitted is False
+    point = protocol_points("unr152", SEDAN_WIDTH_M, ("paper",))[0]
+    case = _case(point, tmp_path / "x.sumocfg", "paper", 1.0, 40.0, params)
+    assert case_vehicle(case) == params
 
 
 def test_r152_verdicts():
@@ -164,7 +160,7 @@ def test_offsets():
 
 @pytest.mark.parametrize(
     ("option", "value", "named"),
-    [("--vehicle", "truck", "truck"), ("--abs", "on", "ABS"), ("--esc", "on", "ESC")],
+    [("--vehicle", "truck", "truck"), ("--abs", "yes", "yes"), ("--esc", "maybe", "maybe")],
 )
 def test_bad_input_is_one_line_and_status_2(tmp_path, option, value, named):
     done = subprocess.run(

@@ -81,3 +81,8 @@ def test_a_catalogue_name_finds_its_file(tmp_path):
     _write(tmp_path, vehicle_toml(ego_e_class_sedan()), "sedan.toml")
     assert catalogue(tmp_path) == ["sedan"]
     assert load_vehicle("sedan", tmp_path) == VehicleParams()
+
+
+def test_the_shipped_sedan_is_the_papers_car():
+    assert catalogue() == ["sedan"]
+    assert load_vehicle("sedan") == ego_e_class_sedan()

@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import get_type_hints
 
 from eoam_sumo.matrix import Case
+from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 
 #: The files a case writes (``sim.runlog.write_run``), in the order they are written, by
 #: ``--timeseries`` format.
@@ -96,6 +97,16 @@ def case_parameters(case: Case) -> dict:
     return asdict(CaseParameters.of(case))
 
 
+def case_vehicle(case: Case) -> VehicleParams:
+    """The ego of a case: the sedan, its ABS and ESC switched as the case asks."""
+    vehicle = ego_e_class_sedan()
+    if case.abs_fitted is not None:
+        vehicle = replace(vehicle, abs_fitted=case.abs_fitted)
+    if case.esc_fitted is not None:
+        vehicle = replace(vehicle, esc_fitted=case.esc_fitted)
+    return vehicle
+
+
 def run_matrix_case(task: CaseTask) -> dict:
     """Run the case; ``{"summary": dict, "files": {name: bytes} or None}``.
 
@@ -114,6 +125,7 @@ def run_matrix_case(task: CaseTask) -> dict:
             radar_model=case.radar_model,
             seed=case.seed,
             after_stop_s=case.after_stop_s,
+            vehicle=case_vehicle(case),
         ),
         case.policy,
         case.v2x_range_m,

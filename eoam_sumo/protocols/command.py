@@ -28,40 +28,18 @@ ON_OFF = ("on", "off")
 def vehicle_params(
     name: str, abs_mode: str | None = None, esc_mode: str | None = None
 ) -> VehicleParams:
-    """The VUT's ``VehicleParams``: ``--vehicle`` NAME, with ABS/ESC fitted or not as asked
-    (None: the vehicle's own). The one place a protocol builds its vehicle: at the merge with
-    main, NAME is looked up with ``vehicle_files.load_vehicle(name)`` here instead of the
-    sedan-only branch below. InputError for an unknown NAME, or ABS/ESC on a build whose
-    ``VehicleParams`` has no such field."""
+    """The VUT's ``VehicleParams``: ``--vehicle`` NAME, with ABS/ESC on or off as asked
+    (None: the vehicle's own). InputError for an unknown NAME."""
     if name != "sedan":
         raise InputError(f"--vehicle {name!r} is not one of {', '.join(VEHICLES)}")
-    params = ego_e_class_sedan()
-    known = {f.name for f in dataclasses.fields(VehicleParams)}
     changes: dict[str, Any] = {}
     for option, mode in (("abs", abs_mode), ("esc", esc_mode)):
         if mode is None:
             continue
         if mode not in ON_OFF:
             raise InputError(f"--{option} {mode!r} is not one of on, off")
-        field = FITTED_FIELDS[option]
-        if field not in known:
-            raise InputError(
-                f"--{option} {mode}: this build has no {option.upper()} "
-                f"(VehicleParams has no field {field!r})"
-            )
-        changes[field] = mode == "on"
-    return dataclasses.replace(params, **changes)
-
-
-def check_runs_carry(params: VehicleParams) -> None:
-    """InputError unless the runs would use ``params``: the batch cases build the default
-    sedan (sim.cosim), so any other vehicle would be scored as the sedan. The lead removes
-    this check when a case carries its vehicle."""
-    if params != ego_e_class_sedan():
-        raise InputError(
-            "--vehicle/--abs/--esc: the batch engine runs the default sedan only in this "
-            "build; this vehicle cannot reach the runs yet"
-        )
+        changes[FITTED_FIELDS[option]] = mode == "on"
+    return dataclasses.replace(ego_e_class_sedan(), **changes)
 
 
 def vehicle_label(args) -> str:
@@ -98,7 +76,6 @@ def selected_points(args) -> list[TestPoint]:
     if args.jobs < 1:
         raise InputError(f"--jobs {args.jobs} must be >= 1")
     params = vehicle_params(args.vehicle, args.abs, args.esc)
-    check_runs_carry(params)
     points = protocol_points(args.name, params.width_m, POLICIES)
     if args.points:
         try:
@@ -127,6 +104,7 @@ def run(args) -> int:
         policy=args.policy,
         mu=args.mu,
         vehicle=vehicle_label(args),
+        params=vehicle_params(args.vehicle, args.abs, args.esc),
         progress=not args.no_progress,
         max_time_s=MAX_TIME_S,
     )

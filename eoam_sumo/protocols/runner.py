@@ -13,6 +13,7 @@ from eoam_sumo.batch.results import SUMMARY_COLUMNS
 from eoam_sumo.batch.runner import run_cases
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.matrix import Case
+from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.protocols import scoring
 from eoam_sumo.protocols.points import TestPoint
 from eoam_sumo.protocols.scenario import write_scenarios
@@ -62,7 +63,9 @@ def _design_low_kmh(tables_dir: Path | None) -> float:
     return LookupTables.load(folder).speed_grid_mps[0] * 3.6
 
 
-def _case(point: TestPoint, cfg: Path, policy: str, mu: float, max_time_s: float) -> Case:
+def _case(
+    point: TestPoint, cfg: Path, policy: str, mu: float, max_time_s: float, params: VehicleParams
+) -> Case:
     return Case(
         point.point_id,
         cfg,
@@ -73,6 +76,8 @@ def _case(point: TestPoint, cfg: Path, policy: str, mu: float, max_time_s: float
         None,
         max_time_s,
         policy=point.policy or policy,
+        abs_fitted=params.abs_fitted,
+        esc_fitted=params.esc_fitted,
     )
 
 
@@ -86,6 +91,7 @@ def run_protocol(
     policy: str = "paper",
     mu: float = 1.0,
     vehicle: str = "sedan",
+    params: VehicleParams | None = None,
     progress: bool = True,
     max_time_s: float = 40.0,
     tables_dir: Path | None = None,
@@ -94,7 +100,8 @@ def run_protocol(
     low = _design_low_kmh(tables_dir)
     runnable = [p for p in points if p.ego_speed_kmh >= low - 1e-9]
     cfgs = write_scenarios(points, out / "scenarios")
-    cases = [_case(p, cfgs[p.point_id], policy, mu, max_time_s) for p in runnable]
+    params = params or ego_e_class_sedan()
+    cases = [_case(p, cfgs[p.point_id], policy, mu, max_time_s, params) for p in runnable]
     batch = run_cases(
         cases, out / BATCH_DIR, jobs, scheduler, progress=progress, tables_dir=tables_dir
     )

@@ -27,7 +27,7 @@ from eoam_sumo.eoam import (
 )
 from eoam_sumo.errors import InputError
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
-from eoam_sumo.params import VehicleParams, ego_e_class_sedan
+from eoam_sumo.params import VehicleParams
 from eoam_sumo.plant import Plant, initial_state
 from eoam_sumo.sensing.automotive import make_radar
 from eoam_sumo.sensing.friction import FrictionBelief
@@ -107,7 +107,7 @@ class CoSimulation:
         self.cfg = Path(cfg)
         self.overrides = overrides = overrides or ScenarioOverrides()
         self.settings = settings = settings or RunSettings()
-        self.params = params or ego_e_class_sedan()
+        self.params = params or settings.vehicle
         tables_dir = settings.tables_dir or default_tables_dir()
         self.tables = LookupTables.cached(tables_dir, params=self.params)
         # refuse what the tables do not cover before starting SUMO (checked again at the start)

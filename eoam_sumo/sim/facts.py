@@ -99,6 +99,9 @@ class RunInfo:
     policy_record: dict  # the policy, V2X and sight-distance fields of the summary
     radar_model: str
     seed: int
+    vehicle: str
+    abs_fitted: bool
+    esc_fitted: bool
     radar_range_m: float
     radar_fov_deg: float
     net_file: str
@@ -197,6 +200,9 @@ def collect_info(sim: EndedRun, loop_wall_s: float) -> RunInfo:
         policy_record=sim.policy_record(),
         radar_model=st.radar_model,
         seed=st.seed,
+        vehicle=sim.params.name,
+        abs_fitted=sim.params.abs_fitted,
+        esc_fitted=sim.params.esc_fitted,
         radar_range_m=st.radar.range_m,
         radar_fov_deg=st.radar.fov_deg,
         net_file=str(sim.session.net_file.resolve()),

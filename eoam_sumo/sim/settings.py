@@ -9,6 +9,7 @@ from pathlib import Path
 from mypy_extensions import mypyc_attr
 
 from eoam_sumo.eoam_settings import EoamSettings
+from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.sensing.next_lane import CornerRadarSettings
 from eoam_sumo.sensing.radar import RadarSettings
 from eoam_sumo.sensing.v2x import V2XSettings
@@ -43,6 +44,7 @@ class RunSettings:
     corner_radar: CornerRadarSettings = field(default_factory=CornerRadarSettings)
     radar_model: str = "ideal"  # sensing.automotive: ideal or automotive
     gui_settings: GuiSettings = field(default_factory=GuiSettings)  # with gui: pacing, view
+    vehicle: VehicleParams = field(default_factory=ego_e_class_sedan)  # the ego's
 
     def __post_init__(self) -> None:
         ms = self.step_s * 1000.0

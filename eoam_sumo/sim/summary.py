@@ -59,6 +59,9 @@ class RunSummary:
     tie_break: str = _doc("safe policy: what the severity tie-breaker chose")
     radar_model: str = _doc("the radar model: ideal or automotive")
     seed: int = _doc("the seed of every random model of the run")
+    vehicle: str = _doc("the ego's vehicle (its name)")
+    abs_fitted: bool = _doc("whether the ego's ABS was on")
+    esc_fitted: bool = _doc("whether the ego's ESC was on")
     min_gap_aro_m: float | None = _doc(
         "smallest box-to-box gap to the in-lane obstacle within 20 m (empty: never that close)"
     )

@@ -110,6 +110,9 @@ def _eoam_fields(facts: RunFacts, info: RunInfo) -> dict[str, Any]:
         **{k: v for k, v in info.policy_record.items() if k != "sight_reason"},
         "radar_model": info.radar_model,
         "seed": info.seed,
+        "vehicle": info.vehicle,
+        "abs_fitted": info.abs_fitted,
+        "esc_fitted": info.esc_fitted,
     }
 
 

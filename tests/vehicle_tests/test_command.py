@@ -65,14 +65,14 @@ def test_bad_input_is_one_line_and_exit_2(args, message, tmp_path, capsys):
     assert err.count("\n") == 1
 
 
-def test_abs_on_is_refused_by_a_plant_without_abs(tmp_path, capsys):
-    from eoam_sumo.params import ego_e_class_sedan
-
-    if hasattr(ego_e_class_sedan(), "abs_fitted"):
-        pytest.skip("the plant has ABS")
-    assert main(["vehicle-test", "brake", "--abs", "on", "--out", str(tmp_path / "x")]) == 2
-    assert "no ABS" in capsys.readouterr().err
-    assert not (tmp_path / "x").exists()
+def test_a_stop_from_100_kmh_with_abs_meets_r13h(tmp_path):
+    """UN R13-H: at most 0.1 v + 0.0060 v^2 = 70 m from 100 km/h on a dry road, with ABS."""
+    out = tmp_path / "abs"
+    assert main(["vehicle-test", "brake", "--abs", "on", "--out", str(out)]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["abs"] is True
+    assert summary["figures"]["stopping_distance_m"] <= 70.0
+    assert summary["passed"] is True
 
 
 def test_an_output_folder_that_cannot_be_written_is_one_line(tmp_path, capsys):
