@@ -53,7 +53,7 @@ class VehicleParams:
     name: str = _p("E-class sedan", "-", PAPER + ", sec. 4.1")
     mass_kg: float = _p(1723.0, "kg", JING)
     yaw_inertia_kgm2: float = _p(
-        3116.0, "kg m^2", NHTSA_INERTIA + ": k^2/(a b) = 1.0 with this mass and CG"
+        4175.0, "kg m^2", JI + " (k^2/(a b) = 1.34; vehicles/sedan-r13h.toml: 3116, 1.0)"
     )
     cg_to_front_m: float = _p(1.232, "m", JING)
     cg_to_rear_m: float = _p(1.468, "m", JING)
@@ -78,7 +78,12 @@ class VehicleParams:
     max_brake_force_n: float = _p(
         22000.0, "N", ASSUMED + " (brakes able to lock all wheels on dry)"
     )
-    brake_front_share: float = _p(0.73, "-", R13H + "; front first up to 0.93 g")
+    brake_front_share: float = _p(
+        0.65,
+        "-",
+        GILLESPIE + " (fixed front brake proportion; locks the rear first on dry road, "
+        "vehicles/sedan-r13h.toml: 0.73)",
+    )
     rolling_resistance_coeff: float = _p(0.012, "-", GILLESPIE)
     drag_area_m2: float = _p(0.62, "m^2", ASSUMED + " (Cd 0.27 x 2.3 m^2 frontal area)")
     steer_lag_s: float = _p(0.05, "s", ASSUMED + " (electric power steering actuator)")

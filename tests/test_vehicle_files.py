@@ -84,5 +84,5 @@ def test_a_catalogue_name_finds_its_file(tmp_path):
 
 
 def test_the_shipped_sedan_is_the_papers_car():
-    assert catalogue() == ["sedan"]
+    assert catalogue() == ["sedan", "sedan-r13h"]
     assert load_vehicle("sedan") == ego_e_class_sedan()

@@ -8,6 +8,7 @@ closed-form lock deceleration of a fixed brake split with load transfer
 """
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -77,12 +78,36 @@ def lock_ramp(plant, mu, rate_n_per_s=4000.0):
 
 
 @pytest.mark.parametrize("mu", [1.0, 0.7, 0.3])
-def test_without_abs_the_front_axle_locks_first(plant, params, mu):
-    first = lock_ramp(plant, mu)
+def test_without_abs_the_r13h_sedan_locks_its_front_axle_first(r13h_plant, r13h_params, mu):
+    first = lock_ramp(r13h_plant, mu)
     assert "front" in first
     if "rear" in first:
         assert first["front"][0] < first["rear"][0]
-    assert first["front"][1] == pytest.approx(front_lock_g(params, mu), abs=0.03)
+    assert first["front"][1] == pytest.approx(front_lock_g(r13h_params, mu), abs=0.03)
+
+
+def test_the_papers_split_locks_the_rear_first_on_dry_road(plant, params):
+    """65/35 with a 0.54 m CG: the rear locks first, at ``z = mu_r a / ((1 - phi) L + mu_r h)``
+    with the unloaded rear tyres' friction ``mu_r`` (load sensitivity, as ``front_lock_g``)."""
+    first = lock_ramp(plant, 1.0)
+    assert first["rear"][0] < first.get("front", (math.inf,))[0]
+    # drag and rolling resistance (about 0.03 g at the lock) are not in the closed form
+    assert first["rear"][1] == pytest.approx(rear_lock_g(params, 1.0), abs=0.05)
+
+
+def rear_lock_g(p, mu):
+    """The rear axle's lock deceleration [g] with its tyres' friction at their load."""
+    tyre = PAC2002_235_60R16
+    z = mu
+    for _ in range(50):
+        fz = p.mass_kg * G_MPS2 * (p.cg_to_front_m - z * p.cg_height_m) / (2 * p.wheelbase_m)
+        mu_r = mu * (1.0 + tyre.pdx2 / tyre.pdx1 * (fz - tyre.fz0) / tyre.fz0)
+        z = (
+            mu_r
+            * p.cg_to_front_m
+            / ((1.0 - p.brake_front_share) * p.wheelbase_m + mu_r * p.cg_height_m)
+        )
+    return z
 
 
 def front_lock_g(p, mu):

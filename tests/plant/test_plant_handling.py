@@ -22,9 +22,10 @@ Y = {name: i for i, name in enumerate(OUTPUT_NAMES)}
 V80_MPS = 80.0 / 3.6
 
 
-def test_dynamic_index_is_a_sedans(params):
-    k2 = params.yaw_inertia_kgm2 / params.mass_kg
-    assert 0.9 <= k2 / (params.cg_to_front_m * params.cg_to_rear_m) <= 1.1
+def test_dynamic_index_is_a_sedans(r13h_params):
+    p = r13h_params
+    k2 = p.yaw_inertia_kgm2 / p.mass_kg
+    assert 0.9 <= k2 / (p.cg_to_front_m * p.cg_to_rear_m) <= 1.1
 
 
 def hold_speed(plant, x, steer_rad, speed_mps, mu=1.0):

@@ -11,12 +11,14 @@ import pytest
 
 from eoam_sumo.params import G_MPS2, ego_e_class_sedan
 from eoam_sumo.plant import OUTPUT_NAMES
+from eoam_sumo.vehicle_files import load_vehicle
 from eoam_sumo.vehicle_tests.common import VehicleTestOptions
 from eoam_sumo.vehicle_tests.equipment import equipped, wheel_speeds
 from eoam_sumo.vehicle_tests.harness import COLUMNS
 from eoam_sumo.vehicle_tests.procedures import TESTS
 
 SEDAN = ego_e_class_sedan()
+R13H = load_vehicle("sedan-r13h")
 
 
 def test_every_test_gives_time_series_with_the_columns_and_a_summary():
@@ -50,12 +52,18 @@ def test_the_stop_is_longer_on_a_slippery_road_and_no_shorter_than_friction_allo
     assert wet["stopping_distance_m"] > 2.5 * dry["stopping_distance_m"]
 
 
-def test_the_brake_ramp_locks_the_sedans_front_axle_first():
-    """The sedan's 73/27 split locks the front first on every friction (UN R13-H Annex 5),
-    below the friction's braking rate: the loaded front tyres lose friction (load
-    sensitivity)."""
+def test_the_brake_ramp_locks_the_r13h_sedans_front_axle_first():
+    """The corrected sedan's 73/27 split locks the front first on every friction (UN R13-H
+    Annex 5), below the friction's braking rate: the loaded front tyres lose friction (load
+    sensitivity). The paper's 65/35 locks the rear first on dry road."""
+    assert (
+        TESTS["brake-ramp"](SEDAN, VehicleTestOptions(mu=1.0)).summary["figures"][
+            "first_locked_axle"
+        ]
+        == "rear"
+    )
     for mu in (1.0, 0.7, 0.3):
-        summary = TESTS["brake-ramp"](SEDAN, VehicleTestOptions(mu=mu)).summary
+        summary = TESTS["brake-ramp"](R13H, VehicleTestOptions(mu=mu)).summary
         assert summary["figures"]["first_locked_axle"] == "front"
         assert 0.8 * mu < summary["figures"]["front_lock_braking_rate"] <= 1.05 * mu
         assert summary["passed"] is True
