@@ -100,11 +100,10 @@ class VehicleParams:
         0.60, "m", PAC2002 + ": PTY1 sin(2 atan(1/PTY2)) R0 (Pacejka 2012 sec. 7.2)"
     )
     front_steer_compliance: float = _p(
-        0.75,
+        1.0,
         "-",
-        GILLESPIE
-        + " ch. 6: the front axle's effective cornering stiffness over its tyres' (steering "
-        "compliance; understeer gradient 1.7 deg/g)",
+        PAPER + " (its car's front axle as stiff as its tyres; vehicles/sedan-r13h.toml: 0.75, "
+        "Gillespie ch. 6 steering compliance, understeer gradient 1.7 deg/g)",
     )
     roll_stiffness_front_share: float = _p(
         0.60, "-", GILLESPIE + " (front-biased roll stiffness of a sedan)"
