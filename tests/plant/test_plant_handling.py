@@ -36,15 +36,15 @@ def hold_speed(plant, x, steer_rad, speed_mps, mu=1.0):
     return plant.advance(x, (steer_rad, max(f, 0.0), 0.0), mu)
 
 
-def test_understeer_gradient_is_a_sedans(plant):
+def test_understeer_gradient_is_a_sedans(r13h_plant):
     """Constant speed 100 km/h, steady steer: the slope of ``delta - L r / v`` over ``ay``
     up to 0.4 g."""
-    p = plant.params
+    p = r13h_plant.params
     points = []
     for steer in (0.005, 0.01, 0.015, 0.02, 0.025):
         x = initial_state(0.0, 0.0, 0.0, 100.0 / 3.6, params=p).tolist()
         for _ in range(800):
-            x, y = hold_speed(plant, x, steer, 100.0 / 3.6)
+            x, y = hold_speed(r13h_plant, x, steer, 100.0 / 3.6)
         ackermann = p.wheelbase_m * x[S["yaw_rate_radps"]] / x[S["vx_mps"]]
         points.append((y[Y["ay_mps2"]] / G_MPS2, math.degrees(steer - ackermann)))
     ay_g, excess_deg = np.array(points).T

@@ -21,6 +21,7 @@ import pytest
 
 from eoam_sumo.eoam_settings import EoamSettings
 from eoam_sumo.params import G_MPS2, ego_e_class_sedan
+from eoam_sumo.plant import STATE_NAMES, initial_state
 from eoam_sumo.plant.compiled import Plant
 from eoam_sumo.sim.cosim import CoSimulation
 from eoam_sumo.sim.scenario import ScenarioOverrides
@@ -42,20 +43,18 @@ def _open_loop_growth(row: dict, steer_rad: float) -> float:
     """Lateral growth of the plant stepped from a logged state, steering held at
     ``steer_rad`` and no brake, until its lateral motion turns."""
     plant = Plant(ego_e_class_sedan())
-    x = [
-        row[k]
-        for k in (
-            "x_m",
-            "y_m",
-            "yaw_rad",
-            "vx_mps",
-            "vy_mps",
-            "yaw_rate_radps",
-            "steer_rad",
-            "drive_force_n",
-            "brake_force_n",
-        )
-    ]
+    # the logged body state; the wheels rolling and the tyres' slips relaxed (not logged)
+    x = initial_state(
+        row["x_m"],
+        row["y_m"],
+        row["yaw_rad"],
+        max(row["vx_mps"], 0.0),
+        steer_rad=row["steer_rad"],
+        drive_force_n=row["drive_force_n"],
+        brake_force_n=row["brake_force_n"],
+    ).tolist()
+    x[STATE_NAMES.index("vy_mps")] = row["vy_mps"]
+    x[STATE_NAMES.index("yaw_rate_radps")] = row["yaw_rate_radps"]
     y0 = y_max = x[1]
     for _ in range(500):
         x, _ = plant.advance(x, [steer_rad, 0.0, 0.0], row["mu"])
