@@ -17,8 +17,9 @@ from dataclasses import replace
 from pathlib import Path
 
 from eoam_sumo import __version__
+from eoam_sumo.arguments import finite, mu, speed_kmh
 from eoam_sumo.errors import InputError
-from eoam_sumo.params import MU_MAX
+from eoam_sumo.fileio import writable_dir
 from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S
 from eoam_sumo.traffic_levels.command import add_scenario_arguments, cmd_scenario
 from eoam_sumo.vehicle_tests import command as vehicle_test_command
@@ -40,30 +41,6 @@ def _positive_int(text: str) -> int:
         raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
     if value < 1:
         raise argparse.ArgumentTypeError(f"{text!r} must be >= 1")
-    return value
-
-
-def _finite(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
-    return value
-
-
-def _mu(text: str) -> float:
-    value = _finite(text)
-    if not 0.0 < value <= MU_MAX:
-        raise argparse.ArgumentTypeError(f"mu {text} is outside (0, {MU_MAX:g}]")
-    return value
-
-
-def _speed_kmh(text: str) -> float:
-    value = _finite(text)
-    if value <= 0.0:
-        raise argparse.ArgumentTypeError(f"speed {text} km/h must be > 0")
     return value
 
 
@@ -94,7 +71,7 @@ def _screenshot_times(text: str) -> tuple[tuple[float, bool], ...]:
 def _distance_or_none(text: str) -> float | None:
     if text.lower() == "none":
         return None
-    value = _finite(text)
+    value = finite(text)
     if value < 0.0:
         raise argparse.ArgumentTypeError(f"distance {text} m must be >= 0 (or 'none')")
     return value
@@ -130,16 +107,16 @@ def _tables_arguments(sub) -> None:
     p = sub.add_parser("tables", help="build the lookup tables and DMM phase boundaries")
     p.add_argument("--out", type=Path, default=Path("tables"), help="output folder")
     p.add_argument("--jobs", type=_positive_int, default=1, help="parallel processes")
-    p.add_argument("--speeds-kmh", type=_speed_kmh, nargs="+", help="speed grid (km/h)")
-    p.add_argument("--mu", type=_mu, nargs="+", help="friction grid")
+    p.add_argument("--speeds-kmh", type=speed_kmh, nargs="+", help="speed grid (km/h)")
+    p.add_argument("--mu", type=mu, nargs="+", help="friction grid")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
 def _run_arguments(sub) -> None:
     p = sub.add_parser("run", help="one co-simulation of a SUMO scenario")
     p.add_argument("cfg", type=Path, help="the scenario's .sumocfg")
-    p.add_argument("--speed-kmh", type=_speed_kmh, help="ego initial speed (km/h)")
-    p.add_argument("--mu", type=_mu, help="surface friction for every lane")
+    p.add_argument("--speed-kmh", type=speed_kmh, help="ego initial speed (km/h)")
+    p.add_argument("--mu", type=mu, help="surface friction for every lane")
     p.add_argument(
         "--oncoming-m",
         type=_distance_or_none,
@@ -149,10 +126,10 @@ def _run_arguments(sub) -> None:
     p.add_argument("--ego", default="ego", help="the ego vehicle's id (default: ego)")
     p.add_argument("--out", type=Path, default=Path("out/run"), help="output folder")
     p.add_argument(
-        "--max-time-s", type=_finite, default=DEFAULT_MAX_TIME_S, help="simulated time limit"
+        "--max-time-s", type=finite, default=DEFAULT_MAX_TIME_S, help="simulated time limit"
     )
     p.add_argument("--tables", type=Path, help="lookup tables folder (default: tables/)")
-    p.add_argument("--radar-range-m", type=_finite, help="ego radar range (default 100 m)")
+    p.add_argument("--radar-range-m", type=finite, help="ego radar range (default 100 m)")
     p.add_argument(
         "--mu-belief",
         default="known",
@@ -176,7 +153,7 @@ def _after_stop_argument(p: argparse.ArgumentParser) -> None:
     """``run`` and ``batch``: how long a run goes on after the ego stops."""
     p.add_argument(
         "--after-stop-s",
-        type=_finite,
+        type=finite,
         metavar="S",
         help="simulate S s after the ego stops (default: 2 s, then as long as a road user "
         "behind it in its lane, within 150 m, still moves towards it)",
@@ -193,17 +170,17 @@ def _policy_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--v2x-range-m",
-        type=_finite,
+        type=finite,
         default=0.0,
         help="V2X reception range (m), 0 = no V2X (safe policy only)",
     )
-    p.add_argument("--v2x-latency-s", type=_finite, default=0.1, help="V2X latency (s)")
+    p.add_argument("--v2x-latency-s", type=finite, default=0.1, help="V2X latency (s)")
     p.add_argument(
-        "--v2x-loss", type=_finite, default=0.0, help="V2X packet-loss probability, in [0, 1)"
+        "--v2x-loss", type=finite, default=0.0, help="V2X packet-loss probability, in [0, 1)"
     )
     p.add_argument(
         "--v2x-penetration",
-        type=_finite,
+        type=finite,
         default=1.0,
         help="share of road users equipped with V2X, in [0, 1]",
     )
@@ -213,7 +190,7 @@ def _gui_arguments(p: argparse.ArgumentParser) -> None:
     """``run --gui``: the sumo-gui view's pace and screenshots."""
     p.add_argument(
         "--gui-delay-ms",
-        type=_finite,
+        type=finite,
         metavar="N",
         help="with --gui: wall ms per SUMO step (default: real time)",
     )
@@ -247,7 +224,7 @@ def _batch_arguments(sub) -> None:
     p.add_argument("--jobs", type=_positive_int, default=1, help="parallel processes")
     p.add_argument("--scheduler", help="Dask scheduler address, or 'local' for a LocalCluster")
     p.add_argument("--resume", action="store_true", help="run only the cases not yet done")
-    p.add_argument("--timeout-s", type=_finite, default=300.0, help="per-case time limit")
+    p.add_argument("--timeout-s", type=finite, default=300.0, help="per-case time limit")
     p.add_argument(
         "--timeseries",
         choices=("csv", "parquet", "none"),
@@ -282,21 +259,10 @@ def _bench_arguments(sub) -> None:
     p.add_argument("--quick", action="store_true", help="tiny settings (for tests)")
 
 
-def _writable_dir(path: Path) -> Path:
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-        probe = path / ".eoam-write-test"
-        probe.write_text("")
-        probe.unlink()
-    except OSError as exc:
-        raise InputError(f"output folder {path} cannot be written: {exc.strerror}") from None
-    return path
-
-
 def _cmd_tables(args) -> int:
     from eoam_sumo.offline.build import build_tables
 
-    out = _writable_dir(args.out)
+    out = writable_dir(args.out)
     build_tables(
         out, jobs=args.jobs, speeds_kmh=args.speeds_kmh, mus=args.mu, progress=not args.no_progress
     )
@@ -310,7 +276,7 @@ def _cmd_run(args) -> int:
     from eoam_sumo.sim.scenario import ScenarioOverrides
 
     _check_run_args(args)
-    out = _writable_dir(args.out)
+    out = writable_dir(args.out)
     settings = _run_settings(args, out)
     overrides = ScenarioOverrides(
         ego_speed_mps=None if args.speed_kmh is None else args.speed_kmh / 3.6,
@@ -495,7 +461,7 @@ def _cmd_plot(args) -> int:
 
     if not args.folder.is_dir():
         raise InputError(f"{args.folder}: no such folder")
-    for path in plot_folder(args.folder, _writable_dir(args.out or args.folder)):
+    for path in plot_folder(args.folder, writable_dir(args.out or args.folder)):
         print(path)
     return 0
 
@@ -510,7 +476,7 @@ def _cmd_animate(args) -> int:
 def _cmd_bench(args) -> int:
     from eoam_sumo.bench import run_bench_cli
 
-    return run_bench_cli(_writable_dir(args.out), quick=args.quick)
+    return run_bench_cli(writable_dir(args.out), quick=args.quick)
 
 
 def _cmd_protocol(args) -> int:

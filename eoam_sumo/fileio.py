@@ -5,6 +5,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from eoam_sumo.errors import InputError
+
 
 def write_atomic(path: Path, data: str | bytes, *, durable: bool = False) -> Path:
     """Write ``data`` (text as UTF-8, newlines kept as given) to ``path`` through a temporary
@@ -19,4 +21,16 @@ def write_atomic(path: Path, data: str | bytes, *, durable: bool = False) -> Pat
             fh.flush()
             os.fsync(fh.fileno())
     os.replace(tmp, path)
+    return path
+
+
+def writable_dir(path: Path) -> Path:
+    """``path`` created if needed; ``InputError`` naming it when it cannot be written."""
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        probe = path / ".eoam-write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:
+        raise InputError(f"output folder {path} cannot be written: {exc.strerror}") from None
     return path

@@ -10,22 +10,9 @@ import io
 import json
 from pathlib import Path
 
-from eoam_sumo.errors import InputError
-from eoam_sumo.fileio import write_atomic
+from eoam_sumo.fileio import writable_dir, write_atomic
 from eoam_sumo.vehicle_tests.common import VehicleTestResult
 from eoam_sumo.vehicle_tests.harness import COLUMNS, Run
-
-
-def writable_dir(path: Path) -> Path:
-    """``path`` created if needed; ``InputError`` naming it when it cannot be written."""
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-        probe = path / ".eoam-write-test"
-        probe.write_text("")
-        probe.unlink()
-    except OSError as exc:
-        raise InputError(f"output folder {path} cannot be written: {exc.strerror}") from None
-    return path
 
 
 def run_path(out: Path, result: VehicleTestResult, run: Run) -> Path:

@@ -51,7 +51,7 @@ def test_the_sine_with_dwell_writes_one_series_per_run(tmp_path):
     ("args", "message"),
     [
         (["vehicle-test", "skid-pad"], "invalid choice: 'skid-pad'"),
-        (["vehicle-test", "brake", "--vehicle", "truck"], "unknown vehicle"),
+        (["vehicle-test", "brake", "--vehicle", "truck"], "not in the catalogue"),
         (["vehicle-test", "brake", "--mu", "0"], "mu 0 is outside"),
         (["vehicle-test", "brake", "--mu", "wet"], "'wet' is not a number"),
         (["vehicle-test", "brake", "--speed-kmh", "-5"], "speed -5 km/h"),
