@@ -17,7 +17,6 @@ from eoam_sumo.vehicle_tests.common import (
     rounded,
     vehicle_for,
 )
-from eoam_sumo.vehicle_tests.equipment import abs_fitted
 from eoam_sumo.vehicle_tests.figures import (
     LOCK_MIN_SPEED_MPS,
     LOCK_SLIP,
@@ -65,7 +64,7 @@ def brake(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle |
         stop=stop,
     )
     summary = header("brake", params, options, v0_mps)
-    summary.update(_brake_figures(run, v0_mps, options.mu, abs_fitted(params)))
+    summary.update(_brake_figures(run, v0_mps, options.mu, params.abs_fitted))
     return VehicleTestResult("brake", (run,), summary)
 
 

@@ -11,7 +11,6 @@ import numpy as np
 
 from eoam_sumo.params import VehicleParams
 from eoam_sumo.plant import cruise_drive_force_n
-from eoam_sumo.vehicle_tests.equipment import abs_fitted, esc_fitted
 from eoam_sumo.vehicle_tests.harness import PlantVehicle, Run, Sample, Vehicle
 
 SPEED_GAIN_PER_S = 1.0
@@ -67,8 +66,8 @@ def header(test: str, params: VehicleParams, options: VehicleTestOptions, speed_
     return {
         "test": test,
         "vehicle": params.name,
-        "abs": abs_fitted(params),
-        "esc": esc_fitted(params),
+        "abs": params.abs_fitted,
+        "esc": params.esc_fitted,
         "speed_kmh": round(speed_mps * 3.6, 6),
         "mu": options.mu,
     }

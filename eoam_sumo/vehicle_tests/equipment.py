@@ -17,17 +17,7 @@ def equipped(params: VehicleParams, abs_on: bool, esc_on: bool) -> VehicleParams
     return dataclasses.replace(params, abs_fitted=abs_on, esc_fitted=esc_on)
 
 
-def abs_fitted(params: VehicleParams) -> bool:
-    """Is ABS fitted and on?"""
-    return params.abs_fitted
-
-
-def esc_fitted(params: VehicleParams) -> bool:
-    """Is ESC fitted and on?"""
-    return params.esc_fitted
-
-
-def wheel_speeds(outputs: Sequence[float], vx_mps: float) -> tuple[float, float]:
+def wheel_speeds(outputs: Sequence[float]) -> tuple[float, float]:
     """Front and rear wheel circumferential speeds [m/s] (the wheel-spin states times the
-    effective radius, from the plant's outputs); ``vx_mps`` is unused and kept for callers."""
+    effective radius, from the plant's outputs)."""
     return outputs[_FRONT], outputs[_REAR]

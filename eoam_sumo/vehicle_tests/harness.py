@@ -106,7 +106,7 @@ class PlantVehicle:
 
     def _sample(self, x: list[float], outputs: list[float]) -> Sample:
         vx_mps = x[_STATE["vx_mps"]]
-        front_mps, rear_mps = wheel_speeds(outputs, vx_mps)
+        front_mps, rear_mps = wheel_speeds(outputs)
         return Sample(
             vx_mps=vx_mps,
             vy_mps=x[_STATE["vy_mps"]],

@@ -121,4 +121,4 @@ def test_wheel_speeds_are_the_plants_outputs():
     outputs = [0.0] * len(OUTPUT_NAMES)
     outputs[OUTPUT_NAMES.index("wheel_speed_front_mps")] = 12.5
     outputs[OUTPUT_NAMES.index("wheel_speed_rear_mps")] = 3.0
-    assert wheel_speeds(outputs, 20.0) == (12.5, 3.0)
+    assert wheel_speeds(outputs) == (12.5, 3.0)
