@@ -3,13 +3,17 @@
 During the lane change the reference is the optimised longitudinal acceleration of the lookup
 table at the current differential x-position (eqs. 14-29 offline); outside it a speed PID
 holds the set speed, standing in for the high-level ARV system. Both act on a net longitudinal
-force ``m a + F_res(v)`` that is split into a drive force (rear axle, >= 0) and a brake force
-(>= 0), never both.
+force ``m_eq a + F_res(v)`` that is split into a drive force (>= 0) and a brake force (>= 0),
+never both. ``m_eq = m + sum(J_w) / r_w^2`` (``equivalent_mass_kg``): the plant's wheels spin up
+and down with the car, so a brake (or drive) force referred to the road moves the body by
+``m a`` only after ``J_w a / r_w^2`` per wheel has decelerated (accelerated) the wheel itself.
 
 Force limits (``limits``): the ego has no ABS and no traction control, so the controller itself
 must never ask for a force that locks or spins a wheel. The brake force is at most the largest
-straight-line force that locks no axle (eq. 33's deceleration times m); the drive force at most
-eq. 37 (mu times the engine limit) and a share of the rear axle's static friction. Both shrink
+straight-line force that locks no axle (eq. 33's deceleration times m), as a command: the
+wheels' inertia takes its share of it, which leaves the tyres a margin against the front
+axle's load-sensitive peak on low friction, where eq. 33's margin is thin; the drive force at
+most eq. 37 (mu times the engine limit) and a share of the rear axle's static friction. Both shrink
 with the friction ellipse sqrt(1 - q^2), q = margin |a_y| / (mu g), so that the lateral
 acceleration in use keeps its tyre force: a locked or spinning axle has none, and a saturated
 rear axle spins the car.
@@ -23,6 +27,14 @@ from dataclasses import dataclass, fields
 from mypy_extensions import mypyc_attr
 
 from eoam_sumo.params import AIR_DENSITY_KGPM3, G_MPS2, VehicleParams
+
+WHEELS = 4  # the plant's two axles of two wheels, each of ``wheel_inertia_kgm2``
+
+
+def equivalent_mass_kg(params: VehicleParams) -> float:
+    """``m + 4 J_w / r_w^2`` [kg]: the mass a longitudinal force at the road accelerates with
+    the wheels rolling (Gillespie 1992, eq. 2-5, the rotating-inertia mass factor)."""
+    return params.mass_kg + WHEELS * params.wheel_inertia_kgm2 / params.wheel_radius_m**2
 
 
 @mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
@@ -103,7 +115,7 @@ class LongitudinalController:
 
     def __init__(self, params: VehicleParams, gains: LongitudinalGains = LongitudinalGains()):
         g = gains
-        self._m = params.mass_kg
+        self._m = equivalent_mass_kg(params)
         self._res0 = params.mass_kg * G_MPS2 * params.rolling_resistance_coeff
         self._drag = 0.5 * AIR_DENSITY_KGPM3 * params.drag_area_m2
         self._fmax = params.max_drive_force_n
@@ -161,7 +173,7 @@ class LongitudinalController:
         brake_limit_n: float,
         dt_s: float,
     ):
-        """Acceleration PID with feedforward m*ax_ref + F_res: (drive, brake)."""
+        """Acceleration PID with feedforward m_eq ax_ref + F_res: (drive, brake)."""
         m = self._m
         res = self.resistance_n(speed_mps)
         lo = -(brake_limit_n + res) / m - ax_ref

@@ -83,24 +83,31 @@ class SteeringCommand(NamedTuple):
     lookahead_error_m: float  # the position feedback's error e + (k_psi / k_e) psi~
 
 
+def axle_cornering_stiffness_npr(params: VehicleParams) -> tuple[float, float]:
+    """(C_f, C_r) [N/rad]: the plant's linear axle cornering stiffnesses at the static axle
+    loads. Its Magic Formula tyre's K_y alpha (Pacejka 2012 eq. 4.E25) at the static load is
+    scaled (LKY) to the tyres' stiffness of the parameters, and the front axle's is that times
+    the steering compliance (Gillespie 1992 ch. 6; ``VehicleParams.front_axle_stiffness_npr``),
+    so the steering law sees the understeer the plant has."""
+    return params.front_axle_stiffness_npr, params.cornering_stiffness_rear_npr
+
+
 def understeer_gradient(params: VehicleParams) -> float:
-    """K_us = m (b / C_f - a / C_r) / L [rad per m/s^2] (axle cornering stiffnesses)."""
+    """K_us = m (b / C_f - a / C_r) / L [rad per m/s^2] (``axle_cornering_stiffness_npr``)."""
+    c_f, c_r = axle_cornering_stiffness_npr(params)
     return (
         params.mass_kg
-        * (
-            params.cg_to_rear_m / params.cornering_stiffness_front_npr
-            - params.cg_to_front_m / params.cornering_stiffness_rear_npr
-        )
-        / params.wheelbase_m
+        * (params.cg_to_rear_m / c_f - params.cg_to_front_m / c_r)
+        / (params.wheelbase_m)
     )
 
 
 def single_track_matrices(params: VehicleParams, speed_mps: float):
     """(A, B) of the linear single-track model with states (vy, r, psi, e) about a straight
-    path at ``speed_mps`` and input the road-wheel angle (axle cornering stiffnesses)."""
+    path at ``speed_mps`` and input the road-wheel angle (``axle_cornering_stiffness_npr``)."""
     m, iz = params.mass_kg, params.yaw_inertia_kgm2
     a, b = params.cg_to_front_m, params.cg_to_rear_m
-    cf, cr, v = params.cornering_stiffness_front_npr, params.cornering_stiffness_rear_npr, speed_mps
+    (cf, cr), v = axle_cornering_stiffness_npr(params), speed_mps
     A = np.array(
         [
             [-(cf + cr) / (m * v), -(a * cf - b * cr) / (m * v) - v, 0.0, 0.0],
@@ -157,16 +164,12 @@ class SteeringController:
         self._kus = understeer_gradient(params)
         self._b = params.cg_to_rear_m
         self._a = params.cg_to_front_m
-        # Fiala: the front force peaks at tan(alpha) = 3 mu Fz_f / C_f; keep to a share of it
+        # Fiala: the front force peaks at tan(alpha) = 3 mu Fz_f / C_f (the plant's Magic
+        # Formula at 2.34 PCY1 mu Fz_f / C_f, 5 % further); keep to a share of it
         fz_front = params.mass_kg * 9.81 * params.cg_to_rear_m / params.wheelbase_m
-        self._slip_frac = (
-            gains.front_slip_fraction * 3.0 * fz_front / (params.cornering_stiffness_front_npr)
-        )
-        self._slip_k = (
-            params.mass_kg
-            * params.cg_to_front_m
-            / (params.wheelbase_m * params.cornering_stiffness_rear_npr)
-        )
+        c_f, c_r = axle_cornering_stiffness_npr(params)
+        self._slip_frac = gains.front_slip_fraction * 3.0 * fz_front / c_f
+        self._slip_k = params.mass_kg * params.cg_to_front_m / (params.wheelbase_m * c_r)
         self._max = params.max_steer_rad
         self._vmin = gains.schedule_min_speed_mps
         n = math.ceil((gains.schedule_max_speed_mps - self._vmin) / gains.schedule_step_mps)

@@ -154,9 +154,11 @@ EGO = ego_e_class_sedan()
 _CRAWLS_PAST = pytest.mark.xfail(
     strict=True,
     reason=(
-        "the EOAM is not yet tuned to the chassis plant: following a person walking away "
-        "1.13 m right of the lane centre, the ego creeps 0.72 m past their back while moving "
-        "(no contact)"
+        "following a person walking away out of the beam, the EOAM brakes to a crawl, hands "
+        "back as the coasted track pulls away and re-accelerates: a stop-and-go against the "
+        "coasted track, whose speed drifts from the person's; with the automotive radar the "
+        "run ends in a cycle's acceleration at 2.56 m/s (the ideal radar's run, 0.72 m past "
+        "their back on the chassis plant as first tuned, now keeps 0.3 m)"
     ),
 )
 
@@ -175,7 +177,7 @@ def test_a_person_walking_in_the_lane_ahead_raises_the_fcw_and_is_not_driven_thr
     never reaches them. With the paper's 18 deg beam alone they leave the beam about 5 m
     ahead and the coasted track keeps the EOAM braking (docs/sensing.md); the run does not
     end while the ego moves close behind them."""
-    if arrival > depart and radar != "ideal+near":
+    if arrival > depart and radar == "automotive":
         request.applymarker(_CRAWLS_PAST)
     cfg = _walker_scenario(tmp_path, depart, arrival)
     out = tmp_path / "run"
