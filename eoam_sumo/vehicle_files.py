@@ -19,6 +19,7 @@ import dataclasses
 import math
 import os
 import tomllib
+from collections.abc import Mapping
 from pathlib import Path
 
 from eoam_sumo.errors import InputError
@@ -112,19 +113,51 @@ def _typed(value, f: dataclasses.Field, path: Path):
     raise InputError(f"{path}: key {f.name!r} = {value!r} must be a {kind.__name__}")
 
 
-def vehicle_toml(params: VehicleParams) -> str:
-    """The vehicle file of ``params`` (every field with its unit and its source)."""
-    blocks = []
+def vehicle_toml(
+    params: VehicleParams, sources: Mapping[str, str] | None = None, header: str = ""
+) -> str:
+    """The vehicle file of ``params``: every field with its unit and its source, the source
+    from ``sources`` where given (a catalogue vehicle's own), else the dataclass's; ``header``
+    as comment lines on top."""
+    given = sources or {}
+    unknown = sorted(set(given) - {f.name for f in dataclasses.fields(params)})
+    if unknown:
+        raise ValueError(f"sources for unknown keys: {unknown}")
+    blocks = [_comment(header)] if header else []
     for f in dataclasses.fields(params):
-        value = getattr(params, f.name)
         lines = [
             f"[{f.name}]",
-            f"value = {_toml_scalar(value)}",
+            f"value = {_toml_scalar(getattr(params, f.name))}",
             f"unit = {_toml_scalar(f.metadata.get('unit', ''))}",
-            f"source = {_toml_scalar(f.metadata.get('source', ''))}",
+            f"source = {_toml_scalar(given.get(f.name, f.metadata.get('source', '')))}",
         ]
         blocks.append("\n".join(lines))
     return "\n\n".join(blocks) + "\n"
+
+
+def _comment(text: str) -> str:
+    return "\n".join(f"# {line}".rstrip() for line in text.strip().splitlines())
+
+
+def sources_of(name_or_file: str, directory: Path | None = None) -> dict[str, str]:
+    """Each parameter's source as a vehicle file states it."""
+    path = vehicle_path(name_or_file, directory)
+    with path.open("rb") as fh:
+        data = tomllib.load(fh)
+    return {key: str(entry.get("source", "")) for key, entry in data.items()}
+
+
+def static_stability_factor(params: VehicleParams) -> float:
+    """NHTSA's static stability factor ``t / (2 h)``: the lateral acceleration [g] at which a
+    rigid vehicle would tip (no suspension roll)."""
+    return params.track_m / (2.0 * params.cg_height_m)
+
+
+def dynamic_index(params: VehicleParams) -> float:
+    """The dynamic index ``k^2 / (a b)`` with ``k^2 = Iz / m`` (1 when the yaw inertia is
+    that of two masses at the axles; passenger cars are close to 1, SAE 1999-01-1336)."""
+    k2 = params.yaw_inertia_kgm2 / params.mass_kg
+    return k2 / (params.cg_to_front_m * params.cg_to_rear_m)
 
 
 def _toml_scalar(value) -> str:
