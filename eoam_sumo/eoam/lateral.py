@@ -12,7 +12,7 @@ from eoam_sumo.eoam.parts import Parts
 from eoam_sumo.eoam.state import ControllerState, LateralOutput
 from eoam_sumo.eoam_messages import EgoMeasurement
 from eoam_sumo.manoeuvre.angles import wrap_angle
-from eoam_sumo.manoeuvre.path_reference import PathReference
+from eoam_sumo.manoeuvre.path_reference import PathReference, retimed
 from eoam_sumo.params import G_MPS2
 
 
@@ -38,8 +38,8 @@ def lateral_control(parts: Parts, state: ControllerState, meas: EgoMeasurement) 
     """The reference at the distance travelled on the active path and the steering command;
     while mode 3 arrests a lateral motion, the envelope's edge against it (no reference)."""
     path = state.path
-    dx = meas.s_m - state.s0_m if path is not None else 0.0
-    ref = reference(parts, path, meas, dx)
+    dx, rate = state.path_progress(meas)
+    ref = reference(parts, path, meas, dx, rate)
     steer = parts.planned_steering if ref.planned else parts.steering
     v, d, mu = meas.vx_mps, meas.d_m, meas.mu
     if state.arrest:  # the most lateral force against the motion the envelope allows
@@ -79,16 +79,17 @@ def steering_share(parts: Parts, steer, speed_mps: float, mu: float, delta_rad: 
 
 
 def reference(
-    parts: Parts, path: PathReference | None, meas: EgoMeasurement, dx_m: float
+    parts: Parts, path: PathReference | None, meas: EgoMeasurement, dx_m: float, rate: float = 1.0
 ) -> Reference:
     """The path at ``dx_m``: past its end its offset and profile, straight along the road; a
     planned lane change with its own steering taken the actuator's lag ahead, else the
-    curvature ``preview_time_s`` ahead for the feedforward."""
+    curvature ``preview_time_s`` ahead for the feedforward; a path laid out in time re-timed
+    to the ego's speed (``rate``: ``PathReference.progress``)."""
     if path is None:
         return _LANE_CENTRE
     st = parts.settings
     v = meas.vx_mps
-    y_ref, yaw_ref, kappa_ref, ax_ref, v_plan, _, beta_plan = path.at(dx_m)
+    y_ref, yaw_ref, kappa_ref, ax_ref, v_plan, _, beta_plan = retimed(path.at(dx_m), rate)
     if not dx_m < path.length_m:
         return Reference(y_ref, 0.0, 0.0, 0.0, ax_ref, v_plan, 0.0, None, False, False)
     if path.planned_steering:  # planned with the plant's tyre
@@ -98,5 +99,5 @@ def reference(
         return Reference(
             y_ref, yaw_ref, kappa_ref, 0.0, ax_ref, v_plan, steer_ff, beta_ref, True, True
         )
-    kappa_ff = path.at(dx_m + v * st.preview_time_s).curvature_1pm
+    kappa_ff = retimed(path.at(dx_m + rate * v * st.preview_time_s), rate).curvature_1pm
     return Reference(y_ref, yaw_ref, kappa_ref, kappa_ff, ax_ref, v_plan, 0.0, None, True, False)

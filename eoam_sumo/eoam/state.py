@@ -16,6 +16,8 @@ from eoam_sumo.decision.dmm import Action, BoundaryCurve, Sector
 from eoam_sumo.decision.modes import NORMAL, Mode
 from eoam_sumo.decision.obstacle import ObstacleDecel, ObstacleTrack
 from eoam_sumo.decision.oncoming import Choice
+from eoam_sumo.eoam_messages import EgoMeasurement
+from eoam_sumo.manoeuvre.lateral_state import lateral_state
 from eoam_sumo.manoeuvre.path_reference import PathReference
 from eoam_sumo.manoeuvre.quintic_shift import QuinticShift
 
@@ -41,6 +43,7 @@ class ControllerState:
     sector: str = ""  # the last step's DMM sector letter ("": nothing in the path)
     path: PathReference | None = None  # the active manoeuvre's reference (None: lane centre)
     s0_m: float = 0.0  # station where the path began
+    t0_s: float = 0.0  # when the path began
     t_steer_s: float = 0.0  # when mode 2 began (manoeuvre timer)
     height_m: float = 0.0  # mode 2's lateral travel (a lane width)
     settle_since_s: float | None = None  # mode 5: since when the ego is settled
@@ -52,6 +55,18 @@ class ControllerState:
     oncoming_choice: Choice | None = None  # the commit/abort decision, when made
     side: int = 1  # the side of the lane change: +1 left, -1 right (the step mirrored)
     target_offset_m: float = 0.0  # the target lane's centre from the ego's (0: a lane width)
+
+    def path_progress(self, meas: EgoMeasurement) -> tuple[float, float]:
+        """(dx on the active path, how many times faster than the ego it advances): the
+        distance travelled since it began, or its pace's for an escape laid out in time
+        (``PathReference.progress``); (0, 1) without a path."""
+        path = self.path
+        if path is None:
+            return 0.0, 1.0
+        travelled = meas.s_m - self.s0_m
+        if path.pace_mps is None:
+            return travelled, 1.0
+        return path.progress(meas.time_s - self.t0_s, travelled, lateral_state(meas)[2])
 
     def friction_now(self) -> Friction:
         """The friction record of this step (the perceive stage refreshes it first)."""

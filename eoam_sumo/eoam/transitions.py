@@ -16,6 +16,7 @@ from eoam_sumo.eoam.shifts import passing_offset_m, quintic_shift
 from eoam_sumo.eoam.state import ControllerState, Decision
 from eoam_sumo.eoam_messages import EgoMeasurement, Perception
 from eoam_sumo.manoeuvre.angles import wrap_angle
+from eoam_sumo.manoeuvre.min_time_shift import MinTimeShift
 from eoam_sumo.manoeuvre.path_reference import PathReference
 
 _STEERING = (UPDATE_STEER_BRAKE, ONCOMING_STEER_BRAKE)
@@ -32,7 +33,7 @@ def advance_mode(
     """At most one transition; a new mode's entry actions, else the current mode's path
     restarts (an urgent return, mode 3's next shift)."""
     mode, path = state.mode, state.path
-    dx = meas.s_m - state.s0_m if path is not None else 0.0
+    dx = state.path_progress(meas)[0]
     settled = settled_in_lane(parts, state, meas, path, dx)
     clear = mode in _STEERING and clear_of_obstacle(parts, state, meas, path, dx)  # 2, 4
     stable = (
@@ -163,14 +164,17 @@ def start_return(
 def start_path(
     parts: Parts, state: ControllerState, meas: EgoMeasurement, traj, height_m: float | None
 ) -> None:
-    """Follow ``traj`` from the ego's offset (by ``height_m``, or as it is when None)."""
+    """Follow ``traj`` from the ego's offset (by ``height_m``, or as it is when None); a
+    time-optimal escape in time, at the pace it was laid out with."""
     state.path = PathReference(
         traj,
         start_offset_m=meas.d_m,
         height_m=height_m,
         speed_mps=meas.vx_mps,
         step_m=parts.settings.reference_step_m,
+        pace_mps=traj.speed_mps if isinstance(traj, MinTimeShift) else None,
     )
     state.s0_m = meas.s_m
+    state.t0_s = meas.time_s
     state.settle_since_s = None
     parts.longitudinal.reset()

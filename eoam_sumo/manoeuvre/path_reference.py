@@ -6,6 +6,16 @@ trigger, for the trigger speed and friction. A ``PathReference`` stores them on 
 grid as plain floats, scaled from the table's lane-change height to the wanted one (y, yaw and
 curvature scale together), so that a lookup in the 10 ms loop is one index and one blend. The
 planned speed follows from the acceleration profile: v(dx)^2 = v0^2 + 2 int_0^dx ax.
+
+A time-optimal escape (``MinTimeShift``) is a lateral motion in time, laid out along the road
+at the speed it began with. While the ego brakes, following it by the distance travelled
+would stretch it in time. Such a path is followed in time instead (``pace_mps``): the ego is
+at ``dx = pace t`` on it, ``t`` after it began, so that its lateral motion keeps the
+duration predicted for it. The course and curvature are re-timed to the ego's speed
+(``retimed``): the lateral speed v_y and acceleration a_y at that time, over the ego's speed v
+(slope v_y / v, curvature a_y / v^2, eqs. 7-13). Below ``MIN_PACE_RATIO`` of that pace, where
+the steering could no longer turn the lateral motion into the ego's course, the path is
+followed no faster than the distance travelled over that ratio.
 """
 
 from __future__ import annotations
@@ -13,6 +23,10 @@ from __future__ import annotations
 import math
 
 from eoam_sumo.manoeuvre.points import PathPoint
+
+#: A path laid out in time is followed at least this share of its pace's speed: at most this
+#: many times faster along the road than the ego travels.
+MIN_PACE_RATIO = 0.5
 
 
 class PathReference:
@@ -29,6 +43,7 @@ class PathReference:
         "_y",
         "_yaw",
         "length_m",
+        "pace_mps",
         "planned_steering",
         "start_offset_m",
     )
@@ -41,9 +56,12 @@ class PathReference:
         height_m: float | None,
         speed_mps: float,
         step_m: float,
+        pace_mps: float | None = None,
     ):
         """Sample ``traj`` (``.at(dx)``, ``.length_m``) to go from start_offset by height;
-        ``height_m=None`` takes the trajectory's own lateral positions as they are."""
+        ``height_m=None`` takes the trajectory's own lateral positions as they are;
+        ``pace_mps``: the speed along the road at which it is laid out in time (None: it is
+        followed by the distance travelled)."""
         if not step_m > 0.0:
             raise ValueError(f"reference step_m={step_m!r} must be > 0")
         length = float(traj.length_m)
@@ -80,6 +98,25 @@ class PathReference:
         self.length_m = length
         self.start_offset_m = self._y[0]
         self._inv, self._n = 1.0 / step, n
+        if pace_mps is not None and not (math.isfinite(pace_mps) and pace_mps > 0.0):
+            raise ValueError(f"reference pace_mps={pace_mps!r} must be finite and > 0")
+        self.pace_mps = pace_mps
+
+    def progress(
+        self, elapsed_s: float, travelled_m: float, speed_mps: float
+    ) -> tuple[float, float]:
+        """(where the ego is on the path, dx [m]; how many times faster than the ego's
+        ``speed_mps`` along the road dx advances) ``elapsed_s`` after it began, having
+        travelled ``travelled_m`` along the road: the distance travelled, or for a path laid
+        out in time its pace's distance, at most ``travelled_m / MIN_PACE_RATIO``."""
+        pace = self.pace_mps
+        if pace is None:
+            return travelled_m, 1.0
+        timed = pace * elapsed_s
+        floor = travelled_m / MIN_PACE_RATIO
+        if floor < timed:
+            return floor, 1.0 / MIN_PACE_RATIO
+        return timed, pace / max(speed_mps, 1e-3)
 
     def at(self, dx_m: float) -> PathPoint:
         """The reference at ``dx_m``, held at the ends of the path."""
@@ -119,3 +156,24 @@ class PathReference:
             self._steer[i],
             self._beta[i],
         )
+
+
+def retimed(point: PathPoint, rate: float) -> PathPoint:
+    """``point`` of a path laid out in time, for an ego ``rate`` times slower than its pace:
+    the same lateral speed and acceleration at the ego's speed, i.e. the slope ``rate`` times
+    and the curvature ``rate^2`` times the path's (with the slope's own factor,
+    kappa = y'' / (1 + y'^2)^1.5)."""
+    if rate == 1.0:
+        return point
+    slope = math.tan(point.yaw_rad)
+    slope_now = rate * slope
+    stretch = ((1.0 + slope * slope) / (1.0 + slope_now * slope_now)) ** 1.5
+    return PathPoint(
+        point.y_m,
+        math.atan(slope_now),
+        point.curvature_1pm * rate * rate * stretch,
+        point.ax_mps2,
+        point.speed_mps,
+        point.steer_rad,
+        point.sideslip_rad,
+    )

@@ -3,6 +3,13 @@
 Each vehicle of ``scenario.scripted_stops`` keeps its departure speed for ``hold_s`` after
 departing, then its speed is commanded down at ``min(decel_mps2, mu_lane * g)`` per second to
 standstill, mu_lane the friction of the lane under it, and stays there.
+
+The hold is exact whatever the vehicle's type: its speed is commanded with SUMO's checks off
+(``HOLD_SPEED_MODE``) and its lane changes off, so that neither the driver's imperfection
+(``sigma``), its speed factor (``speedFactor``, ``speedDev``), a slower car ahead of it nor
+the lane-change model's cooperative slowing moves it off the departure speed or out of its
+lane. After the hold the stop keeps the safe speed (``SCRIPTED_SPEED_MODE``) and the
+vehicle's own lane-change mode is given back.
 """
 
 from __future__ import annotations
@@ -13,6 +20,8 @@ from eoam_sumo.params import G_MPS2
 from eoam_sumo.sim.session.calls import StepCalls
 
 SCRIPTED_SPEED_MODE = 25  # safe speed, right of way, red lights; no accel/decel bound
+HOLD_SPEED_MODE = 32  # the commanded speed as it is: no safe speed, bounds or right of way
+NO_LANE_CHANGES = 0
 
 
 @dataclass
@@ -22,8 +31,10 @@ class _Script:
     hold_end_s: float
     decel_mps2: float
     hold_speed_mps: float
+    lane_change_mode: int  # the vehicle's own, given back after the hold
     mu: float = 1.0
     last_cmd_mps: float = -1.0
+    holding: bool = True
 
 
 class StopScripts:
@@ -38,12 +49,21 @@ class StopScripts:
     def start(self, vid: str, watch) -> None:
         """``vid`` departed: its stop runs from now on (``watch(vid)`` subscribes it)."""
         hold, decel = self._stops[vid]
+        veh = self._veh
         self.pending.discard(vid)
         self.running[vid] = _Script(
-            self._veh.getDeparture(vid) + hold, decel, self._veh.getSpeed(vid)
+            veh.getDeparture(vid) + hold, decel, veh.getSpeed(vid), veh.getLaneChangeMode(vid)
         )
-        self._veh.setSpeedMode(vid, SCRIPTED_SPEED_MODE)
+        veh.setSpeedMode(vid, HOLD_SPEED_MODE)
+        veh.setLaneChangeMode(vid, NO_LANE_CHANGES)
         watch(vid)
+
+    def _release(self, vid: str, script: _Script) -> None:
+        """The hold is over: the stop regards the safe speed, the lane changes are the
+        vehicle's own again."""
+        script.holding = False
+        self._veh.setSpeedMode(vid, SCRIPTED_SPEED_MODE)
+        self._veh.setLaneChangeMode(vid, script.lane_change_mode)
 
     def apply(self, t_next_s: float, dt_s: float, results: dict, friction, watch) -> None:
         """Command each running stop's speed at the end of the coming step, ending at
@@ -57,6 +77,8 @@ class StopScripts:
             if t_next_s <= script.hold_end_s + 1e-9:
                 cmd = script.hold_speed_mps
             else:
+                if script.holding:
+                    self._release(vid, script)
                 if res[tc.VAR_LANE_ID]:
                     script.mu = friction(res[tc.VAR_LANE_ID])
                 decel = min(script.decel_mps2, script.mu * G_MPS2)
