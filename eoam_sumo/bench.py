@@ -23,6 +23,10 @@ Figures:
   SUMO alone stepping the same scenario at 10 ms for the same simulated time, and
   ``traffic_us_per_user_step``: the co-simulation's own cost per road user in SUMO per step
   (CPU time of the step loop less SUMO alone's for as many steps).
+
+``--against REV`` measures instead this tree against git revision ``REV`` in one run
+(``compare_against``): the plant's step and the Table 2 batch, each in fresh interpreters that
+alternate between the trees, and the ratios of this tree's figures over ``REV``'s.
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from eoam_sumo.errors import InputError
 from eoam_sumo.sim.observers import StepObserver
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -336,4 +341,213 @@ def run_bench_cli(out_dir: Path, quick: bool = False) -> int:
     result = run_bench(out_dir, quick)
     print(format_table(result))
     print(f"written {out_dir / 'bench.json'}")
+    return 0
+
+
+# --- the previous plant, measured in the same run (``eoam-sumo bench --against REV``) --------
+
+#: Ratio targets against a previous revision: the plant's step at most 2x the previous
+#: plant's, the Table 2 batch at most 1.3x, both measured in one run (docs/performance.md).
+AGAINST_TARGETS = {
+    "plant_us_per_step_ratio": 2.0,
+    "plant_cpu_us_per_step_ratio": 2.0,
+    "batch_wall_ratio": 1.3,
+    "batch_cpu_ratio": 1.3,
+}
+#: The figures a probe measures in a tree, by kind.
+PROBE_FIGURES = {
+    "plant": ("plant_us_per_step", "plant_cpu_us_per_step"),
+    "batch": ("batch_wall_s", "batch_cpu_s"),
+}
+
+#: Run with ``python -c`` in a subprocess whose ``PYTHONPATH`` is one tree: measures that
+#: tree's figures through the API both trees share, prints them as one line of JSON.
+_PROBE = r"""
+import json, math, os, resource, statistics, sys, time
+from importlib import machinery
+from pathlib import Path
+
+import eoam_sumo
+from eoam_sumo.sim import cosim
+
+kind, quick, out = sys.argv[1], sys.argv[2] == "1", Path(sys.argv[3])
+root = Path(eoam_sumo.__file__).resolve().parents[1]
+speed_mps = 120 / 3.6
+res = {"package": str(root), "load_avg_1min": os.getloadavg()[0],
+       "compiled": isinstance(getattr(cosim.__spec__, "loader", None),
+                              machinery.ExtensionFileLoader)}
+
+def cpu_s():
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+
+if kind == "plant":
+    from eoam_sumo.params import ego_e_class_sedan
+    from eoam_sumo.plant import Plant, initial_state
+    from eoam_sumo.sim.cosim import CoSimulation
+    from eoam_sumo.sim.observers import PhaseTimer
+    from eoam_sumo.sim.scenario import ScenarioOverrides
+    from eoam_sumo.sim.settings import RunSettings
+
+    timer = PhaseTimer()
+    over = ScenarioOverrides(ego_speed_mps=speed_mps, mu=1.0)
+    sim = CoSimulation(root / "scenarios" / "baseline.sumocfg", over, RunSettings(),
+                       observers=[timer])
+    per_step = []
+    for _ in range(1 if quick else 5):
+        sim.run()
+        per_step.append(1e6 * timer.totals["actuate"] / timer.steps)
+    res["plant_us_per_step"] = statistics.median(per_step)
+    advance = Plant(ego_e_class_sedan()).advance
+    x = initial_state(0.0, 0.0, 0.0, speed_mps, drive_force_n=300.0).tolist()
+    calls = 2000 if quick else 20000
+    t0 = time.process_time()
+    for k in range(calls):
+        x, _y = advance(x, (0.02 * math.sin(0.0314 * k), 300.0, 0.0), 1.0)
+    res["plant_cpu_us_per_step"] = 1e6 * (time.process_time() - t0) / calls
+else:
+    from eoam_sumo.batch.runner import run_batch
+
+    matrix = root / "scenarios" / "table2.toml"
+    if quick:
+        matrix = out / "quick.toml"
+        matrix.write_text(
+            f'[scenario]\nsumocfg = "{(root / "scenarios" / "baseline.sumocfg").as_posix()}"\n'
+            "max_time_s = 20.0\n[sweep]\nego_speed_kmh = [120]\nmu = [1.0, 0.7]\n")
+    c0, t0 = cpu_s(), time.perf_counter()
+    results = run_batch(matrix, out / "batch", jobs=2, progress=False)
+    res["batch_wall_s"] = time.perf_counter() - t0
+    res["batch_cpu_s"] = cpu_s() - c0
+    res["batch_cases"] = len(results)
+print(json.dumps(res))
+"""
+
+
+def _git(args: list[str], what: str) -> str:
+    """The output of ``git -C ROOT ARGS``; InputError naming ``what`` when git fails."""
+    try:
+        done = subprocess.run(
+            ["git", "-C", str(ROOT), *args], capture_output=True, text=True, check=False
+        )
+    except OSError as exc:
+        raise InputError(f"bench --against: git not found ({exc})") from exc
+    if done.returncode != 0:
+        raise InputError(f"bench --against: {what}")
+    return done.stdout.strip()
+
+
+def export_revision(rev: str, dest: Path) -> str:
+    """Export ``rev``'s tree (``git archive``) into ``dest``; its commit. InputError when this
+    source tree is not a git checkout or ``rev`` names no commit in it."""
+    _git(["rev-parse", "--is-inside-work-tree"], f"{ROOT} is not a git checkout")
+    commit = _git(
+        ["rev-parse", "--verify", "--quiet", f"{rev}^{{commit}}"], f"unknown revision {rev!r}"
+    )
+    dest.mkdir(parents=True, exist_ok=True)
+    archive = subprocess.Popen(["git", "-C", str(ROOT), "archive", commit], stdout=subprocess.PIPE)
+    subprocess.run(["tar", "-x", "-C", str(dest)], stdin=archive.stdout, check=True)
+    if archive.stdout is not None:
+        archive.stdout.close()
+    if archive.wait() != 0:
+        raise RuntimeError(f"git archive {commit} failed")
+    return commit
+
+
+def _probe(tree: Path, kind: str, quick: bool, work: Path) -> dict:
+    """One probe (``_PROBE``) of ``tree`` in a fresh interpreter: only that tree on the path,
+    its own plant cache (``work/cache``) so that the two trees' C builds never mix."""
+    out = Path(tempfile.mkdtemp(prefix=f"{kind}-", dir=work))
+    env = dict(os.environ, PYTHONPATH=str(tree), EOAM_SUMO_CACHE_DIR=str(work / "cache"))
+    cmd = [sys.executable, "-c", _PROBE, kind, "1" if quick else "0", str(out)]
+    done = subprocess.run(cmd, cwd=tree, env=env, capture_output=True, text=True, check=False)
+    if done.returncode != 0:
+        tail = (done.stderr.strip().splitlines() or ["no output"])[-1]
+        raise RuntimeError(f"bench --against: the {kind} probe of {tree} failed: {tail}")
+    result = json.loads(done.stdout.strip().splitlines()[-1])
+    if Path(result["package"]) != tree.resolve():
+        raise RuntimeError(f"bench --against: the probe of {tree} imported {result['package']}")
+    return result
+
+
+def _compile_tree(tree: Path) -> None:
+    """Compile the tree's step loop in place (setup.py, mypyc), as ``make compiled`` does."""
+    env = dict(os.environ, EOAM_SUMO_COMPILE="1")
+    cmd = [sys.executable, "setup.py", "-q", "build_ext", "--inplace"]
+    subprocess.run(cmd, cwd=tree, env=env, check=True, capture_output=True)
+
+
+def _alternate(trees: dict[str, Path], quick: bool, pairs: int, tmp: Path) -> dict:
+    """Each probe kind ``pairs`` times per tree, the trees alternating (previous, current, then
+    current, previous, ...) so that both see the same machine load; every probe's figures."""
+    samples: dict[str, list[dict]] = {side: [] for side in trees}
+    for side, tree in trees.items():  # warm-up: each tree's plant compiled into its cache
+        (tmp / side).mkdir()
+        _probe(tree, "plant", True, tmp / side)
+    for kind in PROBE_FIGURES:
+        for i in range(pairs):
+            order = list(trees) if i % 2 == 0 else list(reversed(trees))
+            for side in order:
+                samples[side].append(_probe(trees[side], kind, quick, tmp / side))
+    return samples
+
+
+def _summarise(samples: dict[str, list[dict]]) -> dict:
+    """Medians per tree and figure, the current tree's over the previous one's, the load."""
+    result: dict[str, Any] = {}
+    for side, probes in samples.items():
+        for figures in PROBE_FIGURES.values():
+            for name in figures:
+                result[f"{side}_{name}"] = statistics.median(p[name] for p in probes if name in p)
+        loads = [p["load_avg_1min"] for p in probes]
+        result[f"{side}_load_avg_1min"] = [min(loads), max(loads)]
+        result[f"{side}_compiled"] = all(p["compiled"] for p in probes)
+    for ratio, name in zip(AGAINST_TARGETS, [n for f in PROBE_FIGURES.values() for n in f]):
+        result[ratio] = result[f"current_{name}"] / result[f"previous_{name}"]
+    result["targets"] = {
+        k: {"target": f"<= {v:g}", "met": result[k] <= v} for k, v in AGAINST_TARGETS.items()
+    }
+    return result
+
+
+def compare_against(rev: str, out_dir: Path, quick: bool = False, pairs: int = 3) -> dict:
+    """The plant's step and the Table 2 batch of this tree against ``rev``'s, in one run:
+    ``rev`` exported to a temporary folder (compiled when this tree runs compiled), each
+    figure measured ``pairs`` times per tree in alternation; writes ``bench-against.json``."""
+    with tempfile.TemporaryDirectory(prefix="eoam-bench-against-") as tmp_dir:
+        tmp = Path(tmp_dir)
+        commit = export_revision(rev, tmp / "tree")
+        if _compiled():
+            _compile_tree(tmp / "tree")
+        trees = {"previous": tmp / "tree", "current": ROOT}
+        result = {"against": rev, "against_commit": commit, "quick": quick, "pairs": pairs}
+        result.update(_summarise(_alternate(trees, quick, pairs, tmp)))
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / "bench-against.json").write_text(json.dumps(result, indent=2) + "\n")
+    return result
+
+
+def format_against(result: dict) -> str:
+    """The comparison as a table: each figure for both trees, the ratios beside their targets."""
+    lines = [
+        f"against {result['against']} ({result['against_commit'][:12]}), "
+        f"{result['pairs']} alternating probes per tree",
+        f"load average (1 min) previous {result['previous_load_avg_1min']}, "
+        f"current {result['current_load_avg_1min']}",
+        f"{'figure':<24}  {'previous':>10}  {'current':>10}  {'ratio':>6}  target",
+    ]
+    names = [n for f in PROBE_FIGURES.values() for n in f]
+    for ratio, name in zip(AGAINST_TARGETS, names):
+        tgt = result["targets"][ratio]
+        lines.append(
+            f"{name:<24}  {result[f'previous_{name}']:>10.4g}  {result[f'current_{name}']:>10.4g}"
+            f"  {result[ratio]:>6.3f}  {tgt['target']} {'met' if tgt['met'] else 'MISSED'}"
+        )
+    return "\n".join(lines)
+
+
+def run_against_cli(out_dir: Path, rev: str, quick: bool = False, pairs: int = 3) -> int:
+    result = compare_against(rev, out_dir, quick, pairs)
+    print(format_against(result))
+    print(f"written {out_dir / 'bench-against.json'}")
     return 0

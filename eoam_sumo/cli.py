@@ -257,6 +257,12 @@ def _bench_arguments(sub) -> None:
     p = sub.add_parser("bench", help="the performance benchmark")
     p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder")
     p.add_argument("--quick", action="store_true", help="tiny settings (for tests)")
+    p.add_argument(
+        "--against",
+        metavar="REV",
+        help="instead: the plant's step and Table 2 batch against git revision REV, as ratios",
+    )
+    p.add_argument("--pairs", type=_positive_int, default=3, help="with --against: probes per tree")
 
 
 def _cmd_tables(args) -> int:
@@ -474,8 +480,10 @@ def _cmd_animate(args) -> int:
 
 
 def _cmd_bench(args) -> int:
-    from eoam_sumo.bench import run_bench_cli
+    from eoam_sumo.bench import run_against_cli, run_bench_cli
 
+    if args.against is not None:
+        return run_against_cli(writable_dir(args.out), args.against, args.quick, args.pairs)
     return run_bench_cli(writable_dir(args.out), quick=args.quick)
 
 

@@ -1,20 +1,31 @@
 """The benchmark runs on tiny settings and writes every key, each one documented in
-docs/performance.md (no timing is asserted)."""
+docs/performance.md (no timing is asserted); ``--against``: the ratios from the medians, its
+bad input, a quick comparison with HEAD."""
 
 from __future__ import annotations
 
 import json
 import math
 import re
+import subprocess
+import sys
 from importlib import machinery
 from pathlib import Path
 
 import pytest
 
-from eoam_sumo.bench import TARGETS, run_bench
+from eoam_sumo import bench
+from eoam_sumo.bench import (
+    AGAINST_TARGETS,
+    TARGETS,
+    _summarise,
+    compare_against,
+    export_revision,
+    run_bench,
+)
+from eoam_sumo.errors import InputError
 from eoam_sumo.sim import cosim
 
-pytestmark = pytest.mark.sumo
 PERFORMANCE = Path(__file__).resolve().parents[1] / "docs" / "performance.md"
 
 KEYS = (
@@ -35,6 +46,7 @@ KEYS = (
 )
 
 
+@pytest.mark.sumo
 def test_quick_bench_writes_every_key(tmp_path):
     result = run_bench(tmp_path, quick=True)
     saved = json.loads((tmp_path / "bench.json").read_text())
@@ -55,3 +67,85 @@ def _documented_keys() -> set[str]:
     section = text.split("## What is measured", 1)[1].split("\n## ", 1)[0]
     rows = [line.split("|")[1] for line in section.splitlines() if line.startswith("| `")]
     return {key for cell in rows for key in re.findall(r"`([a-z_0-9]+)`", cell)}
+
+
+def test_summarise_takes_medians_per_tree_and_their_ratios():
+    def probe(load, **figures):
+        return {"load_avg_1min": load, "compiled": False, **figures}
+
+    samples = {
+        "previous": [
+            probe(1.0, plant_us_per_step=5.0, plant_cpu_us_per_step=4.0),
+            probe(2.0, plant_us_per_step=7.0, plant_cpu_us_per_step=6.0),
+            probe(1.5, plant_us_per_step=6.0, plant_cpu_us_per_step=5.0),
+            probe(1.0, batch_wall_s=10.0, batch_cpu_s=20.0),
+        ],
+        "current": [
+            probe(3.0, plant_us_per_step=13.0, plant_cpu_us_per_step=9.0),
+            probe(1.0, plant_us_per_step=11.0, plant_cpu_us_per_step=11.0),
+            probe(2.0, plant_us_per_step=12.0, plant_cpu_us_per_step=10.0),
+            probe(2.0, batch_wall_s=14.0, batch_cpu_s=22.0),
+        ],
+    }
+    result = _summarise(samples)
+    assert result["previous_plant_us_per_step"] == 6.0
+    assert result["current_plant_us_per_step"] == 12.0
+    assert result["plant_us_per_step_ratio"] == 2.0
+    assert result["plant_cpu_us_per_step_ratio"] == 2.0
+    assert result["batch_wall_ratio"] == pytest.approx(1.4)
+    assert result["batch_cpu_ratio"] == pytest.approx(1.1)
+    assert result["previous_load_avg_1min"] == [1.0, 2.0]
+    assert result["current_load_avg_1min"] == [1.0, 3.0]
+    met = {k: v["met"] for k, v in result["targets"].items()}
+    assert met == {
+        "plant_us_per_step_ratio": True,
+        "plant_cpu_us_per_step_ratio": True,
+        "batch_wall_ratio": False,
+        "batch_cpu_ratio": True,
+    }
+
+
+def test_against_an_unknown_revision_is_one_line_and_exit_2(tmp_path):
+    if not _in_git_checkout():
+        pytest.skip("not a git checkout")
+    with pytest.raises(InputError, match="unknown revision 'no-such-revision-xyz'"):
+        export_revision("no-such-revision-xyz", tmp_path / "tree")
+    command = ["bench", "--against", "no-such-revision-xyz", "--out", str(tmp_path / "out")]
+    done = subprocess.run(
+        [sys.executable, "-m", "eoam_sumo", *command],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert done.returncode == 2
+    assert len(done.stderr.strip().splitlines()) == 1
+    assert "unknown revision" in done.stderr
+
+
+def test_against_outside_a_git_checkout_is_an_input_error(tmp_path, monkeypatch):
+    monkeypatch.setattr(bench, "ROOT", tmp_path)  # tmp_path: in no git checkout
+    with pytest.raises(InputError, match="is not a git checkout"):
+        export_revision("HEAD", tmp_path / "tree")
+
+
+@pytest.mark.sumo
+def test_quick_against_head_writes_both_trees_and_the_ratios(tmp_path):
+    if not _in_git_checkout():
+        pytest.skip("not a git checkout")
+    result = compare_against("HEAD", tmp_path, quick=True, pairs=1)
+    saved = json.loads((tmp_path / "bench-against.json").read_text())
+    assert saved == json.loads(json.dumps(result))
+    for side in ("previous", "current"):
+        for key in ("plant_us_per_step", "plant_cpu_us_per_step", "batch_wall_s", "batch_cpu_s"):
+            assert math.isfinite(saved[f"{side}_{key}"]) and saved[f"{side}_{key}"] > 0
+    assert set(saved["targets"]) == set(AGAINST_TARGETS)
+    assert all(math.isfinite(saved[k]) and saved[k] > 0 for k in AGAINST_TARGETS)
+
+
+def _in_git_checkout() -> bool:
+    done = subprocess.run(
+        ["git", "-C", str(bench.ROOT), "rev-parse", "--is-inside-work-tree"],
+        capture_output=True,
+        check=False,
+    )
+    return done.returncode == 0

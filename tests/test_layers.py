@@ -94,7 +94,7 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
     "netbuild": ({"errors"}, {"sumolib", "sumo"}),
     "traffic_levels": ({"errors", "netbuild"}, {"numpy", "libsumo"}),
     "bench": (
-        {"params", "plant", "offline", "sensing", "sim", "batch", "traffic_scenario"},
+        {"params", "errors", "plant", "offline", "sensing", "sim", "batch", "traffic_scenario"},
         {"libsumo", "sumolib"},
     ),
     "protocols": (

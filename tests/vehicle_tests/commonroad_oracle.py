@@ -22,12 +22,19 @@ from vehiclemodels.utils.tire_model import formula_lateral, formula_longitudinal
 from vehiclemodels.vehicle_dynamics_mb import vehicle_dynamics_mb
 
 from eoam_sumo.params import VehicleParams
+from eoam_sumo.plant.magic_formula import PAC2002_235_60R16
 from eoam_sumo.vehicle_tests.harness import STEP_S, Controls, Sample, rolling_start
 
 STEER_TAU_S = 0.02
 """Time constant of the steering follower of both models (our ``steer_lag_s`` the same)."""
 
 CR_G_MPS2 = 9.81  # commonroad's gravity, the same as ours
+
+NO_RELAXATION_M = 0.05
+"""Our tyres' relaxation lengths in the comparison: their model's slips are algebraic (no
+relaxation); ours carry the shortest length the plant's 1 ms midpoint rule integrates with a
+margin at the tests' speeds (time constant sigma / v >= 1.8 ms up to 100 km/h; the rule is
+stable down to 0.5 ms)."""
 
 
 def commonroad_params():
@@ -61,13 +68,49 @@ def sliding_friction_ratio(p) -> float:
     return abs(formula_longitudinal(1.0, 0.0, fz, p.tire)) / peak
 
 
+def roll_stiffness_front_share(p) -> float:
+    """The front axle's share of their roll stiffness: per axle the springs ``K_s T^2 / 2``
+    and the auxiliary torsion stiffness ``|K_ts|`` (negative in their sets: it adds,
+    ``vehicle_dynamics_mb``'s suspension forces); their roll centres are at the ground."""
+    front = p.K_sf * p.T_f**2 / 2.0 + abs(p.K_tsf)
+    rear = p.K_sr * p.T_r**2 / 2.0 + abs(p.K_tsr)
+    return float(front / (front + rear))
+
+
+def first_lock_tyre_load_n(p, ours: VehicleParams) -> float:
+    """The load on each tyre of the axle that locks first in a slow brake ramp, at its lock,
+    by the closed form of a load-independent friction (theirs: ``peak_friction``):
+    ``z = mu b / (phi L - mu h)`` front, ``mu a / ((1 - phi) L + mu h)`` rear."""
+    mu = peak_friction(p)[0]
+    a, b, h = ours.cg_to_front_m, ours.cg_to_rear_m, ours.cg_height_m
+    wheelbase, phi = a + b, ours.brake_front_share
+    z_front = mu * b / (phi * wheelbase - mu * h)
+    z_rear = mu * a / ((1.0 - phi) * wheelbase + mu * h)
+    weight_n = ours.mass_kg * CR_G_MPS2
+    if z_front <= z_rear:
+        return 0.5 * weight_n * (b + z_front * h) / wheelbase
+    return 0.5 * weight_n * (a - z_rear * h) / wheelbase
+
+
+def brake_ramp_mu(p, ours: VehicleParams) -> float:
+    """Our road friction for the brake ramp: their tyre's friction (``p_dx1`` at every load:
+    commonroad's ``formula_longitudinal`` has no ``PDX2``) at the load of the tyres that lock
+    first (``first_lock_tyre_load_n``). Our road mu is the friction at the tyre's nominal
+    load (LMUX = mu / PDX1), and it rises at lighter loads by PDX2 (docs/chassis.md)."""
+    c = PAC2002_235_60R16
+    dfz = (first_lock_tyre_load_n(p, ours) - c.fz0) / c.fz0
+    return peak_friction(p)[0] * c.pdx1 / (c.pdx1 + c.pdx2 * dfz)
+
+
 def ours_from_commonroad(p) -> VehicleParams:
     """Our ``VehicleParams`` with commonroad's BMW 320i values: the same mass, yaw inertia,
     static axle loads (so the CG distances), CG height, track and size, cornering stiffness per
     axle (``-p_ky1 Fz`` of their tyre at the static load), brake split, locked-tyre friction,
     steering rate limit and the drive limits of their acceleration constraint (force
-    ``m a_max``, power ``m a_max v_switch``). Theirs has no drag and no rolling resistance: 0.
-    Their model has no steering ratio: ours (16) is kept, for the hand-wheel columns only."""
+    ``m a_max``, power ``m a_max v_switch``), wheel radius and the front share of the roll
+    stiffness. Theirs has no drag, no rolling resistance and no tyre relaxation: 0 (the
+    relaxation lengths ``NO_RELAXATION_M``). Their model has no steering ratio: ours (16) is
+    kept, for the hand-wheel columns only."""
     front_n, rear_n = static_axle_loads_n(p)
     weight_n = p.m * CR_G_MPS2
     wheelbase = p.a + p.b
@@ -89,6 +132,10 @@ def ours_from_commonroad(p) -> VehicleParams:
         cornering_stiffness_front_npr=-float(p.tire.p_ky1) * front_n,
         cornering_stiffness_rear_npr=-float(p.tire.p_ky1) * rear_n,
         front_steer_compliance=1.0,
+        roll_stiffness_front_share=roll_stiffness_front_share(p),
+        wheel_radius_m=float(p.R_w),
+        relaxation_length_long_m=NO_RELAXATION_M,
+        relaxation_length_lat_m=NO_RELAXATION_M,
         sliding_friction_ratio=sliding_friction_ratio(p),
         max_drive_force_n=float(p.m * lon.a_max),
         max_drive_power_w=float(p.m * lon.a_max * lon.v_switch),
