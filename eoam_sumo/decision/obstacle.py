@@ -6,7 +6,10 @@ when it brakes gently; when it brakes hard the closing speed grows faster than t
 assumes and the warning and braking come late (on the baseline at 100 km/h a 3 m/s^2 stop
 ended worse than an 8 m/s^2 one). The decision therefore also places the obstacle where it
 will stop: a standing obstacle at range + v_obj^2 / (2 a_obj), approached at the ego's own
-speed, and takes the more urgent of the two sectors.
+speed, and takes the more urgent of the two sectors. An obstacle braking more gently than the
+ego can is still moving when the speeds match, and the gap is least then, not where it stands:
+the ego needs v_rel^2 / (2 (a_ego - a_obj)) instead of v_rel^2 / (2 a_ego) (relative motion
+under constant decelerations), ``speed_match_factor`` times the paper's stopping distance.
 
 The obstacle's speed is the ego's speed plus the range rate; its deceleration the derivative
 of that speed through a first-order low-pass filter (``time_constant_s``), as an ACC estimates
@@ -24,7 +27,7 @@ from typing import NamedTuple
 class ObstacleDecel:
     """Low-pass estimate of the in-path obstacle's deceleration [m/s^2, braking positive]."""
 
-    __slots__ = ("_speed", "_t", "decel_mps2", "plausible_mps2", "time_constant_s")
+    __slots__ = ("_raw", "_speed", "_t", "decel_mps2", "plausible_mps2", "time_constant_s")
 
     def __init__(self, time_constant_s: float = 0.1, plausible_mps2: float = 15.0):
         if not (math.isfinite(time_constant_s) and time_constant_s > 0.0):
@@ -37,6 +40,7 @@ class ObstacleDecel:
         """Forget the track (a new obstacle, or none)."""
         self._t = math.nan
         self._speed = 0.0
+        self._raw = math.inf  # the last unfiltered derivative (inf: none yet)
         self.decel_mps2 = 0.0
 
     def update(self, time_s: float, obstacle_speed_mps: float) -> float:
@@ -46,10 +50,17 @@ class ObstacleDecel:
             raw = (self._speed - obstacle_speed_mps) / dt
             if -self.plausible_mps2 <= raw <= self.plausible_mps2:
                 self.decel_mps2 += dt / (self.time_constant_s + dt) * (raw - self.decel_mps2)
+                self._raw = raw
             else:
                 self.decel_mps2 = 0.0
+                self._raw = math.inf
         self._t, self._speed = time_s, obstacle_speed_mps
         return self.decel_mps2
+
+    def settled(self, tolerance_mps2: float = 0.5) -> bool:
+        """The estimate follows the last measured derivative within ``tolerance_mps2``: not
+        lagging a change of the obstacle's braking (its onset: the filter still rising)."""
+        return abs(self._raw - self.decel_mps2) <= tolerance_mps2
 
 
 def stopping_range_m(range_m: float, obstacle_speed_mps: float, decel_mps2: float) -> float:
@@ -58,6 +69,21 @@ def stopping_range_m(range_m: float, obstacle_speed_mps: float, decel_mps2: floa
     if decel_mps2 <= 0.0 or obstacle_speed_mps <= 0.0:
         return math.inf if obstacle_speed_mps > 0.0 else range_m
     return range_m + obstacle_speed_mps * obstacle_speed_mps / (2.0 * decel_mps2)
+
+
+def speed_match_factor(
+    closing_mps: float, obstacle_speed_mps: float, decel_mps2: float, ego_decel_mps2: float
+) -> float:
+    """The stopping distance's factor a_ego / (a_ego - a_obj) when an obstacle braking at
+    ``decel_mps2`` is still moving as the ego, braking at ``ego_decel_mps2``, matches its
+    speed (the gap least then); 1.0 otherwise (it holds its speed, stops first, or brakes at
+    least as hard as the ego: the standing placement or the paper's rule)."""
+    rel_decel = ego_decel_mps2 - decel_mps2
+    if decel_mps2 <= 0.0 or rel_decel <= 0.0 or closing_mps <= 0.0:
+        return 1.0
+    if obstacle_speed_mps * rel_decel <= closing_mps * decel_mps2:  # stops before the match
+        return 1.0
+    return ego_decel_mps2 / rel_decel
 
 
 def travel_m(speed_mps: float, decel_mps2: float, dt_s: float) -> float:

@@ -44,10 +44,13 @@ def sector_action(
     if rng is None:
         return None, NONE
     st = parts.settings
-    curve = state.friction_now().curve
+    friction = state.friction_now()
+    curve = friction.curve
     v, closing = meas.vx_mps, situation.closing_mps
+    # the speed-match rule trusts a settled estimate only (not the filter rising at an onset)
+    ego_decel = friction.brake_decel_mps2 if state.obstacle_decel.settled() else 0.0
     sector, stop_range = parts.placement.place(
-        curve, rng, closing, v, situation.obstacle_decel_mps2
+        curve, rng, closing, v, situation.obstacle_decel_mps2, ego_decel
     )
     action = sector.action
     if action is STEER:

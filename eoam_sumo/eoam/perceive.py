@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+from eoam_sumo.control.longitudinal import equivalent_mass_kg
 from eoam_sumo.decision.dmm import BoundaryCurve
 from eoam_sumo.decision.modes import (
     NORMAL,
@@ -29,7 +30,6 @@ def perceive(
     check_measurement(state, meas)
     if state.friction is None or meas.mu != state.friction.mu:
         state.friction = friction_at(parts, meas.mu)
-    st = parts.settings
     rng = perception.aro_range_m
     rate = perception.aro_range_rate_mps
     sensed: float | None = None
@@ -39,7 +39,7 @@ def perceive(
         sensed = rng
         closing = -rate if rate is not None and math.isfinite(rate) else 0.0
         decel = state.obstacle_decel.update(meas.time_s, meas.vx_mps - closing)
-        threat_gone = closing < -st.release_opening_speed_mps
+        threat_gone = pulls_away(parts, state, meas, rng, closing)
         track_obstacle(parts, state, meas, rng, closing, perception.aro_object, decel)
     else:
         state.obstacle_decel.reset()
@@ -62,13 +62,15 @@ def check_measurement(state: ControllerState, meas: EgoMeasurement) -> None:
 
 
 def friction_at(parts: Parts, mu: float) -> Friction:
-    """The limit braking force and the DMM boundaries at the sensed friction."""
+    """The limit braking force, the deceleration it delivers (the wheels spin down with the
+    car: ``equivalent_mass_kg``) and the DMM boundaries at the sensed friction."""
     if not mu > 0.0:
         raise ValueError(f"friction mu={mu!r} must be > 0")
     decel = float(parts.tables.max_decel_mps2(mu))
     brake_limit = parts.settings.limit_brake_fraction * parts.params.mass_kg * decel
+    delivered = brake_limit / equivalent_mass_kg(parts.params)
     bounds = parts.tables.boundaries
-    return Friction(mu, brake_limit, BoundaryCurve(bounds, mu, bounds.speed_grid_mps))
+    return Friction(mu, brake_limit, delivered, BoundaryCurve(bounds, mu, bounds.speed_grid_mps))
 
 
 def track_obstacle(
@@ -110,17 +112,33 @@ def coasted_object(
 ) -> tuple[bool, bool]:
     """(near, holds) for an object lost from view, predicted in the path, in modes 0 and 1:
     no hand-back while it does not pull away (holds); braking while it is within the
-    stopping distance, at the ego's speed or the closing speed (the larger), plus a margin
-    (near)."""
+    stopping distance at the deceleration limit braking delivers, at the ego's speed or the
+    closing speed (the larger), plus a margin (near)."""
     coasted_m = perception.coasted_range_m
     if coasted_m is None or state.mode not in _HOLDING:
         return False, False
     st = parts.settings
     closing = -perception.coasted_range_rate_mps
     vc = max(meas.vx_mps, closing)
-    brake_limit = state.friction_now().brake_limit_n
-    near = coasted_m <= 0.5 * vc * vc * parts.params.mass_kg / brake_limit + st.coasted_margin_m
-    return near, near or closing > -st.release_opening_speed_mps
+    decel = state.friction_now().brake_decel_mps2
+    near = coasted_m <= 0.5 * vc * vc / decel + st.coasted_margin_m
+    return near, near or not pulls_away(parts, state, meas, coasted_m, closing)
+
+
+def pulls_away(
+    parts: Parts, state: ControllerState, meas: EgoMeasurement, range_m: float, closing_mps: float
+) -> bool:
+    """The object ahead clearly pulls away (opening faster than ``release_opening_speed_mps``)
+    and is beyond the distance in which the ego, handed back to its set speed, would brake
+    again: from the set speed down to the object's speed at the deceleration limit braking
+    delivers, plus ``coasted_margin_m``. Nearer, a hand-back would only begin a stop-and-go
+    (accelerate towards the set speed, brake again)."""
+    st = parts.settings
+    if closing_mps >= -st.release_opening_speed_mps:
+        return False
+    catch_up = max(state.initial_speed_mps - (meas.vx_mps - closing_mps), 0.0)
+    decel = state.friction_now().brake_decel_mps2
+    return range_m > 0.5 * catch_up * catch_up / decel + st.coasted_margin_m
 
 
 def oncoming_seen(parts: Parts, perception: Perception) -> bool:

@@ -27,6 +27,7 @@ class Friction(NamedTuple):
 
     mu: float
     brake_limit_n: float  # limit braking: a share of the no-lock brake force
+    brake_decel_mps2: float  # what limit braking delivers: brake_limit_n / m_eq (wheels spin)
     curve: BoundaryCurve  # the DMM boundaries at this friction
 
 

@@ -26,7 +26,7 @@ import math
 
 from eoam_sumo.decision.dmm import SECTOR_ORDER, BoundaryCurve, Sector
 from eoam_sumo.decision.modes import ONCOMING_STEER_BRAKE, UPDATE_STEER_BRAKE
-from eoam_sumo.decision.obstacle import ObstacleTrack, stopping_range_m
+from eoam_sumo.decision.obstacle import ObstacleTrack, speed_match_factor, stopping_range_m
 from eoam_sumo.decision.oncoming import Budget, commit_choice, return_clears
 from eoam_sumo.decision.policy import SafePolicy
 from eoam_sumo.eoam.shifts import lateral_stop, min_time_shift, quintic_shift
@@ -57,14 +57,18 @@ class PaperPlacement:
         closing_mps: float,
         speed_mps: float,
         decel: float,
+        ego_decel_mps2: float,
     ) -> tuple[Sector, float]:
-        """(sector, range to where the obstacle will stand: unknown, inf)."""
+        """(sector, range to where the obstacle will stand: unknown, inf); ``ego_decel_mps2``
+        the deceleration limit braking delivers."""
         return curve.sector(range_m, closing_mps), math.inf
 
 
 class BrakingObstaclePlacement(PaperPlacement):
-    """The more urgent of the paper's sector and the sector of the obstacle standing where its
-    measured braking stops it, approached at the ego's speed (``decision.obstacle``)."""
+    """The most urgent of the paper's sector, the sector of the obstacle standing where its
+    measured braking stops it, approached at the ego's speed, and, when it brakes more gently
+    than the ego and is still moving as their speeds match, the paper's sector at the closing
+    speed whose stopping distance is that of the relative motion (``decision.obstacle``)."""
 
     def track_decel_mps2(self, filtered_mps2: float) -> float:
         return max(filtered_mps2, 0.0)
@@ -76,9 +80,11 @@ class BrakingObstaclePlacement(PaperPlacement):
         closing_mps: float,
         speed_mps: float,
         decel: float,
+        ego_decel_mps2: float,
     ) -> tuple[Sector, float]:
         v = speed_mps
-        sector = curve.sector(range_m, closing_mps)
+        factor = speed_match_factor(closing_mps, v - closing_mps, decel, ego_decel_mps2)
+        sector = curve.sector(range_m, closing_mps * math.sqrt(factor))
         stop_range = stopping_range_m(range_m, v - closing_mps, decel)
         if stop_range < math.inf and (stop_range != range_m or v != closing_mps):  # else same
             standing = curve.sector(stop_range, v)

@@ -3,6 +3,7 @@ keeps the EOAM braking: no hand-back to NORMAL, no speeding up (docs/sensing.md)
 
 import pytest
 
+from eoam_sumo.control import equivalent_mass_kg
 from eoam_sumo.decision import Mode
 from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, Perception
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
@@ -19,8 +20,10 @@ def tables():
 
 
 def stopping_m(tables, v_mps: float) -> float:
-    """The ego's limit-braking stopping distance (the brake limit the EOAM uses)."""
+    """The ego's limit-braking stopping distance (the brake limit the EOAM uses, on the car
+    and its spinning wheels)."""
     decel = EoamSettings().limit_brake_fraction * float(tables.max_decel_mps2(MU))
+    decel *= P.mass_kg / equivalent_mass_kg(P)
     return v_mps * v_mps / (2.0 * decel)
 
 
@@ -71,7 +74,8 @@ def test_no_hand_back_while_a_coasted_object_is_near_or_not_pulling_away(
 ):
     """The person is lost from view (ego at 4 m/s): without a coasted track the threat is
     gone and the EOAM hands back; with one it brakes on unless the prediction pulls away
-    (faster than the release speed) beyond the stopping distance plus the margin."""
+    (faster than the release speed) beyond the stopping distance plus the margin (here the
+    prediction, at 5.4 m/s, is faster than the set speed: no catch-up distance)."""
     assert stopping_m(tables, 4.0) + EoamSettings().coasted_margin_m > 2.5
     ctrl = braking_for_a_person_lost_from_view(tables)
     cmd = step(
@@ -82,12 +86,21 @@ def test_no_hand_back_while_a_coasted_object_is_near_or_not_pulling_away(
         assert cmd.brake_force_cmd_n > 0.0 and cmd.drive_force_cmd_n == 0.0
 
 
-def test_a_stopped_ego_hands_back_once_the_person_walks_on_beyond_the_margin(tables):
-    ctrl = braking_for_a_person_lost_from_view(tables)
-    step(ctrl, DT, 0.0, Perception(coasted_range_m=1.9, coasted_range_rate_mps=1.4))
-    assert ctrl.mode is Mode.UPDATE_BRAKE
-    step(ctrl, 2 * DT, 0.0, Perception(coasted_range_m=2.1, coasted_range_rate_mps=1.4))
-    assert ctrl.mode is Mode.NORMAL
+def test_a_stopped_ego_hands_back_once_the_person_walks_on_beyond_the_catch_up(tables):
+    """Handed back, the ego speeds up to its set speed (5 m/s) and would brake again from it
+    down to the person's 1.4 m/s: no hand-back within that stopping distance plus the margin
+    (whether the person is coasted or seen)."""
+    catch_up_m = stopping_m(tables, 5.0 - 1.4) + EoamSettings().coasted_margin_m
+    for seen in (False, True):
+        ctrl = braking_for_a_person_lost_from_view(tables)
+        for k, range_m in enumerate((0.98 * catch_up_m, 1.02 * catch_up_m)):
+            perception = (
+                Perception(range_m, 1.4)
+                if seen
+                else Perception(coasted_range_m=range_m, coasted_range_rate_mps=1.4)
+            )
+            step(ctrl, (k + 1) * DT, 0.0, perception)
+            assert ctrl.mode is (Mode.NORMAL if k else Mode.UPDATE_BRAKE)
 
 
 def test_a_person_walking_towards_the_ego_counts_at_the_closing_speed(tables):

@@ -111,8 +111,9 @@ def test_a_braking_obstacle_is_never_less_urgent_than_the_papers_sector(
     _parts, state = stage_inputs(tables)
     curve = state.friction.curve
     v = closing + 10.0
-    paper = PaperPlacement().place(curve, range_m, closing, v, decel)[0]
-    ours, stop_range = BrakingObstaclePlacement().place(curve, range_m, closing, v, decel)
+    a_ego = state.friction.brake_decel_mps2
+    paper = PaperPlacement().place(curve, range_m, closing, v, decel, a_ego)[0]
+    ours, stop_range = BrakingObstaclePlacement().place(curve, range_m, closing, v, decel, a_ego)
     assert SECTOR_ORDER.index(ours) <= SECTOR_ORDER.index(paper)
     if decel > 0.0:
         assert stop_range == pytest.approx(range_m + 100.0 / (2.0 * decel))

@@ -6,7 +6,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from eoam_sumo.decision.obstacle import ObstacleDecel, ObstacleTrack, stopping_range_m
+from eoam_sumo.decision.obstacle import (
+    ObstacleDecel,
+    ObstacleTrack,
+    speed_match_factor,
+    stopping_range_m,
+)
 from eoam_sumo.eoam_messages import EgoMeasurement, ObjectState
 
 
@@ -66,3 +71,41 @@ def test_obstacle_track_from_the_sensor():
     assert ObstacleTrack.sensed(meas, 3.9, 30.0, 18.0, None, 12.0, 0.0) == pytest.approx(
         (2.0, 50.0 + 3.9 + 30.0 + 12.0, 12.0, 1.75, 0.0, 12.0)
     )
+
+
+def least_gap_m(range_m: float, v_ego: float, a_ego: float, v_obj: float, a_obj: float) -> float:
+    """The least gap of two bodies braking to their stops, by 1 ms time steps (exact
+    positions of each step)."""
+    gap, t, dt = range_m, 0.0, 1e-3
+    while v_ego - a_ego * t > 0.0:
+        t += dt
+        ego = v_ego * t - 0.5 * a_ego * t * t
+        t_obj = min(t, v_obj / a_obj) if a_obj > 0.0 else t
+        obj = v_obj * t_obj - 0.5 * a_obj * t_obj * t_obj
+        gap = min(gap, range_m + obj - ego)
+    return gap
+
+
+@given(
+    v_ego=st.floats(15.0, 40.0),
+    v_obj=st.floats(0.5, 30.0),
+    a_obj=st.floats(0.0, 10.0),
+    a_ego=st.floats(3.0, 9.0),
+)
+@settings(max_examples=60, deadline=None)
+def test_the_speed_match_distance_is_where_the_least_gap_is_zero(v_ego, v_obj, a_obj, a_ego):
+    """Starting the factor times the paper's stopping distance v_rel^2 / (2 a_ego) apart,
+    the least gap is about zero when the obstacle still moves at the speed match; at least
+    zero otherwise (factor 1: the paper's rule or the standing placement decides)."""
+    closing = v_ego - v_obj
+    if closing < 1.0:
+        return
+    factor = speed_match_factor(closing, v_obj, a_obj, a_ego)
+    start_m = factor * closing * closing / (2.0 * a_ego)
+    gap = least_gap_m(start_m, v_ego, a_ego, v_obj, a_obj)
+    standing_m = v_ego**2 / (2.0 * a_ego) - (v_obj**2 / (2.0 * a_obj) if a_obj > 0 else 0.0)
+    if factor > 1.0:
+        assert gap == pytest.approx(0.0, abs=0.05)
+        assert start_m >= standing_m - 0.05  # the standing placement asks for less
+    elif a_obj > 0.0:
+        assert least_gap_m(max(start_m, standing_m), v_ego, a_ego, v_obj, a_obj) > -0.05

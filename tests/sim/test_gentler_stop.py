@@ -21,16 +21,6 @@ REPO = Path(__file__).resolve().parents[2]
 DECELS = (8.0, 6.0, 4.0, 3.0, 2.0)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        "at 130 km/h on mu 1.0 a 2 m/s2 stop of the obstacle is hit at 2.80 m/s where a 3 m/s2 "
-        "one is avoided: limit braking decides with m a = the brake limit, the plant's spinning "
-        "wheels take 3.5 % of it (a 2.6 m longer stop from 130 km/h), and commanding that "
-        "share on top locks the front axle on mu 0.3 (eq. 33's margin there is thinner than "
-        "the Magic Formula's load sensitivity)"
-    ),
-)
 def test_gentler_obstacle_stop_never_ends_with_a_higher_impact_speed(tmp_path):
     matrix = tmp_path / "decel.toml"
     matrix.write_text(
