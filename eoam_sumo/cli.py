@@ -128,7 +128,18 @@ def _run_arguments(sub) -> None:
     p.add_argument(
         "--max-time-s", type=finite, default=DEFAULT_MAX_TIME_S, help="simulated time limit"
     )
-    p.add_argument("--tables", type=Path, help="lookup tables folder (default: tables/)")
+    p.add_argument(
+        "--tables",
+        type=Path,
+        help="lookup tables folder (default: tables/); a vehicle other than the sedan uses "
+        "its sub-folder TABLES/NAME",
+    )
+    p.add_argument(
+        "--vehicle",
+        metavar="NAME|FILE",
+        help="the ego: a catalogue vehicle (vehicles/NAME.toml) or a vehicle file "
+        "(default: the paper's sedan)",
+    )
     p.add_argument("--radar-range-m", type=finite, help="ego radar range (default 100 m)")
     p.add_argument(
         "--mu-belief",
@@ -328,6 +339,7 @@ def _run_settings(args, out: Path):
     from eoam_sumo.sim.cosim import policy_settings
     from eoam_sumo.sim.session.gui import GuiSettings, virtual_display
     from eoam_sumo.sim.settings import RunSettings
+    from eoam_sumo.vehicle_files import load_vehicle
 
     gui = GuiSettings(
         delay_ms=args.gui_delay_ms,
@@ -350,6 +362,10 @@ def _run_settings(args, out: Path):
     )
     if args.radar_range_m is not None:
         settings = replace(settings, radar=RadarSettings(range_m=args.radar_range_m))
+    if args.vehicle is not None:
+        settings = replace(
+            settings, vehicle=load_vehicle(args.vehicle), vehicle_id=str(args.vehicle)
+        )
     return policy_settings(
         settings,
         args.policy,

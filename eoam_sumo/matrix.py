@@ -25,12 +25,13 @@ from pathlib import Path
 
 from eoam_sumo.colours import OUTCOMES
 from eoam_sumo.errors import InputError
-from eoam_sumo.params import MU_MAX
+from eoam_sumo.params import MU_MAX, ego_e_class_sedan
 from eoam_sumo.sampling import Sample, parse_sample
 from eoam_sumo.sensing.automotive import parse_radar_model
 from eoam_sumo.sensing.friction import parse_mu_belief
 from eoam_sumo.sim.scenario import ScenarioOverrides, check_scenario, scripted_stops
 from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S
+from eoam_sumo.sim.vehicle import vehicle_name, vehicle_tables, vehicle_tables_dir
 from eoam_sumo.traffic_levels.hcm import LEVELS
 from eoam_sumo.traffic_levels.spec import (
     MIN_CURVE_RADIUS_M,
@@ -38,6 +39,7 @@ from eoam_sumo.traffic_levels.spec import (
     SPEED_LIMIT_RANGE_KMH,
     TrafficSpec,
 )
+from eoam_sumo.vehicle_files import DEFAULT_VEHICLE, load_vehicle
 
 NO_ONCOMING = "none"
 #: The keys of a generated scenario (``eoam_sumo.traffic_levels``), in [scenario] one value
@@ -59,6 +61,7 @@ SCHEMA = {
         "radar_model",
         "seed",
         "after_stop_s",
+        "vehicle",
         *TRAFFIC_KEYS,
     ),
     "sweep": (
@@ -67,6 +70,7 @@ SCHEMA = {
         "oncoming_start_m",
         "aro_hold_s",
         "aro_decel_mps2",
+        "vehicle",
         *TRAFFIC_KEYS,
     ),
     "paper": ("table",),
@@ -123,6 +127,9 @@ class Case:
     curve_radius_m: float | None = None
     abs_fitted: bool | None = None  # None: the vehicle's own (the sedan's: off)
     esc_fitted: bool | None = None  # None: the vehicle's own (the sedan's: off)
+    # the ego's vehicle: a catalogue name or a vehicle file (resolved); None: the paper's
+    # sedan (``params.ego_e_class_sedan``, the catalogue's ``sedan``)
+    vehicle: str | None = None
     draw: int | None = None  # the draw's number within its group (sampled matrices)
     group_id: str | None = None  # the case id of its group of swept values (sampled)
 
@@ -173,6 +180,8 @@ class Matrix:
     # the generated scenario's keys given, swept or sampled: (key, values), ``TRAFFIC_KEYS``
     # order; a sampled key's values are (None,)
     traffic_axes: tuple[tuple[str, tuple], ...] = ()
+    # the vehicles given ([scenario] one, [sweep] a list; sampled: (None,)); (): the sedan
+    vehicles: tuple[str | None, ...] = ()
 
     def cases(self) -> list[Case]:
         """Every case, in the paper's Table 2 order (traffic, speed, friction, ARO stop),
@@ -180,6 +189,7 @@ class Matrix:
         ``[sample]`` table, each combination's draws in turn (``<combination id>_dNNNN``)."""
         sampled = self.sample.keys if self.sample else ()
         axes = (
+            *((("vehicle", self.vehicles),) if self.vehicles else ()),
             *self.traffic_axes,
             (
                 "oncoming_start_m",
@@ -245,9 +255,10 @@ class Matrix:
 
 
 def _case_id(values: dict, sampled: tuple[str, ...]) -> str:
-    """A case's id from its values: the generated scenario's keys given (road, ``losC``,
-    ``l3`` lanes, ``lim100`` speed limit, ``R400`` or ``straight``), ``onc-...`` unless
-    sampled, ``v...``, ``mu...``, ``hold...``, ``dec...``; "all" when nothing is left."""
+    """A case's id from its values: the vehicle's name when the matrix names one, the
+    generated scenario's keys given (road, ``losC``, ``l3`` lanes, ``lim100`` speed limit,
+    ``R400`` or ``straight``), ``onc-...`` unless sampled, ``v...``, ``mu...``, ``hold...``,
+    ``dec...``; "all" when nothing is left."""
     road_parts = {
         "road": lambda v: v,
         "los": lambda v: f"los{v}",
@@ -255,7 +266,8 @@ def _case_id(values: dict, sampled: tuple[str, ...]) -> str:
         "speed_limit_kmh": lambda v: f"lim{_id_number(v)}",
         "curve_radius_m": lambda v: f"R{_id_number(v)}",
     }
-    parts = [
+    parts = [vehicle_name(values["vehicle"])] if values.get("vehicle") is not None else []
+    parts += [
         road_parts[k](values[k])
         if values[k] is not None
         else ("straight" if k == "curve_radius_m" else "")
@@ -443,7 +455,8 @@ def load_matrix(path: Path) -> Matrix:
     path = Path(path)
     doc = _read_toml(path)
     _check_tables(path, doc)
-    sample = parse_sample(path, doc["sample"], SAMPLED) if "sample" in doc else None
+    checks = {**SAMPLED, "vehicle": _vehicle_check(path)}
+    sample = parse_sample(path, doc["sample"], checks) if "sample" in doc else None
     sampled = sample.keys if sample else ()
     _check_required(path, doc, sampled)
     scenario = doc.get("scenario", {})
@@ -470,6 +483,7 @@ def load_matrix(path: Path) -> Matrix:
         sample=sample,
         after_stop_s=_after_stop(path, scenario),
         traffic_axes=traffic_axes,
+        vehicles=_vehicle_axis(path, doc, sampled, checks["vehicle"]),
         **_swept_values(path, doc.get("sweep", {}), sampled),
         paper_table=paper,
         policy=policy,
@@ -483,6 +497,48 @@ def _after_stop(path: Path, scenario: dict) -> float | None:
     if value is not None and (not _is_number(value) or value < 0):
         raise InputError(f"{path}: [scenario] after_stop_s = {value!r} must be a number >= 0")
     return None if value is None else float(value)
+
+
+def _vehicle_check(path: Path):
+    """The check of one ``vehicle`` value of the matrix ``path``: a catalogue name, or a
+    vehicle file (relative to the matrix file), read and checked (``vehicle_files``); the
+    value as a case holds it (a file: its absolute path)."""
+
+    def check(value):
+        if not isinstance(value, str) or not value.strip():
+            raise InputError(f"vehicle {value!r} is not a catalogue name or a .toml file")
+        vehicle = value
+        if value.endswith(".toml") or len(Path(value).parts) > 1:
+            vehicle = str((path.parent / value).resolve())
+        load_vehicle(vehicle)
+        return vehicle
+
+    return check
+
+
+def _vehicle_axis(path: Path, doc: dict, sampled: tuple[str, ...], check) -> tuple:
+    """The vehicles of the matrix: [scenario] one, [sweep] a list, sampled (None,), none
+    given (); each checked, no two with the same name (their case ids and tables folder)."""
+    where = [t for t in ("scenario", "sweep") if "vehicle" in doc.get(t, {})]
+    if len(where) > 1:
+        raise InputError(f"{path}: 'vehicle' is in [scenario] and [sweep]; keep one")
+    if "vehicle" in sampled:
+        return (None,)
+    if not where:
+        return ()
+    raw = doc[where[0]]["vehicle"]
+    listed = raw if where[0] == "sweep" else [raw]
+    if not isinstance(listed, list) or not listed:
+        raise InputError(f"{path}: [sweep] vehicle must be a non-empty list")
+    try:
+        values = tuple(check(v) for v in listed)
+    except InputError as exc:
+        raise InputError(f"{path}: [{where[0]}] vehicle: {exc}") from None
+    names = [vehicle_name(v) for v in values]
+    twice = next((n for n in names if names.count(n) > 1), None)
+    if twice is not None:
+        raise InputError(f"{path}: [sweep] vehicle lists two vehicles named {twice!r}")
+    return values
 
 
 def _scenario_file(path: Path, scenario: dict, traffic_axes: tuple) -> Path | None:
@@ -703,11 +759,8 @@ def check_matrix(matrix: Matrix, tables_dir: Path | None = None, ego_id: str = "
     the same ``LookupTables.check_run`` each run applies. InputError names the matrix file,
     the key and the value.
     """
-    from eoam_sumo.offline.tables import LookupTables, default_tables_dir
-
-    folder = Path(tables_dir) if tables_dir is not None else default_tables_dir()
     if matrix.sumocfg is None:  # generated per case: nothing to read yet
-        check_within_tables(matrix, LookupTables.load(folder), folder)
+        _check_vehicles_tables(matrix, tables_dir)
         return
     try:
         files = check_scenario(matrix.sumocfg, ego_id)
@@ -719,7 +772,25 @@ def check_matrix(matrix: Matrix, tables_dir: Path | None = None, ego_id: str = "
                 scripted_stops(files, over, ego_id)
     except InputError as exc:
         raise InputError(f"{matrix.path}: [scenario] sumocfg: {exc}") from exc
-    check_within_tables(matrix, LookupTables.load(folder), folder)
+    _check_vehicles_tables(matrix, tables_dir)
+
+
+def _check_vehicles_tables(matrix: Matrix, tables_dir: Path | None) -> None:
+    """Every vehicle of the matrix (swept, or any its sample may choose; none named: the
+    sedan) has its lookup tables under ``tables_dir`` (``sim.vehicle.vehicle_tables_dir``),
+    built for its parameters, covering every speed and friction of the matrix."""
+    dist = matrix.sample.of("vehicle") if matrix.sample else None
+    named = {v for v in (*matrix.vehicles, *(dist.extremes() if dist else ())) if v is not None}
+    for vehicle in sorted(named) or [None]:
+        params = ego_e_class_sedan() if vehicle is None else load_vehicle(vehicle)
+        name = vehicle or DEFAULT_VEHICLE
+        try:
+            tables = vehicle_tables(name, params, tables_dir, cached=False)
+        except InputError as exc:
+            if vehicle is None:
+                raise
+            raise InputError(f"{matrix.path}: vehicle {vehicle!r}: {exc}") from None
+        check_within_tables(matrix, tables, vehicle_tables_dir(name, tables_dir))
 
 
 def check_within_tables(matrix: Matrix, tables, folder: Path | str | None = None) -> None:

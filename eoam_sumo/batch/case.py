@@ -12,6 +12,7 @@ from typing import get_type_hints
 
 from eoam_sumo.matrix import Case
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
+from eoam_sumo.vehicle_files import DEFAULT_VEHICLE, load_vehicle
 
 #: The files a case writes (``sim.runlog.write_run``), in the order they are written, by
 #: ``--timeseries`` format.
@@ -71,14 +72,17 @@ class CaseParameters:
     lanes: int | None
     speed_limit_kmh: float | None
     curve_radius_m: float | None
+    vehicle: str  # the ego's: a catalogue name or a vehicle file
     draw: int | None  # the sample's number in a sampled matrix
     sumocfg: str  # a generated scenario's: relative to the case folder
 
     @classmethod
     def of(cls, case: Case) -> CaseParameters:
+        own = ("sumocfg", "vehicle")
         return cls(
-            **{f.name: getattr(case, f.name) for f in fields(cls) if f.name != "sumocfg"},
+            **{f.name: getattr(case, f.name) for f in fields(cls) if f.name not in own},
             sumocfg=str(case.sumocfg),
+            vehicle=case.vehicle or DEFAULT_VEHICLE,
         )
 
 
@@ -98,8 +102,9 @@ def case_parameters(case: Case) -> dict:
 
 
 def case_vehicle(case: Case) -> VehicleParams:
-    """The ego of a case: the sedan, its ABS and ESC switched as the case asks."""
-    vehicle = ego_e_class_sedan()
+    """The ego of a case: its vehicle (none named: the paper's sedan), its ABS and ESC
+    switched as the case asks."""
+    vehicle = ego_e_class_sedan() if case.vehicle is None else load_vehicle(case.vehicle)
     if case.abs_fitted is not None:
         vehicle = replace(vehicle, abs_fitted=case.abs_fitted)
     if case.esc_fitted is not None:
@@ -126,6 +131,7 @@ def run_matrix_case(task: CaseTask) -> dict:
             seed=case.seed,
             after_stop_s=case.after_stop_s,
             vehicle=case_vehicle(case),
+            vehicle_id=case.vehicle or DEFAULT_VEHICLE,
         ),
         case.policy,
         case.v2x_range_m,

@@ -26,9 +26,9 @@ from eoam_sumo.eoam import (
     Perception,
 )
 from eoam_sumo.errors import InputError
-from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import VehicleParams
 from eoam_sumo.plant import Plant, initial_state
+from eoam_sumo.plant.model import AX_LOAD, AY_LOAD
 from eoam_sumo.sensing.automotive import make_radar
 from eoam_sumo.sensing.friction import FrictionBelief
 from eoam_sumo.sensing.next_lane import NextLaneSensing
@@ -43,6 +43,7 @@ from eoam_sumo.sim.margins import (
 from eoam_sumo.sim.observers import (
     AvoidedObstacle,
     Extremes,
+    RolloverWatch,
     StepObserver,
     TimeSeries,
     no_lap,
@@ -57,6 +58,7 @@ from eoam_sumo.sim.settings import RunSettings
 from eoam_sumo.sim.severity import ContactRecord, substep_contact
 from eoam_sumo.sim.summary import RunSummary
 from eoam_sumo.sim.trafficlog import TrafficLog
+from eoam_sumo.sim.vehicle import TYRES, rollover_limits, vehicle_tables
 from eoam_sumo.sim.verdict import summarise
 from eoam_sumo.world.bodies import Body, nav_angle_deg
 from eoam_sumo.world.geometry import (
@@ -108,8 +110,7 @@ class CoSimulation:
         self.overrides = overrides = overrides or ScenarioOverrides()
         self.settings = settings = settings or RunSettings()
         self.params = params or settings.vehicle
-        tables_dir = settings.tables_dir or default_tables_dir()
-        self.tables = LookupTables.cached(tables_dir, params=self.params)
+        self.tables = vehicle_tables(settings.vehicle_id, self.params, settings.tables_dir)
         # refuse what the tables do not cover before starting SUMO (checked again at the start)
         self.tables.check_run(
             overrides.mu if overrides.mu is not None else self.tables.mu_grid[-1],
@@ -171,6 +172,8 @@ class CoSimulation:
         self.session = session
         self.wall0 = time.perf_counter() if wall0 is None else wall0
         self.step_s = self.settings.step_s
+        p = self.params
+        session.size_ego(p.length_m, p.width_m, p.mass_kg)
         ego = session.ego_body()
         self._place_ego(session, ego)
         self._set_up_sensing(session, ego)
@@ -277,12 +280,14 @@ class CoSimulation:
         self.timeseries, self.extremes = TimeSeries(), Extremes()
         self.margins = Margins(p.length_m, p.width_m, self._front)
         self.avoided = AvoidedObstacle()
+        self.rollover = RolloverWatch(*rollover_limits(p), AX_LOAD, AY_LOAD, TYRES)
         self.observers = (
             self.timeseries,
             self.extremes,
             self.traffic,
             self.margins,
             self.avoided,
+            self.rollover,
             *self.extra_observers,
         )
         self.lap = no_lap
@@ -433,13 +438,17 @@ class CoSimulation:
                     )
 
     def finished(self) -> bool:
-        """Whether the run is over: a contact, ``settle_s`` after the EOAM handed back to
-        NORMAL after a manoeuvre or stopped (a manoeuvre begun in that time runs to its end;
-        not while the ego moves towards a road user close ahead in its lane:
+        """Whether the run is over: a contact, a rollover (``sim/vehicle.py``: past it the
+        plant, which has no roll, no longer describes the car), ``settle_s`` after the EOAM
+        handed back to NORMAL after a manoeuvre or stopped (a manoeuvre begun in that time
+        runs to its end; not while the ego moves towards a road user close ahead in its lane:
         :func:`~eoam_sumo.sim.margins.road_user_close_ahead`), the end of the road, or the
         time limit. Sets ``end_cause``."""
         if self.first_contact is not None:
             self.end_cause = "contact"
+            return True
+        if self.rollover.time_s is not None:
+            self.end_cause = "rollover"
             return True
         if not self.eoam_done():
             self._stop_at = None  # (again) a manoeuvre under way: run on to its end

@@ -4,10 +4,10 @@ of, and what the summary records of the run's set-up and wall times.
 :class:`RunFacts` holds what happened: the road of the ego's original lane, the EOAM's modes
 and warning, the ego's end state and running extremes, the first contact and what SUMO
 reports of the body hit, the margins, whether a lane change passed the obstacle it avoided,
-and how the run ended. :class:`RunInfo` holds what the summary adds: the settings that shaped
-the run, the scenario's files and the wall times. Both are filled once, at the end of the run,
-from the co-simulation and its observers (:func:`collect_facts`, :func:`collect_info`); a test
-builds them by hand.
+a rollover, and how the run ended. :class:`RunInfo` holds what the summary adds: the
+settings that shaped the run, the scenario's files and the wall times. Both are filled once,
+at the end of the run, from the co-simulation and its observers (:func:`collect_facts`,
+:func:`collect_info`); a test builds them by hand.
 """
 
 from __future__ import annotations
@@ -87,6 +87,11 @@ class RunFacts:
     sim_time_s: float = 0.0
     # the road's width right of the original lane: a lane there the ego may evade into
     right_width_m: float = 0.0
+    # rollover (``sim/vehicle.py``): SUMO time of the step a wheel lifted or the static
+    # stability limit was passed (None: never), which, and the smallest tyre load [N]
+    rollover_time_s: float | None = None
+    rollover_cause: str = ""
+    min_tyre_load_n: float = math.inf
 
 
 @mypyc_attr(native_class=False)  # a Python dataclass: built by hand in tests
@@ -142,6 +147,7 @@ class EndedRun(RunView, Protocol):
     extremes: Any
     margins: Any
     avoided: Any
+    rollover: Any
 
     def eoam_done(self) -> bool: ...
     def policy_record(self) -> dict: ...
@@ -189,6 +195,9 @@ def collect_facts(sim: EndedRun) -> RunFacts:
         end_cause=sim.end_cause or "",
         sim_time_s=sim.t - sim.t_start,
         right_width_m=sim.right_width_m,
+        rollover_time_s=sim.rollover.time_s,
+        rollover_cause=sim.rollover.cause,
+        min_tyre_load_n=sim.rollover.min_load_n,
     )
 
 
@@ -200,7 +209,7 @@ def collect_info(sim: EndedRun, loop_wall_s: float) -> RunInfo:
         policy_record=sim.policy_record(),
         radar_model=st.radar_model,
         seed=st.seed,
-        vehicle=sim.params.name,
+        vehicle=st.vehicle_id,
         abs_fitted=sim.params.abs_fitted,
         esc_fitted=sim.params.esc_fitted,
         radar_range_m=st.radar.range_m,

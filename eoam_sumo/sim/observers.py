@@ -7,9 +7,10 @@ with the ego's end state in ``meas``. Add one with ``CoSimulation(..., observers
 :class:`StepObserver` is a base with empty hooks.
 
 Here: the time series (:class:`TimeSeries`), the running extremes of the ego
-(:class:`Extremes`), the obstacle a lane change avoided (:class:`AvoidedObstacle`) and the
-benchmark's timer of the step's phases (:class:`PhaseTimer`); the margins are in
-``sim/margins.py``, the traffic log in ``sim/trafficlog.py``.
+(:class:`Extremes`), its rollover (:class:`RolloverWatch`), the obstacle a lane change
+avoided (:class:`AvoidedObstacle`) and the benchmark's timer of the step's phases
+(:class:`PhaseTimer`); the margins are in ``sim/margins.py``, the traffic log in
+``sim/trafficlog.py``.
 """
 
 from __future__ import annotations
@@ -73,6 +74,8 @@ class RunView(Protocol):
     def lane_width_m(self) -> float: ...  # the ego's lane's width
     @property
     def left_lane(self) -> bool: ...  # a lane (either direction) lies left of the ego's
+    @property
+    def ay(self) -> float: ...  # the ego's lateral acceleration now (the plant's output)
 
 
 @mypyc_attr(allow_interpreted_subclasses=True)  # observers are written in Python
@@ -139,6 +142,61 @@ class Extremes(StepObserver):
         self.max_abs_heading_error_rad = max(
             self.max_abs_heading_error_rad, abs((meas.e_yaw_rad + math.pi) % math.tau - math.pi)
         )
+
+
+class RolloverWatch(StepObserver):
+    """Rollover, a loss of control (``sim/vehicle.py``): ``time_s`` the SUMO time at the end
+    of the first step in which the normal load of an inner tyre (one the lateral load
+    transfer unloads) reached zero under the plant's load transfer (a wheel lifted) or
+    ``|ay|`` passed the static stability limit (None: never), and
+    ``cause`` which; ``min_load_n`` the smallest normal load of any tyre at a step's end.
+
+    The loads are ``static_n[i] + per_ax[i] ax + per_ay[i] ay`` (``vehicle.RolloverLimits``)
+    with ``ax``, ``ay`` the plant's load accelerations, states ``ax_index`` and ``ay_index``."""
+
+    def __init__(
+        self,
+        static_n: tuple[float, float, float, float],
+        per_ax: tuple[float, float, float, float],
+        per_ay: tuple[float, float, float, float],
+        ssf_ay_mps2: float,
+        ax_index: int,
+        ay_index: int,
+        tyres: tuple[str, str, str, str],
+    ) -> None:
+        self._static, self._per_ax, self._per_ay = static_n, per_ax, per_ay
+        self._ssf_ay_mps2 = ssf_ay_mps2
+        self._ax_index, self._ay_index = ax_index, ay_index
+        self._tyres = tyres
+        self.time_s: float | None = None
+        self.cause = ""
+        self.min_load_n = math.inf
+
+    def start(self, sim: RunView) -> None:
+        self.time_s, self.cause, self.min_load_n = None, "", math.inf
+
+    def after_step(self, sim: RunView) -> None:
+        if self.time_s is not None:
+            return
+        x = sim.x
+        ax, ay = x[self._ax_index], x[self._ay_index]
+        static, per_ax, per_ay = self._static, self._per_ax, self._per_ay
+        low, lifted = math.inf, -1
+        for i in range(4):
+            load = static[i] + per_ax[i] * ax + per_ay[i] * ay
+            low = min(low, load)
+            if load <= 0.0 and per_ay[i] * ay < 0.0:  # an inner wheel: the roll unloads it
+                lifted = i
+        self.min_load_n = min(self.min_load_n, max(low, 0.0))
+        if lifted >= 0:
+            self.time_s = sim.t
+            self.cause = f"wheel lift (inner {self._tyres[lifted]} tyre unloaded)"
+        elif abs(sim.ay) > self._ssf_ay_mps2:
+            self.time_s = sim.t
+            self.cause = (
+                f"lateral acceleration {abs(sim.ay):.1f} m/s2 beyond the static stability "
+                f"limit {self._ssf_ay_mps2:.1f} m/s2"
+            )
 
 
 class PhaseTimer(StepObserver):

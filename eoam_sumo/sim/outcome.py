@@ -14,8 +14,9 @@ Definitions:
 * back in lane: |final lateral offset| <= ``in_lane_tolerance_m``;
 * stopped: final speed <= ``stopped_speed_mps``;
 * lost control: at some time of the run the ego's heading was more than
-  ``lost_control_heading_rad`` (1.0 rad) off the road direction, or its forward speed vx was
-  below ``reversing_speed_mps`` (-0.5 m/s: going backwards);
+  ``lost_control_heading_rad`` (1.0 rad) off the road direction, its forward speed vx was
+  below ``reversing_speed_mps`` (-0.5 m/s: going backwards), or it rolled over (a wheel
+  lifted or the static stability limit was passed, ``sim/vehicle.py``; the run ends there);
 * left the road: the ego's centre of gravity went more than ``road_edge_margin_m`` (0.5 m)
   beyond a road edge; in the road frame of its original lane the road spans
   d in [-lane_width/2, lane_width/2 + left_width], left_width the width to the left of that
@@ -267,6 +268,7 @@ def classify_outcome(
     cut_off: str | None = None,
     manoeuvre_running: bool = False,
     passed_obstacle: bool | None = None,
+    rollover: str | None = None,
 ) -> Outcome:
     """Colour of a run by the rules of the module docstring.
 
@@ -286,7 +288,8 @@ def classify_outcome(
     width in line covered at the contact (direct or offset hit); ``cut_off`` what cut the run
     off (``"time limit"``, ``"end of the road"``; None when it ended by the loop's rules),
     ``manoeuvre_running`` whether a manoeuvre was still under way then; ``passed_obstacle``
-    whether the ego ended ahead of the obstacle its lane change avoided (None: unknown).
+    whether the ego ended ahead of the obstacle its lane change avoided (None: unknown);
+    ``rollover`` what rolled the ego over and when (``sim/vehicle.py``; None: it did not).
     """
     modes = set(modes_visited)
     _check_inputs(
@@ -312,6 +315,7 @@ def classify_outcome(
         min_speed_mps,
         road_departure(min_offset_m, max_offset_m, lane_width_m, left_width_m, right_width_m),
         settings,
+        rollover,
     )
     if lost:
         return _lost_control(modes, lane_change, lost)
@@ -400,9 +404,11 @@ def _loss_of_control(
     min_speed_mps: float,
     departure: tuple[str, float],
     settings: OutcomeSettings,
+    rollover: str | None = None,
 ) -> list[str]:
-    """What went wrong, one phrase per trigger (empty when the ego stayed in control)."""
-    what = []
+    """What went wrong, one phrase per trigger (empty when the ego stayed in control), a
+    rollover first (the run ended there)."""
+    what = [] if rollover is None else [f"rollover: {rollover}"]
     heading = abs(max_abs_heading_error_rad)
     if heading > settings.lost_control_heading_rad:
         what.append(

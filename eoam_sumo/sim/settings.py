@@ -14,6 +14,7 @@ from eoam_sumo.sensing.next_lane import CornerRadarSettings
 from eoam_sumo.sensing.radar import RadarSettings
 from eoam_sumo.sensing.v2x import V2XSettings
 from eoam_sumo.sim.session.gui import GuiSettings
+from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
 
 #: A run's simulated time limit unless set [s]: every Table 2 case ends well before it (the
 #: slowest, 55 km/h on mu 0.1, settles after 29.6 s).
@@ -35,7 +36,7 @@ class RunSettings:
     ego_id: str = "ego"
     gui: bool = False
     use_traci: bool = False
-    tables_dir: Path | None = None
+    tables_dir: Path | None = None  # the tables' folder (None: offline.tables' default)
     radar: RadarSettings = field(default_factory=RadarSettings)
     eoam: EoamSettings = field(default_factory=EoamSettings)
     mu_belief: str | float = "known"  # sensing.friction: known, estimate or a number
@@ -45,6 +46,9 @@ class RunSettings:
     radar_model: str = "ideal"  # sensing.automotive: ideal or automotive
     gui_settings: GuiSettings = field(default_factory=GuiSettings)  # with gui: pacing, view
     vehicle: VehicleParams = field(default_factory=ego_e_class_sedan)  # the ego's
+    # the vehicle as chosen: a catalogue name or a vehicle file; names its tables' folder
+    # under ``tables_dir`` (``sim/vehicle.py``) and is the summary's ``vehicle``
+    vehicle_id: str = DEFAULT_VEHICLE
 
     def __post_init__(self) -> None:
         ms = self.step_s * 1000.0

@@ -59,7 +59,7 @@ class RunSummary:
     tie_break: str = _doc("safe policy: what the severity tie-breaker chose")
     radar_model: str = _doc("the radar model: ideal or automotive")
     seed: int = _doc("the seed of every random model of the run")
-    vehicle: str = _doc("the ego's vehicle (its name)")
+    vehicle: str = _doc("the ego's vehicle: its catalogue name or vehicle file")
     abs_fitted: bool = _doc("whether the ego's ABS was on")
     esc_fitted: bool = _doc("whether the ego's ESC was on")
     min_gap_aro_m: float | None = _doc(
@@ -83,7 +83,14 @@ class RunSummary:
     passed_obstacle: bool | None = _doc(
         "a lane change ended ahead of the obstacle it avoided (empty: no lane change)"
     )
-    end_cause: str = _doc("contact, settled, road_end or time_limit")
+    end_cause: str = _doc("contact, rollover, settled, road_end or time_limit")
+    rollover_time_s: float | None = _doc(
+        "SUMO time a wheel lifted or |ay| passed the static stability limit g track / (2 h) "
+        "(empty: never)"
+    )
+    min_tyre_load_n: float | None = _doc(
+        "smallest normal load of any tyre under the plant's load transfer (0: a wheel lifted)"
+    )
     max_abs_lat_accel_mps2: float = _doc("largest |lateral acceleration| of the ego")
     max_lateral_offset_m: float = _doc("largest |lateral offset| from the original lane centre")
     final_lateral_offset_m: float = _doc("lateral offset when the run ended (left +)")

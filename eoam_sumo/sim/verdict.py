@@ -53,7 +53,15 @@ def outcome_of(facts: RunFacts) -> Outcome:
         cut_off=CUT_OFF.get(facts.end_cause),
         manoeuvre_running=facts.manoeuvre_running,
         passed_obstacle=facts.passed_obstacle,
+        rollover=rollover_of(facts),
     )
+
+
+def rollover_of(facts: RunFacts) -> str | None:
+    """What rolled the ego over and when, for the reason (None: it did not)."""
+    if facts.rollover_time_s is None:
+        return None
+    return f"{facts.rollover_cause} at t={facts.rollover_time_s:.2f} s"
 
 
 def summarise(facts: RunFacts, info: RunInfo) -> RunSummary:
@@ -127,6 +135,8 @@ def _margin_fields(facts: RunFacts) -> dict[str, Any]:
         "near_miss": facts.contact is None and facts.near_miss_margins,
         "passed_obstacle": facts.passed_obstacle,
         "end_cause": facts.end_cause,
+        "rollover_time_s": facts.rollover_time_s,
+        "min_tyre_load_n": finite_or_none(facts.min_tyre_load_n, 1),
     }
 
 

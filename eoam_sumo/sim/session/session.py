@@ -523,6 +523,20 @@ class SumoSession:
         calls.move_to_xy(self.ego_id, "", -1, x_front_m, y_front_m, angle_nav_deg, 2)
         calls.set_speed(self.ego_id, speed_mps)
 
+    def size_ego(self, length_m: float, width_m: float, mass_kg: float) -> None:
+        """Tell SUMO the ego's length, width and mass (its vehicle's, where they differ from
+        what SUMO has: SUMO then gives the ego a type of its own), so that SUMO's drivers,
+        its outputs and sumo-gui see the car the co-simulation drives."""
+        self._check_open()
+        veh, ego = self._veh, self.ego_id
+        for get, put, value in (
+            (veh.getLength, veh.setLength, length_m),
+            (veh.getWidth, veh.setWidth, width_m),
+            (veh.getMass, veh.setMass, mass_kg),
+        ):
+            if float(get(ego)) != value:
+                put(ego, value)
+
     def nearby(self, radius_m: float) -> list[Body]:
         """Every other road user (vehicles of every class, persons on foot) some part of which
         may be within ``radius_m`` of the ego's SUMO position (its front bumper), sorted by id

@@ -1,0 +1,103 @@
+"""The ego's vehicle in a run: the folder of its lookup tables, and the limits past which it
+rolls over.
+
+Tables: the default vehicle (``vehicle_files.DEFAULT_VEHICLE``, the paper's sedan) uses the
+tables folder itself (``$EOAM_TABLES_DIR`` or the repository's ``tables/``, or the folder a
+run names); any other vehicle its sub-folder named after it: ``tables/<name>/``, ``<name>``
+the catalogue name or the vehicle file's stem (``--vehicle trucks/pickup.toml``:
+``tables/pickup/``). ``eoam-sumo tables --vehicle NAME --out tables/NAME`` builds them; a run
+refuses a vehicle whose folder holds no tables or tables built for other parameters
+(``offline.tables.LookupTables.load``).
+
+Rollover (a loss of control, ``sim/outcome.py``): a wheel lifts when the normal load of an
+inner tyre (one the lateral transfer unloads) reaches zero under the plant's quasi-static load
+transfer (``plant.model.tyre_loads_n``: static, plus ``m ax h / L`` along and
+``m ay h / track`` across, shared between the axles by the roll stiffness), or the lateral
+acceleration exceeds the static stability limit of the rigid vehicle, ``|ay| > g track / (2 h)``
+(the static stability factor, Gillespie, *Fundamentals of Vehicle Dynamics*, 1992, ch. 9). A
+rear wheel unloaded by braking alone (pitch, no roll) is not a rollover.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import NamedTuple
+
+from eoam_sumo.errors import InputError
+from eoam_sumo.offline.tables import METADATA_NAME, LookupTables, default_tables_dir
+from eoam_sumo.params import G_MPS2, VehicleParams
+from eoam_sumo.plant.model import AX_LOAD, AY_LOAD, STATE_NAMES, tyre_loads_n
+from eoam_sumo.plant.ops import FLOAT_OPS
+from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
+
+#: The tyres in the order of ``plant.model.tyre_loads_n``.
+TYRES = ("front left", "front right", "rear left", "rear right")
+
+
+def vehicle_name(vehicle: str) -> str:
+    """The name a vehicle's tables folder and case ids use: the catalogue name, or a vehicle
+    file's stem."""
+    path = Path(vehicle)
+    return path.stem if path.suffix == ".toml" else path.name
+
+
+def vehicle_tables_dir(vehicle: str = DEFAULT_VEHICLE, base: Path | None = None) -> Path:
+    """The tables folder of ``vehicle`` (module docstring): ``base`` (default
+    ``offline.tables.default_tables_dir()``) for the default vehicle, else ``base/<name>``."""
+    folder = Path(base) if base is not None else default_tables_dir()
+    name = vehicle_name(vehicle)
+    return folder if name == DEFAULT_VEHICLE else folder / name
+
+
+def vehicle_tables(
+    vehicle: str, params: VehicleParams, base: Path | None = None, cached: bool = True
+) -> LookupTables:
+    """The lookup tables of ``vehicle`` (its parameters ``params``) under ``base``;
+    ``InputError`` in one line when its folder holds none or tables built for other
+    parameters."""
+    folder = vehicle_tables_dir(vehicle, base)
+    if vehicle_name(vehicle) != DEFAULT_VEHICLE and not (folder / METADATA_NAME).is_file():
+        raise InputError(
+            f"{folder}: no lookup tables for vehicle {vehicle!r}; build them with "
+            f"`eoam-sumo tables --vehicle {vehicle} --out {folder}`"
+        )
+    if cached:
+        return LookupTables.cached(folder, params=params)
+    return LookupTables.load(folder, params=params)
+
+
+class RolloverLimits(NamedTuple):
+    """The four tyres' normal loads as affine functions of the plant's load accelerations,
+    ``load_i = static_n[i] + per_ax[i] * ax + per_ay[i] * ay`` [N, N s^2/m] (``TYRES``
+    order), and the static stability limit of ``|ay|`` [m/s^2]."""
+
+    static_n: tuple[float, float, float, float]
+    per_ax: tuple[float, float, float, float]
+    per_ay: tuple[float, float, float, float]
+    ssf_ay_mps2: float
+
+
+def rollover_limits(params: VehicleParams) -> RolloverLimits:
+    """The limits of ``params``: the plant's own ``tyre_loads_n`` evaluated at three load
+    accelerations (it is affine in them until a load reaches zero, where it is clamped; the
+    unit accelerations used here leave every load of a road vehicle far from zero)."""
+
+    def loads(ax: float, ay: float) -> tuple[float, ...]:
+        x = [0.0] * len(STATE_NAMES)
+        x[AX_LOAD], x[AY_LOAD] = ax, ay
+        return tuple(float(v) for v in tyre_loads_n(x, params, FLOAT_OPS))
+
+    static, along, across = loads(0.0, 0.0), loads(1.0, 0.0), loads(0.0, 1.0)
+    h = params.cg_height_m
+    return RolloverLimits(
+        _four(static, (0.0,) * 4),
+        _four(along, static),
+        _four(across, static),
+        G_MPS2 * params.track_m / (2.0 * h) if h > 0.0 else math.inf,
+    )
+
+
+def _four(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, float, float, float]:
+    """The four tyres' ``a - b``."""
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3])
