@@ -201,8 +201,9 @@ def _run(params, settings, jobs, progress) -> dict:
             ProcessPoolExecutor(max_workers=min(jobs, len(settings.mus)), mp_context=ctx) as pool,
         ):
             q = manager.Queue()
-            futures = {
-                pool.submit(_solve_friction, params, settings, mu, q): mu for mu in settings.mus
+            futures = {  # the lowest friction's chain (the slowest) first
+                pool.submit(_solve_friction, params, settings, mu, q): mu
+                for mu in sorted(settings.mus)
             }
             pending = set(futures)
             while pending:
@@ -211,7 +212,8 @@ def _run(params, settings, jobs, progress) -> dict:
                 for f in done:
                     f.result()  # raise a worker's error now
             _drain(q, bar)
-            return {mu: f.result() for f, mu in futures.items()}
+            per_mu = {mu: f.result() for f, mu in futures.items()}
+            return {mu: per_mu[mu] for mu in settings.mus}
     finally:
         bar.close()
 
@@ -299,6 +301,7 @@ def _write_metadata(path: Path, params: VehicleParams, settings: DesignSettings)
             "name": "ipopt (CasADi Opti, direct collocation)",
             "casadi_version": casadi.CasadiMeta.version(),
             "options": solver_options(settings),
+            "last_resort_options": solver_options(settings, patient=True),
         },
         "files": {
             tb.CSV_NAME: "DMM phase boundaries per friction and relative speed",
