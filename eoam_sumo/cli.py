@@ -106,10 +106,11 @@ def _protocol_arguments(sub) -> None:
 def _tables_arguments(sub) -> None:
     p = sub.add_parser("tables", help="build the lookup tables and DMM phase boundaries")
     p.add_argument("--out", type=Path, default=Path("tables"), help="output folder")
-    p.add_argument("--jobs", type=_positive_int, default=1, help="parallel processes")
+    p.add_argument("--jobs", type=_positive_int, default=2, help="parallel processes (2)")
     p.add_argument("--speeds-kmh", type=speed_kmh, nargs="+", help="speed grid (km/h)")
     p.add_argument("--mu", type=mu, nargs="+", help="friction grid")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--vehicle", help="a catalogue name or a vehicle file (default: the sedan)")
 
 
 def _run_arguments(sub) -> None:
@@ -278,10 +279,17 @@ def _bench_arguments(sub) -> None:
 
 def _cmd_tables(args) -> int:
     from eoam_sumo.offline.build import build_tables
+    from eoam_sumo.vehicle_files import load_vehicle
 
+    params = load_vehicle(args.vehicle) if args.vehicle else None
     out = writable_dir(args.out)
     build_tables(
-        out, jobs=args.jobs, speeds_kmh=args.speeds_kmh, mus=args.mu, progress=not args.no_progress
+        out,
+        jobs=args.jobs,
+        speeds_kmh=args.speeds_kmh,
+        mus=args.mu,
+        progress=not args.no_progress,
+        params=params,
     )
     print(f"tables written to {out}")
     return 0

@@ -32,11 +32,11 @@ from eoam_sumo.offline import tables as tb
 from eoam_sumo.offline.boundaries import (
     clearing_distance_m,
     constant_speed_clearing_distance_m,
-    max_decel_no_lock_mps2,
     steer_buffered_m,
     stop_buffered_m,
     stop_distance_m,
 )
+from eoam_sumo.offline.braking import braking_decel_mps2, braking_model
 from eoam_sumo.offline.design import DesignSettings
 from eoam_sumo.offline.ocp import LaneChangeOcp, solve_chain, solver_options
 from eoam_sumo.offline.resim import Resimulation, audit, resimulate
@@ -111,7 +111,7 @@ def _solve_friction(
 ) -> list[SpeedResult]:
     """One friction's chain, audited and reduced to table rows (runs in a worker process)."""
     ocp = LaneChangeOcp(params, settings)
-    decel = max_decel_no_lock_mps2(params, mu)
+    decel = braking_decel_mps2(params, mu)
     ttc = settings.ttc_s(mu)
     results = []
 
@@ -184,7 +184,7 @@ def build_tables(
     out.mkdir(parents=True, exist_ok=True)
     _write_csv(out / tb.CSV_NAME, per_mu, params)
     _write_npz(out / tb.NPZ_NAME, per_mu, settings)
-    _write_metadata(out / tb.METADATA_NAME, params, settings)
+    _write_metadata(out / tb.METADATA_NAME, params, settings, per_mu)
     return out
 
 
@@ -201,8 +201,9 @@ def _run(params, settings, jobs, progress) -> dict:
             ProcessPoolExecutor(max_workers=min(jobs, len(settings.mus)), mp_context=ctx) as pool,
         ):
             q = manager.Queue()
-            futures = {
-                pool.submit(_solve_friction, params, settings, mu, q): mu for mu in settings.mus
+            futures = {  # the lowest friction's chain (the slowest) first
+                pool.submit(_solve_friction, params, settings, mu, q): mu
+                for mu in sorted(settings.mus)
             }
             pending = set(futures)
             while pending:
@@ -211,7 +212,8 @@ def _run(params, settings, jobs, progress) -> dict:
                 for f in done:
                     f.result()  # raise a worker's error now
             _drain(q, bar)
-            return {mu: f.result() for f, mu in futures.items()}
+            per_mu = {mu: f.result() for f, mu in futures.items()}
+            return {mu: per_mu[mu] for mu in settings.mus}
     finally:
         bar.close()
 
@@ -282,12 +284,23 @@ def _write_npz(path: Path, per_mu: dict, settings: DesignSettings) -> None:
     write_atomic(path, buf.getvalue())
 
 
-def _write_metadata(path: Path, params: VehicleParams, settings: DesignSettings) -> None:
+def _write_metadata(
+    path: Path, params: VehicleParams, settings: DesignSettings, per_mu: dict
+) -> None:
+    mus = sorted(per_mu)
+    decel_column = CSV_COLUMNS.index("max_decel_mps2")
     meta = {
         "format": tb.FORMAT_VERSION,
         "package": "eoam-sumo",
         "package_version": eoam_sumo.__version__,
+        "vehicle_name": params.name,
+        "vehicle_digest": tb.vehicle_digest(params),
         "vehicle": describe(params),
+        "braking": {
+            "model": braking_model(params),
+            "mu": mus,
+            "decel_mps2": [per_mu[mu][0].csv_values[decel_column] for mu in mus],
+        },
         "obstacle": describe(aro_d_class_minivan()),
         "design": settings.as_dict(),
         "grids": {
@@ -299,6 +312,7 @@ def _write_metadata(path: Path, params: VehicleParams, settings: DesignSettings)
             "name": "ipopt (CasADi Opti, direct collocation)",
             "casadi_version": casadi.CasadiMeta.version(),
             "options": solver_options(settings),
+            "last_resort_options": solver_options(settings, patient=True),
         },
         "files": {
             tb.CSV_NAME: "DMM phase boundaries per friction and relative speed",

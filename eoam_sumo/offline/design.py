@@ -104,7 +104,27 @@ class DesignSettings:
         "suboptimal profile, cf. the paper's 'suboptimal' profiles) and makes it unique",
     )
     ipopt_tol: float = _p(1e-8, "-", "IPOPT default (tight, so warm starts reach the same optimum)")
-    ipopt_max_iter: int = _p(1000, "-", DESIGN)
+    ipopt_max_iter: int = _p(1000, "-", DESIGN + ": the last resort's iteration limit")
+    ipopt_mu_init: float = _p(
+        1e-4,
+        "-",
+        DESIGN + ": IPOPT's initial barrier parameter in the speed chain, whose every solve "
+        "starts from a neighbouring optimum (IPOPT's default 0.1 pushes such a start off its "
+        "active constraints, and the low-friction, low-speed solves then fail)",
+    )
+    attempt_max_iter: int = _p(
+        200,
+        "-",
+        DESIGN + ": iteration limit of a solve in the speed chain (converging ones take "
+        "fewer); a solve that reaches it is retried from a nearer speed",
+    )
+    speed_halvings: int = _p(
+        3,
+        "-",
+        DESIGN + ": a failed step of the speed chain is split into two half steps, nested "
+        "at most this many times, before the last resort (IPOPT's defaults, then continuation "
+        "in the tyre and the ellipse)",
+    )
     verify_lateral_tol_m: float = _p(0.03, "m", DESIGN + ": re-simulated final y vs y_f")
     verify_distance_tol_m: float = _p(0.10, "m", DESIGN + ": re-simulated vs optimised x(t_f)")
     verify_lat_speed_tol_mps: float = _p(0.05, "m/s", DESIGN + ": final lateral speed")
@@ -130,6 +150,30 @@ class DesignSettings:
     )
 
     def __post_init__(self) -> None:
+        self._check_numbers()
+        self._check_counts()
+        if self.friction_use > 1.0:
+            raise ValueError(f"friction_use={self.friction_use} must be <= 1")
+        if not isinstance(self.plant_tyre, bool):
+            raise ValueError(f"design setting plant_tyre={self.plant_tyre!r} must be true or false")
+        if self.min_speed_fraction >= 1.0:
+            raise ValueError(f"min_speed_fraction={self.min_speed_fraction} must be < 1")
+        if self.lat_accel_fraction > 1.0:
+            raise ValueError(f"lat_accel_fraction={self.lat_accel_fraction} must be <= 1")
+        # the lane-change optimisation is posed for highway manoeuvres: below 20 km/h or
+        # mu 0.1 IPOPT finds no solution (measured: 1 km/h, mu 0.001)
+        _check_grid("speeds_kmh", self.speeds_kmh, MIN_SPEED_KMH, 400.0, inclusive=True)
+        _check_grid("mus", self.mus, MIN_MU, MU_MAX, inclusive=True)
+        _check_grid("ttc_mus", self.ttc_mus, 0.0, MU_MAX)
+        if list(self.ttc_mus) != sorted(self.ttc_mus):
+            raise ValueError(f"ttc_mus={self.ttc_mus} must be in increasing order")
+        if len(self.ttc_values_s) != len(self.ttc_mus) or not all(
+            isinstance(v, (int, float)) and math.isfinite(v) and v > 0 for v in self.ttc_values_s
+        ):
+            raise ValueError("ttc_values_s must hold one finite TTC > 0 per entry of ttc_mus")
+
+    def _check_numbers(self) -> None:
+        """The real-valued settings: finite, positive (or non-negative)."""
         positive = (
             "lane_change_m",
             "obstacle_width_m",
@@ -139,6 +183,7 @@ class DesignSettings:
             "min_speed_fraction",
             "max_yaw_rad",
             "ipopt_tol",
+            "ipopt_mu_init",
             "friction_use",
             "verify_lateral_tol_m",
             "verify_distance_tol_m",
@@ -161,31 +206,23 @@ class DesignSettings:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0.0):
                 raise ValueError(f"design setting {name}={v!r} must be a finite number >= 0")
-        if self.friction_use > 1.0:
-            raise ValueError(f"friction_use={self.friction_use} must be <= 1")
-        if not isinstance(self.plant_tyre, bool):
-            raise ValueError(f"design setting plant_tyre={self.plant_tyre!r} must be true or false")
-        for name in ("ocp_intervals", "collocation_degree", "ipopt_max_iter", "continuation_steps"):
+
+    def _check_counts(self) -> None:
+        """The integer settings."""
+        for name in (
+            "ocp_intervals",
+            "collocation_degree",
+            "ipopt_max_iter",
+            "attempt_max_iter",
+            "continuation_steps",
+        ):
             v = getattr(self, name)
             if not (isinstance(v, int) and v >= 1):
                 raise ValueError(f"design setting {name}={v!r} must be an integer >= 1")
+        if not (isinstance(self.speed_halvings, int) and self.speed_halvings >= 0):
+            raise ValueError(f"speed_halvings={self.speed_halvings!r} must be an integer >= 0")
         if self.ocp_intervals < 10:
             raise ValueError(f"ocp_intervals={self.ocp_intervals} must be >= 10")
-        if self.min_speed_fraction >= 1.0:
-            raise ValueError(f"min_speed_fraction={self.min_speed_fraction} must be < 1")
-        if self.lat_accel_fraction > 1.0:
-            raise ValueError(f"lat_accel_fraction={self.lat_accel_fraction} must be <= 1")
-        # the lane-change optimisation is posed for highway manoeuvres: below 20 km/h or
-        # mu 0.1 IPOPT finds no solution (measured: 1 km/h, mu 0.001)
-        _check_grid("speeds_kmh", self.speeds_kmh, MIN_SPEED_KMH, 400.0, inclusive=True)
-        _check_grid("mus", self.mus, MIN_MU, MU_MAX, inclusive=True)
-        _check_grid("ttc_mus", self.ttc_mus, 0.0, MU_MAX)
-        if list(self.ttc_mus) != sorted(self.ttc_mus):
-            raise ValueError(f"ttc_mus={self.ttc_mus} must be in increasing order")
-        if len(self.ttc_values_s) != len(self.ttc_mus) or not all(
-            isinstance(v, (int, float)) and math.isfinite(v) and v > 0 for v in self.ttc_values_s
-        ):
-            raise ValueError("ttc_values_s must hold one finite TTC > 0 per entry of ttc_mus")
 
     def ttc_s(self, mu: float) -> float:
         """TTC of the do-nothing boundary (eq. 34): linear in mu between the table, clamped."""

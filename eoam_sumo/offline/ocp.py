@@ -15,14 +15,18 @@ lateral dynamics stiff at low speed), piecewise-constant controls (steering rate
 force); the path constraints hold at every interval start (with the new control) and at every
 collocation point. A small penalty on the control steps (``settings.regularisation``) smooths
 the bang-bang optimum. IPOPT solves it; the problem is built once per ``LaneChangeOcp`` with
-the entry speed, the friction, the tyre blend and the ellipse bound as parameters, so that a
-solve that fails directly is reached by continuation from the paper's tyre and the whole
-ellipse (``solve_chain``).
+the entry speed, the friction, the tyre blend and the ellipse bound as parameters.
+
+One friction's speeds are solved as a chain from the highest down (``solve_chain``): each
+solve starts from a prediction through the two previous optima (``predicted_guess``) with a
+small initial barrier parameter; a step that fails is split into half steps, and only where
+those fail too is the point solved with IPOPT's defaults or by continuation from the paper's
+tyre and the whole ellipse (``solve_continued``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import casadi as ca
 import numpy as np
@@ -60,9 +64,11 @@ class OcpSolution:
         return float(self.states[-1, 0])
 
 
-def solver_options(settings: DesignSettings) -> dict:
-    """The CasADi/IPOPT options (also written to metadata.json)."""
-    return {
+def solver_options(settings: DesignSettings, patient: bool = False) -> dict:
+    """The CasADi/IPOPT options (also written to metadata.json): the speed chain's (a small
+    initial barrier parameter, ``settings.attempt_max_iter`` iterations) or, ``patient``, the
+    last resort's (IPOPT's default barrier, ``settings.ipopt_max_iter`` iterations)."""
+    options: dict = {
         "print_time": False,
         "expand": True,
         "ipopt.print_level": 0,
@@ -70,6 +76,10 @@ def solver_options(settings: DesignSettings) -> dict:
         "ipopt.tol": settings.ipopt_tol,
         "ipopt.max_iter": settings.ipopt_max_iter,
     }
+    if not patient:
+        options["ipopt.max_iter"] = settings.attempt_max_iter
+        options["ipopt.mu_init"] = settings.ipopt_mu_init
+    return options
 
 
 def _interval_function(params: VehicleParams, degree: int) -> ca.Function:
@@ -111,11 +121,13 @@ def _interval_function(params: VehicleParams, degree: int) -> ca.Function:
 
 
 class LaneChangeOcp:
-    """The lane-change OCP built once; ``solve`` per entry speed and friction."""
+    """The lane-change OCP built once; ``solve`` per entry speed and friction. IPOPT's options
+    are the speed chain's, or the last resort's if ``patient`` (``solver_options``)."""
 
-    def __init__(self, params: VehicleParams, settings: DesignSettings):
+    def __init__(self, params: VehicleParams, settings: DesignSettings, patient: bool = False):
         self.params = params
         self.settings = settings
+        self.patient = patient
         n, d = settings.ocp_intervals, settings.collocation_degree
         p = params
         opti = ca.Opti()
@@ -165,7 +177,7 @@ class LaneChangeOcp:
             self._w[0, 1:] - self._w[0, :-1], (self._w[1, 1:] - self._w[1, :-1]) / self._mu
         )
         opti.minimize(xs[0, -1] + settings.regularisation * ca.sumsqr(dw))  # eq. 14
-        opti.solver("ipopt", solver_options(settings))
+        opti.solver("ipopt", solver_options(settings, patient))
         self._opti = opti
         self._degree = d
 
@@ -298,24 +310,75 @@ def solve_continued(
     return sol
 
 
+def predicted_guess(history: list[OcpSolution], speed_mps: float) -> OcpSolution:
+    """Warm start at ``speed_mps`` from the chain's solutions so far (nearest last): the last
+    one rescaled (``rescaled_guess``) and extrapolated linearly through the one before it
+    (a secant predictor: the optimum moves smoothly with the entry speed)."""
+    last = rescaled_guess(history[-1], speed_mps)
+    if len(history) < 2:
+        return last
+    before = rescaled_guess(history[-2], speed_mps)
+    w = (speed_mps - history[-1].speed_mps) / (history[-1].speed_mps - history[-2].speed_mps)
+    assert last.colloc_states is not None and before.colloc_states is not None
+    return replace(
+        last,
+        duration_s=last.duration_s + w * (last.duration_s - before.duration_s),
+        states=last.states + w * (last.states - before.states),
+        controls=last.controls + w * (last.controls - before.controls),
+        colloc_states=last.colloc_states + w * (last.colloc_states - before.colloc_states),
+    )
+
+
+class _Chain:
+    """One friction's speed chain: its solver, and the last resort's built when needed."""
+
+    def __init__(self, ocp: LaneChangeOcp, mu: float):
+        self.ocp = ocp
+        self.mu = mu
+        self._patient: LaneChangeOcp | None = ocp if ocp.patient else None
+
+    def first(self, speed_mps: float) -> OcpSolution:
+        """The chain's first (highest) speed, from ``quintic_guess``."""
+        guess = quintic_guess(speed_mps, self.mu, self.ocp.params, self.ocp.settings)
+        try:
+            return self.ocp.solve(speed_mps, self.mu, guess)
+        except OcpError:
+            return self.last_resort(speed_mps, guess)
+
+    def step(self, history: list[OcpSolution], speed_mps: float, halvings: int) -> OcpSolution:
+        """The next speed from ``predicted_guess``; where that fails, two half steps (each
+        allowed ``halvings - 1`` further splits), then the last resort."""
+        try:
+            return self.ocp.solve(speed_mps, self.mu, predicted_guess(history, speed_mps))
+        except OcpError:
+            if halvings <= 0:
+                return self.last_resort(speed_mps, rescaled_guess(history[-1], speed_mps))
+        middle = self.step(history, 0.5 * (history[-1].speed_mps + speed_mps), halvings - 1)
+        return self.step([*history, middle], speed_mps, halvings - 1)
+
+    def last_resort(self, speed_mps: float, guess: OcpSolution) -> OcpSolution:
+        """IPOPT's defaults from ``guess``, then continuation from the paper's problem."""
+        if self._patient is None:
+            self._patient = LaneChangeOcp(self.ocp.params, self.ocp.settings, patient=True)
+        try:
+            return self._patient.solve(speed_mps, self.mu, guess)
+        except OcpError:
+            return solve_continued(self._patient, speed_mps, self.mu, guess)
+
+
 def solve_chain(ocp: LaneChangeOcp, mu: float, speeds_mps, on_solved=None) -> list[OcpSolution]:
     """Solve one friction's speeds from the highest down, each warm-started from the previous.
 
     The highest speed starts from ``quintic_guess`` (fast lane changes converge easily from
-    it), the next ones from the previous solution; where a direct solve fails, by
-    continuation from the same guess (``solve_continued``). ``on_solved(solution)`` is called
-    after each. Returns the solutions, highest first.
+    it), the next ones from ``predicted_guess``; a step that fails is halved up to
+    ``settings.speed_halvings`` times, then solved by the last resort (``_Chain``).
+    ``on_solved(solution)`` is called after each. Returns the solutions, highest first.
     """
+    chain = _Chain(ocp, mu)
+    halvings = ocp.settings.speed_halvings
     solutions: list[OcpSolution] = []
     for v in sorted(speeds_mps, reverse=True):
-        if solutions:
-            guess = rescaled_guess(solutions[-1], v)
-        else:
-            guess = quintic_guess(v, mu, ocp.params, ocp.settings)
-        try:
-            sol = ocp.solve(v, mu, guess)
-        except OcpError:
-            sol = solve_continued(ocp, v, mu, guess)
+        sol = chain.step(solutions, v, halvings) if solutions else chain.first(v)
         solutions.append(sol)
         if on_solved is not None:
             on_solved(sol)

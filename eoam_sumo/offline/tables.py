@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import bisect
 import csv
+import hashlib
 import json
 import os
 from pathlib import Path
@@ -188,6 +189,9 @@ class LookupTables:
         self.params = params
         self._mus = list(self.mu_grid)
         self._speeds = list(self.speed_grid_mps)
+        braking = metadata.get("braking", {})
+        self._braking_mus = [float(m) for m in braking.get("mu", [])]
+        self._braking_decels = [float(a) for a in braking.get("decel_mps2", [])]
 
     @classmethod
     def load(cls, directory=None, params: VehicleParams | None = None) -> LookupTables:
@@ -276,8 +280,14 @@ class LookupTables:
             )
 
     def max_decel_mps2(self, mu: float) -> float:
-        """Largest straight-line deceleration without locking an axle at this friction."""
-        return max_decel_no_lock_mps2(self.params, min(mu, self.mu_grid[-1]))
+        """Eq. 33's braking deceleration at this friction: the largest without locking an
+        axle, or with ABS what the vehicle's ABS achieves (the build's values per grid
+        friction in metadata.json, linear in mu between them, clamped outside)."""
+        mu = min(mu, self.mu_grid[-1])
+        if not self.params.abs_fitted:
+            return max_decel_no_lock_mps2(self.params, mu)
+        i, j, w = _bracket(self._braking_mus, mu)
+        return self._braking_decels[i] + w * (self._braking_decels[j] - self._braking_decels[i])
 
     def trajectory(self, mu: float, speed_mps: float) -> Trajectory:
         """The manoeuvre reference for this friction and entry speed (bilinear blend, once)."""
@@ -344,31 +354,42 @@ DESIGN_FIELDS = (
     "brake_front_share",
 )
 """The vehicle parameters the offline design uses (``offline/``: the design model, the
-inverse dynamics, the boundaries): the tables are valid for a vehicle that matches them; the
-chassis-only fields (tyre, wheels, ABS/ESC, drivetrain) do not change them."""
+inverse dynamics, the boundaries): the tables are valid for a vehicle that matches them. The
+chassis-only fields (tyre, wheels, ESC, drivetrain) do not change them, except with ABS:
+its braking limit comes from the whole plant (``braking.abs_decel_mps2``), so the tables of a
+vehicle with ABS are valid only for the same digest of every parameter (``vehicle_digest``)."""
+
+BUILD_COMMAND = "eoam-sumo tables --vehicle NAME|FILE --out DIR"
+
+
+def vehicle_digest(params: VehicleParams) -> str:
+    """SHA-256 (16 hex digits) of every parameter value of the vehicle, its name aside."""
+    values = {k: v["value"] for k, v in describe(params).items() if k != "name"}
+    text = json.dumps(values, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
 def _check_metadata(path: Path, metadata: dict, params: VehicleParams) -> None:
     if metadata.get("format") != FORMAT_VERSION:
         raise InputError(
             f"{path}: tables format {metadata.get('format')!r} is not "
-            f"{FORMAT_VERSION}; run `eoam-sumo tables`"
+            f"{FORMAT_VERSION}; run `{BUILD_COMMAND}`"
         )
     stored = metadata.get("vehicle", {})
     wanted = describe(params)
+    stored = {"abs_fitted": {"value": False}, **stored}  # tables built before ABS existed
     diffs = [
-        name
-        for name in DESIGN_FIELDS
-        if not isinstance(stored.get(name), dict)
-        or stored[name].get("value") != wanted[name]["value"]
+        f"{n} (tables {stored.get(n, {}).get('value')!r}, in use {wanted[n]['value']!r})"
+        for n in (*DESIGN_FIELDS, "abs_fitted")
+        if not isinstance(stored.get(n), dict) or stored[n].get("value") != wanted[n]["value"]
     ]
+    if not diffs and params.abs_fitted:
+        digest = metadata.get("vehicle_digest")
+        if digest != vehicle_digest(params) or not metadata.get("braking", {}).get("mu"):
+            diffs = [f"parameter digest (tables {digest!r}, in use {vehicle_digest(params)!r})"]
     if diffs:
-        shown = ", ".join(
-            f"{n} (tables {stored.get(n, {}).get('value')!r}, in use "
-            f"{wanted.get(n, {}).get('value')!r})"
-            for n in diffs[:3]
-        )
+        built = stored.get("name", {}).get("value", "an unnamed vehicle")
         raise InputError(
-            f"{path}: the tables were built for other vehicle parameters: {shown}; "
-            "run `eoam-sumo tables` to rebuild them"
+            f"{path}: the tables were built for {built!r}, not for {params.name!r} "
+            f"({', '.join(diffs[:3])}); build its tables with `{BUILD_COMMAND}`"
         )

@@ -86,7 +86,7 @@ def test_chain_runs_from_the_highest_speed(ocp):
 
 
 def test_non_convergence_is_reported_with_speed_and_friction():
-    tight = LaneChangeOcp(P, dataclasses.replace(S, ipopt_max_iter=2))
+    tight = LaneChangeOcp(P, dataclasses.replace(S, attempt_max_iter=2))
     with pytest.raises(OcpError, match=r"mu=0\.7, 100 km/h did not converge"):
         tight.solve(V, MU, quintic_guess(V, MU, P, S))
 
