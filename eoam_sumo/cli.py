@@ -105,12 +105,19 @@ def _protocol_arguments(sub) -> None:
 
 def _tables_arguments(sub) -> None:
     p = sub.add_parser("tables", help="build the lookup tables and DMM phase boundaries")
-    p.add_argument("--out", type=Path, default=Path("tables"), help="output folder")
+    p.add_argument(
+        "--out",
+        type=Path,
+        help="output folder (default: the vehicle's: tables/, tables/NAME/, tables/NAME-abs/)",
+    )
     p.add_argument("--jobs", type=_positive_int, default=2, help="parallel processes (2)")
     p.add_argument("--speeds-kmh", type=speed_kmh, nargs="+", help="speed grid (km/h)")
     p.add_argument("--mu", type=mu, nargs="+", help="friction grid")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--vehicle", help="a catalogue name or a vehicle file (default: the sedan)")
+    p.add_argument(
+        "--abs", choices=("on", "off"), help="ABS fitted or not (default: the vehicle's own)"
+    )
 
 
 def _run_arguments(sub) -> None:
@@ -279,10 +286,14 @@ def _bench_arguments(sub) -> None:
 
 def _cmd_tables(args) -> int:
     from eoam_sumo.offline.build import build_tables
-    from eoam_sumo.vehicle_files import load_vehicle
+    from eoam_sumo.sim.vehicle import vehicle_tables_dir
+    from eoam_sumo.vehicle_files import DEFAULT_VEHICLE, load_vehicle
 
-    params = load_vehicle(args.vehicle) if args.vehicle else None
-    out = writable_dir(args.out)
+    vehicle = args.vehicle or DEFAULT_VEHICLE
+    params = load_vehicle(vehicle)
+    if args.abs is not None:
+        params = replace(params, abs_fitted=args.abs == "on")
+    out = writable_dir(args.out or vehicle_tables_dir(vehicle, None, params))
     build_tables(
         out,
         jobs=args.jobs,

@@ -113,8 +113,37 @@ def test_abs_and_esc_are_switched_on_the_vehicle_and_carried_by_every_case(tmp_p
     params = vehicle_params("sedan", abs_mode="on", esc_mode="off")
     assert params.abs_fitted is True and params.esc_fitted is False
     point = protocol_points("unr152", SEDAN_WIDTH_M, ("paper",))[0]
-    case = _case(point, tmp_path / "x.sumocfg", "paper", 1.0, 40.0, params)
+    case = _case(point, tmp_path / "x.sumocfg", "paper", 1.0, 40.0, "sedan", params)
     assert case_vehicle(case) == params
+    suv = vehicle_params("suv", abs_mode="off")
+    case = _case(point, tmp_path / "x.sumocfg", "paper", 1.0, 40.0, "suv", suv)
+    assert case.vehicle == "suv" and case_vehicle(case) == suv and not suv.abs_fitted
+
+
+def test_a_vut_whose_tables_are_missing_is_refused_in_one_line(tmp_path):
+    """The paper's sedan with ABS needs tables of its own (tables/sedan-abs/): the ABS
+    braking limit is the plant's; an empty tables folder has none."""
+    import shutil
+
+    from eoam_sumo.errors import InputError
+    from eoam_sumo.offline.tables import default_tables_dir
+    from eoam_sumo.protocols.command import vehicle_params
+    from eoam_sumo.protocols.runner import run_protocol
+
+    base = tmp_path / "tables"
+    base.mkdir()
+    for path in default_tables_dir().iterdir():
+        if path.is_file():
+            shutil.copy(path, base)
+    points = protocol_points("unr152", SEDAN_WIDTH_M, ("paper",))[:1]
+    with pytest.raises(InputError, match=r"sedan-abs: no lookup tables.*--abs on"):
+        run_protocol(
+            "unr152",
+            points,
+            tmp_path / "out",
+            params=vehicle_params("sedan", "on"),
+            tables_dir=base,
+        )
 
 
 def test_r152_verdicts():

@@ -163,8 +163,18 @@ def _limit_checks(
             1e-6,
             "rad/s",
         ),
-        ("brake force", -brake.min() - p.max_brake_force_n, 1e-3, "N"),
-        ("drive force (eq. 29)", drive.max() - p.max_drive_force_n, 1e-3, "N"),
+        (
+            "brake force",
+            -brake.min() - p.max_brake_force_n,
+            s.verify_ellipse_tol * p.max_brake_force_n,
+            "N",
+        ),
+        (
+            "drive force (eq. 29)",
+            drive.max() - p.max_drive_force_n,
+            s.verify_ellipse_tol * p.max_drive_force_n,
+            "N",
+        ),
         (
             "drive power (eq. 29)",
             (drive * resim.vx_body_mps).max() - p.max_drive_power_w,

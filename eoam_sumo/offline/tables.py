@@ -357,14 +357,20 @@ DESIGN_FIELDS = (
 inverse dynamics, the boundaries): the tables are valid for a vehicle that matches them. The
 chassis-only fields (tyre, wheels, ESC, drivetrain) do not change them, except with ABS:
 its braking limit comes from the whole plant (``braking.abs_decel_mps2``), so the tables of a
-vehicle with ABS are valid only for the same digest of every parameter (``vehicle_digest``)."""
+vehicle with ABS are valid only for the same digest of every parameter but ESC's
+(``vehicle_digest``)."""
 
-BUILD_COMMAND = "eoam-sumo tables --vehicle NAME|FILE --out DIR"
+BUILD_COMMAND = "eoam-sumo tables --vehicle NAME|FILE [--abs on|off] --out DIR"
 
 
 def vehicle_digest(params: VehicleParams) -> str:
-    """SHA-256 (16 hex digits) of every parameter value of the vehicle, its name aside."""
-    values = {k: v["value"] for k, v in describe(params).items() if k != "name"}
+    """SHA-256 (16 hex digits) of every parameter value of the vehicle but its name and its ESC
+    (which does not act in the straight stop that measures the ABS braking limit)."""
+    values = {
+        k: v["value"]
+        for k, v in describe(params).items()
+        if k != "name" and not k.startswith("esc_")
+    }
     text = json.dumps(values, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 

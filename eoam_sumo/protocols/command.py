@@ -10,13 +10,13 @@ from pathlib import Path
 from typing import Any
 
 from eoam_sumo.errors import InputError
-from eoam_sumo.params import MU_MAX, VehicleParams, ego_e_class_sedan
+from eoam_sumo.params import MU_MAX, VehicleParams
 from eoam_sumo.protocols.points import PROTOCOLS, TestPoint, protocol_points
+from eoam_sumo.vehicle_files import load_vehicle
 
 #: Runs end at this simulated time after the ego's departure [s]: the slowest approach
 #: (CCRm 30 km/h behind 20 km/h, 41.7 m at 2.8 m/s) meets the target after 15 s.
 MAX_TIME_S = 40.0
-VEHICLES = ("sedan",)
 POLICIES = ("paper", "safe")
 
 
@@ -28,10 +28,8 @@ ON_OFF = ("on", "off")
 def vehicle_params(
     name: str, abs_mode: str | None = None, esc_mode: str | None = None
 ) -> VehicleParams:
-    """The VUT's ``VehicleParams``: ``--vehicle`` NAME, with ABS/ESC on or off as asked
-    (None: the vehicle's own). InputError for an unknown NAME."""
-    if name != "sedan":
-        raise InputError(f"--vehicle {name!r} is not one of {', '.join(VEHICLES)}")
+    """The VUT's ``VehicleParams``: ``--vehicle`` NAME (a catalogue name or a vehicle file),
+    with ABS/ESC on or off as asked (None: the vehicle's own). InputError for an unknown NAME."""
     changes: dict[str, Any] = {}
     for option, mode in (("abs", abs_mode), ("esc", esc_mode)):
         if mode is None:
@@ -39,7 +37,7 @@ def vehicle_params(
         if mode not in ON_OFF:
             raise InputError(f"--{option} {mode!r} is not one of on, off")
         changes[FITTED_FIELDS[option]] = mode == "on"
-    return dataclasses.replace(ego_e_class_sedan(), **changes)
+    return dataclasses.replace(load_vehicle(name), **changes)
 
 
 def vehicle_label(args) -> str:
@@ -60,7 +58,9 @@ def add_arguments(subparsers) -> None:
     p.add_argument("--out", type=Path, required=True, help="output folder")
     p.add_argument("--jobs", type=int, default=1, help="parallel processes")
     p.add_argument("--scheduler", help="Dask scheduler address, or 'local'")
-    p.add_argument("--vehicle", default="sedan", help="the VUT (sedan)")
+    p.add_argument(
+        "--vehicle", default="sedan", help="the VUT: a catalogue name or a vehicle file (sedan)"
+    )
     p.add_argument("--policy", choices=POLICIES, default="paper", help="decision policy")
     p.add_argument("--abs", choices=ON_OFF, help="ABS fitted or not (default: the vehicle's)")
     p.add_argument("--esc", choices=ON_OFF, help="ESC fitted or not (default: the vehicle's)")
@@ -104,6 +104,7 @@ def run(args) -> int:
         policy=args.policy,
         mu=args.mu,
         vehicle=vehicle_label(args),
+        vehicle_id=args.vehicle,
         params=vehicle_params(args.vehicle, args.abs, args.esc),
         progress=not args.no_progress,
         max_time_s=MAX_TIME_S,

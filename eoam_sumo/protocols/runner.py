@@ -17,6 +17,7 @@ from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.protocols import scoring
 from eoam_sumo.protocols.points import TestPoint
 from eoam_sumo.protocols.scenario import write_scenarios
+from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
 
 RESULTS_FILE = "results.csv"
 SCORECARD_MD = "scorecard.md"
@@ -56,15 +57,22 @@ class ProtocolSummary:
     failed: int
 
 
-def _design_low_kmh(tables_dir: Path | None) -> float:
-    from eoam_sumo.offline.tables import LookupTables, default_tables_dir
+def _design_low_kmh(tables_dir: Path | None, vehicle_id: str, params: VehicleParams) -> float:
+    """The lowest speed of the VUT's lookup tables (refused in one line when it has none)."""
+    from eoam_sumo.sim.vehicle import vehicle_tables
 
-    folder = Path(tables_dir) if tables_dir is not None else default_tables_dir()
-    return LookupTables.load(folder).speed_grid_mps[0] * 3.6
+    tables = vehicle_tables(vehicle_id, params, tables_dir, cached=False)
+    return tables.speed_grid_mps[0] * 3.6
 
 
 def _case(
-    point: TestPoint, cfg: Path, policy: str, mu: float, max_time_s: float, params: VehicleParams
+    point: TestPoint,
+    cfg: Path,
+    policy: str,
+    mu: float,
+    max_time_s: float,
+    vehicle_id: str,
+    params: VehicleParams,
 ) -> Case:
     return Case(
         point.point_id,
@@ -78,6 +86,7 @@ def _case(
         policy=point.policy or policy,
         abs_fitted=params.abs_fitted,
         esc_fitted=params.esc_fitted,
+        vehicle=None if vehicle_id == DEFAULT_VEHICLE else vehicle_id,
     )
 
 
@@ -90,18 +99,21 @@ def run_protocol(
     scheduler: str | None = None,
     policy: str = "paper",
     mu: float = 1.0,
-    vehicle: str = "sedan",
+    vehicle: str = DEFAULT_VEHICLE,
+    vehicle_id: str = DEFAULT_VEHICLE,
     params: VehicleParams | None = None,
     progress: bool = True,
     max_time_s: float = 40.0,
     tables_dir: Path | None = None,
 ) -> ProtocolSummary:
     """Write the scenarios, run the points inside the design range, score every point."""
-    low = _design_low_kmh(tables_dir)
+    params = params or ego_e_class_sedan()
+    low = _design_low_kmh(tables_dir, vehicle_id, params)
     runnable = [p for p in points if p.ego_speed_kmh >= low - 1e-9]
     cfgs = write_scenarios(points, out / "scenarios")
-    params = params or ego_e_class_sedan()
-    cases = [_case(p, cfgs[p.point_id], policy, mu, max_time_s, params) for p in runnable]
+    cases = [
+        _case(p, cfgs[p.point_id], policy, mu, max_time_s, vehicle_id, params) for p in runnable
+    ]
     batch = run_cases(
         cases, out / BATCH_DIR, jobs, scheduler, progress=progress, tables_dir=tables_dir
     )

@@ -5,7 +5,9 @@ Tables: the default vehicle (``vehicle_files.DEFAULT_VEHICLE``, the paper's seda
 tables folder itself (``$EOAM_TABLES_DIR`` or the repository's ``tables/``, or the folder a
 run names); any other vehicle its sub-folder named after it: ``tables/<name>/``, ``<name>``
 the catalogue name or the vehicle file's stem (``--vehicle trucks/pickup.toml``:
-``tables/pickup/``). ``eoam-sumo tables --vehicle NAME --out tables/NAME`` builds them; a run
+``tables/pickup/``); a run whose ABS is not the vehicle file's has ``-abs`` or ``-noabs``
+after the name (``tables/sedan-abs/``: the paper's sedan with ABS). ``eoam-sumo tables --vehicle
+NAME [--abs on|off]`` builds them there; a run
 refuses a vehicle whose folder holds no tables or tables built for other parameters
 (``offline.tables.LookupTables.load``).
 
@@ -29,7 +31,7 @@ from eoam_sumo.offline.tables import METADATA_NAME, LookupTables, default_tables
 from eoam_sumo.params import G_MPS2, VehicleParams
 from eoam_sumo.plant.model import AX_LOAD, AY_LOAD, STATE_NAMES, tyre_loads_n
 from eoam_sumo.plant.ops import FLOAT_OPS
-from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
+from eoam_sumo.vehicle_files import DEFAULT_VEHICLE, load_vehicle
 
 #: The tyres in the order of ``plant.model.tyre_loads_n``.
 TYRES = ("front left", "front right", "rear left", "rear right")
@@ -42,12 +44,33 @@ def vehicle_name(vehicle: str) -> str:
     return path.stem if path.suffix == ".toml" else path.name
 
 
-def vehicle_tables_dir(vehicle: str = DEFAULT_VEHICLE, base: Path | None = None) -> Path:
-    """The tables folder of ``vehicle`` (module docstring): ``base`` (default
-    ``offline.tables.default_tables_dir()``) for the default vehicle, else ``base/<name>``."""
-    folder = Path(base) if base is not None else default_tables_dir()
+def tables_name(vehicle: str, params: VehicleParams | None = None) -> str:
+    """The name of ``vehicle``'s tables folder: its name (``vehicle_name``), with ``-abs`` or
+    ``-noabs`` when the run's ABS (``params``) differs from the vehicle file's own, for its
+    braking limit differs (``offline.braking``)."""
     name = vehicle_name(vehicle)
+    if params is None or params.abs_fitted == load_vehicle(vehicle).abs_fitted:
+        return name
+    return f"{name}-{'abs' if params.abs_fitted else 'noabs'}"
+
+
+def vehicle_tables_dir(
+    vehicle: str = DEFAULT_VEHICLE, base: Path | None = None, params: VehicleParams | None = None
+) -> Path:
+    """The tables folder of ``vehicle`` (module docstring): ``base`` (default
+    ``offline.tables.default_tables_dir()``) for the default vehicle as its file has it, else
+    ``base/<tables_name>``."""
+    folder = Path(base) if base is not None else default_tables_dir()
+    name = tables_name(vehicle, params)
     return folder if name == DEFAULT_VEHICLE else folder / name
+
+
+def build_command(vehicle: str, params: VehicleParams, folder: Path) -> str:
+    """The command that builds the tables ``vehicle_tables`` looks for."""
+    switch = "" if tables_name(vehicle, params) == vehicle_name(vehicle) else " --abs "
+    if switch:
+        switch += "on" if params.abs_fitted else "off"
+    return f"eoam-sumo tables --vehicle {vehicle}{switch} --out {folder}"
 
 
 def vehicle_tables(
@@ -56,11 +79,14 @@ def vehicle_tables(
     """The lookup tables of ``vehicle`` (its parameters ``params``) under ``base``;
     ``InputError`` in one line when its folder holds none or tables built for other
     parameters."""
-    folder = vehicle_tables_dir(vehicle, base)
-    if vehicle_name(vehicle) != DEFAULT_VEHICLE and not (folder / METADATA_NAME).is_file():
+    folder = vehicle_tables_dir(vehicle, base, params)
+    if (
+        folder != vehicle_tables_dir(DEFAULT_VEHICLE, base)
+        and not (folder / METADATA_NAME).is_file()
+    ):
         raise InputError(
             f"{folder}: no lookup tables for vehicle {vehicle!r}; build them with "
-            f"`eoam-sumo tables --vehicle {vehicle} --out {folder}`"
+            f"`{build_command(vehicle, params, folder)}`"
         )
     if cached:
         return LookupTables.cached(folder, params=params)

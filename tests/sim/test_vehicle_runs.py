@@ -19,8 +19,8 @@ from eoam_sumo.sim.observers import StepObserver
 from eoam_sumo.sim.runlog import write_run
 from eoam_sumo.sim.scenario import ScenarioOverrides
 from eoam_sumo.sim.settings import RunSettings
-from eoam_sumo.sim.vehicle import vehicle_tables_dir
-from eoam_sumo.vehicle_files import vehicle_toml
+from eoam_sumo.sim.vehicle import vehicle_tables, vehicle_tables_dir
+from eoam_sumo.vehicle_files import load_vehicle, vehicle_toml
 
 ROOT = Path(__file__).resolve().parents[2]
 BASELINE = ROOT / "scenarios" / "baseline.sumocfg"
@@ -101,6 +101,18 @@ def test_the_folder_of_a_vehicle_is_its_name_under_the_tables_and_the_sedans_the
     assert vehicle_tables_dir("my/fleet/van.toml", base) == base / "van"
 
 
+def test_a_vehicle_with_its_abs_switched_has_a_folder_of_its_own():
+    """The ABS braking limit is the plant's, so ABS switched is another set of tables."""
+    base = Path("/t")
+    sedan, compact = load_vehicle("sedan"), load_vehicle("compact")
+    assert vehicle_tables_dir("sedan", base, sedan) == base
+    assert vehicle_tables_dir("sedan", base, replace(sedan, abs_fitted=True)) == base / "sedan-abs"
+    assert vehicle_tables_dir("sedan", base, replace(sedan, esc_fitted=True)) == base
+    assert vehicle_tables_dir("compact", base, compact) == base / "compact"
+    off = replace(compact, abs_fitted=False)
+    assert vehicle_tables_dir("compact", base, off) == base / "compact-noabs"
+
+
 def test_tables_built_for_other_parameters_are_refused_in_one_line(capsys, tmp_path, tall_tables):
     _, base = tall_tables
     other = tmp_path / "tall.toml"  # the same name, a heavier car
@@ -147,3 +159,19 @@ def test_the_sedan_does_not_roll_over_in_the_same_case(tmp_path):
     assert summary["end_cause"] != "rollover" and summary["min_tyre_load_n"] > 1000.0
     assert "rollover" not in summary["reason"]
     shutil.rmtree(out)
+
+
+@pytest.mark.parametrize("name", ["compact", "sedan-r13h", "suv", "van", "pickup"])
+def test_every_catalogue_vehicle_ships_tables_built_from_its_file(name):
+    """A changed vehicle file without rebuilt tables fails here, not in a user's run."""
+    params = load_vehicle(name)
+    tables = vehicle_tables(name, params, cached=False)
+    assert tables.params == params
+
+
+def test_the_sedan_with_abs_ships_its_own_tables():
+    params = replace(load_vehicle("sedan"), abs_fitted=True, esc_fitted=True)
+    tables = vehicle_tables("sedan", params, cached=False)
+    assert tables.max_decel_mps2(1.0) > vehicle_tables(
+        "sedan", load_vehicle("sedan")
+    ).max_decel_mps2(1.0)
