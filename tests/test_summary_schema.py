@@ -61,6 +61,7 @@ def test_every_timeseries_column_has_one_source():
         *runlog._FROM_PERCEPTION,
         runlog._SECTOR,
         runlog._ROAD_MU,
+        "brake_force_n",
     ]
     assert sorted(sources) == sorted(runlog.COLUMNS)
     assert set(runlog._FROM_MEAS.values()) <= set(EgoMeasurement._fields)
@@ -69,9 +70,9 @@ def test_every_timeseries_column_has_one_source():
 
 
 def test_a_logged_step_lands_in_its_named_columns():
-    log = runlog.RunLog(3)
+    log = runlog.RunLog(3, brake_gains=(0.6, 0.4))
     meas = EgoMeasurement(1.5, 30.0, 0.1, 0.02, -1.0, 0.5, 200.0, 0.25, 0.01, 0.0, 0.7, 3.5)
-    x = [10.0, -1.75, 0.05, 30.0, 0.1, 0.02, 0.003, 100.0, 200.0]
+    x = [10.0, -1.75, 0.05, 30.0, 0.1, 0.02, 0.003, 100.0, 200.0, 150.0]
     cmd = Command(
         0.004, 110.0, 0.0, 2, True, "F", -2.0, 1.0, 3.0, 0.1, 0.2, 0.001, 0.002, 0.0005, 29.0
     )
@@ -79,7 +80,7 @@ def test_a_logged_step_lands_in_its_named_columns():
     log.add(meas, x, None, None, 0.9)
     first, end = (dict(zip(runlog.COLUMNS, row)) for row in log.array())
     assert first["time_s"] == 1.5 and first["lateral_offset_m"] == 0.25
-    assert first["steer_rad"] == 0.003 and first["brake_force_n"] == 200.0
+    assert first["steer_rad"] == 0.003 and first["brake_force_n"] == 0.6 * 200.0 + 0.4 * 150.0
     assert first["steer_cmd_rad"] == 0.004 and first["sector"] == ord("F")
     assert first["aro_range_m"] == 55.0 and first["oncoming_detected"] == 1.0
     assert first["mode"] == 2 and first["speed_target_mps"] == 29.0
@@ -90,7 +91,7 @@ def test_a_logged_step_lands_in_its_named_columns():
 def test_the_end_row_carries_the_mode_and_sector_in_force_and_no_other_command():
     log = runlog.RunLog(3)
     meas = EgoMeasurement(1.5, 30.0, 0.1, 0.02, -1.0, 0.5, 200.0, 0.25, 0.01, 0.0, 0.7, 3.5)
-    x = [10.0, -1.75, 0.05, 30.0, 0.1, 0.02, 0.003, 100.0, 200.0]
+    x = [10.0, -1.75, 0.05, 30.0, 0.1, 0.02, 0.003, 100.0, 200.0, 150.0]
     cmd = Command(
         0.004, 110.0, 0.0, 3, True, "E", -2.0, 1.0, 3.0, 0.1, 0.2, 0.001, 0.002, 0.0005, 29.0
     )

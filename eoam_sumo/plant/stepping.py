@@ -75,6 +75,13 @@ def initial_state(
     return x
 
 
+def brake_gains_n_per_bar(params: VehicleParams) -> tuple[float, float]:
+    """Road brake force [N] per bar of the front and of the rear line pressure (the plant's
+    fixed split, as ``integrator`` applies it)."""
+    per_bar = constants(params).brake_n_per_bar
+    return per_bar * params.brake_front_share, per_bar * (1.0 - params.brake_front_share)
+
+
 def cruise_drive_force_n(params: VehicleParams, speed_mps: float) -> float:
     """Drive force [N] that holds ``speed_mps`` on a straight level road: aerodynamic drag plus
     rolling resistance, as in ``model.rhs``."""

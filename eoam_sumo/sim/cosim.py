@@ -29,6 +29,7 @@ from eoam_sumo.errors import InputError
 from eoam_sumo.params import VehicleParams
 from eoam_sumo.plant import Plant, initial_state
 from eoam_sumo.plant.model import AX_LOAD, AY_LOAD
+from eoam_sumo.plant.stepping import brake_gains_n_per_bar
 from eoam_sumo.sensing.automotive import make_radar
 from eoam_sumo.sensing.friction import FrictionBelief
 from eoam_sumo.sensing.next_lane import NextLaneSensing
@@ -277,7 +278,8 @@ class CoSimulation:
         obstacle), then those added, all started; the step's phases untimed until one of them
         times them."""
         p = self.params
-        self.timeseries, self.extremes = TimeSeries(), Extremes()
+        self.timeseries = TimeSeries(brake_gains_n_per_bar(p))
+        self.extremes = Extremes()
         self.margins = Margins(p.length_m, p.width_m, self._front)
         self.avoided = AvoidedObstacle()
         self.rollover = RolloverWatch(*rollover_limits(p), AX_LOAD, AY_LOAD, TYRES)

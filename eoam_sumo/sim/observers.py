@@ -98,8 +98,11 @@ class TimeSeries(StepObserver):
 
     log: RunLog  # set when the run starts
 
+    def __init__(self, brake_gains: tuple[float, float] = (1.0, 0.0)) -> None:
+        self._brake_gains = brake_gains  # road brake force per bar, front and rear [N/bar]
+
     def start(self, sim: RunView) -> None:
-        self.log = RunLog(sim.max_steps + 1)
+        self.log = RunLog(sim.max_steps + 1, self._brake_gains)
         self._add = self.log.add
 
     def after_step(self, sim: RunView) -> None:

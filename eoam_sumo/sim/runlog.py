@@ -76,8 +76,11 @@ class RunLog:
     doubling, so that a huge time limit costs nothing up front); ``add`` keeps one step,
     ``array()`` / ``frame()`` give the table."""
 
-    def __init__(self, rows: int):
+    def __init__(self, rows: int, brake_gains: tuple[float, float] = (1.0, 0.0)):
+        """``brake_gains``: road brake force per bar of the front and rear line pressures
+        (``plant.stepping.brake_gains_n_per_bar`` of the ego)."""
         self._limit = rows
+        self._brake_gains = brake_gains
         self._rows: list = [None] * min(rows, PREALLOCATED_ROWS)
         self.n = 0
         self._col = {c: i for i, c in enumerate(COLUMNS)}
@@ -110,7 +113,7 @@ class RunLog:
     def array(self) -> np.ndarray:
         """(n, len(COLUMNS)) float array of the rows logged so far."""
         if self._array is None:
-            self._array = _table(self._rows[: self.n])
+            self._array = _table(self._rows[: self.n], self._brake_gains)
         return self._array
 
     def column(self, name: str) -> np.ndarray:
@@ -119,7 +122,7 @@ class RunLog:
             return self._array[:, self._col[name]]
         col = self._columns.get(name)
         if col is None:
-            col = self._columns[name] = _column(self._rows[: self.n], name)
+            col = self._columns[name] = _column(self._rows[: self.n], name, self._brake_gains)
         return col
 
     def max_abs(self, name: str) -> float:
@@ -151,8 +154,10 @@ _FROM_STATE = {
     "yaw_rate_radps": 5,
     "steer_rad": 6,
     "drive_force_n": 7,
-    "brake_force_n": 8,
 }
+#: the plant states of the front and rear line pressures [bar]: ``brake_force_n`` is the road
+#: brake force they apply (``plant.stepping.brake_gains_n_per_bar``)
+_BRAKE_PRESSURES = (8, 9)
 _FROM_MEAS = {
     "time_s": "time_s",
     "ax_mps2": "ax_mps2",
@@ -186,20 +191,23 @@ _SECTOR = "sector"  # the command's DMM sector letter, stored as its character c
 _ROAD_MU = "mu"  # the road's friction under the ego
 
 
-def _table(rows: list) -> np.ndarray:
+def _table(rows: list, brake_gains: tuple[float, float]) -> np.ndarray:
     """The (n, len(COLUMNS)) float array of logged steps, each column filled by name."""
     out = np.full((len(rows), len(COLUMNS)), _NAN)
     for i, name in enumerate(COLUMNS):
-        out[:, i] = _column(rows, name)
+        out[:, i] = _column(rows, name, brake_gains)
     return out
 
 
-def _column(rows: list, name: str) -> np.ndarray:
+def _column(rows: list, name: str, brake_gains: tuple[float, float]) -> np.ndarray:
     """One column of the logged steps (``_table``'s, without the rest: a run's summary reads
     four of the 34)."""
     if name in _FROM_STATE:
         k = _FROM_STATE[name]
         return np.array([r[1][k] for r in rows], dtype=float)
+    if name == "brake_force_n":
+        (front, rear), (i, j) = brake_gains, _BRAKE_PRESSURES
+        return np.array([front * r[1][i] + rear * r[1][j] for r in rows], dtype=float)
     if name in _FROM_MEAS:
         get = attrgetter(_FROM_MEAS[name])
         return np.array([get(r[0]) for r in rows], dtype=float)

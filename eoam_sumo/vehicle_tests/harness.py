@@ -18,7 +18,7 @@ import numpy as np
 
 from eoam_sumo.params import VehicleParams
 from eoam_sumo.plant import OUTPUT_NAMES, STATE_NAMES, Plant, initial_state
-from eoam_sumo.plant.chassis import constants
+from eoam_sumo.plant.stepping import brake_gains_n_per_bar
 from eoam_sumo.vehicle_tests.equipment import wheel_speeds
 
 COLUMNS = (
@@ -125,12 +125,11 @@ class PlantVehicle:
 
     def _brake_force_n(self, x: list[float]) -> float:
         """The brake force the line pressures apply at the road (both axles)."""
-        share = self.params.brake_front_share
-        pressure_bar = (
-            share * x[_STATE["brake_pressure_front_bar"]]
-            + (1.0 - share) * x[_STATE["brake_pressure_rear_bar"]]
+        front, rear = brake_gains_n_per_bar(self.params)
+        return (
+            front * x[_STATE["brake_pressure_front_bar"]]
+            + rear * x[_STATE["brake_pressure_rear_bar"]]
         )
-        return constants(self.params).brake_n_per_bar * pressure_bar
 
 
 def rolling_start(speed_mps: float) -> Sample:

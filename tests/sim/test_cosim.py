@@ -414,7 +414,7 @@ def test_the_run_log_grows_to_its_limit_and_no_further():
     def meas(t):
         return EgoMeasurement(t, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 3.5)
 
-    x = [0.0] * 9
+    x = [0.0] * 19
     big = RunLog(10**12)
     for k in range(PREALLOCATED_ROWS + 5):
         big.add(meas(0.01 * k), x, None, None, 1.0)
