@@ -36,12 +36,12 @@ def _panel(ax, counts: pd.DataFrame, paper: dict[str, int], colours: list[str], 
     ticks, labels = [0.0], ["paper"]
     x = 1.0
     for vehicle, group in counts.groupby("vehicle", sort=False):
-        start = x + 0.5
+        start = x + 1.0
         for _, row in group.iterrows():
             x += 1.0
             hatch = _HATCHES[equipment.index(row["equipment"]) % len(_HATCHES)]
             _stack(ax, x, row.to_dict(), colours, hatch)
-        ticks.append((start + x + 0.5) / 2.0 - 0.5)
+        ticks.append((start + x) / 2.0)  # under the middle of its bars
         labels.append(str(vehicle))
         x += 1.0
     ax.set_xticks(ticks, labels, rotation=30, ha="right")
