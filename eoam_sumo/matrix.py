@@ -25,7 +25,7 @@ from pathlib import Path
 
 from eoam_sumo.colours import OUTCOMES
 from eoam_sumo.errors import InputError
-from eoam_sumo.params import MU_MAX, ego_e_class_sedan
+from eoam_sumo.params import MU_MAX, VehicleParams, ego_e_class_sedan
 from eoam_sumo.sampling import Sample, parse_sample
 from eoam_sumo.sensing.automotive import parse_radar_model
 from eoam_sumo.sensing.friction import parse_mu_belief
@@ -62,6 +62,9 @@ SCHEMA = {
         "seed",
         "after_stop_s",
         "vehicle",
+        "abs",
+        "esc",
+        "abs_esc",
         *TRAFFIC_KEYS,
     ),
     "sweep": (
@@ -71,6 +74,10 @@ SCHEMA = {
         "aro_hold_s",
         "aro_decel_mps2",
         "vehicle",
+        "abs",
+        "esc",
+        "abs_esc",
+        "policy",
         *TRAFFIC_KEYS,
     ),
     "paper": ("table",),
@@ -79,6 +86,10 @@ SCHEMA = {
 REQUIRED = {"scenario": (), "sweep": ("ego_speed_kmh", "mu")}  # unless sampled
 PAPER_COLUMNS = ("oncoming_start_m", "ego_speed_kmh", "mu", "outcome")
 POLICIES = ("paper", "safe")
+#: The equipment keys: ``abs`` and ``esc`` switch one system, ``abs_esc`` both together;
+#: "on" or "off" ([scenario] one value, [sweep] a list; never sampled).
+EQUIPMENT_KEYS = ("abs", "esc", "abs_esc")
+SWITCH = {"on": True, "off": False}
 #: [scenario] V2X keys: (default, lowest, highest or None, highest included)
 V2X_KEYS = {
     "v2x_range_m": (0.0, 0.0, None, True),
@@ -182,6 +193,12 @@ class Matrix:
     traffic_axes: tuple[tuple[str, tuple], ...] = ()
     # the vehicles given ([scenario] one, [sweep] a list; sampled: (None,)); (): the sedan
     vehicles: tuple[str | None, ...] = ()
+    # [scenario] abs / esc (abs_esc: both); None: the vehicle's own
+    abs_fitted: bool | None = None
+    esc_fitted: bool | None = None
+    # the swept equipment keys as (key, switch values), ``EQUIPMENT_KEYS`` order
+    equipment: tuple[tuple[str, tuple[bool, ...]], ...] = ()
+    policies: tuple[str, ...] = ()  # [sweep] policy; (): every case runs ``policy``
 
     def cases(self) -> list[Case]:
         """Every case, in the paper's Table 2 order (traffic, speed, friction, ARO stop),
@@ -190,6 +207,8 @@ class Matrix:
         sampled = self.sample.keys if self.sample else ()
         axes = (
             *((("vehicle", self.vehicles),) if self.vehicles else ()),
+            *self.equipment,
+            *((("policy", self.policies),) if self.policies else ()),
             *self.traffic_axes,
             (
                 "oncoming_start_m",
@@ -200,26 +219,27 @@ class Matrix:
             ("aro_hold_s", self.aro_holds_s or (None,)),
             ("aro_decel_mps2", self.aro_decels_mps2 or (None,)),
         )
+        settings = {
+            "max_time_s": self.max_time_s,
+            "radar_range_m": self.radar_range_m,
+            "policy": self.policy,
+            "v2x_range_m": self.v2x[0],
+            "v2x_latency_s": self.v2x[1],
+            "v2x_loss": self.v2x[2],
+            "v2x_penetration": self.v2x[3],
+            "mu_belief": self.mu_belief,
+            "radar_model": self.radar_model,
+            "seed": self.seed,
+            "after_stop_s": self.after_stop_s,
+            "abs_fitted": self.abs_fitted,
+            "esc_fitted": self.esc_fitted,
+        }
         cases = []
         for combo in itertools.product(*(values for _, values in axes)):
             values = dict(zip((key for key, _ in axes), combo))
+            case_id = _case_id(values, sampled)
             cases.append(
-                Case(
-                    _case_id(values, sampled),
-                    self.sumocfg or GENERATED,
-                    max_time_s=self.max_time_s,
-                    radar_range_m=self.radar_range_m,
-                    policy=self.policy,
-                    v2x_range_m=self.v2x[0],
-                    v2x_latency_s=self.v2x[1],
-                    v2x_loss=self.v2x[2],
-                    v2x_penetration=self.v2x[3],
-                    mu_belief=self.mu_belief,
-                    radar_model=self.radar_model,
-                    seed=self.seed,
-                    after_stop_s=self.after_stop_s,
-                    **values,
-                )
+                Case(case_id, self.sumocfg or GENERATED, **{**settings, **_case_fields(values)})
             )
         return cases if self.sample is None else self._draws(cases, self.sample)
 
@@ -254,11 +274,40 @@ class Matrix:
         }
 
 
+def _case_fields(values: dict) -> dict:
+    """A combination's values as ``Case`` fields: the equipment keys' switches as
+    ``abs_fitted`` / ``esc_fitted`` (``abs_esc`` sets both)."""
+    fields = {k: v for k, v in values.items() if k not in EQUIPMENT_KEYS}
+    for key, switched in (("abs", ("abs_fitted",)), ("esc", ("esc_fitted",))):
+        if key in values:
+            fields.update(dict.fromkeys(switched, values[key]))
+    if "abs_esc" in values:
+        fields.update(abs_fitted=values["abs_esc"], esc_fitted=values["abs_esc"])
+    return fields
+
+
+def _switch_text(on: bool) -> str:
+    return "on" if on else "off"
+
+
+def _swept_tokens(values: dict) -> list[str]:
+    """The case-id tokens of the swept equipment and policy: ``abs-off``, ``esc-on`` (both
+    for ``abs_esc``), ``paper`` / ``safe``."""
+    tokens = []
+    for key, names in (("abs", ("abs",)), ("esc", ("esc",)), ("abs_esc", ("abs", "esc"))):
+        if key in values:
+            tokens += [f"{name}-{_switch_text(values[key])}" for name in names]
+    if "policy" in values:
+        tokens.append(values["policy"])
+    return tokens
+
+
 def _case_id(values: dict, sampled: tuple[str, ...]) -> str:
-    """A case's id from its values: the vehicle's name when the matrix names one, the
-    generated scenario's keys given (road, ``losC``, ``l3`` lanes, ``lim100`` speed limit,
-    ``R400`` or ``straight``), ``onc-...`` unless sampled, ``v...``, ``mu...``, ``hold...``,
-    ``dec...``; "all" when nothing is left."""
+    """A case's id from its values: the vehicle's name when the matrix names one, the swept
+    equipment and policy (``abs-off_esc-off``, ``safe``), the generated scenario's keys given
+    (road, ``losC``, ``l3`` lanes, ``lim100`` speed limit, ``R400`` or ``straight``),
+    ``onc-...`` unless sampled, ``v...``, ``mu...``, ``hold...``, ``dec...``; "all" when
+    nothing is left."""
     road_parts = {
         "road": lambda v: v,
         "los": lambda v: f"los{v}",
@@ -267,6 +316,7 @@ def _case_id(values: dict, sampled: tuple[str, ...]) -> str:
         "curve_radius_m": lambda v: f"R{_id_number(v)}",
     }
     parts = [vehicle_name(values["vehicle"])] if values.get("vehicle") is not None else []
+    parts += _swept_tokens(values)
     parts += [
         road_parts[k](values[k])
         if values[k] is not None
@@ -465,7 +515,8 @@ def load_matrix(path: Path) -> Matrix:
     sumocfg = _scenario_file(path, scenario, traffic_axes)
     max_time, radar_range = _run_limits(path, scenario)
     policy = _scenario_policy(path, scenario)
-    v2x = _v2x_link(path, scenario, policy)
+    policies = _swept_policies(path, doc)
+    v2x = _v2x_link(path, scenario, policy, bool(policies))
     paper = None
     if "table" in doc.get("paper", {}):
         paper = _existing_file(path, "[paper] table", doc["paper"]["table"])
@@ -484,6 +535,8 @@ def load_matrix(path: Path) -> Matrix:
         after_stop_s=_after_stop(path, scenario),
         traffic_axes=traffic_axes,
         vehicles=_vehicle_axis(path, doc, sampled, checks["vehicle"]),
+        **_equipment(path, doc),
+        policies=policies,
         **_swept_values(path, doc.get("sweep", {}), sampled),
         paper_table=paper,
         policy=policy,
@@ -539,6 +592,63 @@ def _vehicle_axis(path: Path, doc: dict, sampled: tuple[str, ...], check) -> tup
     if twice is not None:
         raise InputError(f"{path}: [sweep] vehicle lists two vehicles named {twice!r}")
     return values
+
+
+def _switches(path: Path, where: str, key: str, raw) -> tuple[bool, ...]:
+    """The "on" / "off" values of an equipment key: [scenario] one, [sweep] a non-empty list
+    of distinct values."""
+    listed = raw if where == "sweep" else [raw]
+    if not isinstance(listed, list) or not listed:
+        raise InputError(f'{path}: [sweep] {key} must be a non-empty list of "on" / "off"')
+    for value in listed:
+        if value not in SWITCH:
+            raise InputError(f'{path}: [{where}] {key} value {value!r} is not "on" or "off"')
+        if listed.count(value) > 1:
+            raise InputError(f"{path}: [sweep] {key} lists {value!r} twice")
+    return tuple(SWITCH[v] for v in listed)
+
+
+def _equipment(path: Path, doc: dict) -> dict:
+    """The ``Matrix`` fields of the equipment keys (``EQUIPMENT_KEYS``): [scenario] values as
+    ``abs_fitted`` / ``esc_fitted``, [sweep] lists as ``equipment`` axes."""
+    fields: dict = {"abs_fitted": None, "esc_fitted": None, "equipment": ()}
+    given = [k for k in EQUIPMENT_KEYS if any(k in doc.get(t, {}) for t in ("scenario", "sweep"))]
+    if "abs_esc" in given and len(given) > 1:
+        raise InputError(f"{path}: 'abs_esc' switches both ABS and ESC; drop '{given[0]}'")
+    axes = []
+    for key in given:
+        where = [t for t in ("scenario", "sweep") if key in doc.get(t, {})]
+        if len(where) > 1:
+            raise InputError(f"{path}: '{key}' is in [scenario] and [sweep]; keep one")
+        values = _switches(path, where[0], key, doc[where[0]][key])
+        if where[0] == "sweep":
+            axes.append((key, values))
+            continue
+        for name in ("abs", "esc"):
+            if key in (name, "abs_esc"):
+                fields[f"{name}_fitted"] = values[0]
+    fields["equipment"] = tuple(axes)
+    return fields
+
+
+def _swept_policies(path: Path, doc: dict) -> tuple[str, ...]:
+    """[sweep] policy: a non-empty list of distinct ``POLICIES`` (not also in [scenario])."""
+    if "policy" not in doc.get("sweep", {}):
+        return ()
+    if "policy" in doc.get("scenario", {}):
+        raise InputError(f"{path}: 'policy' is in [scenario] and [sweep]; keep one")
+    listed = doc["sweep"]["policy"]
+    if not isinstance(listed, list) or not listed:
+        raise InputError(f"{path}: [sweep] policy must be a non-empty list")
+    for value in listed:
+        if value not in POLICIES:
+            raise InputError(
+                f"{path}: [sweep] policy value {value!r} is not one of "
+                f"{', '.join(repr(p) for p in POLICIES)}"
+            )
+        if listed.count(value) > 1:
+            raise InputError(f"{path}: [sweep] policy lists {value!r} twice")
+    return tuple(listed)
 
 
 def _scenario_file(path: Path, scenario: dict, traffic_axes: tuple) -> Path | None:
@@ -677,9 +787,11 @@ def _scenario_policy(path: Path, scenario: dict) -> str:
     return policy
 
 
-def _v2x_link(path: Path, scenario: dict, policy: str) -> tuple[float, float, float, float]:
+def _v2x_link(
+    path: Path, scenario: dict, policy: str, swept: bool = False
+) -> tuple[float, float, float, float]:
     """[scenario] V2X range, latency, loss and penetration, each within its ``V2X_KEYS``
-    bounds; a range > 0 needs the safe policy."""
+    bounds; a range > 0 needs the safe policy (not a swept one)."""
     v2x = []
     for key, (default, low, high, high_in) in V2X_KEYS.items():
         value = scenario.get(key, default)
@@ -693,6 +805,11 @@ def _v2x_link(path: Path, scenario: dict, policy: str) -> tuple[float, float, fl
             )
             raise InputError(f"{path}: [scenario] {key} = {value!r} must be a number {bound}")
         v2x.append(float(value))
+    if v2x[0] > 0.0 and swept:
+        raise InputError(
+            f"{path}: [scenario] v2x_range_m = {v2x[0]:g} with a [sweep] policy: V2X informs "
+            'the safe policy only; set v2x_range_m = 0 or policy = "safe" in [scenario]'
+        )
     if v2x[0] > 0.0 and policy != "safe":
         raise InputError(
             f"{path}: [scenario] v2x_range_m = {v2x[0]:g} needs policy = "
@@ -781,16 +898,39 @@ def _check_vehicles_tables(matrix: Matrix, tables_dir: Path | None) -> None:
     built for its parameters, covering every speed and friction of the matrix."""
     dist = matrix.sample.of("vehicle") if matrix.sample else None
     named = {v for v in (*matrix.vehicles, *(dist.extremes() if dist else ())) if v is not None}
-    for vehicle in sorted(named) or [None]:
-        params = ego_e_class_sedan() if vehicle is None else load_vehicle(vehicle)
+    switches = itertools.product(_switched(matrix, "abs"), _switched(matrix, "esc"))
+    for vehicle, (abs_fitted, esc_fitted) in itertools.product(sorted(named) or [None], switches):
+        params = vehicle_params(vehicle, abs_fitted, esc_fitted)
         name = vehicle or DEFAULT_VEHICLE
         try:
             tables = vehicle_tables(name, params, tables_dir, cached=False)
         except InputError as exc:
-            if vehicle is None:
+            if vehicle is None and abs_fitted is None:
                 raise
-            raise InputError(f"{matrix.path}: vehicle {vehicle!r}: {exc}") from None
-        check_within_tables(matrix, tables, vehicle_tables_dir(name, tables_dir))
+            raise InputError(f"{matrix.path}: vehicle {name!r}: {exc}") from None
+        check_within_tables(matrix, tables, vehicle_tables_dir(name, tables_dir, params))
+
+
+def _switched(matrix: Matrix, system: str) -> tuple[bool | None, ...]:
+    """The values ``abs`` or ``esc`` (``system``) takes in the matrix's cases (None: the
+    vehicle's own)."""
+    for key, values in matrix.equipment:
+        if key in (system, "abs_esc"):
+            return values
+    return (matrix.abs_fitted if system == "abs" else matrix.esc_fitted,)
+
+
+def vehicle_params(
+    vehicle: str | None, abs_fitted: bool | None = None, esc_fitted: bool | None = None
+) -> VehicleParams:
+    """The ego a case runs: ``vehicle`` (None: the paper's sedan), its ABS and ESC switched
+    where given (None: the vehicle's own)."""
+    params = ego_e_class_sedan() if vehicle is None else load_vehicle(vehicle)
+    if abs_fitted is not None:
+        params = replace(params, abs_fitted=abs_fitted)
+    if esc_fitted is not None:
+        params = replace(params, esc_fitted=esc_fitted)
+    return params
 
 
 def check_within_tables(matrix: Matrix, tables, folder: Path | str | None = None) -> None:

@@ -10,9 +10,9 @@ from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 from typing import get_type_hints
 
-from eoam_sumo.matrix import Case
-from eoam_sumo.params import VehicleParams, ego_e_class_sedan
-from eoam_sumo.vehicle_files import DEFAULT_VEHICLE, load_vehicle
+from eoam_sumo.matrix import Case, vehicle_params
+from eoam_sumo.params import VehicleParams
+from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
 
 #: The files a case writes (``sim.runlog.write_run``), in the order they are written, by
 #: ``--timeseries`` format.
@@ -104,12 +104,7 @@ def case_parameters(case: Case) -> dict:
 def case_vehicle(case: Case) -> VehicleParams:
     """The ego of a case: its vehicle (none named: the paper's sedan), its ABS and ESC
     switched as the case asks."""
-    vehicle = ego_e_class_sedan() if case.vehicle is None else load_vehicle(case.vehicle)
-    if case.abs_fitted is not None:
-        vehicle = replace(vehicle, abs_fitted=case.abs_fitted)
-    if case.esc_fitted is not None:
-        vehicle = replace(vehicle, esc_fitted=case.esc_fitted)
-    return vehicle
+    return vehicle_params(case.vehicle, case.abs_fitted, case.esc_fitted)
 
 
 def run_matrix_case(task: CaseTask) -> dict:

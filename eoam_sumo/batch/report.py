@@ -21,7 +21,14 @@ from eoam_sumo.colours import FAILED, LEGEND, MARKERS, OUTCOMES
 NEAR_MISS_MARK = "⚡"
 TABLE_MD = "table2.md"
 TABLE_PNG = "table2.png"
-_EXTRA_PARAMS = (("aro_hold_s", "ARO hold {:g} s"), ("aro_decel_mps2", "ARO decel {:g} m/s²"))
+_EXTRA_PARAMS = (
+    ("aro_hold_s", "ARO hold {:g} s"),
+    ("aro_decel_mps2", "ARO decel {:g} m/s²"),
+    ("vehicle", "{}"),
+    ("abs_fitted", "ABS {}"),
+    ("esc_fitted", "ESC {}"),
+    ("policy", "{} policy"),
+)
 
 
 @dataclass(frozen=True)
@@ -120,7 +127,7 @@ def outcome_grid(results: pd.DataFrame) -> OutcomeGrid:
     varying = [
         (col, fmt)
         for col, fmt in _EXTRA_PARAMS
-        if results[col].notna().any() and results[col].nunique(dropna=False) > 1
+        if col in results and results[col].notna().any() and results[col].nunique(dropna=False) > 1
     ]
     rows: list[tuple[str, str]] = []
     mus: list[float] = []

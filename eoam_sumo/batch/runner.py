@@ -47,6 +47,7 @@ from eoam_sumo.batch.results import (
     kept_rows,
     result_row,
 )
+from eoam_sumo.batch.vehicles_report import sweeps_vehicles, write_vehicles_report
 from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.matrix import Case, Matrix, check_matrix, load_matrix
@@ -184,6 +185,8 @@ def run_batch(
     )
     if matrix.sample is None:
         write_report(out_dir, results)
+        if sweeps_vehicles(results):
+            write_vehicles_report(out_dir, results)
     else:
         write_probabilities(out_dir, results)
     return results

@@ -18,6 +18,7 @@ from matplotlib.patches import Patch, Rectangle
 from eoam_sumo.batch.case import PARAMETERS
 from eoam_sumo.batch.report import TABLE_PNG, mu_text, outcome_grid
 from eoam_sumo.batch.results import RESULTS_FILE, read_results
+from eoam_sumo.batch.vehicles_report import VEHICLES_PNG, sweeps_vehicles
 from eoam_sumo.colours import DARK_TEXT
 from eoam_sumo.colours import HEX as OUTCOME_COLOURS
 from eoam_sumo.params import PONR_FRACTION
@@ -30,6 +31,7 @@ from eoam_sumo.plotting.runfacts import (
     point_of_no_return_m,
     traffic_text,
 )
+from eoam_sumo.plotting.vehicle_plots import plot_vehicles
 from eoam_sumo.sim.margins import NEAR_MISS_GAP_M, NEAR_MISS_TTC_S
 from eoam_sumo.sim.runlog import read_timeseries
 
@@ -301,13 +303,17 @@ _KEY_NAMES = {
 
 def plot_batch_report(results: pd.DataFrame, out_dir: Path) -> list[Path]:
     """The images ``eoam-sumo batch`` draws beside its report: ``table2.png`` and
-    ``margins.png``, or for a sampled batch ``envelope.png``."""
+    ``margins.png`` (and ``vehicles.png`` when vehicles, ABS/ESC or policies are swept), or
+    for a sampled batch ``envelope.png``."""
     if is_sampled(results):
         return plot_envelopes(results, out_dir)
-    return [
+    paths = [
         plot_table2(outcome_grid(results), Path(out_dir) / TABLE_PNG),
         plot_margins(results, Path(out_dir) / MARGINS_PNG),
     ]
+    if sweeps_vehicles(results):  # vehicles, ABS/ESC or policies swept
+        paths.append(plot_vehicles(results, Path(out_dir) / VEHICLES_PNG))
+    return paths
 
 
 def is_sampled(results: pd.DataFrame) -> bool:

@@ -93,14 +93,15 @@ def test_bad_vehicles_are_refused_naming_the_matrix_and_the_key(tmp_path, sweep,
 
 
 def test_a_batch_with_a_vehicle_without_tables_is_refused_before_any_case(capsys, tmp_path):
-    matrix = write_matrix(tmp_path / "m.toml", f'vehicle = ["{SEDAN_R13H}"]\n' + ONE_CASE)
+    _tall(tmp_path)  # the shipped catalogue has its tables; a user's file has none
+    matrix = write_matrix(tmp_path / "m.toml", 'vehicle = ["tall.toml"]\n' + ONE_CASE)
     with pytest.raises(InputError, match="no lookup tables for vehicle"):
         check_matrix(load_matrix(matrix), tmp_path / "tables")
     out = tmp_path / "out"
     status = main(["batch", str(matrix), "--out", str(out), "--no-progress"])
     err = capsys.readouterr().err
     assert status == 2 and len(err.strip().splitlines()) == 1, err
-    assert "sedan-r13h" in err and not (out / "results.csv").exists()
+    assert "tall" in err and not (out / "results.csv").exists()
 
 
 @pytest.mark.sumo
@@ -113,3 +114,78 @@ def test_a_batch_runs_each_case_with_its_vehicle(tmp_path):
     (row,) = results.to_dict("records")
     assert row["status"] == "ok" and row["vehicle"] == str(tall.resolve())
     assert row["outcome"] == "orange" and "rollover: wheel lift" in row["reason"]
+
+
+def test_swept_equipment_and_policy_follow_the_vehicle_in_the_case_id(tmp_path):
+    matrix = write_matrix(
+        tmp_path / "m.toml",
+        'vehicle = ["suv"]\nabs_esc = ["off", "on"]\npolicy = ["paper", "safe"]\n' + ONE_CASE,
+    )
+    cases = load_matrix(matrix).cases()
+    assert [c.case_id for c in cases] == [
+        "suv_abs-off_esc-off_paper_onc-none_v165_mu1.0",
+        "suv_abs-off_esc-off_safe_onc-none_v165_mu1.0",
+        "suv_abs-on_esc-on_paper_onc-none_v165_mu1.0",
+        "suv_abs-on_esc-on_safe_onc-none_v165_mu1.0",
+    ]
+    assert [(c.abs_fitted, c.esc_fitted, c.policy) for c in cases] == [
+        (False, False, "paper"),
+        (False, False, "safe"),
+        (True, True, "paper"),
+        (True, True, "safe"),
+    ]
+    assert case_vehicle(cases[0]).abs_fitted is False and case_vehicle(cases[2]).esc_fitted
+
+
+def test_equipment_given_once_keeps_the_ids_and_none_is_the_vehicles_own(tmp_path):
+    given = write_matrix(tmp_path / "m.toml", ONE_CASE, scenario='abs = "on"\nesc = "off"\n')
+    (case,) = load_matrix(given).cases()
+    assert case.case_id == "onc-none_v165_mu1.0"
+    assert (case.abs_fitted, case.esc_fitted) == (True, False)
+    (plain,) = load_matrix(write_matrix(tmp_path / "p.toml", ONE_CASE)).cases()
+    assert plain.abs_fitted is None and plain.esc_fitted is None
+    swept = write_matrix(tmp_path / "s.toml", 'esc = ["on"]\nabs = ["off"]\n' + ONE_CASE)
+    (one,) = load_matrix(swept).cases()
+    assert one.case_id == "abs-off_esc-on_onc-none_v165_mu1.0"
+
+
+@pytest.mark.parametrize(
+    ("sweep", "scenario", "needle"),
+    [
+        ('abs = ["of"]\n', "", '[sweep] abs value \'of\' is not "on" or "off"'),
+        ('abs = ["on", "on"]\n', "", "lists 'on' twice"),
+        ('abs = ["on"]\n', 'abs = "off"\n', "'abs' is in [scenario] and [sweep]"),
+        ('abs_esc = ["on"]\n', 'esc = "off"\n', "'abs_esc' switches both"),
+        ('policy = ["paper", "fast"]\n', "", "[sweep] policy value 'fast'"),
+        ('policy = ["safe"]\n', 'policy = "safe"\n', "'policy' is in [scenario] and [sweep]"),
+        ('policy = ["paper", "safe"]\n', "v2x_range_m = 300\n", "V2X informs the safe policy"),
+        ("abs = true\n", "", "must be a non-empty list"),
+    ],
+)
+def test_bad_equipment_or_policy_is_one_line(tmp_path, sweep, scenario, needle):
+    matrix = write_matrix(tmp_path / "m.toml", sweep + ONE_CASE, scenario=scenario)
+    with pytest.raises(InputError) as err:
+        load_matrix(matrix)
+    assert str(matrix) in str(err.value) and needle in str(err.value)
+    assert len(str(err.value).splitlines()) == 1
+
+
+def test_equipment_is_not_sampled(tmp_path):
+    sampled = tmp_path / "s.toml"
+    sampled.write_text(
+        write_matrix(tmp_path / "x.toml", ONE_CASE).read_text()
+        + '[sample]\ndraws = 4\nseed = 3\nabs = { choice = ["on", "off"] }\n'
+    )
+    with pytest.raises(InputError, match="'abs' cannot be sampled") as err:
+        load_matrix(sampled)
+    assert len(str(err.value).splitlines()) == 1
+
+
+def test_the_tables_check_uses_the_switched_abs_folder(tmp_path):
+    """A vehicle whose ABS is switched from its file's needs tables/<name>-abs|-noabs."""
+    _tall(tmp_path)
+    sweep = 'vehicle = ["tall.toml"]\nabs = ["on"]\n'
+    matrix = write_matrix(tmp_path / "m.toml", sweep + ONE_CASE)
+    with pytest.raises(InputError, match="tall-abs") as err:
+        check_matrix(load_matrix(matrix), tmp_path / "tables")
+    assert "--abs on" in str(err.value)
