@@ -169,9 +169,17 @@ def test_every_catalogue_vehicle_ships_tables_built_from_its_file(name):
     assert tables.params == params
 
 
-def test_the_sedan_with_abs_ships_its_own_tables():
-    params = replace(load_vehicle("sedan"), abs_fitted=True, esc_fitted=True)
-    tables = vehicle_tables("sedan", params, cached=False)
+@pytest.mark.parametrize("name", ["compact", "suv", "van", "pickup"])
+def test_the_catalogue_without_abs_ships_tables_of_its_own(name):
+    params = replace(load_vehicle(name), abs_fitted=False, esc_fitted=False)
+    tables = vehicle_tables(name, params, cached=False)
+    assert tables.params == params and tables.max_decel_mps2(1.0) < 1.0 * 9.81
+
+
+@pytest.mark.parametrize("name", ["sedan", "sedan-r13h"])
+def test_the_sedans_with_abs_ship_tables_of_their_own(name):
+    params = replace(load_vehicle(name), abs_fitted=True, esc_fitted=True)
+    tables = vehicle_tables(name, params, cached=False)
     assert tables.max_decel_mps2(1.0) > vehicle_tables(
         "sedan", load_vehicle("sedan")
     ).max_decel_mps2(1.0)
