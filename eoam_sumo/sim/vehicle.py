@@ -67,10 +67,10 @@ def vehicle_tables_dir(
 
 def build_command(vehicle: str, params: VehicleParams, folder: Path) -> str:
     """The command that builds the tables ``vehicle_tables`` looks for."""
-    switch = "" if tables_name(vehicle, params) == vehicle_name(vehicle) else " --abs "
-    if switch:
-        switch += "on" if params.abs_fitted else "off"
-    return f"eoam-sumo tables --vehicle {vehicle}{switch} --out {folder}"
+    command = f"eoam-sumo tables --vehicle {vehicle}"
+    if tables_name(vehicle, params) != vehicle_name(vehicle):
+        command += " --abs " + ("on" if params.abs_fitted else "off")
+    return f"{command} --out {folder}"
 
 
 def vehicle_tables(
