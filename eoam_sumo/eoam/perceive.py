@@ -39,7 +39,7 @@ def perceive(
         sensed = rng
         closing = -rate if rate is not None and math.isfinite(rate) else 0.0
         decel = state.obstacle_decel.update(meas.time_s, meas.vx_mps - closing)
-        threat_gone = pulls_away(parts, state, meas, rng, closing)
+        threat_gone = closing < -parts.settings.release_opening_speed_mps
         track_obstacle(parts, state, meas, rng, closing, perception.aro_object, decel)
     else:
         state.obstacle_decel.reset()
@@ -122,23 +122,7 @@ def coasted_object(
     vc = max(meas.vx_mps, closing)
     decel = state.friction_now().brake_decel_mps2
     near = coasted_m <= 0.5 * vc * vc / decel + st.coasted_margin_m
-    return near, near or not pulls_away(parts, state, meas, coasted_m, closing)
-
-
-def pulls_away(
-    parts: Parts, state: ControllerState, meas: EgoMeasurement, range_m: float, closing_mps: float
-) -> bool:
-    """The object ahead clearly pulls away (opening faster than ``release_opening_speed_mps``)
-    and is beyond the distance in which the ego, handed back to its set speed, would brake
-    again: from the set speed down to the object's speed at the deceleration limit braking
-    delivers, plus ``coasted_margin_m``. Nearer, a hand-back would only begin a stop-and-go
-    (accelerate towards the set speed, brake again)."""
-    st = parts.settings
-    if closing_mps >= -st.release_opening_speed_mps:
-        return False
-    catch_up = max(state.initial_speed_mps - (meas.vx_mps - closing_mps), 0.0)
-    decel = state.friction_now().brake_decel_mps2
-    return range_m > 0.5 * catch_up * catch_up / decel + st.coasted_margin_m
+    return near, near or closing > -st.release_opening_speed_mps
 
 
 def oncoming_seen(parts: Parts, perception: Perception) -> bool:
