@@ -285,14 +285,13 @@ def _bench_arguments(sub) -> None:
 
 
 def _cmd_tables(args) -> int:
+    from eoam_sumo.matrix import vehicle_params
     from eoam_sumo.offline.build import build_tables
     from eoam_sumo.sim.vehicle import vehicle_tables_dir
-    from eoam_sumo.vehicle_files import DEFAULT_VEHICLE, load_vehicle
+    from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
 
     vehicle = args.vehicle or DEFAULT_VEHICLE
-    params = load_vehicle(vehicle)
-    if args.abs is not None:
-        params = replace(params, abs_fitted=args.abs == "on")
+    params = vehicle_params(vehicle, None if args.abs is None else args.abs == "on")
     out = writable_dir(args.out or vehicle_tables_dir(vehicle, None, params))
     build_tables(
         out,

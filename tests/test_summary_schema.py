@@ -89,7 +89,7 @@ def test_a_logged_step_lands_in_its_named_columns():
 
 
 def test_the_end_row_carries_the_mode_and_sector_in_force_and_no_other_command():
-    log = runlog.RunLog(3)
+    log = runlog.RunLog(3, (0.6, 0.4))
     meas = EgoMeasurement(1.5, 30.0, 0.1, 0.02, -1.0, 0.5, 200.0, 0.25, 0.01, 0.0, 0.7, 3.5)
     x = [10.0, -1.75, 0.05, 30.0, 0.1, 0.02, 0.003, 100.0, 200.0, 150.0]
     cmd = Command(

@@ -4,15 +4,13 @@ batch, scored into ``results.csv``, ``scorecard.md`` and ``scorecard.png``
 
 from __future__ import annotations
 
-import dataclasses
 import re
 from pathlib import Path
-from typing import Any
 
 from eoam_sumo.errors import InputError
+from eoam_sumo.matrix import vehicle_params as matrix_vehicle_params
 from eoam_sumo.params import MU_MAX, VehicleParams
 from eoam_sumo.protocols.points import PROTOCOLS, TestPoint, protocol_points
-from eoam_sumo.vehicle_files import load_vehicle
 
 #: Runs end at this simulated time after the ego's departure [s]: the slowest approach
 #: (CCRm 30 km/h behind 20 km/h, 41.7 m at 2.8 m/s) meets the target after 15 s.
@@ -20,8 +18,8 @@ MAX_TIME_S = 40.0
 POLICIES = ("paper", "safe")
 
 
-#: --abs / --esc -> the VehicleParams field each sets (fields the chassis work adds)
-FITTED_FIELDS = {"abs": "abs_fitted", "esc": "esc_fitted"}
+#: the equipment switches, --abs and --esc
+EQUIPMENT = ("abs", "esc")
 ON_OFF = ("on", "off")
 
 
@@ -30,19 +28,19 @@ def vehicle_params(
 ) -> VehicleParams:
     """The VUT's ``VehicleParams``: ``--vehicle`` NAME (a catalogue name or a vehicle file),
     with ABS/ESC on or off as asked (None: the vehicle's own). InputError for an unknown NAME."""
-    changes: dict[str, Any] = {}
     for option, mode in (("abs", abs_mode), ("esc", esc_mode)):
-        if mode is None:
-            continue
-        if mode not in ON_OFF:
+        if mode is not None and mode not in ON_OFF:
             raise InputError(f"--{option} {mode!r} is not one of on, off")
-        changes[FITTED_FIELDS[option]] = mode == "on"
-    return dataclasses.replace(load_vehicle(name), **changes)
+    return matrix_vehicle_params(
+        name,
+        None if abs_mode is None else abs_mode == "on",
+        None if esc_mode is None else esc_mode == "on",
+    )
 
 
 def vehicle_label(args) -> str:
     """The VUT as the scorecard names it: NAME, and ABS/ESC where asked."""
-    extra = [f"{o.upper()} {getattr(args, o)}" for o in FITTED_FIELDS if getattr(args, o)]
+    extra = [f"{o.upper()} {getattr(args, o)}" for o in EQUIPMENT if getattr(args, o)]
     return ", ".join([args.vehicle, *extra])
 
 

@@ -98,7 +98,7 @@ class TimeSeries(StepObserver):
 
     log: RunLog  # set when the run starts
 
-    def __init__(self, brake_gains: tuple[float, float] = (1.0, 0.0)) -> None:
+    def __init__(self, brake_gains: tuple[float, float]) -> None:
         self._brake_gains = brake_gains  # road brake force per bar, front and rear [N/bar]
 
     def start(self, sim: RunView) -> None:

@@ -76,7 +76,7 @@ class RunLog:
     doubling, so that a huge time limit costs nothing up front); ``add`` keeps one step,
     ``array()`` / ``frame()`` give the table."""
 
-    def __init__(self, rows: int, brake_gains: tuple[float, float] = (1.0, 0.0)):
+    def __init__(self, rows: int, brake_gains: tuple[float, float]):
         """``brake_gains``: road brake force per bar of the front and rear line pressures
         (``plant.stepping.brake_gains_n_per_bar`` of the ego)."""
         self._limit = rows

@@ -93,6 +93,7 @@ class PlantVehicle:
 
     def __init__(self, params: VehicleParams):
         self.params = params
+        self._brake_gains = brake_gains_n_per_bar(params)  # road force per bar, front/rear
         self._plant = Plant(params, dt_s=0.001, substeps=round(STEP_S / 0.001))
         self._x: list[float] = []
 
@@ -125,7 +126,7 @@ class PlantVehicle:
 
     def _brake_force_n(self, x: list[float]) -> float:
         """The brake force the line pressures apply at the road (both axles)."""
-        front, rear = brake_gains_n_per_bar(self.params)
+        front, rear = self._brake_gains
         return (
             front * x[_STATE["brake_pressure_front_bar"]]
             + rear * x[_STATE["brake_pressure_rear_bar"]]

@@ -415,12 +415,12 @@ def test_the_run_log_grows_to_its_limit_and_no_further():
         return EgoMeasurement(t, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 3.5)
 
     x = [0.0] * 19
-    big = RunLog(10**12)
+    big = RunLog(10**12, (0.6, 0.4))
     for k in range(PREALLOCATED_ROWS + 5):
         big.add(meas(0.01 * k), x, None, None, 1.0)
     assert big.array().shape == (PREALLOCATED_ROWS + 5, len(COLUMNS))
     assert big.column("time_s")[-1] == pytest.approx(0.01 * (PREALLOCATED_ROWS + 4))
-    small = RunLog(5)
+    small = RunLog(5, (0.6, 0.4))
     for k in range(8):
         small.add(meas(float(k)), x, None, None, 1.0)
     assert small.array().shape == (5, len(COLUMNS))
