@@ -18,7 +18,7 @@ TREE_FILES = git ls-files --cached --others --exclude-standard -- \
 RUN_COMPILED := PYTHONPATH=$(CURDIR)/$(COMPILED_TREE)
 
 .PHONY: run test test-fast test-compiled golden-strict golden-update tables bench lint network \
-	lock compiled clean xvfb
+	lock compiled clean
 
 $(STAMP): pyproject.toml setup.py $(LOCK)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -36,18 +36,11 @@ run: $(COMPILED_STAMP)
 	cat $(OUT)/table2_safe_v2x/table2.md
 
 ## Every test on the Python sources, the SUMO co-simulations and the golden Table 2 within its
-## tolerances included (what CI runs, with test-compiled).
-test: $(STAMP) xvfb
+## tolerances included (what CI runs, with test-compiled). It changes nothing outside the
+## project: the sumo-gui tests (tests/sim/test_gui.py) run on DISPLAY or on Xvfb when either
+## is there, and otherwise skip, saying why (.ci/run installs Xvfb on CI's machine).
+test: $(STAMP)
 	$(BIN)/python -m pytest
-
-## Xvfb, the virtual display the sumo-gui tests start (tests/sim/test_gui.py): Debian's xvfb
-## package when Xvfb is missing and apt-get can run as root. Best effort: otherwise those
-## tests skip and say why.
-xvfb:
-	@command -v Xvfb >/dev/null 2>&1 || { \
-	  [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 \
-	  && apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq xvfb; } \
-	  || echo "make: Xvfb not installed (needs apt-get as root): the sumo-gui tests will skip"
 
 ## The tests that need no SUMO (-m "not sumo"), with SUMO made unreachable so that a test
 ## needing it without its marker fails here.

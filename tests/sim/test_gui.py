@@ -1,8 +1,9 @@
 """sumo-gui under the co-simulation: the same run as without it (the handover before the ego
 departs included), screenshots timed from the ego's departure and showing the ego and the
 obstacle, real-time pacing, the window left open at the end or closed on Xvfb. Needs a
-display: DISPLAY, or Xvfb to make one (`make test` installs Debian's xvfb when it can);
-without either every test here that starts sumo-gui is SKIPPED (not passed)."""
+display: DISPLAY, or Xvfb to make one (CI's `.ci/run` installs Debian's xvfb; `make test`
+never installs system packages); without either every test here that starts sumo-gui is
+SKIPPED (not passed), saying why."""
 
 import json
 import os
