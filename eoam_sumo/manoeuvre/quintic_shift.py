@@ -6,13 +6,18 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.optimize import brentq, minimize_scalar
 
 from eoam_sumo.manoeuvre.points import TrajectoryPoint
 
 PEAK_SAMPLES = 200  # intervals over which a shift's peak curvature is checked
 SEARCH_SAMPLES = 50  # intervals of the coarser check while searching the length
-LENGTH_STEP = 1.02  # the length grid of the search (2 %)
+LENGTH_STEP = 1.02  # the scan that brackets the shortest length within the budget (2 %)
+LENGTH_TOL_M = 1e-6  # how closely the root-finding places that length [m]
+STOP_TOL_M = 1e-4  # how closely a lateral stop's end is placed [m]
+STOP_BISECTIONS = 24  # at most, halving the stop's bracket down to STOP_TOL_M
 OVERSHOOT_TOL_M = 1e-3  # a shift may pass its target by this much (rounding) [m]
+_PASSES = 1e30  # the peak given to a shift that passes y1 while minimising the peak [1/m]
 _PEAK_U = [i / PEAK_SAMPLES for i in range(PEAK_SAMPLES + 1)]
 _SEARCH_U = [i / SEARCH_SAMPLES for i in range(SEARCH_SAMPLES + 1)]
 
@@ -58,15 +63,17 @@ class QuinticShift:
         self.y1_m = float(y1_m)
 
     def _check(self, grid) -> tuple[float, float]:
-        """(largest |y''| [1/m] at the grid points, largest passing of y1 away from y0 [m]: at
-        the grid points for the coarse grid, exactly, at the roots of y', for the full one)."""
+        """(largest |y''| [1/m], largest passing of y1 away from y0 [m]): at the grid points
+        for the coarse grid; exactly for the full one, whose points add the stationary points
+        of y and of y'' (the extremes lie there or at the ends)."""
         y0, p, c2, c3, c4, c5 = self._c
         big2 = self.length_m * self.length_m
         side = 1.0 if self.y1_m >= y0 else -1.0
         peak = past = 0.0
         points = list(grid)
-        if grid is _PEAK_U:  # the stationary points of y in (0, 1)
-            roots = np.roots([5.0 * c5, 4.0 * c4, 3.0 * c3, 2.0 * c2, p])
+        if grid is _PEAK_U:  # the stationary points of y and of y'' in (0, 1): exact extremes
+            roots = [*np.roots([5.0 * c5, 4.0 * c4, 3.0 * c3, 2.0 * c2, p])]
+            roots += [*np.roots([10.0 * c5, 4.0 * c4, c3])]
             points += [float(r.real) for r in roots if abs(r.imag) < 1e-9 and 0.0 < r.real < 1.0]
         for u in points:
             k = abs(2.0 * c2 + u * (6.0 * c3 + u * (12.0 * c4 + 20.0 * u * c5))) / big2
@@ -83,6 +90,15 @@ class QuinticShift:
         """How far the path passes its target offset y1 (sampled), 0 when it does not."""
         return self._check(_PEAK_U)[1]
 
+    def _margin(self, limit_1pm: float) -> float:
+        """How far the shift misses its budget: > 0 when its peak |y''| exceeds ``limit_1pm``
+        or it passes y1 by more than ``OVERSHOOT_TOL_M`` (relative peak excess or overshoot
+        per metre of shift, whichever is larger); <= 0 when it is within both. Continuous in
+        the length between appearances of stationary points."""
+        peak, past = self._check(_PEAK_U)
+        scale = max(abs(self.y1_m - self._c[0]), 0.01)
+        return max(peak / limit_1pm - 1.0, (past - OVERSHOOT_TOL_M) / scale)
+
     @classmethod
     def for_lateral_accel(
         cls,
@@ -94,9 +110,12 @@ class QuinticShift:
         min_length_m: float,
         curvature0_1pm: float = 0.0,
     ) -> QuinticShift:
-        """The shortest shift (on a 2 % length grid, not below ``min_length_m``) that does not
-        pass y1 and whose peak lateral acceleration v^2 |y''| is within
-        ``lateral_accel_mps2`` (time-optimal within that friction budget, for a quintic).
+        """The shortest shift (not below ``min_length_m``) that does not pass y1 and whose peak
+        lateral acceleration v^2 |y''| is within ``lateral_accel_mps2`` (time-optimal within
+        that friction budget, for a quintic). Lengths are scanned 2 % apart to bracket the
+        shortest one within the budget, which is then found by root-finding to
+        ``LENGTH_TOL_M``, so the length is a continuous function of the ego's state (no
+        last-bit change of the state can jump it to a neighbouring grid length).
 
         Where no length meets the budget (the ego already moves away from y1 too fast, or its
         lateral acceleration exceeds the budget), the shift without overshoot of least peak.
@@ -111,24 +130,16 @@ class QuinticShift:
         top = 4.0 * min_length_m + 8.0 * (
             rest + abs(slope0) * speed_mps * speed_mps / lateral_accel_mps2
         )
-        best, best_peak = None, math.inf
+        state = (y0_m, slope0, y1_m, curvature0_1pm)
+        failed, lengths = None, []
         while length <= top:
             traj = cls(y0_m, slope0, y1_m, length, curvature0_1pm)
-            if traj._check(_SEARCH_U)[1] <= OVERSHOOT_TOL_M:  # coarse, then the full check
-                peak, past = traj._check(_PEAK_U)
-                if past <= OVERSHOOT_TOL_M:
-                    if peak <= limit:
-                        return traj
-                    if peak < best_peak:
-                        best, best_peak = traj, peak
+            if traj._check(_SEARCH_U)[1] <= OVERSHOOT_TOL_M and traj._margin(limit) <= 0.0:
+                return traj if failed is None else _first_within(cls, state, limit, failed, length)
+            failed = length
+            lengths.append(length)
             length *= LENGTH_STEP
-        length = min_length_m
-        while best is None:  # every allowed length passes y1: shorter ones, until one does not
-            length /= LENGTH_STEP
-            traj = cls(y0_m, slope0, y1_m, length, curvature0_1pm)
-            if length < 0.01 or traj._check(_PEAK_U)[1] <= OVERSHOOT_TOL_M:
-                best = traj
-        return best
+        return _least_peak(cls, state, lengths, min_length_m)
 
     def within(self, speed_mps: float, lateral_accel_mps2: float) -> bool:
         """Peak lateral acceleration within the budget and no overshoot of y1."""
@@ -148,7 +159,7 @@ class QuinticShift:
     ) -> QuinticShift:
         """The shift that arrests the lateral motion soonest: to the nearest offset ahead of
         the motion it can stop at within the budget without passing it (bisection between
-        the constant-deceleration stop v_lat^2 / (2 a) and four times it or more, to 1 cm),
+        the constant-deceleration stop v_lat^2 / (2 a) and four times it or more, to 0.1 mm),
         moved on
         by what the motion covers in ``reaction_s`` (steering and yaw lag) at its present
         lateral speed and acceleration: d + v_lat tau + a tau^2 / 2 + D."""
@@ -174,8 +185,8 @@ class QuinticShift:
         while not best.within(speed_mps, lateral_accel_mps2) and hi < 50.0:
             lo, hi = hi, 2.0 * hi  # the shortest length (min_length_m) asks for more room
             best = shift(hi)
-        for _ in range(12):
-            if hi - lo <= 0.01:
+        for _ in range(STOP_BISECTIONS):
+            if hi - lo <= STOP_TOL_M:
                 break
             mid = 0.5 * (lo + hi)
             traj = shift(mid)
@@ -195,3 +206,61 @@ class QuinticShift:
         dy = (p + u * (2.0 * c2 + u * (3.0 * c3 + u * (4.0 * c4 + 5.0 * u * c5)))) / big
         ddy = (2.0 * c2 + u * (6.0 * c3 + u * (12.0 * c4 + 20.0 * u * c5))) / (big * big)
         return TrajectoryPoint(y, 0.0, math.atan(dy), ddy / (1.0 + dy * dy) ** 1.5, 0.0)
+
+
+def _first_within(cls, state: tuple, limit: float, lo: float, hi: float) -> QuinticShift:
+    """The shortest length in (lo, hi] within the budget (``_margin`` <= 0), by Brent's method
+    on the margin (lo misses the budget, hi meets it), to ``LENGTH_TOL_M``; the bracket's upper
+    end where the root itself misses by its last bits."""
+    y0, slope0, y1, kappa0 = state
+
+    def margin(length: float) -> float:
+        return cls(y0, slope0, y1, length, kappa0)._margin(limit)
+
+    root, result = brentq(margin, lo, hi, xtol=LENGTH_TOL_M, full_output=True, disp=False)
+    for length in (root, root + LENGTH_TOL_M, hi):
+        traj = cls(y0, slope0, y1, min(length, hi), kappa0)
+        if result.converged and traj._margin(limit) <= 0.0:
+            return traj
+    return cls(y0, slope0, y1, hi, kappa0)
+
+
+def _least_peak(cls, state: tuple, lengths: list[float], min_length_m: float) -> QuinticShift:
+    """No scanned length meets the budget: the shift without overshoot of least peak |y''|,
+    its length refined between the scanned neighbours (bounded Brent minimisation), or, where
+    every allowed length passes y1, the longest shorter one that does not."""
+    y0, slope0, y1, kappa0 = state
+    peaks = []
+    for length in lengths:
+        peak, past = cls(y0, slope0, y1, length, kappa0)._check(_PEAK_U)
+        peaks.append(peak if past <= OVERSHOOT_TOL_M else math.inf)
+    if peaks and math.isfinite(min(peaks)):
+        return _refined_least_peak(cls, state, lengths, peaks)
+    length = min_length_m
+    while True:  # every allowed length passes y1: shorter ones, until one does not
+        length /= LENGTH_STEP
+        traj = cls(y0, slope0, y1, length, kappa0)
+        if length < 0.01 or traj._check(_PEAK_U)[1] <= OVERSHOOT_TOL_M:
+            return traj
+
+
+def _refined_least_peak(cls, state: tuple, lengths: list, peaks: list) -> QuinticShift:
+    """The least-peak length between the scanned neighbours of the scan's best (ties within
+    1e-9 relative go to the shorter length, so rounding noise on a plateau does not choose)."""
+    y0, slope0, y1, kappa0 = state
+    least = min(peaks)
+    k = next(i for i, p in enumerate(peaks) if p <= least * (1.0 + 1e-9))
+    lo, hi = lengths[max(k - 1, 0)], lengths[min(k + 1, len(lengths) - 1)]
+    best = cls(y0, slope0, y1, lengths[k], kappa0)
+
+    def peak_of(length: float) -> float:
+        peak, past = cls(y0, slope0, y1, length, kappa0)._check(_PEAK_U)
+        return peak if past <= OVERSHOOT_TOL_M else _PASSES
+
+    if hi > lo:
+        found = minimize_scalar(
+            peak_of, bounds=(lo, hi), method="bounded", options={"xatol": LENGTH_TOL_M}
+        )
+        if found.fun < least * (1.0 - 1e-9):
+            best = cls(y0, slope0, y1, float(found.x), kappa0)
+    return best

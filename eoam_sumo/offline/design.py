@@ -118,6 +118,15 @@ class DesignSettings:
         DESIGN + ": iteration limit of a solve in the speed chain (converging ones take "
         "fewer); a solve that reaches it is retried from a nearer speed",
     )
+    chain_step_kmh: float = _p(
+        2.5,
+        "km/h",
+        DESIGN + ": the largest speed step of the chain (intermediate speeds are solved and "
+        "not tabulated): small enough that every warm-started solve converges far below "
+        "attempt_max_iter (the sedan's chains: at most 60 iterations after the first), so "
+        "which local optimum a chain reaches never hangs on an iteration limit, which a "
+        "last-bit difference between machines could cross",
+    )
     speed_halvings: int = _p(
         3,
         "-",
@@ -219,6 +228,8 @@ class DesignSettings:
             v = getattr(self, name)
             if not (isinstance(v, int) and v >= 1):
                 raise ValueError(f"design setting {name}={v!r} must be an integer >= 1")
+        if not (math.isfinite(self.chain_step_kmh) and self.chain_step_kmh > 0.0):
+            raise ValueError(f"chain_step_kmh={self.chain_step_kmh!r} must be finite and > 0")
         if not (isinstance(self.speed_halvings, int) and self.speed_halvings >= 0):
             raise ValueError(f"speed_halvings={self.speed_halvings!r} must be an integer >= 0")
         if self.ocp_intervals < 10:

@@ -26,6 +26,8 @@ tyre and the whole ellipse (``solve_continued``).
 
 from __future__ import annotations
 
+import itertools
+import math
 from dataclasses import dataclass, replace
 
 import casadi as ca
@@ -366,20 +368,37 @@ class _Chain:
             return solve_continued(self._patient, speed_mps, self.mu, guess)
 
 
+def chain_speeds_mps(speeds_mps, step_kmh: float) -> list[tuple[float, bool]]:
+    """The chain's speeds from the highest down: each asked speed (``True``) and, between
+    two of them further apart than ``step_kmh``, equally spaced intermediate ones."""
+    ordered = sorted(speeds_mps, reverse=True)
+    out = [(ordered[0], True)] if ordered else []
+    for hi, lo in itertools.pairwise(ordered):
+        n = max(1, math.ceil((hi - lo) * 3.6 / step_kmh - 1e-9))
+        out += [(hi + (lo - hi) * k / n, False) for k in range(1, n)]
+        out.append((lo, True))
+    return out
+
+
 def solve_chain(ocp: LaneChangeOcp, mu: float, speeds_mps, on_solved=None) -> list[OcpSolution]:
     """Solve one friction's speeds from the highest down, each warm-started from the previous.
 
     The highest speed starts from ``quintic_guess`` (fast lane changes converge easily from
-    it), the next ones from ``predicted_guess``; a step that fails is halved up to
+    it), the next ones from ``predicted_guess``, at most ``settings.chain_step_kmh`` apart
+    (``chain_speeds_mps``); a step that fails all the same is halved up to
     ``settings.speed_halvings`` times, then solved by the last resort (``_Chain``).
-    ``on_solved(solution)`` is called after each. Returns the solutions, highest first.
+    ``on_solved(solution)`` is called after each asked speed. Returns the asked speeds'
+    solutions, highest first.
     """
     chain = _Chain(ocp, mu)
     halvings = ocp.settings.speed_halvings
+    history: list[OcpSolution] = []
     solutions: list[OcpSolution] = []
-    for v in sorted(speeds_mps, reverse=True):
-        sol = chain.step(solutions, v, halvings) if solutions else chain.first(v)
-        solutions.append(sol)
-        if on_solved is not None:
-            on_solved(sol)
+    for v, asked in chain_speeds_mps(speeds_mps, ocp.settings.chain_step_kmh):
+        sol = chain.step(history, v, halvings) if history else chain.first(v)
+        history.append(sol)
+        if asked:
+            solutions.append(sol)
+            if on_solved is not None:
+                on_solved(sol)
     return solutions

@@ -88,3 +88,20 @@ def test_bad_build_arguments_are_input_errors(tmp_path):
     with pytest.raises(InputError, match="mus"):
         build_tables(tmp_path, mus=[1.0, 1.0])
     assert not list(tmp_path.iterdir())
+
+
+def test_the_ice_chain_rebuilds_every_committed_cell_on_its_own_route(tmp_path):
+    """mu 0.1 is the hardest chain: at 20 km/h its OCP has several local optima (24.02, 24.33
+    and 24.95 m long were found), and which one a solve reaches depends on the route. The
+    chain's steps are at most ``chain_step_kmh`` apart whatever speeds are asked, so the two
+    ends of the grid alone take the full build's route and must give its cells: within 1e-3
+    (the CSV's four decimals, plus IPOPT's tolerance), on any machine."""
+    build_tables(tmp_path, jobs=1, speeds_kmh=[20.0, 175.0], mus=[0.1], progress=False)
+    ours, committed = _csv_rows(tmp_path), _csv_rows(COMMITTED)
+    assert set(ours) == {("0.10", "20.0"), ("0.10", "175.0")}
+    for key, row in ours.items():
+        for column, value in row.items():
+            assert float(value) == pytest.approx(float(committed[key][column]), abs=1e-3), (
+                key,
+                column,
+            )
