@@ -11,8 +11,9 @@ number of jobs or on the order cases finished. Only ``wall_time_s`` and ``realti
 differ between two runs of one matrix.
 
 ``resume`` keeps the rows of an existing results.csv whose status is ``ok`` and whose case
-is still in the matrix (same case id and scenario file), and runs every other case again,
-failed ones included.
+is still in the matrix (same case id and scenario file), and runs every other case of the
+matrix again, failed ones included; the rows of cases not in the matrix stay, after the
+matrix's (the report and the returned frame are the matrix's cases).
 """
 
 from __future__ import annotations
@@ -217,7 +218,7 @@ def run_cases(
         if resume and results_path.is_file()
         else pd.DataFrame(columns=list(COLUMNS), dtype=str)
     )
-    done = set(kept["case_id"])
+    done = set(kept["case_id"]) & {c.case_id for c in cases}
     to_run = [c for c in cases if c.case_id not in done]
     log = RowLog(results_path, kept)
     bar = _progress_bar(len(cases), len(done), progress)
