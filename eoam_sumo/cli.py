@@ -441,9 +441,11 @@ def _cmd_batch(args) -> int:
     and then the count on stderr). Bad input raises InputError before any case runs (exit
     status 2 in :func:`main`).
     """
-    from eoam_sumo.batch.runner import run_batch
+    from eoam_sumo.batch.runner import check_options, plan_batch, run_batch
     from eoam_sumo.outputs.staging import output_folder
 
+    check_options(args.jobs, args.timeout_s, args.timeseries)
+    plan = plan_batch(args.matrix, after_stop_s=args.after_stop_s)
     with (
         _sigterm_interrupts(),
         output_folder(args.out, _batch_output(), in_place=args.resume) as out,
@@ -458,6 +460,7 @@ def _cmd_batch(args) -> int:
             progress=not args.no_progress,
             timeseries=args.timeseries,
             after_stop_s=args.after_stop_s,
+            plan=plan,
         )
         # matplotlib is imported once the cases have run, in this process only
         from eoam_sumo.plotting.batch_plots import plot_batch_report
