@@ -1,4 +1,4 @@
-"""Nothing lost (issue 37): a batch, protocol or scenario folder is written by one process at
+"""Nothing lost: a batch, protocol or scenario folder is written by one process at
 a time; a re-run replaces a finished folder only once complete; ``--resume`` keeps every
 finished row; ``tables`` never writes over another vehicle's tables; unwritable outputs are
 one line. Each case compares the folder before and after."""
