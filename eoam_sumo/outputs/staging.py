@@ -57,7 +57,8 @@ def output_folder(path: Path, kind: OutputKind, *, in_place: bool = False) -> It
         if not names or in_place:
             yield path
             return
-        with _staged(path.resolve() if path.is_symlink() else path) as stage:
+        plain = path.name not in ("", ".", "..") and not path.is_symlink()
+        with _staged(path if plain else path.resolve()) as stage:
             yield stage
 
 

@@ -151,3 +151,13 @@ def test_an_atomic_write_that_fails_leaves_no_temporary_file(tmp_path):
     with pytest.raises(InputError, match=r"summary\.json cannot be written"):
         write_atomic(tmp_path / "summary.json", "{}")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["summary.json"]
+
+
+def test_the_current_folder_is_replaced_by_its_real_path(tmp_path, monkeypatch):
+    out = tmp_path / "out"
+    _finished(out)
+    monkeypatch.chdir(out)
+    with output_folder(Path(), KIND) as stage:
+        assert stage == out.resolve().with_name(f"out.partial-{os.getpid()}")
+        (stage / "results.csv").write_text("new\n")
+    assert snapshot(out) == {"results.csv": b"new\n"}
