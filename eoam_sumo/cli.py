@@ -432,7 +432,7 @@ def _sight_text(summary: dict) -> str:
 
 def _cmd_batch(args) -> int:
     """``eoam-sumo batch``: run the batch, draw its images; SIGTERM stops it like Ctrl-C
-    (rows kept).
+    (the rows written in place kept; a staging folder removed).
 
     The folder is written by this process alone; a re-run without ``--resume`` over an
     earlier batch writes a staging folder that replaces it once complete

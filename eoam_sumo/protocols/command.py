@@ -9,7 +9,7 @@ from pathlib import Path
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.matrix import vehicle_params as matrix_vehicle_params
-from eoam_sumo.outputs.staging import OutputKind
+from eoam_sumo.outputs.staging import OutputKind, output_folder
 from eoam_sumo.params import MU_MAX, VehicleParams
 from eoam_sumo.protocols.points import PROTOCOLS, TestPoint, protocol_points
 
@@ -98,7 +98,6 @@ def run(args) -> int:
     """Run the protocol; 0 when every point ran, 1 when one failed. The output folder is
     written by this process alone; a re-run over an earlier one writes a staging folder that
     replaces it once complete (:mod:`eoam_sumo.outputs.staging`)."""
-    from eoam_sumo.outputs.staging import output_folder
     from eoam_sumo.protocols.runner import run_protocol
 
     points = selected_points(args)
