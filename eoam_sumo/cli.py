@@ -108,7 +108,8 @@ def _tables_arguments(sub) -> None:
     p.add_argument(
         "--out",
         type=Path,
-        help="output folder (default: the vehicle's: tables/, tables/NAME/, tables/NAME-abs/)",
+        help="output folder (default: the vehicle's: tables/, tables/NAME/, tables/NAME-abs/; "
+        "a vehicle file named as a catalogue vehicle: tables/NAME-file/)",
     )
     p.add_argument("--jobs", type=_positive_int, default=2, help="parallel processes (2)")
     p.add_argument("--speeds-kmh", type=speed_kmh, nargs="+", help="speed grid (km/h)")
@@ -117,6 +118,11 @@ def _tables_arguments(sub) -> None:
     p.add_argument("--vehicle", help="a catalogue name or a vehicle file (default: the sedan)")
     p.add_argument(
         "--abs", choices=("on", "off"), help="ABS fitted or not (default: the vehicle's own)"
+    )
+    p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="write even over another vehicle's tables in the folder (refused by default)",
     )
 
 
@@ -287,12 +293,16 @@ def _bench_arguments(sub) -> None:
 def _cmd_tables(args) -> int:
     from eoam_sumo.matrix import vehicle_params
     from eoam_sumo.offline.build import build_tables
+    from eoam_sumo.offline.owner import check_owner
     from eoam_sumo.sim.vehicle import vehicle_tables_dir
     from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
 
     vehicle = args.vehicle or DEFAULT_VEHICLE
     params = vehicle_params(vehicle, None if args.abs is None else args.abs == "on")
-    out = writable_dir(args.out or vehicle_tables_dir(vehicle, None, params))
+    out = args.out or vehicle_tables_dir(vehicle, None, params)
+    if not args.overwrite:
+        check_owner(out, params)
+    out = writable_dir(out)
     build_tables(
         out,
         jobs=args.jobs,
@@ -422,18 +432,27 @@ def _sight_text(summary: dict) -> str:
 
 def _cmd_batch(args) -> int:
     """``eoam-sumo batch``: run the batch, draw its images; SIGTERM stops it like Ctrl-C
-    (rows kept).
+    (the rows written in place kept; a staging folder removed).
 
-    Returns 0 when every case ran, ``EXIT_CASES_FAILED`` when at least one failed (after
-    results.csv and the report are written; each failed case and then the count on stderr).
-    Bad input raises InputError before any case runs (exit status 2 in :func:`main`).
+    The folder is written by this process alone; a re-run without ``--resume`` over an
+    earlier batch writes a staging folder that replaces it once complete
+    (:mod:`eoam_sumo.outputs.staging`). Returns 0 when every case ran, ``EXIT_CASES_FAILED``
+    when at least one failed (after results.csv and the report are written; each failed case
+    and then the count on stderr). Bad input raises InputError before any case runs (exit
+    status 2 in :func:`main`).
     """
-    from eoam_sumo.batch.runner import run_batch
+    from eoam_sumo.batch.runner import check_options, plan_batch, run_batch
+    from eoam_sumo.outputs.staging import output_folder
 
-    with _sigterm_interrupts():
+    check_options(args.jobs, args.timeout_s, args.timeseries)
+    plan = plan_batch(args.matrix, after_stop_s=args.after_stop_s)
+    with (
+        _sigterm_interrupts(),
+        output_folder(args.out, _batch_output(), in_place=args.resume) as out,
+    ):
         results = run_batch(
             args.matrix,
-            args.out,
+            out,
             jobs=args.jobs,
             scheduler=args.scheduler,
             resume=args.resume,
@@ -441,12 +460,23 @@ def _cmd_batch(args) -> int:
             progress=not args.no_progress,
             timeseries=args.timeseries,
             after_stop_s=args.after_stop_s,
+            plan=plan,
         )
         # matplotlib is imported once the cases have run, in this process only
         from eoam_sumo.plotting.batch_plots import plot_batch_report
 
-        plot_batch_report(results, args.out)
+        plot_batch_report(results, out)
     return _batch_status(results, Path(args.out))
+
+
+def _batch_output():
+    """A batch's output folder: what shows a folder holds one."""
+    from eoam_sumo.batch.probabilities import PROBABILITIES_FILE
+    from eoam_sumo.batch.report import TABLE_MD
+    from eoam_sumo.batch.results import CASES_DIR, RESULTS_FILE
+    from eoam_sumo.outputs.staging import OutputKind
+
+    return OutputKind("batch", (RESULTS_FILE, CASES_DIR, TABLE_MD, PROBABILITIES_FILE))
 
 
 def _raise_interrupt(signum, frame):

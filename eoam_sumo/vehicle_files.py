@@ -42,10 +42,28 @@ def catalogue(directory: Path | None = None) -> list[str]:
     return sorted(p.stem for p in folder.glob("*.toml"))
 
 
+def is_vehicle_file(name_or_file: str) -> bool:
+    """Whether ``--vehicle`` names a file (a ``.toml`` suffix or a path separator), not a
+    catalogue vehicle."""
+    text = str(name_or_file)
+    return text.endswith(".toml") or os.sep in text or "/" in text
+
+
+def shadows_catalogue(name_or_file: str, directory: Path | None = None) -> bool:
+    """Whether ``--vehicle`` is a user's file named as a catalogue vehicle (``./sedan.toml``),
+    other than the catalogue's own file."""
+    if not is_vehicle_file(name_or_file):
+        return False
+    path = Path(name_or_file)
+    stem = path.stem if path.suffix == ".toml" else path.name
+    own = (directory or default_vehicles_dir()) / f"{stem}.toml"
+    return own.is_file() and own.resolve() != path.resolve()
+
+
 def vehicle_path(name_or_file: str, directory: Path | None = None) -> Path:
     """The file of a catalogue NAME, or the user's own FILE; ``InputError`` if neither."""
     text = str(name_or_file)
-    if text.endswith(".toml") or os.sep in text or "/" in text:
+    if is_vehicle_file(text):
         path = Path(text)
         if not path.is_file():
             raise InputError(f"{path}: no such vehicle file")

@@ -154,9 +154,10 @@ def _case_keys(cases: list[Case]) -> dict[str, tuple[str, ...]]:
 
 
 def kept_rows(path: Path, cases: list[Case]) -> pd.DataFrame:
-    """Rows of an earlier run worth keeping: finished, and still the same case (same id, and
-    the same scenario file, time limit, radar range, policy and V2X link as written in
-    results.csv)."""
+    """Rows of an earlier run worth keeping (``--resume``): the matrix's cases finished and
+    still the same case (same id, and the same scenario file, time limit, radar range, policy
+    and V2X link as written in results.csv), then every row of a case not in the matrix (a
+    larger matrix's, whose case folders stay)."""
     rows = read_rows(path)
     want = _case_keys(cases)
     same = [
@@ -164,16 +165,20 @@ def kept_rows(path: Path, cases: list[Case]) -> pd.DataFrame:
         for cid, key in zip(rows["case_id"], zip(*(rows[k] for k in RESUME_KEYS)))
     ]
     keep = (rows["status"] == "ok").to_numpy() & pd.Series(same, dtype=bool).to_numpy()
-    return rows[keep].drop_duplicates("case_id", keep="last")
+    others = (~rows["case_id"].isin(list(want))).to_numpy()
+    return rows[keep | others].drop_duplicates("case_id", keep="last")
 
 
 def finalise(path: Path, cases: list[Case], paper: dict[str, str]) -> pd.DataFrame:
-    """Rewrite results.csv atomically in the matrix's order, one row per case, with the
-    paper's colours of the matrix as it is now."""
+    """Rewrite results.csv atomically: one row per case of the matrix in its order, with the
+    paper's colours of the matrix as it is now, then the rows kept of cases not in it; return
+    the matrix's rows (as :func:`read_results`)."""
     rows = read_rows(path).drop_duplicates("case_id", keep="last")
     order = {c.case_id: i for i, c in enumerate(cases)}
-    rows = rows[rows["case_id"].isin(order)]
-    rows = rows.iloc[rows["case_id"].map(order).argsort(kind="stable")].copy()
-    rows["paper_outcome"] = [paper.get(cid, "") for cid in rows["case_id"]]
-    write_atomic(path, rows.to_csv(index=False), durable=True)
-    return read_results(path)
+    mine = rows["case_id"].isin(order)
+    ours = rows[mine]
+    ours = ours.iloc[ours["case_id"].map(order).argsort(kind="stable")].copy()
+    ours["paper_outcome"] = [paper.get(cid, "") for cid in ours["case_id"]]
+    write_atomic(path, pd.concat([ours, rows[~mine]]).to_csv(index=False), durable=True)
+    results = read_results(path)
+    return results[results["case_id"].isin(order)].reset_index(drop=True)

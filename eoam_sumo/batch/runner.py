@@ -11,8 +11,9 @@ number of jobs or on the order cases finished. Only ``wall_time_s`` and ``realti
 differ between two runs of one matrix.
 
 ``resume`` keeps the rows of an existing results.csv whose status is ``ok`` and whose case
-is still in the matrix (same case id and scenario file), and runs every other case again,
-failed ones included.
+is still in the matrix (same case id and scenario file), and runs every other case of the
+matrix again, failed ones included; the rows of cases not in the matrix stay, after the
+matrix's (the report and the returned frame are the matrix's cases).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from __future__ import annotations
 import contextlib
 import sys
 from collections.abc import Callable, Iterator
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import pandas as pd
@@ -142,6 +143,7 @@ def run_batch(
     tables_dir: Path | None = None,
     timeseries: str = "csv",
     after_stop_s: float | None = None,
+    plan: BatchPlan | None = None,
 ) -> pd.DataFrame:
     """Run every case of the matrix; return the final results (as :func:`read_results`).
 
@@ -159,16 +161,12 @@ def run_batch(
     friction against the lookup tables in ``tables_dir`` (default: the co-simulation's,
     :func:`~eoam_sumo.matrix.check_matrix`). A case that fails is a ``failed`` row.
     ``after_stop_s`` sets every case's (over the matrix's ``[scenario] after_stop_s``).
+    ``plan``: the matrix already checked by :func:`plan_batch` (the command line checks it
+    before it takes the output folder).
     """
-    _check_options(jobs, timeout_s, timeseries)
-    if after_stop_s is not None and not after_stop_s >= 0.0:
-        raise InputError(f"--after-stop-s {after_stop_s:g} must be >= 0")
-    matrix: Matrix = load_matrix(Path(matrix_path))
-    check_matrix(matrix, tables_dir)
-    cases = matrix.cases()
-    if after_stop_s is not None:
-        cases = [replace(c, after_stop_s=after_stop_s) for c in cases]
-    paper = matrix.paper_outcomes()
+    check_options(jobs, timeout_s, timeseries)
+    plan = plan or plan_batch(matrix_path, tables_dir, after_stop_s)
+    matrix, cases, paper = plan.matrix, plan.cases, plan.paper
     out_dir = _cases_folder(Path(out_dir))
     results = run_cases(
         cases,
@@ -192,6 +190,29 @@ def run_batch(
     return results
 
 
+@dataclass(frozen=True)
+class BatchPlan:
+    """A checked matrix: its cases (``after_stop_s`` applied) and the paper's colours."""
+
+    matrix: Matrix
+    cases: list[Case]
+    paper: dict[str, str]
+
+
+def plan_batch(
+    matrix_path: Path, tables_dir: Path | None = None, after_stop_s: float | None = None
+) -> BatchPlan:
+    """The matrix loaded and checked (:func:`run_batch`'s bad input), nothing written."""
+    if after_stop_s is not None and not after_stop_s >= 0.0:
+        raise InputError(f"--after-stop-s {after_stop_s:g} must be >= 0")
+    matrix: Matrix = load_matrix(Path(matrix_path))
+    check_matrix(matrix, tables_dir)
+    cases = matrix.cases()
+    if after_stop_s is not None:
+        cases = [replace(c, after_stop_s=after_stop_s) for c in cases]
+    return BatchPlan(matrix, cases, matrix.paper_outcomes())
+
+
 def run_cases(
     cases: list[Case],
     out_dir: Path,
@@ -208,7 +229,7 @@ def run_cases(
 ) -> pd.DataFrame:
     """Run ``cases`` (each with its own scenario file) into ``out_dir``: the cases' folders
     and ``results.csv`` in the cases' order; return the results (as ``read_results``)."""
-    _check_options(jobs, timeout_s, timeseries)
+    check_options(jobs, timeout_s, timeseries)
     paper = paper or {}
     out_dir = _cases_folder(Path(out_dir))
     results_path = out_dir / RESULTS_FILE
@@ -217,7 +238,7 @@ def run_cases(
         if resume and results_path.is_file()
         else pd.DataFrame(columns=list(COLUMNS), dtype=str)
     )
-    done = set(kept["case_id"])
+    done = set(kept["case_id"]) & {c.case_id for c in cases}
     to_run = [c for c in cases if c.case_id not in done]
     log = RowLog(results_path, kept)
     bar = _progress_bar(len(cases), len(done), progress)
@@ -235,7 +256,7 @@ def run_cases(
     return finalise(results_path, cases, paper)
 
 
-def _check_options(jobs: int, timeout_s: float, timeseries: str) -> None:
+def check_options(jobs: int, timeout_s: float, timeseries: str) -> None:
     """InputError for a job count, time limit or time-series format out of range."""
     if not (isinstance(jobs, int) and jobs >= 1):
         raise InputError(f"--jobs {jobs!r} must be an integer >= 1")

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.matrix import vehicle_params as matrix_vehicle_params
+from eoam_sumo.outputs.staging import OutputKind, output_folder
 from eoam_sumo.params import MU_MAX, VehicleParams
 from eoam_sumo.protocols.points import PROTOCOLS, TestPoint, protocol_points
 
@@ -17,6 +18,11 @@ from eoam_sumo.protocols.points import PROTOCOLS, TestPoint, protocol_points
 MAX_TIME_S = 40.0
 POLICIES = ("paper", "safe")
 
+
+#: What shows a folder holds a protocol's output (``protocols.runner``'s files and folders).
+PROTOCOL_OUTPUT = OutputKind(
+    "protocol", ("results.csv", "scorecard.md", "scorecard.png", "scenarios", "batch")
+)
 
 #: the equipment switches, --abs and --esc
 EQUIPMENT = ("abs", "esc")
@@ -89,23 +95,26 @@ def selected_points(args) -> list[TestPoint]:
 
 
 def run(args) -> int:
-    """Run the protocol; 0 when every point ran, 1 when one failed."""
+    """Run the protocol; 0 when every point ran, 1 when one failed. The output folder is
+    written by this process alone; a re-run over an earlier one writes a staging folder that
+    replaces it once complete (:mod:`eoam_sumo.outputs.staging`)."""
     from eoam_sumo.protocols.runner import run_protocol
 
     points = selected_points(args)
-    summary = run_protocol(
-        args.name,
-        points,
-        Path(args.out),
-        jobs=args.jobs,
-        scheduler=args.scheduler,
-        policy=args.policy,
-        mu=args.mu,
-        vehicle=vehicle_label(args),
-        vehicle_id=args.vehicle,
-        params=vehicle_params(args.vehicle, args.abs, args.esc),
-        progress=not args.no_progress,
-        max_time_s=MAX_TIME_S,
-    )
-    print(summary.line)
+    with output_folder(Path(args.out), PROTOCOL_OUTPUT) as out:
+        summary = run_protocol(
+            args.name,
+            points,
+            out,
+            jobs=args.jobs,
+            scheduler=args.scheduler,
+            policy=args.policy,
+            mu=args.mu,
+            vehicle=vehicle_label(args),
+            vehicle_id=args.vehicle,
+            params=vehicle_params(args.vehicle, args.abs, args.esc),
+            progress=not args.no_progress,
+            max_time_s=MAX_TIME_S,
+        )
+    print(summary.line(Path(args.out)))
     return 1 if summary.failed else 0

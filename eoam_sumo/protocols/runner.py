@@ -51,10 +51,19 @@ PROTOCOL_COLUMNS = (
 
 @dataclass(frozen=True)
 class ProtocolSummary:
-    """What ``eoam-sumo protocol`` prints: one line, and whether a point failed."""
+    """What ``eoam-sumo protocol`` prints (:meth:`line`) and whether a point failed."""
 
-    line: str
+    points: int
+    run: int
     failed: int
+    outside: int
+
+    def line(self, out: Path) -> str:
+        """The summary line, naming the files in the output folder ``out``."""
+        return (
+            f"{self.points} points, {self.run} run, {self.failed} failed, {self.outside} "
+            f"outside the design range; {out / RESULTS_FILE}, {out / SCORECARD_MD}"
+        )
 
 
 def _design_low_kmh(tables_dir: Path | None, vehicle_id: str, params: VehicleParams) -> float:
@@ -125,12 +134,7 @@ def run_protocol(
 
     plot_scorecard(frame, out / SCORECARD_PNG, title=f"{name}: {vehicle}, mu {mu:g}")
     failed = int((frame["status"] == "failed").sum())
-    return ProtocolSummary(
-        f"{len(frame)} points, {len(runnable)} run, {failed} failed, "
-        f"{len(points) - len(runnable)} outside the design range; {out / RESULTS_FILE}, "
-        f"{out / SCORECARD_MD}",
-        failed,
-    )
+    return ProtocolSummary(len(frame), len(runnable), failed, len(points) - len(runnable))
 
 
 def _relative(path, out: Path):

@@ -4,12 +4,13 @@ rolls over.
 Tables: the default vehicle (``vehicle_files.DEFAULT_VEHICLE``, the paper's sedan) uses the
 tables folder itself (``$EOAM_TABLES_DIR`` or the repository's ``tables/``, or the folder a
 run names); any other vehicle its sub-folder named after it: ``tables/<name>/``, ``<name>``
-the catalogue name or the vehicle file's stem (``--vehicle trucks/pickup.toml``:
-``tables/pickup/``); a run whose ABS is not the vehicle file's has ``-abs`` or ``-noabs``
-after the name (``tables/sedan-abs/``: the paper's sedan with ABS). ``eoam-sumo tables --vehicle
-NAME [--abs on|off]`` builds them there; a run
-refuses a vehicle whose folder holds no tables or tables built for other parameters
-(``offline.tables.LookupTables.load``).
+the catalogue name or the vehicle file's stem (``--vehicle trucks/truck.toml``:
+``tables/truck/``; a user's file named as a catalogue vehicle, ``./pickup.toml``, has
+``-file`` after its name, ``tables/pickup-file/``, so it never shares the catalogue vehicle's
+tables); a run whose ABS is not the vehicle file's has ``-abs`` or ``-noabs`` after the name
+(``tables/sedan-abs/``: the paper's sedan with ABS). ``eoam-sumo tables --vehicle NAME
+[--abs on|off]`` builds them there; a run refuses a vehicle whose folder holds no tables or
+tables built for other parameters (``offline.tables.LookupTables.load``).
 
 Rollover (a loss of control, ``sim/outcome.py``): a wheel lifts when the normal load of an
 inner tyre (one the lateral transfer unloads) reaches zero under the plant's quasi-static load
@@ -31,7 +32,7 @@ from eoam_sumo.offline.tables import METADATA_NAME, LookupTables, default_tables
 from eoam_sumo.params import G_MPS2, VehicleParams
 from eoam_sumo.plant.model import AX_LOAD, AY_LOAD, STATE_NAMES, tyre_loads_n
 from eoam_sumo.plant.ops import FLOAT_OPS
-from eoam_sumo.vehicle_files import DEFAULT_VEHICLE, load_vehicle
+from eoam_sumo.vehicle_files import DEFAULT_VEHICLE, load_vehicle, shadows_catalogue
 
 #: The tyres in the order of ``plant.model.tyre_loads_n``.
 TYRES = ("front left", "front right", "rear left", "rear right")
@@ -45,10 +46,11 @@ def vehicle_name(vehicle: str) -> str:
 
 
 def tables_name(vehicle: str, params: VehicleParams | None = None) -> str:
-    """The name of ``vehicle``'s tables folder: its name (``vehicle_name``), with ``-abs`` or
-    ``-noabs`` when the run's ABS (``params``) differs from the vehicle file's own, for its
-    braking limit differs (``offline.braking``)."""
-    name = vehicle_name(vehicle)
+    """The name of ``vehicle``'s tables folder: its name (``vehicle_name``; ``NAME-file`` for a
+    user's file named as a catalogue vehicle), with ``-abs`` or ``-noabs`` when the run's ABS
+    (``params``) differs from the vehicle file's own, for its braking limit differs
+    (``offline.braking``)."""
+    name = vehicle_name(vehicle) + ("-file" if shadows_catalogue(vehicle) else "")
     if params is None or params.abs_fitted == load_vehicle(vehicle).abs_fitted:
         return name
     return f"{name}-{'abs' if params.abs_fitted else 'noabs'}"
@@ -68,7 +70,7 @@ def vehicle_tables_dir(
 def build_command(vehicle: str, params: VehicleParams, folder: Path) -> str:
     """The command that builds the tables ``vehicle_tables`` looks for."""
     command = f"eoam-sumo tables --vehicle {vehicle}"
-    if tables_name(vehicle, params) != vehicle_name(vehicle):
+    if tables_name(vehicle, params) != tables_name(vehicle):
         command += " --abs " + ("on" if params.abs_fitted else "off")
     return f"{command} --out {folder}"
 

@@ -6,9 +6,25 @@ import argparse
 import json
 from pathlib import Path
 
-from eoam_sumo.errors import InputError
+from eoam_sumo.outputs.staging import OutputKind, output_folder
 from eoam_sumo.traffic_levels.hcm import LEVELS
+from eoam_sumo.traffic_levels.network import NAME
 from eoam_sumo.traffic_levels.spec import ROADS, TrafficSpec
+
+SCENARIO_CFG = "scenario.sumocfg"
+SCENARIO_JSON = "scenario.json"
+#: What shows a folder holds a generated scenario (``build.write_scenario``'s files).
+SCENARIO_OUTPUT = OutputKind(
+    "scenario",
+    (
+        SCENARIO_CFG,
+        SCENARIO_JSON,
+        "scenario.rou.xml",
+        f"{NAME}.nod.xml",
+        f"{NAME}.edg.xml",
+        f"{NAME}.net.xml",
+    ),
+)
 
 
 def add_scenario_arguments(sub) -> None:
@@ -30,18 +46,21 @@ def add_scenario_arguments(sub) -> None:
 
 
 def cmd_scenario(args: argparse.Namespace) -> int:
-    """Write the scenario; one line with its level as measured."""
+    """Write the scenario; one line with its level as measured. The folder is written by
+    this process alone; over an earlier scenario the new one is written into a staging folder
+    that replaces it once complete (:mod:`eoam_sumo.outputs.staging`), so an interrupted run
+    never leaves a new network beside old routes."""
     spec = TrafficSpec(
         args.road, args.los, args.lanes, args.speed_limit_kmh, args.curve_radius_m, args.seed
     ).checked()
-    if args.out.exists() and not args.out.is_dir():
-        raise InputError(f"--out {args.out}: not a folder")
     from eoam_sumo.traffic_levels.build import write_scenario
 
-    cfg = write_scenario(spec, args.out)
-    measured = json.loads((args.out / "scenario.json").read_text(encoding="utf-8"))["measured"]
+    with output_folder(args.out, SCENARIO_OUTPUT) as out:
+        write_scenario(spec, out)
+        record = json.loads((out / SCENARIO_JSON).read_text(encoding="utf-8"))
+    measured = record["measured"]
     print(
         f"{spec.road} LoS {spec.los}: measured {measured['measure']} = {measured['value']:g} "
-        f"(level {measured['level']}) -> {cfg}"
+        f"(level {measured['level']}) -> {args.out / SCENARIO_CFG}"
     )
     return 0

@@ -20,7 +20,7 @@ from eoam_sumo.sim.runlog import write_run
 from eoam_sumo.sim.scenario import ScenarioOverrides
 from eoam_sumo.sim.settings import RunSettings
 from eoam_sumo.sim.vehicle import vehicle_tables, vehicle_tables_dir
-from eoam_sumo.vehicle_files import load_vehicle, vehicle_toml
+from eoam_sumo.vehicle_files import default_vehicles_dir, load_vehicle, vehicle_toml
 
 ROOT = Path(__file__).resolve().parents[2]
 BASELINE = ROOT / "scenarios" / "baseline.sumocfg"
@@ -98,7 +98,11 @@ def test_the_folder_of_a_vehicle_is_its_name_under_the_tables_and_the_sedans_the
     base = Path("/t")
     assert vehicle_tables_dir("sedan", base) == base
     assert vehicle_tables_dir("suv", base) == base / "suv"
-    assert vehicle_tables_dir("my/fleet/van.toml", base) == base / "van"
+    assert vehicle_tables_dir("my/fleet/truck.toml", base) == base / "truck"
+    # a user's file named as a catalogue vehicle never shares the catalogue vehicle's tables
+    assert vehicle_tables_dir("my/fleet/van.toml", base) == base / "van-file"
+    assert vehicle_tables_dir("my/fleet/sedan.toml", base) == base / "sedan-file"
+    assert vehicle_tables_dir(str(default_vehicles_dir() / "van.toml"), base) == base / "van"
 
 
 def test_a_vehicle_with_its_abs_switched_has_a_folder_of_its_own():
