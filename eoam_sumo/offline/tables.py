@@ -36,6 +36,7 @@ from eoam_sumo.errors import InputError
 from eoam_sumo.manoeuvre.points import TrajectoryPoint
 from eoam_sumo.offline.boundaries import max_decel_no_lock_mps2
 from eoam_sumo.params import VehicleParams, describe, ego_e_class_sedan
+from eoam_sumo.textfiles import not_utf8
 
 CSV_NAME = "phase_boundaries.csv"
 NPZ_NAME = "lookup_tables.npz"
@@ -97,11 +98,13 @@ class PhaseBoundaries:
         """Read ``phase_boundaries.csv`` (``#`` lines are comments)."""
         path = Path(directory) / CSV_NAME
         try:
-            text = path.read_text()
+            text = path.read_text(encoding="utf-8")
         except OSError as exc:
             raise InputError(
                 f"{path}: cannot read the phase boundaries ({exc.strerror}); run `eoam-sumo tables`"
             ) from None
+        except UnicodeDecodeError as exc:
+            raise not_utf8(path, exc, "phase boundaries") from None
         lines = [ln for ln in text.splitlines() if ln and not ln.startswith("#")]
         table: dict[float, dict[float, tuple]] = {}
         try:
@@ -200,7 +203,9 @@ class LookupTables:
         params = params or ego_e_class_sedan()
         meta_path = folder / METADATA_NAME
         try:
-            metadata = json.loads(meta_path.read_text())
+            metadata = json.loads(meta_path.read_text(encoding="utf-8"))
+        except UnicodeDecodeError as exc:
+            raise not_utf8(meta_path, exc, "tables' metadata") from None
         except OSError as exc:
             raise InputError(
                 f"{meta_path}: cannot read the tables' metadata ({exc.strerror}); "

@@ -7,14 +7,29 @@ that fails its standard is a result, not an error: the status is 0 and the summa
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
-from eoam_sumo.arguments import mu, speed_kmh
+from eoam_sumo.arguments import finite, mu
 from eoam_sumo.fileio import writable_dir
 from eoam_sumo.vehicle_files import load_vehicle
 
 TEST_NAMES = ("brake", "brake-ramp", "ramp-steer", "sine-with-dwell", "step-steer")
 """The tests (``procedures.TESTS``; named here so the command line starts without the plant)."""
+
+TEST_SPEED_RANGE_KMH = (1.0, 300.0)
+"""Test speeds accepted [km/h]: from walking pace to 300 km/h, where the tyres' shortest
+admitted relaxation length (0.05 m, ``params.VEHICLE_RANGES``) still spans 0.6 ms, above the
+0.5 ms the plant's 1 ms step integrates stably."""
+
+
+def vehicle_test_speed_kmh(text: str) -> float:
+    """A test speed [km/h] within ``TEST_SPEED_RANGE_KMH``."""
+    value = finite(text)
+    low, high = TEST_SPEED_RANGE_KMH
+    if not low <= value <= high:
+        raise argparse.ArgumentTypeError(f"speed {text} km/h is outside [{low:g}, {high:g}]")
+    return value
 
 
 def add_arguments(subparsers) -> None:
@@ -26,7 +41,11 @@ def add_arguments(subparsers) -> None:
     )
     p.add_argument("--abs", choices=("on", "off"), default="off", help="ABS (default off)")
     p.add_argument("--esc", choices=("on", "off"), default="off", help="ESC (default off)")
-    p.add_argument("--speed-kmh", type=speed_kmh, help="test speed (default: the standard's)")
+    p.add_argument(
+        "--speed-kmh",
+        type=vehicle_test_speed_kmh,
+        help="test speed, 1-300 km/h (default: the standard's)",
+    )
     p.add_argument("--mu", type=mu, default=1.0, help="road friction (default 1.0)")
     p.add_argument("--out", type=Path, required=True, help="output folder")
 
