@@ -21,7 +21,7 @@ from eoam_sumo.arguments import finite, mu, speed_kmh
 from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import writable_dir
 from eoam_sumo.seeds import seed_argument
-from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S
+from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S, MAX_TIME_LIMIT_S
 from eoam_sumo.traffic_levels.command import add_scenario_arguments, cmd_scenario
 from eoam_sumo.vehicle_tests import command as vehicle_test_command
 
@@ -329,8 +329,8 @@ def _check_run_args(args) -> None:
     """InputError for a ``run`` option out of its range, before anything is written."""
     if not args.cfg.is_file():
         raise InputError(f"{args.cfg}: no such scenario file")
-    if args.max_time_s <= 0:
-        raise InputError(f"--max-time-s {args.max_time_s} must be > 0")
+    if not 0 < args.max_time_s <= MAX_TIME_LIMIT_S:
+        raise InputError(f"--max-time-s {args.max_time_s:g} is outside (0, {MAX_TIME_LIMIT_S:g}]")
     if args.radar_range_m is not None and args.radar_range_m <= 0:
         raise InputError(f"--radar-range-m {args.radar_range_m} must be > 0")
     if args.after_stop_s is not None and args.after_stop_s < 0:

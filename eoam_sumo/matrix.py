@@ -31,7 +31,7 @@ from eoam_sumo.seeds import check_seed
 from eoam_sumo.sensing.automotive import parse_radar_model
 from eoam_sumo.sensing.friction import parse_mu_belief
 from eoam_sumo.sim.scenario import ScenarioOverrides, check_scenario, scripted_stops
-from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S
+from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S, MAX_TIME_LIMIT_S
 from eoam_sumo.sim.vehicle import vehicle_name, vehicle_tables, vehicle_tables_dir
 from eoam_sumo.textfiles import not_utf8
 from eoam_sumo.traffic_levels.hcm import LEVELS
@@ -490,7 +490,7 @@ SAMPLED = {
     "oncoming_start_m": _checked(0.0, True, allow_none=True),
     "aro_hold_s": _checked(0.0, True),
     "aro_decel_mps2": _checked(0.0, False),
-    "max_time_s": _checked(0.0, False),
+    "max_time_s": _checked(0.0, False, MAX_TIME_LIMIT_S),
     "radar_range_m": _checked(0.0, False),
     "mu_belief": parse_mu_belief,
     "radar_model": parse_radar_model,
@@ -784,8 +784,11 @@ def _run_limits(path: Path, scenario: dict) -> tuple[float, float | None]:
     """[scenario] max_time_s (default ``DEFAULT_MAX_TIME_S``) and radar_range_m (None: the
     radar's default), each a number > 0."""
     max_time = scenario.get("max_time_s", DEFAULT_MAX_TIME_S)
-    if not _is_number(max_time) or max_time <= 0:
-        raise InputError(f"{path}: [scenario] max_time_s = {max_time!r} must be a number > 0")
+    if not _is_number(max_time) or not 0 < max_time <= MAX_TIME_LIMIT_S:
+        raise InputError(
+            f"{path}: [scenario] max_time_s = {max_time!r} must be a number in "
+            f"(0, {MAX_TIME_LIMIT_S:g}]"
+        )
     radar_range = scenario.get("radar_range_m")
     if radar_range is not None and (not _is_number(radar_range) or radar_range <= 0):
         raise InputError(f"{path}: [scenario] radar_range_m = {radar_range!r} must be a number > 0")
