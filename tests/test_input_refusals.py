@@ -1,4 +1,4 @@
-"""Bad input of issue 37 (vehicle values, crashes on input, matrix checks): each refused with
+"""Bad input (vehicle values, crashes on input, matrix checks): each refused with
 exit status 2 and exactly one line on stderr naming the file, key and value; nothing written
 before is lost. Every refusal here comes before SUMO or the plant starts."""
 
