@@ -145,11 +145,23 @@ def test_inconsistent_values_are_refused_naming_the_relation(values, needle):
 # --- 7. crashes on input -----------------------------------------------------------------
 
 
-@pytest.mark.parametrize("speed", ["1e308", "0.5", "301", "inf"])
-def test_vehicle_test_speed_outside_its_range_is_refused(capsys, tmp_path, speed):
+@pytest.mark.parametrize(
+    "option, value",
+    [
+        ("--speed-kmh", "1e308"),
+        ("--speed-kmh", "0.5"),
+        ("--speed-kmh", "301"),
+        ("--speed-kmh", "inf"),
+        ("--mu", "1e-300"),
+        ("--mu", "0.01"),
+    ],
+)
+def test_vehicle_test_speed_or_friction_outside_its_range_is_refused(
+    capsys, tmp_path, option, value
+):
     out = tmp_path / "o"
-    argv = ["vehicle-test", "brake", "--speed-kmh", speed, "--out", str(out)]
-    _refused(capsys, argv, speed)
+    argv = ["vehicle-test", "brake", option, value, "--out", str(out)]
+    _refused(capsys, argv, option, value)
     assert not out.exists()
 
 

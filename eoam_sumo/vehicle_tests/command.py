@@ -10,8 +10,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from eoam_sumo.arguments import finite, mu
+from eoam_sumo.arguments import finite
 from eoam_sumo.fileio import writable_dir
+from eoam_sumo.params import MU_MAX
 from eoam_sumo.vehicle_files import load_vehicle
 
 TEST_NAMES = ("brake", "brake-ramp", "ramp-steer", "sine-with-dwell", "step-steer")
@@ -21,6 +22,19 @@ TEST_SPEED_RANGE_KMH = (1.0, 300.0)
 """Test speeds accepted [km/h]: from walking pace to 300 km/h, where the tyres' shortest
 admitted relaxation length (0.05 m, ``params.VEHICLE_RANGES``) still spans 0.6 ms, above the
 0.5 ms the plant's 1 ms step integrates stably."""
+
+
+TEST_MU_MIN = 0.05
+"""Lowest road friction accepted: wet glare ice (0.05-0.1); below it a stop from speed lasts
+minutes of simulated time and is no road test."""
+
+
+def vehicle_test_mu(text: str) -> float:
+    """A road friction in [``TEST_MU_MIN``, ``MU_MAX``]."""
+    value = finite(text)
+    if not TEST_MU_MIN <= value <= MU_MAX:
+        raise argparse.ArgumentTypeError(f"mu {text} is outside [{TEST_MU_MIN:g}, {MU_MAX:g}]")
+    return value
 
 
 def vehicle_test_speed_kmh(text: str) -> float:
@@ -46,7 +60,9 @@ def add_arguments(subparsers) -> None:
         type=vehicle_test_speed_kmh,
         help="test speed, 1-300 km/h (default: the standard's)",
     )
-    p.add_argument("--mu", type=mu, default=1.0, help="road friction (default 1.0)")
+    p.add_argument(
+        "--mu", type=vehicle_test_mu, default=1.0, help="road friction, 0.05-1.2 (default 1.0)"
+    )
     p.add_argument("--out", type=Path, required=True, help="output folder")
 
 
