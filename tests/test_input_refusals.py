@@ -351,9 +351,10 @@ def test_matrix_checks_refuse_before_any_case_runs(capsys, tmp_path, text, needl
         (["scenario", "rural", "--los", "A", "--seed", "-1"], "seed = -1"),
         (["run", str(SCEN / "baseline.sumocfg"), "--seed", "2147483648"], "seed = 2147483648"),
         (["run", str(SCEN / "baseline.sumocfg"), "--max-time-s", "1e308"], "--max-time-s 1e+308"),
+        (["protocol", "unr152", "--mu", "0.001"], "--mu 0.001"),
     ],
 )
-def test_seeds_and_time_limits_out_of_range_are_refused(capsys, tmp_path, argv, needle):
+def test_seeds_time_limits_and_frictions_out_of_range_are_refused(capsys, tmp_path, argv, needle):
     out = tmp_path / "o"
     _refused(capsys, [*argv, "--out", str(out)], needle)
     assert not out.exists()
