@@ -11,6 +11,7 @@ import re
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from eoam_sumo.cli import main
@@ -288,6 +289,38 @@ def test_non_utf8_tables_files_are_refused_naming_them(capsys, tmp_path, name):
         str(tmp_path / "o"),
     ]
     _refused(capsys, argv, name, "UTF-8")
+
+
+def _nan_in_tables(tables: Path, name: str) -> str:
+    """A NaN written into the shipped tables' ``name``; the text the refusal must hold."""
+    if name == "phase_boundaries.csv":
+        lines = (tables / name).read_text().splitlines()
+        k = next(i for i, line in enumerate(lines) if line[:1].isdigit())
+        header = next(line for line in lines if line.startswith("mu,")).split(",")
+        cells = lines[k].split(",")
+        cells[3] = "nan"
+        lines[k] = ",".join(cells)
+        (tables / name).write_text("\n".join(lines) + "\n")
+        return f"column {header[3]} is nan"
+    arrays = dict(np.load(tables / name))
+    key = "ax_mps2"
+    arrays[key] = arrays[key].copy()
+    arrays[key].flat[2] = np.nan
+    np.savez_compressed(tables / name, **arrays)
+    return f"array {key} holds a NaN"
+
+
+@pytest.mark.parametrize("name", ["phase_boundaries.csv", "lookup_tables.npz"])
+def test_a_nan_in_the_lookup_tables_is_refused_naming_file_and_place(capsys, tmp_path, name):
+    tables = tmp_path / "tables"
+    tables.mkdir()
+    for shipped in ("phase_boundaries.csv", "metadata.json", "lookup_tables.npz"):
+        shutil.copy(ROOT / "tables" / shipped, tables / shipped)
+    needle = _nan_in_tables(tables, name)
+    out = tmp_path / "o"
+    argv = ["run", str(SCEN / "baseline.sumocfg"), "--tables", str(tables), "--out", str(out)]
+    _refused(capsys, argv, name, needle)
+    assert not out.exists() or not any(out.iterdir())  # the run wrote nothing
 
 
 def test_non_utf8_vehicle_file_is_refused_naming_it(capsys, tmp_path):

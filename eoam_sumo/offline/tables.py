@@ -26,6 +26,7 @@ import bisect
 import csv
 import hashlib
 import json
+import math
 import os
 from pathlib import Path
 from typing import NamedTuple, cast
@@ -111,7 +112,11 @@ class PhaseBoundaries:
             for rec in csv.DictReader(lines):
                 mu = float(rec["mu"])
                 speed = float(rec["speed_kmh"]) / 3.6
-                table.setdefault(mu, {})[speed] = tuple(float(rec[c]) for c in BOUNDARY_COLUMNS)
+                row = tuple(float(rec[c]) for c in BOUNDARY_COLUMNS)
+                table.setdefault(mu, {})[speed] = row
+                _check_finite_row(path, rec, (mu, speed, *row))
+        except InputError:
+            raise
         except (KeyError, ValueError, TypeError) as exc:
             raise InputError(f"{path}: malformed phase boundaries ({exc})") from None
         mus = sorted(table)
@@ -240,6 +245,11 @@ class LookupTables:
             raise InputError(
                 f"{npz_path}: missing arrays {', '.join(missing)}; run `eoam-sumo tables`"
             )
+        for name, array in arrays.items():
+            if array.dtype.kind == "f" and not np.isfinite(array).all():
+                raise InputError(
+                    f"{npz_path}: array {name} holds a NaN or an infinity; run `eoam-sumo tables`"
+                )
         boundaries = PhaseBoundaries.load(folder)
         _check_same_grids(folder, metadata, arrays, boundaries)
         return cls(arrays, boundaries, metadata, params)
@@ -311,6 +321,19 @@ class LookupTables:
         length = sum(c * lengths[m, v] for m, v, c in corners)
         final = TrajectoryPoint(self.lane_change_m, 0.0, 0.0, 0.0, 0.0, 0.0)
         return Trajectory(length, self.dx_step_m, cols, final)
+
+
+def _check_finite_row(path: Path, rec: dict, values: tuple) -> None:
+    """InputError naming the friction, speed and column of a non-finite phase boundary."""
+    if all(math.isfinite(v) for v in values):
+        return
+    column = next(
+        c for c in ("mu", "speed_kmh", *BOUNDARY_COLUMNS) if not math.isfinite(float(rec[c]))
+    )
+    raise InputError(
+        f"{path}: malformed phase boundaries (column {column} is {rec[column]} at mu "
+        f"{rec['mu']}, speed {rec['speed_kmh']} km/h)"
+    )
 
 
 def _check_same_grids(folder: Path, metadata: dict, arrays: dict, boundaries) -> None:
