@@ -209,11 +209,20 @@ TYRE_LOAD_RANGE = (0.1, 2.0)
 DYNAMIC_INDEX_RANGE = (0.3, 3.0)
 
 
+class VehicleValueError(ValueError):
+    """A vehicle value out of its range: ``field`` and what is wrong with it (``detail``,
+    starting with its value), so that a file's loader can name the key."""
+
+    def __init__(self, field: str, detail: str):
+        super().__init__(f"vehicle parameter {field} {detail}")
+        self.field = field
+        self.detail = detail
+
+
 def _in_range(name: str, value: float, unit: str, low: float, high: float) -> None:
     if not low <= value <= high:  # False for NaN too
-        raise ValueError(
-            f"vehicle parameter {name} = {value!r} {unit} is outside its physical range "
-            f"[{low:g}, {high:g}] {unit}"
+        raise VehicleValueError(
+            name, f"= {value!r} {unit} is outside its physical range [{low:g}, {high:g}] {unit}"
         )
 
 
@@ -224,15 +233,15 @@ def check_vehicle(p: VehicleParams) -> None:
     for name, (low, high) in VEHICLE_RANGES.items():
         value = getattr(p, name)
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ValueError(f"vehicle parameter {name} = {value!r} must be a number")
+            raise VehicleValueError(name, f"= {value!r} must be a number")
         _in_range(name, float(value), units[name], low, high)
     if not isinstance(p.name, str) or not p.name.strip():
-        raise ValueError(f"vehicle parameter name = {p.name!r} must be a non-empty string")
+        raise VehicleValueError("name", f"= {p.name!r} must be a non-empty string")
     if p.drivetrain not in DRIVETRAINS:
-        raise ValueError(f"vehicle parameter drivetrain = {p.drivetrain!r} not in {DRIVETRAINS}")
+        raise VehicleValueError("drivetrain", f"= {p.drivetrain!r} is not one of {DRIVETRAINS}")
     for name in ("abs_fitted", "esc_fitted"):
         if not isinstance(getattr(p, name), bool):
-            raise ValueError(f"vehicle parameter {name} = {getattr(p, name)!r} must be a bool")
+            raise VehicleValueError(name, f"= {getattr(p, name)!r} must be a bool")
     _check_relations(p)
 
 
@@ -241,31 +250,30 @@ def _check_relations(p: VehicleParams) -> None:
     static tyre loads within what the plant's tyre describes."""
     axles_m = p.front_overhang_m + p.wheelbase_m
     if axles_m > p.length_m:
-        raise ValueError(
-            f"vehicle parameter length_m = {p.length_m!r} m is shorter than front_overhang_m "
-            f"+ cg_to_front_m + cg_to_rear_m = {axles_m:.3f} m (the rear axle outside the body)"
+        raise VehicleValueError(
+            "length_m",
+            f"= {p.length_m!r} m is shorter than front_overhang_m + cg_to_front_m + "
+            f"cg_to_rear_m = {axles_m:.3f} m (the rear axle outside the body)",
         )
     if p.track_m > p.width_m:
-        raise ValueError(
-            f"vehicle parameter track_m = {p.track_m!r} m exceeds width_m = {p.width_m!r} m"
-        )
+        raise VehicleValueError("track_m", f"= {p.track_m!r} m exceeds width_m = {p.width_m!r} m")
     index = p.yaw_inertia_kgm2 / p.mass_kg / (p.cg_to_front_m * p.cg_to_rear_m)
     low, high = DYNAMIC_INDEX_RANGE
     if not low <= index <= high:
-        raise ValueError(
-            f"vehicle parameter yaw_inertia_kgm2 = {p.yaw_inertia_kgm2!r} kg m^2 gives a dynamic "
-            f"index Iz / (m a b) = {index:.3g} outside [{low:g}, {high:g}] for this mass and "
-            "these axle distances"
+        raise VehicleValueError(
+            "yaw_inertia_kgm2",
+            f"= {p.yaw_inertia_kgm2!r} kg m^2 gives a dynamic index Iz / (m a b) = {index:.3g} "
+            f"outside [{low:g}, {high:g}] for this mass and these axle distances",
         )
     weight_n = p.mass_kg * G_MPS2
     for axle, share in (("front", p.cg_to_rear_m), ("rear", p.cg_to_front_m)):
         load = 0.5 * weight_n * share / p.wheelbase_m / PLANT_TYRE_FNOMIN_N
         if not TYRE_LOAD_RANGE[0] <= load <= TYRE_LOAD_RANGE[1]:
-            raise ValueError(
-                f"vehicle parameter mass_kg = {p.mass_kg!r} kg puts {load:.2f} x FNOMIN on each "
-                f"{axle} tyre, outside [{TYRE_LOAD_RANGE[0]:g}, {TYRE_LOAD_RANGE[1]:g}] x "
-                f"{PLANT_TYRE_FNOMIN_N:g} N, what the plant's passenger-car tyre (PAC2002 "
-                "235/60R16) describes"
+            raise VehicleValueError(
+                "mass_kg",
+                f"= {p.mass_kg!r} kg puts {load:.2f} x FNOMIN on each {axle} tyre, outside "
+                f"[{TYRE_LOAD_RANGE[0]:g}, {TYRE_LOAD_RANGE[1]:g}] x {PLANT_TYRE_FNOMIN_N:g} N, "
+                "what the plant's passenger-car tyre (PAC2002 235/60R16) describes",
             )
 
 

@@ -22,7 +22,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from eoam_sumo.errors import InputError
-from eoam_sumo.params import VehicleParams
+from eoam_sumo.params import VehicleParams, VehicleValueError
 from eoam_sumo.textfiles import not_utf8
 
 DEFAULT_VEHICLE = "sedan"
@@ -82,8 +82,8 @@ def params_from_tables(data: dict, path: Path) -> VehicleParams:
     values = {name: _value(data, f, path) for name, f in fields.items()}
     try:
         return VehicleParams(**values)
-    except ValueError as exc:
-        raise InputError(f"{path}: {exc}") from None
+    except VehicleValueError as exc:
+        raise InputError(f"{path}: key {exc.field!r} {exc.detail}") from None
 
 
 def _value(data: dict, f: dataclasses.Field, path: Path):
