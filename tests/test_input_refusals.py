@@ -399,3 +399,11 @@ def test_seed_range_is_sumos_int_and_warm_up_seeds_stay_in_it():
     for bad in (SEED_MAX + 1, -1, True, 1.0, "3"):
         with pytest.raises(ValueError, match="seed"):
             check_seed(bad, "seed")
+
+
+@pytest.mark.parametrize("options", [{"speed_kmh": 1e308}, {"speed_kmh": 0.0}, {"mu": 1e-300}])
+def test_vehicle_test_options_check_themselves(options):
+    from eoam_sumo.vehicle_tests.common import VehicleTestOptions
+
+    with pytest.raises(ValueError, match=next(iter(options))):
+        VehicleTestOptions(**options)

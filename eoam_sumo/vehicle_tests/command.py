@@ -14,19 +14,10 @@ from eoam_sumo.arguments import finite
 from eoam_sumo.fileio import writable_dir
 from eoam_sumo.params import MU_MAX
 from eoam_sumo.vehicle_files import load_vehicle
+from eoam_sumo.vehicle_tests.clauses import TEST_MU_MIN, TEST_SPEED_RANGE_KMH
 
 TEST_NAMES = ("brake", "brake-ramp", "ramp-steer", "sine-with-dwell", "step-steer")
 """The tests (``procedures.TESTS``; named here so the command line starts without the plant)."""
-
-TEST_SPEED_RANGE_KMH = (1.0, 300.0)
-"""Test speeds accepted [km/h]: from walking pace to 300 km/h, where the tyres' shortest
-admitted relaxation length (0.05 m, ``params.VEHICLE_RANGES``) still spans 0.6 ms, above the
-0.5 ms the plant's 1 ms step integrates stably."""
-
-
-TEST_MU_MIN = 0.05
-"""Lowest road friction accepted: wet glare ice (0.05-0.1); below it a stop from speed lasts
-minutes of simulated time and is no road test."""
 
 
 def vehicle_test_mu(text: str) -> float:
