@@ -102,8 +102,10 @@ V2X_KEYS = {
 
 
 def _id_number(value: float) -> str:
-    """Filesystem-safe, unique text of a number: 165, 92.5, 1.0 (friction keeps its decimal)."""
-    return (str(int(value)) if value.is_integer() else repr(value)).replace("+", "")
+    """Filesystem-safe, unique, short text of a number: 165, 92.5, 1e20 (a whole number of
+    20 digits or more in exponent form: 1e308 as 309 digits made a name too long to write)."""
+    whole = value.is_integer() and abs(value) < 1e20
+    return (str(int(value)) if whole else repr(value)).replace("+", "")
 
 
 def _mu_text(value: float) -> str:

@@ -407,3 +407,14 @@ def test_vehicle_test_options_check_themselves(options):
 
     with pytest.raises(ValueError, match=next(iter(options))):
         VehicleTestOptions(**options)
+
+
+def test_huge_swept_values_give_case_ids_a_file_system_takes(tmp_path):
+    """1e308 written as its 309 digits made a case folder's name too long (a traceback)."""
+    from eoam_sumo.matrix import load_matrix
+
+    sweep = "ego_speed_kmh = [120]\nmu = [1.0]\naro_hold_s = [1e308, 2]\n"
+    matrix = write_matrix(tmp_path / "m.toml", sweep + "oncoming_start_m = [1e20, 400]\n")
+    ids = [case.case_id for case in load_matrix(matrix).cases()]
+    assert "onc-1e20_v120_mu1.0_hold1e308" in ids and "onc-400_v120_mu1.0_hold2" in ids
+    assert max(len(i) for i in ids) < 100
