@@ -418,3 +418,24 @@ def test_huge_swept_values_give_case_ids_a_file_system_takes(tmp_path):
     ids = [case.case_id for case in load_matrix(matrix).cases()]
     assert "onc-1e20_v120_mu1.0_hold1e308" in ids and "onc-400_v120_mu1.0_hold2" in ids
     assert max(len(i) for i in ids) < 100
+
+
+@pytest.mark.parametrize(
+    "sweep, needle",
+    [
+        ("ego_speed_kmh = [100, 100.0]\nmu = [1.0]\n", "ego_speed_kmh lists 100.0 twice"),
+        ("ego_speed_kmh = [100]\nmu = [1.0, 1]\n", "mu lists 1 twice"),
+        ('ego_speed_kmh = [100]\nmu = [1.0]\noncoming_start_m = ["none", "none"]\n', "twice"),
+        ("ego_speed_kmh = [100]\nmu = [1.0]\naro_hold_s = [2, 2]\n", "aro_hold_s lists 2 twice"),
+        ('ego_speed_kmh = [100]\nmu = [1.0]\nabs = ["on", "on"]\n', "abs lists 'on' twice"),
+        ('ego_speed_kmh = [100]\nmu = [1.0]\npolicy = ["safe", "safe"]\n', "policy lists"),
+        (
+            'ego_speed_kmh = [100]\nmu = [1.0]\nvehicle = ["van", "van"]\n',
+            "vehicle lists two vehicles named 'van'",
+        ),
+    ],
+)
+def test_every_sweep_key_refuses_a_value_listed_twice(capsys, tmp_path, sweep, needle):
+    matrix = tmp_path / "m.toml"
+    matrix.write_text(_matrix_text(sweep=sweep))
+    _refused(capsys, ["batch", str(matrix), "--out", str(tmp_path / "o")], "m.toml", needle)
