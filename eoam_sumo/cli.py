@@ -20,7 +20,8 @@ from eoam_sumo import __version__
 from eoam_sumo.arguments import finite, mu, speed_kmh
 from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import writable_dir
-from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S
+from eoam_sumo.seeds import seed_argument
+from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S, MAX_TIME_LIMIT_S
 from eoam_sumo.traffic_levels.command import add_scenario_arguments, cmd_scenario
 from eoam_sumo.vehicle_tests import command as vehicle_test_command
 
@@ -41,16 +42,6 @@ def _positive_int(text: str) -> int:
         raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
     if value < 1:
         raise argparse.ArgumentTypeError(f"{text!r} must be >= 1")
-    return value
-
-
-def _seed(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"seed {text!r} is not an integer") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"seed {text} must be >= 0")
     return value
 
 
@@ -167,7 +158,7 @@ def _run_arguments(sub) -> None:
         help="ideal (exact, every step) or automotive (noise, misses, latency, "
         "occlusion, tracker; docs/sensing.md)",
     )
-    p.add_argument("--seed", type=_seed, default=0, help="seed of every random model (0)")
+    p.add_argument("--seed", type=seed_argument, default=0, help="seed of every random model (0)")
     _after_stop_argument(p)
     p.add_argument("--gui", action="store_true", help="run in sumo-gui through TraCI")
     _policy_arguments(p)
@@ -348,8 +339,8 @@ def _check_run_args(args) -> None:
     """InputError for a ``run`` option out of its range, before anything is written."""
     if not args.cfg.is_file():
         raise InputError(f"{args.cfg}: no such scenario file")
-    if args.max_time_s <= 0:
-        raise InputError(f"--max-time-s {args.max_time_s} must be > 0")
+    if not 0 < args.max_time_s <= MAX_TIME_LIMIT_S:
+        raise InputError(f"--max-time-s {args.max_time_s:g} is outside (0, {MAX_TIME_LIMIT_S:g}]")
     if args.radar_range_m is not None and args.radar_range_m <= 0:
         raise InputError(f"--radar-range-m {args.radar_range_m} must be > 0")
     if args.after_stop_s is not None and args.after_stop_s < 0:
@@ -576,6 +567,9 @@ def main(argv: list[str] | None = None) -> int:
         return _COMMANDS[args.command](args)
     except InputError as exc:
         print(f"eoam-sumo: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except UnicodeDecodeError as exc:  # a reader that does not name its file: still one line
+        print(f"eoam-sumo: error: an input file is not UTF-8 text: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except RuntimeError as exc:  # a SUMO failure, an optimiser that did not converge
         print(f"eoam-sumo: failed: {' '.join(str(exc).split())}", file=sys.stderr)

@@ -27,11 +27,13 @@ from eoam_sumo.colours import OUTCOMES
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import MU_MAX, VehicleParams, ego_e_class_sedan
 from eoam_sumo.sampling import Sample, parse_sample
+from eoam_sumo.seeds import check_seed
 from eoam_sumo.sensing.automotive import parse_radar_model
 from eoam_sumo.sensing.friction import parse_mu_belief
 from eoam_sumo.sim.scenario import ScenarioOverrides, check_scenario, scripted_stops
-from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S
+from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S, MAX_TIME_LIMIT_S
 from eoam_sumo.sim.vehicle import vehicle_name, vehicle_tables, vehicle_tables_dir
+from eoam_sumo.textfiles import not_utf8
 from eoam_sumo.traffic_levels.hcm import LEVELS
 from eoam_sumo.traffic_levels.spec import (
     MIN_CURVE_RADIUS_M,
@@ -100,8 +102,10 @@ V2X_KEYS = {
 
 
 def _id_number(value: float) -> str:
-    """Filesystem-safe, unique text of a number: 165, 92.5, 1.0 (friction keeps its decimal)."""
-    return (str(int(value)) if value.is_integer() else repr(value)).replace("+", "")
+    """Filesystem-safe, unique, short text of a number: 165, 92.5, 1e20 (a whole number of
+    20 digits or more in exponent form: 1e308 as 309 digits made a name too long to write)."""
+    whole = value.is_integer() and abs(value) < 1e20
+    return (str(int(value)) if whole else repr(value)).replace("+", "")
 
 
 def _mu_text(value: float) -> str:
@@ -348,6 +352,8 @@ def load_paper_table(path: Path) -> dict[tuple[float | None, float, float], str]
             header = tuple(rows[0].keys()) if rows else ()
     except OSError as exc:
         raise InputError(f"{path}: cannot read the paper table: {exc}") from exc
+    except UnicodeDecodeError as exc:
+        raise not_utf8(path, exc, "paper table") from None
     missing = [c for c in PAPER_COLUMNS if c not in header]
     if missing:
         raise InputError(f"{path}: the paper table needs the column '{missing[0]}'")
@@ -486,7 +492,7 @@ SAMPLED = {
     "oncoming_start_m": _checked(0.0, True, allow_none=True),
     "aro_hold_s": _checked(0.0, True),
     "aro_decel_mps2": _checked(0.0, False),
-    "max_time_s": _checked(0.0, False),
+    "max_time_s": _checked(0.0, False, MAX_TIME_LIMIT_S),
     "radar_range_m": _checked(0.0, False),
     "mu_belief": parse_mu_belief,
     "radar_model": parse_radar_model,
@@ -511,7 +517,7 @@ def load_matrix(path: Path) -> Matrix:
     _check_required(path, doc, sampled)
     scenario = doc.get("scenario", {})
     _check_sampled_once(path, doc, sample, sampled)
-    traffic_axes = _traffic_axes(path, doc, sampled)
+    traffic_axes = _traffic_axes(path, doc, sample)
     sumocfg = _scenario_file(path, scenario, traffic_axes)
     max_time, radar_range = _run_limits(path, scenario)
     policy = _scenario_policy(path, scenario)
@@ -521,9 +527,7 @@ def load_matrix(path: Path) -> Matrix:
     if "table" in doc.get("paper", {}):
         paper = _existing_file(path, "[paper] table", doc["paper"]["table"])
     settings = _sensing_settings(path, scenario)
-    seed = scenario.get("seed", 0)
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise InputError(f"{path}: [scenario] seed = {seed!r} must be an integer >= 0")
+    seed = check_seed(scenario.get("seed", 0), f"{path}: [scenario] seed")
     return Matrix(
         path=path,
         sumocfg=sumocfg,
@@ -601,8 +605,9 @@ def _switches(path: Path, where: str, key: str, raw) -> tuple[bool, ...]:
     if not isinstance(listed, list) or not listed:
         raise InputError(f'{path}: [sweep] {key} must be a non-empty list of "on" / "off"')
     for value in listed:
-        if value not in SWITCH:
-            raise InputError(f'{path}: [{where}] {key} value {value!r} is not "on" or "off"')
+        if not isinstance(value, str) or value not in SWITCH:
+            what = f"{key} = {value!r}" if where == "scenario" else f"{key} value {value!r}"
+            raise InputError(f'{path}: [{where}] {what} is not "on" or "off"')
         if listed.count(value) > 1:
             raise InputError(f"{path}: [sweep] {key} lists {value!r} twice")
     return tuple(SWITCH[v] for v in listed)
@@ -669,31 +674,40 @@ def _scenario_file(path: Path, scenario: dict, traffic_axes: tuple) -> Path | No
     return None
 
 
-def _traffic_axes(path: Path, doc: dict, sampled: tuple[str, ...]) -> tuple:
-    """The generated scenario's keys as (key, values): [scenario] one value, [sweep] a list,
-    sampled (None,); every swept combination checked as a scenario spec."""
-    axes = []
+def _traffic_axes(path: Path, doc: dict, sample: Sample | None) -> tuple:
+    """The generated scenario's keys as (key, values): [scenario] one value, [sweep] a list
+    of distinct values, sampled (None,); every combination checked as a scenario spec, a
+    sampled key with every value its distribution can give at its bounds (each choice)."""
+    axes, domains = [], []
     for key in TRAFFIC_KEYS:
         where = [t for t in ("scenario", "sweep") if key in doc.get(t, {})]
         if len(where) > 1:
             raise InputError(f"{path}: '{key}' is in [scenario] and [sweep]; keep one")
-        if key in sampled:
+        dist = sample.of(key) if sample else None
+        if dist is not None:
             axes.append((key, (None,)))
+            domains.append((key, tuple(dict.fromkeys(dist.extremes()))))
         elif where:
             raw = doc[where[0]][key]
             listed = raw if where[0] == "sweep" else [raw]
             if not isinstance(listed, list) or not listed:
                 raise InputError(f"{path}: [sweep] {key} must be a non-empty list")
             try:
-                axes.append((key, tuple(TRAFFIC_CHECKS[key](v) for v in listed)))
+                values = tuple(TRAFFIC_CHECKS[key](v) for v in listed)
             except InputError as exc:
                 raise InputError(f"{path}: [{where[0]}] {key}: {exc}") from None
-    _check_specs(path, axes)
+            twice = next((v for v, c in zip(listed, values) if values.count(c) > 1), None)
+            if twice is not None:
+                raise InputError(f"{path}: [sweep] {key} lists {twice!r} twice")
+            axes.append((key, values))
+            domains.append((key, values))
+    _check_specs(path, domains, sample)
     return tuple(axes)
 
 
-def _check_specs(path: Path, axes: list) -> None:
-    """InputError for a swept combination that is not a scenario (a curved motorway)."""
+def _check_specs(path: Path, axes: list, sample: Sample | None = None) -> None:
+    """InputError for a combination that is not a scenario (a curved motorway, a rural road
+    with three lanes), naming the keys and, for a sampled key, the [sample] table."""
     keys = [key for key, _ in axes]
     for combo in itertools.product(*(values for _, values in axes)):
         values = dict(zip(keys, combo))
@@ -708,7 +722,9 @@ def _check_specs(path: Path, axes: list) -> None:
                 values.get("curve_radius_m"),
             ).checked()
         except InputError as exc:
-            raise InputError(f"{path}: {', '.join(keys)}: {exc}") from None
+            drawn = [k for k in keys if sample and sample.of(k)]
+            note = f" (sampled in [sample]: {', '.join(drawn)})" if drawn else ""
+            raise InputError(f"{path}: {', '.join(keys)}{note}: {exc}") from None
 
 
 def _read_toml(path: Path) -> dict:
@@ -722,6 +738,8 @@ def _read_toml(path: Path) -> dict:
         raise InputError(f"{path}: cannot read the matrix file: {exc}") from exc
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"{path}: malformed TOML: {exc}") from exc
+    except UnicodeDecodeError as exc:
+        raise not_utf8(path, exc, "matrix file") from None
 
 
 def _check_tables(path: Path, doc: dict) -> None:
@@ -768,8 +786,11 @@ def _run_limits(path: Path, scenario: dict) -> tuple[float, float | None]:
     """[scenario] max_time_s (default ``DEFAULT_MAX_TIME_S``) and radar_range_m (None: the
     radar's default), each a number > 0."""
     max_time = scenario.get("max_time_s", DEFAULT_MAX_TIME_S)
-    if not _is_number(max_time) or max_time <= 0:
-        raise InputError(f"{path}: [scenario] max_time_s = {max_time!r} must be a number > 0")
+    if not _is_number(max_time) or not 0 < max_time <= MAX_TIME_LIMIT_S:
+        raise InputError(
+            f"{path}: [scenario] max_time_s = {max_time!r} must be a number in "
+            f"(0, {MAX_TIME_LIMIT_S:g}]"
+        )
     radar_range = scenario.get("radar_range_m")
     if radar_range is not None and (not _is_number(radar_range) or radar_range <= 0):
         raise InputError(f"{path}: [scenario] radar_range_m = {radar_range!r} must be a number > 0")

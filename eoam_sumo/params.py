@@ -146,19 +146,135 @@ class VehicleParams:
         return self.length_m - self.cg_to_front_bumper_m
 
     def __post_init__(self) -> None:
-        for f in dataclasses.fields(self):
-            v = getattr(self, f.name)
-            if isinstance(v, float) and not (math.isfinite(v) and v >= 0.0):
-                raise ValueError(f"vehicle parameter {f.name}={v!r} must be finite and >= 0")
-        if not 0.0 < self.brake_front_share < 1.0:
-            raise ValueError(f"brake_front_share={self.brake_front_share} must be in (0, 1)")
-        if self.drivetrain not in DRIVETRAINS:
-            raise ValueError(f"drivetrain={self.drivetrain!r} must be one of {DRIVETRAINS}")
-        for name in ("abs_fitted", "esc_fitted"):
-            if not isinstance(getattr(self, name), bool):
-                raise ValueError(f"vehicle parameter {name}={getattr(self, name)!r} must be a bool")
-        if not 0.0 <= self.awd_front_share <= 1.0:
-            raise ValueError(f"awd_front_share={self.awd_front_share} must be in [0, 1]")
+        check_vehicle(self)
+
+
+#: Each numeric ``VehicleParams`` field's physical range ``(low, high)``, closed, in the
+#: field's unit: wide enough for any road vehicle from a light quadricycle (about 350 kg) to
+#: a 60 t road train, narrow enough that the plant's fixed 1 ms step stays stable and no
+#: division by zero is possible. The reason of each range: docs/vehicles.md.
+VEHICLE_RANGES: dict[str, tuple[float, float]] = {
+    "mass_kg": (200.0, 60000.0),
+    "yaw_inertia_kgm2": (20.0, 2.0e6),
+    "cg_to_front_m": (0.2, 6.0),
+    "cg_to_rear_m": (0.2, 6.0),
+    "cg_height_m": (0.2, 3.0),
+    "track_m": (0.8, 2.6),
+    "length_m": (2.0, 25.25),
+    "width_m": (1.0, 2.6),
+    "front_overhang_m": (0.0, 3.0),
+    "steering_ratio": (5.0, 40.0),
+    "max_steer_rad": (0.1, 1.2),
+    "max_steer_rate_radps": (0.05, 5.0),
+    "cornering_stiffness_front_npr": (1.0e4, 3.0e6),
+    "cornering_stiffness_rear_npr": (1.0e4, 3.0e6),
+    "slip_angle_sat_rad": (0.02, 0.35),
+    "sliding_friction_ratio": (0.3, 1.0),
+    "max_drive_force_n": (100.0, 6.0e5),
+    "max_drive_power_w": (1.0e3, 2.0e6),
+    "max_brake_force_n": (500.0, 1.0e6),
+    "brake_front_share": (0.05, 0.95),
+    "rolling_resistance_coeff": (0.0, 0.05),
+    "drag_area_m2": (0.0, 15.0),
+    "steer_lag_s": (0.005, 2.0),
+    "drive_lag_s": (0.005, 2.0),
+    "brake_lag_s": (0.005, 2.0),
+    "wheel_radius_m": (0.15, 0.75),
+    "wheel_inertia_kgm2": (0.1, 50.0),
+    "tyre_nominal_load_n": (500.0, 60000.0),
+    "relaxation_length_long_m": (0.05, 2.0),
+    "relaxation_length_lat_m": (0.05, 2.0),
+    "front_steer_compliance": (0.3, 1.0),
+    "roll_stiffness_front_share": (0.1, 0.9),
+    "max_brake_pressure_bar": (5.0, 300.0),
+    "brake_build_rate_barps": (10.0, 20000.0),
+    "brake_dump_rate_barps": (10.0, 50000.0),
+    "awd_front_share": (0.0, 1.0),
+    "eawd_gain_per_slip": (0.0, 100.0),
+    "esc_yaw_gain": (0.0, 100.0),
+    "esc_yaw_deadband_radps": (0.0, 0.5),
+    "esc_sideslip_threshold_rad": (0.0, 0.35),
+    "esc_sideslip_gain_nmprad": (0.0, 1.0e7),
+    "esc_lag_s": (0.005, 2.0),
+}
+#: FNOMIN of the plant's one tyre set, the PAC2002 235/60R16 (``plant.magic_formula``) [N].
+PLANT_TYRE_FNOMIN_N = 4850.0
+#: Static load per tyre the plant's tyre describes, as multiples of its FNOMIN: its
+#: load-variation terms (PDX2, PDY2) take its peak friction to zero near 6 x FNOMIN, and a
+#: limit manoeuvre's load transfer can double a tyre's load (docs/vehicles.md, the tyre).
+TYRE_LOAD_RANGE = (0.1, 2.0)
+#: The dynamic index ``k^2 / (a b)`` (``k^2 = Iz / m``) a vehicle may have: measured cars lie
+#: within 0.7-1.4 (Heydinger et al., SAE 1999-01-1336); a body's mass cannot all sit at or
+#: beyond its axles' reach many times over, nor at one point.
+DYNAMIC_INDEX_RANGE = (0.3, 3.0)
+
+
+class VehicleValueError(ValueError):
+    """A vehicle value out of its range: ``field`` and what is wrong with it (``detail``,
+    starting with its value), so that a file's loader can name the key."""
+
+    def __init__(self, field: str, detail: str):
+        super().__init__(f"vehicle parameter {field} {detail}")
+        self.field = field
+        self.detail = detail
+
+
+def _in_range(name: str, value: float, unit: str, low: float, high: float) -> None:
+    if not low <= value <= high:  # False for NaN too
+        raise VehicleValueError(
+            name, f"= {value!r} {unit} is outside its physical range [{low:g}, {high:g}] {unit}"
+        )
+
+
+def check_vehicle(p: VehicleParams) -> None:
+    """``ValueError`` naming the field, its value and unit unless every value has its type and
+    lies in its physical range (``VEHICLE_RANGES``) and the geometry is consistent."""
+    units = {f.name: f.metadata.get("unit", "") for f in dataclasses.fields(p)}
+    for name, (low, high) in VEHICLE_RANGES.items():
+        value = getattr(p, name)
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise VehicleValueError(name, f"= {value!r} must be a number")
+        _in_range(name, float(value), units[name], low, high)
+    if not isinstance(p.name, str) or not p.name.strip():
+        raise VehicleValueError("name", f"= {p.name!r} must be a non-empty string")
+    if p.drivetrain not in DRIVETRAINS:
+        raise VehicleValueError("drivetrain", f"= {p.drivetrain!r} is not one of {DRIVETRAINS}")
+    for name in ("abs_fitted", "esc_fitted"):
+        if not isinstance(getattr(p, name), bool):
+            raise VehicleValueError(name, f"= {getattr(p, name)!r} must be a bool")
+    _check_relations(p)
+
+
+def _check_relations(p: VehicleParams) -> None:
+    """The axles within the body, the track within the width, a physical dynamic index, the
+    static tyre loads within what the plant's tyre describes."""
+    axles_m = p.front_overhang_m + p.wheelbase_m
+    if axles_m > p.length_m:
+        raise VehicleValueError(
+            "length_m",
+            f"= {p.length_m!r} m is shorter than front_overhang_m + cg_to_front_m + "
+            f"cg_to_rear_m = {axles_m:.3f} m (the rear axle outside the body)",
+        )
+    if p.track_m > p.width_m:
+        raise VehicleValueError("track_m", f"= {p.track_m!r} m exceeds width_m = {p.width_m!r} m")
+    index = p.yaw_inertia_kgm2 / p.mass_kg / (p.cg_to_front_m * p.cg_to_rear_m)
+    low, high = DYNAMIC_INDEX_RANGE
+    if not low <= index <= high:
+        raise VehicleValueError(
+            "yaw_inertia_kgm2",
+            f"= {p.yaw_inertia_kgm2!r} kg m^2 gives a dynamic index Iz / (m a b) = {index:.3g} "
+            f"outside [{low:g}, {high:g}] for this mass and these axle distances",
+        )
+    weight_n = p.mass_kg * G_MPS2
+    for axle, share in (("front", p.cg_to_rear_m), ("rear", p.cg_to_front_m)):
+        load = 0.5 * weight_n * share / p.wheelbase_m / PLANT_TYRE_FNOMIN_N
+        if not TYRE_LOAD_RANGE[0] <= load <= TYRE_LOAD_RANGE[1]:
+            raise VehicleValueError(
+                "mass_kg",
+                f"= {p.mass_kg!r} kg puts {load:.2f} x FNOMIN on each {axle} tyre, outside "
+                f"[{TYRE_LOAD_RANGE[0]:g}, {TYRE_LOAD_RANGE[1]:g}] x {PLANT_TYRE_FNOMIN_N:g} N, "
+                "what the plant's passenger-car tyre (PAC2002 235/60R16) describes",
+            )
 
 
 @dataclass(frozen=True)

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from eoam_sumo.errors import InputError
+from eoam_sumo.seeds import check_seed
 
 KINDS = ("uniform", "normal", "choice")
 Z_95 = 1.959963984540054  # standard normal quantile of 0.975
@@ -162,8 +163,7 @@ def parse_sample(path, table: dict, checks: dict[str, Check]) -> Sample:
     draws, seed = table["draws"], table.get("seed", 0)
     if isinstance(draws, bool) or not isinstance(draws, int) or not 1 <= draws <= MAX_DRAWS:
         raise InputError(f"{where} draws = {draws!r} must be an integer in [1, {MAX_DRAWS}]")
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise InputError(f"{where} seed = {seed!r} must be an integer >= 0")
+    check_seed(seed, f"{where} seed")
     distributions = []
     for key in sorted(k for k in table if k not in ("draws", "seed")):
         if key not in checks:

@@ -16,14 +16,14 @@ unknown keys are refused (a misspelt key would otherwise fall back to the sedan'
 from __future__ import annotations
 
 import dataclasses
-import math
 import os
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
 
 from eoam_sumo.errors import InputError
-from eoam_sumo.params import VehicleParams
+from eoam_sumo.params import VehicleParams, VehicleValueError
+from eoam_sumo.textfiles import not_utf8
 
 DEFAULT_VEHICLE = "sedan"
 
@@ -82,8 +82,10 @@ def load_vehicle(name_or_file: str, directory: Path | None = None) -> VehiclePar
     try:
         with path.open("rb") as fh:
             data = tomllib.load(fh)
-    except (OSError, UnicodeDecodeError) as exc:
+    except OSError as exc:
         raise InputError(f"{path}: cannot read: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise not_utf8(path, exc, "vehicle file") from None
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"{path}: not valid TOML: {exc}") from None
     return params_from_tables(data, path)
@@ -98,8 +100,8 @@ def params_from_tables(data: dict, path: Path) -> VehicleParams:
     values = {name: _value(data, f, path) for name, f in fields.items()}
     try:
         return VehicleParams(**values)
-    except ValueError as exc:
-        raise InputError(f"{path}: {exc}") from None
+    except VehicleValueError as exc:
+        raise InputError(f"{path}: key {exc.field!r} {exc.detail}") from None
 
 
 def _value(data: dict, f: dataclasses.Field, path: Path):
@@ -119,13 +121,10 @@ def _value(data: dict, f: dataclasses.Field, path: Path):
 
 
 def _typed(value, f: dataclasses.Field, path: Path):
-    """The value in the field's type (the default's); floats finite and >= 0."""
+    """The value in the field's type (the default's); its range is the dataclass's check."""
     kind = type(f.default)
     if kind is float and isinstance(value, (int, float)) and not isinstance(value, bool):
-        value = float(value)
-        if not (math.isfinite(value) and value >= 0.0):
-            raise InputError(f"{path}: key {f.name!r} = {value!r} must be finite and >= 0")
-        return value
+        return float(value)
     if isinstance(value, kind) and not (kind is int and isinstance(value, bool)):
         return value
     raise InputError(f"{path}: key {f.name!r} = {value!r} must be a {kind.__name__}")

@@ -48,7 +48,11 @@ def test_a_missing_key_is_named(tmp_path, key):
 
 def test_a_negative_value_is_named(tmp_path):
     text = vehicle_toml(ego_e_class_sedan()).replace("value = 1723.0", "value = -1723.0")
-    with pytest.raises(InputError, match=r"key 'mass_kg' = -1723.0 must be finite and >= 0"):
+    with pytest.raises(
+        InputError,
+        match=r"car\.toml: key 'mass_kg' = -1723.0 kg is outside its physical range "
+        r"\[200, 60000\] kg",
+    ):
         load_vehicle(str(_write(tmp_path, text)))
 
 

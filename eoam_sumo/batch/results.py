@@ -19,6 +19,7 @@ from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.matrix import Case
 from eoam_sumo.sim.summary import FIELDS, NUMERIC_FIELDS, TIMING_FIELDS
+from eoam_sumo.textfiles import read_utf8
 
 RESULTS_FILE = "results.csv"
 CASES_DIR = "cases"
@@ -94,7 +95,7 @@ def csv_text(rows: list[dict], header: bool) -> str:
 
 def read_rows(path: Path) -> pd.DataFrame:
     """results.csv as text cells; a last line cut short by an interruption is dropped."""
-    text = path.read_text(encoding="utf-8")
+    text = read_utf8(path, "results file")
     if text and not text.endswith("\n"):
         text = text[: text.rfind("\n") + 1]
     if not text.strip():

@@ -256,12 +256,17 @@ def run_cases(
     return finalise(results_path, cases, paper)
 
 
+#: The longest per-case time limit accepted [s]: a day (a larger one overflows the worker's
+#: wait; 1e308 did).
+MAX_TIMEOUT_S = 86400.0
+
+
 def check_options(jobs: int, timeout_s: float, timeseries: str) -> None:
     """InputError for a job count, time limit or time-series format out of range."""
     if not (isinstance(jobs, int) and jobs >= 1):
         raise InputError(f"--jobs {jobs!r} must be an integer >= 1")
-    if not timeout_s > 0:
-        raise InputError(f"--timeout-s {timeout_s!r} must be > 0")
+    if not 0 < timeout_s <= MAX_TIMEOUT_S:
+        raise InputError(f"--timeout-s {timeout_s!r} is outside (0, {MAX_TIMEOUT_S:g}]")
     if timeseries not in TIMESERIES_FORMATS:
         raise InputError(
             f"--timeseries {timeseries!r} is not one of {', '.join(TIMESERIES_FORMATS)}"

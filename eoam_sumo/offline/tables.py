@@ -26,6 +26,7 @@ import bisect
 import csv
 import hashlib
 import json
+import math
 import os
 from pathlib import Path
 from typing import NamedTuple, cast
@@ -36,6 +37,7 @@ from eoam_sumo.errors import InputError
 from eoam_sumo.manoeuvre.points import TrajectoryPoint
 from eoam_sumo.offline.boundaries import max_decel_no_lock_mps2
 from eoam_sumo.params import VehicleParams, describe, ego_e_class_sedan
+from eoam_sumo.textfiles import not_utf8
 
 CSV_NAME = "phase_boundaries.csv"
 NPZ_NAME = "lookup_tables.npz"
@@ -97,18 +99,24 @@ class PhaseBoundaries:
         """Read ``phase_boundaries.csv`` (``#`` lines are comments)."""
         path = Path(directory) / CSV_NAME
         try:
-            text = path.read_text()
+            text = path.read_text(encoding="utf-8")
         except OSError as exc:
             raise InputError(
                 f"{path}: cannot read the phase boundaries ({exc.strerror}); run `eoam-sumo tables`"
             ) from None
+        except UnicodeDecodeError as exc:
+            raise not_utf8(path, exc, "phase boundaries") from None
         lines = [ln for ln in text.splitlines() if ln and not ln.startswith("#")]
         table: dict[float, dict[float, tuple]] = {}
         try:
             for rec in csv.DictReader(lines):
                 mu = float(rec["mu"])
                 speed = float(rec["speed_kmh"]) / 3.6
-                table.setdefault(mu, {})[speed] = tuple(float(rec[c]) for c in BOUNDARY_COLUMNS)
+                row = tuple(float(rec[c]) for c in BOUNDARY_COLUMNS)
+                table.setdefault(mu, {})[speed] = row
+                _check_finite_row(path, rec, (mu, speed, *row))
+        except InputError:
+            raise
         except (KeyError, ValueError, TypeError) as exc:
             raise InputError(f"{path}: malformed phase boundaries ({exc})") from None
         mus = sorted(table)
@@ -200,7 +208,9 @@ class LookupTables:
         params = params or ego_e_class_sedan()
         meta_path = folder / METADATA_NAME
         try:
-            metadata = json.loads(meta_path.read_text())
+            metadata = json.loads(meta_path.read_text(encoding="utf-8"))
+        except UnicodeDecodeError as exc:
+            raise not_utf8(meta_path, exc, "tables' metadata") from None
         except OSError as exc:
             raise InputError(
                 f"{meta_path}: cannot read the tables' metadata ({exc.strerror}); "
@@ -235,6 +245,11 @@ class LookupTables:
             raise InputError(
                 f"{npz_path}: missing arrays {', '.join(missing)}; run `eoam-sumo tables`"
             )
+        for name, array in arrays.items():
+            if array.dtype.kind == "f" and not np.isfinite(array).all():
+                raise InputError(
+                    f"{npz_path}: array {name} holds a NaN or an infinity; run `eoam-sumo tables`"
+                )
         boundaries = PhaseBoundaries.load(folder)
         _check_same_grids(folder, metadata, arrays, boundaries)
         return cls(arrays, boundaries, metadata, params)
@@ -306,6 +321,19 @@ class LookupTables:
         length = sum(c * lengths[m, v] for m, v, c in corners)
         final = TrajectoryPoint(self.lane_change_m, 0.0, 0.0, 0.0, 0.0, 0.0)
         return Trajectory(length, self.dx_step_m, cols, final)
+
+
+def _check_finite_row(path: Path, rec: dict, values: tuple) -> None:
+    """InputError naming the friction, speed and column of a non-finite phase boundary."""
+    if all(math.isfinite(v) for v in values):
+        return
+    column = next(
+        c for c in ("mu", "speed_kmh", *BOUNDARY_COLUMNS) if not math.isfinite(float(rec[c]))
+    )
+    raise InputError(
+        f"{path}: malformed phase boundaries (column {column} is {rec[column]} at mu "
+        f"{rec['mu']}, speed {rec['speed_kmh']} km/h)"
+    )
 
 
 def _check_same_grids(folder: Path, metadata: dict, arrays: dict, boundaries) -> None:

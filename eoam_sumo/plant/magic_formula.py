@@ -18,6 +18,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
+from eoam_sumo.params import PLANT_TYRE_FNOMIN_N
 from eoam_sumo.plant.ops import FLOAT_OPS
 
 FZ_MIN_N = 10.0
@@ -28,7 +29,7 @@ FZ_MIN_N = 10.0
 class MfCoefficients:
     """MF 5.2 coefficients used here (names as in the .tir file, lower case)."""
 
-    fz0: float = 4850.0
+    fz0: float = PLANT_TYRE_FNOMIN_N
     pcx1: float = 1.6411
     pdx1: float = 1.1739
     pdx2: float = -0.16395

@@ -80,6 +80,7 @@ def selected_points(args) -> list[TestPoint]:
     if args.jobs < 1:
         raise InputError(f"--jobs {args.jobs} must be >= 1")
     params = vehicle_params(args.vehicle, args.abs, args.esc)
+    _check_mu_in_tables(args, params)
     points = protocol_points(args.name, params.width_m, POLICIES)
     if args.points:
         try:
@@ -92,6 +93,17 @@ def selected_points(args) -> list[TestPoint]:
         if not points:
             raise InputError(f"--points {args.points!r} matches no test point of {args.name}")
     return points
+
+
+def _check_mu_in_tables(args, params: VehicleParams) -> None:
+    """InputError for a ``--mu`` below the VUT's lookup tables (every point would fail)."""
+    from eoam_sumo.sim.vehicle import vehicle_tables
+
+    tables = vehicle_tables(args.vehicle, params, cached=False)
+    try:
+        tables.check_run(args.mu, tables.speed_grid_mps[0])
+    except InputError as exc:
+        raise InputError(f"--mu {args.mu:g}: {exc}") from None
 
 
 def run(args) -> int:

@@ -240,9 +240,15 @@ def _column(rows: list, name: str, brake_gains: tuple[float, float]) -> np.ndarr
     )
 
 
+#: The columns a run writes finite in every row (the plant's state and its clock); a plot
+#: or an animation of a time series with a NaN or an infinity there is refused.
+FINITE_COLUMNS = ("time_s", "x_m", "y_m", "yaw_rad", "vx_mps", "vy_mps", "yaw_rate_radps")
+
+
 def read_timeseries(path: Path, columns: list[str] | None = None):
     """A run's timeseries.csv as a DataFrame (``columns`` only, if given): InputError naming
-    the file when it is missing, empty, cut short or not numbers where numbers belong."""
+    the file when it is missing, empty, cut short or not numbers where numbers belong, and
+    naming the column and row of a non-finite value in ``FINITE_COLUMNS``."""
     import pandas as pd
 
     try:
@@ -254,7 +260,22 @@ def read_timeseries(path: Path, columns: list[str] | None = None):
         raise InputError(
             f"{path}: cannot be read as a run's time series: no rows, or a row cut short"
         )
+    check_finite(path, frame, FINITE_COLUMNS)
     return frame
+
+
+def check_finite(path: Path, frame, columns: tuple[str, ...]) -> None:
+    """InputError naming the file, column, value and row (1 = the first after the header)
+    of the first non-finite value in ``columns`` (those of the frame's)."""
+    for column in (c for c in columns if c in frame.columns):
+        values = frame[column].to_numpy(dtype=float)
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            row = int(bad[0])
+            raise InputError(
+                f"{path}: column {column} is {values[row]} in row {row + 1} (line {row + 2}); "
+                "a run writes it finite in every row"
+            )
 
 
 def write_run(

@@ -19,6 +19,9 @@ from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
 #: A run's simulated time limit unless set [s]: every Table 2 case ends well before it (the
 #: slowest, 55 km/h on mu 0.1, settles after 29.6 s).
 DEFAULT_MAX_TIME_S = 60.0
+#: The longest simulated time limit accepted [s]: a day of traffic (a larger one only
+#: overflows the step count; 1e308 did).
+MAX_TIME_LIMIT_S = 86400.0
 
 
 @mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
@@ -57,8 +60,8 @@ class RunSettings:
         n = self.step_s / self.plant_dt_s
         if self.plant_dt_s <= 0 or abs(n - round(n)) > 1e-9:
             raise ValueError(f"plant_dt_s={self.plant_dt_s} must divide step_s={self.step_s}")
-        if self.max_time_s <= 0:
-            raise ValueError(f"max_time_s={self.max_time_s} must be > 0")
+        if not 0 < self.max_time_s <= MAX_TIME_LIMIT_S:
+            raise ValueError(f"max_time_s={self.max_time_s} must be in (0, {MAX_TIME_LIMIT_S:g}]")
         if self.after_stop_s is not None and not self.after_stop_s >= 0.0:
             raise ValueError(f"after_stop_s={self.after_stop_s} must be >= 0")
         if self.v2x.enabled and self.eoam.policy.name != "safe":

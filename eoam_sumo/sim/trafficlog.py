@@ -296,6 +296,7 @@ def read_traffic(path: Path):
     import pandas as pd
 
     from eoam_sumo.errors import InputError
+    from eoam_sumo.sim.runlog import check_finite
 
     try:
         frame = pd.read_csv(
@@ -309,4 +310,5 @@ def read_traffic(path: Path):
     missing = [c for c in TRAFFIC_COLUMNS if c not in frame.columns]
     if missing:
         raise InputError(f"{path}: cannot be read as a run's traffic log: no column {missing[0]}")
+    check_finite(path, frame, ("time_s", "x_m", "y_m"))
     return frame

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from eoam_sumo.errors import InputError
+from eoam_sumo.seeds import sumo_seed
 from eoam_sumo.traffic_levels import hcm
 from eoam_sumo.traffic_levels.network import BACKWARD, FORWARD, ROAD_M, write_network
 from eoam_sumo.traffic_levels.spec import TrafficSpec
@@ -166,7 +167,11 @@ def warm_up(spec: TrafficSpec, net: Path, scale: float, attempt: int) -> list[Ve
         cfg = work / "warmup.sumocfg"
         cfg.write_text(
             _sumocfg(
-                str(net.resolve()), "warmup.rou.xml", spec.seed + attempt, WARMUP_STEP_S, WARMUP_S
+                str(net.resolve()),
+                "warmup.rou.xml",
+                sumo_seed(spec.seed, attempt),
+                WARMUP_STEP_S,
+                WARMUP_S,
             ),
             encoding="utf-8",
         )

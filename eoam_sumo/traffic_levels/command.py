@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 from eoam_sumo.outputs.staging import OutputKind, output_folder
+from eoam_sumo.seeds import seed_argument
 from eoam_sumo.traffic_levels.hcm import LEVELS
 from eoam_sumo.traffic_levels.network import NAME
 from eoam_sumo.traffic_levels.spec import ROADS, TrafficSpec
@@ -41,7 +42,7 @@ def add_scenario_arguments(sub) -> None:
     p.add_argument("--lanes", type=int, help="motorway: lanes of the carriageway (3)")
     p.add_argument("--speed-limit-kmh", type=float, help="speed limit (rural 100, motorway 120)")
     p.add_argument("--curve-radius-m", type=float, help="rural: a left-hand curve of this radius")
-    p.add_argument("--seed", type=int, default=0, help="seed of the traffic (0)")
+    p.add_argument("--seed", type=seed_argument, default=0, help="seed of the traffic (0)")
     p.add_argument("--out", type=Path, default=Path("out/scenario"), help="output folder")
 
 

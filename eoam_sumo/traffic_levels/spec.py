@@ -7,6 +7,7 @@ import math
 from dataclasses import dataclass
 
 from eoam_sumo.errors import InputError
+from eoam_sumo.seeds import check_seed
 from eoam_sumo.traffic_levels.hcm import LEVELS
 
 ROADS = ("rural", "motorway")
@@ -54,6 +55,5 @@ class TrafficSpec:
             if not (math.isfinite(radius) and radius >= MIN_CURVE_RADIUS_M):
                 raise InputError(f"curve radius {radius:g} m must be >= {MIN_CURVE_RADIUS_M:g}")
             radius = float(radius)
-        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
-            raise InputError(f"seed {self.seed!r} must be an integer >= 0")
+        check_seed(self.seed, "seed")
         return TrafficSpec(self.road, self.los, lanes, limit, radius, self.seed)

@@ -60,6 +60,14 @@ STEP_SPEED_KMH = 80.0  # ISO 7401 sec. 10 (standard test speed)
 STEP_AY_MPS2 = 4.0  # ISO 7401 sec. 10 (steady-state lateral acceleration)
 RAMP_SPEED_KMH = 80.0  # ISO 4138 constant speed method (one of the speeds it allows)
 
+#: Ours: test speeds accepted [km/h], walking pace to 300 km/h, where the tyres' shortest
+#: admitted relaxation length (0.05 m, ``params.VEHICLE_RANGES``) still spans 0.6 ms, above
+#: the 0.5 ms the plant's 1 ms step integrates stably.
+TEST_SPEED_RANGE_KMH = (1.0, 300.0)
+#: Ours: the lowest road friction accepted, wet glare ice; below it a stop from speed lasts
+#: minutes of simulated time and is no road test.
+TEST_MU_MIN = 0.05
+
 CITE = {
     "sis": "FMVSS 126 S7.6 (slowly increasing steer)",
     "swd": "FMVSS 126 S7.9 / UN R140 Annex 3 (sine with dwell)",

@@ -7,14 +7,34 @@ that fails its standard is a result, not an error: the status is 0 and the summa
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
-from eoam_sumo.arguments import mu, speed_kmh
+from eoam_sumo.arguments import finite
 from eoam_sumo.fileio import writable_dir
+from eoam_sumo.params import MU_MAX
 from eoam_sumo.vehicle_files import load_vehicle
+from eoam_sumo.vehicle_tests.clauses import TEST_MU_MIN, TEST_SPEED_RANGE_KMH
 
 TEST_NAMES = ("brake", "brake-ramp", "ramp-steer", "sine-with-dwell", "step-steer")
 """The tests (``procedures.TESTS``; named here so the command line starts without the plant)."""
+
+
+def vehicle_test_mu(text: str) -> float:
+    """A road friction in [``TEST_MU_MIN``, ``MU_MAX``]."""
+    value = finite(text)
+    if not TEST_MU_MIN <= value <= MU_MAX:
+        raise argparse.ArgumentTypeError(f"mu {text} is outside [{TEST_MU_MIN:g}, {MU_MAX:g}]")
+    return value
+
+
+def vehicle_test_speed_kmh(text: str) -> float:
+    """A test speed [km/h] within ``TEST_SPEED_RANGE_KMH``."""
+    value = finite(text)
+    low, high = TEST_SPEED_RANGE_KMH
+    if not low <= value <= high:
+        raise argparse.ArgumentTypeError(f"speed {text} km/h is outside [{low:g}, {high:g}]")
+    return value
 
 
 def add_arguments(subparsers) -> None:
@@ -26,8 +46,14 @@ def add_arguments(subparsers) -> None:
     )
     p.add_argument("--abs", choices=("on", "off"), default="off", help="ABS (default off)")
     p.add_argument("--esc", choices=("on", "off"), default="off", help="ESC (default off)")
-    p.add_argument("--speed-kmh", type=speed_kmh, help="test speed (default: the standard's)")
-    p.add_argument("--mu", type=mu, default=1.0, help="road friction (default 1.0)")
+    p.add_argument(
+        "--speed-kmh",
+        type=vehicle_test_speed_kmh,
+        help="test speed, 1-300 km/h (default: the standard's)",
+    )
+    p.add_argument(
+        "--mu", type=vehicle_test_mu, default=1.0, help="road friction, 0.05-1.2 (default 1.0)"
+    )
     p.add_argument("--out", type=Path, required=True, help="output folder")
 
 

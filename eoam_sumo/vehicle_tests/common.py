@@ -9,8 +9,9 @@ from typing import Any
 
 import numpy as np
 
-from eoam_sumo.params import VehicleParams
+from eoam_sumo.params import MU_MAX, VehicleParams
 from eoam_sumo.plant import cruise_drive_force_n
+from eoam_sumo.vehicle_tests.clauses import TEST_MU_MIN, TEST_SPEED_RANGE_KMH
 from eoam_sumo.vehicle_tests.harness import PlantVehicle, Run, Sample, Vehicle
 
 SPEED_GAIN_PER_S = 1.0
@@ -26,6 +27,13 @@ class VehicleTestOptions:
 
     speed_kmh: float | None = None
     mu: float = 1.0
+
+    def __post_init__(self) -> None:
+        low, high = TEST_SPEED_RANGE_KMH
+        if self.speed_kmh is not None and not low <= self.speed_kmh <= high:
+            raise ValueError(f"speed_kmh={self.speed_kmh!r} must be in [{low:g}, {high:g}] km/h")
+        if not TEST_MU_MIN <= self.mu <= MU_MAX:
+            raise ValueError(f"mu={self.mu!r} must be in [{TEST_MU_MIN:g}, {MU_MAX:g}]")
 
     def speed_mps(self, standard_kmh: float) -> float:
         return (standard_kmh if self.speed_kmh is None else self.speed_kmh) / 3.6

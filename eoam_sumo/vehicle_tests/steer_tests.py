@@ -65,17 +65,10 @@ def ramp_steer(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehi
     run = slowly_increasing_steer(
         params, speed_mps, options.mu, vehicle, rate_degps=RAMP_STEER_RATE_DEGPS
     )
-    road_rad = np.radians(run["steer_wheel_deg"]) / params.steering_ratio
-    steer_gradient = steer_angle_gradient_deg_per_g(run["ay_mps2"], road_rad)
-    gradient = understeer_gradient_deg_per_g(
-        run["ay_mps2"], road_rad, run["yaw_rate_radps"], run["vx_mps"], params.wheelbase_m
-    )
     peak_mps2 = float(np.max(np.abs(run["ay_mps2"])))
     summary = header("ramp-steer", params, options, speed_mps)
     summary["figures"] = {
-        "understeer_gradient_deg_per_g": round(gradient, 4),
-        "steer_angle_gradient_deg_per_g": round(steer_gradient, 4),
-        "steering_wheel_angle_gradient_deg_per_g": round(steer_gradient * params.steering_ratio, 3),
+        **_gradients(run, params),
         "steer_rate_degps": RAMP_STEER_RATE_DEGPS,
         "fit_range_g": list(LINEAR_AY_RANGE_G),
         "peak_lateral_acceleration_mps2": round(peak_mps2, 4),
@@ -85,6 +78,32 @@ def ramp_steer(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehi
     summary["criteria"] = []
     summary["passed"] = None
     return VehicleTestResult("ramp-steer", (run,), summary)
+
+
+def _gradients(run: Run, params: VehicleParams) -> dict:
+    """The ramp steer's gradients over ``LINEAR_AY_RANGE_G``; ``None`` with the reason under
+    ``not_measured`` when the run never reaches that range (a low mu or speed: the road or the
+    turn cannot give 0.1 g), as ISO 4138's figures are defined there only."""
+    road_rad = np.radians(run["steer_wheel_deg"]) / params.steering_ratio
+    try:
+        steer_gradient = steer_angle_gradient_deg_per_g(run["ay_mps2"], road_rad)
+        gradient = understeer_gradient_deg_per_g(
+            run["ay_mps2"], road_rad, run["yaw_rate_radps"], run["vx_mps"], params.wheelbase_m
+        )
+    except ValueError:
+        peak_g = float(np.max(np.abs(run["ay_mps2"]))) / G_MPS2
+        return {
+            "understeer_gradient_deg_per_g": None,
+            "steer_angle_gradient_deg_per_g": None,
+            "steering_wheel_angle_gradient_deg_per_g": None,
+            "not_measured": f"the lateral acceleration (peak {peak_g:.3f} g) never spans the "
+            f"fit range {LINEAR_AY_RANGE_G[0]:g}-{LINEAR_AY_RANGE_G[1]:g} g",
+        }
+    return {
+        "understeer_gradient_deg_per_g": round(gradient, 4),
+        "steer_angle_gradient_deg_per_g": round(steer_gradient, 4),
+        "steering_wheel_angle_gradient_deg_per_g": round(steer_gradient * params.steering_ratio, 3),
+    }
 
 
 def slowly_increasing_steer(
