@@ -41,13 +41,16 @@ def _cell_text(r) -> str:
     shown = "0" if pd.isna(value) else f"{value:.0f}"
     if r.test == "CCFhos" and pd.isna(value):
         shown = "no hit"
-    return f"{shown}{' ' + r.manoeuvre if isinstance(r.manoeuvre, str) else ''}"
+    mark = f" {r.manoeuvre}" if isinstance(r.manoeuvre, str) else ""
+    warning = {"pass": " W", "fail": " w!"}.get(r.warning, "") if isinstance(r.warning, str) else ""
+    return f"{shown}{mark}{warning}"
 
 
 def _panel_title(test: str, own: pd.DataFrame, totals: dict) -> str:
     t = next((x for x in totals.get("tests", []) if x["test"] == test), None)
     if t is not None:
-        return f"{test}: {t['points']:.2f} of {t['max_points']:.2f}"
+        gated = "" if totals.get("gate_passed", True) else " before the gate"
+        return f"{test}: {t['points']:.2f} of {t['max_points']:.2f}{gated}"
     if test.startswith("R152"):
         passed = int((own["verdict"] == "pass").sum())
         return f"{test}: {passed} of {len(own)} pass"
@@ -87,10 +90,10 @@ def _row_label(row: tuple) -> str:
 def _legend(fig: Figure, kind: str) -> None:
     handles: list = [Patch(facecolor=FILL[k], edgecolor="black", label=k) for k in LEGEND[kind]]
     handles.append(Line2D([], [], color="black", ls="--", lw=1.4, label="extended range"))
-    value = "impact km/h (CCFhos: speed reduction km/h)"
-    handles.append(
-        Patch(facecolor="white", edgecolor="none", label=f"cell: {value}; B braked, S steered")
-    )
+    value = "impact km/h (CCFhos: speed reduction km/h); B braked, S steered"
+    if kind == "verdicts":
+        value += "; W warning in time, w! late or none"
+    handles.append(Patch(facecolor="white", edgecolor="none", label=f"cell: {value}"))
     fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 5), fontsize=7)
 
 
