@@ -98,11 +98,17 @@ def _legend(fig: Figure, kind: str) -> None:
 
 
 def plot_scorecard(
-    frame: pd.DataFrame, path: Path, headline: str, kind: str, totals: dict | None = None
+    frame: pd.DataFrame,
+    path: Path,
+    headline: str,
+    kind: str,
+    totals: dict | None = None,
+    footnote: str = "",
 ) -> Path:
     """Draw the scorecard grid of a protocol's results into ``path`` (PNG): ``headline`` its
     title, ``kind`` a ``LEGEND`` key, ``totals`` (scored protocols) with a ``tests`` list of
-    per-test points and maxima for the panel titles."""
+    per-test points and maxima for the panel titles, ``footnote`` (the tests not built) in a
+    spare panel or under the grids."""
     totals = totals or {}
     panels = list(frame.groupby("test", sort=False))
     ncols = min(3, len(panels))
@@ -113,10 +119,14 @@ def plot_scorecard(
     axes = fig.subplots(nrows, ncols, squeeze=False)
     for ax, (test, own) in zip(axes.flat, panels):
         _draw_panel(ax, str(test), own, totals)
-    for ax in list(axes.flat)[len(panels) :]:
+    spare = list(axes.flat)[len(panels) :]
+    for ax in spare:
         ax.axis("off")
     fig.suptitle(headline, fontsize=9)
     _legend(fig, kind)
-    fig.tight_layout(rect=(0, 0.08, 1, 0.95))
+    fig.tight_layout(rect=(0, 0.08 if spare or not footnote else 0.14, 1, 0.95))
+    if footnote:  # placed after the layout, which it must not squeeze
+        x, y = (spare[0].get_position().x0, spare[0].get_position().y1) if spare else (0.01, 0.13)
+        fig.text(x, y, footnote, va="top", ha="left", fontsize=7)
     fig.savefig(path, dpi=130)
     return Path(path)
