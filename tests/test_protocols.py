@@ -444,3 +444,20 @@ def test_aeb_brakes_in_lane_where_the_eoam_changes_lanes(tmp_path):
     assert aeb["manoeuvre"] == "B" and aeb["time_in_next_lane_s"] == 0.0
     assert not {"2", "4"} & set(str(aeb["modes_visited"]).split("-"))
     assert eoam["manoeuvre"] == "S"
+
+
+def test_run_facts_read_the_batch_text_columns():
+    """The batch's results hold booleans as text: "False" is no departure, no warning."""
+    from eoam_sumo.protocols.runner import _facts
+
+    run = {
+        "modes_visited": "0-1",
+        "time_in_next_lane_s": 0.0,
+        "left_road": "False",
+        "max_lateral_offset_m": 0.0,
+        "lane_width_m": 3.5,
+        "fcw_raised": "False",
+    }
+    assert _facts(run, SEDAN_WIDTH_M) == scoring.RunFacts(False, False, False)
+    run |= {"left_road": "True", "fcw_raised": "True", "modes_visited": "0-2"}
+    assert _facts(run, SEDAN_WIDTH_M) == scoring.RunFacts(True, True, True)

@@ -87,14 +87,28 @@ def _row_label(row: tuple) -> str:
     return text + (f", {gap:.0f} m, {decel:g} m/s2" if decel else "")
 
 
+#: what a cell's text says, by the kind of protocol
+CELL_TEXT = {
+    "bands": "cell: impact km/h (CCFhos: speed reduction km/h); B braked in lane, S steered",
+    "verdicts": "cell: impact km/h; B braked in lane, S steered; W warning in time, w! late "
+    "or none",
+    "unscored": "cell: impact km/h; B braked in lane, S steered",
+}
+
+
 def _legend(fig: Figure, kind: str) -> None:
+    """The colours (and the extended range's border) in one row, what a cell says under it."""
     handles: list = [Patch(facecolor=FILL[k], edgecolor="black", label=k) for k in LEGEND[kind]]
-    handles.append(Line2D([], [], color="black", ls="--", lw=1.4, label="extended range"))
-    value = "impact km/h (CCFhos: speed reduction km/h); B braked, S steered"
-    if kind == "verdicts":
-        value += "; W warning in time, w! late or none"
-    handles.append(Patch(facecolor="white", edgecolor="none", label=f"cell: {value}"))
-    fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 5), fontsize=7)
+    if kind != "verdicts":
+        handles.append(Line2D([], [], color="black", ls="--", lw=1.4, label="extended range"))
+    fig.legend(
+        handles=handles,
+        loc="lower center",
+        bbox_to_anchor=(0.5, 0.03),
+        ncol=len(handles),
+        fontsize=7,
+    )
+    fig.text(0.5, 0.01, CELL_TEXT[kind], ha="center", va="bottom", fontsize=7)
 
 
 def plot_scorecard(

@@ -163,17 +163,22 @@ def results_frame(
     return pd.DataFrame(rows, columns=[*PROTOCOL_COLUMNS, *SUMMARY_COLUMNS])
 
 
+def _flag(value) -> bool:
+    """A results.csv boolean (the batch reads every non-number column as text)."""
+    return str(value).strip().lower() == "true"
+
+
 def _facts(run: dict, width_m: float) -> scoring.RunFacts:
     """What the run did beside its impact (steered, left its lane, raised the FCW)."""
     return scoring.RunFacts(
         steered=steered(run.get("modes_visited", ""), float(run["time_in_next_lane_s"])),
         left_lane=rules.left_lane(
-            bool(run["left_road"]),
+            _flag(run["left_road"]),
             float(run["max_lateral_offset_m"]),
             float(run["lane_width_m"]),
             width_m,
         ),
-        fcw_raised=bool(run["fcw_raised"]),
+        fcw_raised=_flag(run["fcw_raised"]),
     )
 
 

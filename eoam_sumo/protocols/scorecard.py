@@ -28,7 +28,8 @@ class RunLabel:
 
     @property
     def title(self) -> str:
-        return f"{self.name}, system {self.system}, policy {self.policy}"
+        ours = " (our extension, not the protocol's score)" if self.system == "eoam" else ""
+        return f"{self.name}, system {self.system}{ours}, policy {self.policy}"
 
 
 #: What the CCFhos source says and what we did (the scorecard prints it)
