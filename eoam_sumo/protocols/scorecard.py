@@ -62,7 +62,7 @@ def scorecard_markdown(frame: pd.DataFrame, run: RunLabel) -> str:
         lines += r152_lines(rows)
     else:
         lines += unscored_lines(rows)
-    lines += not_run_lines(rows, run.low_kmh) + short_lines(rows)
+    lines += not_run_lines(rows, run) + short_lines(rows)
     return "\n".join(lines) + "\n"
 
 
@@ -156,17 +156,22 @@ def unscored_lines(rows: list[dict]) -> list[str]:
     ]
 
 
-def not_run_lines(rows: list[dict], low_kmh: float) -> list[str]:
+def not_run_lines(rows: list[dict], run: RunLabel) -> list[str]:
+    """The points below the tables' speed range, and what that does to the score."""
     out = [r for r in rows if r["status"] == "not_run"]
     if not out:
         return []
+    effect = {
+        PROTOCOLS[1]: "They score 0 and count in the maximum; a standard CCRs cell at 10 km/h "
+        "not run is not green, so the FC gate fails",
+        PROTOCOLS[2]: "Their verdict is not_run (neither pass nor fail)",
+    }.get(run.name, "They are listed, unscored like the rest of the edition")
     ids = ", ".join(r["point_id"] for r in out)
     return [
         f"## Not run: below the tables' speed range ({len(out)} points)",
         "",
-        f"The lookup tables and DMM boundaries start at {low_kmh:g} km/h: a run below it is "
-        "refused. These points score 0 and count in the maximum (a CCRs cell at 10 km/h not "
-        f"run fails the FC gate): {ids}.",
+        f"The lookup tables and DMM boundaries start at {run.low_kmh:g} km/h: a run below it is "
+        f"refused. {effect}: {ids}.",
         "",
     ]
 
