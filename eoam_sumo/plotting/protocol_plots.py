@@ -99,7 +99,7 @@ CELL_TEXT = {
 def _legend(fig: Figure, kind: str) -> None:
     """The colours (and the extended range's border) in one row, what a cell says under it."""
     handles: list = [Patch(facecolor=FILL[k], edgecolor="black", label=k) for k in LEGEND[kind]]
-    if kind != "verdicts":
+    if kind == "bands":
         handles.append(Line2D([], [], color="black", ls="--", lw=1.4, label="extended range"))
     fig.legend(
         handles=handles,
