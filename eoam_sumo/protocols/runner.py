@@ -137,8 +137,8 @@ def run_protocol(
     failed = int((frame["status"] == "failed").sum())
     return ProtocolSummary(
         f"{len(frame)} points, {len(runnable)} run, {failed} failed, "
-        f"{len(points) - len(runnable)} outside the design range; {out / RESULTS_FILE}, "
-        f"{out / SCORECARD_MD}",
+        f"{len(points) - len(runnable)} not run (below the tables' speed range); "
+        f"{out / RESULTS_FILE}, {out / SCORECARD_MD}",
         failed,
     )
 

@@ -164,7 +164,7 @@ def _r152(point: TestPoint, measured: Measured, facts: RunFacts) -> dict:
     }
 
 
-#: Why a head-on point the EOAM never reacted to falls short (the run's own account follows).
+#: Why a point the EOAM never reacted to falls short (the run's own account follows).
 NO_TRIGGER = "the EOAM never reacted (no mode other than 0 visited)"
 
 
