@@ -62,6 +62,8 @@ class EoamSettings:
     return_lateral_g: float = 0.3  # mode 5 after 2: return's peak lateral acceleration / (mu g)
     evasive_lateral_g: float = 0.9  # modes 3, 4 and the return after 4 (oncoming traffic): the same
     return_min_length_m: float = 10.0  # mode 5: shortest return path
+    steering_inhibited: bool = False  # braking only, an AEB (protocol --system aeb): a STEER
+    # sector brakes at the limit in lane, as with no lane to change into; the FCW is its warning
     next_lane_clear_m: float = 50.0  # a standing object in the next lane closer than the
     # in-path obstacle's range plus this (room to pass it and return) blocks the lane change
     # as oncoming traffic does (modes 3, 4); the paper checks the next lane for oncoming only

@@ -147,6 +147,9 @@ class Case:
     vehicle: str | None = None
     draw: int | None = None  # the draw's number within its group (sampled matrices)
     group_id: str | None = None  # the case id of its group of swept values (sampled)
+    # braking only (the EOAM's lane change inhibited, ``EoamSettings.steering_inhibited``):
+    # the protocol command's ``--system aeb``
+    steering_inhibited: bool = False
 
     def traffic(self) -> TrafficSpec | None:
         """The generated scenario's spec (None: the case runs its sumocfg)."""

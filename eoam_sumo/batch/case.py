@@ -8,11 +8,14 @@ from __future__ import annotations
 import tempfile
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
-from typing import get_type_hints
+from typing import TYPE_CHECKING, get_type_hints
 
 from eoam_sumo.matrix import Case, vehicle_params
 from eoam_sumo.params import VehicleParams
 from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
+
+if TYPE_CHECKING:
+    from eoam_sumo.sim.settings import RunSettings
 
 #: The files a case writes (``sim.runlog.write_run``), in the order they are written, by
 #: ``--timeseries`` format.
@@ -107,13 +110,11 @@ def case_vehicle(case: Case) -> VehicleParams:
     return vehicle_params(case.vehicle, case.abs_fitted, case.esc_fitted)
 
 
-def run_matrix_case(task: CaseTask) -> dict:
-    """Run the case; ``{"summary": dict, "files": {name: bytes} or None}``.
-
-    Old output files of the case are removed first, so a folder never mixes runs.
-    """
+def case_settings(task: CaseTask) -> RunSettings:
+    """The ``RunSettings`` of a case: its vehicle, policy, V2X link, radar range and whether
+    the EOAM may steer (``Case.steering_inhibited``)."""
     from eoam_sumo.sensing.radar import RadarSettings
-    from eoam_sumo.sim.cosim import policy_settings, run_case
+    from eoam_sumo.sim.cosim import policy_settings
     from eoam_sumo.sim.settings import RunSettings
 
     case = task.case
@@ -136,6 +137,20 @@ def run_matrix_case(task: CaseTask) -> dict:
     )
     if case.radar_range_m is not None:
         settings = replace(settings, radar=RadarSettings(range_m=case.radar_range_m))
+    if case.steering_inhibited:
+        settings = replace(settings, eoam=replace(settings.eoam, steering_inhibited=True))
+    return settings
+
+
+def run_matrix_case(task: CaseTask) -> dict:
+    """Run the case; ``{"summary": dict, "files": {name: bytes} or None}``.
+
+    Old output files of the case are removed first, so a folder never mixes runs.
+    """
+    from eoam_sumo.sim.cosim import run_case
+
+    case = task.case
+    settings = case_settings(task)
     extra = {"case": case_parameters(case)}
     if task.case_dir is not None:
         case_dir = Path(task.case_dir)

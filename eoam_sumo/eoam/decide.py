@@ -38,8 +38,8 @@ def sector_action(
 ) -> tuple[Sector | None, Action]:
     """The sector where ``parts.placement`` puts the obstacle (None: nothing in the path) and
     its action, a STEER turned into braking where a lane change is not wanted: too slow for
-    one (``min_steer_speed_mps``), braking already stopping short of the obstacle (mode 1), or
-    no lane to change into."""
+    one (``min_steer_speed_mps``), braking already stopping short of the obstacle (mode 1), no
+    lane to change into, or steering inhibited (``steering_inhibited``: an AEB)."""
     rng = situation.range_m
     if rng is None:
         return None, NONE
@@ -62,6 +62,6 @@ def sector_action(
             and stop_range > curve.at(v).stop_m
         ):
             action = BRAKE  # braking already stops short of it: no lane change
-        elif not meas.left_lane_available:
-            action = LIMIT_BRAKE  # no lane to change into: brake in lane
+        elif not meas.left_lane_available or st.steering_inhibited:
+            action = LIMIT_BRAKE  # no lane to change into, or braking only: brake in lane
     return sector, action

@@ -1,6 +1,7 @@
 """The protocol scorecard as the protocols draw their grids: one panel per test, VUT speed
-down the rows, overlap or impact location across, each cell the point's colour with its
-impact speed; extended-range cells dashed; R152 rows coloured by verdict."""
+down the rows, overlap or impact location across, each cell the point's colour (R152: its
+verdict) with the scored value and B or S (braked or steered); extended-range cells with a
+thick dashed border; a colour legend; the totals of the system and policy in the title."""
 
 from __future__ import annotations
 
@@ -8,7 +9,8 @@ from pathlib import Path
 
 import pandas as pd
 from matplotlib.figure import Figure
-from matplotlib.patches import Rectangle
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch, Rectangle
 
 FILL = {
     "green": "#2e9e44",
@@ -17,51 +19,66 @@ FILL = {
     "brown": "#8b5a2b",
     "red": "#d62728",
     "not_run": "#bbbbbb",
+    "unscored": "#9ecae1",
     "pass": "#2e9e44",
     "fail": "#d62728",
     "undetermined": "#f2d22e",
 }
+#: the legend's keys by the kind of protocol: scored bands, R152 verdicts, unscored runs
+LEGEND = {
+    "bands": ("green", "yellow", "orange", "brown", "red", "not_run"),
+    "verdicts": ("pass", "fail", "undetermined", "not_run"),
+    "unscored": ("unscored", "not_run"),
+}
+ROW_KEYS = ["ego_speed_kmh", "target_speed_kmh", "gap_m", "target_decel_mps2"]
 
 
-def _panels(frame: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
-    out = []
-    for (test, side), own in frame.groupby(["test", "policy_side"], sort=False, dropna=False):
-        label = f"{test} ({side})" if isinstance(side, str) and side else str(test)
-        out.append((label, own))
-    return out
+def _cell_text(r) -> str:
+    """The cell's value (impact or, head-on, reduction km/h) and B/S; '-' not run."""
+    if r.status != "ok":
+        return "-"
+    value = r.speed_reduction_kmh if r.test == "CCFhos" else r.impact_speed_kmh
+    shown = "0" if pd.isna(value) else f"{value:.0f}"
+    if r.test == "CCFhos" and pd.isna(value):
+        shown = "no hit"
+    mark = f" {r.manoeuvre}" if isinstance(r.manoeuvre, str) else ""
+    warning = {"pass": " W", "fail": " w!"}.get(r.warning, "") if isinstance(r.warning, str) else ""
+    return f"{shown}{mark}{warning}"
 
 
-def _draw_panel(ax, label: str, own: pd.DataFrame) -> None:
-    rows = sorted(
-        {
-            (r.ego_speed_kmh, r.target_speed_kmh, r.gap_m, r.target_decel_mps2)
-            for r in own.itertuples()
-        }
-    )
+def _panel_title(test: str, own: pd.DataFrame, totals: dict) -> str:
+    t = next((x for x in totals.get("tests", []) if x["test"] == test), None)
+    if t is not None:
+        gated = "" if totals.get("gate_passed", True) else " before the gate"
+        return f"{test}: {t['points']:.2f} of {t['max_points']:.2f}{gated}"
+    if test.startswith("R152"):
+        passed = int((own["verdict"] == "pass").sum())
+        return f"{test}: {passed} of {len(own)} pass"
+    return test
+
+
+def _draw_panel(ax, test: str, own: pd.DataFrame, totals: dict) -> None:
+    rows = sorted({tuple(getattr(r, k) for k in ROW_KEYS) for r in own.itertuples()})
     cols = sorted(set(own["overlap"]))
     for r in own.itertuples():
-        i = rows.index((r.ego_speed_kmh, r.target_speed_kmh, r.gap_m, r.target_decel_mps2))
-        j = cols.index(r.overlap)
+        i, j = rows.index(tuple(getattr(r, k) for k in ROW_KEYS)), cols.index(r.overlap)
         key = r.verdict if isinstance(r.verdict, str) and r.verdict else r.colour
         ax.add_patch(
-            Rectangle(
-                (j, i),
-                1,
-                1,
-                facecolor=FILL.get(key, "white"),
-                edgecolor="black",
-                linewidth=0.5,
-                linestyle="--" if r.range == "extended" else "-",
-            )
+            Rectangle((j, i), 1, 1, facecolor=FILL.get(key, "white"), edgecolor="black", lw=0.4)
         )
-        text = "-" if pd.isna(r.impact_speed_kmh) else f"{r.impact_speed_kmh:.0f}"
-        ax.text(j + 0.5, i + 0.5, text, ha="center", va="center", fontsize=6)
+        if r.range == "extended":
+            ax.add_patch(Rectangle((j + 0.06, i + 0.08), 0.88, 0.84, fill=False, lw=1.4, ls="--"))
+        ax.text(j + 0.5, i + 0.5, _cell_text(r), ha="center", va="center", fontsize=5.5)
     ax.set_xlim(0, len(cols))
     ax.set_ylim(len(rows), 0)
-    ax.set_xticks([j + 0.5 for j in range(len(cols))], [f"{c:g}" for c in cols], fontsize=6)
+    r152 = test.startswith("R152")
+    xlabels = ["centred"] if r152 else [f"{c:g}" for c in cols]
+    ax.set_xticks([j + 0.5 for j in range(len(cols))], xlabels, fontsize=6)
     ax.set_yticks([i + 0.5 for i in range(len(rows))], [_row_label(r) for r in rows], fontsize=6)
-    ax.set_xlabel("overlap / impact location [%]", fontsize=7)
-    ax.set_title(label, fontsize=8)
+    xlabel = "target" if r152 else "overlap / impact location [%]"
+    ax.set_xlabel(xlabel, fontsize=7)
+    ax.set_ylabel("VUT / target km/h", fontsize=7)
+    ax.set_title(_panel_title(test, own, totals), fontsize=8)
 
 
 def _row_label(row: tuple) -> str:
@@ -70,28 +87,60 @@ def _row_label(row: tuple) -> str:
     return text + (f", {gap:.0f} m, {decel:g} m/s2" if decel else "")
 
 
-def plot_scorecard(frame: pd.DataFrame, path: Path, title: str = "") -> Path:
-    """Draw the scorecard grid of a protocol's results into ``path`` (PNG)."""
-    panels = _panels(frame)
+#: what a cell's text says, by the kind of protocol
+CELL_TEXT = {
+    "bands": "cell: impact km/h (CCFhos: speed reduction km/h); B braked in lane, S steered",
+    "verdicts": "cell: impact km/h; B braked in lane, S steered; W warning in time, w! late "
+    "or none",
+    "unscored": "cell: impact km/h; B braked in lane, S steered",
+}
+
+
+def _legend(fig: Figure, kind: str) -> None:
+    """The colours (and the extended range's border) in one row, what a cell says under it."""
+    handles: list = [Patch(facecolor=FILL[k], edgecolor="black", label=k) for k in LEGEND[kind]]
+    if kind == "bands":
+        handles.append(Line2D([], [], color="black", ls="--", lw=1.4, label="extended range"))
+    fig.legend(
+        handles=handles,
+        loc="lower center",
+        bbox_to_anchor=(0.5, 0.03),
+        ncol=len(handles),
+        fontsize=7,
+    )
+    fig.text(0.5, 0.01, CELL_TEXT[kind], ha="center", va="bottom", fontsize=7)
+
+
+def plot_scorecard(
+    frame: pd.DataFrame,
+    path: Path,
+    headline: str,
+    kind: str,
+    totals: dict | None = None,
+    footnote: str = "",
+) -> Path:
+    """Draw the scorecard grid of a protocol's results into ``path`` (PNG): ``headline`` its
+    title, ``kind`` a ``LEGEND`` key, ``totals`` (scored protocols) with a ``tests`` list of
+    per-test points and maxima for the panel titles, ``footnote`` (the tests not built) in a
+    spare panel or under the grids."""
+    totals = totals or {}
+    panels = list(frame.groupby("test", sort=False))
     ncols = min(3, len(panels))
     nrows = -(-len(panels) // ncols)
-    heights = [
-        max(
-            len(own.groupby(["ego_speed_kmh", "target_speed_kmh", "gap_m", "target_decel_mps2"]))
-            for _, own in panels
-        )
-        * 0.28
-        + 1.2
-    ]
-    fig = Figure(figsize=(4.2 * ncols, heights[0] * nrows))
+    most_rows = max(len(own.groupby(ROW_KEYS)) for _, own in panels)
+    width = max(4.4 * ncols, 8.0)
+    fig = Figure(figsize=(width, (most_rows * 0.3 + 1.3) * nrows + 1.6))
     axes = fig.subplots(nrows, ncols, squeeze=False)
-    for ax, (label, own) in zip(axes.flat, panels):
-        _draw_panel(ax, label, own)
-    for ax in list(axes.flat)[len(panels) :]:
+    for ax, (test, own) in zip(axes.flat, panels):
+        _draw_panel(ax, str(test), own, totals)
+    spare = list(axes.flat)[len(panels) :]
+    for ax in spare:
         ax.axis("off")
-    fig.suptitle(
-        title + "  (cell: impact speed km/h; rows VUT/target km/h; dashed: extended)", fontsize=9
-    )
-    fig.tight_layout()
+    fig.suptitle(headline, fontsize=9)
+    _legend(fig, kind)
+    fig.tight_layout(rect=(0, 0.08 if spare or not footnote else 0.14, 1, 0.95))
+    if footnote:  # placed after the layout, which it must not squeeze
+        x, y = (spare[0].get_position().x0, spare[0].get_position().y1) if spare else (0.01, 0.13)
+        fig.text(x, y, footnote, va="top", ha="left", fontsize=7)
     fig.savefig(path, dpi=130)
     return Path(path)

@@ -17,6 +17,8 @@ from eoam_sumo.protocols.points import PROTOCOLS, TestPoint, protocol_points
 #: (CCRm 30 km/h behind 20 km/h, 41.7 m at 2.8 m/s) meets the target after 15 s.
 MAX_TIME_S = 40.0
 POLICIES = ("paper", "safe")
+#: --system: aeb (the EOAM braking only, what the protocol scores) or eoam (with its lane change)
+SYSTEMS = ("aeb", "eoam")
 
 
 #: What shows a folder holds a protocol's output (``protocols.runner``'s files and folders).
@@ -66,6 +68,13 @@ def add_arguments(subparsers) -> None:
         "--vehicle", default="sedan", help="the VUT: a catalogue name or a vehicle file (sedan)"
     )
     p.add_argument("--policy", choices=POLICIES, default="paper", help="decision policy")
+    p.add_argument(
+        "--system",
+        choices=SYSTEMS,
+        default="aeb",
+        help="aeb: the EOAM with its lane change inhibited, what the protocol scores (default); "
+        "eoam: with its lane change (our extension, reported beside aeb)",
+    )
     p.add_argument("--abs", choices=ON_OFF, help="ABS fitted or not (default: the vehicle's)")
     p.add_argument("--esc", choices=ON_OFF, help="ESC fitted or not (default: the vehicle's)")
     p.add_argument("--mu", type=float, default=1.0, help="friction of every lane (1.0)")
@@ -74,14 +83,14 @@ def add_arguments(subparsers) -> None:
 
 
 def selected_points(args) -> list[TestPoint]:
-    """The protocol's points (head-on ones under both policies), filtered by ``--points``."""
+    """The protocol's points, filtered by ``--points``."""
     if not 0.0 < args.mu <= MU_MAX:
         raise InputError(f"--mu {args.mu:g} is outside (0, {MU_MAX:g}]")
     if args.jobs < 1:
         raise InputError(f"--jobs {args.jobs} must be >= 1")
     params = vehicle_params(args.vehicle, args.abs, args.esc)
     _check_mu_in_tables(args, params)
-    points = protocol_points(args.name, params.width_m, POLICIES)
+    points = protocol_points(args.name, params.width_m)
     if args.points:
         try:
             pattern = re.compile(args.points)
@@ -121,6 +130,7 @@ def run(args) -> int:
             jobs=args.jobs,
             scheduler=args.scheduler,
             policy=args.policy,
+            system=args.system,
             mu=args.mu,
             vehicle=vehicle_label(args),
             vehicle_id=args.vehicle,

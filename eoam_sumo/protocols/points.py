@@ -19,7 +19,8 @@ github.com/vectorgrp/OSC-NCAP-scenarios (MPL-2.0), commit ee7aa11 (``VECTOR``):
   ``EXTENDED_RANGE_CELLS``: first and last column, CCRb rows from 90 km/h, CCFhos 100 % and
   rows from 90 km/h.
 - The initial gap of a CCR test: ``Ego_initTimeHeadway`` 5 s times the VUT speed (VECTOR
-  ``CCRs.xosc``); a head-on test: 5 s times the closing speed (our choice, same margin).
+  ``CCRs.xosc``); a head-on test: ``startupTime`` 8 s times the closing speed (VECTOR
+  ``CA-FC_2026/CCFhos.xosc`` ``_Target_initDist``).
 - UN R152 rows: the relative speeds of the M1 table of para. 5.2.1.4 (10-60 km/h, ``R152``
   in rules.py) against a stationary target, and those a target at 20 km/h allows within the
   subject speed range of para. 5.2.1.3 (10-40 km/h, subject 30-60 km/h); target centred.
@@ -38,6 +39,8 @@ VECTOR = "vectorgrp/OSC-NCAP-scenarios@ee7aa11"
 GVT_LENGTH_M = 4.023
 GVT_WIDTH_M = 1.712
 INIT_HEADWAY_S = 5.0
+#: CCFhos: the target starts this long of closing apart (VECTOR ``startupTime``) [s]
+HEAD_ON_STARTUP_S = 8.0
 BRAKING_DELAY_S = 3.0
 #: hold time of a target that keeps its speed to the end of the run [s]
 FOREVER_S = 1.0e6
@@ -60,7 +63,6 @@ class TestPoint:
     offset_m: float  # target centre left (+) of the ego lane centre
     extended: bool = False
     head_on: bool = False
-    policy: str = ""  # set only where the protocol runs both policies side by side
 
     @property
     def point_id(self) -> str:
@@ -73,8 +75,6 @@ class TestPoint:
         ]
         if self.target_decel_mps2:
             parts.append(f"d{self.target_decel_mps2:g}")
-        if self.policy:
-            parts.append(self.policy)
         return "_".join(parts).replace("-", "m").replace(".", "p")
 
 
@@ -135,9 +135,8 @@ CCRM_2026: tuple[tuple[int, int], ...] = (
 CCFHOS_2026 = ((30, 50), (40, 50), (50, 50), (60, 70), (70, 70), (80, 70), (90, 90), (100, 100))
 
 
-def points_2026(width: float, policies: tuple[str, ...]) -> list[TestPoint]:
-    """Crash Avoidance FC 2026: CCRs, CCRm, CCRb standard and extended grids, CCFhos (once per
-    policy in ``policies``)."""
+def points_2026(width: float) -> list[TestPoint]:
+    """Crash Avoidance FC 2026: CCRs, CCRm, CCRb and CCFhos, standard and extended grids."""
     p = PROTOCOLS[1]
 
     def edge(il: float) -> bool:
@@ -167,33 +166,28 @@ def points_2026(width: float, policies: tuple[str, ...]) -> list[TestPoint]:
         for v in range(30, 140, 10)
         for il in IL_2026
     ]
-    return out + head_on_2026(width, policies)
+    return out + head_on_2026(width)
 
 
-def head_on_2026(width: float, policies: tuple[str, ...]) -> list[TestPoint]:
+def head_on_2026(width: float) -> list[TestPoint]:
     """CCFhos: the target drives towards the VUT in its lane (impact locations 25-100 %)."""
-    out = []
-    for policy in policies:
-        for v, t in CCFHOS_2026:
-            for il in (100, 75, 50, 25):
-                gap = INIT_HEADWAY_S * (v + t) / 3.6
-                out.append(
-                    TestPoint(
-                        PROTOCOLS[1],
-                        "CCFhos",
-                        float(v),
-                        float(t),
-                        float(il),
-                        round(gap, 3),
-                        0.0,
-                        FOREVER_S,
-                        round(offset_2026_m(il, width), 4),
-                        extended=il == 100 or v >= 90,
-                        head_on=True,
-                        policy=policy,
-                    )
-                )
-    return out
+    return [
+        TestPoint(
+            PROTOCOLS[1],
+            "CCFhos",
+            float(v),
+            float(t),
+            float(il),
+            round(HEAD_ON_STARTUP_S * (v + t) / 3.6, 3),
+            0.0,
+            FOREVER_S,
+            round(offset_2026_m(il, width), 4),
+            extended=il == 100 or v >= 90,
+            head_on=True,
+        )
+        for v, t in CCFHOS_2026
+        for il in (100, 75, 50, 25)
+    ]
 
 
 def points_r152() -> list[TestPoint]:
@@ -206,12 +200,12 @@ def points_r152() -> list[TestPoint]:
     return out
 
 
-def protocol_points(name: str, vut_width_m: float, policies: tuple[str, ...]) -> list[TestPoint]:
+def protocol_points(name: str, vut_width_m: float) -> list[TestPoint]:
     """Every test point of a protocol, in grid order; ValueError for an unknown name."""
     if name == PROTOCOLS[0]:
         return points_2023(vut_width_m)
     if name == PROTOCOLS[1]:
-        return points_2026(vut_width_m, policies)
+        return points_2026(vut_width_m)
     if name == PROTOCOLS[2]:
         return points_r152()
     raise ValueError(f"unknown protocol {name!r}; one of {', '.join(PROTOCOLS)}")

@@ -3,7 +3,6 @@ scorecard (markdown and PNG)."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -11,12 +10,15 @@ import pandas as pd
 
 from eoam_sumo.batch.results import SUMMARY_COLUMNS
 from eoam_sumo.batch.runner import run_cases
+from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.matrix import Case
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
-from eoam_sumo.protocols import scoring
+from eoam_sumo.protocols import rules, scoring
+from eoam_sumo.protocols.impact import measure, steered
 from eoam_sumo.protocols.points import TestPoint
 from eoam_sumo.protocols.scenario import write_scenarios
+from eoam_sumo.protocols.scorecard import RunLabel, plot, scorecard_markdown
 from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
 
 RESULTS_FILE = "results.csv"
@@ -27,6 +29,8 @@ BATCH_DIR = "batch"
 PROTOCOL_COLUMNS = (
     "point_id",
     "protocol",
+    "system",
+    "policy",
     "test",
     "ego_speed_kmh",
     "target_speed_kmh",
@@ -35,13 +39,15 @@ PROTOCOL_COLUMNS = (
     "target_decel_mps2",
     "target_offset_m",
     "range",
-    "policy",
-    "policy_side",
     "impact_speed_kmh",
+    "speed_reduction_kmh",
+    "manoeuvre",
     "colour",
     "points",
     "max_points",
     "verdict",
+    "warning",
+    "warning_lead_s",
     "note",
     "status",
     "error",
@@ -62,7 +68,8 @@ class ProtocolSummary:
         """The summary line, naming the files in the output folder ``out``."""
         return (
             f"{self.points} points, {self.run} run, {self.failed} failed, {self.outside} "
-            f"outside the design range; {out / RESULTS_FILE}, {out / SCORECARD_MD}"
+            f"not run (below the tables' speed range); {out / RESULTS_FILE}, "
+            f"{out / SCORECARD_MD}"
         )
 
 
@@ -82,7 +89,9 @@ def _case(
     max_time_s: float,
     vehicle_id: str,
     params: VehicleParams,
+    system: str = "aeb",
 ) -> Case:
+    """The point's case; ``system`` aeb inhibits the EOAM's lane change."""
     return Case(
         point.point_id,
         cfg,
@@ -92,10 +101,11 @@ def _case(
         None,
         None,
         max_time_s,
-        policy=point.policy or policy,
+        policy=policy,
         abs_fitted=params.abs_fitted,
         esc_fitted=params.esc_fitted,
         vehicle=None if vehicle_id == DEFAULT_VEHICLE else vehicle_id,
+        steering_inhibited=system == "aeb",
     )
 
 
@@ -107,6 +117,7 @@ def run_protocol(
     jobs: int = 1,
     scheduler: str | None = None,
     policy: str = "paper",
+    system: str = "aeb",
     mu: float = 1.0,
     vehicle: str = DEFAULT_VEHICLE,
     vehicle_id: str = DEFAULT_VEHICLE,
@@ -121,18 +132,18 @@ def run_protocol(
     runnable = [p for p in points if p.ego_speed_kmh >= low - 1e-9]
     cfgs = write_scenarios(points, out / "scenarios")
     cases = [
-        _case(p, cfgs[p.point_id], policy, mu, max_time_s, vehicle_id, params) for p in runnable
+        _case(p, cfgs[p.point_id], policy, mu, max_time_s, vehicle_id, params, system)
+        for p in runnable
     ]
     batch = run_cases(
         cases, out / BATCH_DIR, jobs, scheduler, progress=progress, tables_dir=tables_dir
     )
-    frame = results_frame(points, batch, low, policy)
+    run = RunLabel(name, system, policy, vehicle, mu, low, params.width_m)
+    frame = results_frame(points, batch, run, out)
     frame["net_file"] = [_relative(v, out) for v in frame["net_file"]]
     write_atomic(out / RESULTS_FILE, frame.to_csv(index=False), durable=True)
-    write_atomic(out / SCORECARD_MD, scorecard_markdown(name, frame, vehicle, mu, policy, low))
-    from eoam_sumo.plotting.protocol_plots import plot_scorecard
-
-    plot_scorecard(frame, out / SCORECARD_PNG, title=f"{name}: {vehicle}, mu {mu:g}")
+    write_atomic(out / SCORECARD_MD, scorecard_markdown(frame, run))
+    plot(frame, out / SCORECARD_PNG, run)
     failed = int((frame["status"] == "failed").sum())
     return ProtocolSummary(len(frame), len(runnable), failed, len(points) - len(runnable))
 
@@ -149,133 +160,54 @@ def _relative(path, out: Path):
 
 
 def results_frame(
-    points: list[TestPoint], batch: pd.DataFrame, low_kmh: float, policy: str
+    points: list[TestPoint], batch: pd.DataFrame, run: RunLabel, out: Path
 ) -> pd.DataFrame:
     """One row per point: protocol columns, then the summary fields of its run."""
     by_id = {r["case_id"]: r for r in batch.to_dict("records")}
-    rows = []
-    for point in points:
-        run = by_id.get(point.point_id)
-        rows.append(_row(point, run, low_kmh, point.policy or policy))
+    rows = [_row(point, by_id.get(point.point_id), run, out) for point in points]
     return pd.DataFrame(rows, columns=[*PROTOCOL_COLUMNS, *SUMMARY_COLUMNS])
 
 
-def _row(point: TestPoint, run: dict | None, low_kmh: float, policy: str) -> dict:
+def _flag(value) -> bool:
+    """A results.csv boolean (the batch reads every non-number column as text)."""
+    return str(value).strip().lower() == "true"
+
+
+def _facts(run: dict, width_m: float) -> scoring.RunFacts:
+    """What the run did beside its impact (steered, left its lane, raised the FCW)."""
+    return scoring.RunFacts(
+        steered=steered(run.get("modes_visited", ""), float(run["time_in_next_lane_s"])),
+        left_lane=rules.left_lane(
+            _flag(run["left_road"]),
+            float(run["max_lateral_offset_m"]),
+            float(run["lane_width_m"]),
+            width_m,
+        ),
+        fcw_raised=_flag(run["fcw_raised"]),
+    )
+
+
+def _row(point: TestPoint, run: dict | None, label: RunLabel, out: Path) -> dict:
+    head = {"point_id": point.point_id, "system": label.system, "policy": label.policy}
     if run is None:
-        note = scoring.OUTSIDE_DESIGN.format(v=point.ego_speed_kmh, low=low_kmh)
+        note = scoring.OUTSIDE_DESIGN.format(v=point.ego_speed_kmh, low=label.low_kmh)
         row = scoring.point_row(point, None, note)
-        return {
-            **row,
-            "point_id": point.point_id,
-            "policy": policy,
-            "status": "not_run",
-            "error": "",
-            "case_dir": "",
-        }
-    ok = run["status"] == "ok"
-    impact: float | None = None
-    if ok:
-        mps = run["impact_speed_mps"]
-        impact = 0.0 if mps is None or math.isnan(mps) else round(float(mps) * 3.6, 3)
-    row = scoring.point_row(point, impact, "" if ok else "the run failed: " + str(run["error"]))
+        return {**row, **head, "status": "not_run", "error": "", "case_dir": ""}
     summary = {c: run.get(c) for c in SUMMARY_COLUMNS}
+    case_dir = f"{BATCH_DIR}/{run['case_dir']}"
+    if run["status"] != "ok":
+        row = scoring.point_row(point, None, "the run failed: " + str(run["error"]))
+    else:
+        contact = run.get("contact_time_s")
+        measured = measure(out / case_dir, None if contact is None else float(contact))
+        if measured is None:
+            raise InputError(f"{out / case_dir}: no timeseries.csv to measure the impact from")
+        row = scoring.point_row(point, measured, "", _facts(run, label.width_m))
     return {
         **summary,
         **row,
-        "point_id": point.point_id,
-        "policy": policy,
+        **head,
         "status": run["status"],
         "error": run.get("error") or "",
-        "case_dir": f"{BATCH_DIR}/{run['case_dir']}",
+        "case_dir": case_dir,
     }
-
-
-def scorecard_markdown(
-    name: str, frame: pd.DataFrame, vehicle: str, mu: float, policy: str, low_kmh: float
-) -> str:
-    """The scorecard: edition, totals per test and overall, R152 verdicts, points not run,
-    every failed point with its reason."""
-    rows = frame.to_dict("records")
-    lines = [
-        f"# Scorecard: {name}",
-        "",
-        f"Edition: {scoring.EDITION[name]}.",
-        "",
-        f"Vehicle {vehicle}, friction {mu:g}, policy {policy} (head-on tests: both policies "
-        "side by side). Colours and points per point in results.csv; docs/protocols.md.",
-        "",
-    ]
-    lines += _totals_table(scoring.totals(rows))
-    unscored = [r["point_id"] for r in rows if r["colour"] == scoring.NO_BAND]
-    if unscored:
-        lines += [
-            f"Not scored (no band row for their VUT speed; run, impact speed in "
-            f"results.csv, left out of the totals): {', '.join(unscored)}.",
-            "",
-        ]
-    lines += _not_run_lines(rows, low_kmh) + _failed_lines(rows)
-    return "\n".join(lines) + "\n"
-
-
-def _totals_table(totals: list[dict]) -> list[str]:
-    lines = ["| test | policy | rows | points | of | verdicts |", "|---|---|---|---|---|---|"]
-    points = maxima = 0.0
-    for t in totals:
-        extra = ", ".join(
-            f"{k} {t[k]}" for k in ("pass", "fail", "undetermined", "not_run") if k in t
-        )
-        if math.isnan(t["points"]):
-            lines.append(
-                f"| {t['test']} | {t['policy_side'] or '-'} | {t['rows']} | - | - | {extra} |"
-            )
-            continue
-        points, maxima = points + t["points"], maxima + t["max_points"]
-        lines.append(
-            f"| {t['test']} | {t['policy_side'] or '-'} | {t['rows']} | "
-            f"{t['points']:.3f} | {t['max_points']:.3f} | |"
-        )
-    if maxima:
-        lines.append(f"| **overall** | | | **{points:.3f}** | **{maxima:.3f}** | |")
-    return [*lines, ""]
-
-
-def _not_run_lines(rows: list[dict], low_kmh: float) -> list[str]:
-    out = [r for r in rows if r["status"] == "not_run"]
-    if not out:
-        return []
-    ids = ", ".join(r["point_id"] for r in out)
-    return [
-        f"## Not run: outside the design range ({len(out)} points)",
-        "",
-        f"The lookup tables and DMM boundaries start at {low_kmh:g} km/h "
-        "(offline/design.py speeds_kmh): a run below it is refused, so these points score "
-        f"0 (counted in the totals): {ids}.",
-        "",
-    ]
-
-
-def _failed_lines(rows: list[dict]) -> list[str]:
-    bad = [
-        r
-        for r in rows
-        if r["status"] == "failed"
-        or r["colour"] in ("red", "brown", "orange", "yellow")
-        or r["verdict"] in ("fail", "undetermined")
-    ]
-    if not bad:
-        return ["No point short of full marks among those run.", ""]
-    lines = [
-        f"## Points short of full marks ({len(bad)})",
-        "",
-        "Cause: the scoring's note, why the EOAM did not do better, and the run's own account "
-        "(results.csv `reason`).",
-        "",
-        "| point | impact km/h | colour / verdict | cause |",
-        "|---|---|---|---|",
-    ]
-    lines += [
-        f"| {r['point_id']} | {r['impact_speed_kmh']} | {r['colour'] or r['verdict']} "
-        f"| {scoring.failure_cause(r)} |"
-        for r in bad
-    ]
-    return [*lines, ""]

@@ -2,6 +2,7 @@
 stage, the point-of-no-return rules and the rules chosen from the settings."""
 
 import math
+from dataclasses import replace
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -95,6 +96,10 @@ def test_dmm_stage_places_a_steady_obstacle_in_the_tables_sector(
         assert action is Action.STEER
         no_lane = sector_action(parts, state, meas._replace(left_lane_available=False), situation)
         assert no_lane == (sector, Action.LIMIT_BRAKE)  # no lane to change into
+        base = PAPER if paper else EoamSettings()
+        aeb, aeb_state = stage_inputs(tables, replace(base, steering_inhibited=True), mu)
+        # steering inhibited (an AEB): the same sector brakes at the limit in lane
+        assert sector_action(aeb, aeb_state, meas, situation) == (sector, Action.LIMIT_BRAKE)
 
 
 @settings(max_examples=200, deadline=None, suppress_health_check=FIXTURE)

@@ -1,0 +1,250 @@
+"""The scorecard of a protocol run (scorecard.md): edition, system and policy, totals per test
+with the FC gate and the maxima, the tests not built with their points at stake, points not
+run, and every point short of full marks with its cause."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import pandas as pd
+
+from eoam_sumo.protocols import rules, scoring
+from eoam_sumo.protocols.points import PROTOCOLS
+
+
+@dataclass(frozen=True)
+class RunLabel:
+    """What a protocol run was: its name, system, policy, vehicle, friction, the tables'
+    lowest speed [km/h] and the VUT's width [m]."""
+
+    name: str
+    system: str
+    policy: str
+    vehicle: str
+    mu: float
+    low_kmh: float
+    width_m: float
+
+    @property
+    def title(self) -> str:
+        ours = " (our extension, not the protocol's score)" if self.system == "eoam" else ""
+        return f"{self.name}, system {self.system}{ours}, policy {self.policy}"
+
+
+#: What the CCFhos source says and what we did (the scorecard prints it)
+CCFHOS_TEXT = (
+    "CCFhos bands: the rating code scores the VUT's speed reduction (v_reduction) with "
+    "mitigation_scenarios_thresholds: <= 10 km/h red, <= 20 orange, <= 30 green, above 30 "
+    "red (FC v1.2 Figure 5-2, not held here). Read literally a full stop at 50/50 would score "
+    "red like no reaction; we score a reduction above 30 km/h green, and a run without "
+    "contact green, so the points never fall as the reduction grows."
+)
+
+
+def scorecard_markdown(frame: pd.DataFrame, run: RunLabel) -> str:
+    """The whole scorecard of one system and one policy."""
+    rows = frame.to_dict("records")
+    lines = [
+        f"# Scorecard: {run.title}",
+        "",
+        f"Edition: {scoring.EDITION[run.name]}.",
+        "",
+        f"System {scoring.SYSTEM_TEXT[run.system]}.",
+        "",
+        f"Vehicle {run.vehicle}, friction {run.mu:g}, decision policy {run.policy}. Colours, "
+        "points, B/S (braked / steered) per point in results.csv; docs/protocols.md.",
+        "",
+    ]
+    if run.name == PROTOCOLS[1]:
+        lines += fc_lines(rows, run) + not_built_lines() + [CCFHOS_TEXT, ""]
+    elif run.name == PROTOCOLS[2]:
+        lines += r152_lines(rows)
+    else:
+        lines += unscored_lines(rows)
+    lines += not_run_lines(rows, run) + short_lines(rows)
+    return "\n".join(lines) + "\n"
+
+
+def fc_lines(rows: list[dict], run: RunLabel) -> list[str]:
+    """The 2026 totals per test, the FC gate and the overall line of this system and policy."""
+    t = scoring.fc_totals(rows)
+    lines = [
+        f"## Totals: system {run.system}, policy {run.policy}",
+        "",
+        "| test | points run / rows | standard | extended (banded) | robustness | points | of |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    lines += [
+        f"| {x['test']} | {x['run']} / {x['rows']} | {x['standard']:.3f} of "
+        f"{x['max_standard']:.3f} | {x['extended']:.3f} of {x['max_extended']:.3f} | "
+        f"not assessed, 0 of {x['max_robustness']:.3f} | {x['points']:.3f} | "
+        f"{x['max_points']:.3f} |"
+        for x in t["tests"]
+    ]
+    gate = "passed" if t["gate_passed"] else "FAILED"
+    lines += [
+        "",
+        f"**FC gate {gate}** (rating code `check_general_requirements_rules`: every Frontal "
+        "Collision point is 0 unless every standard-range CCRs cell at 10 and 20 km/h is "
+        "green; its general-requirement and pedestrian (CPNA) conditions are not assessed "
+        "here)." + ("" if t["gate_passed"] else f" Failing: {', '.join(t['gate_failing'])}."),
+        "",
+        f"**Overall, system {run.system}, policy {run.policy}: {t['points']:.3f} of "
+        f"{t['max_run']:.3f}** for the tests run ({t['points_before_gate']:.3f} before the "
+        f"gate); the protocol's car-target Frontal Collision maximum is "
+        f"{t['max_protocol']:.3f} (the tests not built below hold the rest).",
+        "",
+    ]
+    return lines
+
+
+def not_built_lines() -> list[str]:
+    """Every car test of the 2026 protocol not built here, its weight and why."""
+    lines = [
+        "## Tests not built (points at stake)",
+        "",
+        "| test | standard / extended / robustness | at stake | why |",
+        "|---|---|---|---|",
+    ]
+    for test, why in scoring.NOT_BUILT.items():
+        w = rules.TOTAL_SCORES[test]
+        lines.append(
+            f"| {test} (FC) | {w['standard']:g} / {w['extended']:g} / {w['robustness']:g} | "
+            f"{rules.weight_total(test):g} | {why} |"
+        )
+    for test, why in scoring.NOT_BUILT_LSC.items():
+        lines.append(
+            f"| {test} (Low Speed Collisions) | {rules.LSC_CAR_SCORES[test]:g} / - / - | "
+            f"{rules.LSC_CAR_SCORES[test]:g} | {why} |"
+        )
+    return [*lines, ""]
+
+
+def r152_lines(rows: list[dict]) -> list[str]:
+    """R152 verdicts per target: pass / fail, and the warning's."""
+    lines = [
+        "## Verdicts (pass: speed within the table, lane kept, warning >= 0.8 s before the "
+        "braking)",
+        "",
+        "| test | rows | pass | fail | undetermined | not run | warning pass | warning fail |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    lines += [
+        f"| {c['test']} | {c['rows']} | {c.get('pass', 0)} | {c.get('fail', 0)} | "
+        f"{c.get('undetermined', 0)} | {c.get('not_run', 0)} | {c['warning_pass']} | "
+        f"{c['warning_fail']} |"
+        for c in scoring.verdict_counts(rows)
+    ]
+    return [*lines, ""]
+
+
+def unscored_lines(rows: list[dict]) -> list[str]:
+    """2023: per test the rows run and those avoided (no points: the bands are not held)."""
+    lines = ["## Runs (unscored)", "", "| test | rows | run | no contact |", "|---|---|---|---|"]
+    for test in dict.fromkeys(r["test"] for r in rows):
+        own = [r for r in rows if r["test"] == test]
+        ran = [r for r in own if r["colour"] != rules.NOT_RUN]
+        avoided = sum(r["impact_speed_kmh"] == 0.0 for r in ran)
+        lines.append(f"| {test} | {len(own)} | {len(ran)} | {avoided} |")
+    return [
+        *lines,
+        "",
+        "Not built for 2023: CCFhos, CCFhol and CCFtap (their 2023 weights are not held; "
+        "docs/protocols.md, tests not built).",
+        "",
+    ]
+
+
+def not_run_lines(rows: list[dict], run: RunLabel) -> list[str]:
+    """The points below the tables' speed range, and what that does to the score."""
+    out = [r for r in rows if r["status"] == "not_run"]
+    if not out:
+        return []
+    effect = {
+        PROTOCOLS[1]: "They score 0 and count in the maximum; a standard CCRs cell at 10 km/h "
+        "not run is not green, so the FC gate fails",
+        PROTOCOLS[2]: "Their verdict is not_run (neither pass nor fail)",
+    }.get(run.name, "They are listed, unscored like the rest of the edition")
+    ids = ", ".join(r["point_id"] for r in out)
+    return [
+        f"## Not run: below the tables' speed range ({len(out)} points)",
+        "",
+        f"The lookup tables and DMM boundaries start at {run.low_kmh:g} km/h: a run below it is "
+        f"refused. {effect}: {ids}.",
+        "",
+    ]
+
+
+def short_lines(rows: list[dict]) -> list[str]:
+    bad = [
+        r
+        for r in rows
+        if r["status"] == "failed"
+        or r["colour"] in ("red", "brown", "orange", "yellow")
+        or r["verdict"] in ("fail", "undetermined")
+    ]
+    if not bad:
+        return ["No point short of full marks among those run.", ""]
+    lines = [
+        f"## Points short of full marks ({len(bad)})",
+        "",
+        "| point | impact km/h | reduction km/h | B/S | colour / verdict | cause |",
+        "|---|---|---|---|---|---|",
+    ]
+    lines += [
+        f"| {r['point_id']} | {_num(r['impact_speed_kmh'])} | "
+        f"{_num(r['speed_reduction_kmh'])} | {r['manoeuvre']} | {r['colour'] or r['verdict']} "
+        f"| {scoring.failure_cause(r)} |"
+        for r in bad
+    ]
+    return [*lines, ""]
+
+
+def _num(value) -> str:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "-"
+    return f"{float(value):.2f}"
+
+
+def picture_headline(run: RunLabel, totals: dict) -> str:
+    """The picture's title: the run, and (2026) the overall points and the gate."""
+    head = f"{run.title}; {run.vehicle}, mu {run.mu:g}"
+    if run.name == PROTOCOLS[0]:
+        return head + "\nunscored: the 2023 bands are not held"
+    if run.name != PROTOCOLS[1]:
+        return head + "\nR152 rows: pass needs the speed limit, the lane kept and the warning"
+    gate = "passed" if totals["gate_passed"] else "FAILED: every FC point 0"
+    return (
+        f"{head}\noverall {totals['points']:.2f} of {totals['max_run']:.2f} for the tests run "
+        f"({totals['points_before_gate']:.2f} before the gate); FC gate {gate}; "
+        f"protocol maximum {totals['max_protocol']:.0f}"
+    )
+
+
+def plot(frame: pd.DataFrame, path, run: RunLabel) -> None:
+    """scorecard.png of the run (plotting.protocol_plots)."""
+    from eoam_sumo.plotting.protocol_plots import plot_scorecard
+
+    scored = run.name == PROTOCOLS[1]
+    totals = scoring.fc_totals(frame.to_dict("records")) if scored else {}
+    kind = {PROTOCOLS[0]: "unscored", PROTOCOLS[1]: "bands", PROTOCOLS[2]: "verdicts"}[run.name]
+    plot_scorecard(frame, path, picture_headline(run, totals), kind, totals, not_built_note(run))
+
+
+def not_built_note(run: RunLabel) -> str:
+    """The picture's list of the tests not built and their points at stake."""
+    if run.name == PROTOCOLS[0]:
+        return "Not built for 2023: CCFhos, CCFhol, CCFtap (2023 weights not held)."
+    if run.name != PROTOCOLS[1]:
+        return ""
+    fc = [f"{t} {rules.weight_total(t):g}" for t in scoring.NOT_BUILT]
+    lsc = [f"{t} {rules.LSC_CAR_SCORES[t]:g}" for t in scoring.NOT_BUILT_LSC]
+    return (
+        "Tests not built (points at stake):\n"
+        f"Frontal Collisions: {', '.join(fc)}\n"
+        f"Low Speed Collisions: {', '.join(lsc)}\n"
+        "(CCFhol: scripted lane change not built; the others are junction tests, out of a "
+        "highway EOAM's scope; docs/protocols.md)\n"
+        "Robustness layer: not assessed, 0 of its weight in every test"
+    )
