@@ -7,7 +7,13 @@ import numpy as np
 import pytest
 
 from eoam_sumo.offline.design import DesignSettings
-from eoam_sumo.offline.ocp import OcpError, OcpSolution, predicted_guess, solve_chain
+from eoam_sumo.offline.ocp import (
+    OcpError,
+    OcpSolution,
+    chain_speeds_mps,
+    predicted_guess,
+    solve_chain,
+)
 from eoam_sumo.params import ego_e_class_sedan
 
 N = 10
@@ -45,7 +51,8 @@ class _ReachLimitedSolver:
 
     def __init__(self, reach_mps: float, halvings: int):
         self.params = ego_e_class_sedan()
-        self.settings = DesignSettings(speed_halvings=halvings)
+        # steps as asked (no intermediate speeds), to test the halving alone
+        self.settings = DesignSettings(speed_halvings=halvings, chain_step_kmh=100.0)
         self.patient = False
         self.reach_mps = reach_mps
         self.last: float | None = None
@@ -74,3 +81,16 @@ def test_a_step_too_far_for_its_halvings_reaches_the_last_resort():
         solve_chain(solver, 0.5, [30.0, 26.0])
     # 26 fails; 28 (100.8 km/h) fails, then its last resort: direct, continuation
     assert solver.calls == [30.0, 26.0, 28.0, 28.0, 28.0]
+
+
+def test_the_chain_steps_at_most_its_step_whatever_speeds_are_asked():
+    """The route does not depend on the grid asked: the grid's ends alone walk the full grid's
+    speeds (within their last bits), each asked speed flagged, highest first."""
+    full = chain_speeds_mps([v / 3.6 for v in range(20, 176, 5)], 2.5)
+    ends = chain_speeds_mps([20 / 3.6, 175 / 3.6], 2.5)
+    assert [a for _, a in ends] == [True] + [False] * 61 + [True]
+    assert [v for v, _ in ends] == pytest.approx([v for v, _ in full], rel=1e-12)
+    steps = np.diff([v * 3.6 for v, _ in full])
+    assert (steps < 0).all() and (-steps <= 2.5 + 1e-9).all()
+    assert sum(a for _, a in full) == 32
+    assert chain_speeds_mps([10.0], 2.5) == [(10.0, True)] and chain_speeds_mps([], 2.5) == []
