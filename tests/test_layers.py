@@ -33,7 +33,7 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
     "vehicle_files": ({"params", "errors", "textfiles"}, set()),
     "sampling": ({"errors", "seeds"}, {"numpy"}),
     "plant": ({"params"}, {"numpy", "casadi"}),
-    "manoeuvre": ({"params"}, {"numpy"}),
+    "manoeuvre": ({"params"}, {"numpy", "scipy"}),
     "offline": (
         {"params", "errors", "fileio", "textfiles", "plant", "manoeuvre"},
         {"numpy", "scipy", "casadi", "tqdm"},

@@ -136,7 +136,7 @@ def test_tables_never_write_over_another_vehicles(tmp_path, capsys, monkeypatch)
     status = main(["tables", "--vehicle", str(mine), *fast])
     _one_line(capsys, status, str(base / "sedan-file"), "Cadillac SRX", "--overwrite")
     status = main(["tables", "--vehicle", str(mine), "--out", str(base), *fast])
-    _one_line(capsys, status, str(base), "'E-class sedan' (other mass_kg)")
+    _one_line(capsys, status, str(base), "not of 'E-class sedan'")
     assert snapshot(base) == {
         **sedan,
         **{f"sedan-file/{k}": v for k, v in suv.items()},

@@ -179,7 +179,7 @@ def test_make_radar_and_settings_checks():
     ("option", "value", "named"),
     [
         ("--radar-model", "sonar", "radar_model 'sonar'"),
-        ("--seed", "-1", "seed -1"),
+        ("--seed", "-1", "seed = -1"),
         ("--seed", "x", "seed 'x'"),
     ],
 )
