@@ -330,21 +330,24 @@ def follower_arriving(
     lane_width_m: float,
     bodies: Sequence[Body],
 ) -> bool:
-    """Whether a road user has its centre in the ego's lane behind the ego's rear bumper
-    (``cg_to_rear_m`` ahead of the CG: negative), within ``FOLLOWER_REACH_M``, still moving
-    towards it: it has not yet stopped behind the ego, and may hit it. The run of a stopped
-    ego waits for it (``RunSettings.after_stop_s`` None)."""
+    """Whether the nearest road user behind the ego in its lane (centre in the lane, behind
+    the ego's rear bumper, ``cg_to_rear_m`` ahead of the CG: negative, within
+    ``FOLLOWER_REACH_M``) still moves towards it: it has not yet stopped behind the ego, and
+    may hit it. The run of a stopped ego waits for that one road user to stop or pass
+    (``RunSettings.after_stop_s`` None), not for the queue forming behind it."""
     X, Y = x[0], x[1]
     s_ego, d_ego, _ = road.project(X, Y)
     rear_s = s_ego + cg_to_rear_m
     lane_d = lane_width_m * round(d_ego / lane_width_m)
     band = lane_band_m(lane_width_m)
+    nearest_s, closing = -math.inf, False
     for b in bodies:
         if b.parked:
             continue
         s, d, road_yaw = road.project(b.x_m, b.y_m)
         if not rear_s - FOLLOWER_REACH_M < s < rear_s or abs(d - lane_d) >= band:
             continue
-        if b.speed_mps * math.cos(b.yaw_rad - road_yaw) > EGO_STANDSTILL_MPS:
-            return True
-    return False
+        if s > nearest_s:
+            nearest_s = s
+            closing = b.speed_mps * math.cos(b.yaw_rad - road_yaw) > EGO_STANDSTILL_MPS
+    return closing

@@ -7,7 +7,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from eoam_sumo.sim.margins import NEAR_MISS_TTC_S, Margins
+from eoam_sumo.sim.margins import NEAR_MISS_TTC_S, Margins, follower_arriving
 from eoam_sumo.sim.roadframe import RoadFrame
 from eoam_sumo.world.bodies import Body
 from eoam_sumo.world.geometry import OrientedBox, time_to_contact
@@ -116,3 +116,20 @@ def test_a_follower_closing_in_gives_its_gap_drac_and_deceleration():
     assert margins.follower_decel_id == "f"
     assert margins.min_ttc_rear_s < (first_gap / 10.0) + 0.05
     assert not margins.near_miss()  # 5 m/s2 is a heavy reaction, not an emergency
+
+
+def test_a_stopped_ego_waits_for_its_nearest_follower_only():
+    """The run of a stopped ego waits while the nearest road user behind it in its lane still
+    moves towards it, not while a queue forms further back (or in the next lane)."""
+    road = RoadFrame(np.array([[0.0, 0.0], [1000.0, 0.0]]))
+    ego = [500.0, 0.0, 0.0, 0.0]
+    rear = -0.5 * EGO_L
+
+    def car(x, speed, y=0.0):
+        return Body(f"c{x:g}", "passenger", x, y, 0.0, speed, 4.70, 1.82)
+
+    stopped, arriving = car(490.0, 0.0), car(440.0, 12.0)
+    assert not follower_arriving(ego, rear, road, 3.5, [stopped, arriving])
+    assert follower_arriving(ego, rear, road, 3.5, [car(490.0, 3.0), car(440.0, 0.0)])
+    assert not follower_arriving(ego, rear, road, 3.5, [car(490.0, 20.0, y=3.5)])  # next lane
+    assert not follower_arriving(ego, rear, road, 3.5, [car(300.0, 20.0)])  # beyond the reach
