@@ -98,8 +98,8 @@ class TimeSeries(StepObserver):
 
     log: RunLog  # set when the run starts
 
-    def __init__(self, brake_gains: tuple[float, float]) -> None:
-        self._brake_gains = brake_gains  # road brake force per bar, front and rear [N/bar]
+    def __init__(self, brake_gains: tuple[float, ...]) -> None:
+        self._brake_gains = brake_gains  # road brake force per bar, per wheel [N/bar]
 
     def start(self, sim: RunView) -> None:
         self.log = RunLog(sim.max_steps + 1, self._brake_gains)

@@ -18,7 +18,7 @@ import numpy as np
 
 from eoam_sumo.params import VehicleParams
 from eoam_sumo.plant import OUTPUT_NAMES, STATE_NAMES, Plant, initial_state
-from eoam_sumo.plant.stepping import brake_gains_n_per_bar
+from eoam_sumo.plant.stepping import brake_force_n
 from eoam_sumo.vehicle_tests.equipment import wheel_speeds
 
 COLUMNS = (
@@ -93,7 +93,6 @@ class PlantVehicle:
 
     def __init__(self, params: VehicleParams):
         self.params = params
-        self._brake_gains = brake_gains_n_per_bar(params)  # road force per bar, front/rear
         self._plant = Plant(params, dt_s=0.001, substeps=round(STEP_S / 0.001))
         self._x: list[float] = []
 
@@ -121,15 +120,7 @@ class PlantVehicle:
             wheel_speed_front_mps=front_mps,
             wheel_speed_rear_mps=rear_mps,
             drive_force_n=x[_STATE["drive_force_n"]],
-            brake_force_n=self._brake_force_n(x),
-        )
-
-    def _brake_force_n(self, x: list[float]) -> float:
-        """The brake force the line pressures apply at the road (both axles)."""
-        front, rear = self._brake_gains
-        return (
-            front * x[_STATE["brake_pressure_front_bar"]]
-            + rear * x[_STATE["brake_pressure_rear_bar"]]
+            brake_force_n=brake_force_n(x, self.params),
         )
 
 
