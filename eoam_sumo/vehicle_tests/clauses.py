@@ -24,6 +24,12 @@ Sources (found in the regulations' public texts and NHTSA's papers on them):
   acceleration. ISO 7401:2011 sec. 10 (lateral transient response, step input): yaw-rate gain,
   response time (from 50 % of the steering input to 90 % of the steady-state response), peak
   response time and overshoot. Neither ISO method sets a pass mark: their figures are reported.
+- ISO 7975:2019 (passenger cars, braking in a turn, open-loop): how the steady-state circular
+  response is altered by braking only. Initial radius 100 m, initial lateral acceleration
+  5 m/s^2, the steering held, brake decelerations in steps; the figures taken 1 s after the
+  brake's onset. (The scope is from ISO's public page; the radius, lateral acceleration and
+  measuring time are the commonly cited values, not checked against the standard's text.)
+  The deceleration step of 1 m/s^2 is ours (a short series). No pass mark.
 """
 
 from __future__ import annotations
@@ -59,6 +65,10 @@ LOCK_ORDER_RATE_MAX = 0.8  # ... to 0.8: front locks first or together
 STEP_SPEED_KMH = 80.0  # ISO 7401 sec. 10 (standard test speed)
 STEP_AY_MPS2 = 4.0  # ISO 7401 sec. 10 (steady-state lateral acceleration)
 RAMP_SPEED_KMH = 80.0  # ISO 4138 constant speed method (one of the speeds it allows)
+TURN_BRAKE_RADIUS_M = 100.0  # ISO 7975 (initial radius)
+TURN_BRAKE_AY_MPS2 = 5.0  # ISO 7975 (initial lateral acceleration)
+TURN_BRAKE_MEASURE_S = 1.0  # ISO 7975 (figures 1 s after the brake's onset)
+TURN_BRAKE_DECEL_STEP_MPS2 = 1.0  # ours: the series' deceleration step
 
 CITE = {
     "sis": "FMVSS 126 S7.6 (slowly increasing steer)",
@@ -72,4 +82,5 @@ CITE = {
     "lock_order": "UN R13-H Annex 5 Appendix 1 (wheel-lock sequence)",
     "ramp": "ISO 4138 (steady-state circular driving, constant speed, slowly increasing steer)",
     "step": "ISO 7401:2011 sec. 10 (step input)",
+    "turn_brake": "ISO 7975:2019 (braking in a turn, open-loop)",
 }

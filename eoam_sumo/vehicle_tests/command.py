@@ -13,7 +13,14 @@ from eoam_sumo.arguments import mu, speed_kmh
 from eoam_sumo.fileio import writable_dir
 from eoam_sumo.vehicle_files import load_vehicle
 
-TEST_NAMES = ("brake", "brake-ramp", "ramp-steer", "sine-with-dwell", "step-steer")
+TEST_NAMES = (
+    "brake",
+    "brake-in-turn",
+    "brake-ramp",
+    "ramp-steer",
+    "sine-with-dwell",
+    "step-steer",
+)
 """The tests (``procedures.TESTS``; named here so the command line starts without the plant)."""
 
 

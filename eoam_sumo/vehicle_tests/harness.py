@@ -18,6 +18,7 @@ import numpy as np
 
 from eoam_sumo.params import VehicleParams
 from eoam_sumo.plant import OUTPUT_NAMES, STATE_NAMES, Plant, initial_state
+from eoam_sumo.plant.model import WHEELS
 from eoam_sumo.plant.stepping import brake_force_n
 from eoam_sumo.vehicle_tests.equipment import wheel_speeds
 
@@ -36,6 +37,8 @@ COLUMNS = (
     "wheel_speed_rear_mps",
     "drive_force_n",
     "brake_force_n",
+    "friction_use_max",
+    "friction_ellipse_max",
 )
 """The columns of a run's time series (``timeseries.csv``), in order."""
 
@@ -59,6 +62,8 @@ class Sample(NamedTuple):
     wheel_speed_rear_mps: float
     drive_force_n: float
     brake_force_n: float
+    friction_use_max: float = math.nan  # the largest tyre |F| / (mu Fz) (NaN: not modelled)
+    friction_ellipse_max: float = math.nan  # the largest tyre sqrt((Fx/Dx)^2 + (Fy/Dy)^2)
 
 
 class Controls(NamedTuple):
@@ -86,6 +91,8 @@ Stop = Callable[[float, Sample], bool]
 
 _STATE = {name: i for i, name in enumerate(STATE_NAMES)}
 _OUTPUT = {name: i for i, name in enumerate(OUTPUT_NAMES)}
+_USE = tuple(_OUTPUT[f"friction_use_{w}"] for w in WHEELS)
+_ELLIPSE = tuple(_OUTPUT[f"friction_ellipse_{w}"] for w in WHEELS)
 
 
 class PlantVehicle:
@@ -121,6 +128,8 @@ class PlantVehicle:
             wheel_speed_rear_mps=rear_mps,
             drive_force_n=x[_STATE["drive_force_n"]],
             brake_force_n=brake_force_n(x, self.params),
+            friction_use_max=max(outputs[i] for i in _USE),
+            friction_ellipse_max=max(outputs[i] for i in _ELLIPSE),
         )
 
 
@@ -171,5 +180,5 @@ def _row(t_s: float, s: Sample, steering_ratio: float) -> tuple[float, ...]:
     return (
         t_s, s.vx_mps, s.vy_mps, s.x_m, s.y_m, s.yaw_rad, s.yaw_rate_radps, steer_wheel_deg,
         s.ax_mps2, s.ay_mps2, s.wheel_speed_front_mps, s.wheel_speed_rear_mps,
-        s.drive_force_n, s.brake_force_n,
+        s.drive_force_n, s.brake_force_n, s.friction_use_max, s.friction_ellipse_max,
     )  # fmt: skip
