@@ -17,7 +17,11 @@ Sources (found in the regulations' public texts and NHTSA's papers on them):
   disconnected, 100 km/h): stopping distance at most ``0.1 v + 0.0060 v^2`` (70 m; FMVSS 135
   S7.5 gives the same 70 m from 100 km/h). Annex 5 (distribution of braking among the axles,
   Appendix 1 wheel-lock sequence): for all braking rates between 0.15 and 0.8 the front wheels
-  lock simultaneously with or before the rear wheels. Annex 6 (anti-lock systems, Appendix 2):
+  lock simultaneously with or before the rear wheels; the pedal force is raised so that the
+  first axle locks between 0.5 s and 1 s after braking begins, from 65 km/h on a surface of
+  adhesion up to 0.5 and from 100 km/h above (as issue 38 quotes the Appendix; the search
+  corpora held neither R13-H's Annex 5 text, so these figures are not checked against it).
+  Annex 6 (anti-lock systems, Appendix 2):
   utilisation of adhesion, at least 0.75.
 - ISO 4138 (passenger cars, steady-state circular driving behaviour, open-loop): the constant
   speed method with a slowly increasing steer; understeer gradient and the maximum lateral
@@ -61,6 +65,8 @@ MFDD_TO_FRACTION = 0.1  # R13-H Annex 3 para. 1.1.2: ve = 0.1 v0
 ADHESION_UTILISATION_MIN = 0.75  # R13-H Annex 6 (with ABS)
 LOCK_ORDER_RATE_MIN = 0.15  # R13-H Annex 5: braking rates 0.15 ...
 LOCK_ORDER_RATE_MAX = 0.8  # ... to 0.8: front locks first or together
+LOCK_SEQUENCE_FIRST_LOCK_S = (0.5, 1.0)  # R13-H Annex 5 App. 1: first axle locks 0.5-1 s in
+LOCK_SEQUENCE_LOW_MU = 0.5  # R13-H Annex 5 App. 1: from 65 km/h at or below, else 100 km/h
 
 STEP_SPEED_KMH = 80.0  # ISO 7401 sec. 10 (standard test speed)
 STEP_AY_MPS2 = 4.0  # ISO 7401 sec. 10 (steady-state lateral acceleration)
@@ -80,6 +86,8 @@ CITE = {
     "mfdd": "UN R13-H Annex 3 para. 1.1.2 (R13 Annex 4 para. 1.1.2)",
     "adhesion": "UN R13-H Annex 6 Appendix 2 (utilisation of adhesion, ABS)",
     "lock_order": "UN R13-H Annex 5 Appendix 1 (wheel-lock sequence)",
+    "lock_sequence": "UN R13-H Annex 5 Appendix 1 (pedal force raised so that the first axle "
+    "locks 0.5-1 s after braking begins; 65 km/h at mu <= 0.5, else 100 km/h)",
     "ramp": "ISO 4138 (steady-state circular driving, constant speed, slowly increasing steer)",
     "step": "ISO 7401:2011 sec. 10 (step input)",
     "turn_brake": "ISO 7975:2019 (braking in a turn, open-loop)",
