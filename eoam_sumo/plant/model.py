@@ -9,16 +9,19 @@ its offline model leaves out (docs/chassis.md has the equations and sources)::
     J omega_i'     = T_drive_i - r_w Fx_i          (brake and rolling resistance: integrator)
 
 Each axle's force is the sum of its two tyres' combined-slip Magic Formula forces
-(``magic_formula.py``), each at its own load: quasi-static longitudinal and lateral load
-transfer (roll stiffness shared by ``roll_stiffness_front_share``) from the accelerations
-lagged by ``LOAD_TRANSFER_LAG_S``. ``M_lr`` is the moment of the left/right longitudinal
-force difference (load transfer, ESC). Both tyres of an axle share its slips (single-track
-kinematics): the longitudinal slip and the slip angle are relaxed states (relaxation lengths,
-Pacejka 2012 sec. 7.2), with a low-speed damping so the car rests without ringing.
+(``magic_formula.py``), each at its own load and its own longitudinal slip (wheel spin per
+wheel, contact-patch speeds -/+ r track / 2), the axle sharing the slip angle: quasi-static
+longitudinal and lateral load transfer (roll stiffness shared by ``roll_stiffness_front_share``)
+from the accelerations lagged by ``LOAD_TRANSFER_LAG_S``. ``M_lr`` is the moment of the
+left/right longitudinal force difference (load transfer, brakes, ESC). The slips are relaxed
+states (relaxation lengths, Pacejka 2012 sec. 7.2), with a low-speed damping so the car rests
+without ringing. Steering compliance turns the road wheels back by ``Fy_f / k_s``.
 
-Brakes: line pressure per axle (build and dump rate limits, ABS per axle), a fixed
-proportioning ``brake_front_share`` (front axle locks first, UN R13-H Annex 5); ESC brakes one
-wheel; the drive force is wheel torque on the driven axle(s) (``drivetrain``).
+Brakes: a pressure per wheel (build and dump rate limits, ABS per wheel), the driver's line
+pressure equal on both sides of an axle, a fixed proportioning ``brake_front_share`` (front
+axle locks first, UN R13-H Annex 5); ESC adds pressure on one wheel, so its force comes
+through that tyre's slip and friction ellipse; the drive force is wheel torque on the driven
+axle(s) (``drivetrain``), half to each wheel.
 
 ``x``, ``u`` are sequences of scalars (floats, or CasADi SX/MX elements) in the order of
 ``STATE_NAMES`` and ``INPUT_NAMES``; ``mu`` is the peak surface friction under the vehicle.
