@@ -53,6 +53,7 @@ class Chassis(NamedTuple):
     damping_speed_lat_mps: float
     peak_slip_per_mu: float  # the tyre's braking peak slip per unit road mu (ABS reference)
     understeer_spmpm: float  # K of r = v delta / (L + K v^2), the ESC's reference [s^2/m]
+    yaw_damping_nmspr: float  # a^2 C_f + b^2 C_r: the yaw time constant is Iz v / this
     front_share: float  # drive torque share of the front axle (fixed drivetrains)
 
 
@@ -94,6 +95,8 @@ def constants(p: VehicleParams) -> Chassis:
         damping_speed_lat_mps=zeta2 * math.sqrt(k_lat * p.relaxation_length_lat_m / p.mass_kg),
         peak_slip_per_mu=peak_slip(PAC2002_235_60R16) / tyre.pdx1,
         understeer_spmpm=understeer / p.wheelbase_m,
+        yaw_damping_nmspr=p.cg_to_front_m**2 * c_front
+        + p.cg_to_rear_m**2 * p.cornering_stiffness_rear_npr,
         front_share=share,
     )
 
@@ -159,14 +162,25 @@ def front_drive_share(slip_front, slip_rear, p: VehicleParams, ch: Chassis, ops)
     return ops.fmin(ops.fmax(ch.front_share + moved, 0.0), EAWD_MAX_FRONT_SHARE)
 
 
-def esc_target_moment_nm(vx, vy, r, steer, mu, p: VehicleParams, ch: Chassis, ops):
-    """The ESC's corrective yaw moment [N m]: the yaw-rate error to the linear single-track
-    reference ``v delta / (L + K v^2)`` limited to ``0.85 mu g / v``, past a dead band, times
-    ``Iz * esc_yaw_gain``; plus ``esc_sideslip_gain`` times the sideslip past its threshold."""
+def esc_reference_rate(vx, steer, r_ref, mu, p: VehicleParams, ch: Chassis, ops):
+    """Rate of the ESC's yaw-rate reference: the linear single-track steady state
+    ``v delta / (L + K v^2)``, limited to ``0.85 mu g / v``, through a first-order lag of the
+    car's own yaw time constant ``Iz v / (a^2 C_f + b^2 C_r)`` (Rajamani 2012 ch. 8: the
+    desired yaw rate of a yaw-dynamics reference model), so a car that follows its steering
+    as a linear car would is never corrected."""
     v = ops.fmax(vx, ESC_MIN_SPEED_MPS)
     r_lin = v * steer / (p.wheelbase_m + ch.understeer_spmpm * v * v)
     r_max = ESC_YAW_LIMIT * mu * G_MPS2 / v
-    error = ops.fmin(ops.fmax(r_lin, -r_max), r_max) - r
+    tau = p.yaw_inertia_kgm2 * v / ch.yaw_damping_nmspr
+    return (ops.fmin(ops.fmax(r_lin, -r_max), r_max) - r_ref) / tau
+
+
+def esc_target_moment_nm(vx, vy, r, r_ref, p: VehicleParams, ops):
+    """The ESC's corrective yaw moment [N m]: the yaw-rate error to the reference
+    (``esc_reference_rate``) past a dead band, times ``Iz * esc_yaw_gain``; plus
+    ``esc_sideslip_gain`` times the sideslip past its threshold."""
+    v = ops.fmax(vx, ESC_MIN_SPEED_MPS)
+    error = r_ref - r
     yaw_part = ops.sign(error) * ops.fmax(ops.fabs(error) - p.esc_yaw_deadband_radps, 0.0)
     beta = ops.atan(vy / v)
     beta_part = ops.sign(beta) * ops.fmax(ops.fabs(beta) - p.esc_sideslip_threshold_rad, 0.0)

@@ -56,6 +56,7 @@ STATE_NAMES = (
     "ax_load_mps2",
     "ay_load_mps2",
     "esc_moment_nm",
+    "esc_reference_radps",
 )
 INPUT_NAMES = ("steer_cmd_rad", "drive_force_cmd_n", "brake_force_cmd_n")
 OUTPUT_NAMES = (
@@ -97,7 +98,7 @@ steering compliance; per wheel: its speed, load, ``|F| / (mu Fz)`` against the r
 PRESSURES = (8, 9, 10, 11)
 OMEGAS = (12, 13, 14, 15)
 SLIPS = (16, 17, 18, 19)
-(TAN_F, TAN_R, AX_LOAD, AY_LOAD, ESC) = range(20, 25)
+(TAN_F, TAN_R, AX_LOAD, AY_LOAD, ESC, ESC_REF) = range(20, 26)
 STEER_CMD, DRIVE_CMD, BRAKE_CMD = range(len(INPUT_NAMES))
 
 LOCK_SLIP = -0.5
@@ -275,10 +276,11 @@ def rhs(x, u, mu, params: VehicleParams, ops) -> list:
     moment = p.cg_to_front_m * f.front.fy_n - p.cg_to_rear_m * f.rear.fy_n
     moment = moment + f.front.moment_nm + f.rear.moment_nm
     slips = _slip_rates(x, f.steer_rad, p, ch, ops)
-    esc_rate = 0.0
+    esc_rate = ref_rate = 0.0
     if p.esc_fitted:
-        target = ch_.esc_target_moment_nm(vx, vy, r, x[STEER], mu, p, ch, ops)
+        target = ch_.esc_target_moment_nm(vx, vy, r, x[ESC_REF], p, ops)
         esc_rate = (target - x[ESC]) / p.esc_lag_s
+        ref_rate = ch_.esc_reference_rate(vx, x[STEER], x[ESC_REF], mu, p, ch, ops)
     lag = ch_.LOAD_TRANSFER_LAG_S
     fx_tyres = (f.front.fx_n + f.rear.fx_n) / p.mass_kg
     return [
@@ -294,6 +296,7 @@ def rhs(x, u, mu, params: VehicleParams, ops) -> list:
         (fx_tyres - x[AX_LOAD]) / lag,
         (ay - x[AY_LOAD]) / lag,
         esc_rate,
+        ref_rate,
     ]
 
 
