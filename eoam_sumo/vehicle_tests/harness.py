@@ -39,6 +39,7 @@ COLUMNS = (
     "brake_force_n",
     "friction_use_max",
     "friction_ellipse_max",
+    "wheel_speed_min_mps",
 )
 """The columns of a run's time series (``timeseries.csv``), in order."""
 
@@ -64,6 +65,7 @@ class Sample(NamedTuple):
     brake_force_n: float
     friction_use_max: float = math.nan  # the largest tyre |F| / (mu Fz) (NaN: not modelled)
     friction_ellipse_max: float = math.nan  # the largest tyre sqrt((Fx/Dx)^2 + (Fy/Dy)^2)
+    wheel_speed_min_mps: float = math.nan  # the slowest of the four wheels (omega r_w)
 
 
 class Controls(NamedTuple):
@@ -93,6 +95,7 @@ _STATE = {name: i for i, name in enumerate(STATE_NAMES)}
 _OUTPUT = {name: i for i, name in enumerate(OUTPUT_NAMES)}
 _USE = tuple(_OUTPUT[f"friction_use_{w}"] for w in WHEELS)
 _ELLIPSE = tuple(_OUTPUT[f"friction_ellipse_{w}"] for w in WHEELS)
+_WHEEL_SPEEDS = tuple(_OUTPUT[f"wheel_speed_{w}_mps"] for w in WHEELS)
 
 
 class PlantVehicle:
@@ -130,12 +133,16 @@ class PlantVehicle:
             brake_force_n=brake_force_n(x, self.params),
             friction_use_max=max(outputs[i] for i in _USE),
             friction_ellipse_max=max(outputs[i] for i in _ELLIPSE),
+            wheel_speed_min_mps=min(outputs[i] for i in _WHEEL_SPEEDS),
         )
 
 
 def rolling_start(speed_mps: float) -> Sample:
     """The sample of a vehicle at the origin rolling straight along +x at ``speed_mps``."""
-    return Sample(speed_mps, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, speed_mps, speed_mps, 0.0, 0.0)
+    return Sample(
+        speed_mps, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, speed_mps, speed_mps, 0.0, 0.0,
+        wheel_speed_min_mps=speed_mps,
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -181,4 +188,5 @@ def _row(t_s: float, s: Sample, steering_ratio: float) -> tuple[float, ...]:
         t_s, s.vx_mps, s.vy_mps, s.x_m, s.y_m, s.yaw_rad, s.yaw_rate_radps, steer_wheel_deg,
         s.ax_mps2, s.ay_mps2, s.wheel_speed_front_mps, s.wheel_speed_rear_mps,
         s.drive_force_n, s.brake_force_n, s.friction_use_max, s.friction_ellipse_max,
+        s.wheel_speed_min_mps,
     )  # fmt: skip

@@ -133,6 +133,7 @@ def _figures(run: Run, decel_mps2: float, radius_m: float) -> dict:
         "path_deviation_m": rounded(deviation),
         "front_locked": bool(locked(run["wheel_speed_front_mps"][i0:], vx[i0:]).any()),
         "rear_locked": bool(locked(run["wheel_speed_rear_mps"][i0:], vx[i0:]).any()),
+        "a_wheel_locked": bool(locked(run["wheel_speed_min_mps"][i0:], vx[i0:]).any()),
         "max_sideslip_deg": rounded(max_beta_deg),
         "max_friction_use": rounded(float(np.max(use))) if np.isfinite(use).all() else None,
         "spun": max_beta_deg >= SPIN_SIDESLIP_DEG,
