@@ -1,5 +1,5 @@
 """Fixed-step integration of the plant, for any arithmetic: the explicit midpoint rule (RK2)
-for the smooth dynamics, then the wheels' Coulomb torques (brakes, rolling resistance) applied
+for the smooth dynamics, then the four wheels' Coulomb torques (brakes, rolling resistance) applied
 exactly for the step (``resist``), a splitting that keeps the stiff stick-slip of a braked
 wheel out of the explicit step."""
 
@@ -7,35 +7,23 @@ from __future__ import annotations
 
 from eoam_sumo.params import VehicleParams
 from eoam_sumo.plant.chassis import constants
-from eoam_sumo.plant.model import (
-    OMEGA_F,
-    OMEGA_R,
-    P_FRONT,
-    P_REAR,
-    outputs,
-    rhs,
-    tyre_loads_n,
-)
+from eoam_sumo.plant.model import OMEGAS, PRESSURES, outputs, rhs, tyre_loads_n
 
 
 def resist(x, params: VehicleParams, dt_s: float, ops) -> list:
     """The brake and rolling-resistance torques over ``dt_s`` as Coulomb friction on each
-    axle's wheels: the spin falls by ``dt T / J`` and stops at zero (a wheel the brake can hold
-    stays at rest: no reversal, no chatter); line pressures kept >= 0."""
+    wheel: the spin falls by ``dt T / J`` and stops at zero (a wheel the brake can hold stays
+    at rest: no reversal, no chatter); pressures kept >= 0."""
     p = params
     ch = constants(p)
-    fl, fr, rl, rr = tyre_loads_n(x, p, ops)
-    r_w = p.wheel_radius_m
-    step = dt_s * r_w / ch.axle_inertia_kgm2
-    pf, pr = ops.fmax(x[P_FRONT], 0.0), ops.fmax(x[P_REAR], 0.0)
-    brake_f = ch.brake_n_per_bar * p.brake_front_share * pf
-    brake_r = ch.brake_n_per_bar * (1.0 - p.brake_front_share) * pr
-    torque_f = brake_f + p.rolling_resistance_coeff * (fl + fr)
-    torque_r = brake_r + p.rolling_resistance_coeff * (rl + rr)
+    loads = tyre_loads_n(x, p, ops)
+    step = dt_s * p.wheel_radius_m / p.wheel_inertia_kgm2
     out = list(x)
-    out[OMEGA_F] = ops.fmax(x[OMEGA_F] - step * torque_f, 0.0)
-    out[OMEGA_R] = ops.fmax(x[OMEGA_R] - step * torque_r, 0.0)
-    out[P_FRONT], out[P_REAR] = pf, pr
+    for p_i, omega_i, gain, fz in zip(PRESSURES, OMEGAS, ch.wheel_brake_n_per_bar, loads):
+        pressure = ops.fmax(x[p_i], 0.0)
+        torque = gain * pressure + p.rolling_resistance_coeff * fz
+        out[omega_i] = ops.fmax(x[omega_i] - step * torque, 0.0)
+        out[p_i] = pressure
     return out
 
 

@@ -195,25 +195,37 @@ def tyre_forces(kappa, alpha, fz_n, lmux, lmuy, lky, c: MfCoefficients, ops):
     return fx, fy, fx0
 
 
-def axle_forces(kappa, alpha, loads, mu, lky, c: MfCoefficients, ops):
-    """``((Fx, Fy) left, (Fx, Fy) right)`` of an axle's two tyres sharing the slips on a road
-    of friction ``mu`` (LMUX = mu / PDX1, LMUY = mu / PDY1), each at its own load; ``c``
+class TyreForce(NamedTuple):
+    """One tyre's wheel-frame forces [N] and its pure-slip peaks ``Dx``, ``Dy`` [N] (the axes
+    of its friction ellipse at this load and road)."""
+
+    fx_n: Any
+    fy_n: Any
+    dx_n: Any
+    dy_n: Any
+
+
+def axle_forces(kappas, alpha, loads, mu, lky, c: MfCoefficients, ops):
+    """``(left, right)`` ``TyreForce`` of an axle's two tyres, each at its own longitudinal
+    slip ``kappas[i]`` and load ``loads[i]``, sharing the slip angle (``alpha`` is its
+    tangent), on a road of friction ``mu`` (LMUX = mu / PDX1, LMUY = mu / PDY1); ``c``
     symmetric. Two adaptations for the plant (docs/chassis.md): the combined-slip weights
     take the slips over ``mu`` (the peak slips scale with the friction, B = K / (C D)) at the
     axle's mean load (they depend on it only through REX2, REY2); each tyre's force is kept
     inside the ellipse of its pure-slip peaks, ``(Fx / Dx)^2 + (Fy / Dy)^2 <= 1``."""
     mean = 0.5 * (loads[0] + loads[1])
-    gx = weight_x(kappa / mu, alpha / mu, mean, c, ops)
-    gy = weight_y(kappa / mu, alpha / mu, mean, c, ops)
     out = []
-    for fz in loads:
+    for kappa, fz in zip(kappas, loads):
+        gx = weight_x(kappa / mu, alpha / mu, mean, c, ops)
+        gy = weight_y(kappa / mu, alpha / mu, mean, c, ops)
         fx0 = pure_fx(kappa, fz, mu / c.pdx1, c, ops)
         fy0 = pure_fy(alpha, fz, mu / c.pdy1, lky, c, ops)
         fx, fy = gx * fx0.force_n, gy * fy0.force_n
         load = ops.fmax(fz, FZ_MIN_N)
-        ex, ey = fx / (fx0.mu * load), fy / (fy0.mu * load)
+        dx, dy = fx0.mu * load, fy0.mu * load
+        ex, ey = fx / dx, fy / dy
         scale = 1.0 / ops.fmax(ops.sqrt(ex * ex + ey * ey), 1.0)
-        out.append((fx * scale, fy * scale))
+        out.append(TyreForce(fx * scale, fy * scale, dx, dy))
     return out[0], out[1]
 
 

@@ -9,16 +9,19 @@ its offline model leaves out (docs/chassis.md has the equations and sources)::
     J omega_i'     = T_drive_i - r_w Fx_i          (brake and rolling resistance: integrator)
 
 Each axle's force is the sum of its two tyres' combined-slip Magic Formula forces
-(``magic_formula.py``), each at its own load: quasi-static longitudinal and lateral load
-transfer (roll stiffness shared by ``roll_stiffness_front_share``) from the accelerations
-lagged by ``LOAD_TRANSFER_LAG_S``. ``M_lr`` is the moment of the left/right longitudinal
-force difference (load transfer, ESC). Both tyres of an axle share its slips (single-track
-kinematics): the longitudinal slip and the slip angle are relaxed states (relaxation lengths,
-Pacejka 2012 sec. 7.2), with a low-speed damping so the car rests without ringing.
+(``magic_formula.py``), each at its own load and its own longitudinal slip (wheel spin per
+wheel, contact-patch speeds -/+ r track / 2), the axle sharing the slip angle: quasi-static
+longitudinal and lateral load transfer (roll stiffness shared by ``roll_stiffness_front_share``)
+from the accelerations lagged by ``LOAD_TRANSFER_LAG_S``. ``M_lr`` is the moment of the
+left/right longitudinal force difference (load transfer, brakes, ESC). The slips are relaxed
+states (relaxation lengths, Pacejka 2012 sec. 7.2), with a low-speed damping so the car rests
+without ringing. Steering compliance turns the road wheels back by ``Fy_f / k_s``.
 
-Brakes: line pressure per axle (build and dump rate limits, ABS per axle), a fixed
-proportioning ``brake_front_share`` (front axle locks first, UN R13-H Annex 5); ESC brakes one
-wheel; the drive force is wheel torque on the driven axle(s) (``drivetrain``).
+Brakes: a pressure per wheel (build and dump rate limits, ABS per wheel), the driver's line
+pressure equal on both sides of an axle, a fixed proportioning ``brake_front_share`` (front
+axle locks first, UN R13-H Annex 5); ESC adds pressure on one wheel, so its force comes
+through that tyre's slip and friction ellipse; the drive force is wheel torque on the driven
+axle(s) (``drivetrain``), half to each wheel.
 
 ``x``, ``u`` are sequences of scalars (floats, or CasADi SX/MX elements) in the order of
 ``STATE_NAMES`` and ``INPUT_NAMES``; ``mu`` is the peak surface friction under the vehicle.
@@ -31,7 +34,10 @@ from typing import Any, NamedTuple
 from eoam_sumo.params import AIR_DENSITY_KGPM3, G_MPS2, VehicleParams
 from eoam_sumo.plant import chassis as ch_
 from eoam_sumo.plant.chassis import Chassis, constants
-from eoam_sumo.plant.magic_formula import axle_forces
+from eoam_sumo.plant.magic_formula import FZ_MIN_N, axle_forces
+
+WHEELS = ("fl", "fr", "rl", "rr")
+"""The wheels, in the order of every per-wheel state and output (``tyre_loads_n``'s)."""
 
 STATE_NAMES = (
     "x_m",
@@ -42,17 +48,15 @@ STATE_NAMES = (
     "yaw_rate_radps",
     "steer_rad",
     "drive_force_n",
-    "brake_pressure_front_bar",
-    "brake_pressure_rear_bar",
-    "wheel_spin_front_radps",
-    "wheel_spin_rear_radps",
-    "slip_front",
-    "slip_rear",
+    *(f"brake_pressure_{w}_bar" for w in WHEELS),
+    *(f"wheel_spin_{w}_radps" for w in WHEELS),
+    *(f"slip_{w}" for w in WHEELS),
     "tan_slip_angle_front",
     "tan_slip_angle_rear",
     "ax_load_mps2",
     "ay_load_mps2",
     "esc_moment_nm",
+    "esc_reference_radps",
 )
 INPUT_NAMES = ("steer_cmd_rad", "drive_force_cmd_n", "brake_force_cmd_n")
 OUTPUT_NAMES = (
@@ -77,28 +81,38 @@ OUTPUT_NAMES = (
     "brake_pressure_front_bar",
     "brake_pressure_rear_bar",
     "esc_moment_nm",
+    "road_wheel_angle_rad",
+    *(f"wheel_speed_{w}_mps" for w in WHEELS),
+    *(f"fz_{w}_n" for w in WHEELS),
+    *(f"friction_use_{w}" for w in WHEELS),
+    *(f"friction_ellipse_{w}" for w in WHEELS),
 )
-"""Body-frame accelerations (eqs. 4-5), lock flags (1.0: braking slip beyond ``LOCK_SLIP``),
-body-frame axle tyre forces, axle loads, relaxed slip angles, the drive force after the power
-limit and ESC, the aerodynamic drag, wheel speeds (omega r_w), longitudinal slips, line
-pressures and the ESC's yaw moment."""
+"""Body-frame accelerations (eqs. 4-5), lock flags (1.0: an axle's mean braking slip beyond
+``LOCK_SLIP``), body-frame axle tyre forces, axle loads, relaxed slip angles, the drive force
+after the power limit and ESC, the aerodynamic drag, the axles' mean wheel speeds (omega r_w),
+longitudinal slips and line pressures, the ESC's yaw moment, the road-wheel angle after the
+steering compliance; per wheel: its speed, load, ``|F| / (mu Fz)`` against the road's mu and
+``sqrt((Fx/Dx)^2 + (Fy/Dy)^2)`` against its own friction ellipse."""
 
-(X, Y, YAW, VX, VY, YAW_RATE, STEER, DRIVE, P_FRONT, P_REAR) = range(10)
-(OMEGA_F, OMEGA_R, SLIP_F, SLIP_R, TAN_F, TAN_R, AX_LOAD, AY_LOAD, ESC) = range(10, 19)
-BRAKE = P_FRONT  # the first brake state (kept for callers of the former single state)
+(X, Y, YAW, VX, VY, YAW_RATE, STEER, DRIVE) = range(8)
+PRESSURES = (8, 9, 10, 11)
+OMEGAS = (12, 13, 14, 15)
+SLIPS = (16, 17, 18, 19)
+(TAN_F, TAN_R, AX_LOAD, AY_LOAD, ESC, ESC_REF) = range(20, 26)
 STEER_CMD, DRIVE_CMD, BRAKE_CMD = range(len(INPUT_NAMES))
 
 LOCK_SLIP = -0.5
-"""An axle counts as locked while its braking slip is beyond this."""
+"""An axle counts as locked while its mean braking slip is beyond this."""
 
 
 class Axle(NamedTuple):
-    """One axle: its force on the body (BODY frame), its tyres' longitudinal force (wheel
-    frame, for the wheel spin), the moment of the left/right force difference, its load."""
+    """One axle: its force on the body (BODY frame), its tyres' wheel-frame forces (for the
+    wheel spins and the friction use), the moment of the left/right force difference, its
+    load."""
 
     fx_n: Any
     fy_n: Any
-    fx_wheel_n: Any
+    tyres: tuple
     moment_nm: Any
     fz_n: Any
 
@@ -109,6 +123,8 @@ class _Forces(NamedTuple):
     drive_n: Any
     drag_n: Any
     esc_nm: Any
+    steer_rad: Any  # the road-wheel angle after the steering compliance
+    loads: tuple
 
 
 def tyre_loads_n(x, p: VehicleParams, ops):
@@ -129,51 +145,49 @@ def tyre_loads_n(x, p: VehicleParams, ops):
     )
 
 
-def _esc_brake(force, fz, esc_n, mu, ops):
-    """A tyre's wheel-frame ``(Fx, Fy)`` with ESC's braking force on it, capped by
-    ``ESC_WHEEL_SHARE`` of its friction, its lateral force derated by the ellipse."""
-    if esc_n is None:
-        return force
-    capacity = mu * ops.fmax(fz, 1.0)
-    esc = ops.fmin(esc_n, ch_.ESC_WHEEL_SHARE * capacity)
-    ratio = esc / capacity
-    return force[0] - esc, force[1] * ops.sqrt(1.0 - ratio * ratio)
-
-
-def _axle(x, slip_i, tan_i, loads, esc, steer_cs, mu, lky, p, ch: Chassis, ops) -> Axle:
-    """The axle's two tyres (own loads, shared slips) summed; front ones rotated by the
-    road-wheel angle ``steer_cs = (cos, sin)``."""
-    alpha = x[tan_i]  # MF's slip-angle measure is tan(alpha) (Pacejka 2012 eq. 4.E3)
-    left, right = axle_forces(x[slip_i], alpha, loads, mu, lky, ch.tyre, ops)
-    fx0_l, fx0_r = left[0], right[0]
-    fx_l, fy_l = _esc_brake(left, loads[0], esc[0], mu, ops)
-    fx_r, fy_r = _esc_brake(right, loads[1], esc[1], mu, ops)
-    fx, fy = fx_l + fx_r, fy_l + fy_r
+def _axle(kappas, alpha, loads, steer_cs, mu, lky, p: VehicleParams, ch: Chassis, ops) -> Axle:
+    """The axle's two tyres (own loads, own longitudinal slips, the axle's slip angle) summed;
+    front ones rotated by the road-wheel angle ``steer_cs = (cos, sin)``."""
+    left, right = axle_forces(kappas, alpha, loads, mu, lky, ch.tyre, ops)
+    fx, fy = left.fx_n + right.fx_n, left.fy_n + right.fy_n
     c, s = steer_cs
     return Axle(
         fx_n=fx * c - fy * s,
         fy_n=fx * s + fy * c,
-        fx_wheel_n=fx0_l + fx0_r,
-        moment_nm=0.5 * p.track_m * (fx_r - fx_l) * c,
+        tyres=(left, right),
+        moment_nm=0.5 * p.track_m * (right.fx_n - left.fx_n) * c,
         fz_n=loads[0] + loads[1],
     )
 
 
 def _forces(x, mu, p: VehicleParams, ops) -> _Forces:
+    """The tyres' forces at state ``x``: the rear axle's, the front one's, whose lateral
+    force turns the road wheels back by the steering compliance (``compliant_steer``)."""
     ch = constants(p)
-    vx, r = x[VX], x[YAW_RATE]
     loads = tyre_loads_n(x, p, ops)
-    steer_cs = (ops.cos(x[STEER]), ops.sin(x[STEER]))
-    none = (None, None, None, None)
+    k = [x[i] for i in SLIPS]
+    rear = _axle(k[2:], x[TAN_R], loads[2:], (1.0, 0.0), mu, ch.lky_rear, p, ch, ops)
+    front_wheel = _axle(k[:2], x[TAN_F], loads[:2], (1.0, 0.0), mu, ch.lky_front, p, ch, ops)
+    steer = compliant_steer(x[STEER], front_wheel.fy_n, ch)
+    c, s = ops.cos(steer), ops.sin(steer)
+    fx_w, fy_w = front_wheel.fx_n, front_wheel.fy_n
+    front = front_wheel._replace(
+        fx_n=fx_w * c - fy_w * s, fy_n=fx_w * s + fy_w * c, moment_nm=front_wheel.moment_nm * c
+    )
+    vx = x[VX]
     esc_nm = x[ESC] if p.esc_fitted else 0.0
-    esc = ch_.esc_side_forces(esc_nm, r, p, ops) if p.esc_fitted else none
-    front = _axle(x, SLIP_F, TAN_F, loads[:2], esc[:2], steer_cs, mu, ch.lky_front, p, ch, ops)
-    rear = _axle(x, SLIP_R, TAN_R, loads[2:], esc[2:], (1.0, 0.0), mu, ch.lky_rear, p, ch, ops)
     drive_n = ops.fmin(x[DRIVE], p.max_drive_power_w / ops.fmax(vx, 1.0))
     if p.esc_fitted:
         drive_n = drive_n * ops.fmax(1.0 - ops.fabs(esc_nm) / ch_.ESC_TORQUE_CUT_NM, 0.0)
     drag_n = 0.5 * AIR_DENSITY_KGPM3 * p.drag_area_m2 * vx * ops.fabs(vx)
-    return _Forces(front, rear, drive_n, drag_n, esc_nm)
+    return _Forces(front, rear, drive_n, drag_n, esc_nm, steer, loads)
+
+
+def compliant_steer(steer_rad, fy_front_n, ch: Chassis):
+    """The road-wheel angle ``delta - Fy_f / k_s`` (Gillespie 1992 ch. 6, steering system
+    compliance): the front tyres' lateral force (wheel frame) turns the wheels back against
+    the steering's stiffness ``k_s``; the tyres' own curve is unchanged."""
+    return steer_rad - fy_front_n * ch.steer_compliance_rad_per_n
 
 
 def _body_accelerations(f: _Forces, p: VehicleParams):
@@ -182,37 +196,40 @@ def _body_accelerations(f: _Forces, p: VehicleParams):
     return ax, ay
 
 
-def wheel_velocities(x, p: VehicleParams, ops):
-    """``((v_long, v_lat) front, (v_long, v_lat) rear)``: the contact patches' velocities in
-    their wheel frames (single-track kinematics)."""
-    vx, vy_f = x[VX], x[VY] + p.cg_to_front_m * x[YAW_RATE]
-    c, s = ops.cos(x[STEER]), ops.sin(x[STEER])
-    return (vx * c + vy_f * s, -vx * s + vy_f * c), (vx, x[VY] - p.cg_to_rear_m * x[YAW_RATE])
+def wheel_velocities(x, steer, p: VehicleParams, ops):
+    """``(v_long per wheel, (v_lat front, v_lat rear))``: the contact patches' longitudinal
+    velocities in their wheel frames (FL, FR, RL, RR: each side ``-/+ r track / 2``), and the
+    lateral velocity of each axle's centre, at road-wheel angle ``steer``."""
+    vx, half = x[VX], 0.5 * p.track_m * x[YAW_RATE]
+    vy_f = x[VY] + p.cg_to_front_m * x[YAW_RATE]
+    c, s = ops.cos(steer), ops.sin(steer)
+    v_long = ((vx - half) * c + vy_f * s, (vx + half) * c + vy_f * s, vx - half, vx + half)
+    return v_long, (-vx * s + vy_f * c, x[VY] - p.cg_to_rear_m * x[YAW_RATE])
 
 
-def _slip_rates(x, p: VehicleParams, ch: Chassis, ops) -> list:
-    """Relaxation of the slips (Pacejka 2012 sec. 7.2.1): ``sigma kappa' = omega r_w - v_long
-    - v_eff kappa`` and ``sigma tan(alpha)' = v_lat - v_eff tan(alpha)``, ``v_eff = |v_long|``
-    plus the low-speed damping speed faded in below ``LOW_SPEED_MPS``."""
+def _slip_rates(x, steer, p: VehicleParams, ch: Chassis, ops) -> list:
+    """Relaxation of the slips (Pacejka 2012 sec. 7.2.1): per wheel ``sigma kappa' = omega
+    r_w - v_long - v_eff kappa``; per axle ``sigma tan(alpha)' = v_lat - v_eff tan(alpha)``;
+    ``v_eff = |v_long|`` plus the low-speed damping speed faded in below ``LOW_SPEED_MPS``."""
+    v_long, v_lat = wheel_velocities(x, steer, p, ops)
     rates = []
-    wheels = wheel_velocities(x, p, ops)
-    for (v_long, v_lat), omega_i, slip_i, tan_i in zip(
-        wheels, (OMEGA_F, OMEGA_R), (SLIP_F, SLIP_R), (TAN_F, TAN_R)
-    ):
-        v_abs = ops.fabs(v_long)
-        fade = ch_.low_speed_fade(v_abs, ops)
-        v_long_eff = v_abs + ch.damping_speed_long_mps * fade
-        v_lat_eff = v_abs + ch.damping_speed_lat_mps * fade
+    for v, omega_i, slip_i in zip(v_long, OMEGAS, SLIPS):
+        v_abs = ops.fabs(v)
+        v_eff = v_abs + ch.damping_speed_long_mps * ch_.low_speed_fade(v_abs, ops)
         rates.append(
-            (x[omega_i] * p.wheel_radius_m - v_long - v_long_eff * x[slip_i])
-            / p.relaxation_length_long_m
+            (x[omega_i] * p.wheel_radius_m - v - v_eff * x[slip_i]) / p.relaxation_length_long_m
         )
-        rates.append((v_lat - v_lat_eff * x[tan_i]) / p.relaxation_length_lat_m)
-    return rates  # slip front, tan front, slip rear, tan rear
+    for axle, tan_i in enumerate((TAN_F, TAN_R)):
+        v_abs = ops.fabs(0.5 * (v_long[2 * axle] + v_long[2 * axle + 1]))
+        v_eff = v_abs + ch.damping_speed_lat_mps * ch_.low_speed_fade(v_abs, ops)
+        rates.append((v_lat[axle] - v_eff * x[tan_i]) / p.relaxation_length_lat_m)
+    return rates  # slips FL, FR, RL, RR, tan front, tan rear
 
 
-def _actuator_rates(x, u, mu, p: VehicleParams, ch: Chassis, ops) -> list:
-    """Rates of steer (rate limited lag), drive force (lag) and the two line pressures."""
+def _actuator_rates(x, u, mu, steer, p: VehicleParams, ch: Chassis, ops) -> list:
+    """Rates of steer (rate limited lag), drive force (lag) and the four wheels' pressures:
+    the driver's line pressure on each (equal on the two sides of an axle), plus the ESC's on
+    one wheel (``chassis.esc_side_forces``), each through that wheel's ABS."""
     steer_target = ops.fmin(ops.fmax(u[STEER_CMD], -p.max_steer_rad), p.max_steer_rad)
     steer_rate = ops.fmin(
         ops.fmax((steer_target - x[STEER]) / p.steer_lag_s, -p.max_steer_rate_radps),
@@ -221,26 +238,29 @@ def _actuator_rates(x, u, mu, p: VehicleParams, ch: Chassis, ops) -> list:
     drive_target = ops.fmin(ops.fmax(u[DRIVE_CMD], 0.0), p.max_drive_force_n)
     brake_target = ops.fmin(ops.fmax(u[BRAKE_CMD], 0.0), p.max_brake_force_n)
     p_cmd = brake_target / ch.brake_n_per_bar
-    r_w = p.wheel_radius_m
-    wheels = wheel_velocities(x, p, ops)
-    return [
-        steer_rate,
-        (drive_target - x[DRIVE]) / p.drive_lag_s,
-        ch_.pressure_rate(p_cmd, x[P_FRONT], x[OMEGA_F] * r_w, wheels[0][0], mu, p, ch, ops),
-        ch_.pressure_rate(p_cmd, x[P_REAR], x[OMEGA_R] * r_w, wheels[1][0], mu, p, ch, ops),
-    ]
+    esc = ch_.esc_side_forces(x[ESC], x[YAW_RATE], p, ops) if p.esc_fitted else (0.0,) * 4
+    v_long, _ = wheel_velocities(x, steer, p, ops)
+    pressures = []
+    for i, (p_i, omega_i) in enumerate(zip(PRESSURES, OMEGAS)):
+        wheel_mps = x[omega_i] * p.wheel_radius_m
+        esc_bar = esc[i] / ch.wheel_brake_n_per_bar[i] if p.esc_fitted else 0.0
+        target = ch_.wheel_pressure_target(p_cmd, esc_bar, wheel_mps, v_long[i], mu, p, ch, ops)
+        pressures.append(ch_.pressure_rate(target, x[p_i], wheel_mps, v_long[i], mu, p, ch, ops))
+    return [steer_rate, (drive_target - x[DRIVE]) / p.drive_lag_s, *pressures]
 
 
 def _wheel_rates(x, f: _Forces, p: VehicleParams, ch: Chassis, ops) -> list:
     """Wheel spin rates without the brake and rolling-resistance torques (the integrator
-    applies those as Coulomb friction, ``integrator.resist``)."""
-    share = ch_.front_drive_share(x[SLIP_F], x[SLIP_R], p, ch, ops)
-    torque_n = f.drive_n * p.wheel_radius_m
-    j = ch.axle_inertia_kgm2
-    return [
-        (share * torque_n - p.wheel_radius_m * f.front.fx_wheel_n) / j,
-        ((1.0 - share) * torque_n - p.wheel_radius_m * f.rear.fx_wheel_n) / j,
-    ]
+    applies those as Coulomb friction, ``integrator.resist``); an open differential gives
+    each wheel of an axle half its drive torque."""
+    slip_f = 0.5 * (x[SLIPS[0]] + x[SLIPS[1]])
+    slip_r = 0.5 * (x[SLIPS[2]] + x[SLIPS[3]])
+    share = ch_.front_drive_share(slip_f, slip_r, p, ch, ops)
+    half_torque = 0.5 * f.drive_n * p.wheel_radius_m
+    tyres = (*f.front.tyres, *f.rear.tyres)
+    shares = (share, share, 1.0 - share, 1.0 - share)
+    j = p.wheel_inertia_kgm2
+    return [(s * half_torque - p.wheel_radius_m * t.fx_n) / j for s, t in zip(shares, tyres)]
 
 
 def rhs(x, u, mu, params: VehicleParams, ops) -> list:
@@ -255,11 +275,12 @@ def rhs(x, u, mu, params: VehicleParams, ops) -> list:
     cos_yaw, sin_yaw = ops.cos(yaw), ops.sin(yaw)
     moment = p.cg_to_front_m * f.front.fy_n - p.cg_to_rear_m * f.rear.fy_n
     moment = moment + f.front.moment_nm + f.rear.moment_nm
-    slips = _slip_rates(x, p, ch, ops)
-    esc_rate = 0.0
+    slips = _slip_rates(x, f.steer_rad, p, ch, ops)
+    esc_rate = ref_rate = 0.0
     if p.esc_fitted:
-        target = ch_.esc_target_moment_nm(vx, vy, r, x[STEER], mu, p, ch, ops)
+        target = ch_.esc_target_moment_nm(vx, vy, r, x[ESC_REF], p, ops)
         esc_rate = (target - x[ESC]) / p.esc_lag_s
+        ref_rate = ch_.esc_reference_rate(vx, x[STEER], x[ESC_REF], mu, p, ch, ops)
     lag = ch_.LOAD_TRANSFER_LAG_S
     fx_tyres = (f.front.fx_n + f.rear.fx_n) / p.mass_kg
     return [
@@ -269,16 +290,25 @@ def rhs(x, u, mu, params: VehicleParams, ops) -> list:
         ax + vy * r,  # eq. 4
         ay - vx * r,  # eq. 5
         moment / p.yaw_inertia_kgm2,
-        *_actuator_rates(x, u, mu, p, ch, ops),
+        *_actuator_rates(x, u, mu, f.steer_rad, p, ch, ops),
         *_wheel_rates(x, f, p, ch, ops),
-        slips[0],
-        slips[2],
-        slips[1],
-        slips[3],
+        *slips,
         (fx_tyres - x[AX_LOAD]) / lag,
         (ay - x[AY_LOAD]) / lag,
         esc_rate,
+        ref_rate,
     ]
+
+
+def _tyre_use(f: _Forces, mu, ops) -> tuple[list, list]:
+    """Per wheel ``|F| / (mu Fz)`` (the road's mu) and ``sqrt((Fx/Dx)^2 + (Fy/Dy)^2)`` (the
+    tyre's own ellipse, at most 1)."""
+    use, ellipse = [], []
+    for t, fz in zip((*f.front.tyres, *f.rear.tyres), f.loads):
+        use.append(ops.sqrt(t.fx_n * t.fx_n + t.fy_n * t.fy_n) / (mu * ops.fmax(fz, FZ_MIN_N)))
+        ex, ey = t.fx_n / t.dx_n, t.fy_n / t.dy_n
+        ellipse.append(ops.sqrt(ex * ex + ey * ey))
+    return use, ellipse
 
 
 def outputs(x, mu, params: VehicleParams, ops) -> list:
@@ -287,11 +317,14 @@ def outputs(x, mu, params: VehicleParams, ops) -> list:
     f = _forces(x, mu, params, ops)
     ax, ay = _body_accelerations(f, params)
     r_w = params.wheel_radius_m
+    speeds = [x[i] * r_w for i in OMEGAS]
+    slip_f, slip_r = 0.5 * (x[SLIPS[0]] + x[SLIPS[1]]), 0.5 * (x[SLIPS[2]] + x[SLIPS[3]])
+    use, ellipse = _tyre_use(f, mu, ops)
     return [
         ax,
         ay,
-        ops.if_else(x[SLIP_F] < LOCK_SLIP, 1.0, 0.0),
-        ops.if_else(x[SLIP_R] < LOCK_SLIP, 1.0, 0.0),
+        ops.if_else(slip_f < LOCK_SLIP, 1.0, 0.0),
+        ops.if_else(slip_r < LOCK_SLIP, 1.0, 0.0),
         f.front.fx_n,
         f.front.fy_n,
         f.rear.fx_n,
@@ -302,11 +335,16 @@ def outputs(x, mu, params: VehicleParams, ops) -> list:
         ops.atan(x[TAN_R]),
         f.drive_n,
         f.drag_n,
-        x[OMEGA_F] * r_w,
-        x[OMEGA_R] * r_w,
-        x[SLIP_F],
-        x[SLIP_R],
-        x[P_FRONT],
-        x[P_REAR],
+        0.5 * (speeds[0] + speeds[1]),
+        0.5 * (speeds[2] + speeds[3]),
+        slip_f,
+        slip_r,
+        0.5 * (x[PRESSURES[0]] + x[PRESSURES[1]]),
+        0.5 * (x[PRESSURES[2]] + x[PRESSURES[3]]),
         f.esc_nm,
+        f.steer_rad,
+        *speeds,
+        *f.loads,
+        *use,
+        *ellipse,
     ]

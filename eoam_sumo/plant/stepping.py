@@ -8,19 +8,7 @@ import numpy as np
 
 from eoam_sumo.params import AIR_DENSITY_KGPM3, G_MPS2, VehicleParams, ego_e_class_sedan
 from eoam_sumo.plant.chassis import constants
-from eoam_sumo.plant.model import (
-    DRIVE,
-    OMEGA_F,
-    OMEGA_R,
-    P_FRONT,
-    P_REAR,
-    STATE_NAMES,
-    STEER,
-    VX,
-    YAW,
-    X,
-    Y,
-)
+from eoam_sumo.plant.model import DRIVE, OMEGAS, PRESSURES, STATE_NAMES, STEER, VX, YAW, X, Y
 
 MAX_DT_S = 0.002
 """Largest sub-step accepted: keeps the wheel-and-tyre mode (about 160 rad/s) and the slip
@@ -70,16 +58,23 @@ def initial_state(
     x = np.zeros(len(STATE_NAMES))
     x[X], x[Y], x[YAW], x[VX] = x_m, y_m, yaw_rad, speed_mps
     x[STEER], x[DRIVE] = steer_rad, drive_force_n
-    x[P_FRONT] = x[P_REAR] = brake_force_n / constants(p).brake_n_per_bar
-    x[OMEGA_F] = x[OMEGA_R] = speed_mps / p.wheel_radius_m
+    for i in PRESSURES:
+        x[i] = brake_force_n / constants(p).brake_n_per_bar
+    for i in OMEGAS:
+        x[i] = speed_mps / p.wheel_radius_m
     return x
 
 
-def brake_gains_n_per_bar(params: VehicleParams) -> tuple[float, float]:
-    """Road brake force [N] per bar of the front and of the rear line pressure (the plant's
-    fixed split, as ``integrator`` applies it)."""
-    per_bar = constants(params).brake_n_per_bar
-    return per_bar * params.brake_front_share, per_bar * (1.0 - params.brake_front_share)
+def brake_gains_n_per_bar(params: VehicleParams) -> tuple[float, float, float, float]:
+    """Road brake force [N] per bar of each wheel's pressure (``model.PRESSURES``: FL, FR, RL,
+    RR; the plant's fixed front/rear split, as ``integrator`` applies it)."""
+    return constants(params).wheel_brake_n_per_bar
+
+
+def brake_force_n(x, params: VehicleParams) -> float:
+    """The road brake force [N] the four wheels' pressures of state ``x`` apply."""
+    gains = constants(params).wheel_brake_n_per_bar
+    return sum(g * float(x[i]) for g, i in zip(gains, PRESSURES))
 
 
 def cruise_drive_force_n(params: VehicleParams, speed_mps: float) -> float:

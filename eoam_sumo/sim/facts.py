@@ -87,11 +87,15 @@ class RunFacts:
     sim_time_s: float = 0.0
     # the road's width right of the original lane: a lane there the ego may evade into
     right_width_m: float = 0.0
-    # rollover (``sim/vehicle.py``): SUMO time of the step a wheel lifted or the static
-    # stability limit was passed (None: never), which, and the smallest tyre load [N]
+    # rollover (``sim/vehicle.py``): SUMO time of the step both inner wheels had lifted or
+    # the static stability limit was passed (None: never), which, and the smallest tyre load
+    # [N]; the first single wheel lift (None: never), its tyre and the load's ay [m/s2]
     rollover_time_s: float | None = None
     rollover_cause: str = ""
     min_tyre_load_n: float = math.inf
+    wheel_lift_time_s: float | None = None
+    wheel_lift_tyre: str = ""
+    wheel_lift_ay_mps2: float = 0.0
 
 
 @mypyc_attr(native_class=False)  # a Python dataclass: built by hand in tests
@@ -198,6 +202,9 @@ def collect_facts(sim: EndedRun) -> RunFacts:
         rollover_time_s=sim.rollover.time_s,
         rollover_cause=sim.rollover.cause,
         min_tyre_load_n=sim.rollover.min_load_n,
+        wheel_lift_time_s=sim.rollover.lift_time_s,
+        wheel_lift_tyre=sim.rollover.lift_tyre,
+        wheel_lift_ay_mps2=sim.rollover.lift_ay_mps2,
     )
 
 

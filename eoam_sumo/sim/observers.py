@@ -98,8 +98,8 @@ class TimeSeries(StepObserver):
 
     log: RunLog  # set when the run starts
 
-    def __init__(self, brake_gains: tuple[float, float]) -> None:
-        self._brake_gains = brake_gains  # road brake force per bar, front and rear [N/bar]
+    def __init__(self, brake_gains: tuple[float, ...]) -> None:
+        self._brake_gains = brake_gains  # road brake force per bar, per wheel [N/bar]
 
     def start(self, sim: RunView) -> None:
         self.log = RunLog(sim.max_steps + 1, self._brake_gains)
@@ -149,13 +149,15 @@ class Extremes(StepObserver):
 
 class RolloverWatch(StepObserver):
     """Rollover, a loss of control (``sim/vehicle.py``): ``time_s`` the SUMO time at the end
-    of the first step in which the normal load of an inner tyre (one the lateral load
-    transfer unloads) reached zero under the plant's load transfer (a wheel lifted) or
-    ``|ay|`` passed the static stability limit (None: never), and
-    ``cause`` which; ``min_load_n`` the smallest normal load of any tyre at a step's end.
+    of the first step in which both inner tyres (front and rear of the side the lateral load
+    transfer unloads) had lost their normal load under the plant's load transfer, or ``|ay|``
+    passed the static stability limit (None: never), and ``cause`` which. A single inner wheel
+    lifting is no rollover: ``lift_time_s`` (None: never), ``lift_tyre`` and ``lift_ay_mps2``
+    report the first. ``min_load_n`` is the smallest normal load of any tyre at a step's end.
 
     The loads are ``static_n[i] + per_ax[i] ax + per_ay[i] ay`` (``vehicle.RolloverLimits``)
-    with ``ax``, ``ay`` the plant's load accelerations, states ``ax_index`` and ``ay_index``."""
+    with ``ax``, ``ay`` the plant's load accelerations, states ``ax_index`` and ``ay_index``;
+    tyres in the order FL, FR, RL, RR."""
 
     def __init__(
         self,
@@ -174,9 +176,13 @@ class RolloverWatch(StepObserver):
         self.time_s: float | None = None
         self.cause = ""
         self.min_load_n = math.inf
+        self.lift_time_s: float | None = None
+        self.lift_tyre = ""
+        self.lift_ay_mps2 = 0.0
 
     def start(self, sim: RunView) -> None:
         self.time_s, self.cause, self.min_load_n = None, "", math.inf
+        self.lift_time_s, self.lift_tyre, self.lift_ay_mps2 = None, "", 0.0
 
     def after_step(self, sim: RunView) -> None:
         if self.time_s is not None:
@@ -184,17 +190,23 @@ class RolloverWatch(StepObserver):
         x = sim.x
         ax, ay = x[self._ax_index], x[self._ay_index]
         static, per_ax, per_ay = self._static, self._per_ax, self._per_ay
-        low, lifted = math.inf, -1
+        low = math.inf
+        lifted = [False, False, False, False]
         for i in range(4):
             load = static[i] + per_ax[i] * ax + per_ay[i] * ay
             low = min(low, load)
-            if load <= 0.0 and per_ay[i] * ay < 0.0:  # an inner wheel: the roll unloads it
-                lifted = i
+            lifted[i] = load <= 0.0 and per_ay[i] * ay < 0.0  # inner: the roll unloads it
         self.min_load_n = min(self.min_load_n, max(low, 0.0))
-        if lifted >= 0:
-            self.time_s = sim.t
-            self.cause = f"wheel lift (inner {self._tyres[lifted]} tyre unloaded)"
-        elif abs(sim.ay) > self._ssf_ay_mps2:
+        if self.lift_time_s is None and any(lifted):
+            self.lift_time_s, self.lift_ay_mps2 = sim.t, ay
+            self.lift_tyre = self._tyres[lifted.index(True)]
+        for front, rear in ((0, 2), (1, 3)):
+            if lifted[front] and lifted[rear]:
+                self.time_s = sim.t
+                side = self._tyres[front].split()[-1]
+                self.cause = f"both inner {side} wheels lifted"
+                return
+        if abs(sim.ay) > self._ssf_ay_mps2:
             self.time_s = sim.t
             self.cause = (
                 f"lateral acceleration {abs(sim.ay):.1f} m/s2 beyond the static stability "

@@ -76,8 +76,8 @@ class RunLog:
     doubling, so that a huge time limit costs nothing up front); ``add`` keeps one step,
     ``array()`` / ``frame()`` give the table."""
 
-    def __init__(self, rows: int, brake_gains: tuple[float, float]):
-        """``brake_gains``: road brake force per bar of the front and rear line pressures
+    def __init__(self, rows: int, brake_gains: tuple[float, ...]):
+        """``brake_gains``: road brake force per bar of each wheel's pressure
         (``plant.stepping.brake_gains_n_per_bar`` of the ego)."""
         self._limit = rows
         self._brake_gains = brake_gains
@@ -155,9 +155,9 @@ _FROM_STATE = {
     "steer_rad": 6,
     "drive_force_n": 7,
 }
-#: the plant states of the front and rear line pressures [bar]: ``brake_force_n`` is the road
-#: brake force they apply (``plant.stepping.brake_gains_n_per_bar``)
-_BRAKE_PRESSURES = (8, 9)
+#: the plant states of the four wheels' pressures [bar] (``plant.model.PRESSURES``):
+#: ``brake_force_n`` is the road brake force they apply (``plant.stepping.brake_gains_n_per_bar``)
+_BRAKE_PRESSURES = (8, 9, 10, 11)
 _FROM_MEAS = {
     "time_s": "time_s",
     "ax_mps2": "ax_mps2",
@@ -191,7 +191,7 @@ _SECTOR = "sector"  # the command's DMM sector letter, stored as its character c
 _ROAD_MU = "mu"  # the road's friction under the ego
 
 
-def _table(rows: list, brake_gains: tuple[float, float]) -> np.ndarray:
+def _table(rows: list, brake_gains: tuple[float, ...]) -> np.ndarray:
     """The (n, len(COLUMNS)) float array of logged steps, each column filled by name."""
     out = np.full((len(rows), len(COLUMNS)), _NAN)
     for i, name in enumerate(COLUMNS):
@@ -199,15 +199,15 @@ def _table(rows: list, brake_gains: tuple[float, float]) -> np.ndarray:
     return out
 
 
-def _column(rows: list, name: str, brake_gains: tuple[float, float]) -> np.ndarray:
+def _column(rows: list, name: str, brake_gains: tuple[float, ...]) -> np.ndarray:
     """One column of the logged steps (``_table``'s, without the rest: a run's summary reads
     four of the 34)."""
     if name in _FROM_STATE:
         k = _FROM_STATE[name]
         return np.array([r[1][k] for r in rows], dtype=float)
     if name == "brake_force_n":
-        (front, rear), (i, j) = brake_gains, _BRAKE_PRESSURES
-        return np.array([front * r[1][i] + rear * r[1][j] for r in rows], dtype=float)
+        pairs = tuple(zip(brake_gains, _BRAKE_PRESSURES))
+        return np.array([sum(g * r[1][i] for g, i in pairs) for r in rows], dtype=float)
     if name in _FROM_MEAS:
         get = attrgetter(_FROM_MEAS[name])
         return np.array([get(r[0]) for r in rows], dtype=float)

@@ -85,8 +85,15 @@ class RunSummary:
     )
     end_cause: str = _doc("contact, rollover, settled, road_end or time_limit")
     rollover_time_s: float | None = _doc(
-        "SUMO time a wheel lifted or |ay| passed the static stability limit g track / (2 h) "
-        "(empty: never)"
+        "SUMO time both inner wheels had lifted or |ay| passed the static stability limit "
+        "g track / (2 h) (empty: never)"
+    )
+    wheel_lift_time_s: float | None = _doc(
+        "SUMO time one inner wheel first lifted, not a loss of control (empty: never)"
+    )
+    wheel_lift_tyre: str = _doc("the tyre that lifted first (front left, ...; empty: none)")
+    wheel_lift_ay_mps2: float | None = _doc(
+        "the load-transfer lateral acceleration at the first wheel lift (empty: none)"
     )
     min_tyre_load_n: float | None = _doc(
         "smallest normal load of any tyre under the plant's load transfer (0: a wheel lifted)"

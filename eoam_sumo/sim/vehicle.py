@@ -12,13 +12,14 @@ tables); a run whose ABS is not the vehicle file's has ``-abs`` or ``-noabs`` af
 [--abs on|off]`` builds them there; a run refuses a vehicle whose folder holds no tables or
 tables built for other parameters (``offline.tables.LookupTables.load``).
 
-Rollover (a loss of control, ``sim/outcome.py``): a wheel lifts when the normal load of an
-inner tyre (one the lateral transfer unloads) reaches zero under the plant's quasi-static load
+Rollover (a loss of control, ``sim/outcome.py``): both inner wheels (front and rear of the side
+the lateral transfer unloads) have lost their normal load under the plant's quasi-static load
 transfer (``plant.model.tyre_loads_n``: static, plus ``m ax h / L`` along and
 ``m ay h / track`` across, shared between the axles by the roll stiffness), or the lateral
 acceleration exceeds the static stability limit of the rigid vehicle, ``|ay| > g track / (2 h)``
-(the static stability factor, Gillespie, *Fundamentals of Vehicle Dynamics*, 1992, ch. 9). A
-rear wheel unloaded by braking alone (pitch, no roll) is not a rollover.
+(the static stability factor, Gillespie, *Fundamentals of Vehicle Dynamics*, 1992, ch. 9). One
+inner wheel lifting is reported, not a loss of control; a rear wheel unloaded by braking alone
+(pitch, no roll) is neither.
 """
 
 from __future__ import annotations

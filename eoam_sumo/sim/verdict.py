@@ -136,6 +136,11 @@ def _margin_fields(facts: RunFacts) -> dict[str, Any]:
         "passed_obstacle": facts.passed_obstacle,
         "end_cause": facts.end_cause,
         "rollover_time_s": facts.rollover_time_s,
+        "wheel_lift_time_s": facts.wheel_lift_time_s,
+        "wheel_lift_tyre": facts.wheel_lift_tyre,
+        "wheel_lift_ay_mps2": (
+            None if facts.wheel_lift_time_s is None else rounded(facts.wheel_lift_ay_mps2)
+        ),
         "min_tyre_load_n": finite_or_none(facts.min_tyre_load_n, 1),
     }
 

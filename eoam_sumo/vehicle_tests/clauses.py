@@ -17,13 +17,23 @@ Sources (found in the regulations' public texts and NHTSA's papers on them):
   disconnected, 100 km/h): stopping distance at most ``0.1 v + 0.0060 v^2`` (70 m; FMVSS 135
   S7.5 gives the same 70 m from 100 km/h). Annex 5 (distribution of braking among the axles,
   Appendix 1 wheel-lock sequence): for all braking rates between 0.15 and 0.8 the front wheels
-  lock simultaneously with or before the rear wheels. Annex 6 (anti-lock systems, Appendix 2):
+  lock simultaneously with or before the rear wheels; the pedal force is raised so that the
+  first axle locks between 0.5 s and 1 s after braking begins, from 65 km/h on a surface of
+  adhesion up to 0.5 and from 100 km/h above (as issue 38 quotes the Appendix; the search
+  corpora held neither R13-H's Annex 5 text, so these figures are not checked against it).
+  Annex 6 (anti-lock systems, Appendix 2):
   utilisation of adhesion, at least 0.75.
 - ISO 4138 (passenger cars, steady-state circular driving behaviour, open-loop): the constant
   speed method with a slowly increasing steer; understeer gradient and the maximum lateral
   acceleration. ISO 7401:2011 sec. 10 (lateral transient response, step input): yaw-rate gain,
   response time (from 50 % of the steering input to 90 % of the steady-state response), peak
   response time and overshoot. Neither ISO method sets a pass mark: their figures are reported.
+- ISO 7975:2019 (passenger cars, braking in a turn, open-loop): how the steady-state circular
+  response is altered by braking only. Initial radius 100 m, initial lateral acceleration
+  5 m/s^2, the steering held, brake decelerations in steps; the figures taken 1 s after the
+  brake's onset. (The scope is from ISO's public page; the radius, lateral acceleration and
+  measuring time are the commonly cited values, not checked against the standard's text.)
+  The deceleration step of 1 m/s^2 is ours (a short series). No pass mark.
 """
 
 from __future__ import annotations
@@ -55,10 +65,16 @@ MFDD_TO_FRACTION = 0.1  # R13-H Annex 3 para. 1.1.2: ve = 0.1 v0
 ADHESION_UTILISATION_MIN = 0.75  # R13-H Annex 6 (with ABS)
 LOCK_ORDER_RATE_MIN = 0.15  # R13-H Annex 5: braking rates 0.15 ...
 LOCK_ORDER_RATE_MAX = 0.8  # ... to 0.8: front locks first or together
+LOCK_SEQUENCE_FIRST_LOCK_S = (0.5, 1.0)  # R13-H Annex 5 App. 1: first axle locks 0.5-1 s in
+LOCK_SEQUENCE_LOW_MU = 0.5  # R13-H Annex 5 App. 1: from 65 km/h at or below, else 100 km/h
 
 STEP_SPEED_KMH = 80.0  # ISO 7401 sec. 10 (standard test speed)
 STEP_AY_MPS2 = 4.0  # ISO 7401 sec. 10 (steady-state lateral acceleration)
 RAMP_SPEED_KMH = 80.0  # ISO 4138 constant speed method (one of the speeds it allows)
+TURN_BRAKE_RADIUS_M = 100.0  # ISO 7975 (initial radius)
+TURN_BRAKE_AY_MPS2 = 5.0  # ISO 7975 (initial lateral acceleration)
+TURN_BRAKE_MEASURE_S = 1.0  # ISO 7975 (figures 1 s after the brake's onset)
+TURN_BRAKE_DECEL_STEP_MPS2 = 1.0  # ours: the series' deceleration step
 
 #: Ours: test speeds accepted [km/h], walking pace to 300 km/h, where the tyres' shortest
 #: admitted relaxation length (0.05 m, ``params.VEHICLE_RANGES``) still spans 0.6 ms, above
@@ -78,6 +94,9 @@ CITE = {
     "mfdd": "UN R13-H Annex 3 para. 1.1.2 (R13 Annex 4 para. 1.1.2)",
     "adhesion": "UN R13-H Annex 6 Appendix 2 (utilisation of adhesion, ABS)",
     "lock_order": "UN R13-H Annex 5 Appendix 1 (wheel-lock sequence)",
+    "lock_sequence": "UN R13-H Annex 5 Appendix 1 (pedal force raised so that the first axle "
+    "locks 0.5-1 s after braking begins; 65 km/h at mu <= 0.5, else 100 km/h)",
     "ramp": "ISO 4138 (steady-state circular driving, constant speed, slowly increasing steer)",
     "step": "ISO 7401:2011 sec. 10 (step input)",
+    "turn_brake": "ISO 7975:2019 (braking in a turn, open-loop)",
 }

@@ -16,7 +16,14 @@ from eoam_sumo.params import MU_MAX
 from eoam_sumo.vehicle_files import load_vehicle
 from eoam_sumo.vehicle_tests.clauses import TEST_MU_MIN, TEST_SPEED_RANGE_KMH
 
-TEST_NAMES = ("brake", "brake-ramp", "ramp-steer", "sine-with-dwell", "step-steer")
+TEST_NAMES = (
+    "brake",
+    "brake-in-turn",
+    "brake-ramp",
+    "ramp-steer",
+    "sine-with-dwell",
+    "step-steer",
+)
 """The tests (``procedures.TESTS``; named here so the command line starts without the plant)."""
 
 

@@ -18,7 +18,8 @@ import numpy as np
 
 from eoam_sumo.params import VehicleParams
 from eoam_sumo.plant import OUTPUT_NAMES, STATE_NAMES, Plant, initial_state
-from eoam_sumo.plant.stepping import brake_gains_n_per_bar
+from eoam_sumo.plant.model import WHEELS
+from eoam_sumo.plant.stepping import brake_force_n
 from eoam_sumo.vehicle_tests.equipment import wheel_speeds
 
 COLUMNS = (
@@ -36,6 +37,9 @@ COLUMNS = (
     "wheel_speed_rear_mps",
     "drive_force_n",
     "brake_force_n",
+    "friction_use_max",
+    "friction_ellipse_max",
+    "wheel_speed_min_mps",
 )
 """The columns of a run's time series (``timeseries.csv``), in order."""
 
@@ -59,6 +63,9 @@ class Sample(NamedTuple):
     wheel_speed_rear_mps: float
     drive_force_n: float
     brake_force_n: float
+    friction_use_max: float = math.nan  # the largest tyre |F| / (mu Fz) (NaN: not modelled)
+    friction_ellipse_max: float = math.nan  # the largest tyre sqrt((Fx/Dx)^2 + (Fy/Dy)^2)
+    wheel_speed_min_mps: float = math.nan  # the slowest of the four wheels (omega r_w)
 
 
 class Controls(NamedTuple):
@@ -86,6 +93,9 @@ Stop = Callable[[float, Sample], bool]
 
 _STATE = {name: i for i, name in enumerate(STATE_NAMES)}
 _OUTPUT = {name: i for i, name in enumerate(OUTPUT_NAMES)}
+_USE = tuple(_OUTPUT[f"friction_use_{w}"] for w in WHEELS)
+_ELLIPSE = tuple(_OUTPUT[f"friction_ellipse_{w}"] for w in WHEELS)
+_WHEEL_SPEEDS = tuple(_OUTPUT[f"wheel_speed_{w}_mps"] for w in WHEELS)
 
 
 class PlantVehicle:
@@ -93,7 +103,6 @@ class PlantVehicle:
 
     def __init__(self, params: VehicleParams):
         self.params = params
-        self._brake_gains = brake_gains_n_per_bar(params)  # road force per bar, front/rear
         self._plant = Plant(params, dt_s=0.001, substeps=round(STEP_S / 0.001))
         self._x: list[float] = []
 
@@ -121,21 +130,19 @@ class PlantVehicle:
             wheel_speed_front_mps=front_mps,
             wheel_speed_rear_mps=rear_mps,
             drive_force_n=x[_STATE["drive_force_n"]],
-            brake_force_n=self._brake_force_n(x),
-        )
-
-    def _brake_force_n(self, x: list[float]) -> float:
-        """The brake force the line pressures apply at the road (both axles)."""
-        front, rear = self._brake_gains
-        return (
-            front * x[_STATE["brake_pressure_front_bar"]]
-            + rear * x[_STATE["brake_pressure_rear_bar"]]
+            brake_force_n=brake_force_n(x, self.params),
+            friction_use_max=max(outputs[i] for i in _USE),
+            friction_ellipse_max=max(outputs[i] for i in _ELLIPSE),
+            wheel_speed_min_mps=min(outputs[i] for i in _WHEEL_SPEEDS),
         )
 
 
 def rolling_start(speed_mps: float) -> Sample:
     """The sample of a vehicle at the origin rolling straight along +x at ``speed_mps``."""
-    return Sample(speed_mps, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, speed_mps, speed_mps, 0.0, 0.0)
+    return Sample(
+        speed_mps, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, speed_mps, speed_mps, 0.0, 0.0,
+        wheel_speed_min_mps=speed_mps,
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -180,5 +187,6 @@ def _row(t_s: float, s: Sample, steering_ratio: float) -> tuple[float, ...]:
     return (
         t_s, s.vx_mps, s.vy_mps, s.x_m, s.y_m, s.yaw_rad, s.yaw_rate_radps, steer_wheel_deg,
         s.ax_mps2, s.ay_mps2, s.wheel_speed_front_mps, s.wheel_speed_rear_mps,
-        s.drive_force_n, s.brake_force_n,
+        s.drive_force_n, s.brake_force_n, s.friction_use_max, s.friction_ellipse_max,
+        s.wheel_speed_min_mps,
     )  # fmt: skip

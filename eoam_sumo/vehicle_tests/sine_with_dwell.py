@@ -6,6 +6,7 @@ ratios (S5.2.1, S5.2.2) and, from 5 A, the lateral displacement (S5.2.3). Clause
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -34,6 +35,18 @@ COMPLETION_S = PERIOD_S + c.SWD_DWELL_S
 """Completion of steer, after the beginning of steer."""
 SPIN_YAW_DEG = 90.0
 """A run counts as a spin once the heading has turned this far from the start (ours)."""
+ROBOT_RATE_DEGPS = 1500.0
+"""The steering robot's hand-wheel rate limit [deg/s] (ours: above the 1188 deg/s the 270 deg
+sine of 0.7 Hz needs, 2 pi 0.7 x 270; FMVSS 126 S7.9 has the input made by a robot)."""
+ROBOT_LAG_S = 0.01
+"""The steering robot's lag [s] (ours: 0.1 % of the amplitude lost at 0.7 Hz)."""
+
+
+def steering_robot(params: VehicleParams) -> VehicleParams:
+    """``params`` steered by the test's robot (FMVSS 126 S7.9) in place of the vehicle's own
+    steering actuator (the EOAM's, rate limited): ``ROBOT_RATE_DEGPS``, ``ROBOT_LAG_S``."""
+    rate = math.radians(ROBOT_RATE_DEGPS) / params.steering_ratio
+    return dataclasses.replace(params, max_steer_rate_radps=rate, steer_lag_s=ROBOT_LAG_S)
 
 
 def sine_with_dwell_steer(t_s: float, amplitude: float) -> float:
@@ -104,7 +117,9 @@ def _swd_run(
     label: str,
 ) -> Run:
     """One sine-with-dwell run: speed held, then from the beginning of steer (``SETTLE_S``) the
-    throttle released and the hand wheel through ``sine_with_dwell_steer``."""
+    throttle released and the hand wheel through ``sine_with_dwell_steer`` by the steering
+    robot (``steering_robot``)."""
+    params = steering_robot(params)
     keep = speed_keeper(params, speed_mps)
     amp_rad = math.radians(amp_deg) / params.steering_ratio
 
@@ -154,6 +169,7 @@ def _judge(run: Run, amp_deg: float, a_deg: float) -> tuple[dict, list[dict]]:
         "run": label,
         "amplitude_deg": round(amp_deg, 3),
         "amplitude_A": round(amp_deg / a_deg, 3),
+        "peak_steer_wheel_deg": round(float(np.max(np.abs(run["steer_wheel_deg"]))), 3),
         "peak_yaw_rate_degps": round(math.degrees(ratios.peak_radps), 3),
         "yaw_ratio_1s": round(ratios.ratio_1s, 4),
         "yaw_ratio_1.75s": round(ratios.ratio_175s, 4),

@@ -115,10 +115,12 @@ def test_axle_forces_keep_inside_the_friction_ellipse_and_scale_with_mu(mu):
         dy = (tyre.pdy1 + tyre.pdy2 * dfz) / tyre.pdy1 * mu * fz
         for kappa in np.linspace(-1.0, 1.0, 41):
             for alpha in np.radians(np.linspace(-25.0, 25.0, 41)):
-                (fx, fy), _ = axle_forces(
-                    kappa, math.tan(alpha), (fz, fz), mu, 1.0, tyre, FLOAT_OPS
+                left, right = axle_forces(
+                    (kappa, -kappa), math.tan(alpha), (fz, fz), mu, 1.0, tyre, FLOAT_OPS
                 )
-                worst = max(worst, math.hypot(fx / dx, fy / dy))
+                for t in (left, right):
+                    assert t.dx_n == pytest.approx(dx) and t.dy_n == pytest.approx(dy)
+                    worst = max(worst, math.hypot(t.fx_n / dx, t.fy_n / dy))
     assert worst <= 1.0 + 1e-12
     assert worst > 0.98  # the peak is reached
 

@@ -43,7 +43,9 @@ def test_fiala_slope_at_zero_is_the_cornering_stiffness_and_it_saturates_at_the_
 
 @pytest.mark.parametrize("esc", [False, True])
 def test_casadi_form_of_the_model_equals_the_float_form(params, esc):
-    params = dataclasses.replace(params, esc_fitted=esc, abs_fitted=esc, drivetrain="eawd")
+    params = dataclasses.replace(
+        params, esc_fitted=esc, abs_fitted=esc, drivetrain="eawd", front_steer_compliance=0.75
+    )
     x = casadi.MX.sym("x", len(STATE_NAMES))
     u = casadi.MX.sym("u", len(INPUT_NAMES))
     mu = casadi.MX.sym("mu")
@@ -56,8 +58,9 @@ def test_casadi_form_of_the_model_equals_the_float_form(params, esc):
     )  # fmt: skip
     rng = np.random.default_rng(3)
     for _ in range(30):
-        lo = [-50, -50, -3, 0, -2, -0.8, -0.6, 0, 0, 0, 0, 0, -1, -1, -0.5, -0.5, -9, -9, -5e3]
-        hi = [50, 50, 3, 45, 2, 0.8, 0.6, 7000, 150, 150, 140, 140, 1, 1, 0.5, 0.5, 9, 9, 5e3]
+        lo = [-50, -50, -3, 0, -2, -0.8, -0.6, 0, *[0] * 8, *[-1] * 4, -0.5, -0.5, -9, -9, -5e3, -1]
+        hi = [50, 50, 3, 45, 2, 0.8, 0.6, 7000, *[150] * 4, *[140] * 4, *[1] * 4, 0.5, 0.5, 9, 9]
+        hi.extend([5e3, 1.0])
         xv = rng.uniform(lo, hi)
         uv = rng.uniform([-0.7, 0, 0], [0.7, 7000, 22000])
         muv = rng.uniform(0.1, 1.2)

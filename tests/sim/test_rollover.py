@@ -52,18 +52,26 @@ def _step(watch: RolloverWatch, ax: float, ay: float, t: float = 1.0) -> None:
     watch.after_step(SimpleNamespace(x=_state(ax, ay), ay=ay, t=t))
 
 
-def test_a_left_turn_lifts_an_inner_left_wheel_of_the_tall_car():
+def test_one_inner_wheel_lifting_is_reported_and_both_are_a_rollover():
     watch = _watch(TALL)
     watch.start(None)
     # the inner front wheel lifts when its share (0.6) of m ay h / track is half the front
-    # axle's load, m g b / (2 L): at ay = g b track / (1.2 L h), 4.44 m/s2 (SSF: 4.9 m/s2)
-    lift = G_MPS2 * TALL.cg_to_rear_m * TALL.track_m / (1.2 * TALL.wheelbase_m * 1.6)
-    _step(watch, 0.0, 0.99 * lift, t=1.0)
-    assert watch.time_s is None and watch.min_load_n > 0.0
-    _step(watch, 0.0, 1.01 * lift, t=1.01)
-    assert watch.time_s == 1.01
-    assert watch.cause == "wheel lift (inner front left tyre unloaded)"
+    # axle's load, m g b / (2 L): at ay = g b track / (1.2 L h), 4.44 m/s2; the inner rear
+    # when its share (0.4) is half the rear's, m g a / (2 L): at g a track / (0.8 L h)
+    h, t, wb = 1.6, TALL.track_m, TALL.wheelbase_m
+    front = G_MPS2 * TALL.cg_to_rear_m * t / (1.2 * wb * h)
+    rear = G_MPS2 * TALL.cg_to_front_m * t / (0.8 * wb * h)
+    assert front < rear
+    _step(watch, 0.0, 0.99 * front, t=1.0)
+    assert watch.lift_time_s is None and watch.min_load_n > 0.0
+    _step(watch, 0.0, 1.01 * front, t=1.01)
+    assert watch.time_s is None  # one wheel up: reported, no loss of control
+    assert watch.lift_time_s == 1.01 and watch.lift_tyre == "front left"
+    assert watch.lift_ay_mps2 == pytest.approx(1.01 * front)
     assert watch.min_load_n == 0.0
+    _step(watch, 0.0, 1.01 * rear, t=1.5)
+    assert watch.time_s == 1.5 and watch.cause == "both inner left wheels lifted"
+    assert watch.lift_time_s == 1.01  # the first lift is kept
 
 
 def test_braking_that_unloads_the_rear_without_roll_is_no_rollover():
@@ -99,7 +107,7 @@ def test_a_rollover_is_orange_without_contact_and_says_so():
     facts = _facts(
         modes_visited=(0, 1, 2),
         rollover_time_s=3.92,
-        rollover_cause="wheel lift (inner rear left tyre unloaded)",
+        rollover_cause="both inner left wheels lifted",
         end_cause="rollover",
         manoeuvre_running=True,
         max_abs_offset_m=0.2,
@@ -107,6 +115,6 @@ def test_a_rollover_is_orange_without_contact_and_says_so():
     )
     out = outcome_of(facts)
     assert out.colour == "orange" and out.collision_with == "none"
-    assert "rollover: wheel lift (inner rear left tyre unloaded) at t=3.92 s" in out.reason
+    assert "rollover: both inner left wheels lifted at t=3.92 s" in out.reason
     assert outcome_of(replace(facts, rollover_time_s=None)).colour != "orange"
     assert math.isinf(_facts(modes_visited=(0,)).min_tyre_load_n)

@@ -32,10 +32,13 @@ def test_the_catalogue_is_the_papers_car_and_the_corrected_vehicles():
 @pytest.mark.parametrize("name", CORRECTED)
 @pytest.mark.parametrize("mu", [1.0, 0.3])
 def test_without_abs_the_front_axle_locks_first(name, mu):
-    """UN R13-H Annex 5: front first (or together) for braking rates 0.15-0.8, on a slowly
-    rising brake; the lock comes below the road's friction (its peak at the loaded tyres)."""
+    """UN R13-H Annex 5: front first (or together) for braking rates 0.15-0.8, on the ramp
+    of Appendix 1 (first lock 0.5-1 s after braking begins, from 100 km/h, 65 km/h at mu 0.5
+    or less); the lock comes below the road's friction (its peak at the loaded tyres)."""
     params = equipped(load_vehicle(name), abs_on=False, esc_on=False)
     summary = TESTS["brake-ramp"](params, VehicleTestOptions(mu=mu)).summary
+    assert summary["speed_kmh"] == (100.0 if mu > 0.5 else 65.0)
+    assert 0.5 <= summary["figures"]["first_lock_time_s"] <= 1.0
     assert summary["figures"]["first_locked_axle"] == "front"
     assert 0.75 * mu < summary["figures"]["front_lock_braking_rate"] <= 1.05 * mu
     assert summary["passed"] is True

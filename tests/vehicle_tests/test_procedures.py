@@ -122,3 +122,12 @@ def test_wheel_speeds_are_the_plants_outputs():
     outputs[OUTPUT_NAMES.index("wheel_speed_front_mps")] = 12.5
     outputs[OUTPUT_NAMES.index("wheel_speed_rear_mps")] = 3.0
     assert wheel_speeds(outputs) == (12.5, 3.0)
+
+
+def test_the_steering_robot_reaches_every_sine_with_dwell_amplitude():
+    """FMVSS 126 S7.9's robot, not the EOAM's rate-limited actuator: the 270 deg run needs
+    2 pi 0.7 x 270 = 1188 deg/s at the hand wheel, and its peak is the amplitude."""
+    runs = TESTS["sine-with-dwell"](R13H, VehicleTestOptions()).summary["figures"]["runs"]
+    assert runs[-1]["amplitude_deg"] == 270.0
+    for run in runs:
+        assert run["peak_steer_wheel_deg"] == pytest.approx(run["amplitude_deg"], rel=0.002)
