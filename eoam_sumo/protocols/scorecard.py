@@ -136,7 +136,7 @@ def r152_lines(rows: list[dict]) -> list[str]:
         f"{c['warning_fail']} |"
         for c in scoring.verdict_counts(rows)
     ]
-    return [*lines, ""]
+    return [*lines, "", rules.R152_WARNING_SOURCE, ""]
 
 
 def unscored_lines(rows: list[dict]) -> list[str]:
