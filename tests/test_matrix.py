@@ -332,7 +332,7 @@ def test_check_matrix_refuses_a_stop_profile_for_a_scenario_without_an_aro(tmp_p
 
 def test_speeds_below_the_design_range_are_refused():
     tables = _Tables()
-    with pytest.raises(InputError, match=r"4.0 km/h is outside the tables' range \[5, 175\]"):
+    with pytest.raises(InputError, match=r"4.0 km/h is outside the design range \[5, 175\]"):
         tables.check_run(1.0, 4.0 / 3.6)
     tables.check_run(1.0, 5.0 / 3.6)  # the design range's floor (below the grid: braking only)
     tables.check_run(1.0, 15.0 / 3.6)

@@ -292,9 +292,9 @@ class LookupTables:
         top = self.speed_grid_mps[-1]
         if not low - 1e-9 <= speed_mps <= top + 1e-9:
             raise InputError(
-                f"ego speed {speed_mps * 3.6:.1f} km/h is outside the tables' "
-                f"range [{low * 3.6:.0f}, {top * 3.6:.0f}] km/h; rebuild with "
-                "`eoam-sumo tables --speeds-kmh ...`"
+                f"ego speed {speed_mps * 3.6:.1f} km/h is outside the design range "
+                f"[{low * 3.6:.0f}, {top * 3.6:.0f}] km/h (the top is the tables'; rebuild "
+                "with `eoam-sumo tables --speeds-kmh ...` to go higher)"
             )
         if mu < self.mu_grid[0] - 1e-9:
             raise InputError(

@@ -255,7 +255,7 @@ def test_braking_boundaries_below_the_grid_are_the_closed_form(tables, mu, kmh):
 def test_runs_outside_the_tables_are_refused(tables):
     tables.check_run(1.0, 5 / 3.6)  # the design range starts at 5 km/h
     tables.check_run(0.1, 10 / 3.6)
-    with pytest.raises(InputError, match=r"4\.0 km/h is outside the tables' range \[5, 175\]"):
+    with pytest.raises(InputError, match=r"4\.0 km/h is outside the design range \[5, 175\]"):
         tables.check_run(1.0, 4 / 3.6)
     tables.check_run(1.0, 175 / 3.6)
     tables.check_run(1.2, 55 / 3.6)
