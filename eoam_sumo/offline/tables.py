@@ -16,7 +16,8 @@ Interpolation rules:
   clamped to the top row above the highest (only an obstacle moving towards the ego closes
   faster than the ego drives, and runs above the grid are refused by ``check_run``);
 - trajectories in entry speed: linear within the grid, clamped to the lowest grid speed below
-  it (no lane change is chosen there for a closing speed below the grid, see above) and to
+  it (never read there: no STEER sector below the grid's closing speeds, and
+  ``EoamSettings.min_steer_speed_mps`` brakes a STEER sector below 20 km/h of ego speed) and to
   the highest above it (``check_run`` refuses runs above the grid);
 - in differential x: linear between the rows of the uniform grid; before 0 the first row,
   past the manoeuvre's end the final values (y = h, ax = 0, yaw = 0, curvature = 0, steer 0).
