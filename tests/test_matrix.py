@@ -330,11 +330,12 @@ def test_check_matrix_refuses_a_stop_profile_for_a_scenario_without_an_aro(tmp_p
         check_matrix(load_matrix(path))
 
 
-def test_speeds_below_the_tables_lowest_are_refused():
+def test_speeds_below_the_design_range_are_refused():
     tables = _Tables()
-    with pytest.raises(InputError, match=r"15.0 km/h is outside the tables' range \[20, 175\]"):
-        tables.check_run(1.0, 15.0 / 3.6)
-    tables.check_run(1.0, 20.0 / 3.6)  # the lowest itself is covered
+    with pytest.raises(InputError, match=r"4.0 km/h is outside the design range \[5, 175\]"):
+        tables.check_run(1.0, 4.0 / 3.6)
+    tables.check_run(1.0, 5.0 / 3.6)  # the design range's floor (below the grid: braking only)
+    tables.check_run(1.0, 15.0 / 3.6)
 
 
 def test_a_matrix_sampling_every_swept_key_needs_no_sweep_table(tmp_path):

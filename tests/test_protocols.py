@@ -405,8 +405,8 @@ def test_the_same_protocol_twice_gives_the_same_results(tmp_path):
 
     first, second = run(tmp_path / "a"), run(tmp_path / "b")
     pd.testing.assert_frame_equal(first, second)
-    assert list(first["status"]) == ["not_run", "ok", "ok"]
-    assert (tmp_path / "a" / "scorecard.md").read_text().count("below the tables' speed") == 1
+    assert list(first["status"]) == ["ok", "ok", "ok"]  # 10 km/h too: the design range's
+    assert "Not run" not in (tmp_path / "a" / "scorecard.md").read_text()
     assert not math.isnan(first["impact_speed_kmh"].iloc[1])
     assert set(first["system"]) == {"aeb"}
 
@@ -461,3 +461,26 @@ def test_run_facts_read_the_batch_text_columns():
     assert _facts(run, SEDAN_WIDTH_M) == scoring.RunFacts(False, False, False)
     run |= {"left_road": "True", "fcw_raised": "True", "modes_visited": "0-2"}
     assert _facts(run, SEDAN_WIDTH_M) == scoring.RunFacts(True, True, True)
+
+
+def test_every_protocol_point_is_in_the_design_range_the_10_kmh_ones_included():
+    """The design range starts at 5 km/h (``MIN_ENTRY_SPEED_KMH``): the runner's floor for the
+    sedan is 5 km/h, below the tables' 20 km/h, so no point of any protocol is left not run,
+    the 2026 CCRs cells at 10 km/h (the FC gate's) included."""
+    from eoam_sumo.offline.tables import MIN_ENTRY_SPEED_KMH
+    from eoam_sumo.params import ego_e_class_sedan
+    from eoam_sumo.protocols.runner import _design_low_kmh
+    from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
+
+    params = ego_e_class_sedan()
+    low = _design_low_kmh(None, DEFAULT_VEHICLE, params)
+    assert low == MIN_ENTRY_SPEED_KMH == 5.0
+    for name in PROTOCOLS:
+        speeds = [p.ego_speed_kmh for p in protocol_points(name, params.width_m)]
+        assert min(speeds) >= low, name
+    ccrs_10 = [
+        p
+        for p in protocol_points(PROTOCOLS[1], params.width_m)
+        if p.test == "CCRs" and p.ego_speed_kmh == 10.0
+    ]
+    assert len(ccrs_10) == 7

@@ -132,21 +132,29 @@ class BoundaryRow(NamedTuple):
     ttc_s: float  # T / v (eq. 34)
 
 
+#: Samples of the boundary curve between 0 and the lowest table speed (see ``BoundaryCurve``).
+LOW_SPEED_SAMPLES = 24
+
+
 class BoundaryCurve:
     """The DMM boundaries at one friction as plain floats at fixed closing speeds.
 
-    Built once per friction value from ``boundaries.at(mu, v)`` at v = 0 and the given speeds
-    (the tables' own speed grid, between which ``at`` is linear in v, so the curve is exact);
-    ``at`` and ``sector`` then cost a bisection and a linear blend. Above the last speed the
-    last row is used.
+    Built once per friction value from ``boundaries.at(mu, v)`` at the given speeds (the
+    tables' own speed grid, between which ``at`` is linear in v, so the curve is exact) and at
+    ``LOW_SPEED_SAMPLES`` speeds from 0 to the lowest of them, where the stopping distance is
+    quadratic in v (eq. 33; linear blending between samples 1/24 of the lowest speed apart
+    overestimates it by at most 1/4608 of B0 there); ``at`` and ``sector`` then cost a
+    bisection and a linear blend. Above the last speed the last row is used.
     """
 
     __slots__ = ("_rows", "_speeds", "mu")
 
     def __init__(self, boundaries, mu: float, speeds_mps):
-        speeds = sorted({0.0, *(float(v) for v in speeds_mps)})
-        if len(speeds) < 2 or speeds[0] < 0.0 or not math.isfinite(speeds[-1]):
+        given = sorted({0.0, *(float(v) for v in speeds_mps)})
+        if len(given) < 2 or given[0] < 0.0 or not math.isfinite(given[-1]):
             raise ValueError(f"bad boundary speeds: {speeds_mps!r}")
+        n = LOW_SPEED_SAMPLES
+        speeds = sorted({*given, *(given[1] * k / n for k in range(n))})
         rows = []
         for v in speeds:
             b = boundaries.at(mu, v)

@@ -10,12 +10,15 @@ Interpolation rules:
   (``check_run`` raises ``InputError``), above the highest the highest is used (a grippier
   surface needs less distance, so this is conservative); linear interpolation of the convex
   1/mu-like boundaries overestimates them between grid frictions (conservative too);
-- boundaries in relative speed: linear within the grid, scaled linearly to 0 at zero relative
-  speed below the lowest grid speed (no closing speed, nothing to avoid; TTC itself is kept),
+- boundaries in relative speed: linear within the grid; below the lowest grid speed the
+  closed forms (``PhaseBoundaries._below_grid``: B0 = v^2 / (2 a), Bb = B0 + t_b v + c_b, the
+  TTC kept, and S = Sb = B0: no lane change below the grid, so the DMM only brakes there),
   clamped to the top row above the highest (only an obstacle moving towards the ego closes
   faster than the ego drives, and runs above the grid are refused by ``check_run``);
 - trajectories in entry speed: linear within the grid, clamped to the lowest grid speed below
-  it and to the highest above it (``check_run`` refuses runs above the grid);
+  it (never read there: no STEER sector below the grid's closing speeds, and
+  ``EoamSettings.min_steer_speed_mps`` brakes a STEER sector below 20 km/h of ego speed) and to
+  the highest above it (``check_run`` refuses runs above the grid);
 - in differential x: linear between the rows of the uniform grid; before 0 the first row,
   past the manoeuvre's end the final values (y = h, ax = 0, yaw = 0, curvature = 0, steer 0).
 """
@@ -43,6 +46,9 @@ CSV_NAME = "phase_boundaries.csv"
 NPZ_NAME = "lookup_tables.npz"
 METADATA_NAME = "metadata.json"
 FORMAT_VERSION = 2
+#: The lowest entry speed a run may have [km/h] (the design range's floor); below the tables'
+#: lowest speed the DMM only brakes: no lane change is offered there.
+MIN_ENTRY_SPEED_KMH = 5.0
 TABLE_NAMES = ("y_m", "ax_mps2", "yaw_rad", "curvature_1pm", "steer_rad", "sideslip_rad")
 BOUNDARY_COLUMNS = (
     "stop_distance_m",
@@ -135,20 +141,36 @@ class PhaseBoundaries:
     def at(self, mu: float, rel_speed_mps: float) -> Boundary:
         """Boundaries at this friction and relative (closing) speed; see the module rules."""
         i_m, j_m, w_m = _bracket(self._mus, mu)
-        v = rel_speed_mps
         speeds = self._speeds
-        scale = 1.0
-        if v < speeds[0]:
-            scale = max(v, 0.0) / speeds[0]
-            v = speeds[0]
-        i_v, j_v, w_v = _bracket(speeds, v)
+        if rel_speed_mps < speeds[0]:
+            return self._below_grid(i_m, j_m, w_m, max(rel_speed_mps, 0.0))
+        i_v, j_v, w_v = _bracket(speeds, rel_speed_mps)
         lo = self._row(i_m, i_v, j_v, w_v)
         if j_m != i_m:
             hi = self._row(j_m, i_v, j_v, w_v)
             lo = [x + w_m * (y - x) for x, y in zip(lo, hi)]
-        return Boundary(
-            lo[0] * scale, lo[1] * scale, lo[2] * scale, lo[3] * scale, lo[4] * scale, lo[5]
-        )
+        return Boundary(*lo)
+
+    def _below_grid(self, i_m: int, j_m: int, w_m: float, v: float) -> Boundary:
+        """Below the lowest grid speed: B0 = v^2 / (2 a) (eq. 33) with the deceleration a of
+        the lowest row, Bb = B0 + t_b v + c_b (sec. 6.2) with t_b, c_b from the two lowest
+        rows (Bb - B0 is linear in v), TTC kept; no lane change is offered (no tables
+        there), so S = Sb = B0 and the steering sectors F and B are empty. Linear in mu
+        between the grid frictions, as within the grid."""
+        lo, hi = (self._low_speed_row(i, v) for i in (i_m, j_m))
+        stop, buffered, ttc = (a + w_m * (b - a) for a, b in zip(lo, hi))
+        return Boundary(stop, buffered, stop, stop, stop, ttc)
+
+    def _low_speed_row(self, i_mu: int, v: float) -> tuple[float, float, float]:
+        """(B0, Bb, TTC) of friction row ``i_mu`` at a speed v below the grid."""
+        rows, speeds = self._rows[i_mu], self._speeds
+        v0, (stop0, buffered0, *_rest, ttc) = speeds[0], rows[0]
+        t_b = 0.0
+        if len(speeds) > 1:
+            t_b = ((rows[1][1] - rows[1][0]) - (buffered0 - stop0)) / (speeds[1] - v0)
+        c_b = buffered0 - stop0 - t_b * v0
+        stop = stop0 * (v / v0) ** 2  # v^2 / (2 a) with a = v0^2 / (2 B0(v0))
+        return stop, stop + t_b * v + c_b, ttc
 
 
 class Trajectory:
@@ -278,15 +300,17 @@ class LookupTables:
         return tables
 
     def check_run(self, mu: float, speed_mps: float) -> None:
-        """Refuse (``InputError``) a run the tables do not cover: entry speed outside the grid
-        or friction below it (above it the highest friction's tables are used: they ask for
-        less than the road gives)."""
-        low, top = self.speed_grid_mps[0], self.speed_grid_mps[-1]
+        """Refuse (``InputError``) a run the tables do not cover: entry speed below
+        ``MIN_ENTRY_SPEED_KMH`` or above the grid, or friction below the grid (above it the
+        highest friction's tables are used: they ask for less than the road gives). Below the
+        grid's lowest speed the DMM only brakes (``PhaseBoundaries._below_grid``)."""
+        low = min(MIN_ENTRY_SPEED_KMH / 3.6, self.speed_grid_mps[0])
+        top = self.speed_grid_mps[-1]
         if not low - 1e-9 <= speed_mps <= top + 1e-9:
             raise InputError(
-                f"ego speed {speed_mps * 3.6:.1f} km/h is outside the tables' "
-                f"range [{low * 3.6:.0f}, {top * 3.6:.0f}] km/h; rebuild with "
-                "`eoam-sumo tables --speeds-kmh ...`"
+                f"ego speed {speed_mps * 3.6:.1f} km/h is outside the design range "
+                f"[{low * 3.6:.0f}, {top * 3.6:.0f}] km/h (the top is the tables'; rebuild "
+                "with `eoam-sumo tables --speeds-kmh ...` to go higher)"
             )
         if mu < self.mu_grid[0] - 1e-9:
             raise InputError(

@@ -17,9 +17,9 @@ Sources (cited per rule below):
   ECE/TRANS/WP.29/2019/61), and its Supplement 1, Add.151/Amend.1 (in force 25 Sep 2020;
   ECE/TRANS/WP.29/2020/9): para. 5.2.1.3 (speed range 10-60 km/h) and para. 5.2.1.4 (speed
   reduction by braking demand), table "Maximum relative impact speed (km/h) for M1 vehicles"
-  (page 7 of both), and para. 5.2.1.1 (the collision warning at the latest 0.8 s before the
-  start of emergency braking; read in summaries of Supplement 1 found through the code search
-  index, not in the authentic text). The 01-03 series are not held here.
+  (page 7 of both). Para. 5.2.1.1's warning lead (0.8 s before the start of emergency
+  braking) is NOT verified against the authentic text: ``R152_WARNING_SOURCE`` says where it
+  comes from. The 01-03 series are not held here.
 """
 
 from __future__ import annotations
@@ -273,9 +273,19 @@ def r152_verdict(limit_kmh: float | None, impact_speed_kmh: float) -> tuple[str,
     return FAIL, f"impact {impact_speed_kmh:.1f} > {limit_kmh:g} km/h allowed"
 
 
-#: R152 para. 5.2.1.1: the collision warning at the latest this long before the start of
-#: emergency braking [s]
+#: R152 para. 5.2.1.1 as secondary sources give it: the collision warning at the latest this
+#: long before the start of emergency braking [s] (unverified: ``R152_WARNING_SOURCE``)
 R152_WARNING_LEAD_S = 0.8
+#: Where the warning rule comes from (the scorecard prints it)
+R152_WARNING_SOURCE = (
+    "Warning rule (0.8 s before the start of emergency braking, para. 5.2.1.1) NOT verified "
+    "against the regulation's authentic text (ECE/TRANS/WP.29/2019/61, or Supplement 1's "
+    "ECE/TRANS/WP.29/2020/9), which we do not hold: it is taken from secondary sources that "
+    "quote or summarise R152 (a paper quoting 'collision warning [..] shall be provided at "
+    "the latest 0.8 seconds before the start of emergency braking' and a summary of para. "
+    "5.2.1), neither naming the series or supplement; any condition or exception the clause "
+    "may carry is not applied. The speed verdict does not depend on it."
+)
 
 
 def r152_warning(fcw_raised: bool, lead_s: float | None, braked: bool) -> tuple[str, str]:

@@ -13,6 +13,7 @@ from eoam_sumo.batch.runner import run_cases
 from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.matrix import Case
+from eoam_sumo.offline.tables import MIN_ENTRY_SPEED_KMH
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.protocols import rules, scoring
 from eoam_sumo.protocols.impact import measure, steered
@@ -68,17 +69,18 @@ class ProtocolSummary:
         """The summary line, naming the files in the output folder ``out``."""
         return (
             f"{self.points} points, {self.run} run, {self.failed} failed, {self.outside} "
-            f"not run (below the tables' speed range); {out / RESULTS_FILE}, "
+            f"not run (below the design range); {out / RESULTS_FILE}, "
             f"{out / SCORECARD_MD}"
         )
 
 
 def _design_low_kmh(tables_dir: Path | None, vehicle_id: str, params: VehicleParams) -> float:
-    """The lowest speed of the VUT's lookup tables (refused in one line when it has none)."""
+    """The lowest entry speed the VUT runs at [km/h]: the design range's floor, or the lookup
+    tables' lowest speed if lower (refused in one line when the VUT has no tables)."""
     from eoam_sumo.sim.vehicle import vehicle_tables
 
     tables = vehicle_tables(vehicle_id, params, tables_dir, cached=False)
-    return tables.speed_grid_mps[0] * 3.6
+    return min(MIN_ENTRY_SPEED_KMH, tables.speed_grid_mps[0] * 3.6)
 
 
 def _case(

@@ -15,8 +15,8 @@ from eoam_sumo.protocols.points import PROTOCOLS
 
 @dataclass(frozen=True)
 class RunLabel:
-    """What a protocol run was: its name, system, policy, vehicle, friction, the tables'
-    lowest speed [km/h] and the VUT's width [m]."""
+    """What a protocol run was: its name, system, policy, vehicle, friction, the design
+    range's lowest speed [km/h] and the VUT's width [m]."""
 
     name: str
     system: str
@@ -136,7 +136,7 @@ def r152_lines(rows: list[dict]) -> list[str]:
         f"{c['warning_fail']} |"
         for c in scoring.verdict_counts(rows)
     ]
-    return [*lines, ""]
+    return [*lines, "", rules.R152_WARNING_SOURCE, ""]
 
 
 def unscored_lines(rows: list[dict]) -> list[str]:
@@ -157,7 +157,7 @@ def unscored_lines(rows: list[dict]) -> list[str]:
 
 
 def not_run_lines(rows: list[dict], run: RunLabel) -> list[str]:
-    """The points below the tables' speed range, and what that does to the score."""
+    """The points below the design range, and what that does to the score."""
     out = [r for r in rows if r["status"] == "not_run"]
     if not out:
         return []
@@ -168,9 +168,9 @@ def not_run_lines(rows: list[dict], run: RunLabel) -> list[str]:
     }.get(run.name, "They are listed, unscored like the rest of the edition")
     ids = ", ".join(r["point_id"] for r in out)
     return [
-        f"## Not run: below the tables' speed range ({len(out)} points)",
+        f"## Not run: below the design range ({len(out)} points)",
         "",
-        f"The lookup tables and DMM boundaries start at {run.low_kmh:g} km/h: a run below it is "
+        f"The design range starts at {run.low_kmh:g} km/h: a run below it is "
         f"refused. {effect}: {ids}.",
         "",
     ]

@@ -10,10 +10,10 @@ from eoam_sumo.protocols import rules
 from eoam_sumo.protocols.impact import Measured
 from eoam_sumo.protocols.points import PROTOCOLS, TestPoint
 
-#: Why a point is not run: its VUT speed is below the lookup tables' speeds.
+#: Why a point is not run: its VUT speed is below the design range.
 OUTSIDE_DESIGN = (
-    "not run: below the tables' speed range (VUT speed {v:g} km/h, the lookup tables start "
-    "at {low:g} km/h, offline/design.py speeds_kmh); it scores 0 and counts in the maximum"
+    "not run: below the design range (VUT speed {v:g} km/h, the design range starts at "
+    "{low:g} km/h, offline/tables.py MIN_ENTRY_SPEED_KMH); it scores 0 and counts in the maximum"
 )
 #: colour of a point that ran but is not scored (the 2023 edition: its bands are not held)
 UNSCORED = "unscored"

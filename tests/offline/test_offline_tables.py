@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from eoam_sumo import __version__
+from eoam_sumo.decision.dmm import Action, BoundaryCurve
 from eoam_sumo.errors import InputError
 from eoam_sumo.offline.boundaries import max_decel_no_lock_mps2
 from eoam_sumo.offline.design import DesignSettings
@@ -144,12 +145,11 @@ def test_boundaries_at_grid_points_equal_the_csv_and_interpolate_linearly(tables
 
 def test_boundaries_outside_the_grid(tables):
     b = tables.boundaries
-    low = b.at(1.0, 10.0 / 3.6)  # half the lowest grid speed: half the lowest row
-    assert low.clear_opt_m == pytest.approx(0.5 * ROWS[(1.0, 20.0)]["clear_distance_opt_m"])
+    low = b.at(1.0, 10.0 / 3.6)  # below the grid: no lane change, S = Sb = B0
+    assert low.clear_opt_m == low.clear_buffered_m == low.clear_const_m == low.stop_m
     assert low.ttc_s == 2.5
-    still = b.at(0.3, 0.0)
-    assert still[:5] == (0.0,) * 5
-    assert b.at(0.3, -3.0)[:5] == (0.0,) * 5
+    assert b.at(0.3, 0.0)[:4] == pytest.approx((0.0, S.brake_buffer_m, 0.0, 0.0), abs=1e-3)
+    assert b.at(0.3, -3.0) == b.at(0.3, 0.0)
     assert b.at(1.0, 300 / 3.6) == b.at(1.0, 175 / 3.6)
     assert b.at(1.2, 90 / 3.6) == b.at(1.0, 90 / 3.6)
 
@@ -232,7 +232,31 @@ def test_missing_or_broken_tables_are_input_errors(tmp_path):
         PhaseBoundaries.load(partial)
 
 
+@pytest.mark.parametrize("mu", [1.0, 0.7, 0.3, 0.1])
+@pytest.mark.parametrize("kmh", [5.0, 10.0, 15.0, 19.0])
+def test_braking_boundaries_below_the_grid_are_the_closed_form(tables, mu, kmh):
+    """Below 20 km/h: B0 = v^2 / (2 a) (eq. 33) with the csv's deceleration at this mu,
+    Bb = B0 + t_b v + c_b (sec. 6.2) with the design's buffers; the DMM's curve agrees."""
+    v = kmh / 3.6
+    stop = v * v / (2.0 * ROWS[(mu, 20.0)]["max_decel_mps2"])
+    buffered = stop + S.brake_buffer_time_s * v + S.brake_buffer_m
+    got = tables.boundaries.at(mu, v)
+    assert got.stop_m == pytest.approx(stop, rel=1e-3)
+    assert got.stop_buffered_m == pytest.approx(buffered, rel=1e-3)
+    assert got.clear_opt_m == got.clear_buffered_m == got.stop_m  # no steering sector
+    curve = BoundaryCurve(tables.boundaries, mu, tables.speed_grid_mps)
+    row = curve.at(v)
+    assert row.stop_m == pytest.approx(stop, rel=2e-3, abs=1e-3)
+    assert row.stop_buffered_m == pytest.approx(buffered, rel=1e-3)
+    for d in np.linspace(0.01, 2.0 * buffered, 50):  # braking or FCW, never a steer
+        assert curve.sector(float(d), v).action is not Action.STEER
+
+
 def test_runs_outside_the_tables_are_refused(tables):
+    tables.check_run(1.0, 5 / 3.6)  # the design range starts at 5 km/h
+    tables.check_run(0.1, 10 / 3.6)
+    with pytest.raises(InputError, match=r"4\.0 km/h is outside the design range \[5, 175\]"):
+        tables.check_run(1.0, 4 / 3.6)
     tables.check_run(1.0, 175 / 3.6)
     tables.check_run(1.2, 55 / 3.6)
     with pytest.raises(InputError, match=r"180\.0 km/h"):

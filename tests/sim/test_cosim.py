@@ -493,3 +493,22 @@ def test_a_vehicle_overlapping_the_ego_at_its_departure_is_bad_input(tmp_path):
     cfg = baseline_variant(tmp_path, 'departPos="225.09"', 'departPos="102.00"')
     with pytest.raises(InputError, match="vehicle 'aro' overlaps the ego at its departure"):
         _run(cfg, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0)
+
+
+@pytest.mark.sumo
+def test_at_10_kmh_the_eoam_brakes_to_a_stop_without_steering(tmp_path):
+    """Below the tables' 20 km/h the design range's floor admits the run and the DMM only
+    brakes (docs/design-choices.md, "Low speed"): a car halted 25 m ahead on a two-lane road,
+    the ego at 10 km/h, stops short in its lane; no lane-change or return mode is visited."""
+    cfg = halted_car_scenario(
+        tmp_path,
+        '<nodes><node id="a" x="0" y="0"/><node id="b" x="400" y="0"/></nodes>',
+        '<edges><edge id="fwd" from="a" to="b" numLanes="2" speed="30"/></edges>',
+        50.0,
+    )
+    summary, _ = _run(cfg, tmp_path, ego_speed_mps=10.0 / 3.6, mu=1.0, max_time_s=20.0)
+    assert summary["collision_with"] == "none", summary["reason"]
+    assert 1 in summary["modes_visited"]
+    assert not {2, 3, 4, 5} & set(summary["modes_visited"]), summary["modes_visited"]
+    assert summary["max_lateral_offset_m"] < 0.2
+    assert 0.0 < summary["min_gap_aro_m"] < 5.0  # stopped short, within about the 2 m buffer
