@@ -206,11 +206,18 @@ def _start(clock: Clock, node: Node, default: float) -> float:
 
 def _first_dynamic(trigger: Node | None) -> Node:
     assert trigger is not None
-    static = ("SimulationTimeCondition", "ParameterCondition", "StoryboardElementStateCondition")
+    static = (
+        "Condition",
+        "ByValueCondition",
+        "ByEntityCondition",
+        "EntityCondition",
+        "SimulationTimeCondition",
+        "ParameterCondition",
+        "StoryboardElementStateCondition",
+    )
     for node in trigger.iter():
-        if node.tag.endswith("Condition") and node.tag not in ("Condition",) + static:
-            if node.tag not in ("ByValueCondition", "ByEntityCondition", "EntityCondition"):
-                return node
+        if node.tag.endswith("Condition") and node.tag not in static:
+            return node
     return trigger
 
 

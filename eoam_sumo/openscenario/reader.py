@@ -99,11 +99,11 @@ def _distribution(path: Path, dist: Node) -> tuple[Path, dict[str, str]]:
 
 def _catalog_dirs(root: Node, values: dict[str, str], base: Path) -> list[Path]:
     locations = root.find("CatalogLocations")
-    dirs = []
-    for loc in [] if locations is None else locations.children:
-        for d in loc.findall("Directory"):
-            dirs.append((base / _sub(d.need("path"), values, d)).resolve())
-    return dirs
+    return [
+        (base / _sub(d.need("path"), values, d)).resolve()
+        for loc in ([] if locations is None else locations.children)
+        for d in loc.findall("Directory")
+    ]
 
 
 def _resolve(node: Node, values: dict[str, str], catalogs: list[Path], via: str = "") -> Node:

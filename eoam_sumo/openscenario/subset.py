@@ -14,28 +14,111 @@ from eoam_sumo.errors import InputError
 from eoam_sumo.openscenario.xmltree import Node
 
 STRUCTURE = frozenset(
-    "OpenSCENARIO FileHeader License Properties Property ParameterDeclarations "
-    "ParameterDeclaration ConstraintGroup ValueConstraint VariableDeclarations "
-    "VariableDeclaration CatalogLocations VehicleCatalog ControllerCatalog PedestrianCatalog "
-    "MiscObjectCatalog ManeuverCatalog EnvironmentCatalog RouteCatalog TrajectoryCatalog "
-    "Directory RoadNetwork LogicFile SceneGraphFile Entities ScenarioObject Vehicle "
-    "BoundingBox Center Dimensions Performance Axles FrontAxle RearAxle AdditionalAxle "
-    "ObjectController Controller Storyboard Init Actions Private PrivateAction GlobalAction "
-    "Story Act ManeuverGroup Actors EntityRef Maneuver Event Action StartTrigger StopTrigger "
-    "ConditionGroup Condition ByValueCondition ByEntityCondition TriggeringEntities "
-    "EntityCondition ParameterAssignments ParameterAssignment".split()
+    [
+        "OpenSCENARIO",
+        "FileHeader",
+        "License",
+        "Properties",
+        "Property",
+        "ParameterDeclarations",
+        "ParameterDeclaration",
+        "ConstraintGroup",
+        "ValueConstraint",
+        "VariableDeclarations",
+        "VariableDeclaration",
+        "CatalogLocations",
+        "VehicleCatalog",
+        "ControllerCatalog",
+        "PedestrianCatalog",
+        "MiscObjectCatalog",
+        "ManeuverCatalog",
+        "EnvironmentCatalog",
+        "RouteCatalog",
+        "TrajectoryCatalog",
+        "Directory",
+        "RoadNetwork",
+        "LogicFile",
+        "SceneGraphFile",
+        "Entities",
+        "ScenarioObject",
+        "Vehicle",
+        "BoundingBox",
+        "Center",
+        "Dimensions",
+        "Performance",
+        "Axles",
+        "FrontAxle",
+        "RearAxle",
+        "AdditionalAxle",
+        "ObjectController",
+        "Controller",
+        "Storyboard",
+        "Init",
+        "Actions",
+        "Private",
+        "PrivateAction",
+        "GlobalAction",
+        "Story",
+        "Act",
+        "ManeuverGroup",
+        "Actors",
+        "EntityRef",
+        "Maneuver",
+        "Event",
+        "Action",
+        "StartTrigger",
+        "StopTrigger",
+        "ConditionGroup",
+        "Condition",
+        "ByValueCondition",
+        "ByEntityCondition",
+        "TriggeringEntities",
+        "EntityCondition",
+        "ParameterAssignments",
+        "ParameterAssignment",
+    ]
 )
 ACTIONS = frozenset(
-    "TeleportAction Position LanePosition RelativeLanePosition LongitudinalAction SpeedAction "
-    "SpeedActionDynamics SpeedActionTarget AbsoluteTargetSpeed LongitudinalDistanceAction "
-    "ControllerAction ActivateControllerAction VariableAction VariableSetAction SetAction "
-    "EnvironmentAction Environment TimeOfDay Weather Sun Fog Precipitation Wind "
-    "RoadCondition".split()
+    [
+        "TeleportAction",
+        "Position",
+        "LanePosition",
+        "RelativeLanePosition",
+        "LongitudinalAction",
+        "SpeedAction",
+        "SpeedActionDynamics",
+        "SpeedActionTarget",
+        "AbsoluteTargetSpeed",
+        "LongitudinalDistanceAction",
+        "ControllerAction",
+        "ActivateControllerAction",
+        "VariableAction",
+        "VariableSetAction",
+        "SetAction",
+        "EnvironmentAction",
+        "Environment",
+        "TimeOfDay",
+        "Weather",
+        "Sun",
+        "Fog",
+        "Precipitation",
+        "Wind",
+        "RoadCondition",
+    ]
 )
 CONDITIONS = frozenset(
-    "SimulationTimeCondition StoryboardElementStateCondition ParameterCondition "
-    "VariableCondition CollisionCondition SpeedCondition StandStillCondition "
-    "RelativeSpeedCondition RelativeDistanceCondition TraveledDistanceCondition".split()
+    [
+        "SimulationTimeCondition",
+        "StoryboardElementStateCondition",
+        "ParameterCondition",
+        "VariableCondition",
+        "CollisionCondition",
+        "SpeedCondition",
+        "StandStillCondition",
+        "RelativeSpeedCondition",
+        "RelativeDistanceCondition",
+        "TraveledDistanceCondition",
+    ]
 )
 SUPPORTED = STRUCTURE | ACTIONS | CONDITIONS
 ZERO_M = 1e-6
@@ -90,7 +173,7 @@ CHECKS: dict[str, Callable[[Node], None]] = {
 def check_subset(root: Node) -> None:
     """InputError for the first element of ``root`` outside the subset."""
     for node in root.iter():
-        if node.tag in ("ParameterDeclarations",):
+        if node.tag == "ParameterDeclarations":
             continue
         if node.tag not in SUPPORTED:
             raise refuse(node, f"{node.tag} is outside the supported subset")
