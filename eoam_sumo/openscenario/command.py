@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.openscenario.runner import Loaded, load, run_loaded
@@ -16,6 +17,12 @@ def xosc_arguments(p) -> None:
         default=[],
         metavar="NAME=VALUE",
         help="an .xosc parameter's value (repeatable)",
+    )
+    p.add_argument(
+        "--system",
+        choices=("eoam", "aeb"),
+        default=None,
+        help="of an .xosc: eoam (default) or aeb (braking only, as `protocol --system aeb`)",
     )
 
 
@@ -47,10 +54,12 @@ def run_xosc_command(args, loaded: Loaded, out, settings) -> dict:
     """Run the loaded scenario; notes on what was not applied go to stderr, one line each."""
     for note in dict.fromkeys(loaded.plan.notes):
         print(f"eoam-sumo: {args.cfg.name}: {note}", file=sys.stderr)
+    if args.system == "aeb":
+        settings = replace(settings, eoam=replace(settings.eoam, steering_inhibited=True))
     return run_loaded(loaded, out, settings, args.mu)
 
 
 def refuse_params_for_sumocfg(args) -> None:
     """``--param`` only applies to an .xosc."""
-    if args.param and not is_xosc(args):
-        raise InputError("--param applies to an .xosc scenario only")
+    if (args.param or args.system) and not is_xosc(args):
+        raise InputError("--param and --system apply to an .xosc scenario only")
