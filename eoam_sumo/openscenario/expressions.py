@@ -1,7 +1,8 @@
 """OpenSCENARIO 1.2 parameter references ``$name`` and expressions ``${...}`` (sec. 8.4).
 
 Expressions are evaluated by walking Python's syntax tree over a fixed set of node types
-(numbers, names, + - * / % **, unary minus, not/and/or, round floor ceil sqrt pow), never by
+(numbers, names, + - * / % **, unary minus, not/and/or, and the 1.2 functions round floor
+ceil sqrt pow sin cos tan asin acos atan abs sign min max), never by
 ``eval``: anything else is refused with the expression in the message.
 """
 
@@ -27,6 +28,16 @@ _FUNCTIONS = {
     "ceil": lambda x: float(math.ceil(x)),
     "sqrt": math.sqrt,
     "pow": math.pow,
+    "sin": math.sin,
+    "cos": math.cos,
+    "tan": math.tan,
+    "asin": math.asin,
+    "acos": math.acos,
+    "atan": math.atan,
+    "abs": abs,
+    "sign": lambda x: float((x > 0) - (x < 0)),
+    "min": min,
+    "max": max,
 }
 
 

@@ -5,7 +5,9 @@ Every vehicle departs at ``DEPART_S`` (scenario time 0), its front bumper where 
 reference point plus the box's front lie (SUMO places vehicles by the front bumper). A
 target keeps its Init speed; its one speed change, if any, must be a stop (to below
 ``STOP_MPS``): the scripted stop holds the speed until the change starts, then brakes at
-the action's rate (capped by the road's friction, as every scripted stop).
+the action's rate (capped by the road's friction, as every scripted stop). The vehicle types
+carry ``speedFactor=4`` so that the road's speed limits (OpenDRIVE ``<speed>``) never refuse
+a departure: the scenario, not the road, gives the speeds.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ VCLASS = {"car": "passenger", "van": "delivery", "truck": "truck", "bus": "bus",
           "motorbike": "motorcycle", "bicycle": "bicycle"}  # fmt: skip
 EGO_VTYPE = (
     '<vType id="ego" vClass="passenger" length="4.92" width="1.85" minGap="2.00" '
-    'maxSpeed="70.00" accel="4.00" decel="9.00" emergencyDecel="12.00" sigma="0" speedDev="0"/>'
+    'maxSpeed="70.00" accel="4.00" decel="9.00" emergencyDecel="12.00" sigma="0" speedDev="0" speedFactor="4"/>'
 )
 SUMOCFG = """<?xml version="1.0" encoding="UTF-8"?>
 <!-- from {source} by eoam_sumo {version} -->
@@ -50,7 +52,7 @@ def _vtype(body: Body) -> str:
     return (
         f'<vType id="t_{body.name}" vClass="{vclass}" length="{body.length_m:g}" '
         f'width="{body.width_m:g}" minGap="1.00" maxSpeed="70.00" accel="2.50" decel="10.00" '
-        f'emergencyDecel="12.00" sigma="0" speedDev="0"/>'
+        f'emergencyDecel="12.00" sigma="0" speedDev="0" speedFactor="4"/>'
     )
 
 
