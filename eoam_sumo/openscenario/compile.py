@@ -65,9 +65,9 @@ def _bodies(root: Node) -> dict[str, Body]:
         name = obj.need("name")
         bodies[name] = Body(
             name,
-            float(dims.need("length")),
-            float(dims.need("width")),
-            float(centre.need("x")),
+            dims.num("length"),
+            dims.num("width"),
+            centre.num("x"),
             veh.get("vehicleCategory", "car") or "car",
         )
     return bodies
@@ -110,11 +110,9 @@ def _place(plan: Plan, name: str, node: Node) -> Place:
     if where is None:
         raise refuse(node, "a TeleportAction needs a Position")
     if where.tag == "LanePosition":
-        return Place(
-            where.need("roadId"), int(float(where.need("laneId"))), float(where.need("s")), where
-        )
+        return Place(where.need("roadId"), int(where.num("laneId")), where.num("s"), where)
     ref = _placed(plan, where.need("entityRef"), where)
-    return Place(ref.road, ref.lane, ref.s_m + float(where.need("ds")), where)
+    return Place(ref.road, ref.lane, ref.s_m + where.num("ds"), where)
 
 
 def _placed(plan: Plan, name: str, node: Node) -> Place:
@@ -129,9 +127,9 @@ def _distance_place(plan: Plan, name: str, node: Node) -> Place:
     other = node.need("entityRef")
     ref = _placed(plan, other, node)
     if node.get("distance") is not None:
-        gap = float(node.need("distance"))
+        gap = node.num("distance")
     else:
-        gap = float(node.need("timeGap")) * plan.speeds_mps.get(other, 0.0)
+        gap = node.num("timeGap") * plan.speeds_mps.get(other, 0.0)
     if node.get("freespace") in ("true", "1"):
         me, it = plan.bodies[name], plan.bodies[other]
         gap += it.front_ahead_m - me.rear_ahead_m
@@ -143,11 +141,11 @@ def _speed(plan: Plan, name: str, node: Node, t_s: float) -> float:
     absolute = None if target is None else target.find("AbsoluteTargetSpeed")
     if dyn is None or absolute is None:
         raise refuse(node, "a SpeedAction needs its dynamics and an AbsoluteTargetSpeed")
-    speed = float(absolute.need("value"))
+    speed = absolute.num("value")
     if t_s == 0.0 and dyn.need("dynamicsShape") == "step":
         plan.speeds_mps[name] = speed
         return t_s
-    rate = math.inf if dyn.need("dynamicsShape") == "step" else float(dyn.need("value"))
+    rate = math.inf if dyn.need("dynamicsShape") == "step" else dyn.num("value")
     if rate <= 0:
         raise refuse(dyn, f"rate {rate} must be > 0")
     before = _speed_at(plan, name, t_s, node)

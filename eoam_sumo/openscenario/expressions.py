@@ -12,6 +12,7 @@ import ast
 import math
 import operator
 import re
+from collections.abc import Callable
 
 NAME_RE = re.compile(r"\$([A-Za-z_][A-Za-z0-9_]*)")
 _BINARY = {
@@ -22,7 +23,7 @@ _BINARY = {
     ast.Mod: math.fmod,
     ast.Pow: operator.pow,
 }
-_FUNCTIONS = {
+_FUNCTIONS: dict[str, Callable[..., float]] = {
     "round": lambda x: float(math.floor(x + 0.5)),
     "floor": lambda x: float(math.floor(x)),
     "ceil": lambda x: float(math.ceil(x)),

@@ -139,15 +139,16 @@ def _speed_dynamics(node: Node) -> None:
 
 
 def _no_offset(node: Node) -> None:
-    if abs(float(node.get("offset", "0"))) > ZERO_M:
+    if abs(node.num("offset", 0.0)) > ZERO_M:
         raise refuse(node, f"a lateral offset ({node.get('offset')} m) is not supported")
-    if node.find("Orientation") is not None:
-        raise refuse(node.find("Orientation"), "an orientation is not supported")
+    orientation = node.find("Orientation")
+    if orientation is not None:
+        raise refuse(orientation, "an orientation is not supported")
 
 
 def _relative_lane(node: Node) -> None:
     _no_offset(node)
-    if int(float(node.get("dLane", "0"))) != 0:
+    if int(node.num("dLane", 0.0)) != 0:
         raise refuse(node, "only dLane=0 is supported")
     if node.get("ds") is None:
         raise refuse(node, "only ds (not dsLane) is supported")
@@ -158,8 +159,9 @@ def _distance(node: Node) -> None:
         raise refuse(node, "a continuous LongitudinalDistanceAction is not supported")
     if node.get("displacement", "leadingReferencedEntity") != "leadingReferencedEntity":
         raise refuse(node, "only displacement=leadingReferencedEntity is supported")
-    if node.find("DynamicConstraints") is not None:
-        raise refuse(node.find("DynamicConstraints"), "dynamic constraints are not supported")
+    constraints = node.find("DynamicConstraints")
+    if constraints is not None:
+        raise refuse(constraints, "dynamic constraints are not supported")
 
 
 CHECKS: dict[str, Callable[[Node], None]] = {

@@ -29,7 +29,8 @@ VCLASS = {"car": "passenger", "van": "delivery", "truck": "truck", "bus": "bus",
           "motorbike": "motorcycle", "bicycle": "bicycle"}  # fmt: skip
 EGO_VTYPE = (
     '<vType id="ego" vClass="passenger" length="4.92" width="1.85" minGap="2.00" '
-    'maxSpeed="70.00" accel="4.00" decel="9.00" emergencyDecel="12.00" sigma="0" speedDev="0" speedFactor="4"/>'
+    'maxSpeed="70.00" accel="4.00" decel="9.00" emergencyDecel="12.00" sigma="0" speedDev="0" '
+    'speedFactor="4"/>'
 )
 SUMOCFG = """<?xml version="1.0" encoding="UTF-8"?>
 <!-- from {source} by eoam_sumo {version} -->

@@ -54,7 +54,7 @@ class Clock:
         return max(float(t) for t in times) if times else NEVER
 
     def _condition(self, cond: Node) -> float | str:
-        delay = float(cond.get("delay", "0"))
+        delay = cond.num("delay", 0.0)
         inner = cond.children[0].children[0] if cond.children[0].children else cond
         t = self._value_time(inner)
         return t if t == DYNAMIC else float(t) + delay
@@ -64,7 +64,7 @@ class Clock:
             rule = node.need("rule")
             if rule not in ("greaterThan", "greaterOrEqual", "equalTo"):
                 raise refuse(node, f"rule={rule} is not supported for a simulation time")
-            return float(node.need("value"))
+            return node.num("value")
         if node.tag == "ParameterCondition":
             return 0.0 if self._parameter_true(node) else NEVER
         if node.tag == "StoryboardElementStateCondition":
@@ -78,15 +78,18 @@ class Clock:
         have = self.parameters[ref]
         try:
             a, b = float(have), float(want)
-        except ValueError:
-            a, b = have.strip().lower(), want.strip().lower()  # type: ignore[assignment]
+        except ValueError:  # text: equal or not
+            same = have.strip().lower() == want.strip().lower()
+            if rule not in ("equalTo", "notEqualTo"):
+                raise refuse(node, f"rule={rule} on text {have!r}") from None
+            return same == (rule == "equalTo")
         ops = {
             "equalTo": a == b,
             "notEqualTo": a != b,
-            "greaterThan": a > b,  # type: ignore[operator]
-            "lessThan": a < b,  # type: ignore[operator]
-            "greaterOrEqual": a >= b,  # type: ignore[operator]
-            "lessOrEqual": a <= b,  # type: ignore[operator]
+            "greaterThan": a > b,
+            "lessThan": a < b,
+            "greaterOrEqual": a >= b,
+            "lessOrEqual": a <= b,
         }
         if rule not in ops:
             raise refuse(node, f"rule={rule} is not supported")

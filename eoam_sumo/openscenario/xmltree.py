@@ -46,11 +46,25 @@ class Node:
         """An attribute's value."""
         return self.attrib.get(key, default)
 
+    def num(self, key: str, default: float | None = None) -> float:
+        """A numeric attribute (``default`` when absent, required without one); InputError
+        naming the element when it is not a number."""
+        if key not in self.attrib and default is not None:
+            return default
+        return _number(self, key, self.need(key))
+
     def need(self, key: str) -> str:
         """A required attribute, InputError naming the element when missing."""
         if key not in self.attrib:
             raise InputError(f"{self.where()}: attribute {key!r} is missing")
         return self.attrib[key]
+
+
+def _number(node: Node, key: str, text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise InputError(f"{node.where()}: {key}={text!r} is not a number") from None
 
 
 def parse(path: Path) -> Node:
