@@ -27,6 +27,9 @@ STOP_MPS = 0.6  # a change to below this is run as a stop to standstill (2 km/h 
 STEP_DECEL_MPS2 = 1.0e3  # a step to standstill: the scripted stop caps it at mu * g
 VCLASS = {"car": "passenger", "van": "delivery", "truck": "truck", "bus": "bus",
           "motorbike": "motorcycle", "bicycle": "bicycle"}  # fmt: skip
+# the storyboard alone moves a target across lanes: SUMO's own lane changes (strategic,
+# cooperative, speed gain, keep right) are off, also after a scripted stop's hold
+NO_OWN_LANE_CHANGES = 'lcStrategic="-1" lcCooperative="-1" lcSpeedGain="0" lcKeepRight="0"'
 EGO_VTYPE = (
     '<vType id="ego" vClass="passenger" length="4.92" width="1.85" minGap="2.00" '
     'maxSpeed="70.00" accel="4.00" decel="9.00" emergencyDecel="12.00" sigma="0" speedDev="0" '
@@ -53,7 +56,7 @@ def _vtype(body: Body) -> str:
     return (
         f'<vType id="t_{body.name}" vClass="{vclass}" length="{body.length_m:g}" '
         f'width="{body.width_m:g}" minGap="1.00" maxSpeed="70.00" accel="2.50" decel="10.00" '
-        f'emergencyDecel="12.00" sigma="0" speedDev="0" speedFactor="4"/>'
+        f'emergencyDecel="12.00" sigma="0" speedDev="0" speedFactor="4" {NO_OWN_LANE_CHANGES}/>'
     )
 
 

@@ -70,6 +70,17 @@ def test_alks_emergency_brake_compiles_with_its_end() -> None:
     assert plan.end_s == pytest.approx(10.0 + (60 / 3.6) / 9.81 + 10.0)
 
 
+def test_a_blocking_target_given_as_a_car_by_its_parameters() -> None:
+    """4.2_1's target is a pedestrian by default; its catalog parameters can name a car."""
+    path = ALKS / "alks_scenario_4_2_1_fully_blocking_target_template.xosc"
+    params = {"TargetBlocking_Catalog": "vehicle_catalog", "TargetBlocking_Model": "car"}
+    plan = compile_plan(read_scenario(path, params))
+    place = plan.places["TargetBlocking"]
+    assert (place.lane, place.s_m) == (-4, 500.0)
+    assert plan.speeds_mps.get("TargetBlocking", 0.0) == 0.0
+    assert plan.bodies["TargetBlocking"].length_m == 5.0
+
+
 def test_param_replaces_a_declared_value_and_refuses_an_undeclared_one() -> None:
     path = ALKS / "alks_scenario_4_3_2_follow_lead_vehicle_emergency_brake_template.xosc"
     plan = compile_plan(read_scenario(path, {"Ego_InitSpeed_Ve0_kph": "36"}))

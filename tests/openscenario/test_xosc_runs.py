@@ -69,11 +69,13 @@ def test_alks_emergency_brake_runs_its_storyboard(tmp_path: Path) -> None:
     """4.3_2: the lead holds 60 km/h for 10 s after the start, then stops at 9.81 m/s^2."""
     path = ALKS / "alks_scenario_4_3_2_follow_lead_vehicle_emergency_brake_template.xosc"
     assert main(["run", str(path), "--out", str(tmp_path / "o")]) == 0
-    lead = [
-        (float(r["time_s"]), float(r["speed_mps"]))
+    rows = [
+        r
         for r in csv.DictReader((tmp_path / "o" / "traffic.csv").open())
         if r["id"] == "LeadVehicle"
     ]
+    assert {r["y_m"] for r in rows} == {"-5.25"}  # lane -4 throughout: no lane change of SUMO's
+    lead = [(float(r["time_s"]), float(r["speed_mps"])) for r in rows]
     depart = lead[0][0]
     assert all(v == pytest.approx(60 / 3.6, abs=0.01) for t, v in lead if t < depart + 9.99)
     stop_s = depart + 10.0 + (60 / 3.6) / 9.81
