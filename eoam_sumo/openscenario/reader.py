@@ -38,7 +38,7 @@ def read_scenario(path: Path, overrides: dict[str, str] | None = None) -> Scenar
     given = dict(overrides or {})
     dist = root.find("ParameterValueDistribution")
     if dist is not None:
-        path, chosen = _distribution(path, dist)
+        path, chosen = _distribution(path, dist, set(given))
         given = {**chosen, **given}
         root = parse(path)
     if root.find("Storyboard") is None:
@@ -70,8 +70,9 @@ def _sub(text: str, values: dict[str, str], node: Node) -> str:
         raise InputError(f"{node.where()}: {exc}") from exc
 
 
-def _distribution(path: Path, dist: Node) -> tuple[Path, dict[str, str]]:
-    """The scenario file and the single set of values a parameter distribution names."""
+def _distribution(path: Path, dist: Node, given: set[str]) -> tuple[Path, dict[str, str]]:
+    """The scenario file and the single set of values a parameter distribution names (a
+    parameter given with ``--param`` may have many values there: ``--param`` picks one)."""
     scen = dist.find("ScenarioFile")
     if scen is None:
         raise InputError(f"{dist.where()}: no <ScenarioFile>")
@@ -81,20 +82,30 @@ def _distribution(path: Path, dist: Node) -> tuple[Path, dict[str, str]]:
         raise InputError(f"{other.where()}: only a Deterministic distribution is supported")
     chosen: dict[str, str] = {}
     for node in det.children:
-        sets = [n for n in node.iter() if n.tag in ("Element", "ParameterValueSet")]
-        if len(sets) != 1:
-            raise InputError(
-                f"{node.where()}: {len(sets)} values; `run` takes one parameter set "
-                "(give one with --param NAME=VALUE)"
-            )
-        if node.tag == "DeterministicSingleParameterDistribution" and sets[0].tag == "Element":
-            chosen[node.need("parameterName")] = sets[0].need("value")
-        elif sets[0].tag == "ParameterValueSet":
-            for a in sets[0].findall("ParameterAssignment"):
-                chosen[a.need("parameterRef")] = a.need("value")
-        else:
-            raise InputError(f"{node.where()}: not a supported distribution")
+        names = {node.get("parameterName")} | {
+            a.get("parameterRef") for a in node.iter() if a.tag == "ParameterAssignment"
+        }
+        if names - {None} <= given:
+            continue
+        chosen |= _one_set(node)
     return (path.parent / scen.need("filepath")).resolve(), chosen
+
+
+def _one_set(node: Node) -> dict[str, str]:
+    """The values of a distribution with exactly one value (set)."""
+    sets = [n for n in node.iter() if n.tag in ("Element", "ParameterValueSet", "Range")]
+    if len(sets) != 1 or sets[0].tag == "Range":
+        raise InputError(
+            f"{node.where()}: {node.get('parameterName') or 'this distribution'} has many "
+            "values; `run` takes one (give it with --param NAME=VALUE)"
+        )
+    if node.tag == "DeterministicSingleParameterDistribution" and sets[0].tag == "Element":
+        return {node.need("parameterName"): sets[0].need("value")}
+    if sets[0].tag == "ParameterValueSet":
+        return {
+            a.need("parameterRef"): a.need("value") for a in sets[0].findall("ParameterAssignment")
+        }
+    raise InputError(f"{node.where()}: not a supported distribution")
 
 
 def _catalog_dirs(root: Node, values: dict[str, str], base: Path) -> list[Path]:

@@ -136,3 +136,15 @@ def test_a_start_that_depends_on_the_run_is_refused(tmp_path: Path) -> None:
     src.write_text(text, encoding="utf-8")
     with pytest.raises(InputError, match=r"<SpeedCondition> at .*:\d+: a start that depends"):
         compile_plan(read_scenario(src))
+
+
+def test_a_variation_with_many_values_needs_them_picked() -> None:
+    """Vector's CCRs standard range sweeps the speed 10-50 km/h and five impact locations:
+    `run` refuses it naming the distribution, and runs the point --param picks."""
+    path = NCAP_RUNS.parent / "StandardRange" / "CCRs.xosc"
+    with pytest.raises(InputError, match=r"CCRs.xosc:28: Ego_speed_kph has many values"):
+        read_scenario(path)
+    plan = compile_plan(read_scenario(path, {"Ego_speed_kph": "30", "ImpactLocation": "50"}))
+    assert plan.speeds_mps == pytest.approx({"Ego": 30 / 3.6, "Target": 0.0})
+    # the target 5 s at 30 km/h ahead (Ego_initTimeHeadway, reference points) of s = 50 m
+    assert plan.places["Target"].s_m == pytest.approx(50 + 5 * 30 / 3.6)
