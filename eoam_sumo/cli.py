@@ -20,6 +20,13 @@ from eoam_sumo import __version__
 from eoam_sumo.arguments import finite, mu, speed_kmh
 from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import writable_dir
+from eoam_sumo.openscenario.command import (
+    is_xosc,
+    prepare_command,
+    refuse_params_for_sumocfg,
+    run_xosc_command,
+    xosc_arguments,
+)
 from eoam_sumo.seeds import seed_argument
 from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S, MAX_TIME_LIMIT_S
 from eoam_sumo.traffic_levels.command import add_scenario_arguments, cmd_scenario
@@ -119,7 +126,7 @@ def _tables_arguments(sub) -> None:
 
 def _run_arguments(sub) -> None:
     p = sub.add_parser("run", help="one co-simulation of a SUMO scenario")
-    p.add_argument("cfg", type=Path, help="the scenario's .sumocfg")
+    p.add_argument("cfg", type=Path, help="the scenario's .sumocfg, or an OpenSCENARIO .xosc")
     p.add_argument("--speed-kmh", type=speed_kmh, help="ego initial speed (km/h)")
     p.add_argument("--mu", type=mu, help="surface friction for every lane")
     p.add_argument(
@@ -128,7 +135,10 @@ def _run_arguments(sub) -> None:
         default=None,
         help="add an oncoming car this far ahead (m), or 'none'",
     )
-    p.add_argument("--ego", default="ego", help="the ego vehicle's id (default: ego)")
+    p.add_argument(
+        "--ego", help="the ego vehicle's id (default: ego); of an .xosc, the ego entity's name"
+    )
+    xosc_arguments(p)
     p.add_argument("--out", type=Path, default=Path("out/run"), help="output folder")
     p.add_argument(
         "--max-time-s", type=finite, default=DEFAULT_MAX_TIME_S, help="simulated time limit"
@@ -312,14 +322,19 @@ def _cmd_run(args) -> int:
     from eoam_sumo.sim.scenario import ScenarioOverrides
 
     _check_run_args(args)
+    if is_xosc(args):
+        xosc = prepare_command(args)  # refuses what the subset lacks before writing anything
     out = writable_dir(args.out)
     settings = _run_settings(args, out)
-    overrides = ScenarioOverrides(
-        ego_speed_mps=None if args.speed_kmh is None else args.speed_kmh / 3.6,
-        mu=args.mu,
-        oncoming_start_m=args.oncoming_m,
-    )
-    s = run_case(args.cfg, overrides, out, settings)
+    if is_xosc(args):
+        s = run_xosc_command(args, xosc, out, settings)
+    else:
+        overrides = ScenarioOverrides(
+            ego_speed_mps=None if args.speed_kmh is None else args.speed_kmh / 3.6,
+            mu=args.mu,
+            oncoming_start_m=args.oncoming_m,
+        )
+        s = run_case(args.cfg, overrides, out, settings)
     print(
         f"{s['outcome']}: collision_with={s['collision_with']} "
         f"impact={s['impact_speed_mps']:.1f} m/s modes={s['modes_visited']} "
@@ -346,6 +361,7 @@ def _check_run_args(args) -> None:
     if args.after_stop_s is not None and args.after_stop_s < 0:
         raise InputError(f"--after-stop-s {args.after_stop_s:g} must be >= 0")
     _check_v2x(args)
+    refuse_params_for_sumocfg(args)
     if not args.gui and (args.gui_delay_ms is not None or args.gui_screenshot or args.gui_close):
         raise InputError("--gui-delay-ms, --gui-screenshot and --gui-close need --gui")
 
@@ -369,7 +385,7 @@ def _run_settings(args, out: Path):
     )
     settings = RunSettings(
         max_time_s=args.max_time_s,
-        ego_id=args.ego,
+        ego_id=args.ego or "ego",
         gui=args.gui,
         use_traci=args.gui,
         gui_settings=gui,

@@ -1,0 +1,317 @@
+"""A resolved scenario's storyboard as a plan: who is where, which speeds when, when it ends.
+
+Init places each entity (``LanePosition``, ``RelativeLanePosition``, a non-continuous
+``LongitudinalDistanceAction``) and sets its speed (a step ``SpeedAction``). Each story event
+is timed before the run (:mod:`.timing`); its actions become speed changes (``SpeedAction``),
+placements at the start, or the ego's controller (``ActivateControllerAction``). Events whose
+start depends on the run and that only set variables (logging) are left out with a note.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from eoam_sumo.errors import InputError
+from eoam_sumo.openscenario.model import Body, Place, Plan, SpeedChange
+from eoam_sumo.openscenario.reader import Scenario
+from eoam_sumo.openscenario.subset import refuse
+from eoam_sumo.openscenario.timing import DYNAMIC, NEVER, Clock, NotYet
+from eoam_sumo.openscenario.xmltree import Node
+
+
+@dataclass(frozen=True)
+class _Event:
+    act: Node
+    actors: tuple[str, ...]
+    group: Node
+    maneuver: Node
+    event: Node
+
+
+def compile_plan(scenario: Scenario, ego: str | None = None) -> Plan:
+    """The plan of ``scenario``; ``ego`` names the ego entity (default: the one handed to a
+    controller, else the one named Ego)."""
+    board = scenario.root.find("Storyboard")
+    assert board is not None  # the reader checked
+    bodies = _bodies(scenario.root)
+    plan = Plan(bodies, "", {}, {})
+    init = board.find("Init")
+    for private in [] if init is None else _privates(init):
+        _init_private(plan, private)
+    clock = Clock(scenario.parameters)
+    controlled = _time_events(plan, clock, _events(board))
+    plan.ego = _choose_ego(plan, controlled, ego, scenario.root)
+    _end(plan, clock, board.find("StopTrigger"))
+    missing = sorted(set(bodies) - set(plan.places))
+    if missing:
+        raise InputError(f"{scenario.path}: entity {missing[0]} is never placed (no Init)")
+    return plan
+
+
+def _bodies(root: Node) -> dict[str, Body]:
+    bodies = {}
+    entities = root.find("Entities")
+    for obj in [] if entities is None else entities.findall("ScenarioObject"):
+        veh = obj.find("Vehicle")
+        if veh is None:
+            other = next((c for c in obj.children if c.tag != "ObjectController"), obj)
+            raise refuse(other, "only vehicles are supported as entities")
+        box = veh.find("BoundingBox")
+        dims = None if box is None else box.find("Dimensions")
+        centre = None if box is None else box.find("Center")
+        if dims is None or centre is None:
+            raise refuse(veh, "a vehicle needs a BoundingBox with Center and Dimensions")
+        name = obj.need("name")
+        bodies[name] = Body(
+            name,
+            dims.num("length"),
+            dims.num("width"),
+            centre.num("x"),
+            veh.get("vehicleCategory", "car") or "car",
+        )
+    return bodies
+
+
+def _privates(init: Node) -> list[Node]:
+    actions = init.find("Actions")
+    return [] if actions is None else actions.findall("Private")
+
+
+def _init_private(plan: Plan, private: Node) -> None:
+    name = private.need("entityRef")
+    if name not in plan.bodies:
+        raise refuse(private, f"entity {name} is not declared")
+    for pa in private.findall("PrivateAction"):
+        _private_action(plan, name, pa.children[0], 0.0)
+
+
+def _private_action(plan: Plan, name: str, action: Node, t_s: float) -> float:
+    """Apply one private action of ``name`` starting at ``t_s``; its end time."""
+    inner = action.children[0] if action.children else action
+    if action.tag == "TeleportAction" or inner.tag == "LongitudinalDistanceAction":
+        if t_s > 0.0:
+            raise refuse(action, "a placement after the start is not supported")
+        place = _place(plan, name, action if action.tag == "TeleportAction" else inner)
+        plan.places[name] = place
+        return t_s
+    if inner.tag == "SpeedAction":
+        return _speed(plan, name, inner, t_s)
+    if inner.tag == "ActivateControllerAction":
+        return t_s
+    raise refuse(inner, f"{inner.tag} is not supported here")
+
+
+def _place(plan: Plan, name: str, node: Node) -> Place:
+    if node.tag == "LongitudinalDistanceAction":
+        return _distance_place(plan, name, node)
+    pos = node.find("Position")
+    where = None if pos is None or not pos.children else pos.children[0]
+    if where is None:
+        raise refuse(node, "a TeleportAction needs a Position")
+    if where.tag == "LanePosition":
+        return Place(where.need("roadId"), int(where.num("laneId")), where.num("s"), where)
+    ref = _placed(plan, where.need("entityRef"), where)
+    return Place(ref.road, ref.lane, ref.s_m + where.num("ds"), where)
+
+
+def _placed(plan: Plan, name: str, node: Node) -> Place:
+    if name not in plan.places:
+        raise refuse(node, f"{name} is not placed before this position refers to it")
+    return plan.places[name]
+
+
+def _distance_place(plan: Plan, name: str, node: Node) -> Place:
+    """``name`` ahead of the referenced entity by the distance or time gap (freespace: bumper
+    to bumper; otherwise reference point to reference point)."""
+    other = node.need("entityRef")
+    ref = _placed(plan, other, node)
+    if node.get("distance") is not None:
+        gap = node.num("distance")
+    else:
+        gap = node.num("timeGap") * plan.speeds_mps.get(other, 0.0)
+    if node.get("freespace") in ("true", "1"):
+        me, it = plan.bodies[name], plan.bodies[other]
+        gap += it.front_ahead_m - me.rear_ahead_m
+    return Place(ref.road, ref.lane, ref.s_m + gap, node)
+
+
+def _speed(plan: Plan, name: str, node: Node, t_s: float) -> float:
+    dyn, target = node.find("SpeedActionDynamics"), node.find("SpeedActionTarget")
+    absolute = None if target is None else target.find("AbsoluteTargetSpeed")
+    if dyn is None or absolute is None:
+        raise refuse(node, "a SpeedAction needs its dynamics and an AbsoluteTargetSpeed")
+    speed = absolute.num("value")
+    if t_s == 0.0 and dyn.need("dynamicsShape") == "step":
+        plan.speeds_mps[name] = speed
+        return t_s
+    rate = math.inf if dyn.need("dynamicsShape") == "step" else dyn.num("value")
+    if rate <= 0:
+        raise refuse(dyn, f"rate {rate} must be > 0")
+    before = _speed_at(plan, name, t_s, node)
+    plan.changes.append(SpeedChange(name, t_s, speed, rate, node))
+    return t_s + (0.0 if math.isinf(rate) else abs(speed - before) / rate)
+
+
+def _speed_at(plan: Plan, name: str, t_s: float, node: Node) -> float:
+    """The speed ``name`` holds at ``t_s`` (the last earlier change reached)."""
+    earlier = [c for c in plan.changes if c.entity == name and c.start_s <= t_s]
+    if not earlier:
+        return plan.speeds_mps.get(name, 0.0)
+    raise refuse(node, f"a second speed change of {name} is not supported")
+
+
+def _events(board: Node) -> list[_Event]:
+    out = []
+    for story in board.findall("Story"):
+        for act in story.findall("Act"):
+            for group in act.findall("ManeuverGroup"):
+                actors_node = group.find("Actors")
+                refs = [] if actors_node is None else actors_node.findall("EntityRef")
+                actors = tuple(r.need("entityRef") for r in refs)
+                for man in group.findall("Maneuver"):
+                    out += [_Event(act, actors, group, man, ev) for ev in man.findall("Event")]
+    return out
+
+
+def _time_events(plan: Plan, clock: Clock, events: list[_Event]) -> set[str]:
+    """Time every event (in as many passes as state conditions need); the entities handed to
+    a controller."""
+    controlled: set[str] = set()
+    waiting = list(events)
+    while waiting:
+        later = []
+        for ev in waiting:
+            try:
+                controlled |= _time_event(plan, clock, ev)
+            except NotYet as exc:
+                later.append((ev, exc))
+        if len(later) == len(waiting):
+            raise refuse(later[0][1].node, "refers to an element that is never timed (a cycle)")
+        waiting = [ev for ev, _ in later]
+        _close(clock, events)
+    _close(clock, events)
+    return controlled
+
+
+def _start(clock: Clock, node: Node, default: float) -> float:
+    t = clock.trigger_time(node.find("StartTrigger"), default)
+    if t == DYNAMIC:
+        cond = _first_dynamic(node.find("StartTrigger"))
+        raise refuse(cond, "a start that depends on the run is not supported")
+    return max(float(t), default)
+
+
+def _first_dynamic(trigger: Node | None) -> Node:
+    assert trigger is not None
+    static = (
+        "Condition",
+        "ByValueCondition",
+        "ByEntityCondition",
+        "EntityCondition",
+        "SimulationTimeCondition",
+        "ParameterCondition",
+        "StoryboardElementStateCondition",
+    )
+    for node in trigger.iter():
+        if node.tag.endswith("Condition") and node.tag not in static:
+            return node
+    return trigger
+
+
+def _time_event(plan: Plan, clock: Clock, ev: _Event) -> set[str]:
+    act_name = ev.act.need("name")
+    if act_name not in clock.starts:
+        clock.starts[act_name] = _start(clock, ev.act, 0.0)
+    t_act = clock.starts[act_name]
+    for node in (ev.group, ev.maneuver):
+        clock.starts.setdefault(node.need("name"), t_act)
+    actions = ev.event.findall("Action")
+    if t_act < NEVER and _logging_only(actions):
+        t = clock.trigger_time(ev.event.find("StartTrigger"), t_act)
+        if t == DYNAMIC:
+            plan.notes.append(f"event {ev.event.need('name')} (sets variables) not evaluated")
+            return set()
+    t_ev = _start(clock, ev.event, t_act) if t_act < NEVER else NEVER
+    clock.starts[ev.event.need("name")] = t_ev
+    return _run_actions(plan, clock, ev, actions, t_ev)
+
+
+def _logging_only(actions: list[Node]) -> bool:
+    return all(a.find("GlobalAction") is not None for a in actions) and all(
+        a.find("GlobalAction").children[0].tag == "VariableAction"  # type: ignore[union-attr]
+        for a in actions
+    )
+
+
+def _run_actions(
+    plan: Plan, clock: Clock, ev: _Event, actions: list[Node], t_ev: float
+) -> set[str]:
+    controlled: set[str] = set()
+    end = t_ev
+    for action in actions:
+        name = action.need("name")
+        clock.starts[name] = t_ev
+        t_end = t_ev
+        if t_ev < NEVER and action.find("PrivateAction") is not None:
+            inner = action.find("PrivateAction").children[0]  # type: ignore[union-attr]
+            for actor in ev.actors:
+                t_end = max(t_end, _private_action(plan, actor, inner, t_ev))
+            if inner.children and inner.children[0].tag == "ActivateControllerAction":
+                controlled |= set(ev.actors)
+        elif t_ev < NEVER:
+            glob = action.find("GlobalAction")
+            what = glob.children[0].tag if glob is not None and glob.children else "action"
+            plan.notes.append(f"{what} of {name} not applied")
+        clock.ends[name] = t_end
+        end = max(end, t_end)
+    clock.ends[ev.event.need("name")] = end
+    return controlled
+
+
+def _close(clock: Clock, events: list[_Event]) -> None:
+    """The end of every maneuver, group and act whose events are all timed."""
+    for key in ("maneuver", "group", "act"):
+        owners: dict[str, list[str]] = {}
+        for ev in events:
+            owners.setdefault(getattr(ev, key).need("name"), []).append(ev.event.need("name"))
+        for owner, names in owners.items():
+            if all(n in clock.ends for n in names):
+                ends = [clock.ends[n] for n in names if clock.ends[n] < NEVER]
+                clock.ends[owner] = max(ends, default=NEVER)
+
+
+def _choose_ego(plan: Plan, controlled: set[str], ego: str | None, root: Node) -> str:
+    if ego is not None:
+        if ego not in plan.bodies:
+            raise InputError(f"--ego {ego}: no such entity (have {', '.join(plan.bodies)})")
+        return ego
+    entities = root.find("Entities")
+    for obj in [] if entities is None else entities.findall("ScenarioObject"):
+        if obj.find("ObjectController") is not None:
+            controlled.add(obj.need("name"))
+    if len(controlled) == 1:
+        return next(iter(controlled))
+    named = [n for n in plan.bodies if n.lower() == "ego"]
+    if not controlled and len(named) == 1:
+        plan.notes.append(f"no entity is handed to a controller: the ego is {named[0]}")
+        return named[0]
+    raise InputError(f"{root.file}: cannot tell the ego (name it with --ego)")
+
+
+def _end(plan: Plan, clock: Clock, stop: Node | None) -> None:
+    """The run's end from a stop trigger timed before the run; else the run's own criteria."""
+    if stop is None or not stop.children:
+        return
+    static = []
+    for group in stop.findall("ConditionGroup"):
+        try:
+            t = clock.trigger_time(Node("StopTrigger", {}, group.file, group.line, [group]), 0)
+        except NotYet:
+            t = DYNAMIC
+        if t == DYNAMIC:
+            plan.notes.append(f"stop condition group at line {group.line} not evaluated")
+        else:
+            static.append(float(t))
+    if static and min(static) < NEVER:
+        plan.end_s = min(static)

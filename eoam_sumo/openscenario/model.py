@@ -1,0 +1,64 @@
+"""The plan a storyboard compiles to: bodies, placements, speeds over time, the end."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from eoam_sumo.openscenario.xmltree import Node
+
+
+@dataclass(frozen=True)
+class Body:
+    """An entity's footprint: ``centre_ahead_m`` is its box centre ahead of its reference
+    point (OpenSCENARIO positions place the reference point, usually the rear axle)."""
+
+    name: str
+    length_m: float
+    width_m: float
+    centre_ahead_m: float
+    category: str
+
+    @property
+    def front_ahead_m(self) -> float:
+        """The front bumper ahead of the reference point."""
+        return self.centre_ahead_m + self.length_m / 2
+
+    @property
+    def rear_ahead_m(self) -> float:
+        """The rear bumper ahead of the reference point (negative: behind it)."""
+        return self.centre_ahead_m - self.length_m / 2
+
+
+@dataclass(frozen=True)
+class Place:
+    """A reference point on an OpenDRIVE lane: road, lane id, s along the road."""
+
+    road: str
+    lane: int
+    s_m: float
+    node: Node
+
+
+@dataclass(frozen=True)
+class SpeedChange:
+    """From ``start_s`` (after the start) the entity's speed goes to ``target_mps`` at
+    ``rate_mps2`` (inf: a step)."""
+
+    entity: str
+    start_s: float
+    target_mps: float
+    rate_mps2: float
+    node: Node
+
+
+@dataclass
+class Plan:
+    """Everything the SUMO scenario is written from."""
+
+    bodies: dict[str, Body]
+    ego: str
+    places: dict[str, Place]
+    speeds_mps: dict[str, float]
+    changes: list[SpeedChange] = field(default_factory=list)
+    end_s: float | None = None
+    notes: list[str] = field(default_factory=list)
