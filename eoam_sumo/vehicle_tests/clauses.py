@@ -19,7 +19,7 @@ Sources (found in the regulations' public texts and NHTSA's papers on them):
   Appendix 1 wheel-lock sequence): for all braking rates between 0.15 and 0.8 the front wheels
   lock simultaneously with or before the rear wheels; the pedal force is raised so that the
   first axle locks between 0.5 s and 1 s after braking begins, from 65 km/h on a surface of
-  adhesion up to 0.5 and from 100 km/h above (as issue 38 quotes the Appendix; the search
+  adhesion up to 0.5 and from 100 km/h above (as the chassis review quotes the Appendix; the search
   corpora held neither R13-H's Annex 5 text, so these figures are not checked against it).
   Annex 6 (anti-lock systems, Appendix 2):
   utilisation of adhesion, at least 0.75.
