@@ -11,13 +11,14 @@ Interpolation rules:
   surface needs less distance, so this is conservative); linear interpolation of the convex
   1/mu-like boundaries overestimates them between grid frictions (conservative too);
 - boundaries in relative speed: linear within the grid; below the lowest grid speed the
-  closed forms (``PhaseBoundaries._below_grid``: B0 = v^2 / (2 a), Bb = B0 + t_b v + c_b, the
-  TTC kept, and S = Sb = B0: no lane change below the grid, so the DMM only brakes there),
+  braking boundaries' closed forms (``PhaseBoundaries._below_grid``: B0 = v^2 / (2 a),
+  Bb = B0 + t_b v + c_b), the clearing boundaries scaled linearly to 0 at zero closing speed
+  (nothing to avoid), the TTC kept;
   clamped to the top row above the highest (only an obstacle moving towards the ego closes
   faster than the ego drives, and runs above the grid are refused by ``check_run``);
 - trajectories in entry speed: linear within the grid, clamped to the lowest grid speed below
-  it (never read there: no STEER sector below the grid's closing speeds, and
-  ``EoamSettings.min_steer_speed_mps`` brakes a STEER sector below 20 km/h of ego speed) and to
+  it (never read there: ``EoamSettings.min_steer_speed_mps`` brakes a STEER sector below
+  20 km/h of ego speed, and a lane change's entry speed is the ego's) and to
   the highest above it (``check_run`` refuses runs above the grid);
 - in differential x: linear between the rows of the uniform grid; before 0 the first row,
   past the manoeuvre's end the final values (y = h, ax = 0, yaw = 0, curvature = 0, steer 0).
@@ -152,25 +153,26 @@ class PhaseBoundaries:
         return Boundary(*lo)
 
     def _below_grid(self, i_m: int, j_m: int, w_m: float, v: float) -> Boundary:
-        """Below the lowest grid speed: B0 = v^2 / (2 a) (eq. 33) with the deceleration a of
-        the lowest row, Bb = B0 + t_b v + c_b (sec. 6.2) with t_b, c_b from the two lowest
-        rows (Bb - B0 is linear in v), TTC kept; no lane change is offered (no tables
-        there), so S = Sb = B0 and the steering sectors F and B are empty. Linear in mu
-        between the grid frictions, as within the grid."""
+        """Below the lowest grid closing speed: B0 = v^2 / (2 a) (eq. 33) with the
+        deceleration a of the lowest row, Bb = B0 + t_b v + c_b (sec. 6.2) with t_b, c_b from
+        the two lowest rows (Bb - B0 is linear in v); the clearing boundaries, which have no
+        closed form, scaled linearly to 0 from the lowest row (nothing closes, nothing to
+        avoid); TTC kept. Linear in mu between the grid frictions, as within the grid. (Below
+        20 km/h of ego speed the EOAM only brakes: ``EoamSettings.min_steer_speed_mps``.)"""
         lo, hi = (self._low_speed_row(i, v) for i in (i_m, j_m))
-        stop, buffered, ttc = (a + w_m * (b - a) for a, b in zip(lo, hi))
-        return Boundary(stop, buffered, stop, stop, stop, ttc)
+        return Boundary(*(a + w_m * (b - a) for a, b in zip(lo, hi)))
 
-    def _low_speed_row(self, i_mu: int, v: float) -> tuple[float, float, float]:
-        """(B0, Bb, TTC) of friction row ``i_mu`` at a speed v below the grid."""
+    def _low_speed_row(self, i_mu: int, v: float) -> tuple[float, ...]:
+        """(B0, Bb, S, S*, Sb, TTC) of friction row ``i_mu`` at a speed v below the grid."""
         rows, speeds = self._rows[i_mu], self._speeds
-        v0, (stop0, buffered0, *_rest, ttc) = speeds[0], rows[0]
+        v0, (stop0, buffered0, clear, clear_opt, clear_b, ttc) = speeds[0], rows[0]
         t_b = 0.0
         if len(speeds) > 1:
             t_b = ((rows[1][1] - rows[1][0]) - (buffered0 - stop0)) / (speeds[1] - v0)
         c_b = buffered0 - stop0 - t_b * v0
         stop = stop0 * (v / v0) ** 2  # v^2 / (2 a) with a = v0^2 / (2 B0(v0))
-        return stop, stop + t_b * v + c_b, ttc
+        scale = v / v0
+        return (stop, stop + t_b * v + c_b, clear * scale, clear_opt * scale, clear_b * scale, ttc)
 
 
 class Trajectory:

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from eoam_sumo import __version__
-from eoam_sumo.decision.dmm import Action, BoundaryCurve
+from eoam_sumo.decision.dmm import BoundaryCurve
 from eoam_sumo.errors import InputError
 from eoam_sumo.offline.boundaries import max_decel_no_lock_mps2
 from eoam_sumo.offline.design import DesignSettings
@@ -145,8 +145,12 @@ def test_boundaries_at_grid_points_equal_the_csv_and_interpolate_linearly(tables
 
 def test_boundaries_outside_the_grid(tables):
     b = tables.boundaries
-    low = b.at(1.0, 10.0 / 3.6)  # below the grid: no lane change, S = Sb = B0
-    assert low.clear_opt_m == low.clear_buffered_m == low.clear_const_m == low.stop_m
+    # below the grid: B0 = v^2 / (2 a) (a quarter at half the lowest speed), the clearing
+    # boundaries scaled linearly to 0 (a half), the TTC kept
+    low, first = b.at(1.0, 10.0 / 3.6), ROWS[(1.0, 20.0)]
+    assert low.stop_m == pytest.approx(first["stop_distance_m"] / 4)
+    assert low.clear_opt_m == pytest.approx(first["clear_distance_opt_m"] / 2)
+    assert low.clear_buffered_m == pytest.approx(first["clear_distance_buffered_m"] / 2)
     assert low.ttc_s == 2.5
     assert b.at(0.3, 0.0)[:4] == pytest.approx((0.0, S.brake_buffer_m, 0.0, 0.0), abs=1e-3)
     assert b.at(0.3, -3.0) == b.at(0.3, 0.0)
@@ -235,21 +239,23 @@ def test_missing_or_broken_tables_are_input_errors(tmp_path):
 @pytest.mark.parametrize("mu", [1.0, 0.7, 0.3, 0.1])
 @pytest.mark.parametrize("kmh", [5.0, 10.0, 15.0, 19.0])
 def test_braking_boundaries_below_the_grid_are_the_closed_form(tables, mu, kmh):
-    """Below 20 km/h: B0 = v^2 / (2 a) (eq. 33) with the csv's deceleration at this mu,
-    Bb = B0 + t_b v + c_b (sec. 6.2) with the design's buffers; the DMM's curve agrees."""
+    """Below 20 km/h of closing speed: B0 = v^2 / (2 a) (eq. 33) with the csv's deceleration
+    at this mu, Bb = B0 + t_b v + c_b (sec. 6.2) with the design's buffers; the DMM's curve
+    agrees."""
     v = kmh / 3.6
     stop = v * v / (2.0 * ROWS[(mu, 20.0)]["max_decel_mps2"])
     buffered = stop + S.brake_buffer_time_s * v + S.brake_buffer_m
     got = tables.boundaries.at(mu, v)
     assert got.stop_m == pytest.approx(stop, rel=1e-3)
     assert got.stop_buffered_m == pytest.approx(buffered, rel=1e-3)
-    assert got.clear_opt_m == got.clear_buffered_m == got.stop_m  # no steering sector
+    # the clearing boundaries have no closed form: scaled linearly to 0 from the lowest row
+    low = ROWS[(mu, 20.0)]
+    assert got.clear_opt_m == pytest.approx(low["clear_distance_opt_m"] * kmh / 20.0)
+    assert got.clear_buffered_m == pytest.approx(low["clear_distance_buffered_m"] * kmh / 20.0)
     curve = BoundaryCurve(tables.boundaries, mu, tables.speed_grid_mps)
     row = curve.at(v)
     assert row.stop_m == pytest.approx(stop, rel=2e-3, abs=1e-3)
     assert row.stop_buffered_m == pytest.approx(buffered, rel=1e-3)
-    for d in np.linspace(0.01, 2.0 * buffered, 50):  # braking or FCW, never a steer
-        assert curve.sector(float(d), v).action is not Action.STEER
 
 
 def test_runs_outside_the_tables_are_refused(tables):

@@ -151,19 +151,6 @@ RADARS = {  # the paper's beam (the default), with a near-range beam, the automo
 EGO = ego_e_class_sedan()
 
 
-_CRAWLS_PAST = pytest.mark.xfail(
-    strict=True,
-    reason=(
-        "following a person walking away, the EOAM brakes to a crawl behind them and hands "
-        "back as soon as they open faster than release_opening_speed_mps; it then speeds up "
-        "towards its set speed and brakes again (a stop-and-go); with the automotive radar "
-        "the run ends in a cycle's acceleration at 2.56 m/s. Holding the hand-back until the "
-        "person is beyond the set speed's catch-up distance cures it but also brakes the ego "
-        "to a stop behind a car slowing at 1 m/s2 on a motorway (tests/sim/test_cosim.py)"
-    ),
-)
-
-
 @pytest.mark.parametrize("radar", RADARS)
 @pytest.mark.parametrize(
     ("depart", "arrival"),
@@ -171,15 +158,13 @@ _CRAWLS_PAST = pytest.mark.xfail(
     ids=["walking-away", "walking-towards"],
 )
 def test_a_person_walking_in_the_lane_ahead_raises_the_fcw_and_is_not_driven_through(
-    tmp_path, depart, arrival, radar, request
+    tmp_path, depart, arrival, radar
 ):
     """A person walking 1.13 m right of the lane centre: first seen at the radar's range, the
     FCW raised, the ego brakes and follows at walking pace or stops behind them; a moving ego
     never reaches them. With the paper's 18 deg beam alone they leave the beam about 5 m
     ahead and the coasted track keeps the EOAM braking (docs/sensing.md); the run does not
     end while the ego moves close behind them."""
-    if arrival > depart and radar == "automotive":
-        request.applymarker(_CRAWLS_PAST)
     cfg = _walker_scenario(tmp_path, depart, arrival)
     out = tmp_path / "run"
     summary = run_case(

@@ -81,6 +81,10 @@ CORNERS = {
 }
 
 
+#: columns the plant's step writes: NaN in the harness's start row, before the first step
+FROM_THE_PLANT = ("friction_use_max", "friction_ellipse_max")
+
+
 @pytest.mark.parametrize("fitted", [False, True], ids=["plain", "abs-esc"])
 @pytest.mark.parametrize("test", ["brake", "step-steer"])
 @pytest.mark.parametrize("corner", sorted(CORNERS))
@@ -92,5 +96,7 @@ def test_a_corner_of_the_ranges_gives_a_finite_time_series(corner, test, fitted)
     for run in result.runs:
         for name, column in run.columns.items():
             values = np.asarray(column)
+            if name in FROM_THE_PLANT:  # the start row is the harness's: no tyre forces yet
+                values = values[1:]
             if values.dtype.kind == "f":
                 assert np.isfinite(values).all(), (corner, test, run.label, name)
