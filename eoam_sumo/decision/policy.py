@@ -56,6 +56,11 @@ ONCOMING_MPS = 0.5  # a road user moving towards the ego faster than this is onc
 FOLLOWER_REACTION_S = 0.4
 FOLLOWER_DECEL_MPS2 = 3.0
 FOLLOWER_HEADWAY_S = 1.0
+#: The longest lane change the policy plans (from its commit until the ego's body has left the
+#: target lane) [s]: a pass that takes longer (the obstacle about as fast as the ego, closing
+#: speed near 0) is not an avoidance manoeuvre and counts as never passed (the EOAM brakes
+#: in lane and follows); it also bounds every prediction over the manoeuvre.
+PLAN_HORIZON_S = 30.0
 
 
 @mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
@@ -196,8 +201,12 @@ def follower_keeps_distance(
     ``FOLLOWER_DECEL_MPS2`` from ``FOLLOWER_REACTION_S`` after the lane change begins, and
     the gap stays at least its own ``FOLLOWER_HEADWAY_S`` of travel (and ``min_gap_m``): the
     project's assumption (see ``FOLLOWER_REACTION_S``). Until it reacts it keeps its own
-    ``accel_mps2`` (where known; 0: its speed)."""
+    ``accel_mps2`` (where known; 0: its speed). Bounded: the prediction stops once nothing
+    changes any more (past the reaction and the lane change, the follower no faster than the
+    ego: the gap cannot shrink) and at ``PLAN_HORIZON_S``."""
     t, step = 0.0, 0.05
+    t_s = min(t_s, PLAN_HORIZON_S)
+    settled_s = max(FOLLOWER_REACTION_S, need.t_lane_change_s)
     ego_x, x_b, v_b = 0.0, 0.0, speed_mps
     v0 = need.lane_change_m / need.t_lane_change_s if need.t_lane_change_s > 0.0 else 0.0
     while t < t_s:
@@ -211,6 +220,8 @@ def follower_keeps_distance(
         t += step
         if gap_m + ego_x - x_b < max(min_gap_m, v_b * FOLLOWER_HEADWAY_S):
             return False
+        if t >= settled_s and v_b <= v_e:
+            return True  # the gap no longer shrinks, the headway needed no longer grows
     return True
 
 
@@ -246,6 +257,8 @@ def sight_needed(
     obstacle_end = max(obstacle_speed_mps - decel * t_lc, 0.0)
     moved = road_user_travel_m(obstacle_speed_mps, -decel, t_lc)
     t_beside = beside_time_s(to_pass_m - (trajectory.length_m - moved), v_end, obstacle_end, decel)
+    if t_lc + t_beside > PLAN_HORIZON_S:  # a closing speed near 0: never passed
+        t_beside = math.inf
     back = QuinticShift.for_lateral_accel(
         travel_m, 0.0, 0.0, v_end, return_lateral_g * mu * G_MPS2, return_min_length_m
     )
@@ -414,7 +427,7 @@ class SafePolicy:
         elapsed = meas.time_s - self._commit_s
         t_left = max(need.t_total_s - elapsed, 0.0)
         into_m = abs(meas.d_m) + 0.5 * (self.params.width_m - meas.lane_width_m)
-        t = max(t_left, escape_time_s(into_m, meas.mu)) + need.margin_s
+        t = min(max(t_left, escape_time_s(into_m, meas.mu)) + need.margin_s, PLAN_HORIZON_S)
         now = remaining_plan(need, elapsed)
         return self._behind_reason(view, now, t) or self._ahead_reason(view, now, t)
 
