@@ -385,15 +385,20 @@ class SafePolicy:
             return "unseen road behind: a road user at the speed limit could catch the ego up"
         return ""
 
-    def _ahead_reason(self, view: NextLaneView, need: SightNeed, t_s: float) -> str:
+    def _ahead_reason(
+        self, view: NextLaneView, need: SightNeed, t_s: float, moving_only: bool = False
+    ) -> str:
         """A road user ahead in the target lane (at its own speed) that the ego would come
         within ``margin_m`` of during ``t_s``, or that would reach the ego (oncoming); one
-        beside the ego always closes the lane."""
+        beside the ego always closes the lane. ``moving_only``: the oncoming and standing
+        road users ahead are left out (the paper's own rules judge them)."""
         margin = self.settings.margin_m
         times = (0.0, min(need.t_lane_change_s, t_s), t_s)
         for gap, speed, accel in view.users_ahead_accel():
             if gap <= 0.0:
                 return "a road user beside the ego in the target lane"
+            if moving_only and speed <= ONCOMING_MPS:
+                continue
             if any(
                 gap + road_user_travel_m(speed, accel, t) - need.ego_travel_m(t) <= margin
                 for t in times
@@ -454,6 +459,23 @@ class SafePolicy:
             reason = self._behind_reason(view, need, t, unseen=False)
             return need, reason or self._ahead_reason(view, need, t)
         return need, self._commit_reason(meas, view, need)
+
+    def occupied_reason(
+        self, meas, perception, view: NextLaneView | None, obstacle_decel_mps2: float = 0.0
+    ) -> str:
+        """The paper policy's added check at a commit ("": the lane may be entered): a road
+        user of the target lane beside the ego, one behind that could not keep its distance
+        (:func:`follower_keeps_distance`), or one ahead moving the ego's way that it would come
+        within ``margin_m`` of, over the planned manoeuvre (at most ``PLAN_HORIZON_S``). The
+        paper is silent on traffic in the target lane; its oncoming and standing road users
+        stay with the paper's rules."""
+        if view is None:
+            return ""
+        need = self.sight_need(meas, perception, view, obstacle_decel_mps2)
+        t = min(need.t_total_s + need.margin_s, PLAN_HORIZON_S)
+        return self._behind_reason(view, need, t, unseen=False) or self._ahead_reason(
+            view, need, t, moving_only=True
+        )
 
     def blocks(
         self,

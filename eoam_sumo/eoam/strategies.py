@@ -285,9 +285,15 @@ class StableReturn(TimerReturn):
 
 # ------------------------------------------------------------------------------ next lane
 class NextLaneGate:
-    """The paper's policy: only oncoming traffic (and a standing car) closes the next lane."""
+    """The paper's policy: oncoming traffic (and a standing car) closes the next lane; at a
+    commit also a road user of the ego's direction in it, beside, behind or ahead
+    (``SafePolicy.occupied_reason``: the paper is silent on such traffic)."""
 
     policy: SafePolicy | None = None
+
+    def __init__(self, judge: SafePolicy | None = None):
+        self._judge = judge
+        self.reason = ""  # why the lane was found occupied (the first time)
 
     def blocks(
         self,
@@ -298,7 +304,13 @@ class NextLaneGate:
         obstacle_decel_mps2: float = 0.0,
     ) -> bool:
         """The next lane is closed to the lane change (treated as oncoming traffic)."""
-        return False
+        if not committing or self._judge is None:
+            return False
+        reason = self._judge.occupied_reason(
+            meas, perception, perception.next_lane, obstacle_decel_mps2
+        )
+        self.reason = self.reason or reason
+        return bool(reason)
 
     def prefer_braking(self, meas: EgoMeasurement, perception: Perception) -> bool:
         """Past the point of no return: braking in lane is predicted to end softer."""
@@ -306,6 +318,7 @@ class NextLaneGate:
 
     def reset(self) -> None:
         """Forget the run."""
+        self.reason = ""
 
 
 class SafeGate(NextLaneGate):
@@ -313,6 +326,7 @@ class SafeGate(NextLaneGate):
     lane watched during the lane change and the return, the severity tie-breaker."""
 
     def __init__(self, policy: SafePolicy):
+        super().__init__(policy)
         self.policy = policy
         self._policy = policy
 

@@ -533,12 +533,12 @@ class CoSimulation:
         )
 
     def _next_lane_sensing(self, side: int) -> NextLaneSensing | None:
-        """The sensing of the lane on ``side`` (+1 left, -1 right): the left one for the safe
-        policy, both when the ego's class may use the right one (the EOAM then chooses its
-        side); None: not needed, or no usable lane there."""
+        """The sensing of the lane on ``side`` (+1 left, -1 right): the left one for every
+        policy (each checks the road users in it at a commit), the right one too when the
+        ego's class may use it (the EOAM then chooses its side); None: no usable lane there."""
         st = self.settings
         left, right = self.side_lanes
-        if right is None and (side < 0 or st.eoam.policy.name != "safe"):
+        if right is None and side < 0:
             return None
         lane = left if side > 0 else right
         if lane is None:
@@ -578,6 +578,7 @@ class CoSimulation:
             "sight_needed_m": None,
             "sight_known_free_m": None,
             "sight_time_s": None,
+            "sight_reason": self.ctrl.parts.gate.reason,
             "tie_break": "",
         }
 

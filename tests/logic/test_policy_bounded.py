@@ -89,3 +89,26 @@ def test_a_pass_within_the_horizon_is_still_planned(tables):
     pol = SafePolicy(P, tables, EoamSettings(), PolicySettings(name="safe"))
     need, _ = pol.lane_reason(_meas(33.3), _seen(view, 20.0, 5.0), view)
     assert math.isfinite(need.t_total_s) and need.t_total_s < PLAN_HORIZON_S
+
+
+def _lane(**kw):
+    return NextLaneView(False, 36.0, coverage_ahead_m=0.0, **kw)
+
+
+def test_the_paper_check_closes_an_occupied_lane_and_leaves_oncoming_traffic_to_the_paper(
+    tables,
+):
+    pol = SafePolicy(P, tables, EoamSettings(), PolicySettings(name="paper"))
+    meas, seen = _meas(33.3), (lambda v: _seen(v, 40.0, 33.3))
+    # nothing seen in the lane, and no sight distance asked of the paper's policy
+    assert pol.occupied_reason(meas, seen(_lane()), _lane()) == ""
+    beside = _lane(ahead=((-1.0, 33.3),))
+    assert "beside" in pol.occupied_reason(meas, seen(beside), beside)
+    follower = _lane(nearest_behind_m=5.0, nearest_behind_speed_mps=40.0)
+    assert "behind" in pol.occupied_reason(meas, seen(follower), follower)
+    slower = _lane(ahead=((15.0, 20.0),))  # caught up within the manoeuvre
+    assert "ahead" in pol.occupied_reason(meas, seen(slower), slower)
+    oncoming = NextLaneView(True, 27.0, coverage_ahead_m=0.0, ahead=((80.0, -27.0),))
+    assert pol.occupied_reason(meas, seen(oncoming), oncoming) == ""
+    parked = _lane(ahead=((30.0, 0.0),))
+    assert pol.occupied_reason(meas, seen(parked), parked) == ""

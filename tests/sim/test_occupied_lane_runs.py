@@ -1,0 +1,39 @@
+"""No lane change into an occupied lane under any policy (issue 40, item 1), real SUMO runs
+on the motorway of ``test_motorway_runs`` with the ego in its right lane (the only lane to
+change into is the middle one): a car alongside, and a faster one coming up from behind,
+close it to the paper's policy too; the EOAM brakes in lane instead."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.sim.test_motorway_runs import SPEED_MPS, car, motorway, run
+
+pytestmark = pytest.mark.sumo
+
+EGO_LENGTH_M = 4.92
+TAKEN = {
+    # its front level with the ego's front, as fast (issue 40: dx 0.0 m at the commit)
+    "alongside": car("left", 1, 100.0, SPEED_MPS),
+    # 11 m behind the ego's rear at 40 m/s: it would have to brake hard behind the ego
+    "coming up": car("left", 1, 100.0 - EGO_LENGTH_M - 11.0, 40.0),
+}
+
+
+@pytest.mark.parametrize("taken", sorted(TAKEN))
+@pytest.mark.parametrize("policy", ["paper", "safe"])
+def test_a_taken_middle_lane_is_never_entered(tmp_path, policy, taken):
+    cfg = motorway(tmp_path / "road", ego_lane=0, others=TAKEN[taken])
+    summary, ts = run(cfg, tmp_path / policy, policy)
+    assert ts["lateral_offset_m"].max() < 1.0  # never into the middle lane
+    assert summary["collision_with"] in ("none", "aro"), summary["reason"]
+    assert 2 not in summary["modes_visited"]
+    assert "in the target lane" in summary["reason"] or summary["collision_with"] == "aro"
+
+
+def test_with_the_middle_lane_free_the_paper_policy_still_passes(tmp_path):
+    cfg = motorway(tmp_path / "road", ego_lane=0)
+    summary, ts = run(cfg, tmp_path / "paper", "paper")
+    assert 2 in summary["modes_visited"]
+    assert summary["collision_with"] == "none", summary["reason"]
+    assert ts["lateral_offset_m"].max() > 2.5
