@@ -287,7 +287,7 @@ class StableReturn(TimerReturn):
 class NextLaneGate:
     """The paper's policy: oncoming traffic (and a standing car) closes the next lane; at a
     commit also a road user of the ego's direction in it, beside, behind or ahead
-    (``SafePolicy.occupied_reason``: the paper is silent on such traffic)."""
+    (``SafePolicy.occupied_reason``; the paper is silent on such traffic)."""
 
     policy: SafePolicy | None = None
 

@@ -1,5 +1,5 @@
 """The safe policy's predictions are bounded: a closing speed near 0 (the cut-in car about as
-fast as the ego) gives a finite answer at once (issue 40, item 7), against closed-form physics."""
+fast as the ego) gives a finite answer at once, against closed-form physics."""
 
 import math
 
@@ -33,7 +33,7 @@ def _plan(t_lc=3.0, v=33.3):
 
 
 def test_a_follower_as_fast_as_the_ego_over_10058_s_is_answered_from_the_steady_gap():
-    # the hang of issue 40: t_s = 10 058 s; the answer is the steady one (gap > headway)
+    # the reported hang: t_s = 10 058 s; the answer is the steady one (gap > headway)
     need = _plan()
     assert follower_keeps_distance(need, 40.0, 33.0, 10_058.0, 10.0)
     # a gap below its own headway fails at once, whatever the horizon

@@ -1,4 +1,4 @@
-"""No lane change into an occupied lane under any policy (issue 40, item 1), real SUMO runs
+"""No lane change into an occupied lane under any policy, real SUMO runs
 on the motorway of ``test_motorway_runs`` with the ego in its right lane (the only lane to
 change into is the middle one): a car alongside, and a faster one coming up from behind,
 close it to the paper's policy too; the EOAM brakes in lane instead."""
@@ -13,7 +13,7 @@ pytestmark = pytest.mark.sumo
 
 EGO_LENGTH_M = 4.92
 TAKEN = {
-    # its front level with the ego's front, as fast (issue 40: dx 0.0 m at the commit)
+    # its front level with the ego's front, as fast
     "alongside": car("left", 1, 100.0, SPEED_MPS),
     # 11 m behind the ego's rear at 40 m/s: it would have to brake hard behind the ego
     "coming up": car("left", 1, 100.0 - EGO_LENGTH_M - 11.0, 40.0),
