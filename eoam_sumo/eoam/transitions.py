@@ -14,6 +14,7 @@ from eoam_sumo.decision.modes import (
 from eoam_sumo.eoam.parts import Parts
 from eoam_sumo.eoam.shifts import passing_offset_m, quintic_shift
 from eoam_sumo.eoam.state import ControllerState, Decision
+from eoam_sumo.eoam.strategies import beside_obstacle
 from eoam_sumo.eoam_messages import EgoMeasurement, Perception
 from eoam_sumo.manoeuvre.angles import wrap_angle
 from eoam_sumo.manoeuvre.min_time_shift import MinTimeShift
@@ -48,7 +49,8 @@ def advance_mode(
         decision.action,
         oncoming=oncoming,
         past_ponr=past_ponr,
-        timer_expired=meas.time_s - state.t_steer_s >= parts.settings.manoeuvre_time_s - 1e-9,
+        timer_expired=meas.time_s - state.t_steer_s >= parts.settings.manoeuvre_time_s - 1e-9
+        and not beside_obstacle(parts.settings, parts.params, state, meas),
         stable_in_next_lane=stable,
         clear_of_obstacle=clear,
         settled=settled,
