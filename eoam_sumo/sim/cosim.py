@@ -256,6 +256,9 @@ class CoSimulation:
         self.min_gap_aro_m = math.inf
         self._gaps: dict = {}  # vid -> (box, gap) measured at the last step's ego pose
         self._gaps_pose: tuple | None = None
+        # vid -> True: first met in the ego's lane band ahead of the ego (the obstacle, which
+        # keeps that identity once passed); False: first met behind it (a follower)
+        self._met_ahead: dict[str, bool] = {}
         self.end_cause: str | None = None
         self.n_steps = 0
         self._stop_at: float | None = None
@@ -425,8 +428,14 @@ class CoSimulation:
                 else box_distance(ego_box, b.box)
             )
             self._gaps[b.vid] = (b.box, gap)
-            if role == "aro" and gap < self.min_gap_aro_m:
-                self.min_gap_aro_m = gap
+            if (
+                role == "aro"
+                and gap < self.min_gap_aro_m
+                and self._met_ahead.setdefault(
+                    b.vid, (b.x_m - ego_cx) * cy + (b.y_m - ego_cy) * sy > 0.0
+                )
+            ):
+                self.min_gap_aro_m = gap  # the obstacle's, never a follower's
             # contact during the step is possible only if the gap is within both moves
             if self.first_contact is None and gap <= reach_m:
                 before = next((o for o in self.bodies_before if o.vid == b.vid), b)

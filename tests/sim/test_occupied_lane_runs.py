@@ -37,3 +37,15 @@ def test_with_the_middle_lane_free_the_paper_policy_still_passes(tmp_path):
     assert 2 in summary["modes_visited"]
     assert summary["collision_with"] == "none", summary["reason"]
     assert ts["lateral_offset_m"].max() > 2.5
+
+
+def test_the_gap_to_the_obstacle_is_never_a_followers(tmp_path):
+    # a car 0.8 m behind the ego's rear in its lane, as fast: the ego passes the ARO in the
+    # free middle lane; the least gap to the obstacle is the same with and without it
+    follower = car("behind", 0, 100.0 - EGO_LENGTH_M - 0.8, SPEED_MPS)
+    alone, _ = run(motorway(tmp_path / "alone", ego_lane=0), tmp_path / "a", "paper")
+    followed, _ = run(
+        motorway(tmp_path / "followed", ego_lane=0, others=follower), tmp_path / "f", "paper"
+    )
+    assert alone["collision_with"] == "none" and followed["collision_with"] == "none"
+    assert followed["min_gap_aro_m"] == pytest.approx(alone["min_gap_aro_m"], abs=0.05)
