@@ -428,14 +428,8 @@ class CoSimulation:
                 else box_distance(ego_box, b.box)
             )
             self._gaps[b.vid] = (b.box, gap)
-            if (
-                role == "aro"
-                and gap < self.min_gap_aro_m
-                and self._met_ahead.setdefault(
-                    b.vid, (b.x_m - ego_cx) * cy + (b.y_m - ego_cy) * sy > 0.0
-                )
-            ):
-                self.min_gap_aro_m = gap  # the obstacle's, never a follower's
+            if role == "aro" and gap < self.min_gap_aro_m and self._met_ahead_of(b, ego_cx, ego_cy):
+                self.min_gap_aro_m = gap
             # contact during the step is possible only if the gap is within both moves
             if self.first_contact is None and gap <= reach_m:
                 before = next((o for o in self.bodies_before if o.vid == b.vid), b)
@@ -447,6 +441,12 @@ class CoSimulation:
                     self.first_contact = ContactRecord(
                         hit, role or role_of(b, road, lane_width), self.t, b, ebox, obox
                     )
+
+    def _met_ahead_of(self, b, ego_x_m: float, ego_y_m: float) -> bool:
+        """Whether a road user in the ego's lane band was first met ahead of the ego (the
+        obstacle, which keeps that identity once passed), not behind it (a follower)."""
+        ahead = (b.x_m - ego_x_m) * self._cy + (b.y_m - ego_y_m) * self._sy > 0.0
+        return self._met_ahead.setdefault(b.vid, ahead)
 
     def finished(self) -> bool:
         """Whether the run is over: a contact, a rollover (``sim/vehicle.py``: past it the
