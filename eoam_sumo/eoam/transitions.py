@@ -4,6 +4,7 @@ entry actions of a new mode or the path restarts within one (paper sec. 3.1-3.2,
 from __future__ import annotations
 
 from eoam_sumo.decision.modes import (
+    NORMAL,
     ONCOMING_BRAKE,
     ONCOMING_STEER_BRAKE,
     RETURN,
@@ -54,7 +55,7 @@ def advance_mode(
         stable_in_next_lane=stable,
         clear_of_obstacle=clear,
         settled=settled,
-        threat_gone=threat_gone,
+        threat_gone=threat_gone and (mode is not ONCOMING_BRAKE or released(parts, meas, decision)),
     )
     if new is not mode:
         enter(parts, state, new, meas)
@@ -65,6 +66,17 @@ def advance_mode(
         traj = parts.escapes.abort_next(state, meas, path, dx)
         if traj is not None:
             start_path(parts, state, meas, traj, None)
+
+
+def released(parts: Parts, meas: EgoMeasurement, decision: Decision) -> bool:
+    """Mode 3 may hand back (the obstacle pulls away): only with the obstacle still sensed
+    in the path (not merely lost) and the ego in its lane and straight."""
+    st = parts.settings
+    return (
+        decision.sector is not None
+        and abs(meas.d_m) <= st.settle_offset_m
+        and abs(wrap_angle(meas.e_yaw_rad)) <= st.settle_heading_rad
+    )
 
 
 def settled_in_lane(
@@ -120,6 +132,8 @@ def enter(parts: Parts, state: ControllerState, mode: Mode, meas: EgoMeasurement
     """Entry actions of a new mode (mode 4 keeps the lane change of mode 2 going)."""
     previous = state.mode
     state.arrest = 0.0
+    if mode is NORMAL and previous is ONCOMING_BRAKE:
+        state.following = True  # the obstacle drove on: follow it at a time gap
     if mode is UPDATE_STEER_BRAKE:  # the table lane change for the trigger speed and friction
         state.hold_speed_mps = None
         # to the target lane's centre: one lane width, or centre to centre
