@@ -73,6 +73,9 @@ class PolicySettings:
     margin_s: float = 0.5  # sensing, tracking and decision latency added to the times [s]
     margin_m: float = 10.0  # added to the sight distance [m]
     rear_gap_m: float = 10.0  # same-direction lane: a road user this close behind blocks [m]
+    # the paper's policy checks the road users of the target lane at a commit (False: as
+    # published, the paper being silent on them; the follower measures' test uses it)
+    check_target_lane: bool = True
 
     def __post_init__(self) -> None:
         if self.name not in POLICIES:
