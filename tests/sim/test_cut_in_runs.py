@@ -2,7 +2,8 @@
 predictions are bounded when the two speeds match), and the EOAM follows the car instead of
 braking to a standstill behind it on the motorway.
 
-The road: two lanes eastwards, the left one closed to cars after 300 m, so that a car
+The road: two lanes eastwards, the left one closed to cars after 700 m (beyond the
+reach within which the EOAM needs it open), so that a car
 inserted in it at 85 km/h moves right at once (SUMO's own lane change), 20 m ahead of the ego
 at 120 km/h."""
 
@@ -28,7 +29,7 @@ EGO_MPS, CUT_MPS = 120 / 3.6, 85 / 3.6
 def cut_in_road(folder: Path) -> Path:
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "m.nod.xml").write_text(
-        '<nodes><node id="a" x="0" y="0"/><node id="b" x="300" y="0"/>'
+        '<nodes><node id="a" x="0" y="0"/><node id="b" x="700" y="0"/>'
         '<node id="c" x="3000" y="0"/></nodes>'
     )
     (folder / "m.edg.xml").write_text(

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import pytest
 
+from eoam_sumo import netbuild
 from tests.sim.test_motorway_runs import SPEED_MPS, car, motorway, run
 
 pytestmark = pytest.mark.sumo
@@ -49,3 +50,27 @@ def test_the_gap_to_the_obstacle_is_never_a_followers(tmp_path):
     )
     assert alone["collision_with"] == "none" and followed["collision_with"] == "none"
     assert followed["min_gap_aro_m"] == pytest.approx(alone["min_gap_aro_m"], abs=0.05)
+
+
+def test_a_right_lane_closed_to_cars_ahead_is_never_evaded_into(tmp_path):
+    # the right lane is open where the ego starts, closed to cars from 100 m ahead on (the
+    # lane permissions along the manoeuvre, not at its start only); the left lane is taken
+    folder = tmp_path / "road"
+    cfg = motorway(folder, ego_lane=1, others=TAKEN["alongside"].replace('"1"', '"2"'))
+    (folder / "m.nod.xml").write_text(
+        '<nodes><node id="a" x="0" y="0"/><node id="b" x="200" y="0"/>'
+        '<node id="c" x="3000" y="0"/></nodes>'
+    )
+    (folder / "m.edg.xml").write_text(
+        '<edges><edge id="mw" from="a" to="b" numLanes="3" speed="36.12" width="3.5"/>'
+        '<edge id="mw2" from="b" to="c" numLanes="3" speed="36.12" width="3.5">'
+        '<lane index="0" disallow="passenger"/></edge></edges>'
+    )
+    netbuild.build_network(folder / "m.nod.xml")
+    routes = (folder / "r.rou.xml").read_text().replace('edges="mw"', 'edges="mw mw2"')
+    (folder / "r.rou.xml").write_text(routes)
+    for policy in ("paper", "safe"):
+        summary, ts = run(cfg, tmp_path / policy, policy)
+        assert ts["lateral_offset_m"].min() > -1.0, policy  # never into the closed lane
+        assert ts["lateral_offset_m"].max() < 1.0, policy  # nor into the taken one
+        assert summary["collision_with"] in ("none", "aro"), summary["reason"]
