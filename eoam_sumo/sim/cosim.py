@@ -205,6 +205,11 @@ class CoSimulation:
             opposing, limit = session.next_lane_traffic()
             self._left_fallback = SideLane("", self.lane_width_m, limit, opposing)
         self.left_usable = self.side_lanes[0] is not None
+        # the lowest friction of the lanes a lane change may use (the net's, or --mu)
+        self.mu_side = min(
+            (session.lane_friction(lane.lane_id) for lane in self.side_lanes if lane),
+            default=math.inf,
+        )
         self.right_width_m = self.side_lanes[1].width_m if self.side_lanes[1] else 0.0
         self.x = initial_state(
             ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps, params=self.params
@@ -328,7 +333,10 @@ class CoSimulation:
         X, Y, yaw, vx, vy, r = x[:6]
         s, d, road_yaw = road.project(X, Y)
         self.mu_true = mu_true = self.session.friction_at_ego()
-        mu = self.belief.mu(mu_true, self.t, self.ax, self.ay)  # what the EOAM believes
+        # what the EOAM believes; known friction: the lowest of the lanes its manoeuvre uses
+        known = self.belief.belief == "known"
+        mu_road = min(mu_true, self.mu_side) if known else mu_true
+        mu = self.belief.mu(mu_road, self.t, self.ax, self.ay)
         front = self._front
         front_xy = (X + front * self._cy, Y + front * self._sy)
         report = self.radar.scan(front_xy, yaw, vx, road, self.bodies, self.lane_width_m, self.t)

@@ -456,7 +456,8 @@ class SumoSession:
         return self._ego_mu
 
     def lane_friction(self, lane_id: str) -> float:
-        return float(self._lane.getFriction(lane_id))
+        """Friction of ``lane_id`` (the net's, or the ``mu`` override)."""
+        return self._friction(lane_id)
 
     def next_lane_traffic(self) -> tuple[bool, float]:
         """(opposing, speed limit [m/s]) of the lane left of the ego's along its route: opposing
