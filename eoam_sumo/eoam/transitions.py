@@ -13,7 +13,7 @@ from eoam_sumo.decision.modes import (
     next_mode,
 )
 from eoam_sumo.eoam.parts import Parts
-from eoam_sumo.eoam.shifts import passing_offset_m, quintic_shift
+from eoam_sumo.eoam.shifts import lane_change_height_m, passing_offset_m, quintic_shift
 from eoam_sumo.eoam.state import ControllerState, Decision
 from eoam_sumo.eoam.strategies import beside_obstacle
 from eoam_sumo.eoam_messages import EgoMeasurement, Perception
@@ -137,7 +137,10 @@ def enter(parts: Parts, state: ControllerState, mode: Mode, meas: EgoMeasurement
     if mode is UPDATE_STEER_BRAKE:  # the table lane change for the trigger speed and friction
         state.hold_speed_mps = None
         # to the target lane's centre: one lane width, or centre to centre
-        state.height_m = height = state.target_offset_m or meas.lane_width_m
+        height = lane_change_height_m(
+            parts.params, parts.settings, state.obstacle, meas, state.target_offset_m
+        )
+        state.height_m = height = height or state.target_offset_m or meas.lane_width_m
         state.t_steer_s = meas.time_s
         traj = parts.tables.trajectory(meas.mu, meas.vx_mps)  # clamped to the speed grid
         start_path(parts, state, meas, traj, height)
