@@ -77,4 +77,6 @@ def next_mode(
         return RETURN if clear_of_obstacle else mode
     if mode is RETURN:
         return NORMAL if settled else mode
+    if mode is ONCOMING_BRAKE and threat_gone and not oncoming:
+        return NORMAL  # the obstacle drives away: follow it (mode 0, 1), do not stop for it
     return mode

@@ -56,6 +56,11 @@ ONCOMING_MPS = 0.5  # a road user moving towards the ego faster than this is onc
 FOLLOWER_REACTION_S = 0.4
 FOLLOWER_DECEL_MPS2 = 3.0
 FOLLOWER_HEADWAY_S = 1.0
+#: The longest lane change the policy plans (from its commit until the ego's body has left the
+#: target lane) [s]: a pass that takes longer (the obstacle about as fast as the ego, closing
+#: speed near 0) is not an avoidance manoeuvre and counts as never passed (the EOAM brakes
+#: in lane and follows); it also bounds every prediction over the manoeuvre.
+PLAN_HORIZON_S = 30.0
 
 
 @mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
@@ -68,6 +73,9 @@ class PolicySettings:
     margin_s: float = 0.5  # sensing, tracking and decision latency added to the times [s]
     margin_m: float = 10.0  # added to the sight distance [m]
     rear_gap_m: float = 10.0  # same-direction lane: a road user this close behind blocks [m]
+    # the paper's policy checks the road users of the target lane at a commit (False: as
+    # published, the paper being silent on them; the follower measures' test uses it)
+    check_target_lane: bool = True
 
     def __post_init__(self) -> None:
         if self.name not in POLICIES:
@@ -196,8 +204,12 @@ def follower_keeps_distance(
     ``FOLLOWER_DECEL_MPS2`` from ``FOLLOWER_REACTION_S`` after the lane change begins, and
     the gap stays at least its own ``FOLLOWER_HEADWAY_S`` of travel (and ``min_gap_m``): the
     project's assumption (see ``FOLLOWER_REACTION_S``). Until it reacts it keeps its own
-    ``accel_mps2`` (where known; 0: its speed)."""
+    ``accel_mps2`` (where known; 0: its speed). Bounded: the prediction stops once nothing
+    changes any more (past the reaction and the lane change, the follower no faster than the
+    ego: the gap cannot shrink) and at ``PLAN_HORIZON_S``."""
     t, step = 0.0, 0.05
+    t_s = min(t_s, PLAN_HORIZON_S)
+    settled_s = max(FOLLOWER_REACTION_S, need.t_lane_change_s)
     ego_x, x_b, v_b = 0.0, 0.0, speed_mps
     v0 = need.lane_change_m / need.t_lane_change_s if need.t_lane_change_s > 0.0 else 0.0
     while t < t_s:
@@ -211,6 +223,8 @@ def follower_keeps_distance(
         t += step
         if gap_m + ego_x - x_b < max(min_gap_m, v_b * FOLLOWER_HEADWAY_S):
             return False
+        if t >= settled_s and v_b <= v_e:
+            return True  # the gap no longer shrinks, the headway needed no longer grows
     return True
 
 
@@ -246,6 +260,8 @@ def sight_needed(
     obstacle_end = max(obstacle_speed_mps - decel * t_lc, 0.0)
     moved = road_user_travel_m(obstacle_speed_mps, -decel, t_lc)
     t_beside = beside_time_s(to_pass_m - (trajectory.length_m - moved), v_end, obstacle_end, decel)
+    if t_lc + t_beside > PLAN_HORIZON_S:  # a closing speed near 0: never passed
+        t_beside = math.inf
     back = QuinticShift.for_lateral_accel(
         travel_m, 0.0, 0.0, v_end, return_lateral_g * mu * G_MPS2, return_min_length_m
     )
@@ -372,15 +388,20 @@ class SafePolicy:
             return "unseen road behind: a road user at the speed limit could catch the ego up"
         return ""
 
-    def _ahead_reason(self, view: NextLaneView, need: SightNeed, t_s: float) -> str:
+    def _ahead_reason(
+        self, view: NextLaneView, need: SightNeed, t_s: float, moving_only: bool = False
+    ) -> str:
         """A road user ahead in the target lane (at its own speed) that the ego would come
         within ``margin_m`` of during ``t_s``, or that would reach the ego (oncoming); one
-        beside the ego always closes the lane."""
+        beside the ego always closes the lane. ``moving_only``: the oncoming and standing
+        road users ahead are left out (the paper's own rules judge them)."""
         margin = self.settings.margin_m
         times = (0.0, min(need.t_lane_change_s, t_s), t_s)
         for gap, speed, accel in view.users_ahead_accel():
             if gap <= 0.0:
                 return "a road user beside the ego in the target lane"
+            if moving_only and speed <= ONCOMING_MPS:
+                continue
             if any(
                 gap + road_user_travel_m(speed, accel, t) - need.ego_travel_m(t) <= margin
                 for t in times
@@ -414,7 +435,7 @@ class SafePolicy:
         elapsed = meas.time_s - self._commit_s
         t_left = max(need.t_total_s - elapsed, 0.0)
         into_m = abs(meas.d_m) + 0.5 * (self.params.width_m - meas.lane_width_m)
-        t = max(t_left, escape_time_s(into_m, meas.mu)) + need.margin_s
+        t = min(max(t_left, escape_time_s(into_m, meas.mu)) + need.margin_s, PLAN_HORIZON_S)
         now = remaining_plan(need, elapsed)
         return self._behind_reason(view, now, t) or self._ahead_reason(view, now, t)
 
@@ -441,6 +462,23 @@ class SafePolicy:
             reason = self._behind_reason(view, need, t, unseen=False)
             return need, reason or self._ahead_reason(view, need, t)
         return need, self._commit_reason(meas, view, need)
+
+    def occupied_reason(
+        self, meas, perception, view: NextLaneView | None, obstacle_decel_mps2: float = 0.0
+    ) -> str:
+        """The paper policy's added check at a commit ("": the lane may be entered): a road
+        user of the target lane beside the ego, one behind that could not keep its distance
+        (:func:`follower_keeps_distance`), or one ahead moving the ego's way that it would come
+        within ``margin_m`` of, over the planned manoeuvre (at most ``PLAN_HORIZON_S``). The
+        paper is silent on traffic in the target lane; its oncoming and standing road users
+        stay with the paper's rules."""
+        if view is None:
+            return ""
+        need = self.sight_need(meas, perception, view, obstacle_decel_mps2)
+        t = min(need.t_total_s + need.margin_s, PLAN_HORIZON_S)
+        return self._behind_reason(view, need, t, unseen=False) or self._ahead_reason(
+            view, need, t, moving_only=True
+        )
 
     def blocks(
         self,

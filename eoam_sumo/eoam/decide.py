@@ -6,6 +6,7 @@ from __future__ import annotations
 from eoam_sumo.decision.dmm import BRAKE, LIMIT_BRAKE, NONE, STEER, Action, Sector
 from eoam_sumo.decision.modes import NORMAL, RETURN, UPDATE_BRAKE, UPDATE_STEER_BRAKE
 from eoam_sumo.eoam.parts import Parts
+from eoam_sumo.eoam.shifts import lane_change_height_m
 from eoam_sumo.eoam.state import ControllerState, Decision, Situation
 from eoam_sumo.eoam_messages import EgoMeasurement, Perception
 
@@ -64,4 +65,9 @@ def sector_action(
             action = BRAKE  # braking already stops short of it: no lane change
         elif not meas.left_lane_available or st.steering_inhibited:
             action = LIMIT_BRAKE  # no lane to change into, or braking only: brake in lane
+        elif (
+            lane_change_height_m(parts.params, st, state.obstacle, meas, state.target_offset_m)
+            is None
+        ):
+            action = LIMIT_BRAKE  # no offset within the target lane clears the obstacle
     return sector, action

@@ -31,7 +31,7 @@ def longitudinal_control(
     tracking = lateral.in_path and mode in _STEERING  # the table's ax already fits the ellipse
     drive_lim, brake_lim = force_limits(parts, state, meas, lateral.steer_rad, tracking)
     if mode is NORMAL:
-        target = state.initial_speed_mps
+        target = following_speed_mps(parts, state, meas)
         drive, brake, ax_target = long.track_speed(target, v, mu, drive_lim, brake_lim, dt_s)
         return LongitudinalOutput(drive, brake, ax_target, target)
     if mode is UPDATE_BRAKE or mode is ONCOMING_BRAKE:  # limit braking without locking
@@ -50,6 +50,27 @@ def longitudinal_control(
         long.reset()
     drive, brake, ax_target = long.track_speed(hold, v, mu, drive_lim, brake_lim, dt_s)
     return LongitudinalOutput(drive, brake, ax_target, hold)
+
+
+#: Mode 0 after mode 3 let a moving obstacle go: the time gap kept behind it, and the time in
+#: which a gap error is closed. The project's assumptions: 1.8 s is the "half the
+#: speedometer" rule of thumb (a gap of half the speed in km/h, in metres).
+FOLLOW_GAP_S = 1.8
+FOLLOW_CLOSE_S = 3.0
+
+
+def following_speed_mps(parts: Parts, state: ControllerState, meas: EgoMeasurement) -> float:
+    """Mode 0's speed target: the set speed, or after mode 3 let a moving obstacle go
+    (``state.following``) at most the obstacle's speed plus the gap error beyond
+    ``FOLLOW_GAP_S`` of its speed, closed in ``FOLLOW_CLOSE_S`` (car-following, no standstill
+    behind a car that drives on)."""
+    target = state.initial_speed_mps
+    obstacle = state.obstacle
+    if not state.following or obstacle is None:
+        return target
+    front_s, v_obs = obstacle.at(meas.time_s)
+    gap = front_s - obstacle.length_m - meas.s_m - parts.params.cg_to_front_bumper_m
+    return min(target, max(v_obs + (gap - FOLLOW_GAP_S * v_obs) / FOLLOW_CLOSE_S, 0.0))
 
 
 def shares_ellipse(parts: Parts, state: ControllerState, meas: EgoMeasurement) -> bool:

@@ -68,6 +68,8 @@ def build_parts(params: VehicleParams, tables: Any, settings: EoamSettings) -> P
         StableReturn(st) if st.return_when_stable else TimerReturn(st),
         SafeGate(SafePolicy(params, tables, st, st.policy))
         if st.policy.name == "safe"
-        else NextLaneGate(),
+        else NextLaneGate(
+            SafePolicy(params, tables, st, st.policy) if st.policy.check_target_lane else None
+        ),
         SafePolicy(params, tables, st, st.policy),
     )

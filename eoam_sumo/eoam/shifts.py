@@ -67,6 +67,38 @@ def passing_offset_m(
     (less exposure to the oncoming vehicle than a whole lane), at most to the target lane's
     centre (``target_offset_m``; 0: a lane width), and never back towards the obstacle from
     where the ego already is."""
-    left_edge = obstacle.left_edge_m if obstacle is not None else 0.5 * meas.lane_width_m
-    need = left_edge + 0.5 * params.width_m + settings.side_clearance_m
+    need = clearing_offset_m(params, settings, obstacle, meas)
     return max(min(need, target_offset_m or meas.lane_width_m), meas.d_m)
+
+
+def clearing_offset_m(
+    params: VehicleParams,
+    settings: EoamSettings,
+    obstacle: ObstacleTrack | None,
+    meas: EgoMeasurement,
+) -> float:
+    """The ego's offset that clears the obstacle's box (its left side, or the ego's lane's
+    edge without a track) by ``side_clearance_m``."""
+    left_edge = obstacle.left_edge_m if obstacle is not None else 0.5 * meas.lane_width_m
+    return left_edge + 0.5 * params.width_m + settings.side_clearance_m
+
+
+def lane_change_height_m(
+    params: VehicleParams,
+    settings: EoamSettings,
+    obstacle: ObstacleTrack | None,
+    meas: EgoMeasurement,
+    target_offset_m: float = 0.0,
+) -> float | None:
+    """Mode 2's lateral travel: to the target lane's centre (``target_offset_m``; 0: a lane
+    width), or farther where the obstacle reaches so far into the target lane that its centre
+    does not clear it (``clearing_offset_m``), as long as the ego's body stays inside the
+    target lane; None: no offset within it clears the obstacle (brake in lane)."""
+    centre = target_offset_m or meas.lane_width_m
+    need = clearing_offset_m(params, settings, obstacle, meas)
+    if need <= centre:
+        return centre
+    target_width = 2.0 * centre - meas.lane_width_m  # centre to centre = half of both widths
+    if need + 0.5 * params.width_m <= centre + 0.5 * target_width + 1e-9:
+        return need
+    return None

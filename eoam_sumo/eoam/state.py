@@ -56,6 +56,7 @@ class ControllerState:
     oncoming_choice: Choice | None = None  # the commit/abort decision, when made
     side: int = 1  # the side of the lane change: +1 left, -1 right (the step mirrored)
     target_offset_m: float = 0.0  # the target lane's centre from the ego's (0: a lane width)
+    following: bool = False  # mode 0 after mode 3 let a moving obstacle go: keep a time gap
 
     def path_progress(self, meas: EgoMeasurement) -> tuple[float, float]:
         """(dx on the active path, how many times faster than the ego it advances): the

@@ -26,7 +26,12 @@ import math
 
 from eoam_sumo.decision.dmm import SECTOR_ORDER, BoundaryCurve, Sector
 from eoam_sumo.decision.modes import ONCOMING_STEER_BRAKE, UPDATE_STEER_BRAKE
-from eoam_sumo.decision.obstacle import ObstacleTrack, speed_match_factor, stopping_range_m
+from eoam_sumo.decision.obstacle import (
+    ObstacleTrack,
+    speed_match_factor,
+    stopping_range_m,
+    travel_m,
+)
 from eoam_sumo.decision.oncoming import Budget, commit_choice, return_clears
 from eoam_sumo.decision.policy import SafePolicy
 from eoam_sumo.eoam.shifts import lateral_stop, min_time_shift, quintic_shift
@@ -38,7 +43,7 @@ from eoam_sumo.manoeuvre.lateral_state import lateral_state
 from eoam_sumo.manoeuvre.min_time_shift import MinTimeShift
 from eoam_sumo.manoeuvre.path_reference import PathReference
 from eoam_sumo.manoeuvre.quintic_shift import QuinticShift
-from eoam_sumo.params import VehicleParams
+from eoam_sumo.params import G_MPS2, VehicleParams
 
 
 # ---------------------------------------------------------------------------- DMM placement
@@ -121,6 +126,27 @@ class LateralStopPonr(OffsetPonr):
 
 
 # ----------------------------------------------------------------------- commit on oncoming
+def return_time_s(settings: EoamSettings, meas: EgoMeasurement) -> float:
+    """Duration of a quintic return from the ego's offset to its lane centre at the
+    return's peak lateral acceleration ``return_lateral_g`` mu g (a quintic's peak is
+    10 sqrt(3) / 3 h / T^2)."""
+    a_lat = settings.return_lateral_g * max(meas.mu, 0.05) * G_MPS2
+    return math.sqrt(10.0 * math.sqrt(3.0) / 3.0 * abs(meas.d_m) / a_lat)
+
+
+def beside_obstacle(settings: EoamSettings, params: VehicleParams, state, meas) -> bool:
+    """The ego overlaps lengthwise, within ``pass_margin_m``, the tracked obstacle in the lane
+    it would return into (its box predicted to now): no return may begin."""
+    obstacle = state.obstacle
+    if obstacle is None:
+        return False
+    front_s = obstacle.at(meas.time_s)[0]
+    margin = settings.pass_margin_m
+    ego_rear = meas.s_m - params.cg_to_rear_bumper_m
+    ego_front = meas.s_m + params.cg_to_front_bumper_m
+    return ego_rear < front_s + margin and ego_front > front_s - obstacle.length_m - margin
+
+
 class PonrCommit:
     """Oncoming traffic seen in mode 2: pass on (mode 4) past the point of no return, else
     abort (mode 3); mode 4 returns once the ego's rear is ``pass_margin_m`` past the
@@ -143,10 +169,18 @@ class PonrCommit:
         return self.ponr.past(state, meas, travel_m, height_m)
 
     def passed(self, state: ControllerState, meas: EgoMeasurement, obstacle: ObstacleTrack) -> bool:
-        """Mode 2 or 4 clear of the tracked obstacle (predicted to its stop)."""
-        front_s = obstacle.at(meas.time_s)[0]
+        """Mode 2 or 4 clear of the tracked obstacle: the ego's rear ``pass_margin_m`` past
+        its front now and over the return begun now (``return_time_s``), the obstacle at its
+        speed and braking (to its stop), the ego at its own acceleration (a braking ego must
+        not return in front of a car it has only just passed)."""
         ego_rear_s = meas.s_m - self.params.cg_to_rear_bumper_m
-        return ego_rear_s - front_s >= self.settings.pass_margin_m
+        t_ret = return_time_s(self.settings, meas)
+        for dt in (0.0, 0.5 * t_ret, t_ret):
+            ego_decel = max(-meas.ax_mps2, 0.0) if dt > 0.0 else 0.0
+            ego_s = ego_rear_s + travel_m(meas.vx_mps, ego_decel, dt)
+            if ego_s - obstacle.at(meas.time_s + dt)[0] < self.settings.pass_margin_m:
+                return False
+        return True
 
     def budget(self, state: ControllerState, meas: EgoMeasurement) -> Budget:
         """What the ego can do at the sensed friction (``decision.oncoming``)."""
@@ -285,9 +319,15 @@ class StableReturn(TimerReturn):
 
 # ------------------------------------------------------------------------------ next lane
 class NextLaneGate:
-    """The paper's policy: only oncoming traffic (and a standing car) closes the next lane."""
+    """The paper's policy: oncoming traffic (and a standing car) closes the next lane; at a
+    commit also a road user of the ego's direction in it, beside, behind or ahead
+    (``SafePolicy.occupied_reason``; the paper is silent on such traffic)."""
 
     policy: SafePolicy | None = None
+
+    def __init__(self, judge: SafePolicy | None = None):
+        self._judge = judge
+        self.reason = ""  # why the lane was found occupied (the first time)
 
     def blocks(
         self,
@@ -298,7 +338,13 @@ class NextLaneGate:
         obstacle_decel_mps2: float = 0.0,
     ) -> bool:
         """The next lane is closed to the lane change (treated as oncoming traffic)."""
-        return False
+        if not committing or self._judge is None:
+            return False
+        reason = self._judge.occupied_reason(
+            meas, perception, perception.next_lane, obstacle_decel_mps2
+        )
+        self.reason = self.reason or reason
+        return bool(reason)
 
     def prefer_braking(self, meas: EgoMeasurement, perception: Perception) -> bool:
         """Past the point of no return: braking in lane is predicted to end softer."""
@@ -306,6 +352,7 @@ class NextLaneGate:
 
     def reset(self) -> None:
         """Forget the run."""
+        self.reason = ""
 
 
 class SafeGate(NextLaneGate):
@@ -313,6 +360,7 @@ class SafeGate(NextLaneGate):
     lane watched during the lane change and the return, the severity tie-breaker."""
 
     def __init__(self, policy: SafePolicy):
+        super().__init__(policy)
         self.policy = policy
         self._policy = policy
 

@@ -4,6 +4,7 @@ entry actions of a new mode or the path restarts within one (paper sec. 3.1-3.2,
 from __future__ import annotations
 
 from eoam_sumo.decision.modes import (
+    NORMAL,
     ONCOMING_BRAKE,
     ONCOMING_STEER_BRAKE,
     RETURN,
@@ -12,8 +13,9 @@ from eoam_sumo.decision.modes import (
     next_mode,
 )
 from eoam_sumo.eoam.parts import Parts
-from eoam_sumo.eoam.shifts import passing_offset_m, quintic_shift
+from eoam_sumo.eoam.shifts import lane_change_height_m, passing_offset_m, quintic_shift
 from eoam_sumo.eoam.state import ControllerState, Decision
+from eoam_sumo.eoam.strategies import beside_obstacle
 from eoam_sumo.eoam_messages import EgoMeasurement, Perception
 from eoam_sumo.manoeuvre.angles import wrap_angle
 from eoam_sumo.manoeuvre.min_time_shift import MinTimeShift
@@ -48,11 +50,12 @@ def advance_mode(
         decision.action,
         oncoming=oncoming,
         past_ponr=past_ponr,
-        timer_expired=meas.time_s - state.t_steer_s >= parts.settings.manoeuvre_time_s - 1e-9,
+        timer_expired=meas.time_s - state.t_steer_s >= parts.settings.manoeuvre_time_s - 1e-9
+        and not beside_obstacle(parts.settings, parts.params, state, meas),
         stable_in_next_lane=stable,
         clear_of_obstacle=clear,
         settled=settled,
-        threat_gone=threat_gone,
+        threat_gone=threat_gone and (mode is not ONCOMING_BRAKE or released(parts, meas, decision)),
     )
     if new is not mode:
         enter(parts, state, new, meas)
@@ -63,6 +66,17 @@ def advance_mode(
         traj = parts.escapes.abort_next(state, meas, path, dx)
         if traj is not None:
             start_path(parts, state, meas, traj, None)
+
+
+def released(parts: Parts, meas: EgoMeasurement, decision: Decision) -> bool:
+    """Mode 3 may hand back (the obstacle pulls away): only with the obstacle still sensed
+    in the path (not merely lost) and the ego in its lane and straight."""
+    st = parts.settings
+    return (
+        decision.sector is not None
+        and abs(meas.d_m) <= st.settle_offset_m
+        and abs(wrap_angle(meas.e_yaw_rad)) <= st.settle_heading_rad
+    )
 
 
 def settled_in_lane(
@@ -118,10 +132,15 @@ def enter(parts: Parts, state: ControllerState, mode: Mode, meas: EgoMeasurement
     """Entry actions of a new mode (mode 4 keeps the lane change of mode 2 going)."""
     previous = state.mode
     state.arrest = 0.0
+    if mode is NORMAL and previous is ONCOMING_BRAKE:
+        state.following = True  # the obstacle drove on: follow it at a time gap
     if mode is UPDATE_STEER_BRAKE:  # the table lane change for the trigger speed and friction
         state.hold_speed_mps = None
         # to the target lane's centre: one lane width, or centre to centre
-        state.height_m = height = state.target_offset_m or meas.lane_width_m
+        height = lane_change_height_m(
+            parts.params, parts.settings, state.obstacle, meas, state.target_offset_m
+        )
+        state.height_m = height = height or state.target_offset_m or meas.lane_width_m
         state.t_steer_s = meas.time_s
         traj = parts.tables.trajectory(meas.mu, meas.vx_mps)  # clamped to the speed grid
         start_path(parts, state, meas, traj, height)

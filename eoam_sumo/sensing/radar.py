@@ -31,7 +31,9 @@ road speed = target speed times the cosine of its heading relative to the road):
   band (in the ego lane or any lane to its left; a wrong-way driver in the ego lane counts);
 * ``in_path``: centre ahead of the ego's front bumper along the road, inside the lane band,
   and not oncoming (road speed above -oncoming_speed_mps): stopped, moving with the road, or
-  slowly towards the ego (a person walking towards it in its lane, a car backing up);
+  slowly towards the ego (a person walking towards it in its lane, a car backing up); also a
+  car ahead in a neighbouring lane cutting in (``cutting_in``: more than ``CUT_IN_WANDER_M``
+  from its lane's centre towards the ego's lane and moving towards it);
 * ``in_next_lane``: stopped (speed below stationary_speed_mps), ahead, and the centre in the
   band of the next lane to the left (from the lane band's edge to one lane width beyond it):
   a standing car in the lane an evasive lane change would take;
@@ -145,6 +147,13 @@ class RadarReport(NamedTuple):
 
 
 _range_of = attrgetter("range_m")
+#: A car in the next lane is cutting in once its centre has moved this far from that lane's
+#: centre towards the ego's lane while still moving towards it: the lateral wandering
+#: threshold of the competent and careful driver model of UN R157 (ALKS), as the project
+#: recalls it (0.375 m; with a 0.4 s risk perception time, which the EOAM does not add).
+CUT_IN_WANDER_M = 0.375
+CUT_IN_LATERAL_MPS = 0.1  # the lateral speed towards the ego's lane that counts as moving [m/s]
+
 EMPTY_REPORT = RadarReport(None, None, False, ())  # immutable: one for every empty scan
 
 
@@ -353,7 +362,10 @@ class Radar:
         s, d, road_yaw = road_frame.project(box.x_m, box.y_m)
         road_speed = tgt.speed_mps * math.cos(box.yaw_rad - road_yaw)
         ahead = s > ego.s_m
-        category = self.classify(ahead, d, tgt.speed_mps, road_speed, ego.band_m, ego.lane_width_m)
+        lateral = tgt.speed_mps * math.sin(box.yaw_rad - road_yaw)
+        category = self.classify(
+            ahead, d, tgt.speed_mps, road_speed, ego.band_m, ego.lane_width_m, lateral
+        )
         return Detection(
             index,
             rng,
@@ -416,8 +428,11 @@ class Radar:
         road_speed_mps: float,
         band_m: float,
         lane_width_m: float,
+        lateral_mps: float = 0.0,
     ) -> str:
-        """The class of a target (rules: module doc)."""
+        """The class of a target (rules: module doc); ``lateral_mps`` its speed across the
+        road (positive to the left): a car ahead in a neighbouring lane moving towards the
+        ego's lane beyond ``CUT_IN_WANDER_M`` of its lane centre is in the path (a cut-in)."""
         st = self.settings
         if road_speed_mps < -st.oncoming_speed_mps and d_m > -band_m:
             return "oncoming"
@@ -425,6 +440,8 @@ class Radar:
             if ahead:  # not oncoming (tested above)
                 return "in_path"
             return "other"
+        if ahead and cutting_in(d_m, lateral_mps, lane_width_m, band_m):
+            return "in_path"
         if abs(speed_mps) < st.stationary_speed_mps:
             if ahead and d_m < band_m + lane_width_m and d_m > 0.0:
                 return "in_next_lane"
@@ -435,3 +452,13 @@ class Radar:
         """Whether a target of ``category`` is oncoming with its centre ahead inside the lane
         band: a wrong-way road user in the ego's lane, the in-path obstacle as well."""
         return category == "oncoming" and ahead and abs(d_m) < band_m
+
+
+def cutting_in(d_m: float, lateral_mps: float, lane_width_m: float, band_m: float) -> bool:
+    """A road user centred ``d_m`` from the ego's lane centre, in a neighbouring lane (outside
+    the lane band, within one lane width beyond it), moved more than ``CUT_IN_WANDER_M`` from
+    that lane's centre towards the ego's lane and still moving towards it."""
+    if not band_m <= abs(d_m) < band_m + lane_width_m:
+        return False
+    towards = -math.copysign(1.0, d_m) * lateral_mps
+    return lane_width_m - abs(d_m) > CUT_IN_WANDER_M and towards > CUT_IN_LATERAL_MPS

@@ -205,6 +205,11 @@ class CoSimulation:
             opposing, limit = session.next_lane_traffic()
             self._left_fallback = SideLane("", self.lane_width_m, limit, opposing)
         self.left_usable = self.side_lanes[0] is not None
+        # the lowest friction of the lanes a lane change may use (the net's, or --mu)
+        self.mu_side = min(
+            (session.lane_friction(lane.lane_id) for lane in self.side_lanes if lane),
+            default=math.inf,
+        )
         self.right_width_m = self.side_lanes[1].width_m if self.side_lanes[1] else 0.0
         self.x = initial_state(
             ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps, params=self.params
@@ -256,6 +261,9 @@ class CoSimulation:
         self.min_gap_aro_m = math.inf
         self._gaps: dict = {}  # vid -> (box, gap) measured at the last step's ego pose
         self._gaps_pose: tuple | None = None
+        # vid -> True: first met in the ego's lane band ahead of the ego (the obstacle, which
+        # keeps that identity once passed); False: first met behind it (a follower)
+        self._met_ahead: dict[str, bool] = {}
         self.end_cause: str | None = None
         self.n_steps = 0
         self._stop_at: float | None = None
@@ -325,7 +333,10 @@ class CoSimulation:
         X, Y, yaw, vx, vy, r = x[:6]
         s, d, road_yaw = road.project(X, Y)
         self.mu_true = mu_true = self.session.friction_at_ego()
-        mu = self.belief.mu(mu_true, self.t, self.ax, self.ay)  # what the EOAM believes
+        # what the EOAM believes; known friction: the lowest of the lanes its manoeuvre uses
+        known = self.belief.belief == "known"
+        mu_road = min(mu_true, self.mu_side) if known else mu_true
+        mu = self.belief.mu(mu_road, self.t, self.ax, self.ay)
         front = self._front
         front_xy = (X + front * self._cy, Y + front * self._sy)
         report = self.radar.scan(front_xy, yaw, vx, road, self.bodies, self.lane_width_m, self.t)
@@ -425,7 +436,7 @@ class CoSimulation:
                 else box_distance(ego_box, b.box)
             )
             self._gaps[b.vid] = (b.box, gap)
-            if role == "aro" and gap < self.min_gap_aro_m:
+            if role == "aro" and gap < self.min_gap_aro_m and self._met_ahead_of(b, ego_cx, ego_cy):
                 self.min_gap_aro_m = gap
             # contact during the step is possible only if the gap is within both moves
             if self.first_contact is None and gap <= reach_m:
@@ -438,6 +449,12 @@ class CoSimulation:
                     self.first_contact = ContactRecord(
                         hit, role or role_of(b, road, lane_width), self.t, b, ebox, obox
                     )
+
+    def _met_ahead_of(self, b, ego_x_m: float, ego_y_m: float) -> bool:
+        """Whether a road user in the ego's lane band was first met ahead of the ego (the
+        obstacle, which keeps that identity once passed), not behind it (a follower)."""
+        ahead = (b.x_m - ego_x_m) * self._cy + (b.y_m - ego_y_m) * self._sy > 0.0
+        return self._met_ahead.setdefault(b.vid, ahead)
 
     def finished(self) -> bool:
         """Whether the run is over: a contact, a rollover (``sim/vehicle.py``: past it the
@@ -533,12 +550,12 @@ class CoSimulation:
         )
 
     def _next_lane_sensing(self, side: int) -> NextLaneSensing | None:
-        """The sensing of the lane on ``side`` (+1 left, -1 right): the left one for the safe
-        policy, both when the ego's class may use the right one (the EOAM then chooses its
-        side); None: not needed, or no usable lane there."""
+        """The sensing of the lane on ``side`` (+1 left, -1 right): the left one for every
+        policy (each checks the road users in it at a commit), the right one too when the
+        ego's class may use it (the EOAM then chooses its side); None: no usable lane there."""
         st = self.settings
         left, right = self.side_lanes
-        if right is None and (side < 0 or st.eoam.policy.name != "safe"):
+        if right is None and side < 0:
             return None
         lane = left if side > 0 else right
         if lane is None:
@@ -578,6 +595,7 @@ class CoSimulation:
             "sight_needed_m": None,
             "sight_known_free_m": None,
             "sight_time_s": None,
+            "sight_reason": self.ctrl.parts.gate.reason,
             "tie_break": "",
         }
 

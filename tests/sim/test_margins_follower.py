@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
 from eoam_sumo.sim.cosim import run_case
@@ -36,7 +38,12 @@ def test_a_follower_forced_to_brake_shows_in_the_summary(tmp_path):
     )
     (tmp_path / "r.rou.xml").write_text(ROUTES)
     cfg = write_sumocfg(tmp_path / "lc.sumocfg", net.name, "r.rou.xml", [VTYPES], 0.01)
-    s = run_case(cfg, settings=RunSettings(max_time_s=20.0))
+    # the paper's policy as published: the lane change ignores the car behind (by default the
+    # policy refuses it, tests/sim/test_occupied_lane_runs.py)
+    base = RunSettings(max_time_s=20.0)
+    policy = replace(base.eoam.policy, check_target_lane=False)
+    settings = replace(base, eoam=replace(base.eoam, policy=policy))
+    s = run_case(cfg, settings=settings)
     assert 2 in s["modes_visited"]  # the lane change
     assert s["collision_with"] == "none"
     assert s["follower_decel_id"] == "follower"

@@ -65,6 +65,9 @@ from eoam_sumo.sim.session.scripts import StopScripts
 from eoam_sumo.sim.session.tracking import RoadUsers
 from eoam_sumo.world.bodies import PEDESTRIAN, Body
 
+#: How far along the route a lane beside the ego's must be open to its class for the EOAM to
+#: evade into it [m]: a lane change and a pass at 50 m/s take about 8 s (400 m).
+PERMISSION_REACH_M = 500.0
 _open_libsumo: list[SumoSession] = []  # libsumo runs one simulation per process
 _NO_OVERRIDES = ScenarioOverrides()
 _GUI_DEFAULTS = GuiSettings()
@@ -453,7 +456,8 @@ class SumoSession:
         return self._ego_mu
 
     def lane_friction(self, lane_id: str) -> float:
-        return float(self._lane.getFriction(lane_id))
+        """Friction of ``lane_id`` (the net's, or the ``mu`` override)."""
+        return self._friction(lane_id)
 
     def next_lane_traffic(self) -> tuple[bool, float]:
         """(opposing, speed limit [m/s]) of the lane left of the ego's along its route: opposing
@@ -487,7 +491,7 @@ class SumoSession:
             lane_id = self._files.opposite_lanes.get(ego.lane_id, "")
         else:
             lane_id = ""
-        if not lane_id or not self._permits(lane_id):
+        if not lane_id or not self._permits(lane_id) or not self._permitted_ahead(index):
             return None
         if side > 0:
             opposing, limit = self.next_lane_traffic()
@@ -502,6 +506,20 @@ class SumoSession:
         if allowed:
             return vclass in allowed
         return vclass not in self._lane.getDisallowed(lane_id)
+
+    def _permitted_ahead(self, index: int) -> bool:
+        """The ego's class may use lane ``index`` on every edge of its route that begins
+        within ``PERMISSION_REACH_M`` of its start edge's start (where the lane exists): the
+        whole manoeuvre, not only its start."""
+        begun_m = 0.0
+        for edge in self._ego.route_edges:
+            if begun_m > PERMISSION_REACH_M:
+                break
+            lane_id = f"{edge}_{index}"
+            if index < self._api.edge.getLaneNumber(edge) and not self._permits(lane_id):
+                return False
+            begun_m += float(self._lane.getLength(f"{edge}_0"))
+        return True
 
     def _side_limit(self, index: int) -> float:
         """The highest speed limit of lane ``index`` along the ego's route (0: none)."""

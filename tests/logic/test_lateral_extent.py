@@ -1,0 +1,48 @@
+"""The lane change clears the obstacle's real lateral extent: to the target lane's centre, or
+farther within the target lane when the obstacle reaches into it, else braking in lane
+(closed-form geometry)."""
+
+from __future__ import annotations
+
+import pytest
+
+from eoam_sumo.decision.obstacle import ObstacleTrack
+from eoam_sumo.eoam import EgoMeasurement
+from eoam_sumo.eoam.shifts import lane_change_height_m
+from eoam_sumo.eoam_settings import EoamSettings
+from eoam_sumo.params import ego_e_class_sedan
+
+P = ego_e_class_sedan()
+ST = EoamSettings()
+LANE = 3.5
+
+
+def _meas():
+    return EgoMeasurement(0.0, 30.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, LANE)
+
+
+def _truck(over_line_m):
+    """A stopped truck whose left side is ``over_line_m`` past the ego lane's left marker."""
+    return ObstacleTrack(0.0, 50.0, 0.0, 0.5 * LANE + over_line_m, 0.0, 12.0)
+
+
+def test_an_obstacle_inside_its_lane_is_passed_at_the_target_lane_centre():
+    assert lane_change_height_m(P, ST, _truck(-0.5), _meas()) == pytest.approx(LANE)
+    assert lane_change_height_m(P, ST, None, _meas()) == pytest.approx(LANE)
+
+
+@pytest.mark.parametrize("over_m", [0.37, 0.82, 0.9])
+def test_a_truck_over_the_line_is_cleared_by_the_side_clearance_within_the_lane(over_m):
+    height = lane_change_height_m(P, ST, _truck(over_m), _meas())
+    clearance = height - 0.5 * P.width_m - (0.5 * LANE + over_m)
+    if height > LANE:  # moved over: exactly the clearance
+        assert clearance == pytest.approx(ST.side_clearance_m)
+    assert clearance >= ST.side_clearance_m - 1e-9
+    assert height + 0.5 * P.width_m <= 1.5 * LANE + 1e-9  # the body within the target lane
+
+
+def test_a_truck_reaching_too_far_into_the_target_lane_makes_the_ego_brake():
+    # the body cannot both clear it and stay in the target lane
+    too_far = 1.5 * LANE - P.width_m - ST.side_clearance_m - 0.5 * LANE + 0.05
+    assert lane_change_height_m(P, ST, _truck(too_far), _meas()) is None
+    assert lane_change_height_m(P, ST, _truck(too_far - 0.1), _meas()) is not None
