@@ -98,7 +98,7 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
             "traffic_levels",
             "vehicle_files",
         },
-        {"pandas", "dask", "distributed", "tqdm", "pyarrow"},
+        {"numpy", "pandas", "statsmodels", "dask", "distributed", "tqdm", "pyarrow"},
     ),
     "plotting": (
         {"params", "errors", "colours", "sampling", "offline", "decision", "world", "sim", "batch"},

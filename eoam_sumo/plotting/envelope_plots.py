@@ -1,85 +1,192 @@
-"""Envelope plots of a sampled batch: probability of contact and of red over speed x friction.
+"""Envelope plots of a sampled batch: each outcome's probability over speed x friction.
 
-Each cell pools every finished draw at that speed and friction (over the other swept and
-sampled values) and shows p with its Wilson 95 % interval and n. A sampled (continuous)
-speed or friction is binned into ``BINS`` equal-width bins.
+Per outcome (any contact, red, near miss) a row of three panels: the draws pooled in cells
+(:mod:`eoam_sumo.plotting.envelope_bins`; each cell ``events/draws``, empty cells hatched),
+the probability map (:mod:`eoam_sumo.batch.probability_map`, a binomial GLM; the draws
+marked) and the width of its 95 % band. An outcome no draw had is named in the title instead
+of drawn. Generated-scenario studies: one ``envelope_<road>.png`` per road, a row per level of
+service and outcome. The map's values go to ``outcome_probability_map.csv`` beside them.
 """
 
 from __future__ import annotations
 
-from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
+from matplotlib.patches import Rectangle
+from matplotlib.transforms import Bbox
 
+from eoam_sumo.batch.probability_map import (
+    OUTCOMES,
+    X,
+    Y,
+    probability_map,
+    write_probability_map,
+)
+from eoam_sumo.plotting.envelope_bins import Axis, axes_of, cell_counts, cell_probability
 from eoam_sumo.plotting.figures import save
+from eoam_sumo.plotting.label_fit import fit_in_cells, thin_ticks
 from eoam_sumo.sampling import wilson_interval
 
 ENVELOPE_PNG = "envelope.png"
-BINS = 6
-MAX_LEVELS = 12  # more distinct values than this: binned
+LABELS = {"contact": "P(contact)", "red": "P(red: head-on after a lane change)"}
+LABELS["near_miss"] = "P(near miss)"
+SPEED_LABEL, MU_LABEL = "initial ego speed [km/h]", "surface friction mu"
+LEVELS = np.linspace(0.0, 1.0, 11)
 
 
-def _levels(values: pd.Series) -> tuple[pd.Series, list[str]]:
-    """Each value's level index and the level labels (distinct values, or bins)."""
-    distinct = sorted(values.dropna().unique())
-    if len(distinct) <= MAX_LEVELS:
-        index = values.map({v: i for i, v in enumerate(distinct)})
-        return index, [f"{v:g}" for v in distinct]
-    edges = np.linspace(distinct[0], distinct[-1], BINS + 1)
-    index = pd.Series(np.clip(np.digitize(values, edges[1:-1]), 0, BINS - 1), index=values.index)
-    return index, [f"{a:.3g}-{b:.3g}" for a, b in pairwise(edges)]
+def _coords(axis: Axis) -> tuple[np.ndarray, list[float], list[str]]:
+    """Cell edges in plot coordinates, tick positions, tick labels (levels: 0, 1, ...)."""
+    if axis.levels:
+        edges = np.arange(len(axis.levels) + 1) - 0.5
+        return edges, list(range(len(axis.levels))), axis.labels()
+    return np.asarray(axis.edges), list(axis.edges), axis.labels()
 
 
-def envelope_table(results: pd.DataFrame, event: pd.Series) -> tuple:
-    """(count, n, speed labels, friction labels) arrays of ``event`` over the finished draws."""
-    ok = results["status"] == "ok"
-    speed_i, speeds = _levels(results.loc[ok, "ego_speed_kmh"])
-    mu_i, mus = _levels(results.loc[ok, "mu"])
-    count = np.zeros((len(speeds), len(mus)), dtype=int)
-    n = np.zeros_like(count)
-    for i, j, e in zip(speed_i, mu_i, event[ok]):
-        n[i, j] += 1
-        count[i, j] += bool(e)
-    return count, n, speeds, mus
+def _hatch_empty(ax) -> None:
+    """Cells without draws show the hatched background (NaN cells are left undrawn)."""
+    ax.add_patch(
+        Rectangle(
+            (0, 0),
+            1,
+            1,
+            transform=ax.transAxes,
+            fill=False,
+            hatch="///",
+            edgecolor="0.75",
+            linewidth=0,
+            zorder=0,
+        )
+    )
 
 
-def _events(results: pd.DataFrame) -> dict[str, pd.Series]:
-    return {
-        "P(contact with any road user)": results["collision_with"].fillna("none") != "none",
-        "P(red: head-on after a lane change)": results["outcome"] == "red",
-    }
+def _bins_panel(ax, draws: pd.DataFrame, event: np.ndarray, title: str) -> list:
+    """Events/draws per cell over speed (y) x friction (x); the texts with their cells."""
+    sx, sy = axes_of(draws)
+    count, n = cell_counts(sx, sy, event)
+    (ye, yt, yl), (xe, xt, xl) = _coords(sx), _coords(sy)
+    _hatch_empty(ax)
+    mesh = ax.pcolormesh(xe, ye, cell_probability(count, n), cmap="Reds", vmin=0, vmax=1)
+    texts = []
+    for i, j in zip(*np.nonzero(n)):
+        p = count[i, j] / n[i, j]
+        text = ax.text(
+            (xe[j] + xe[j + 1]) / 2,
+            (ye[i] + ye[i + 1]) / 2,
+            f"{count[i, j]}/{n[i, j]}",
+            ha="center",
+            va="center",
+            fontsize=8,
+            color="white" if p > 0.6 else "black",
+        )
+        texts.append((text, Bbox.from_extents(xe[j], ye[i], xe[j + 1], ye[i + 1])))
+    ax.set_xticks(xt, xl, rotation=45 if len(xl) > 6 else 0)
+    ax.set_yticks(yt, yl)
+    ax.set_xlabel(MU_LABEL + ("" if sy.levels else f" (bins of {sy.step:g})"))
+    ax.set_ylabel(SPEED_LABEL if sx.levels else f"{SPEED_LABEL} (bins of {sx.step:g})")
+    ax.set_title(f"{title}: events/draws per cell", fontsize=9)
+    ax.figure.colorbar(mesh, ax=ax, shrink=0.85, label="probability")
+    return texts
 
 
-def _panel(ax, results: pd.DataFrame, event: pd.Series, title: str, fig: Figure) -> None:
-    """One envelope: ``event``'s probability over speed x friction, each cell annotated."""
-    count, n, speeds, mus = envelope_table(results, event)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        p = np.where(n > 0, count / np.maximum(n, 1), np.nan)
-    image = ax.imshow(p, cmap="Reds", vmin=0.0, vmax=1.0, aspect="auto")
-    for i in range(len(speeds)):
-        for j in range(len(mus)):
-            if n[i, j] == 0:
-                continue
-            low, high = wilson_interval(int(count[i, j]), int(n[i, j]))
-            ax.text(
-                j,
-                i,
-                f"{p[i, j]:.2f}\n[{low:.2f}, {high:.2f}]\nn={n[i, j]}",
-                ha="center",
-                va="center",
-                fontsize=8,
-                color="white" if p[i, j] > 0.6 else "black",
-            )
-    ax.set_xticks(range(len(mus)), mus)
-    ax.set_yticks(range(len(speeds)), speeds)
-    ax.invert_yaxis()  # the highest speed on top
-    ax.set_xlabel("surface friction mu")
-    ax.set_ylabel("initial ego speed [km/h]")
-    ax.set_title(title)
-    fig.colorbar(image, ax=ax, shrink=0.8, label="probability")
+def _short(model: str) -> str:
+    return model.replace(X, "v").replace(Y, "mu").replace("logit GLM: ", "logit GLM ")
+
+
+def _map_panels(ax_p, ax_w, fitted: pd.DataFrame, draws: pd.DataFrame, event) -> None:
+    """The map (colours and contours of p, the draws marked) and its band's width."""
+    xs, ys = np.unique(fitted[Y]), np.unique(fitted[X])
+    model = str(fitted["model"].iloc[0])
+    if model.startswith("none"):
+        p, low, high = fitted[["p", "p_low", "p_high"]].iloc[0]
+        for ax in (ax_p, ax_w):
+            ax.set_axis_off()
+        ax_p.text(
+            0.5,
+            0.5,
+            f"no map: {model[model.index('(') + 1 : model.index(')')]}\n"
+            f"overall p = {p:.2f} [{low:.2f}, {high:.2f}]",
+            ha="center",
+            va="center",
+            transform=ax_p.transAxes,
+            fontsize=9,
+            wrap=True,
+        )
+        return
+    if len(xs) < 2 or len(ys) < 2:  # one parameter constant: a curve with its band
+        _curve(ax_p, fitted, draws, event, model)
+        ax_w.set_axis_off()
+        return
+    grid = fitted.pivot_table(index=X, columns=Y, values=["p", "p_low", "p_high"])
+    fig = ax_p.figure
+    filled = ax_p.contourf(xs, ys, grid["p"].to_numpy(), levels=LEVELS, cmap="Reds")
+    lines = ax_p.contour(
+        xs, ys, grid["p"].to_numpy(), levels=[0.1, 0.5, 0.9], colors="k", linewidths=0.6
+    )
+    ax_p.clabel(lines, fontsize=7, fmt="%.1f")
+    hit = np.asarray(event, bool)
+    ax_p.scatter(
+        draws[Y][~hit], draws[X][~hit], s=6, facecolors="none", edgecolors="0.4", linewidths=0.5
+    )
+    ax_p.scatter(draws[Y][hit], draws[X][hit], s=10, marker="x", color="k", linewidths=0.8)
+    ax_p.set_title(f"map: {_short(model)}\n(o no event, x event)", fontsize=9)
+    fig.colorbar(filled, ax=ax_p, shrink=0.85, label="probability")
+    width = (grid["p_high"] - grid["p_low"]).to_numpy()
+    band = ax_w.contourf(xs, ys, width, levels=LEVELS, cmap="Greys")
+    ax_w.set_title("map's 95 % band: p_high - p_low", fontsize=9)
+    fig.colorbar(band, ax=ax_w, shrink=0.85, label="band width")
+    for ax in (ax_p, ax_w):
+        ax.set_xlabel(MU_LABEL)
+        ax.set_ylabel(SPEED_LABEL)
+
+
+def _curve(ax, fitted: pd.DataFrame, draws: pd.DataFrame, event, model: str) -> None:
+    """A map over one parameter: p with its 95 % band, the draws at 0 and 1."""
+    column = X if fitted[X].nunique() > 1 else Y
+    fitted = fitted.sort_values(column)
+    ax.fill_between(
+        fitted[column], fitted["p_low"], fitted["p_high"], color="C3", alpha=0.25, label="95 % band"
+    )
+    ax.plot(fitted[column], fitted["p"], color="C3", label="p")
+    ax.scatter(draws[column], np.asarray(event, float), s=8, marker="|", color="k")
+    ax.set_ylim(-0.05, 1.05)
+    ax.set_xlabel(SPEED_LABEL if column == X else MU_LABEL)
+    ax.set_ylabel("probability")
+    ax.set_title(f"map: {_short(model)}", fontsize=9)
+    ax.legend(fontsize=7, loc="best")
+
+
+def _rows(results: pd.DataFrame, fitted: pd.DataFrame, slice_of) -> tuple[list, list[str]]:
+    """(slice name, draws, outcome, its map) per drawn row; notes on outcomes none had."""
+    rows, notes = [], []
+    ok = results[results["status"] == "ok"]
+    for outcome, event in OUTCOMES.items():
+        hits = event(ok)
+        if not hits.any():
+            high = wilson_interval(0, len(ok))[1]
+            notes.append(f"{LABELS[outcome]} = 0 in all {len(ok)} draws [0, {high:.3f}]")
+            continue
+        for name, draws, selected in slice_of(ok, fitted):
+            rows.append((name, draws, outcome, selected[selected["outcome"] == outcome]))
+    return rows, notes
+
+
+def _figure(rows: list, notes: list[str], title: str, path: Path) -> Path:
+    """The figure of ``rows`` (three panels each), titled, labels fitted, saved."""
+    fig = Figure(figsize=(15, 3.4 * max(len(rows), 1) + 0.6), layout="constrained")
+    texts = []
+    if rows:
+        axes = fig.subplots(len(rows), 3, squeeze=False)
+        for (name, draws, outcome, fitted), (ax_b, ax_p, ax_w) in zip(rows, axes):
+            event = OUTCOMES[outcome](draws).to_numpy()
+            texts += _bins_panel(ax_b, draws, event, f"{name}{LABELS[outcome]}")
+            _map_panels(ax_p, ax_w, fitted, draws, event)
+    fig.suptitle("\n".join([title, *notes]), fontsize=11)
+    thin_ticks(fig)
+    fit_in_cells(fig, texts)
+    return save(fig, path)
 
 
 def _title(results: pd.DataFrame, what: str) -> str:
@@ -87,38 +194,42 @@ def _title(results: pd.DataFrame, what: str) -> str:
     return (
         f"{what}: {int((results['status'] == 'ok').sum())} draws"
         + (f" ({failed} failed, left out)" if failed else "")
-        + "; each cell p [Wilson 95 %] and n"
+        + "; hatched cells: no draw"
     )
 
 
+def _one_slice(ok: pd.DataFrame, fitted: pd.DataFrame):
+    yield "", ok, fitted
+
+
 def plot_envelopes(results: pd.DataFrame, out_dir: Path) -> list[Path]:
-    """``envelope.png``: P(contact) and P(red) over initial speed x friction; for generated
-    scenarios (a ``road`` column) one ``envelope_<road>.png`` per road instead, a row of
-    the two per level of service."""
+    """``envelope.png`` and ``outcome_probability_map.csv``; for generated scenarios (a
+    ``road`` column) one ``envelope_<road>.png`` per road instead."""
     if not (results["status"] == "ok").any():
         return []
+    fitted = probability_map(results)
+    write_probability_map(Path(out_dir), fitted)
     roads = results["road"].fillna("").astype(str) if "road" in results else pd.Series()
     if (roads != "").any():
         return [
-            _road_envelopes(results[roads == road], road, out_dir)
+            _road_envelopes(results[roads == road], fitted, road, out_dir)
             for road in sorted(set(roads) - {""})
         ]
-    fig = Figure(figsize=(12, 5.5), layout="constrained")
-    axes = fig.subplots(1, 2)
-    for ax, (title, event) in zip(axes, _events(results).items()):
-        _panel(ax, results, event, title, fig)
-    fig.suptitle(_title(results, "Outcome envelopes"))
-    return [save(fig, Path(out_dir) / ENVELOPE_PNG)]
+    rows, notes = _rows(results, fitted, _one_slice)
+    path = Path(out_dir) / ENVELOPE_PNG
+    return [_figure(rows, notes, _title(results, "Outcome envelopes"), path)]
 
 
-def _road_envelopes(results: pd.DataFrame, road: str, out_dir: Path) -> Path:
-    """``envelope_<road>.png``: per level of service (rows), P(contact) and P(red)."""
-    levels = sorted(set(results["los"].fillna("").astype(str)) - {""}) or [None]
-    fig = Figure(figsize=(12, 4.8 * len(levels)), layout="constrained")
-    axes = fig.subplots(len(levels), 2, squeeze=False)
-    for row, level in zip(axes, levels):
-        subset = results if level is None else results[results["los"] == level]
-        for ax, (title, event) in zip(row, _events(subset).items()):
-            _panel(ax, subset, event, f"LoS {level}: {title}", fig)
-    fig.suptitle(_title(results, f"Outcome envelopes, {road} road"))
-    return save(fig, Path(out_dir) / f"envelope_{road}.png")
+def _road_envelopes(results: pd.DataFrame, fitted: pd.DataFrame, road: str, out_dir) -> Path:
+    """``envelope_<road>.png``: per level of service and outcome, the three panels."""
+
+    def per_level(ok: pd.DataFrame, fitted: pd.DataFrame):
+        for level in sorted(set(ok["los"].fillna("").astype(str))):
+            mine = fitted[fitted["road"].astype(str) == road]
+            if level:
+                mine = mine[mine["los"].astype(str) == level]
+            yield (f"LoS {level}: " if level else ""), ok[ok["los"].fillna("") == level], mine
+
+    rows, notes = _rows(results, fitted, per_level)
+    title = _title(results, f"Outcome envelopes, {road} road")
+    return _figure(rows, notes, title, Path(out_dir) / f"envelope_{road}.png")

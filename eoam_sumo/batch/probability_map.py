@@ -1,0 +1,172 @@
+"""Probability maps of a sampled batch: ``outcome_probability_map.csv``.
+
+The probability of each outcome (any contact, red, near miss) as a smooth function of the
+initial speed and the friction, with a pointwise 95 % confidence band: a binomial GLM with a
+logit link (statsmodels), its terms B-splines (patsy ``bs``) or straight lines in each
+parameter and their product, the candidate with the lowest AIC (Akaike 1974) among those with
+at least ``EVENTS_PER_PARAMETER`` of the rarer result per coefficient (Vittinghoff and
+McCulloch 2007). Each draw is shrunk towards the overall rate by k/n pseudo-draws (Clogg et al.
+1991: y* = (y + p k/n) / (1 + k/n), k coefficients, n draws), so that a parameter range with
+no event gives a small probability with a finite band instead of a diverging fit. The band is
+the GLM's Wald interval of the linear predictor mapped through the logistic function. The map
+covers the observed range only. Degenerate data fall back to the overall Wilson interval
+(:func:`eoam_sumo.sampling.wilson_interval`) at every grid point, the ``model`` column saying
+why: no event or only events, fewer than ``MIN_DRAWS`` draws, or no fit converged.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from eoam_sumo.fileio import write_atomic
+from eoam_sumo.sampling import wilson_interval
+
+MAP_FILE = "outcome_probability_map.csv"
+X, Y = "ego_speed_kmh", "mu"  # the map's two parameters
+GRID_POINTS = 21  # per varying parameter
+MIN_DRAWS = 10  # fewer finished draws: no map, the overall rate
+EVENTS_PER_PARAMETER = 5.0
+SPLINE_MIN_DISTINCT = 6  # distinct values a parameter needs for a spline term
+SLICE_COLUMNS = ("road", "los")  # generated-scenario studies: one map per road and level
+
+#: outcome -> whether each finished draw had it
+OUTCOMES: dict[str, Callable[[pd.DataFrame], pd.Series]] = {
+    "contact": lambda r: r["collision_with"].fillna("none").astype(str) != "none",
+    "red": lambda r: r["outcome"].astype(str) == "red",
+    "near_miss": lambda r: r["near_miss"].astype(str) == "True",
+}
+
+
+def _terms(name: str, distinct: int) -> list[tuple[str, int]]:
+    """A parameter's candidate terms and their coefficients: a straight line, and B-splines
+    when it has the values for them."""
+    if distinct < 2:
+        return []
+    splines = [(f"bs({name}, df={df})", df) for df in (3, 4) if distinct >= SPLINE_MIN_DISTINCT]
+    return [(name, 1), *splines]
+
+
+def candidate_formulas(distinct_x: int, distinct_y: int) -> list[tuple[str, int]]:
+    """The candidate right-hand sides with their number of coefficients, simplest first
+    (``1``: no parameter varies)."""
+    xs, ys = _terms(X, distinct_x) or [("", 0)], _terms(Y, distinct_y) or [("", 0)]
+    formulas = []
+    for tx, kx in xs:
+        for ty, ky in ys:
+            formulas.append((" + ".join(t for t in (tx, ty) if t) or "1", 1 + kx + ky))
+    if distinct_x >= 2 and distinct_y >= 2:
+        formulas += [(f"{f} + {X}:{Y}", k + 1) for f, k in list(formulas)]
+    return formulas
+
+
+def _grid(draws: pd.DataFrame) -> pd.DataFrame:
+    """The map's grid over the observed range of each parameter (one value if constant)."""
+    axes = [np.linspace(draws[c].min(), draws[c].max(), GRID_POINTS) for c in (X, Y)]
+    axes = [np.unique(a) for a in axes]
+    gx, gy = np.meshgrid(*axes, indexing="ij")
+    return pd.DataFrame({X: gx.ravel(), Y: gy.ravel()})
+
+
+def _fallback(grid: pd.DataFrame, events: int, n: int, why: str) -> pd.DataFrame:
+    low, high = wilson_interval(events, n)
+    return grid.assign(p=events / n, p_low=low, p_high=high, model=f"none ({why}): overall")
+
+
+def _fit(formula: str, coefficients: int, data: pd.DataFrame):
+    """The shrunk binomial GLM of ``formula`` (statsmodels imported here only), or None for
+    a singular design or a diverging, separated or non-converging fit."""
+    import statsmodels.api as sm
+    import statsmodels.formula.api as smf
+    from statsmodels.tools.sm_exceptions import ModelWarning
+
+    n, rate = len(data), float(data["event"].mean())
+    with warnings.catch_warnings():
+        for category in (RuntimeWarning, ModelWarning):
+            warnings.simplefilter("error", category)
+        try:
+            shrink = coefficients / n
+            shrunk = data.assign(event=(data["event"] + rate * shrink) / (1.0 + shrink))
+            result = smf.glm(
+                f"event ~ {formula}",
+                shrunk,
+                family=sm.families.Binomial(),
+                var_weights=np.full(n, 1.0 + shrink),
+            ).fit()
+        except (ValueError, ArithmeticError, np.linalg.LinAlgError, RuntimeWarning, ModelWarning):
+            return None
+    return result if result.converged and np.isfinite(result.aic) else None
+
+
+def fit_map(draws: pd.DataFrame) -> pd.DataFrame:
+    """The map of one outcome over ``draws`` (columns X, Y and ``event``, 0/1): the grid with
+    ``p, p_low, p_high`` and ``model`` (the chosen formula, or why there is none)."""
+    grid, n, events = _grid(draws), len(draws), int(draws["event"].sum())
+    if n < MIN_DRAWS:
+        return _fallback(grid, events, n, f"{n} draws")
+    if events in (0, n):
+        return _fallback(grid, events, n, f"{events} of {n}")
+    budget = max(3.0, min(events, n - events) / EVENTS_PER_PARAMETER)
+    distinct = [draws[c].nunique() for c in (X, Y)]
+    best = None
+    for formula, coefficients in candidate_formulas(*distinct):
+        result = _fit(formula, coefficients, draws) if coefficients <= budget else None
+        if result is None:
+            continue
+        if best is None or result.aic < best[1].aic - 1e-9:
+            best = (formula, result)
+    if best is None:
+        return _fallback(grid, events, n, "no fit")
+    frame = best[1].get_prediction(grid).summary_frame(alpha=0.05)
+    return grid.assign(
+        p=frame["mean"].to_numpy(),
+        p_low=frame["mean_ci_lower"].to_numpy(),
+        p_high=frame["mean_ci_upper"].to_numpy(),
+        model=f"logit GLM: {best[0]}",
+    )
+
+
+def _slices(ok: pd.DataFrame) -> list[tuple[dict, pd.DataFrame]]:
+    """(slice values, draws) per road and level of service of a generated-scenario study,
+    else one slice of every draw."""
+    keys = [c for c in SLICE_COLUMNS if c in ok and ok[c].fillna("").astype(str).ne("").any()]
+    if not keys:
+        return [({}, ok)]
+    return [
+        (dict(zip(keys, values if isinstance(values, tuple) else (values,))), draws)
+        for values, draws in ok.groupby(keys, sort=True)
+    ]
+
+
+def probability_map(results: pd.DataFrame) -> pd.DataFrame:
+    """Every outcome's map over the finished draws of a results frame (``read_results``):
+    [road, los,] ego_speed_kmh, mu, outcome, p, p_low, p_high, n, events, model."""
+    ok = results[results["status"] == "ok"]
+    frames = []
+    for values, draws in _slices(ok):
+        data = draws[[X, Y]].astype(float).reset_index(drop=True)
+        for outcome, event in OUTCOMES.items():
+            data["event"] = event(draws).astype(float).to_numpy()
+            fitted = fit_map(data)
+            frames.append(
+                fitted.assign(
+                    **values, outcome=outcome, n=len(data), events=int(data["event"].sum())
+                )
+            )
+    if not frames:
+        return pd.DataFrame()
+    columns = [c for c in SLICE_COLUMNS if c in frames[0]]
+    columns += [X, Y, "outcome", "p", "p_low", "p_high", "n", "events", "model"]
+    return pd.concat(frames, ignore_index=True)[columns]
+
+
+def write_probability_map(out_dir: Path, frame: pd.DataFrame) -> Path:
+    """Write ``outcome_probability_map.csv`` (atomically, 6 significant digits)."""
+    path = Path(out_dir) / MAP_FILE
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_atomic(path, frame.to_csv(index=False, float_format="%.6g"))
+    return path
