@@ -20,6 +20,7 @@ from eoam_sumo import netbuild
 from eoam_sumo.decision.policy import FOLLOWER_HEADWAY_S
 from eoam_sumo.eoam_settings import EoamSettings
 from eoam_sumo.params import ego_e_class_sedan
+from eoam_sumo.plotting.roadtracks import closest_approach
 from eoam_sumo.sensing.radar import CUT_IN_PERCEPTION_S, CUT_IN_WANDER_M
 from eoam_sumo.sim.cosim import policy_settings, run_case
 from eoam_sumo.sim.margins import EMERGENCY_DECEL_MPS2
@@ -198,6 +199,8 @@ def test_a_passed_car_is_returned_in_front_of_only_at_its_distance_and_stays_the
         for r in both.itertuples()
     ]
     assert summary["min_gap_aro_m"] == pytest.approx(min(gaps), abs=0.05)
+    # traffic.png's "closest obstacle" label says the same
+    assert closest_approach(traffic, "aro").gap_m == pytest.approx(min(gaps), abs=0.01)
     if decel.max() > 0.5:  # it braked: the follower measure saw it, by name
         assert summary["follower_decel_id"] == "car"
         assert summary["max_follower_decel_mps2"] == pytest.approx(decel.max(), abs=0.3)
