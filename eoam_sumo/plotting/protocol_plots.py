@@ -31,15 +31,18 @@ LEGEND = {
     "unscored": ("unscored", "not_run"),
 }
 ROW_KEYS = ["ego_speed_kmh", "target_speed_kmh", "gap_m", "target_decel_mps2"]
+#: tests scored on the VUT's speed reduction (the cell shows it, not the impact speed)
+REDUCTION_TESTS = ("CCFhos", "CCFhol")
 
 
 def _cell_text(r) -> str:
     """The cell's value (impact or, head-on, reduction km/h) and B/S; '-' not run."""
     if r.status != "ok":
         return "-"
-    value = r.speed_reduction_kmh if r.test == "CCFhos" else r.impact_speed_kmh
+    reduction = r.test in REDUCTION_TESTS
+    value = r.speed_reduction_kmh if reduction else r.impact_speed_kmh
     shown = "0" if pd.isna(value) else f"{value:.0f}"
-    if r.test == "CCFhos" and pd.isna(value):
+    if reduction and pd.isna(value):
         shown = "no hit"
     mark = f" {r.manoeuvre}" if isinstance(r.manoeuvre, str) else ""
     warning = {"pass": " W", "fail": " w!"}.get(r.warning, "") if isinstance(r.warning, str) else ""
@@ -89,7 +92,7 @@ def _row_label(row: tuple) -> str:
 
 #: what a cell's text says, by the kind of protocol
 CELL_TEXT = {
-    "bands": "cell: impact km/h (CCFhos: speed reduction km/h); B braked in lane, S steered",
+    "bands": "cell: impact km/h (CCFhos, CCFhol: speed reduction km/h); B braked in lane, S steered",
     "verdicts": "cell: impact km/h; B braked in lane, S steered; W warning in time, w! late "
     "or none",
     "unscored": "cell: impact km/h; B braked in lane, S steered",

@@ -32,13 +32,18 @@ class RunLabel:
         return f"{self.name}, system {self.system}{ours}, policy {self.policy}"
 
 
-#: What the CCFhos source says and what we did (the scorecard prints it)
+#: What the head-on sources say and what we did (the scorecard prints it)
 CCFHOS_TEXT = (
-    "CCFhos bands: the rating code scores the VUT's speed reduction (v_reduction) with "
-    "mitigation_scenarios_thresholds: <= 10 km/h red, <= 20 orange, <= 30 green, above 30 "
-    "red (FC v1.2 Figure 5-2, not held here). Read literally a full stop at 50/50 would score "
-    "red like no reaction; we score a reduction above 30 km/h green, and a run without "
-    "contact green, so the points never fall as the reduction grows."
+    "CCFhos and CCFhol bands: the rating code scores the VUT's speed reduction (v_reduction) "
+    "with mitigation_scenarios_thresholds: <= 10 km/h red, <= 20 orange, <= 30 green, above "
+    "30 red (FC v1.2 Figure 5-2, not held here). Read literally a full stop at 50/50 would "
+    "score red like no reaction; we score a reduction above 30 km/h green, and a run without "
+    "contact green, so the points never fall as the reduction grows.\n\n"
+    "CCFhol: the rating code gives it CCFhos's matrix (8 rows x 4 impact locations, the same "
+    "extended cells); its row speeds are not held, so we run CCFhos's rows. The target pulls "
+    "out from behind an obstruction vehicle and changes lanes along Vector's 2023 path "
+    "(3.5 m over 43 m at 50 km/h, 60 m at 70 km/h, the 70 km/h path stretched above) to end "
+    "at its impact location at a TTC of 1.5 s (docs/protocols.md)."
 )
 
 
@@ -244,7 +249,6 @@ def not_built_note(run: RunLabel) -> str:
         "Tests not built (points at stake):\n"
         f"Frontal Collisions: {', '.join(fc)}\n"
         f"Low Speed Collisions: {', '.join(lsc)}\n"
-        "(CCFhol: scripted lane change not built; the others are junction tests, out of a "
-        "highway EOAM's scope; docs/protocols.md)\n"
+        "(junction tests, out of a highway EOAM's scope; docs/protocols.md)\n"
         "Robustness layer: not assessed, 0 of its weight in every test"
     )

@@ -184,9 +184,6 @@ def failure_cause(row: dict) -> str:
 
 #: The car-target FC tests not built here, and why (docs/protocols.md): test -> reason
 NOT_BUILT = {
-    "CCFhol": "the target's lane change along a scripted path is not built (our target "
-    "follows a SUMO lane at a fixed offset); the rating code gives CCFhol no verification "
-    "test either (a corner case in full)",
     "CCFtap": "a junction test (the VUT turns across an oncoming car): out of a highway "
     "EOAM's scope, no junction network here",
     "CCCscp": "a junction test (crossing straight paths): out of a highway EOAM's scope, no "
