@@ -320,18 +320,23 @@ def test_totals_of_one_system_and_policy_stay_within_the_maximum():
         if p.ego_speed_kmh < 20
     ]
     t = scoring.fc_totals(rows)
-    assert t["max_run"] == pytest.approx(9.0) and t["max_protocol"] == pytest.approx(24.0)
-    # every point run green: the robustness layer (1.125) is not assessed; the 10 km/h
+    assert t["max_run"] == pytest.approx(11.5) and t["max_protocol"] == pytest.approx(24.0)
+    # every point run green: the robustness layer (1.375) is not assessed; the 10 km/h
     # CCRs row not run: 5 of 40 standard cells (-0.15), 2 of 16 extended (14/16 = 87.5 %,
     # banded to 75 %: -0.0375), and the gate fails
-    assert t["points_before_gate"] == pytest.approx(8.1 - 0.15 - 0.0375)
+    assert t["points_before_gate"] == pytest.approx(10.35 - 0.15 - 0.0375)
     assert not t["gate_passed"] and t["points"] == 0.0
 
 
 def test_grids():
     p2026 = protocol_points(PROTOCOLS[1], SEDAN_WIDTH_M)
-    count = {t: sum(p.test == t for p in p2026) for t in ("CCRs", "CCRm", "CCRb", "CCFhos")}
-    assert count == {"CCRs": 8 * 7, "CCRm": 11 * 7, "CCRb": 11 * 7, "CCFhos": 8 * 4}
+    tests = ("CCRs", "CCRm", "CCRb", "CCFhos", "CCFhol")
+    count = {t: sum(p.test == t for p in p2026) for t in tests}
+    assert count == {"CCRs": 8 * 7, "CCRm": 11 * 7, "CCRb": 11 * 7, "CCFhos": 32, "CCFhol": 32}
+    # the rating code's EXTENDED_RANGE_CELLS of CCFhos and CCFhol: the first column (100 %)
+    # and the last two rows, 14 cells each
+    for test in ("CCFhos", "CCFhol"):
+        assert sum(p.extended for p in p2026 if p.test == test) == 14
     assert len({p.point_id for p in p2026}) == len(p2026)
     # CCFhos starts 8 s of closing apart (Vector's startupTime): 50/50 km/h -> 222.2 m
     assert next(p.gap_m for p in p2026 if p.test == "CCFhos" and p.ego_speed_kmh == 50) == (

@@ -92,7 +92,8 @@ def _row_label(row: tuple) -> str:
 
 #: what a cell's text says, by the kind of protocol
 CELL_TEXT = {
-    "bands": "cell: impact km/h (CCFhos, CCFhol: speed reduction km/h); B braked in lane, S steered",
+    "bands": "cell: impact km/h (CCFhos, CCFhol: speed reduction km/h); B braked in lane, "
+    "S steered",
     "verdicts": "cell: impact km/h; B braked in lane, S steered; W warning in time, w! late "
     "or none",
     "unscored": "cell: impact km/h; B braked in lane, S steered",
