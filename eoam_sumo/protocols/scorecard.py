@@ -123,7 +123,26 @@ def not_built_lines() -> list[str]:
             f"| {test} (Low Speed Collisions) | {rules.LSC_CAR_SCORES[test]:g} / - / - | "
             f"{rules.LSC_CAR_SCORES[test]:g} | {why} |"
         )
-    return [*lines, ""]
+    lines += [_ptw_line(test, why) for test, why in scoring.NOT_BUILT_PTW.items()]
+    return [
+        *lines,
+        "",
+        "The car-target tests count in the protocol's maximum above; the motorcycle-target "
+        "tests of the same Car & PTW subelement do not.",
+        "",
+    ]
+
+
+def _ptw_line(test: str, why: str) -> str:
+    """A motorcycle-target test's row: FC weights, or the LSC one (SfS)."""
+    if test in rules.LSC_PTW_SCORES:
+        w = rules.LSC_PTW_SCORES[test]
+        return f"| {test} (Low Speed Collisions, motorcycle) | {w:g} / - / - | {w:g} | {why} |"
+    parts = rules.PTW_SCORES[test]
+    return (
+        f"| {test} (FC, motorcycle) | {parts['standard']:g} / {parts['extended']:g} / "
+        f"{parts['robustness']:g} | {sum(parts.values()):g} | {why} |"
+    )
 
 
 def r152_lines(rows: list[dict]) -> list[str]:
@@ -245,10 +264,13 @@ def not_built_note(run: RunLabel) -> str:
         return ""
     fc = [f"{t} {rules.weight_total(t):g}" for t in scoring.NOT_BUILT]
     lsc = [f"{t} {rules.LSC_CAR_SCORES[t]:g}" for t in scoring.NOT_BUILT_LSC]
+    ptw = [f"{t} {sum(w.values()):g}" for t, w in rules.PTW_SCORES.items()]
+    ptw += [f"{t} {w:g}" for t, w in rules.LSC_PTW_SCORES.items()]
     return (
         "Tests not built (points at stake):\n"
         f"Frontal Collisions: {', '.join(fc)}\n"
         f"Low Speed Collisions: {', '.join(lsc)}\n"
+        f"Motorcycle target (not in the car maximum): {', '.join(ptw)}\n"
         "(junction tests, out of a highway EOAM's scope; docs/protocols.md)\n"
         "Robustness layer: not assessed, 0 of its weight in every test"
     )

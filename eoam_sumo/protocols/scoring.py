@@ -194,6 +194,15 @@ NOT_BUILT_LSC = {
     "CCCscp SfS": "junction, from standstill: out of scope (the EOAM works from 5 km/h)",
     "CCFtap SfS": "junction, from standstill: out of scope",
 }
+#: The motorcycle-target tests of the Car & PTW subelement (outside the car-target maximum)
+NOT_BUILT_PTW = {
+    "CMRs": "a motorcycle target (Euro NCAP's EMT) and its radar signature are not modelled",
+    "CMRb": "as CMRs",
+    "CMFtap": "a junction test with a motorcycle target: out of scope",
+    "CMCscp": "a junction test with a motorcycle target: out of scope",
+    "CMCscp SfS": "junction, from standstill, motorcycle target: out of scope",
+    "CMFtap SfS": "junction, from standstill, motorcycle target: out of scope",
+}
 
 
 def per_test_totals(rows: list[dict]) -> list[dict]:
