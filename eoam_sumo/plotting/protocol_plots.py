@@ -5,6 +5,7 @@ thick dashed border; a colour legend; the totals of the system and policy in the
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import pandas as pd
@@ -30,6 +31,8 @@ LEGEND = {
     "verdicts": ("pass", "fail", "undetermined", "not_run"),
     "unscored": ("unscored", "not_run"),
 }
+#: characters of the 7 pt footnote per inch of figure width (a spare panel's text wraps)
+FOOTNOTE_CHARS_PER_INCH = 18.0
 ROW_KEYS = ["ego_speed_kmh", "target_speed_kmh", "gap_m", "target_decel_mps2"]
 #: tests scored on the VUT's speed reduction (the cell shows it, not the impact speed)
 REDUCTION_TESTS = ("CCFhos", "CCFhol")
@@ -50,14 +53,18 @@ def _cell_text(r) -> str:
 
 
 def _panel_title(test: str, own: pd.DataFrame, totals: dict) -> str:
+    """The test, its points (or R152 passes) and what its cells show."""
+    shows = "speed reduction" if test in REDUCTION_TESTS else "impact speed"
     t = next((x for x in totals.get("tests", []) if x["test"] == test), None)
     if t is not None:
         gated = "" if totals.get("gate_passed", True) else " before the gate"
-        return f"{test}: {t['points']:.2f} of {t['max_points']:.2f}{gated}"
-    if test.startswith("R152"):
+        head = f"{test}: {t['points']:.2f} of {t['max_points']:.2f} points{gated}"
+    elif test.startswith("R152"):
         passed = int((own["verdict"] == "pass").sum())
-        return f"{test}: {passed} of {len(own)} pass"
-    return test
+        head = f"{test}: {passed} of {len(own)} rows pass"
+    else:
+        head = test
+    return f"{head}\ncells: {shows} [km/h]"
 
 
 def _draw_panel(ax, test: str, own: pd.DataFrame, totals: dict) -> None:
@@ -145,6 +152,10 @@ def plot_scorecard(
     fig.tight_layout(rect=(0, 0.08 if spare or not footnote else 0.14, 1, 0.95))
     if footnote:  # placed after the layout, which it must not squeeze
         x, y = (spare[0].get_position().x0, spare[0].get_position().y1) if spare else (0.01, 0.13)
-        fig.text(x, y, footnote, va="top", ha="left", fontsize=7)
+        width = FOOTNOTE_CHARS_PER_INCH * width * (1.0 - x) if spare else 200
+        lines = [
+            textwrap.fill(line, int(width), subsequent_indent="  ") for line in footnote.split("\n")
+        ]
+        fig.text(x, y, "\n".join(lines), va="top", ha="left", fontsize=7)
     fig.savefig(path, dpi=130)
     return Path(path)

@@ -60,6 +60,8 @@ def scorecard_markdown(frame: pd.DataFrame, run: RunLabel) -> str:
         f"Vehicle {run.vehicle}, friction {run.mu:g}, decision policy {run.policy}. Colours, "
         "points, B/S (braked / steered) per point in results.csv; docs/protocols.md.",
         "",
+        manoeuvre_line(rows) + ".",
+        "",
     ]
     if run.name == PROTOCOLS[1]:
         lines += fc_lines(rows, run) + not_built_lines() + [CCFHOS_TEXT, ""]
@@ -69,6 +71,15 @@ def scorecard_markdown(frame: pd.DataFrame, run: RunLabel) -> str:
         lines += unscored_lines(rows)
     lines += not_run_lines(rows, run) + short_lines(rows)
     return "\n".join(lines) + "\n"
+
+
+def manoeuvre_line(rows: list[dict]) -> str:
+    """What the runs did: braked in lane (B), steered (S), never intervened (-)."""
+    marks = [r["manoeuvre"] for r in rows if r["status"] == "ok"]
+    return (
+        f"Manoeuvres of the {len(marks)} runs: B (braked in lane) {marks.count('B')}, "
+        f"S (steered) {marks.count('S')}, - (never intervened) {marks.count('-')}"
+    )
 
 
 def fc_lines(rows: list[dict], run: RunLabel) -> list[str]:
@@ -231,9 +242,9 @@ def _num(value) -> str:
     return f"{float(value):.2f}"
 
 
-def picture_headline(run: RunLabel, totals: dict) -> str:
+def picture_headline(run: RunLabel, totals: dict, rows: list[dict]) -> str:
     """The picture's title: the run, and (2026) the overall points and the gate."""
-    head = f"{run.title}; {run.vehicle}, mu {run.mu:g}"
+    head = f"{run.title}; {run.vehicle}, mu {run.mu:g}\n{manoeuvre_line(rows)}"
     if run.name == PROTOCOLS[0]:
         return head + "\nunscored: the 2023 bands are not held"
     if run.name != PROTOCOLS[1]:
@@ -253,7 +264,8 @@ def plot(frame: pd.DataFrame, path, run: RunLabel) -> None:
     scored = run.name == PROTOCOLS[1]
     totals = scoring.fc_totals(frame.to_dict("records")) if scored else {}
     kind = {PROTOCOLS[0]: "unscored", PROTOCOLS[1]: "bands", PROTOCOLS[2]: "verdicts"}[run.name]
-    plot_scorecard(frame, path, picture_headline(run, totals), kind, totals, not_built_note(run))
+    headline = picture_headline(run, totals, frame.to_dict("records"))
+    plot_scorecard(frame, path, headline, kind, totals, not_built_note(run))
 
 
 def not_built_note(run: RunLabel) -> str:
@@ -271,6 +283,7 @@ def not_built_note(run: RunLabel) -> str:
         f"Frontal Collisions: {', '.join(fc)}\n"
         f"Low Speed Collisions: {', '.join(lsc)}\n"
         f"Motorcycle target (not in the car maximum): {', '.join(ptw)}\n"
-        "(junction tests, out of a highway EOAM's scope; docs/protocols.md)\n"
+        "(junction tests: out of a highway EOAM's scope; the motorcycle target is not "
+        "modelled; docs/protocols.md)\n"
         "Robustness layer: not assessed, 0 of its weight in every test"
     )
