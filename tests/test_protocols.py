@@ -489,3 +489,36 @@ def test_every_protocol_point_is_in_the_design_range_the_10_kmh_ones_included():
         if p.test == "CCRs" and p.ego_speed_kmh == 10.0
     ]
     assert len(ccrs_10) == 7
+
+
+@pytest.mark.sumo
+def test_an_r152_run_that_leaves_its_lane_fails(tmp_path):
+    """R152 at 50 km/h against a stopped car: the eoam system changes lanes and avoids it with
+    its warning in time; leaving its lane alone makes the row fail (para. 5.2.1.4 is a speed
+    reduction by braking demand)."""
+    out = tmp_path / "r152"
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "eoam_sumo",
+            "protocol",
+            "unr152",
+            "--out",
+            str(out),
+            "--points",
+            "^R152mstationary_v50_",
+            "--system",
+            "eoam",
+            "--no-progress",
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    row = pd.read_csv(out / "results.csv").iloc[0]
+    assert row["manoeuvre"] == "S" and row["impact_speed_kmh"] == 0.0
+    assert row["warning"] == "pass"
+    assert row["max_lateral_offset_m"] > (row["lane_width_m"] - SEDAN_WIDTH_M) / 2
+    assert row["verdict"] == "fail" and "left its lane" in row["note"]

@@ -38,10 +38,21 @@ ROW_KEYS = ["ego_speed_kmh", "target_speed_kmh", "gap_m", "target_decel_mps2"]
 REDUCTION_TESTS = ("CCFhos", "CCFhol")
 
 
+def _r152_text(r) -> str:
+    """An R152 row: the impact, B/S, the lane (left it: fails) and the warning's lead."""
+    hit = "no contact" if not r.impact_speed_kmh else f"hit at {r.impact_speed_kmh:.1f} km/h"
+    lane = ", LEFT ITS LANE" if "left its lane" in str(r.note) else ""
+    lead = "no warning" if pd.isna(r.warning_lead_s) else f"warning {r.warning_lead_s:.2f} s"
+    late = " (< 0.8 s: late)" if r.warning == "fail" else ""
+    return f"{hit} {r.manoeuvre}{lane}; {lead}{late}"
+
+
 def _cell_text(r) -> str:
     """The cell's value (impact or, head-on, reduction km/h) and B/S; '-' not run."""
     if r.status != "ok":
         return "-"
+    if str(r.test).startswith("R152"):
+        return _r152_text(r)
     reduction = r.test in REDUCTION_TESTS
     value = r.speed_reduction_kmh if reduction else r.impact_speed_kmh
     shown = "0" if pd.isna(value) else f"{value:.0f}"
@@ -54,7 +65,9 @@ def _cell_text(r) -> str:
 
 def _panel_title(test: str, own: pd.DataFrame, totals: dict) -> str:
     """The test, its points (or R152 passes) and what its cells show."""
-    shows = "speed reduction" if test in REDUCTION_TESTS else "impact speed"
+    shows = "speed reduction [km/h]" if test in REDUCTION_TESTS else "impact speed [km/h]"
+    if test.startswith("R152"):
+        shows = "impact, manoeuvre, the warning's lead over the braking"
     t = next((x for x in totals.get("tests", []) if x["test"] == test), None)
     if t is not None:
         gated = "" if totals.get("gate_passed", True) else " before the gate"
@@ -64,7 +77,7 @@ def _panel_title(test: str, own: pd.DataFrame, totals: dict) -> str:
         head = f"{test}: {passed} of {len(own)} rows pass"
     else:
         head = test
-    return f"{head}\ncells: {shows} [km/h]"
+    return f"{head}\ncells: {shows}"
 
 
 def _draw_panel(ax, test: str, own: pd.DataFrame, totals: dict) -> None:
@@ -101,8 +114,9 @@ def _row_label(row: tuple) -> str:
 CELL_TEXT = {
     "bands": "cell: impact km/h (CCFhos, CCFhol: speed reduction km/h); B braked in lane, "
     "S steered",
-    "verdicts": "cell: impact km/h; B braked in lane, S steered; W warning in time, w! late "
-    "or none",
+    "verdicts": "a row passes with its impact within R152's limit, its lane kept and the warning "
+    "at least 0.8 s before the braking (unverified: docs/protocols.md); B braked in lane, "
+    "S steered",
     "unscored": "cell: impact km/h; B braked in lane, S steered",
 }
 

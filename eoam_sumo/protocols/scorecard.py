@@ -221,8 +221,9 @@ def short_lines(rows: list[dict]) -> list[str]:
     ]
     if not bad:
         return ["No point short of full marks among those run.", ""]
+    r152 = str(bad[0]["test"]).startswith("R152")
     lines = [
-        f"## Points short of full marks ({len(bad)})",
+        f"## {'Rows that do not pass' if r152 else 'Points short of full marks'} ({len(bad)})",
         "",
         "| point | impact km/h | reduction km/h | B/S | colour / verdict | cause |",
         "|---|---|---|---|---|---|",
@@ -248,7 +249,9 @@ def picture_headline(run: RunLabel, totals: dict, rows: list[dict]) -> str:
     if run.name == PROTOCOLS[0]:
         return head + "\nunscored: the 2023 bands are not held"
     if run.name != PROTOCOLS[1]:
-        return head + "\nR152 rows: pass needs the speed limit, the lane kept and the warning"
+        return (
+            head + "\nR152 rows: pass needs the speed limit, the lane kept and the warning in time"
+        )
     gate = "passed" if totals["gate_passed"] else "FAILED: every FC point 0"
     return (
         f"{head}\noverall {totals['points']:.2f} of {totals['max_run']:.2f} for the tests run "
