@@ -344,6 +344,10 @@ def test_grids():
     )
     p2023 = protocol_points(PROTOCOLS[0], SEDAN_WIDTH_M)
     assert sum(p.test == "CCRb" for p in p2023) == 4
+    # Vector's 2023 head-on variations: both cars at 50 or 70 km/h, the target centred
+    for test in ("CCFhos", "CCFhol"):
+        head_on = [(p.ego_speed_kmh, p.offset_m) for p in p2023 if p.test == test]
+        assert head_on == [(50, 0.0), (70, 0.0)]
     r152 = protocol_points(PROTOCOLS[2], SEDAN_WIDTH_M)
     # the M1 table's 12 relative speeds against a stationary target; against a target at
     # 20 km/h those up to a subject speed of 60 km/h (para. 5.2.1.3): 10-40 km/h, 7 rows

@@ -135,7 +135,8 @@ def _ccr(
 
 
 def points_2023(width: float) -> list[TestPoint]:
-    """AEB C2C 2023 (protocol 4.3.1): CCRs, CCRm, CCRb as VECTOR encodes them."""
+    """AEB C2C 2023 (protocol 4.3.1): CCRs, CCRm, CCRb, CCFhos and CCFhol as VECTOR encodes
+    them."""
     p, overlaps = PROTOCOLS[0], (-75, -50, 50, 75, 100)
     out = [_ccr(p, "CCRs", v, 0, o, width) for v in range(10, 85, 5) for o in overlaps]
     out += [_ccr(p, "CCRm", v, 20, o, width) for v in range(30, 85, 5) for o in overlaps]
@@ -144,7 +145,7 @@ def points_2023(width: float) -> list[TestPoint]:
         for g in (12.0, 40.0)
         for d in (2.0, 6.0)
     ]
-    return out
+    return out + head_on_2023()
 
 
 IL_2026 = (-25, 0, 25, 50, 75, 100, 125)
@@ -190,22 +191,31 @@ def points_2026(width: float) -> list[TestPoint]:
     return out + head_on_2026(width) + head_on_lane_change_2026(width)
 
 
+def _head_on(protocol: str, test: str, v: float, t: float, il: float, offset_m: float) -> TestPoint:
+    """A head-on point: CCFhos 8 s of closing apart, CCFhol ``lane_change_gap_m``; 2026:
+    extended at 100 % and from 90 km/h."""
+    hol = test == "CCFhol"
+    gap = lane_change_gap_m(v, t) if hol else HEAD_ON_STARTUP_S * (v + t) / 3.6
+    return TestPoint(
+        protocol,
+        test,
+        float(v),
+        float(t),
+        float(il),
+        round(gap, 3),
+        0.0,
+        FOREVER_S,
+        round(offset_m, 4),
+        extended=protocol == PROTOCOLS[1] and (il == 100 or v >= 90),
+        head_on=True,
+        lane_change=hol,
+    )
+
+
 def head_on_2026(width: float) -> list[TestPoint]:
     """CCFhos: the target drives towards the VUT in its lane (impact locations 25-100 %)."""
     return [
-        TestPoint(
-            PROTOCOLS[1],
-            "CCFhos",
-            float(v),
-            float(t),
-            float(il),
-            round(HEAD_ON_STARTUP_S * (v + t) / 3.6, 3),
-            0.0,
-            FOREVER_S,
-            round(offset_2026_m(il, width), 4),
-            extended=il == 100 or v >= 90,
-            head_on=True,
-        )
+        _head_on(PROTOCOLS[1], "CCFhos", v, t, il, offset_2026_m(il, width))
         for v, t in CCFHOS_2026
         for il in (100, 75, 50, 25)
     ]
@@ -221,7 +231,7 @@ def lane_change_gap_m(ego_kmh: float, target_kmh: float) -> float:
     return (
         (HEAD_ON_STARTUP_S + HOL_END_TTC_S) * (ve + vt)
         + ve * duration
-        + (lane_change.path_extent_m(target_kmh))
+        + lane_change.path_extent_m(target_kmh)
     )
 
 
@@ -229,22 +239,20 @@ def head_on_lane_change_2026(width: float) -> list[TestPoint]:
     """CCFhol: the oncoming target pulls out from behind an obstruction vehicle into the VUT's
     lane, ending at the impact location's offset (CCFhos's grid: module docstring)."""
     return [
-        TestPoint(
-            PROTOCOLS[1],
-            "CCFhol",
-            float(v),
-            float(t),
-            float(il),
-            round(lane_change_gap_m(v, t), 3),
-            0.0,
-            FOREVER_S,
-            round(offset_2026_m(il, width), 4),
-            extended=il == 100 or v >= 90,
-            head_on=True,
-            lane_change=True,
-        )
+        _head_on(PROTOCOLS[1], "CCFhol", v, t, il, offset_2026_m(il, width))
         for v, t in CCFHOS_2026
         for il in (100, 75, 50, 25)
+    ]
+
+
+def head_on_2023() -> list[TestPoint]:
+    """2023 CCFhos and CCFhol (VECTOR ``NCAP_AEB_C2C_CCFho{s,l}_Variation_2023``): both cars
+    at 50 or 70 km/h, the target centred (``dt`` 0; the lane change ends on the VUT's lane
+    centre), overlap 100 %."""
+    return [
+        _head_on(PROTOCOLS[0], test, v, v, 100, 0.0)
+        for test in ("CCFhos", "CCFhol")
+        for v in (50, 70)
     ]
 
 

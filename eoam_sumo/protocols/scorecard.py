@@ -185,7 +185,7 @@ def unscored_lines(rows: list[dict]) -> list[str]:
     return [
         *lines,
         "",
-        "Not built for 2023: CCFhos, CCFhol and CCFtap (their 2023 weights are not held; "
+        "Not built for 2023: CCFtap (its 2023 weight is not held; "
         "docs/protocols.md, tests not built).",
         "",
     ]
@@ -274,7 +274,7 @@ def plot(frame: pd.DataFrame, path, run: RunLabel) -> None:
 def not_built_note(run: RunLabel) -> str:
     """The picture's list of the tests not built and their points at stake."""
     if run.name == PROTOCOLS[0]:
-        return "Not built for 2023: CCFhos, CCFhol, CCFtap (2023 weights not held)."
+        return "Not built for 2023: CCFtap (a junction test; 2023 weights not held)."
     if run.name != PROTOCOLS[1]:
         return ""
     fc = [f"{t} {rules.weight_total(t):g}" for t in scoring.NOT_BUILT]
