@@ -1,30 +1,23 @@
-"""The plan as SUMO files: vehicle types from the bounding boxes, routes along the road,
-each target's speeds as a scripted stop (``eoam.aro_hold_s``, ``eoam.aro_decel_mps2``).
+"""The plan as SUMO files: vehicle types from the bounding boxes, routes along the road.
 
 Every vehicle departs at ``DEPART_S`` (scenario time 0), its front bumper where its
-reference point plus the box's front lie (SUMO places vehicles by the front bumper). A
-target keeps its Init speed; its one speed change, if any, must be a stop (to below
-``STOP_MPS``): the scripted stop holds the speed until the change starts, then brakes at
-the action's rate (capped by the road's friction, as every scripted stop). The vehicle types
+reference point plus the box's front lie (SUMO places vehicles by the front bumper), on its
+lane's centre (the storyboard engine, :mod:`.engine`, moves the targets from the first step
+on, lateral offsets included). The vehicle types
 carry ``speedFactor=4`` so that the road's speed limits (OpenDRIVE ``<speed>``) never refuse
 a departure: the scenario, not the road, gives the speeds.
 """
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.openscenario.model import Body, Plan
 from eoam_sumo.openscenario.road import SumoLane, lane_table, locate
-from eoam_sumo.openscenario.subset import refuse
 
 DEPART_S = 1.0
-HOLD_FOREVER_S = 1.0e6
-STOP_MPS = 0.6  # a change to below this is run as a stop to standstill (2 km/h is 0.56)
-STEP_DECEL_MPS2 = 1.0e3  # a step to standstill: the scripted stop caps it at mu * g
 VCLASS = {"car": "passenger", "van": "delivery", "truck": "truck", "bus": "bus",
           "motorbike": "motorcycle", "bicycle": "bicycle"}  # fmt: skip
 # the storyboard alone moves a target across lanes: SUMO's own lane changes (strategic,
@@ -60,22 +53,6 @@ def _vtype(body: Body) -> str:
     )
 
 
-def _script(plan: Plan, name: str) -> tuple[float, float]:
-    """(hold_s, decel_mps2) of a target's scripted stop."""
-    changes = [c for c in plan.changes if c.entity == name]
-    if not changes:
-        if plan.speeds_mps.get(name, 0.0) == 0.0:
-            return 0.0, STEP_DECEL_MPS2
-        return HOLD_FOREVER_S, STEP_DECEL_MPS2
-    change = changes[0]
-    if change.target_mps >= STOP_MPS:
-        raise refuse(change.node, f"{name}: only a stop (to < {STOP_MPS} m/s) is supported")
-    if change.target_mps > 0.0:
-        plan.notes.append(f"{name} stops to standstill, not to {change.target_mps:.2f} m/s")
-    rate = STEP_DECEL_MPS2 if math.isinf(change.rate_mps2) else change.rate_mps2
-    return change.start_s, rate
-
-
 def _route(net, lane: SumoLane) -> list[str]:
     """The lane's edge and its successors (first outgoing edge each), up to 50 edges."""
     edges = [lane.edge]
@@ -95,19 +72,12 @@ def _vehicle(plan: Plan, name: str, table: dict, net) -> str:
     front = pos + body.front_ahead_m
     speed = plan.speeds_mps.get(name, 0.0)
     vid = "ego" if name == plan.ego else name
-    params = ""
-    if name != plan.ego:
-        hold, decel = _script(plan, name)
-        params = (
-            f'\n        <param key="eoam.aro_hold_s" value="{hold:g}"/>'
-            f'\n        <param key="eoam.aro_decel_mps2" value="{decel:g}"/>\n    '
-        )
     vtype = "ego" if name == plan.ego else f"t_{name}"
     return (
         f'    <route id="r_{vid}" edges="{" ".join(_route(net, lane))}"/>\n'
         f'    <vehicle id={quoteattr(vid)} type={quoteattr(vtype)} route="r_{vid}" '
         f'depart="{DEPART_S:.2f}" departLane="{lane.index}" departPos="{front:.3f}" '
-        f'departSpeed="{speed:.6f}" insertionChecks="none">{params}</vehicle>'
+        f'departSpeed="{speed:.6f}" insertionChecks="none"/>'
     )
 
 
@@ -117,9 +87,6 @@ def write_sumo(plan: Plan, net_file: Path, xodr: Path, folder: Path, source: Pat
 
     from eoam_sumo import __version__
 
-    for change in plan.changes:
-        if change.entity == plan.ego:
-            raise refuse(change.node, "the ego's speed is the controller's: not scripted")
     folder.mkdir(parents=True, exist_ok=True)
     table = lane_table(net_file, xodr)
     net = sumolib.net.readNet(str(net_file))

@@ -61,6 +61,7 @@ from eoam_sumo.sim.session.launch import (
     sumo_command,
     traci_connect,
 )
+from eoam_sumo.sim.session.puppets import Puppets
 from eoam_sumo.sim.session.scripts import StopScripts
 from eoam_sumo.sim.session.tracking import RoadUsers
 from eoam_sumo.world.bodies import PEDESTRIAN, Body
@@ -540,6 +541,11 @@ class SumoSession:
         calls = self._calls
         calls.move_to_xy(self.ego_id, "", -1, x_front_m, y_front_m, angle_nav_deg, 2)
         calls.set_speed(self.ego_id, speed_mps)
+
+    def puppets(self) -> Puppets:
+        """The road users an outside storyboard moves (OpenSCENARIO), and the ego's lane."""
+        self._check_open()
+        return Puppets(self._api, self._calls, self.ego_id)
 
     def size_ego(self, length_m: float, width_m: float, mass_kg: float) -> None:
         """Tell SUMO the ego's length, width and mass (its vehicle's, where they differ from
