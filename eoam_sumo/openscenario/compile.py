@@ -45,7 +45,6 @@ def compile_plan(scenario: Scenario, ego: str | None = None) -> Plan:
     controlled = _time_events(plan, clock, events)
     plan.ego = _choose_ego(plan, controlled, ego, scenario.root)
     _check_ego_actions(plan.ego, events)
-    _end(plan, clock, board.find("StopTrigger"))
     missing = sorted(set(bodies) - set(plan.places))
     if missing:
         raise InputError(f"{scenario.path}: entity {missing[0]} is never placed (no Init)")
@@ -275,19 +274,3 @@ def _check_ego_actions(ego: str, events: list[_Event]) -> None:
                 "TeleportAction",
             ):
                 raise refuse(inner, f"the ego {ego} is driven by the EOAM, not by the storyboard")
-
-
-def _end(plan: Plan, clock: Clock, stop: Node | None) -> None:
-    """The run's end from a stop trigger timed before the run; else the run's own criteria."""
-    if stop is None or not stop.children:
-        return
-    static = []
-    for group in stop.findall("ConditionGroup"):
-        try:
-            t = clock.trigger_time(Node("StopTrigger", {}, group.file, group.line, [group]), 0)
-        except NotYet:
-            t = DYNAMIC
-        if t != DYNAMIC:
-            static.append(float(t))
-    if static and min(static) < NEVER:
-        plan.end_s = min(static)

@@ -48,5 +48,4 @@ class Plan:
     ego: str
     places: dict[str, Place]
     speeds_mps: dict[str, float]
-    end_s: float | None = None
     notes: list[str] = field(default_factory=list)

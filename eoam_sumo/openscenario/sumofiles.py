@@ -101,7 +101,7 @@ def write_sumo(plan: Plan, net_file: Path, xodr: Path, folder: Path, source: Pat
     write_atomic(
         folder / "scenario.rou.xml", head + "<routes>\n" + "\n".join(vehicles) + "\n</routes>\n"
     )
-    end = 600.0 if plan.end_s is None else DEPART_S + plan.end_s
+    end = 3600.0  # the run ends by the storyboard, its own criteria or --max-time-s
     cfg = SUMOCFG.format(
         source=source.name, version=__version__, net=quoteattr(str(net_file)), end=end
     )
