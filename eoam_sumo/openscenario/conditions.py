@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 import operator
 from collections.abc import Callable
+from typing import Any
 
 from eoam_sumo.openscenario.actors import Actor, euclid, lateral_gap_m, longitudinal_gap_m
 from eoam_sumo.openscenario.subset import refuse
@@ -115,7 +116,7 @@ def _relative_speed(node: Node, world, me: Actor) -> bool:
     return compare(node, me.speed_mps - world.actors[node.need("entityRef")].speed_mps)
 
 
-ENTITY: dict[str, Callable[[Node, object, Actor], bool]] = {
+ENTITY: dict[str, Callable[[Node, Any, Actor], bool]] = {
     "RelativeDistanceCondition": _relative_distance,
     "TimeHeadwayCondition": _headway,
     "TimeToCollisionCondition": _ttc,

@@ -72,7 +72,7 @@ class SpeedMotion:
                 math.inf if self.value == 0 else delta * PEAK_SLOPE[self.shape] / abs(self.value)
             )
         elif self.shape != "step":
-            raise refuse(self.dyn, f"dynamicsDimension={self.dim} is not supported for a speed")
+            raise refuse(self.node, f"dynamicsDimension={self.dim} is not supported for a speed")
 
     def step(self, world, actor: Actor, dt_s: float) -> bool:
         if self.continuous:
