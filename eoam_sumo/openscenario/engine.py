@@ -130,10 +130,14 @@ class Storyboard(StepObserver):
         self.world.ego_xy = (float(x[0]), float(x[1]))
 
     def _place(self, actor: Actor) -> None:
-        x, y, heading = self.world.lanes.point(
-            actor.road, actor.lane, actor.front_s_m(), actor.offset_m
-        )
-        drive = heading if actor.direction > 0 else heading + math.pi
+        """The front bumper where the actor's lane position puts it, heading along the chord
+        from its rear to its front (as SUMO draws a vehicle on a curve: a long truck's rear
+        does not swing out of its lane) turned by its lateral speed."""
+        lanes, front = self.world.lanes, actor.front_s_m()
+        x, y, _ = lanes.point(actor.road, actor.lane, front, actor.offset_m)
+        rear = front - actor.direction * actor.body.length_m
+        xr, yr, _ = lanes.point(actor.road, actor.lane, rear, actor.offset_m)
+        drive = math.atan2(y - yr, x - xr)
         yaw = drive + math.atan2(actor.lat_speed_mps * actor.direction, max(actor.speed_mps, 0.1))
         self.puppets.place(actor.name, x, y, (90.0 - math.degrees(yaw)) % 360.0, actor.speed_mps)
 

@@ -58,7 +58,13 @@ class LaneMap:
         return (road, lane) in self.table
 
     def locate(self, road: str, lane: int, s_m: float) -> tuple[str, float]:
-        """(SUMO lane id, position along it) of the lane's centre at ``s_m``."""
+        """(SUMO lane id, position along it) of the lane's centre at ``s_m`` (clamped to the
+        lane's ends: an entity driven past the end of the road stays at it)."""
+        lanes = self.table[(road, lane)]
+        ends = [sl.start_s_m for sl in lanes] + [
+            sl.start_s_m + sl.length_m / sl.scale for sl in lanes
+        ]
+        s_m = min(max(s_m, min(ends)), max(ends))
         sl, pos = locate(self.table, road, lane, s_m, f"road {road} lane {lane}")
         return f"{sl.edge}_{sl.index}", pos
 

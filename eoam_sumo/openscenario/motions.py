@@ -106,6 +106,8 @@ class LateralMotion:
             actor.odometer_m,
         )
         self.lane1, offset1 = self._goal(world, actor)
+        if not lanes.has(actor.road, self.lane1):  # no such lane: the actor keeps its own
+            self.lane1 = self.lane0
         shift = lanes.shift_m(actor.road, self.lane0, self.lane1, actor.s_m) * actor.direction
         self.delta = shift + offset1 - self.o0
         self.offset1 = offset1

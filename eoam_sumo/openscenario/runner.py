@@ -51,7 +51,7 @@ def load(xosc: Path, params: dict[str, str], ego: str | None = None) -> Loaded:
 
 def write_scenario(loaded: Loaded, folder: Path) -> Path:
     """The SUMO files of ``loaded`` in ``folder``; the .sumocfg."""
-    return write_sumo(loaded.plan, loaded.net, loaded.scenario.road, folder, loaded.scenario.path)
+    return write_sumo(loaded.plan, loaded.net, loaded.lanes, folder, loaded.scenario.path)
 
 
 def run_loaded(

@@ -14,8 +14,9 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 from eoam_sumo.fileio import write_atomic
+from eoam_sumo.openscenario.geometry import LaneMap
 from eoam_sumo.openscenario.model import Body, Plan
-from eoam_sumo.openscenario.road import SumoLane, lane_table, locate
+from eoam_sumo.openscenario.road import SumoLane, locate
 
 DEPART_S = 1.0
 VCLASS = {"car": "passenger", "van": "delivery", "truck": "truck", "bus": "bus",
@@ -66,9 +67,23 @@ def _route(net, lane: SumoLane) -> list[str]:
     return edges
 
 
-def _vehicle(plan: Plan, name: str, table: dict, net) -> str:
+def _nearest_lane(lanes: LaneMap, place) -> int:
+    """The lane whose centre is nearest the place's lateral offset (the departure lane: the
+    storyboard engine puts the entity at its exact offset from the first step on)."""
+    if abs(place.offset_m) < 1e-9:
+        return place.lane
+    side = [k for r, k in lanes.table if r == place.road and (k < 0) == (place.lane < 0)]
+
+    def miss(k: int) -> float:
+        return abs(lanes.shift_m(place.road, place.lane, k, place.s_m) - place.offset_m)
+
+    return min(side, key=miss)
+
+
+def _vehicle(plan: Plan, name: str, lanes: LaneMap, net) -> str:
     place, body = plan.places[name], plan.bodies[name]
-    lane, pos = locate(table, place.road, place.lane, place.s_m, place.node.where())
+    lane_id = _nearest_lane(lanes, place)
+    lane, pos = locate(lanes.table, place.road, lane_id, place.s_m, place.node.where())
     front = pos + body.front_ahead_m
     speed = plan.speeds_mps.get(name, 0.0)
     vid = "ego" if name == plan.ego else name
@@ -81,14 +96,13 @@ def _vehicle(plan: Plan, name: str, table: dict, net) -> str:
     )
 
 
-def write_sumo(plan: Plan, net_file: Path, xodr: Path, folder: Path, source: Path) -> Path:
+def write_sumo(plan: Plan, net_file: Path, lanes: LaneMap, folder: Path, source: Path) -> Path:
     """Write the scenario's SUMO files into ``folder``; the .sumocfg."""
     import sumolib
 
     from eoam_sumo import __version__
 
     folder.mkdir(parents=True, exist_ok=True)
-    table = lane_table(net_file, xodr)
     net = sumolib.net.readNet(str(net_file))
     others = [n for n in plan.bodies if n != plan.ego]
     vtypes = [EGO_VTYPE] + [_vtype(plan.bodies[n]) for n in others]
@@ -97,7 +111,7 @@ def write_sumo(plan: Plan, net_file: Path, xodr: Path, folder: Path, source: Pat
         folder / "scenario_vtypes.add.xml",
         head + "<additional>\n    " + "\n    ".join(vtypes) + "\n</additional>\n",
     )
-    vehicles = [_vehicle(plan, n, table, net) for n in [plan.ego, *others]]
+    vehicles = [_vehicle(plan, n, lanes, net) for n in [plan.ego, *others]]
     write_atomic(
         folder / "scenario.rou.xml", head + "<routes>\n" + "\n".join(vehicles) + "\n</routes>\n"
     )
