@@ -130,16 +130,20 @@ class Storyboard(StepObserver):
         self.world.ego_xy = (float(x[0]), float(x[1]))
 
     def _place(self, actor: Actor) -> None:
-        """The front bumper where the actor's lane position puts it, heading along the chord
-        from its rear to its front (as SUMO draws a vehicle on a curve: a long truck's rear
-        does not swing out of its lane) turned by its lateral speed."""
-        lanes, front = self.world.lanes, actor.front_s_m()
-        x, y, _ = lanes.point(actor.road, actor.lane, front, actor.offset_m)
-        rear = front - actor.direction * actor.body.length_m
-        xr, yr, _ = lanes.point(actor.road, actor.lane, rear, actor.offset_m)
-        drive = math.atan2(y - yr, x - xr)
-        yaw = drive + math.atan2(actor.lat_speed_mps * actor.direction, max(actor.speed_mps, 0.1))
-        self.puppets.place(actor.name, x, y, (90.0 - math.degrees(yaw)) % 360.0, actor.speed_mps)
+        """The actor's reference point where its lane position puts it, its heading along
+        the chord from its rear to its front on the lane (as SUMO draws a vehicle on a curve:
+        a long truck's rear does not swing out of its lane) turned by its lateral speed, and
+        its front bumper ahead of the reference point along that heading."""
+        lanes, body, d = self.world.lanes, actor.body, actor.direction
+        x, y, _ = lanes.point(actor.road, actor.lane, actor.s_m, actor.offset_m)
+        xf, yf, _ = lanes.point(actor.road, actor.lane, actor.front_s_m(), actor.offset_m)
+        xr, yr, _ = lanes.point(actor.road, actor.lane, actor.rear_s_m(), actor.offset_m)
+        yaw = math.atan2(yf - yr, xf - xr)
+        yaw += math.atan2(actor.lat_speed_mps * d, max(actor.speed_mps, 0.1))
+        front_x = x + body.front_ahead_m * math.cos(yaw)
+        front_y = y + body.front_ahead_m * math.sin(yaw)
+        nav = (90.0 - math.degrees(yaw)) % 360.0
+        self.puppets.place(actor.name, front_x, front_y, nav, actor.speed_mps)
 
     # ------------------------------------------------------------------ the state machines
     def _step_element(self, el: Element) -> None:

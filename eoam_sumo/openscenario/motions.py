@@ -16,6 +16,9 @@ from eoam_sumo.openscenario.subset import refuse
 from eoam_sumo.openscenario.xmltree import Node
 from eoam_sumo.params import G_MPS2
 
+# a speed below this is a stop to standstill (Vector's CCRb brakes its target "to 2 km/h",
+# 0.56 m/s, where Euro NCAP's protocol stops it: the protocol's own points stop it too)
+STOP_MPS = 0.6
 # peak slope of each shape over tau in [0, 1] (for a rate: the duration |delta| * peak / rate)
 PEAK_SLOPE = {"linear": 1.0, "cubic": 1.5, "sinusoidal": math.pi / 2}
 # peak second derivative (for a lateral acceleration limit: T = sqrt(|delta| * peak / a))
@@ -53,7 +56,8 @@ class SpeedMotion:
     def _target_mps(self, world) -> float:
         t = self.target
         if t.tag == "AbsoluteTargetSpeed":
-            return t.num("value")
+            value = t.num("value")
+            return 0.0 if value < STOP_MPS else value
         ref = world.actors[t.need("entityRef")].speed_mps
         if t.get("speedTargetValueType", "delta") == "factor":
             return ref * t.num("value")
