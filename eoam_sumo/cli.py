@@ -488,6 +488,10 @@ def _cmd_xosc_batch(args) -> int:
     from eoam_sumo.openscenario.variations import load_batch
     from eoam_sumo.outputs.staging import OutputKind, output_folder
 
+    for flag, given in (("--scheduler", args.scheduler), ("--resume", args.resume),
+                        ("--after-stop-s", args.after_stop_s is not None)):  # fmt: skip
+        if given:
+            raise InputError(f"{flag} does not apply to a batch over an .xosc")
     batch = load_batch(args.matrix)
     check_cases(batch)  # refusals before anything is written
     with output_folder(args.out, OutputKind("xosc batch", (RESULTS, CASES))) as out:

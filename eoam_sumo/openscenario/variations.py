@@ -101,9 +101,10 @@ def _distribution_cases(
     root = parse(path)
     dist = root.find("ParameterValueDistribution")
     scen = None if dist is None else dist.find("ScenarioFile")
-    if dist is None or scen is None:
-        raise InputError(f"{path}: not a parameter variation file (no ParameterValueDistribution "
-                         "with a ScenarioFile); give it to `run`")  # fmt: skip
+    if dist is None:  # a scenario: one case, its declared values
+        return path.resolve(), [{}]
+    if scen is None:
+        raise InputError(f"{dist.where()}: no <ScenarioFile>")
     det = dist.find("Deterministic")
     if det is None:
         other = next(c for c in dist.children if c.tag != "ScenarioFile")

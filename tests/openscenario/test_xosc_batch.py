@@ -94,3 +94,14 @@ def test_batch_runs_each_case_into_its_folder(
     ]
     assert {r["collision_with"] for r in rows} == {"none"}
     assert all((out / "cases" / r["case_id"] / "summary.json").is_file() for r in rows)
+
+
+def test_a_scenario_file_is_one_case_and_foreign_options_are_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    batch = load_batch(CUT_IN)
+    assert (batch.scenario, batch.cases, batch.left_out) == (CUT_IN.resolve(), [{}], 0)
+    for flag in (["--resume"], ["--scheduler", "local"], ["--after-stop-s", "1"]):
+        assert main(["batch", str(CUT_IN), *flag, "--out", str(tmp_path / "o")]) == 2
+        assert f"{flag[0]} does not apply to a batch over an .xosc" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
