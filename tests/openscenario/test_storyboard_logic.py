@@ -3,7 +3,9 @@ delay (OpenSCENARIO 1.2 sec. 7.4.1), the dynamics shapes, the gaps between entit
 
 from __future__ import annotations
 
+import itertools
 import math
+import tempfile
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -11,9 +13,9 @@ import pytest
 
 from eoam_sumo.openscenario.actors import Actor, lane_plus, longitudinal_gap_m
 from eoam_sumo.openscenario.model import Body
-from eoam_sumo.openscenario.motions import shape_fraction
+from eoam_sumo.openscenario.motions import LateralMotion, shape_fraction
 from eoam_sumo.openscenario.story import Condition
-from eoam_sumo.openscenario.xmltree import Node
+from eoam_sumo.openscenario.xmltree import Node, parse
 
 
 def _time_condition(edge: str, delay: float, value: float) -> Condition:
@@ -78,3 +80,64 @@ def test_lane_ids_skip_zero() -> None:
         -3,
         -5,
     )
+
+
+class _Lanes:
+    """Two straight lanes 3.5 m apart (lane -1 left of lane -2), any friction 1."""
+
+    def shift_m(self, road: str, lane_from: int, lane_to: int, s_m: float) -> float:
+        return 3.5 * (lane_to - lane_from)
+
+    def has(self, road: str, lane: int) -> bool:
+        return lane in (-1, -2)
+
+
+def _xml(text: str) -> Node:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "a.xml"
+        path.write_text(text, encoding="utf-8")
+        return parse(path)
+
+
+def _step_through(motion, actor: Actor, world, until_s: float) -> list[tuple[float, float]]:
+    motion.start(world, actor)
+    out, done = [], False
+    while not done and world.time_s < until_s:
+        done = motion.step(world, actor, 0.01)
+        actor.advance(actor.speed_mps, 0.01)
+        world.time_s = round(world.time_s + 0.01, 10)
+        out.append((world.time_s, actor.offset_m))
+    return out
+
+
+def test_a_sinusoidal_lane_change_by_rate_peaks_at_that_lateral_speed() -> None:
+    """OpenSCENARIO rate = the peak lateral speed: 3.5 m at 2 m/s peak takes pi 3.5 / 4 s."""
+    node = _xml(
+        '<LaneChangeAction><LaneChangeActionDynamics dynamicsShape="sinusoidal" value="2" '
+        'dynamicsDimension="rate"/><LaneChangeTarget><AbsoluteTargetLane value="-1"/>'
+        "</LaneChangeTarget></LaneChangeAction>"
+    )
+    actor = Actor("c", Body("c", 4.0, 1.8, 1.5, "car"), "0", -2, 0.0, 0.0, 10.0)
+    world = SimpleNamespace(time_s=0.0, lanes=_Lanes(), actors={})
+    path = _step_through(LateralMotion(node), actor, world, 10.0)
+    assert path[-1][0] == pytest.approx(math.pi * 3.5 / 4, abs=0.011)
+    assert (actor.lane, actor.offset_m) == (-1, 0.0)
+    speeds = [(b[1] - a[1]) / 0.01 for a, b in itertools.pairwise(path[:-1])]  # then lane -1
+    assert max(speeds) == pytest.approx(2.0, abs=0.01)
+
+
+def test_a_lane_offset_respects_its_lateral_acceleration() -> None:
+    """A cubic offset of 1 m at most 0.5 m/s^2: T = sqrt(6 x 1 / 0.5) = 3.46 s."""
+    node = _xml(
+        '<LaneOffsetAction continuous="false"><LaneOffsetActionDynamics maxLateralAcc="0.5" '
+        'dynamicsShape="cubic"/><LaneOffsetTarget><AbsoluteTargetLaneOffset value="-1"/>'
+        "</LaneOffsetTarget></LaneOffsetAction>"
+    )
+    actor = Actor("c", Body("c", 4.0, 1.8, 1.5, "car"), "0", -2, 0.0, 0.0, 10.0)
+    world = SimpleNamespace(time_s=0.0, lanes=_Lanes(), actors={})
+    path = _step_through(LateralMotion(node), actor, world, 10.0)
+    assert path[-1][0] == pytest.approx(math.sqrt(12.0), abs=0.011)
+    assert actor.offset_m == pytest.approx(-1.0) and actor.lane == -2
+    ys = [y for _, y in path]
+    acc = [(ys[k + 1] - 2 * ys[k] + ys[k - 1]) / 1e-4 for k in range(1, len(ys) - 1)]
+    assert max(abs(a) for a in acc) <= 0.5 * 1.01
