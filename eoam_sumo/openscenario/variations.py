@@ -21,6 +21,8 @@ from eoam_sumo.openscenario.conditions import RULES
 from eoam_sumo.openscenario.expressions import ExpressionError, format_value, substitute
 from eoam_sumo.openscenario.reader import declared_values
 from eoam_sumo.openscenario.xmltree import Node, parse
+from eoam_sumo.params import MU_MAX
+from eoam_sumo.sim.settings import MAX_TIME_LIMIT_S
 
 MAX_CASES = 100_000
 SCENARIO_KEYS = ("xosc", "system", "mu", "max_time_s")
@@ -45,7 +47,7 @@ def is_xosc_batch(path: Path) -> bool:
     try:
         with Path(path).open("rb") as fh:
             doc = tomllib.load(fh)
-    except (OSError, tomllib.TOMLDecodeError):
+    except (OSError, ValueError):  # malformed TOML, not UTF-8
         return False  # the matrix reader says what is wrong with it
     return isinstance(doc.get("scenario"), dict) and "xosc" in doc["scenario"]
 
@@ -64,6 +66,8 @@ def load_batch(path: Path) -> XoscBatch:
         raise InputError(f"{path}: unknown key {unknown[0]!r} (an .xosc matrix takes [scenario] "
                          f"{', '.join(SCENARIO_KEYS)} and [sweep] of its parameters)")  # fmt: skip
     sweep = doc.get("sweep", {})
+    if not isinstance(sweep, dict):
+        raise InputError(f"{path}: [sweep] must be a table of parameter = [values]")
     for name, values in sweep.items():
         if not isinstance(values, list) or not values:
             raise InputError(f"{path}: [sweep] {name} must be a non-empty list")
@@ -81,8 +85,11 @@ def load_batch(path: Path) -> XoscBatch:
     system = str(scen.get("system", "eoam"))
     if system not in ("eoam", "aeb"):
         raise InputError(f"{path}: [scenario] system {system!r} must be eoam or aeb")
-    mu = scen.get("mu")
-    max_time = scen.get("max_time_s")
+    mu, max_time = scen.get("mu"), scen.get("max_time_s")
+    for key, value, top in (("mu", mu, MU_MAX), ("max_time_s", max_time, MAX_TIME_LIMIT_S)):
+        ok = isinstance(value, int | float) and not isinstance(value, bool) and 0 < value <= top
+        if value is not None and not ok:
+            raise InputError(f"{path}: [scenario] {key} = {value!r} must be in (0, {top:g}]")
     return _kept(XoscBatch(xosc, combos, 0, system, mu, max_time))
 
 

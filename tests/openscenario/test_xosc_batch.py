@@ -105,3 +105,15 @@ def test_a_scenario_file_is_one_case_and_foreign_options_are_refused(
         assert main(["batch", str(CUT_IN), *flag, "--out", str(tmp_path / "o")]) == 2
         assert f"{flag[0]} does not apply to a batch over an .xosc" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize(
+    ("extra", "needle"),
+    [("mu = 2.0\n", "mu = 2.0 must be in (0, 1.2]"), ("max_time_s = -1\n", "max_time_s = -1")],
+)
+def test_a_matrix_value_out_of_range_is_refused(tmp_path: Path, extra: str, needle: str) -> None:
+    matrix = tmp_path / "m.toml"
+    matrix.write_text(f'[scenario]\nxosc = "{CUT_IN}"\n{extra}', encoding="utf-8")
+    with pytest.raises(InputError) as err:
+        load_batch(matrix)
+    assert needle in str(err.value)
