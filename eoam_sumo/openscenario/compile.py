@@ -45,6 +45,7 @@ def compile_plan(scenario: Scenario, ego: str | None = None) -> Plan:
     controlled = _time_events(plan, clock, events)
     plan.ego = _choose_ego(plan, controlled, ego, scenario.root)
     _check_ego_actions(plan.ego, events)
+    plan.notes += _not_applied(board)
     missing = sorted(set(bodies) - set(plan.places))
     if missing:
         raise InputError(f"{scenario.path}: entity {missing[0]} is never placed (no Init)")
@@ -258,6 +259,20 @@ def _choose_ego(plan: Plan, controlled: set[str], ego: str | None, root: Node) -
         plan.notes.append(f"no entity is handed to a controller: the ego is {named[0]}")
         return named[0]
     raise InputError(f"{root.file}: cannot tell the ego (name it with --ego)")
+
+
+def _not_applied(board: Node) -> list[str]:
+    """What is read but not applied, one note each (said on stderr: nothing dropped silently)."""
+    notes = []
+    for node in board.iter():
+        if node.tag == "EnvironmentAction":
+            notes.append(
+                f"EnvironmentAction at line {node.line} not applied (friction: the road's, --mu)"
+            )
+        if node.tag == "ManeuverGroup" and node.num("maximumExecutionCount", 1.0) > 1:
+            times = node.get("maximumExecutionCount")
+            notes.append(f"ManeuverGroup {node.get('name')} runs once, not {times} times")
+    return notes
 
 
 def _check_ego_actions(ego: str, events: list[_Event]) -> None:
