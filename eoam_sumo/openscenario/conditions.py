@@ -55,8 +55,9 @@ def by_value(node: Node, world) -> bool:
     raise refuse(node, f"{tag} is not supported at run time")
 
 
-def by_entity(cond: Node, world) -> bool:
-    """A ``ByEntityCondition`` now: its condition for each triggering entity, any or all."""
+def by_entity(cond: Node) -> Callable[[Any], bool]:
+    """A ``ByEntityCondition`` as a function of the world: its condition for each triggering
+    entity, any or all (the nodes looked up once, not at every step)."""
     trig = cond.find("TriggeringEntities")
     inner = cond.find("EntityCondition").children[0]  # type: ignore[union-attr]
     assert trig is not None
@@ -64,8 +65,12 @@ def by_entity(cond: Node, world) -> bool:
     check = ENTITY.get(inner.tag)
     if check is None:
         raise refuse(inner, f"{inner.tag} is not supported at run time")
-    results = [check(inner, world, world.actors[n]) for n in names]
-    return any(results) if trig.get("triggeringEntitiesRule", "any") == "any" else all(results)
+    combine = any if trig.get("triggeringEntitiesRule", "any") == "any" else all
+
+    def holds(world) -> bool:
+        return combine([check(inner, world, world.actors[n]) for n in names])
+
+    return holds
 
 
 def _free(node: Node) -> bool:

@@ -150,8 +150,8 @@ class Storyboard(StepObserver):
         """Start ``el`` when its trigger fires, stop it when its stop trigger does, then its
         children (an element with no start trigger starts with its parent)."""
         world = self.world
-        fired = el.start.fired(world) if el.start is not None else True
-        if el.state == STANDBY and fired:
+        standby = el.state == STANDBY  # a start trigger is evaluated while it can fire
+        if standby and (el.start is None or el.start.fired(world)):
             if el.kind == "Event":
                 self._start_event(el)
             else:

@@ -29,14 +29,15 @@ class Condition:
         self.delay_s = node.num("delay", 0.0)
         self._last: bool | None = None
         self._seen: deque[tuple[float, bool]] = deque()
+        inner = self.inner
+        if inner.tag == "ByValueCondition":
+            value = inner.children[0]
+            self._holds = lambda world: by_value(value, world)
+        else:
+            self._holds = by_entity(inner)
 
     def value(self, world) -> bool:
-        inner = self.inner
-        raw = (
-            by_value(inner.children[0], world)
-            if inner.tag == "ByValueCondition"
-            else by_entity(inner, world)
-        )
+        raw = self._holds(world)
         last, self._last = self._last, raw
         if self.edge == "none":
             edged = raw
