@@ -133,3 +133,21 @@ def test_a_variation_with_many_values_needs_them_picked() -> None:
     assert plan.speeds_mps == pytest.approx({"Ego": 30 / 3.6, "Target": 0.0})
     # the target 5 s at 30 km/h ahead (Ego_initTimeHeadway, reference points) of s = 50 m
     assert plan.places["Target"].s_m == pytest.approx(50 + 5 * 30 / 3.6)
+
+
+@pytest.mark.parametrize(
+    ("name", "target", "lane", "speed_kmh"),
+    [
+        ("alks_scenario_4_4_1_cut_in_no_collision_template.xosc", "CutInVehicle", -5, 40.0),
+        ("alks_scenario_4_1_2_swerving_lead_vehicle_template.xosc", "LeadVehicle", -4, 60.0),
+    ],
+)
+def test_run_time_storyboards_compile_with_their_departures(
+    name: str, target: str, lane: int, speed_kmh: float
+) -> None:
+    """Refused before the storyboard engine: a dLane, a RelativeTargetSpeed, a start on a
+    distance, a LaneChangeAction or LaneOffsetAction. Now the departures come from Init
+    (4.4_1: one lane right of the ego at the ego's speed - 20 km/h)."""
+    plan = compile_plan(read_scenario(ALKS / name))
+    assert plan.places[target].lane == lane
+    assert plan.speeds_mps[target] == pytest.approx(speed_kmh / 3.6)
