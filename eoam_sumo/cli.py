@@ -245,7 +245,9 @@ def _batch_arguments(sub) -> None:
         "failed count is the last line on stderr); 2 bad input, found before any case runs "
         "(the matrix, its scenario files, a speed or friction outside the lookup tables).",
     )
-    p.add_argument("matrix", type=Path, help="experiment matrix (.toml)")
+    p.add_argument(
+        "matrix", type=Path, help="experiment matrix (.toml), or an .xosc parameter variation file"
+    )
     p.add_argument("--out", type=Path, default=Path("out/batch"), help="output folder")
     p.add_argument("--jobs", type=_positive_int, default=1, help="parallel processes")
     p.add_argument("--scheduler", help="Dask scheduler address, or 'local' for a LocalCluster")
@@ -457,9 +459,12 @@ def _cmd_batch(args) -> int:
     status 2 in :func:`main`).
     """
     from eoam_sumo.batch.runner import check_options, plan_batch, run_batch
+    from eoam_sumo.openscenario.variations import is_xosc_batch
     from eoam_sumo.outputs.staging import output_folder
 
     check_options(args.jobs, args.timeout_s, args.timeseries)
+    if is_xosc_batch(args.matrix):
+        return _cmd_xosc_batch(args)
     plan = plan_batch(args.matrix, after_stop_s=args.after_stop_s)
     with (
         _sigterm_interrupts(),
@@ -482,6 +487,34 @@ def _cmd_batch(args) -> int:
 
         plot_batch_report(results, out)
     return _batch_status(results, Path(args.out))
+
+
+def _cmd_xosc_batch(args) -> int:
+    """``batch`` over an .xosc's variations (docs/openscenario.md): every case checked, then
+    run; counts per outcome on stdout; status 1 when a case failed."""
+    from eoam_sumo.openscenario.batch import CASES, RESULTS, check_cases, run_batch
+    from eoam_sumo.openscenario.variations import load_batch
+    from eoam_sumo.outputs.staging import OutputKind, output_folder
+
+    for flag, given in (("--scheduler", args.scheduler), ("--resume", args.resume),
+                        ("--after-stop-s", args.after_stop_s is not None)):  # fmt: skip
+        if given:
+            raise InputError(f"{flag} does not apply to a batch over an .xosc")
+    batch = load_batch(args.matrix)
+    check_cases(batch)  # refusals before anything is written
+    with output_folder(args.out, OutputKind("xosc batch", (RESULTS, CASES))) as out:
+        rows = run_batch(batch, out, args.jobs, args.timeout_s, args.timeseries, None)
+    counts: dict[str, int] = {}
+    for row in rows:
+        key = row.get("outcome") or row["status"]
+        counts[key] = counts.get(key, 0) + 1
+    text = ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
+    print(f"{len(rows)} cases ({batch.left_out} outside the parameter constraints left out): "
+          f"{text}; {Path(args.out) / RESULTS}")  # fmt: skip
+    failed = [r for r in rows if r["status"] != "ok"]
+    for row in failed:
+        print(f"eoam-sumo: {row['case_id']} failed: {row['error']}", file=sys.stderr)
+    return 1 if failed else 0
 
 
 def _batch_output():

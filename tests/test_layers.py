@@ -110,7 +110,7 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
     ),
     "traffic_scenario": (set(), {"sumolib"}),
     "netbuild": ({"errors"}, {"sumolib", "sumo"}),
-    "openscenario": ({"errors", "fileio", "netbuild", "sim"}, {"sumolib"}),
+    "openscenario": ({"params", "errors", "fileio", "netbuild", "sim", "batch"}, {"sumolib"}),
     "traffic_levels": ({"errors", "seeds", "netbuild", "outputs"}, {"numpy", "libsumo"}),
     "bench": (
         {"params", "errors", "plant", "offline", "sensing", "sim", "batch", "traffic_scenario"},

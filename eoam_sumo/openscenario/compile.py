@@ -1,19 +1,20 @@
-"""A resolved scenario's storyboard as a plan: who is where, which speeds when, when it ends.
+"""A resolved scenario's start: who is where at what speed, the ego, a stop time if fixed.
 
 Init places each entity (``LanePosition``, ``RelativeLanePosition``, a non-continuous
-``LongitudinalDistanceAction``) and sets its speed (a step ``SpeedAction``). Each story event
-is timed before the run (:mod:`.timing`); its actions become speed changes (``SpeedAction``),
-placements at the start, or the ego's controller (``ActivateControllerAction``). Events whose
-start depends on the run and that only set variables (logging) are left out with a note.
+``LongitudinalDistanceAction``) and sets its speed (a step ``SpeedAction`` to an absolute or
+relative target). Story events whose start is known before the run (:mod:`.timing`) and
+falls at time 0 may place entities too (Vector's NCAP files do): their placements are the
+SUMO departures. Everything after the start, and every start that depends on the run, is the
+storyboard engine's (:mod:`.engine`), which runs all events again during the simulation.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from eoam_sumo.errors import InputError
-from eoam_sumo.openscenario.model import Body, Place, Plan, SpeedChange
+from eoam_sumo.openscenario.actors import lane_plus
+from eoam_sumo.openscenario.model import Body, Place, Plan
 from eoam_sumo.openscenario.reader import Scenario
 from eoam_sumo.openscenario.subset import refuse
 from eoam_sumo.openscenario.timing import DYNAMIC, NEVER, Clock, NotYet
@@ -40,9 +41,11 @@ def compile_plan(scenario: Scenario, ego: str | None = None) -> Plan:
     for private in [] if init is None else _privates(init):
         _init_private(plan, private)
     clock = Clock(scenario.parameters)
-    controlled = _time_events(plan, clock, _events(board))
+    events = _events(board)
+    controlled = _time_events(plan, clock, events)
     plan.ego = _choose_ego(plan, controlled, ego, scenario.root)
-    _end(plan, clock, board.find("StopTrigger"))
+    _check_ego_actions(plan.ego, events)
+    plan.notes += _not_applied(board)
     missing = sorted(set(bodies) - set(plan.places))
     if missing:
         raise InputError(f"{scenario.path}: entity {missing[0]} is never placed (no Init)")
@@ -89,17 +92,15 @@ def _init_private(plan: Plan, private: Node) -> None:
 def _private_action(plan: Plan, name: str, action: Node, t_s: float) -> float:
     """Apply one private action of ``name`` starting at ``t_s``; its end time."""
     inner = action.children[0] if action.children else action
+    if t_s > 0.0:  # the engine's, at run time
+        return t_s
     if action.tag == "TeleportAction" or inner.tag == "LongitudinalDistanceAction":
-        if t_s > 0.0:
-            raise refuse(action, "a placement after the start is not supported")
         place = _place(plan, name, action if action.tag == "TeleportAction" else inner)
         plan.places[name] = place
         return t_s
     if inner.tag == "SpeedAction":
         return _speed(plan, name, inner, t_s)
-    if inner.tag == "ActivateControllerAction":
-        return t_s
-    raise refuse(inner, f"{inner.tag} is not supported here")
+    return t_s
 
 
 def _place(plan: Plan, name: str, node: Node) -> Place:
@@ -109,10 +110,13 @@ def _place(plan: Plan, name: str, node: Node) -> Place:
     where = None if pos is None or not pos.children else pos.children[0]
     if where is None:
         raise refuse(node, "a TeleportAction needs a Position")
+    offset = where.num("offset", 0.0)
     if where.tag == "LanePosition":
-        return Place(where.need("roadId"), int(where.num("laneId")), where.num("s"), where)
+        return Place(where.need("roadId"), int(where.num("laneId")), where.num("s"), where, offset)
     ref = _placed(plan, where.need("entityRef"), where)
-    return Place(ref.road, ref.lane, ref.s_m + where.num("ds"), where)
+    direction = 1 if ref.lane < 0 else -1
+    lane = lane_plus(ref.lane, int(where.num("dLane", 0.0)))
+    return Place(ref.road, lane, ref.s_m + direction * where.num("ds"), where, offset)
 
 
 def _placed(plan: Plan, name: str, node: Node) -> Place:
@@ -133,32 +137,24 @@ def _distance_place(plan: Plan, name: str, node: Node) -> Place:
     if node.get("freespace") in ("true", "1"):
         me, it = plan.bodies[name], plan.bodies[other]
         gap += it.front_ahead_m - me.rear_ahead_m
-    return Place(ref.road, ref.lane, ref.s_m + gap, node)
+    return Place(ref.road, ref.lane, ref.s_m + (1 if ref.lane < 0 else -1) * gap, node)
 
 
 def _speed(plan: Plan, name: str, node: Node, t_s: float) -> float:
+    """A step to a speed at the start is the entity's departure speed (the rest: the engine)."""
     dyn, target = node.find("SpeedActionDynamics"), node.find("SpeedActionTarget")
-    absolute = None if target is None else target.find("AbsoluteTargetSpeed")
-    if dyn is None or absolute is None:
-        raise refuse(node, "a SpeedAction needs its dynamics and an AbsoluteTargetSpeed")
-    speed = absolute.num("value")
-    if t_s == 0.0 and dyn.need("dynamicsShape") == "step":
-        plan.speeds_mps[name] = speed
+    if dyn is None or target is None or not target.children:
+        raise refuse(node, "a SpeedAction needs its dynamics and a target")
+    if dyn.need("dynamicsShape") != "step":
         return t_s
-    rate = math.inf if dyn.need("dynamicsShape") == "step" else dyn.num("value")
-    if rate <= 0:
-        raise refuse(dyn, f"rate {rate} must be > 0")
-    before = _speed_at(plan, name, t_s, node)
-    plan.changes.append(SpeedChange(name, t_s, speed, rate, node))
-    return t_s + (0.0 if math.isinf(rate) else abs(speed - before) / rate)
-
-
-def _speed_at(plan: Plan, name: str, t_s: float, node: Node) -> float:
-    """The speed ``name`` holds at ``t_s`` (the last earlier change reached)."""
-    earlier = [c for c in plan.changes if c.entity == name and c.start_s <= t_s]
-    if not earlier:
-        return plan.speeds_mps.get(name, 0.0)
-    raise refuse(node, f"a second speed change of {name} is not supported")
+    goal = target.children[0]
+    if goal.tag == "AbsoluteTargetSpeed":
+        plan.speeds_mps[name] = goal.num("value")
+        return t_s
+    ref = plan.speeds_mps.get(goal.need("entityRef"), 0.0)
+    factor = goal.get("speedTargetValueType", "delta") == "factor"
+    plan.speeds_mps[name] = ref * goal.num("value") if factor else ref + goal.num("value")
+    return t_s
 
 
 def _events(board: Node) -> list[_Event]:
@@ -195,28 +191,10 @@ def _time_events(plan: Plan, clock: Clock, events: list[_Event]) -> set[str]:
 
 
 def _start(clock: Clock, node: Node, default: float) -> float:
+    """When ``node`` starts, if known before the run (NEVER when it depends on the run: the
+    engine starts it)."""
     t = clock.trigger_time(node.find("StartTrigger"), default)
-    if t == DYNAMIC:
-        cond = _first_dynamic(node.find("StartTrigger"))
-        raise refuse(cond, "a start that depends on the run is not supported")
-    return max(float(t), default)
-
-
-def _first_dynamic(trigger: Node | None) -> Node:
-    assert trigger is not None
-    static = (
-        "Condition",
-        "ByValueCondition",
-        "ByEntityCondition",
-        "EntityCondition",
-        "SimulationTimeCondition",
-        "ParameterCondition",
-        "StoryboardElementStateCondition",
-    )
-    for node in trigger.iter():
-        if node.tag.endswith("Condition") and node.tag not in static:
-            return node
-    return trigger
+    return NEVER if t == DYNAMIC else max(float(t), default)
 
 
 def _time_event(plan: Plan, clock: Clock, ev: _Event) -> set[str]:
@@ -227,21 +205,9 @@ def _time_event(plan: Plan, clock: Clock, ev: _Event) -> set[str]:
     for node in (ev.group, ev.maneuver):
         clock.starts.setdefault(node.need("name"), t_act)
     actions = ev.event.findall("Action")
-    if t_act < NEVER and _logging_only(actions):
-        t = clock.trigger_time(ev.event.find("StartTrigger"), t_act)
-        if t == DYNAMIC:
-            plan.notes.append(f"event {ev.event.need('name')} (sets variables) not evaluated")
-            return set()
     t_ev = _start(clock, ev.event, t_act) if t_act < NEVER else NEVER
     clock.starts[ev.event.need("name")] = t_ev
     return _run_actions(plan, clock, ev, actions, t_ev)
-
-
-def _logging_only(actions: list[Node]) -> bool:
-    return all(a.find("GlobalAction") is not None for a in actions) and all(
-        a.find("GlobalAction").children[0].tag == "VariableAction"  # type: ignore[union-attr]
-        for a in actions
-    )
 
 
 def _run_actions(
@@ -259,10 +225,6 @@ def _run_actions(
                 t_end = max(t_end, _private_action(plan, actor, inner, t_ev))
             if inner.children and inner.children[0].tag == "ActivateControllerAction":
                 controlled |= set(ev.actors)
-        elif t_ev < NEVER:
-            glob = action.find("GlobalAction")
-            what = glob.children[0].tag if glob is not None and glob.children else "action"
-            plan.notes.append(f"{what} of {name} not applied")
         clock.ends[name] = t_end
         end = max(end, t_end)
     clock.ends[ev.event.need("name")] = end
@@ -299,19 +261,31 @@ def _choose_ego(plan: Plan, controlled: set[str], ego: str | None, root: Node) -
     raise InputError(f"{root.file}: cannot tell the ego (name it with --ego)")
 
 
-def _end(plan: Plan, clock: Clock, stop: Node | None) -> None:
-    """The run's end from a stop trigger timed before the run; else the run's own criteria."""
-    if stop is None or not stop.children:
-        return
-    static = []
-    for group in stop.findall("ConditionGroup"):
-        try:
-            t = clock.trigger_time(Node("StopTrigger", {}, group.file, group.line, [group]), 0)
-        except NotYet:
-            t = DYNAMIC
-        if t == DYNAMIC:
-            plan.notes.append(f"stop condition group at line {group.line} not evaluated")
-        else:
-            static.append(float(t))
-    if static and min(static) < NEVER:
-        plan.end_s = min(static)
+def _not_applied(board: Node) -> list[str]:
+    """What is read but not applied, one note each (said on stderr: nothing dropped silently)."""
+    notes = []
+    for node in board.iter():
+        if node.tag == "EnvironmentAction":
+            notes.append(
+                f"EnvironmentAction at line {node.line} not applied (friction: the road's, --mu)"
+            )
+        if node.tag == "ManeuverGroup" and node.num("maximumExecutionCount", 1.0) > 1:
+            times = node.get("maximumExecutionCount")
+            notes.append(f"ManeuverGroup {node.get('name')} runs once, not {times} times")
+    return notes
+
+
+def _check_ego_actions(ego: str, events: list[_Event]) -> None:
+    """The ego is the EOAM's after its Init: no storyboard action may move it."""
+    for ev in events:
+        if ego not in ev.actors:
+            continue
+        for action in ev.event.findall("Action"):
+            private = action.find("PrivateAction")
+            inner = None if private is None else private.children[0]
+            if inner is not None and inner.tag in (
+                "LongitudinalAction",
+                "LateralAction",
+                "TeleportAction",
+            ):
+                raise refuse(inner, f"the ego {ego} is driven by the EOAM, not by the storyboard")

@@ -1,4 +1,4 @@
-"""The plan a storyboard compiles to: bodies, placements, speeds over time, the end."""
+"""What the SUMO scenario is written from: bodies, departure places and speeds, the ego."""
 
 from __future__ import annotations
 
@@ -37,18 +37,7 @@ class Place:
     lane: int
     s_m: float
     node: Node
-
-
-@dataclass(frozen=True)
-class SpeedChange:
-    """From ``start_s`` (after the start) the entity's speed goes to ``target_mps`` at
-    ``rate_mps2`` (inf: a step)."""
-
-    entity: str
-    start_s: float
-    target_mps: float
-    rate_mps2: float
-    node: Node
+    offset_m: float = 0.0  # from the lane's centre, left of the direction of s
 
 
 @dataclass
@@ -59,6 +48,4 @@ class Plan:
     ego: str
     places: dict[str, Place]
     speeds_mps: dict[str, float]
-    changes: list[SpeedChange] = field(default_factory=list)
-    end_s: float | None = None
     notes: list[str] = field(default_factory=list)

@@ -6,11 +6,14 @@ import os
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from eoam_sumo.errors import InputError
 from eoam_sumo.openscenario.compile import compile_plan
+from eoam_sumo.openscenario.engine import Storyboard
+from eoam_sumo.openscenario.geometry import LaneMap
 from eoam_sumo.openscenario.model import Plan
 from eoam_sumo.openscenario.reader import Scenario, read_scenario
 from eoam_sumo.openscenario.road import convert
-from eoam_sumo.openscenario.sumofiles import DEPART_S, write_sumo
+from eoam_sumo.openscenario.sumofiles import write_sumo
 
 CACHE_ENV = "EOAM_SUMO_CACHE_DIR"
 
@@ -22,6 +25,7 @@ class Loaded:
     scenario: Scenario
     plan: Plan
     net: Path
+    lanes: LaneMap
 
 
 def road_cache() -> Path:
@@ -36,23 +40,34 @@ def load(xosc: Path, params: dict[str, str], ego: str | None = None) -> Loaded:
     """Everything outside the subset is refused here, before any run or output."""
     scenario = read_scenario(xosc, params)
     plan = compile_plan(scenario, ego)
-    return Loaded(scenario, plan, convert(scenario.road, road_cache()))
+    net = convert(scenario.road, road_cache())
+    lanes = LaneMap(net, scenario.road)
+    for name, place in plan.places.items():
+        if not lanes.has(place.road, place.lane):
+            where = f"{place.node.where()}: {name}'s road {place.road} lane {place.lane}"
+            raise InputError(f"{where} is not a drivable SUMO lane")
+    return Loaded(scenario, plan, net, lanes)
 
 
 def write_scenario(loaded: Loaded, folder: Path) -> Path:
     """The SUMO files of ``loaded`` in ``folder``; the .sumocfg."""
-    return write_sumo(loaded.plan, loaded.net, loaded.scenario.road, folder, loaded.scenario.path)
+    return write_sumo(loaded.plan, loaded.net, loaded.lanes, folder, loaded.scenario.path)
 
 
-def run_loaded(loaded: Loaded, out: Path, settings, mu: float | None = None) -> dict:
+def run_loaded(
+    loaded: Loaded, out: Path, settings, mu: float | None = None, timeseries: str = "csv"
+) -> dict:
     """Run with the ordinary co-simulation (outputs as any run, the SUMO files in
     ``out/scenario``); the summary."""
-    from eoam_sumo.sim.cosim import run_case
+    from eoam_sumo.sim.cosim import CoSimulation
+    from eoam_sumo.sim.runlog import write_run
     from eoam_sumo.sim.scenario import ScenarioOverrides
 
     cfg = write_scenario(loaded, out / "scenario")
     settings = replace(settings, ego_id="ego")
-    end = loaded.plan.end_s
-    if end is not None:
-        settings = replace(settings, max_time_s=min(settings.max_time_s, DEPART_S + end))
-    return run_case(cfg, ScenarioOverrides(mu=mu), out, settings)
+    board = Storyboard(loaded.scenario.root, loaded.plan, loaded.lanes, loaded.scenario.parameters)
+    sim = CoSimulation(cfg, ScenarioOverrides(mu=mu), settings, observers=(board,))
+    summary, log = sim.run()
+    summary = {**summary, "storyboard_ended": board.ended_by_storyboard}
+    write_run(out, summary, log, timeseries, sim.traffic, sim.session.ego_lane_centreline())
+    return summary

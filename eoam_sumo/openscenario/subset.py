@@ -95,6 +95,19 @@ ACTIONS = frozenset(
         "VariableAction",
         "VariableSetAction",
         "SetAction",
+        "RelativeTargetSpeed",
+        "LateralAction",
+        "LaneChangeAction",
+        "LaneChangeActionDynamics",
+        "LaneChangeTarget",
+        "RelativeTargetLane",
+        "AbsoluteTargetLane",
+        "LaneOffsetAction",
+        "LaneOffsetActionDynamics",
+        "LaneOffsetTarget",
+        "AbsoluteTargetLaneOffset",
+        "RelativeTargetLaneOffset",
+        "Orientation",
         "EnvironmentAction",
         "Environment",
         "TimeOfDay",
@@ -118,6 +131,11 @@ CONDITIONS = frozenset(
         "RelativeSpeedCondition",
         "RelativeDistanceCondition",
         "TraveledDistanceCondition",
+        "TimeHeadwayCondition",
+        "TimeToCollisionCondition",
+        "TimeToCollisionConditionTarget",
+        "ReachPositionCondition",
+        "AccelerationCondition",
     ]
 )
 SUPPORTED = STRUCTURE | ACTIONS | CONDITIONS
@@ -129,29 +147,39 @@ def refuse(node: Node, why: str) -> InputError:
     return InputError(f"{node.where()}: {why} (docs/openscenario.md lists the subset)")
 
 
+SHAPES = ("step", "linear", "cubic", "sinusoidal")
+
+
 def _speed_dynamics(node: Node) -> None:
     shape, dim = node.get("dynamicsShape"), node.get("dynamicsDimension")
-    if shape == "step":
-        return
-    if shape == "linear" and dim == "rate":
+    if shape in SHAPES and (shape == "step" or dim in ("time", "rate")):
         return
     raise refuse(node, f"dynamicsShape={shape} dynamicsDimension={dim} is not supported")
 
 
-def _no_offset(node: Node) -> None:
-    if abs(node.num("offset", 0.0)) > ZERO_M:
-        raise refuse(node, f"a lateral offset ({node.get('offset')} m) is not supported")
-    orientation = node.find("Orientation")
-    if orientation is not None:
-        raise refuse(orientation, "an orientation is not supported")
+def _lane_change_dynamics(node: Node) -> None:
+    shape, dim = node.get("dynamicsShape"), node.get("dynamicsDimension")
+    if shape not in SHAPES or dim not in ("time", "distance", "rate"):
+        raise refuse(node, f"dynamicsShape={shape} dynamicsDimension={dim} is not supported")
+    if shape != "step" and node.num("value") <= 0:
+        raise refuse(node, f"value {node.get('value')} must be > 0")
+
+
+def _orientation(node: Node) -> None:
+    if node.get("type", "relative") != "relative" or abs(node.num("h", 0.0)) > ZERO_M:
+        raise refuse(node, "only an orientation along the lane (relative, h=0) is supported")
+    if abs(node.num("p", 0.0)) > ZERO_M or abs(node.num("r", 0.0)) > ZERO_M:
+        raise refuse(node, "pitch and roll are not supported")
 
 
 def _relative_lane(node: Node) -> None:
-    _no_offset(node)
-    if int(node.num("dLane", 0.0)) != 0:
-        raise refuse(node, "only dLane=0 is supported")
     if node.get("ds") is None:
         raise refuse(node, "only ds (not dsLane) is supported")
+
+
+def _lateral_target(node: Node) -> None:
+    if node.tag == "LaneOffsetAction" and node.get("continuous") in ("true", "1"):
+        raise refuse(node, "a continuous LaneOffsetAction is not supported")
 
 
 def _distance(node: Node) -> None:
@@ -166,8 +194,10 @@ def _distance(node: Node) -> None:
 
 CHECKS: dict[str, Callable[[Node], None]] = {
     "SpeedActionDynamics": _speed_dynamics,
-    "LanePosition": _no_offset,
+    "LaneChangeActionDynamics": _lane_change_dynamics,
+    "Orientation": _orientation,
     "RelativeLanePosition": _relative_lane,
+    "LaneOffsetAction": _lateral_target,
     "LongitudinalDistanceAction": _distance,
 }
 

@@ -1,30 +1,24 @@
-"""The plan as SUMO files: vehicle types from the bounding boxes, routes along the road,
-each target's speeds as a scripted stop (``eoam.aro_hold_s``, ``eoam.aro_decel_mps2``).
+"""The plan as SUMO files: vehicle types from the bounding boxes, routes along the road.
 
 Every vehicle departs at ``DEPART_S`` (scenario time 0), its front bumper where its
-reference point plus the box's front lie (SUMO places vehicles by the front bumper). A
-target keeps its Init speed; its one speed change, if any, must be a stop (to below
-``STOP_MPS``): the scripted stop holds the speed until the change starts, then brakes at
-the action's rate (capped by the road's friction, as every scripted stop). The vehicle types
+reference point plus the box's front lie (SUMO places vehicles by the front bumper), on its
+lane's centre (the storyboard engine, :mod:`.engine`, moves the targets from the first step
+on, lateral offsets included). The vehicle types
 carry ``speedFactor=4`` so that the road's speed limits (OpenDRIVE ``<speed>``) never refuse
 a departure: the scenario, not the road, gives the speeds.
 """
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 from eoam_sumo.fileio import write_atomic
+from eoam_sumo.openscenario.geometry import LaneMap
 from eoam_sumo.openscenario.model import Body, Plan
-from eoam_sumo.openscenario.road import SumoLane, lane_table, locate
-from eoam_sumo.openscenario.subset import refuse
+from eoam_sumo.openscenario.road import SumoLane, locate
 
 DEPART_S = 1.0
-HOLD_FOREVER_S = 1.0e6
-STOP_MPS = 0.6  # a change to below this is run as a stop to standstill (2 km/h is 0.56)
-STEP_DECEL_MPS2 = 1.0e3  # a step to standstill: the scripted stop caps it at mu * g
 VCLASS = {"car": "passenger", "van": "delivery", "truck": "truck", "bus": "bus",
           "motorbike": "motorcycle", "bicycle": "bicycle"}  # fmt: skip
 # the storyboard alone moves a target across lanes: SUMO's own lane changes (strategic,
@@ -60,22 +54,6 @@ def _vtype(body: Body) -> str:
     )
 
 
-def _script(plan: Plan, name: str) -> tuple[float, float]:
-    """(hold_s, decel_mps2) of a target's scripted stop."""
-    changes = [c for c in plan.changes if c.entity == name]
-    if not changes:
-        if plan.speeds_mps.get(name, 0.0) == 0.0:
-            return 0.0, STEP_DECEL_MPS2
-        return HOLD_FOREVER_S, STEP_DECEL_MPS2
-    change = changes[0]
-    if change.target_mps >= STOP_MPS:
-        raise refuse(change.node, f"{name}: only a stop (to < {STOP_MPS} m/s) is supported")
-    if change.target_mps > 0.0:
-        plan.notes.append(f"{name} stops to standstill, not to {change.target_mps:.2f} m/s")
-    rate = STEP_DECEL_MPS2 if math.isinf(change.rate_mps2) else change.rate_mps2
-    return change.start_s, rate
-
-
 def _route(net, lane: SumoLane) -> list[str]:
     """The lane's edge and its successors (first outgoing edge each), up to 50 edges."""
     edges = [lane.edge]
@@ -89,39 +67,42 @@ def _route(net, lane: SumoLane) -> list[str]:
     return edges
 
 
-def _vehicle(plan: Plan, name: str, table: dict, net) -> str:
+def _nearest_lane(lanes: LaneMap, place) -> int:
+    """The lane whose centre is nearest the place's lateral offset (the departure lane: the
+    storyboard engine puts the entity at its exact offset from the first step on)."""
+    if abs(place.offset_m) < 1e-9:
+        return place.lane
+    side = [k for r, k in lanes.table if r == place.road and (k < 0) == (place.lane < 0)]
+
+    def miss(k: int) -> float:
+        return abs(lanes.shift_m(place.road, place.lane, k, place.s_m) - place.offset_m)
+
+    return min(side, key=miss)
+
+
+def _vehicle(plan: Plan, name: str, lanes: LaneMap, net) -> str:
     place, body = plan.places[name], plan.bodies[name]
-    lane, pos = locate(table, place.road, place.lane, place.s_m, place.node.where())
+    lane_id = _nearest_lane(lanes, place)
+    lane, pos = locate(lanes.table, place.road, lane_id, place.s_m, place.node.where())
     front = pos + body.front_ahead_m
     speed = plan.speeds_mps.get(name, 0.0)
     vid = "ego" if name == plan.ego else name
-    params = ""
-    if name != plan.ego:
-        hold, decel = _script(plan, name)
-        params = (
-            f'\n        <param key="eoam.aro_hold_s" value="{hold:g}"/>'
-            f'\n        <param key="eoam.aro_decel_mps2" value="{decel:g}"/>\n    '
-        )
     vtype = "ego" if name == plan.ego else f"t_{name}"
     return (
         f'    <route id="r_{vid}" edges="{" ".join(_route(net, lane))}"/>\n'
         f'    <vehicle id={quoteattr(vid)} type={quoteattr(vtype)} route="r_{vid}" '
         f'depart="{DEPART_S:.2f}" departLane="{lane.index}" departPos="{front:.3f}" '
-        f'departSpeed="{speed:.6f}" insertionChecks="none">{params}</vehicle>'
+        f'departSpeed="{speed:.6f}" insertionChecks="none"/>'
     )
 
 
-def write_sumo(plan: Plan, net_file: Path, xodr: Path, folder: Path, source: Path) -> Path:
+def write_sumo(plan: Plan, net_file: Path, lanes: LaneMap, folder: Path, source: Path) -> Path:
     """Write the scenario's SUMO files into ``folder``; the .sumocfg."""
     import sumolib
 
     from eoam_sumo import __version__
 
-    for change in plan.changes:
-        if change.entity == plan.ego:
-            raise refuse(change.node, "the ego's speed is the controller's: not scripted")
     folder.mkdir(parents=True, exist_ok=True)
-    table = lane_table(net_file, xodr)
     net = sumolib.net.readNet(str(net_file))
     others = [n for n in plan.bodies if n != plan.ego]
     vtypes = [EGO_VTYPE] + [_vtype(plan.bodies[n]) for n in others]
@@ -130,11 +111,11 @@ def write_sumo(plan: Plan, net_file: Path, xodr: Path, folder: Path, source: Pat
         folder / "scenario_vtypes.add.xml",
         head + "<additional>\n    " + "\n    ".join(vtypes) + "\n</additional>\n",
     )
-    vehicles = [_vehicle(plan, n, table, net) for n in [plan.ego, *others]]
+    vehicles = [_vehicle(plan, n, lanes, net) for n in [plan.ego, *others]]
     write_atomic(
         folder / "scenario.rou.xml", head + "<routes>\n" + "\n".join(vehicles) + "\n</routes>\n"
     )
-    end = 600.0 if plan.end_s is None else DEPART_S + plan.end_s
+    end = 3600.0  # the run ends by the storyboard, its own criteria or --max-time-s
     cfg = SUMOCFG.format(
         source=source.name, version=__version__, net=quoteattr(str(net_file)), end=end
     )

@@ -41,8 +41,8 @@ def test_expressions_refuse_anything_else(expr: str) -> None:
 
 
 def test_ccrb_compiles_to_the_protocol_timeline() -> None:
-    """CCRb 50 km/h: the target 1 s (13.89 m) bumper to bumper ahead, braking at 4 m/s^2
-    3 s after the start (Target_braking_delay), to 2 km/h."""
+    """CCRb 50 km/h: the target departs 1 s (13.89 m) bumper to bumper ahead (its
+    LongitudinalDistanceAction at time 0 is a departure placement)."""
     plan = compile_plan(read_scenario(NCAP_RUNS / "CCRb_50kph.xosc"))
     assert plan.ego == "Ego"
     ego, tgt = plan.bodies["Ego"], plan.bodies["Target"]
@@ -51,23 +51,17 @@ def test_ccrb_compiles_to_the_protocol_timeline() -> None:
     )
     assert gap == pytest.approx(50 / 3.6 * 1.0)
     assert plan.speeds_mps == pytest.approx({"Ego": 50 / 3.6, "Target": 50 / 3.6})
-    [change] = plan.changes
-    assert (change.start_s, change.rate_mps2) == (3.0, 4.0)
-    assert change.target_mps == pytest.approx(2 / 3.6)
 
 
-def test_alks_emergency_brake_compiles_with_its_end() -> None:
-    """4.3_2: the lead brakes at 9.81 m/s^2 at 10 s; the stop trigger is the brake action's
-    completion plus 10 s."""
+def test_alks_emergency_brake_compiles_its_start() -> None:
+    """4.3_2: ego and lead depart at 60 km/h (the brake is the engine's, at run time)."""
     plan = compile_plan(
         read_scenario(
             ALKS / "alks_scenario_4_3_2_follow_lead_vehicle_emergency_brake_template.xosc"
         )
     )
     assert plan.ego == "Ego"  # the one with an ObjectController
-    [change] = plan.changes
-    assert (change.entity, change.start_s, change.rate_mps2) == ("LeadVehicle", 10.0, 9.81)
-    assert plan.end_s == pytest.approx(10.0 + (60 / 3.6) / 9.81 + 10.0)
+    assert plan.speeds_mps == pytest.approx({"Ego": 60 / 3.6, "LeadVehicle": 60 / 3.6})
 
 
 def test_a_blocking_target_given_as_a_car_by_its_parameters() -> None:
@@ -93,24 +87,11 @@ def test_param_replaces_a_declared_value_and_refuses_an_undeclared_one() -> None
     ("path", "element", "line", "why"),
     [
         (
-            ALKS / "alks_scenario_4_4_1_cut_in_no_collision_template.xosc",
-            "RelativeLanePosition",
-            114,
-            "dLane",
-        ),
-        (
-            ALKS / "alks_scenario_4_1_2_swerving_lead_vehicle_template.xosc",
-            "RelativeTargetSpeed",
-            103,
-            "outside",
-        ),
-        (
             ALKS / "alks_scenario_4_2_1_fully_blocking_target_template.xosc",
             "Pedestrian",
             8,
             "outside",
         ),
-        (NCAP_RUNS / "CMRb_50kph.xosc", "RelativeLanePosition", 133, "lateral offset"),
         (NCAP_RUNS / "CCFhos_50kph_50kph.xosc", "RelativeRoadPosition", 112, "outside"),
     ],
 )
@@ -124,17 +105,21 @@ def test_files_outside_the_subset_are_refused_by_element_file_and_line(
     assert "\n" not in text
 
 
-def test_a_start_that_depends_on_the_run_is_refused(tmp_path: Path) -> None:
-    """The brake of 4.3_2 triggered by a distance instead of a time: refused, not ignored."""
+def test_a_continuous_lane_offset_is_refused(tmp_path: Path) -> None:
+    """Outside the subset: refused by element, file and line, not ignored."""
     alks = shutil.copytree(ALKS, tmp_path / "alks")
     src = alks / "alks_scenario_4_3_2_follow_lead_vehicle_emergency_brake_template.xosc"
     text = src.read_text(encoding="utf-8-sig").replace(
-        '<SimulationTimeCondition value="10.0" rule="greaterOrEqual" />',
-        '<SpeedCondition value="10.0" rule="greaterThan" />',
+        "<LongitudinalAction>",
+        '<LateralAction><LaneOffsetAction continuous="true"><LaneOffsetActionDynamics '
+        'maxLateralAcc="1" dynamicsShape="cubic"/><LaneOffsetTarget><AbsoluteTargetLaneOffset '
+        'value="1"/></LaneOffsetTarget></LaneOffsetAction></LateralAction>'
+        "<LongitudinalAction>",
+        1,
     )
-    assert "SpeedCondition" in text
+    assert "LaneOffsetAction" in text
     src.write_text(text, encoding="utf-8")
-    with pytest.raises(InputError, match=r"<SpeedCondition> at .*:\d+: a start that depends"):
+    with pytest.raises(InputError, match=r"<LaneOffsetAction> at .*:\d+: a continuous"):
         compile_plan(read_scenario(src))
 
 
@@ -148,3 +133,21 @@ def test_a_variation_with_many_values_needs_them_picked() -> None:
     assert plan.speeds_mps == pytest.approx({"Ego": 30 / 3.6, "Target": 0.0})
     # the target 5 s at 30 km/h ahead (Ego_initTimeHeadway, reference points) of s = 50 m
     assert plan.places["Target"].s_m == pytest.approx(50 + 5 * 30 / 3.6)
+
+
+@pytest.mark.parametrize(
+    ("name", "target", "lane", "speed_kmh"),
+    [
+        ("alks_scenario_4_4_1_cut_in_no_collision_template.xosc", "CutInVehicle", -5, 40.0),
+        ("alks_scenario_4_1_2_swerving_lead_vehicle_template.xosc", "LeadVehicle", -4, 60.0),
+    ],
+)
+def test_run_time_storyboards_compile_with_their_departures(
+    name: str, target: str, lane: int, speed_kmh: float
+) -> None:
+    """Refused before the storyboard engine: a dLane, a RelativeTargetSpeed, a start on a
+    distance, a LaneChangeAction or LaneOffsetAction. Now the departures come from Init
+    (4.4_1: one lane right of the ego at the ego's speed - 20 km/h)."""
+    plan = compile_plan(read_scenario(ALKS / name))
+    assert plan.places[target].lane == lane
+    assert plan.speeds_mps[target] == pytest.approx(speed_kmh / 3.6)

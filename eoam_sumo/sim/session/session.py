@@ -61,6 +61,7 @@ from eoam_sumo.sim.session.launch import (
     sumo_command,
     traci_connect,
 )
+from eoam_sumo.sim.session.puppets import Puppets
 from eoam_sumo.sim.session.scripts import StopScripts
 from eoam_sumo.sim.session.tracking import RoadUsers
 from eoam_sumo.world.bodies import PEDESTRIAN, Body
@@ -222,6 +223,7 @@ class SumoSession:
         self._time_s = self._sim.getTime()
         self._mu_cache: dict[str, float] = {}
         self._scripts = StopScripts(api, calls, constants, scripted_stops(files, overrides, ego_id))
+        self._puppets: Puppets | None = None  # road users an outside storyboard moves
         self._users = RoadUsers(api, calls, constants, ego_id, self._scripts.running)
         self._radius_m: float | None = None
         self._ego_mu = 1.0
@@ -400,6 +402,8 @@ class SumoSession:
             scripts.apply(
                 self._time_s + self._dt, self._dt, users.step_results(), self._friction, users.watch
             )
+        if self._puppets is not None:
+            self._puppets.apply()
         calls = self._calls
         calls.step(0.0)
         users.new_step()
@@ -545,6 +549,13 @@ class SumoSession:
         calls = self._calls
         calls.move_to_xy(self.ego_id, "", -1, x_front_m, y_front_m, angle_nav_deg, 2)
         calls.set_speed(self.ego_id, speed_mps)
+
+    def puppets(self) -> Puppets:
+        """The road users an outside storyboard moves (OpenSCENARIO), and the ego's lane."""
+        self._check_open()
+        if self._puppets is None:
+            self._puppets = Puppets(self._api, self._calls, self.ego_id, [])
+        return self._puppets
 
     def size_ego(self, length_m: float, width_m: float, mass_kg: float) -> None:
         """Tell SUMO the ego's length, width and mass (its vehicle's, where they differ from
