@@ -18,6 +18,7 @@ from pathlib import Path
 
 from eoam_sumo import __version__
 from eoam_sumo.arguments import finite, mu, speed_kmh
+from eoam_sumo.drivers import DRIVERS
 from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import writable_dir
 from eoam_sumo.openscenario.command import (
@@ -169,6 +170,12 @@ def _run_arguments(sub) -> None:
         "occlusion, tracker; docs/sensing.md)",
     )
     p.add_argument("--seed", type=seed_argument, default=0, help="seed of every random model (0)")
+    p.add_argument(
+        "--driver",
+        choices=DRIVERS,
+        default="eoam",
+        help="the ego's controller: the EOAM or a reference driver (docs/reference-drivers.md)",
+    )
     _after_stop_argument(p)
     p.add_argument("--gui", action="store_true", help="run in sumo-gui through TraCI")
     _policy_arguments(p)
@@ -394,6 +401,7 @@ def _run_settings(args, out: Path):
         seed=args.seed,
         radar_model=parse_radar_model(args.radar_model),
         after_stop_s=args.after_stop_s,
+        driver=args.driver,
     )
     if args.radar_range_m is not None:
         settings = replace(settings, radar=RadarSettings(range_m=args.radar_range_m))

@@ -1,0 +1,59 @@
+"""UN R157 (ALKS) Annex 4, Appendix 3: the competent and careful human driver.
+
+A risk is perceived ``perception_s`` (0.4 s) after it appears: an object entering the ego's
+path (a cut-in beyond the lateral wandering threshold of 0.375 m, which is where the forward
+radar classes it in path, ``sensing.radar.cutting_in``; a vehicle revealed by a cut-out) or
+the lead braking. Once perceived, the situation is critical when TTC < 2 s or the time
+headway < 2 s (esmini ``ReferenceDriver::CheckCritical``); the driver then reacts for
+``reaction_s`` (0.75 s) coasting at 0.4 m/s^2 and brakes, the deceleration rising to 0.774 g
+in 0.6 s, until the lead is no longer closing and no longer braking, or the ego stands.
+"""
+
+from __future__ import annotations
+
+from eoam_sumo.drivers.common import STOPPED_MPS, Lead, Response, released, time_to_collision_s
+from eoam_sumo.drivers.params import CarefulDriverParams
+
+CAREFUL = CarefulDriverParams()  # the published parameter set
+
+
+class CarefulDriver:
+    """The careful driver's longitudinal decision: ``step`` -> acceleration or None (no
+    intervention: the cruise holds its speed)."""
+
+    name = "r157-cc"
+
+    def __init__(self, params: CarefulDriverParams = CAREFUL):
+        self.p = p = params
+        self.response = Response(p.reaction_s, -p.coast_mps2, p.jerk_mps3, p.decel_mps2)
+        self.reset()
+
+    def reset(self) -> None:
+        self.perceived_at_s: float | None = None  # when the risk is perceived
+        self.response.stop()
+
+    def critical(self, lead: Lead, v_mps: float) -> bool:
+        p = self.p
+        thw = lead.gap_m / v_mps if v_mps > 0.0 else float("inf")
+        return time_to_collision_s(lead, v_mps) < p.critical_ttc_s or thw < p.critical_thw_s
+
+    def step(self, t_s: float, v_mps: float, a_mps2: float, lead: Lead | None, dt_s: float):
+        p, resp = self.p, self.response
+        if resp.active:
+            if v_mps < STOPPED_MPS:
+                return -p.decel_mps2
+            if released(lead, v_mps, p.lead_braking_mps2):
+                self.reset()
+                return None
+            return resp.accel(t_s, dt_s)
+        if lead is None:
+            self.perceived_at_s = None
+            return None
+        if self.perceived_at_s is None and (lead.fresh or lead.accel_mps2 < -p.lead_braking_mps2):
+            self.perceived_at_s = t_s + p.perception_s
+        if self.perceived_at_s is None or t_s < self.perceived_at_s - 1e-9:
+            return None
+        if not self.critical(lead, v_mps):
+            return None
+        resp.start(t_s)
+        return resp.accel(t_s, dt_s)
