@@ -91,9 +91,22 @@ def build_parser() -> argparse.ArgumentParser:
         vehicle_test_command.add_arguments,
         _protocol_arguments,
         add_scenario_arguments,
+        _r157_arguments,
     ):
         add_arguments(sub)
     return parser
+
+
+def _r157_arguments(sub) -> None:
+    from eoam_sumo.r157.command import add_arguments
+
+    add_arguments(sub)
+
+
+def _cmd_r157(args) -> int:
+    from eoam_sumo.r157.command import run
+
+    return run(args)
 
 
 def _protocol_arguments(sub) -> None:
@@ -582,6 +595,7 @@ _COMMANDS = {
     "vehicle-test": vehicle_test_command.run,
     "protocol": _cmd_protocol,
     "scenario": cmd_scenario,
+    "r157-study": _cmd_r157,
 }
 
 

@@ -81,16 +81,33 @@ class Response:
         self.jerk, self.decel_max = jerk_mps3, decel_mps2
         self.start_s: float | None = None
         self.decel = 0.0
+        self.cap = math.inf  # the last step's cap
 
     @property
     def active(self) -> bool:
         return self.start_s is not None
 
     def start(self, t_s: float) -> None:
-        self.start_s, self.decel = t_s, math.nan
+        self.start_s, self.decel, self.cap = t_s, math.nan, math.inf
 
     def stop(self) -> None:
         self.start_s = None
+
+    def preview(self, t_s: float, dt_s: float, ahead_s: float) -> float | None:
+        """The acceleration ``ahead_s`` after this step's (``accel`` called first), the cap
+        held; None when not responding. An actuator lagging by ``ahead_s`` commanded with it
+        gives the car the profile itself (a first-order lag follows a ramp ``ahead_s`` late)."""
+        if self.start_s is None:
+            return None
+        elapsed = t_s + ahead_s - self.start_s
+        if elapsed < self.delay_s - 1e-9:
+            return self.delay_accel
+        if math.isnan(self.decel) or t_s - self.start_s < self.delay_s - 1e-9:
+            into = elapsed - self.delay_s + 0.5 * dt_s  # the ramp's time at that step's middle
+            decel = max(-self.delay_accel, 0.0) + self.jerk * into
+        else:
+            decel = self.decel + self.jerk * ahead_s
+        return -min(decel, self.decel_max, self.cap)
 
     def accel(self, t_s: float, dt_s: float, cap_mps2: float = math.inf) -> float:
         """The acceleration over the step from ``t_s`` (negative: braking)."""
@@ -102,5 +119,6 @@ class Response:
             rise = max(-self.delay_accel, 0.0) + 0.5 * step
         else:
             rise = self.decel + step
+        self.cap = cap_mps2
         self.decel = min(rise, self.decel_max, cap_mps2)
         return -self.decel

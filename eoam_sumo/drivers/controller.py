@@ -11,6 +11,7 @@ run), when it lets go mode 0 again (a hand-back)."""
 
 from __future__ import annotations
 
+from eoam_sumo.control.longitudinal import LongitudinalController, LongitudinalGains
 from eoam_sumo.decision.modes import NORMAL, UPDATE_BRAKE
 from eoam_sumo.drivers import DRIVERS
 from eoam_sumo.drivers.careful import CarefulDriver
@@ -26,6 +27,14 @@ from eoam_sumo.eoam_messages import Command, EgoMeasurement, Perception
 from eoam_sumo.eoam_settings import EoamSettings
 from eoam_sumo.params import VehicleParams
 
+#: A driver's profile is carried out by feedforward (the acceleration loop's, gains 0: the
+#: equivalent mass and the resistance) commanded the brake's lag ahead, plus this gain on the
+#: speed error to the profile's speed [1/s] (an acceleration PID on the body acceleration,
+#: wound up during the ramp's lag, held the deceleration 0.06 m/s^2 too hard for seconds:
+#: 1 m of gap at 100 km/h).
+DRIVER_ACCEL_GAINS = LongitudinalGains(accel_kp=0.0, accel_ki_per_s=0.0, accel_kd_s=0.0)
+SPEED_GAIN_PER_S = 2.0
+
 _MODELS = {"r157-cc": CarefulDriver, "fsm": FsmDriver, "rss": RssDriver}
 
 
@@ -37,12 +46,15 @@ class DriverController(EoamController):
         self.model = model
         self.lead = LeadTracker()
         self.intervened = False
+        self.v_ref: float | None = None  # the profile's speed since the driver intervened
+        self.accel_loop = LongitudinalController(params, DRIVER_ACCEL_GAINS)
 
     def reset(self, initial_speed_mps: float) -> None:
         super().reset(initial_speed_mps)
         self.model.reset()
         self.lead.reset()
         self.intervened = False
+        self.v_ref = None
 
     def step(self, meas: EgoMeasurement, perception: Perception, dt_s: float) -> Command:
         parts, state = self.parts, self.state
@@ -54,6 +66,7 @@ class DriverController(EoamController):
         state.mode = NORMAL  # the lane centre for the steering
         lateral = lateral_control(parts, state, meas)
         if accel is None:
+            self.v_ref = None
             if self.intervened and state.hold_speed_mps is None:
                 state.hold_speed_mps = meas.vx_mps  # the speed the driver left the ego at
                 parts.longitudinal.reset()
@@ -61,19 +74,32 @@ class DriverController(EoamController):
                 state.initial_speed_mps = state.hold_speed_mps
             longitudinal = longitudinal_control(parts, state, meas, lateral, dt_s)
         else:
-            if not self.intervened:
-                parts.longitudinal.reset()
-            self.intervened = True
-            state.hold_speed_mps = None
-            state.mode = UPDATE_BRAKE
-            if UPDATE_BRAKE not in state.modes_visited:
-                state.modes_visited.append(int(UPDATE_BRAKE))
-            drive_lim, brake_lim = force_limits(parts, state, meas, lateral.steer_rad, False)
-            drive, brake = parts.longitudinal.track_accel(
-                accel, meas.ax_mps2, meas.vx_mps, drive_lim, brake_lim, dt_s
-            )
-            longitudinal = LongitudinalOutput(drive, brake, accel, meas.vx_mps)
+            longitudinal = self._follow(meas, lateral, accel, dt_s)
         return command(state, None, lateral, longitudinal)
+
+    def _follow(self, meas: EgoMeasurement, lateral, accel: float, dt_s: float):
+        """Mode 1: the driver's acceleration profile carried out, commanded ``brake_lag_s``
+        ahead (``Response.preview``) plus ``SPEED_GAIN_PER_S`` times the speed error to the
+        profile's own speed, through the feedforward (equivalent mass, resistance)."""
+        parts, state = self.parts, self.state
+        if not self.intervened:
+            self.accel_loop.reset()
+        self.intervened = True
+        state.hold_speed_mps = None
+        state.mode = UPDATE_BRAKE
+        if UPDATE_BRAKE not in state.modes_visited:
+            state.modes_visited.append(int(UPDATE_BRAKE))
+        v = meas.vx_mps
+        if self.v_ref is None:
+            self.v_ref = v
+        ahead = self.model.response.preview(meas.time_s, dt_s, self.params.brake_lag_s)
+        a_cmd = (accel if ahead is None else ahead) + SPEED_GAIN_PER_S * (self.v_ref - v)
+        self.v_ref = max(self.v_ref + accel * dt_s, 0.0)
+        drive_lim, brake_lim = force_limits(parts, state, meas, lateral.steer_rad, False)
+        drive, brake = self.accel_loop.track_accel(
+            a_cmd, meas.ax_mps2, v, drive_lim, brake_lim, dt_s
+        )
+        return LongitudinalOutput(drive, brake, accel, self.v_ref)
 
 
 def make_controller(
