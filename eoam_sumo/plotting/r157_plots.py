@@ -63,7 +63,9 @@ def r157_figure(rows: list[dict], kind: str, failed: list[dict], path: Path) -> 
             label="EOAM hits, careful driver avoids",
         ),
     ]
-    fig.legend(handles=handles, loc="upper center", ncol=3, frameon=False)
-    fig.suptitle(f"UN R157 Annex 4 App. 3 {kind}: careful driver vs EOAM", y=0.995, fontsize=11)
-    fig.tight_layout(rect=(0, 0, 1, 0.96))
+    fig.suptitle(f"UN R157 Annex 4 App. 3 {kind}: careful driver vs EOAM", fontsize=11)
+    fig.tight_layout(rect=(0, 0, 1, 0.93))
+    fig.legend(
+        handles=handles, loc="upper center", ncol=3, frameon=False, bbox_to_anchor=(0.5, 0.965)
+    )
     return save(fig, path)

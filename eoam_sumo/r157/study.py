@@ -17,18 +17,23 @@ from pathlib import Path
 
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.r157.scenario import R157Point, write_scenario
+from eoam_sumo.sensing.radar import RadarSettings
 from eoam_sumo.sim.cosim import run_case
 from eoam_sumo.sim.settings import RunSettings
 
 SPEEDS_KMH = (60.0, 100.0, 130.0)
-CUT_IN_GAPS_M = (5.0, 10.0, 20.0, 30.0, 45.0)
-CUT_IN_LATERAL_MPS = (0.5, 1.0, 2.0, 3.0)
+CUT_IN_GAPS_M = (4.0, 8.0, 12.0, 16.0, 20.0, 30.0, 45.0)
+CUT_IN_LATERAL_MPS = (0.5, 1.0, 1.5, 2.0, 3.0)
 CUT_IN_RELATIVE_KMH = 20.0  # the cutting-in car's speed below the ego's (the study's choice)
 CUT_OUT_GAPS_M = (20.0, 40.0, 60.0, 90.0)
 CUT_OUT_LATERAL_MPS = (1.0, 2.0, 3.0)
 DECEL_GAPS_S = (1.0, 1.6, 2.5)  # the lead's time gap (x the ego's speed)
 DECELS_MPS2 = (3.0, 5.0, 7.0, 9.0)
 MAX_TIME_S = 16.0
+#: The radar of the studies: the project's forward radar with its near-range beam (40 m,
+#: 90 deg), so that a car cutting in close ahead is seen from its first lateral move, as R157
+#: assumes of the careful driver; the EOAM and the drivers see the same.
+STUDY_RADAR = RadarSettings(near_range_m=40.0)
 FIELDS = (
     "kind",
     "driver",
@@ -77,15 +82,19 @@ def run_study(
     out: Path,
     settings: RunSettings | None = None,
     progress: Callable[[str], None] | None = None,
+    timeseries: str = "none",
 ) -> list[dict]:
-    """Run every point for every driver under ``out``; write and return the rows."""
-    base = settings or RunSettings(max_time_s=MAX_TIME_S)
+    """Run every point for every driver under ``out``; write and return the rows (each run's
+    summary.json, and with ``timeseries`` csv its time series and traffic log)."""
+    base = settings or RunSettings(max_time_s=MAX_TIME_S, radar=STUDY_RADAR)
     rows = []
     for point in points:
         cfg = write_scenario(point, out / "scenarios" / point.point_id)
         for driver in drivers:
             case_dir = out / "runs" / point.point_id / driver
-            summary = run_case(cfg, None, case_dir, replace(base, driver=driver), timeseries="none")
+            summary = run_case(
+                cfg, None, case_dir, replace(base, driver=driver), timeseries=timeseries
+            )
             rows.append(_row(point, driver, summary, case_dir.relative_to(out)))
             if progress is not None:
                 progress(f"{point.point_id} {driver}: {summary['outcome']}")
