@@ -1,12 +1,14 @@
 """UN R157 (ALKS) Annex 4, Appendix 3: the competent and careful human driver.
 
 A risk is perceived ``perception_s`` (0.4 s) after it appears: an object entering the ego's
-path (a cut-in beyond the lateral wandering threshold of 0.375 m, which is where the forward
-radar classes it in path, ``sensing.radar.cutting_in``; a vehicle revealed by a cut-out) or
-the lead braking. Once perceived, the situation is critical when TTC < 2 s or the time
-headway < 2 s (esmini ``ReferenceDriver::CheckCritical``); the driver then reacts for
-``reaction_s`` (0.75 s) coasting at 0.4 m/s^2 and brakes, the deceleration rising to 0.774 g
-in 0.6 s, until the lead is no longer closing and no longer braking, or the ego stands.
+path from the side (a cut-in beyond the lateral wandering threshold of 0.375 m, which is where
+the forward radar classes it in path, ``sensing.radar.cutting_in``), a vehicle revealed ahead
+(a cut-out) or the lead braking. A cut-in is then critical only when TTC < 2 s or the time
+headway < 2 s (esmini ``ReferenceDriver::CheckCritical``; JRC-FSM
+``CC_check_safety_cut_in``: TTC); a revealed vehicle or a braking lead always is (JRC-FSM
+``CC_check_safety``). The driver reacts for ``reaction_s`` (0.75 s) coasting at 0.4 m/s^2,
+then brakes, the deceleration rising from 0.4 m/s^2 to 0.774 g at 12.65 m/s^3 (0.774 g in 0.6
+s), until the lead is no longer closing and no longer braking, or the ego stands.
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ class CarefulDriver:
 
     def reset(self) -> None:
         self.perceived_at_s: float | None = None  # when the risk is perceived
+        self.gated = False  # a cut-in: critical only below the TTC or headway
         self.response.stop()
 
     def critical(self, lead: Lead, v_mps: float) -> bool:
@@ -51,9 +54,12 @@ class CarefulDriver:
             return None
         if self.perceived_at_s is None and (lead.fresh or lead.accel_mps2 < -p.lead_braking_mps2):
             self.perceived_at_s = t_s + p.perception_s
+            self.gated = lead.fresh and lead.from_side
+        if lead.accel_mps2 < -p.lead_braking_mps2:
+            self.gated = False  # the lead brakes: a risk whatever its distance
         if self.perceived_at_s is None or t_s < self.perceived_at_s - 1e-9:
             return None
-        if not self.critical(lead, v_mps):
+        if self.gated and not self.critical(lead, v_mps):
             return None
         resp.start(t_s)
         return resp.accel(t_s, dt_s)

@@ -20,13 +20,15 @@ MATCHED_MPS = 0.05
 
 class Lead(NamedTuple):
     """The in-path object: gap from the ego's front bumper, its speed and acceleration along
-    the road (the ego's speed plus the range rate, differenced), and whether it was first
-    seen at this step (not at the first step of a run)."""
+    the road (the ego's speed plus the range rate, differenced), whether it was first seen
+    at this step (not at the first step of a run) and whether it then came from the side (its
+    centre outside the ego's lane: a cut-in; else a vehicle revealed, or first seen, ahead)."""
 
     gap_m: float
     speed_mps: float
     accel_mps2: float
     fresh: bool
+    from_side: bool = False
 
 
 class LeadTracker:
@@ -39,7 +41,9 @@ class LeadTracker:
         self._prev: tuple[float, float, float] | None = None  # gap, range rate, lead speed
         self._started = False
 
-    def update(self, v_mps: float, perception: Perception, dt_s: float) -> Lead | None:
+    def update(
+        self, v_mps: float, perception: Perception, dt_s: float, lane_width_m: float = 3.5
+    ) -> Lead | None:
         gap, rate = perception.aro_range_m, perception.aro_range_rate_mps
         first, self._started = not self._started, True
         prev = self._prev
@@ -49,7 +53,9 @@ class LeadTracker:
         speed = v_mps + rate
         self._prev = (gap, rate, speed)
         if prev is None or abs(gap - (prev[0] + prev[1] * dt_s)) > FRESH_JUMP_M:
-            return Lead(gap, speed, 0.0, not first)
+            obj = perception.aro_object
+            side = obj is not None and abs(obj.d_m) > 0.5 * lane_width_m
+            return Lead(gap, speed, 0.0, not first, side)
         accel = (speed - prev[2]) / dt_s if dt_s > 0.0 else 0.0
         return Lead(gap, speed, accel, False)
 

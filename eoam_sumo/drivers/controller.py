@@ -61,7 +61,7 @@ class DriverController(EoamController):
         check_measurement(state, meas)
         if state.friction is None or meas.mu != state.friction.mu:
             state.friction = friction_at(parts, meas.mu)
-        lead = self.lead.update(meas.vx_mps, perception, dt_s)
+        lead = self.lead.update(meas.vx_mps, perception, dt_s, meas.lane_width_m)
         accel = self.model.step(meas.time_s, meas.vx_mps, meas.ax_mps2, lead, dt_s)
         state.mode = NORMAL  # the lane centre for the steering
         lateral = lateral_control(parts, state, meas)

@@ -1,0 +1,42 @@
+"""The careful driver's criticality (R157 Annex 4 App. 3 as esmini and JRC-FSM run it): a car
+cutting in is acted on only when TTC < 2 s or the headway < 2 s; a vehicle revealed ahead is
+acted on once perceived (0.4 s), whatever its distance."""
+
+from __future__ import annotations
+
+from eoam_sumo.drivers.careful import CarefulDriver
+from eoam_sumo.drivers.common import Lead
+
+DT = 0.01
+V = 100 / 3.6
+
+
+def first_reaction_s(lead_at, t_end=6.0):
+    """When the driver first asks for an acceleration (None: never), the ego held at ``V``."""
+    driver = CarefulDriver()
+    for k in range(round(t_end / DT)):
+        t = k * DT
+        if driver.step(t, V, 0.0, lead_at(t, k), DT) is not None:
+            return t
+    return None
+
+
+def test_a_cut_in_far_enough_ahead_is_not_acted_on():
+    # 60 m ahead at 5 m/s slower: TTC 10.8 s, headway 2.2 s, throughout (held for the test)
+    assert first_reaction_s(lambda t, k: Lead(60.0, V - 5.0, 0.0, k == 10, True)) is None
+
+
+def test_a_cut_in_becomes_critical_below_a_2_s_headway():
+    # 60 m ahead closing at 5 m/s: perceived at 0.1 + 0.4 s, not critical then (headway
+    # 2.1 s); the headway falls below 2 s (55.56 m) after 0.889 s: the reaction starts then
+    def lead(t, k):
+        return Lead(60.0 - 5.0 * t, V - 5.0, 0.0, k == 10, True)
+
+    t = first_reaction_s(lead)
+    assert t is not None and abs(t - 0.89) < 1e-6
+
+
+def test_a_revealed_car_is_acted_on_once_perceived_whatever_its_distance():
+    # a stopped car revealed 90 m ahead (TTC 3.2 s, headway 3.2 s) at 0.1 s
+    t = first_reaction_s(lambda t, k: Lead(90.0 - V * t, 0.0, 0.0, k == 10, False))
+    assert t is not None and abs(t - 0.5) < 1e-6
