@@ -218,7 +218,7 @@ def _documented() -> dict[str, set[str]]:
     table = {}
     for line in ARCHITECTURE.read_text(encoding="utf-8").splitlines():
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        name = re.fullmatch(r"`([a-z_][a-z0-9_]*)(?:/|\.py)`", cells[0]) if len(cells) == 3 else None
+        name = re.fullmatch(r"`(\w+)(?:/|\.py)`", cells[0]) if len(cells) == 3 else None
         if name:
             table[name.group(1)] = set(re.findall(r"`([a-z_*]+)`", cells[2]))
     return table
