@@ -5,6 +5,7 @@ jerk-limited ramp to a full deceleration, held to standstill)."""
 from __future__ import annotations
 
 import math
+from collections import deque
 from typing import NamedTuple
 
 from eoam_sumo.eoam_messages import Perception
@@ -16,13 +17,18 @@ FRESH_JUMP_M = 2.0
 STOPPED_MPS = 0.05
 #: The lead is no longer closing when it is at most this much slower [m/s].
 MATCHED_MPS = 0.05
+#: The lead's acceleration is its speed's slope over this window [s] (shorter while the
+#: object is newer): a radar's range rate is noisy and arrives once per scan, and a one-step
+#: difference of it would be noise (the project's choice).
+ACCEL_WINDOW_S = 0.2
 
 
 class Lead(NamedTuple):
     """The in-path object: gap from the ego's front bumper, its speed and acceleration along
-    the road (the ego's speed plus the range rate, differenced), whether it was first seen
-    at this step (not at the first step of a run) and whether it then came from the side (its
-    centre outside the ego's lane: a cut-in; else a vehicle revealed, or first seen, ahead)."""
+    the road (the ego's speed plus the range rate; its slope over ``ACCEL_WINDOW_S``),
+    whether it was first seen at this step (not at the first step of a run) and whether it
+    then came from the side (its centre outside the ego's lane: a cut-in; else a vehicle
+    revealed, or first seen, ahead)."""
 
     gap_m: float
     speed_mps: float
@@ -40,6 +46,7 @@ class LeadTracker:
     def reset(self) -> None:
         self._prev: tuple[float, float, float] | None = None  # gap, range rate, lead speed
         self._started = False
+        self._speeds: deque[float] = deque()  # the lead's speeds, one a step, newest last
 
     def update(
         self, v_mps: float, perception: Perception, dt_s: float, lane_width_m: float = 3.5
@@ -52,11 +59,17 @@ class LeadTracker:
             return None
         speed = v_mps + rate
         self._prev = (gap, rate, speed)
+        speeds = self._speeds
         if prev is None or abs(gap - (prev[0] + prev[1] * dt_s)) > FRESH_JUMP_M:
+            speeds.clear()
+            speeds.append(speed)
             obj = perception.aro_object
             side = obj is not None and abs(obj.d_m) > 0.5 * lane_width_m
             return Lead(gap, speed, 0.0, not first, side)
-        accel = (speed - prev[2]) / dt_s if dt_s > 0.0 else 0.0
+        speeds.append(speed)
+        if dt_s > 0.0 and len(speeds) > round(ACCEL_WINDOW_S / dt_s) + 1:
+            speeds.popleft()
+        accel = (speed - speeds[0]) / ((len(speeds) - 1) * dt_s) if dt_s > 0.0 else 0.0
         return Lead(gap, speed, accel, False)
 
 

@@ -13,7 +13,7 @@ import pytest
 from eoam_sumo.r157.scenario import DEPART_S, LEAD_IN_S, R157Point, write_scenario
 from eoam_sumo.sim.cosim import run_case
 from eoam_sumo.sim.settings import RunSettings
-from tests.drivers.test_closed_form import FULL, JERK, ego_closed_form
+from tests.drivers.test_closed_form import FULL, JERK, ego_closed_form, seen_braking_s
 
 pytestmark = pytest.mark.sumo
 
@@ -61,9 +61,11 @@ def worst_errors(ts, first, delay_accel, decel_from):
 
 def test_the_careful_driver_on_the_plant_matches_its_closed_form(tmp_path):
     ts = run(tmp_path, "r157-cc")
-    t_react = T_BRAKE + DT + 0.4  # the lead's braking seen one step later, perceived 0.4 s on
-    first = ts[ts.time_s >= t_react - 1e-9].iloc[0]
-    assert ts[ts["mode"] == 1].time_s.iloc[0] == pytest.approx(first.time_s)
+    # the lead's braking seen when its speed's slope over 0.2 s passes -1 m/s^2, perceived
+    # 0.4 s later (within a step: SUMO's scripted stop begins on the step grid)
+    t_react = seen_braking_s(V0, DECEL, T_BRAKE) + 0.4
+    first = ts[ts["mode"] == 1].iloc[0]
+    assert first.time_s == pytest.approx(t_react, abs=DT + 1e-9)
     worst_gap, worst_v = worst_errors(ts, first, -0.4, 0.4)
     assert worst_gap < 0.2
     assert worst_v < 0.15
