@@ -3,7 +3,8 @@
 A risk is perceived ``perception_s`` (0.4 s) after it appears: an object entering the ego's
 path from the side (a cut-in beyond the lateral wandering threshold of 0.375 m, which is where
 the forward radar classes it in path, ``sensing.radar.cutting_in``), a vehicle revealed ahead
-(a cut-out) or the lead braking. A cut-in is then critical only when TTC < 2 s or the time
+(a cut-out; closing faster than 1 m/s: a car first seen ahead at about the ego's speed is
+none) or the lead braking. A cut-in is then critical only when TTC < 2 s or the time
 headway < 2 s (esmini ``ReferenceDriver::CheckCritical``; JRC-FSM
 ``CC_check_safety_cut_in``: TTC); a revealed vehicle or a braking lead always is (JRC-FSM
 ``CC_check_safety``). The driver reacts for ``reaction_s`` (0.75 s) coasting at 0.4 m/s^2,
@@ -52,7 +53,8 @@ class CarefulDriver:
         if lead is None:
             self.perceived_at_s = None
             return None
-        if self.perceived_at_s is None and (lead.fresh or lead.accel_mps2 < -p.lead_braking_mps2):
+        risk = lead.fresh and (lead.from_side or v_mps - lead.speed_mps > p.closing_mps)
+        if self.perceived_at_s is None and (risk or lead.accel_mps2 < -p.lead_braking_mps2):
             self.perceived_at_s = t_s + p.perception_s
             self.gated = lead.fresh and lead.from_side
         if lead.accel_mps2 < -p.lead_braking_mps2:

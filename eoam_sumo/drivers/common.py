@@ -20,7 +20,7 @@ MATCHED_MPS = 0.05
 #: The lead's acceleration is its speed's slope over this window [s] (shorter while the
 #: object is newer): a radar's range rate is noisy and arrives once per scan, and a one-step
 #: difference of it would be noise (the project's choice).
-ACCEL_WINDOW_S = 0.2
+ACCEL_WINDOW_S = 0.5
 
 
 class Lead(NamedTuple):

@@ -52,6 +52,7 @@ class CarefulDriverParams:
     critical_ttc_s: float = 2.0  # [s] critical below this TTC (esmini ``critical_ttc_``)
     critical_thw_s: float = 2.0  # [s] ... or below this time headway (esmini ``critical_thw_``)
     lead_braking_mps2: float = 1.0  # [m/s^2] a lead braking harder is a risk (assumption)
+    closing_mps: float = 1.0  # [m/s] a car revealed ahead closing faster is a risk (assumption)
 
     def __post_init__(self) -> None:
         _check_positive(self)

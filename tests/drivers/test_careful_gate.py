@@ -40,3 +40,8 @@ def test_a_revealed_car_is_acted_on_once_perceived_whatever_its_distance():
     # a stopped car revealed 90 m ahead (TTC 3.2 s, headway 3.2 s) at 0.1 s
     t = first_reaction_s(lambda t, k: Lead(90.0 - V * t, 0.0, 0.0, k == 10, False))
     assert t is not None and abs(t - 0.5) < 1e-6
+
+
+def test_a_car_first_seen_ahead_at_the_ego_s_speed_is_no_risk():
+    # a tracker confirming the lead late: a new object 40 m ahead, as fast as the ego
+    assert first_reaction_s(lambda t, k: Lead(40.0, V, 0.0, k == 10, False)) is None

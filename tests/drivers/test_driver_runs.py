@@ -61,7 +61,7 @@ def worst_errors(ts, first, delay_accel, decel_from):
 
 def test_the_careful_driver_on_the_plant_matches_its_closed_form(tmp_path):
     ts = run(tmp_path, "r157-cc")
-    # the lead's braking seen when its speed's slope over 0.2 s passes -1 m/s^2, perceived
+    # the lead's braking seen when its speed's slope over 0.5 s passes -1 m/s^2, perceived
     # 0.4 s later (within a step: SUMO's scripted stop begins on the step grid)
     t_react = seen_braking_s(V0, DECEL, T_BRAKE) + 0.4
     first = ts[ts["mode"] == 1].iloc[0]
