@@ -5,9 +5,10 @@ FCW), on the same plant and sensing.
 The driver model decides the longitudinal acceleration (``careful``, ``fsm``, ``rss``); the
 EOAM's own controllers carry it out: the lane-keeping steering of mode 0, the speed PID holding
 the set speed while the model does not intervene (or, after it did, the speed it left the ego
-at), and the acceleration PID with feedforward while it brakes. It never changes lanes. While
-it brakes the mode is 1 (a brake in the lane, as the EOAM's limit braking: a stop ends the
-run), when it lets go mode 0 again (a hand-back)."""
+at), and while it brakes the feedforward of the acceleration loop, the profile commanded the
+brake's lag ahead, with feedback on the speed (``DriverController._follow``). It never
+changes lanes. While it brakes the mode is 1 (a brake in the lane, as the EOAM's limit
+braking: a stop ends the run), when it lets go mode 0 again (a hand-back)."""
 
 from __future__ import annotations
 
