@@ -18,7 +18,7 @@ TREE_FILES = git ls-files --cached --others --exclude-standard -- \
 RUN_COMPILED := PYTHONPATH=$(CURDIR)/$(COMPILED_TREE)
 
 .PHONY: run test test-fast test-compiled golden-strict golden-update tables bench lint network \
-	lock compiled clean
+	lock compiled clean readme-pictures
 
 $(STAMP): pyproject.toml setup.py $(LOCK)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -66,6 +66,17 @@ tables: $(STAMP)
 
 bench: $(COMPILED_STAMP)
 	$(RUN_COMPILED) $(BIN)/eoam-sumo bench --out $(OUT)/bench
+
+## The README's pictures (docs/img/), from fresh runs: Table 2 of the paper's batch, one frame
+## of an evasion in it (oncoming car at 500 m, 55 km/h, mu 1.0: past the obstacle in the
+## opposite lane) and the UN R152 scorecard. Commit them when they change.
+README_OUT := $(OUT)/readme
+readme-pictures: $(STAMP)
+	$(BIN)/eoam-sumo batch scenarios/table2.toml --out $(README_OUT)/table2 --jobs 2 --no-progress
+	$(BIN)/eoam-sumo animate $(README_OUT)/table2/cases/onc-500_v55_mu1.0 --out docs/img/evasion.png
+	$(BIN)/eoam-sumo protocol unr152 --out $(README_OUT)/r152 --jobs 2
+	cp $(README_OUT)/table2/table2.png docs/img/table2.png
+	cp $(README_OUT)/r152/scorecard.png docs/img/scorecard.png
 
 ## ruff (rules chosen in pyproject.toml; formatting checked) and mypy over eoam_sumo/.
 lint: $(STAMP)

@@ -293,7 +293,15 @@ def _animate_arguments(sub) -> None:
         "run_dir", type=Path, help="a run folder (summary.json, timeseries.csv, traffic.csv)"
     )
     p.add_argument(
-        "--out", type=Path, help="GIF, or MP4 with ffmpeg (default: RUN_DIR/animation.gif)"
+        "--out",
+        type=Path,
+        help="GIF, MP4 with ffmpeg, or PNG: one still (default: RUN_DIR/animation.gif)",
+    )
+    p.add_argument(
+        "--at-s",
+        type=finite,
+        default=None,
+        help="a PNG still's time_s (default: the ego farthest from its lane's centre)",
     )
     p.add_argument("--fps", type=_positive_int, default=10, help="frames per second of run time")
     p.add_argument("--labels", action="store_true", help="write each road user's id beside it")
@@ -567,7 +575,7 @@ def _cmd_plot(args) -> int:
 def _cmd_animate(args) -> int:
     from eoam_sumo.plotting.animate import animate_cli
 
-    print(animate_cli(args.run_dir, args.out, args.fps, args.labels))
+    print(animate_cli(args.run_dir, args.out, args.fps, args.labels, args.at_s))
     return 0
 
 

@@ -15,11 +15,11 @@ from eoam_sumo.eoam import Command, EgoMeasurement, Perception
 from eoam_sumo.sim import runlog
 from eoam_sumo.sim.summary import FIELDS, RunSummary
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+OUTPUTS_DOC = Path(__file__).resolve().parents[1] / "docs" / "outputs.md"
 
 
 def _outputs() -> str:
-    return README.read_text().split("## Outputs\n", 1)[1].split("\n## ", 1)[0]
+    return OUTPUTS_DOC.read_text(encoding="utf-8")
 
 
 def test_the_readme_lists_every_summary_field_in_order():

@@ -33,7 +33,7 @@ from eoam_sumo.decision.obstacle import (
     travel_m,
 )
 from eoam_sumo.decision.oncoming import Budget, commit_choice, return_clears
-from eoam_sumo.decision.policy import SafePolicy
+from eoam_sumo.decision.policy import SafePolicy, SightNeed, follower_keeps_distance
 from eoam_sumo.eoam.shifts import lateral_stop, min_time_shift, quintic_shift
 from eoam_sumo.eoam.state import ControllerState
 from eoam_sumo.eoam_messages import EgoMeasurement, Perception
@@ -136,7 +136,8 @@ def return_time_s(settings: EoamSettings, meas: EgoMeasurement) -> float:
 
 def beside_obstacle(settings: EoamSettings, params: VehicleParams, state, meas) -> bool:
     """The ego overlaps lengthwise, within ``pass_margin_m``, the tracked obstacle in the lane
-    it would return into (its box predicted to now): no return may begin."""
+    it would return into (its box predicted to now), or is ahead of it but a return begun now
+    would leave it too close behind (:func:`passed_keeps_distance`): no return may begin."""
     obstacle = state.obstacle
     if obstacle is None:
         return False
@@ -144,7 +145,36 @@ def beside_obstacle(settings: EoamSettings, params: VehicleParams, state, meas) 
     margin = settings.pass_margin_m
     ego_rear = meas.s_m - params.cg_to_rear_bumper_m
     ego_front = meas.s_m + params.cg_to_front_bumper_m
-    return ego_rear < front_s + margin and ego_front > front_s - obstacle.length_m - margin
+    if ego_front <= front_s - obstacle.length_m - margin:
+        return False  # still wholly behind it
+    return ego_rear < front_s + margin or not passed_keeps_distance(
+        settings, params, obstacle, meas
+    )
+
+
+def passed_keeps_distance(
+    settings: EoamSettings, params: VehicleParams, obstacle: ObstacleTrack, meas: EgoMeasurement
+) -> bool:
+    """The road user passed, behind the ego once it is back in its lane, keeps its distance
+    over a return begun now (``return_time_s``): the car-behind rule of the policy
+    (:func:`~eoam_sumo.decision.policy.follower_keeps_distance`: it holds its speed and
+    braking for 0.4 s, then may brake at 3 m/s^2, and keeps 1 s of its travel and
+    ``pass_margin_m``), the ego at its own braking."""
+    t_ret = return_time_s(settings, meas)
+    front_s, speed = obstacle.at(meas.time_s)
+    gap = meas.s_m - params.cg_to_rear_bumper_m - front_s
+    v_end = max(meas.vx_mps - max(-meas.ax_mps2, 0.0) * t_ret, 0.0)
+    plan = SightNeed(
+        0.0, 0.0, t_ret, 0.0, 0.0, 0.0, 0.0, 0.0, 0.5 * (meas.vx_mps + v_end) * t_ret, v_end
+    )
+    return follower_keeps_distance(
+        plan,
+        gap,
+        speed,
+        t_ret,
+        settings.pass_margin_m,
+        -obstacle.decel_mps2 if speed > 0.0 else 0.0,
+    )
 
 
 class PonrCommit:
@@ -172,7 +202,8 @@ class PonrCommit:
         """Mode 2 or 4 clear of the tracked obstacle: the ego's rear ``pass_margin_m`` past
         its front now and over the return begun now (``return_time_s``), the obstacle at its
         speed and braking (to its stop), the ego at its own acceleration (a braking ego must
-        not return in front of a car it has only just passed)."""
+        not return in front of a car it has only just passed); in mode 2 the obstacle also
+        keeps its distance behind the ego (:func:`passed_keeps_distance`)."""
         ego_rear_s = meas.s_m - self.params.cg_to_rear_bumper_m
         t_ret = return_time_s(self.settings, meas)
         for dt in (0.0, 0.5 * t_ret, t_ret):
@@ -180,7 +211,9 @@ class PonrCommit:
             ego_s = ego_rear_s + travel_m(meas.vx_mps, ego_decel, dt)
             if ego_s - obstacle.at(meas.time_s + dt)[0] < self.settings.pass_margin_m:
                 return False
-        return True
+        if state.mode is ONCOMING_STEER_BRAKE:
+            return True  # passing oncoming traffic: back as soon as clear
+        return passed_keeps_distance(self.settings, self.params, obstacle, meas)
 
     def budget(self, state: ControllerState, meas: EgoMeasurement) -> Budget:
         """What the ego can do at the sensed friction (``decision.oncoming``)."""

@@ -36,6 +36,7 @@ from matplotlib.transforms import Affine2D
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.plotting.animation_frames import ROLE_RANK, RunFrames, load_frames
+from eoam_sumo.plotting.figures import save
 from eoam_sumo.plotting.roadmap import read_road_map
 from eoam_sumo.plotting.run_plots import MODE_NAMES
 from eoam_sumo.plotting.view import radar_cone
@@ -66,9 +67,18 @@ def _check_out(out: Path) -> bool:
     mp4 = out.suffix.lower() == ".mp4"
     if mp4 and shutil.which("ffmpeg") is None:
         raise InputError(f"{out}: an MP4 needs ffmpeg on PATH; name a .gif instead")
-    if not mp4 and out.suffix.lower() != ".gif":
-        raise InputError(f"{out}: the animation's file name must end in .gif or .mp4")
+    if not mp4 and out.suffix.lower() not in (".gif", ".png"):
+        raise InputError(f"{out}: the animation's file name must end in .gif, .mp4 or .png")
     return mp4
+
+
+def still_frame(frames: RunFrames, at_s: float | None) -> int:
+    """The frame of a still: the one nearest ``time_s`` = ``at_s``, or (None) the one with
+    the ego farthest from its lane's centre (the evasion at its widest)."""
+    if at_s is not None:
+        return int(np.argmin(np.abs(frames.time_s - at_s)))
+    offset = frames.series["lateral_offset_m"].to_numpy()[frames.rows]
+    return int(np.nanargmax(np.abs(offset))) if np.isfinite(offset).any() else 0
 
 
 def animate_run(
@@ -78,12 +88,20 @@ def animate_run(
     size_in: tuple[float, float] = (9.0, 3.6),
     dpi: int = 90,
     labels: bool = False,
+    at_s: float | None = None,
 ) -> tuple[Path, int]:
-    """Write the animation of ``run_dir``; (its path, the number of frames)."""
+    """Write the animation of ``run_dir`` (a ``.png`` ``out``: one still,
+    :func:`still_frame`); (its path, the number of frames)."""
     frames = load_frames(Path(run_dir), fps, picture_aspect(size_in))
     out = Path(out) if out is not None else Path(run_dir) / "animation.gif"
     mp4 = _check_out(out)
     scene = Scene(frames, size_in, dpi, labels)
+    if out.suffix.lower() == ".png":
+        scene.draw(still_frame(frames, at_s))
+        try:
+            return save(scene.fig, out, dpi), 1
+        except OSError as exc:
+            raise InputError(f"{out}: cannot be written: {exc.strerror or exc}") from exc
     writer = FFMpegWriter(fps=fps) if mp4 else PillowWriter(fps=fps)
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
@@ -383,7 +401,9 @@ class Scene:
         return line
 
 
-def animate_cli(run_dir: Path, out: Path | None, fps: int, labels: bool = False) -> str:
+def animate_cli(
+    run_dir: Path, out: Path | None, fps: int, labels: bool = False, at_s: float | None = None
+) -> str:
     """The line ``eoam-sumo animate`` prints."""
-    path, n = animate_run(run_dir, out, fps, labels=labels)
+    path, n = animate_run(run_dir, out, fps, labels=labels, at_s=at_s)
     return f"{path} ({n} frames at {fps} fps)"

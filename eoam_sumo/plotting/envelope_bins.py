@@ -4,8 +4,9 @@ A parameter with at most ``MAX_LEVELS`` distinct values, each drawn at least twi
 ``choice`` parameter), keeps its values as levels. Any other (a sampled continuous one) is cut
 into bins of a round width, a step of the 1-2-2.5-5 series times a power of ten, the edges on
 multiples of it. Of the pairs of widths giving at most ``MAX_BINS`` bins per parameter, the
-finest whose median non-empty cell holds at least ``MIN_MEDIAN_DRAWS`` draws is chosen (ties:
-the more even number of bins); when none does, the coarsest.
+finest whose median non-empty cell holds at least ``MIN_MEDIAN_DRAWS`` draws is chosen: the most
+bins on the axis with fewer, then the most cells, then the more even split (one bin of speed by
+five of friction says nothing about speed); when none does, the coarsest.
 """
 
 from __future__ import annotations
@@ -108,7 +109,14 @@ def choose_axes(speeds: np.ndarray, mus: np.ndarray) -> tuple[Axis, Axis]:
     good = [p for p in pairs if median_cell_draws(*p) >= MIN_MEDIAN_DRAWS]
     if not good:
         return min(pairs, key=lambda p: (p[0].cells * p[1].cells, abs(p[0].cells - p[1].cells)))
-    return max(good, key=lambda p: (p[0].cells * p[1].cells, -abs(p[0].cells - p[1].cells)))
+    return max(
+        good,
+        key=lambda p: (
+            min(p[0].cells, p[1].cells),
+            p[0].cells * p[1].cells,
+            -abs(p[0].cells - p[1].cells),
+        ),
+    )
 
 
 def cell_counts(x: Axis, y: Axis, event: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

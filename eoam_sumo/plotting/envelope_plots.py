@@ -127,10 +127,17 @@ def _map_panels(ax_p, ax_w, fitted: pd.DataFrame, draws: pd.DataFrame, event) ->
     )
     ax_p.clabel(lines, fontsize=7, fmt="%.1f")
     hit = np.asarray(event, bool)
+    marks = {"clip_on": False, "zorder": 3}  # swept levels sit on the axes' edges and corners
     ax_p.scatter(
-        draws[Y][~hit], draws[X][~hit], s=6, facecolors="none", edgecolors="0.4", linewidths=0.5
+        draws[Y][~hit],
+        draws[X][~hit],
+        s=14,
+        facecolors="none",
+        edgecolors="0.3",
+        linewidths=0.6,
+        **marks,
     )
-    ax_p.scatter(draws[Y][hit], draws[X][hit], s=10, marker="x", color="k", linewidths=0.8)
+    ax_p.scatter(draws[Y][hit], draws[X][hit], s=22, marker="x", color="k", linewidths=0.9, **marks)
     ax_p.set_title(f"map: {_short(model)}\n(o no event, x event)", fontsize=9)
     fig.colorbar(filled, ax=ax_p, shrink=0.85, label="probability")
     width = (grid["p_high"] - grid["p_low"]).to_numpy()

@@ -32,8 +32,8 @@ road speed = target speed times the cosine of its heading relative to the road):
 * ``in_path``: centre ahead of the ego's front bumper along the road, inside the lane band,
   and not oncoming (road speed above -oncoming_speed_mps): stopped, moving with the road, or
   slowly towards the ego (a person walking towards it in its lane, a car backing up); also a
-  car ahead in a neighbouring lane cutting in (``cutting_in``: more than ``CUT_IN_WANDER_M``
-  from its lane's centre towards the ego's lane and moving towards it);
+  car ahead in a neighbouring lane cutting in (``cutting_in``: moving towards the ego's lane,
+  past ``CUT_IN_WANDER_M`` from its lane's centre for ``CUT_IN_PERCEPTION_S``);
 * ``in_next_lane``: stopped (speed below stationary_speed_mps), ahead, and the centre in the
   band of the next lane to the left (from the lane band's edge to one lane width beyond it):
   a standing car in the lane an evasive lane change would take;
@@ -147,11 +147,16 @@ class RadarReport(NamedTuple):
 
 
 _range_of = attrgetter("range_m")
-#: A car in the next lane is cutting in once its centre has moved this far from that lane's
-#: centre towards the ego's lane while still moving towards it: the lateral wandering
-#: threshold of the competent and careful driver model of UN R157 (ALKS), as the project
-#: recalls it (0.375 m; with a 0.4 s risk perception time, which the EOAM does not add).
+#: A car in the next lane is cutting in once its centre has moved more than this from that
+#: lane's centre towards the ego's lane, still moving towards it, and ``CUT_IN_PERCEPTION_S``
+#: has passed since: the lateral wandering threshold (0.375 m) and the risk perception time
+#: (0.4 s) of the competent and careful driver model of UN Regulation No. 157 (ALKS), Annex 4
+#: Appendix 3, as implemented by esmini's ALKS reference driver
+#: (EnvironmentSimulator/Modules/Controllers/ControllerALKS_R157SM.hpp, ReferenceDriver:
+#: ``wandering_threshold_`` 0.375, ``perception_time_`` 0.4) after the JRC's ec-jrc/JRC-FSM.
+#: The regulation's own text was not in the searchable corpora.
 CUT_IN_WANDER_M = 0.375
+CUT_IN_PERCEPTION_S = 0.4
 CUT_IN_LATERAL_MPS = 0.1  # the lateral speed towards the ego's lane that counts as moving [m/s]
 
 EMPTY_REPORT = RadarReport(None, None, False, ())  # immutable: one for every empty scan
@@ -432,7 +437,8 @@ class Radar:
     ) -> str:
         """The class of a target (rules: module doc); ``lateral_mps`` its speed across the
         road (positive to the left): a car ahead in a neighbouring lane moving towards the
-        ego's lane beyond ``CUT_IN_WANDER_M`` of its lane centre is in the path (a cut-in)."""
+        ego's lane beyond ``CUT_IN_WANDER_M`` of its lane centre for ``CUT_IN_PERCEPTION_S``
+        is in the path (a cut-in, :func:`cutting_in`)."""
         st = self.settings
         if road_speed_mps < -st.oncoming_speed_mps and d_m > -band_m:
             return "oncoming"
@@ -456,9 +462,12 @@ class Radar:
 
 def cutting_in(d_m: float, lateral_mps: float, lane_width_m: float, band_m: float) -> bool:
     """A road user centred ``d_m`` from the ego's lane centre, in a neighbouring lane (outside
-    the lane band, within one lane width beyond it), moved more than ``CUT_IN_WANDER_M`` from
-    that lane's centre towards the ego's lane and still moving towards it."""
+    the lane band, within one lane width beyond it), moving towards the ego's lane, that
+    crossed ``CUT_IN_WANDER_M`` from that lane's centre at least ``CUT_IN_PERCEPTION_S`` ago
+    at its present lateral speed (R157's competent and careful driver: the risk is perceived
+    that long after the wandering threshold is crossed)."""
     if not band_m <= abs(d_m) < band_m + lane_width_m:
         return False
     towards = -math.copysign(1.0, d_m) * lateral_mps
-    return lane_width_m - abs(d_m) > CUT_IN_WANDER_M and towards > CUT_IN_LATERAL_MPS
+    beyond_m = lane_width_m - abs(d_m) - CUT_IN_WANDER_M
+    return towards > CUT_IN_LATERAL_MPS and beyond_m >= CUT_IN_PERCEPTION_S * towards

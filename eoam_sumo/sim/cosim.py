@@ -449,8 +449,16 @@ class CoSimulation:
                 if found is not None:
                     hit, ebox, obox = found
                     self.first_contact = ContactRecord(
-                        hit, role or role_of(b, road, lane_width), self.t, b, ebox, obox
+                        hit, self._role_hit(b, role, ego_cx, ego_cy), self.t, b, ebox, obox
                     )
+
+    def _role_hit(self, b, role: str | None, ego_x_m: float, ego_y_m: float) -> str:
+        """The role of a road user hit (``role_of``; ``role`` when known): one in the ego's
+        lane band first met behind the ego is a follower (``other``), never the obstacle."""
+        role = role or role_of(b, self.road, self.lane_width_m)
+        if role == "aro" and not self._met_ahead_of(b, ego_x_m, ego_y_m):
+            return "other"
+        return role
 
     def _met_ahead_of(self, b, ego_x_m: float, ego_y_m: float) -> bool:
         """Whether a road user in the ego's lane band was first met ahead of the ego (the

@@ -16,10 +16,13 @@ left of its lane, and whether a run without contact was a near miss.
   in the ego's lane aside (its margin is ``min_gap_aro_m``); ``min_ttc_rear_s`` the same for
   those behind the ego;
 * the ego's follower (the nearest road user behind it overlapping its width, within
-  ``FOLLOWER_REACH_M``): the smallest gap along the road ``min_gap_rear_m``, and while it
-  closes in on the ego the largest DRAC ``max_drac_rear_mps2`` (deceleration rate to avoid
-  the crash, (v_f - v_ego)^2 / (2 gap)) and the largest deceleration it made,
-  ``max_follower_decel_mps2`` (``follower_decel_id`` who);
+  ``FOLLOWER_REACH_M``; a car the ego passed and cut in front of is one, whatever role it
+  had before): the smallest gap along the road ``min_gap_rear_m``, while it closes in on the
+  ego the largest DRAC ``max_drac_rear_mps2`` (deceleration rate to avoid the crash,
+  (v_f - v_ego)^2 / (2 gap)), and the largest deceleration it made while closing in or
+  within ``LEADER_HEADWAY_S`` of the ego, ``max_follower_decel_mps2`` (``follower_decel_id``
+  who; a vehicle whose stop is scripted and that is not closing in brakes for its script,
+  not for the ego);
 * ``time_in_opposite_lane_s``: steps with the ego's centre left of its lane (in the next lane
   to the left, the opposite lane on a two-way road) times the step;
 * ``closest_gap_m`` and ``closest_id``: the smallest gap to any road user once within
@@ -80,6 +83,10 @@ FOLLOWER_REACH_M = 150.0
 #: as tabulated for the DST/a_long,req metrics by Westhofen et al., "Criticality metrics for
 #: automated driving: a review", 2023: < 4 considerable, < 6 heavy reaction, >= 6 emergency).
 EMERGENCY_DECEL_MPS2 = 6.0
+#: A follower not closing in on the ego still brakes for it while within this time gap of
+#: it (its own speed times this): the "two-second rule" of the UK Highway Code (rule 126),
+#: the gap below which a driver adjusts to the car in front [s].
+LEADER_HEADWAY_S = 2.0
 
 
 class Margins(StepObserver):
@@ -110,6 +117,7 @@ class Margins(StepObserver):
         self.max_drac_rear_mps2 = 0.0
         self.max_follower_decel_mps2 = 0.0
         self.follower_decel_id: str | None = None
+        self._scripted: frozenset[str] = getattr(sim.session, "scripted_ids", frozenset())
 
     @property
     def time_in_opposite_lane_s(self) -> float:
@@ -260,17 +268,18 @@ class Margins(StepObserver):
         v: tuple[float, float],
     ) -> None:
         """The nearest road user behind the ego overlapping its width (the ego is its
-        leader): the gap between them along the road, and while it closes in on the ego its
-        DRAC ((v_f - v_ego)^2 / (2 gap)) and its deceleration over the step (forced by the
-        ego; a follower falling back, such as an obstacle the ego passed stopping behind it,
-        is not)."""
+        leader): the gap between them along the road, while it closes in on the ego its DRAC
+        ((v_f - v_ego)^2 / (2 gap)), and its deceleration over the step while closing in or
+        within ``LEADER_HEADWAY_S`` of its own travel behind the ego (forced by the ego: a car
+        the ego cut in front of brakes though it is slower; one falling back farther, or a
+        scripted stop such as an obstacle the ego passed, is not)."""
         gap = ego.x_m - 0.5 * ego.length_m - (box.x_m + 0.5 * b.length_m)
         self.min_gap_rear_m = min(self.min_gap_rear_m, max(gap, 0.0))
         closing = v[0] - ego_v[0]
-        if closing <= 0.0:
-            return
-        if gap > 0.0:
+        if closing > 0.0 and gap > 0.0:
             self.max_drac_rear_mps2 = max(self.max_drac_rear_mps2, closing * closing / (2.0 * gap))
+        if closing <= 0.0 and (b.vid in self._scripted or gap > LEADER_HEADWAY_S * v[0]):
+            return
         before = next((o for o in sim.bodies_before if o.vid == b.vid), None)
         if before is not None:
             decel = (before.speed_mps - b.speed_mps) / self._step_s

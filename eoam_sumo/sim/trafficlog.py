@@ -18,9 +18,11 @@ the radar's classes are, with the radar's thresholds):
 * ``parked``: SUMO reports the road user parked;
 * ``oncoming``: moving against the road direction faster than 2 m/s, not right of the
   ego's lane;
-* ``aro``: ahead of the ego (station beyond the ego's centre) with its centre in the ego
-  lane's band (half the lane width + 0.5 m): the obstacle in the ego's lane, whatever
-  it is (a stopped car, a person walking on the road);
+* ``aro``: its centre in the ego lane's band (half the lane width + 0.5 m), ahead of the
+  ego (station beyond the ego's centre) or first met in the band ahead of it: the obstacle
+  in the ego's lane, whatever it is (a stopped car, a person walking on the road), which
+  keeps that role once passed (as ``min_gap_aro_m`` counts it); one first met in the band
+  behind the ego is a follower (``other``);
 * ``other``: the rest (traffic in other lanes, behind the ego, people on the pavement).
 
 Cost in the step loop: one tuple kept per step (the ``Body`` tuples the loop already has are
@@ -245,17 +247,20 @@ class TrafficLog(StepObserver):
         for k in np.flatnonzero(parked):
             roles[k] = "parked"
         by_id = sorted(others.tolist(), key=lambda k: (ids[k], k))
-        previous = None
+        previous, met_ahead = None, None
         for k in by_id:
             x, y, yaw, speed = num[k, :4]
             if ids[k] != previous:
                 road.locate(x, y)
-                previous = ids[k]
+                previous, met_ahead = ids[k], None
             s, d, road_yaw = road.project(x, y)
             if speed * math.cos(yaw - road_yaw) < -ONCOMING_SPEED_MPS and d > -band:
                 roles[k] = "oncoming"
-            elif abs(d) < band and s > ego_s[step_of[k]]:
-                roles[k] = "aro"
+            elif abs(d) < band:
+                ahead = s > ego_s[step_of[k]]
+                met_ahead = ahead if met_ahead is None else met_ahead
+                if ahead or met_ahead:
+                    roles[k] = "aro"
         return roles
 
     def write(self, path: Path) -> None:

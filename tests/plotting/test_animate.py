@@ -15,7 +15,13 @@ import pytest
 from PIL import Image
 
 from eoam_sumo.cli import main
-from eoam_sumo.plotting.animate import ROLE_COLOURS, Scene, animate_run, picture_aspect
+from eoam_sumo.plotting.animate import (
+    ROLE_COLOURS,
+    Scene,
+    animate_run,
+    picture_aspect,
+    still_frame,
+)
 from eoam_sumo.plotting.animation_frames import load_frames
 from eoam_sumo.sim.cosim import run_case
 from eoam_sumo.sim.scenario import ScenarioOverrides
@@ -120,6 +126,21 @@ def test_animate_writes_a_gif_that_follows_the_ego(run_dir, tmp_path):
     for image in (first, last):  # the ego's box is in every frame
         assert (np.abs(image.astype(int) - blue).sum(axis=2) < 40).sum() > 20
     assert not np.array_equal(first, last)
+
+
+def test_a_png_is_one_still_of_the_frame_asked_for(run_dir, tmp_path, capsys):
+    """``--out X.png``: one frame, by default where the ego is farthest from its lane centre;
+    ``--at-s``: the frame nearest that time."""
+    frames = load_frames(run_dir, 10, picture_aspect((9.0, 3.6)))
+    offset = np.abs(frames.series["lateral_offset_m"].to_numpy()[frames.rows])
+    widest = still_frame(frames, None)
+    assert offset[widest] == np.nanmax(offset)
+    assert still_frame(frames, 1.04) == int(np.argmin(np.abs(frames.time_s - 1.04)))
+    out = tmp_path / "still.png"
+    assert main(["animate", str(run_dir), "--out", str(out), "--at-s", "1.0"]) == 0
+    assert capsys.readouterr().out.strip() == f"{out} (1 frames at 10 fps)"
+    with Image.open(out) as png:
+        assert png.format == "PNG" and getattr(png, "n_frames", 1) == 1
 
 
 def test_animate_cli_bad_run_dir_is_one_line_and_exit_2(tmp_path, capsys):

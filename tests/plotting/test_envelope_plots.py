@@ -38,7 +38,7 @@ def test_sampled_values_are_cut_on_round_edges_with_enough_draws_per_cell(n):
     for axis, values in ((sx, speeds), (sy, mus)):
         assert all(_is_round(e, axis.step) for e in axis.edges), axis.edges
         assert axis.edges[0] <= values.min() and values.max() <= axis.edges[-1]
-        assert 1 <= axis.cells <= MAX_BINS
+        assert 2 <= axis.cells <= MAX_BINS  # both parameters resolved, never one bin of either
     assert median_cell_draws(sx, sy) >= MIN_MEDIAN_DRAWS
     count, draws = cell_counts(sx, sy, speeds > 120)
     assert draws.sum() == n and count.sum() == (speeds > 120).sum()

@@ -50,6 +50,7 @@ def test_by_default_the_run_waits_for_the_follower_and_its_hit_is_a_contact(tmp_
     assert early["final_speed_mps"] < 0.05  # the ego had stopped
     assert waited["end_cause"] == "contact"
     assert waited["collision_with_id"] == "follower"
+    assert waited["collision_with"] == "other"  # a follower, never the obstacle
     assert waited["contact_kind"] == "rear_end" and waited["outcome"] != "green"
     assert waited["sim_time_s"] > early["sim_time_s"]
 

@@ -80,15 +80,18 @@ def test_roles_relative_to_the_ego_lane():
     }
 
 
-def test_role_follows_the_ego_station_step_by_step():
-    """The ARO stays 'aro' while ahead of the ego's centre and becomes 'other' once the ego
-    (in the next lane) has passed it."""
+def test_the_obstacle_keeps_its_role_once_passed_and_a_follower_never_takes_it():
+    """The ARO, first met ahead in the ego's lane, stays 'aro' once the ego (in the next lane)
+    has passed it, as ``min_gap_aro_m`` counts it; a car first met behind the ego in its lane
+    is a follower ('other') throughout, and so is the ARO once out of the ego's lane."""
     log = _log()
-    aro = User("aro", "passenger", 200.0, -1.75, 0.0, 0.0, 5.0, 2.0, False)
     for k, x in enumerate((150.0, 199.0, 201.0, 250.0)):
-        log.add(k * 0.01, _ego(x, 1.75), [aro])
+        aro = User("aro", "passenger", 200.0, -1.75 if k < 3 else 1.75, 0.0, 0.0, 5.0, 2.0, False)
+        follower = User("follower", "passenger", x - 10.0, -1.75, 0.0, 30.0, 5.0, 2.0, False)
+        log.add(k * 0.01, _ego(x, 1.75), [aro, follower])
     c = log.columns()
-    assert [r for i, r in zip(c["id"], c["role"]) if i == "aro"] == ["aro", "aro", "other", "other"]
+    assert [r for i, r in zip(c["id"], c["role"]) if i == "aro"] == ["aro", "aro", "aro", "other"]
+    assert {r for i, r in zip(c["id"], c["role"]) if i == "follower"} == {"other"}
 
 
 def test_written_file_has_the_columns_and_reads_back(tmp_path):

@@ -46,6 +46,11 @@ class StopScripts:
         self.pending = set(stops)  # not yet departed
         self.running: dict[str, _Script] = {}
 
+    @property
+    def ids(self) -> frozenset[str]:
+        """Every vehicle whose stop is scripted, departed or not."""
+        return frozenset(self._stops)
+
     def start(self, vid: str, watch) -> None:
         """``vid`` departed: its stop runs from now on (``watch(vid)`` subscribes it)."""
         hold, decel = self._stops[vid]

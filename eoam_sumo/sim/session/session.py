@@ -433,6 +433,11 @@ class SumoSession:
         return self._dt
 
     @property
+    def scripted_ids(self) -> frozenset[str]:
+        """The vehicles whose emergency stop is scripted (their braking is not traffic's)."""
+        return self._scripts.ids
+
+    @property
     def net_file(self) -> Path:
         """The scenario's network file."""
         return self._files.net_file
