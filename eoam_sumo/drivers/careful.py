@@ -1,15 +1,16 @@
 """UN R157 (ALKS) Annex 4, Appendix 3: the competent and careful human driver.
 
-A risk is perceived ``perception_s`` (0.4 s) after it appears: an object entering the ego's
-path from the side (a cut-in beyond the lateral wandering threshold of 0.375 m, which is where
-the forward radar classes it in path, ``sensing.radar.cutting_in``), a vehicle revealed ahead
-(a cut-out; closing faster than 1 m/s: a car first seen ahead at about the ego's speed is
-none) or the lead braking. A cut-in is then critical only when TTC < 2 s or the time
-headway < 2 s (esmini ``ReferenceDriver::CheckCritical``; JRC-FSM
-``CC_check_safety_cut_in``: TTC); a revealed vehicle or a braking lead always is (JRC-FSM
-``CC_check_safety``). The driver reacts for ``reaction_s`` (0.75 s) coasting at 0.4 m/s^2,
-then brakes, the deceleration rising from 0.4 m/s^2 to 0.774 g at 12.65 m/s^3 (0.774 g in 0.6
-s), until the lead is no longer closing and no longer braking, or the ego stands.
+A risk is perceived ``perception_s`` (0.4 s) after it appears: a vehicle revealed ahead (a
+cut-out; closing faster than 1 m/s: a car first seen ahead at about the ego's speed is none)
+or the lead braking. A car cutting in is perceived when the forward radar classes it in the
+path: 0.4 s after it crossed the lateral wandering threshold of 0.375 m
+(``sensing.radar.cutting_in``, ``CUT_IN_PERCEPTION_S``: the radar holds R157's perception
+for every controller). A cut-in is then critical only when TTC < 2 s or the time headway
+< 2 s (esmini ``ReferenceDriver::CheckCritical``; JRC-FSM ``CC_check_safety_cut_in``: TTC);
+a revealed vehicle or a braking lead always is (JRC-FSM ``CC_check_safety``). The driver
+reacts for ``reaction_s`` (0.75 s) coasting at 0.4 m/s^2, then brakes, the deceleration
+rising from 0.4 m/s^2 to 0.774 g at 12.65 m/s^3 (0.774 g in 0.6 s), until the lead is no
+longer closing and no longer braking, or the ego stands.
 """
 
 from __future__ import annotations
@@ -55,8 +56,8 @@ class CarefulDriver:
             return None
         risk = lead.fresh and (lead.from_side or v_mps - lead.speed_mps > p.closing_mps)
         if self.perceived_at_s is None and (risk or lead.accel_mps2 < -p.lead_braking_mps2):
-            self.perceived_at_s = t_s + p.perception_s
-            self.gated = lead.fresh and lead.from_side
+            self.gated = cut_in = lead.fresh and lead.from_side
+            self.perceived_at_s = t_s + (0.0 if cut_in else p.perception_s)
         if lead.accel_mps2 < -p.lead_braking_mps2:
             self.gated = False  # the lead brakes: a risk whatever its distance
         if self.perceived_at_s is None or t_s < self.perceived_at_s - 1e-9:
