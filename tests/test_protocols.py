@@ -320,18 +320,23 @@ def test_totals_of_one_system_and_policy_stay_within_the_maximum():
         if p.ego_speed_kmh < 20
     ]
     t = scoring.fc_totals(rows)
-    assert t["max_run"] == pytest.approx(9.0) and t["max_protocol"] == pytest.approx(24.0)
-    # every point run green: the robustness layer (1.125) is not assessed; the 10 km/h
+    assert t["max_run"] == pytest.approx(11.5) and t["max_protocol"] == pytest.approx(24.0)
+    # every point run green: the robustness layer (1.375) is not assessed; the 10 km/h
     # CCRs row not run: 5 of 40 standard cells (-0.15), 2 of 16 extended (14/16 = 87.5 %,
     # banded to 75 %: -0.0375), and the gate fails
-    assert t["points_before_gate"] == pytest.approx(8.1 - 0.15 - 0.0375)
+    assert t["points_before_gate"] == pytest.approx(10.35 - 0.15 - 0.0375)
     assert not t["gate_passed"] and t["points"] == 0.0
 
 
 def test_grids():
     p2026 = protocol_points(PROTOCOLS[1], SEDAN_WIDTH_M)
-    count = {t: sum(p.test == t for p in p2026) for t in ("CCRs", "CCRm", "CCRb", "CCFhos")}
-    assert count == {"CCRs": 8 * 7, "CCRm": 11 * 7, "CCRb": 11 * 7, "CCFhos": 8 * 4}
+    tests = ("CCRs", "CCRm", "CCRb", "CCFhos", "CCFhol")
+    count = {t: sum(p.test == t for p in p2026) for t in tests}
+    assert count == {"CCRs": 8 * 7, "CCRm": 11 * 7, "CCRb": 11 * 7, "CCFhos": 32, "CCFhol": 32}
+    # the rating code's EXTENDED_RANGE_CELLS of CCFhos and CCFhol: the first column (100 %)
+    # and the last two rows, 14 cells each
+    for test in ("CCFhos", "CCFhol"):
+        assert sum(p.extended for p in p2026 if p.test == test) == 14
     assert len({p.point_id for p in p2026}) == len(p2026)
     # CCFhos starts 8 s of closing apart (Vector's startupTime): 50/50 km/h -> 222.2 m
     assert next(p.gap_m for p in p2026 if p.test == "CCFhos" and p.ego_speed_kmh == 50) == (
@@ -339,6 +344,10 @@ def test_grids():
     )
     p2023 = protocol_points(PROTOCOLS[0], SEDAN_WIDTH_M)
     assert sum(p.test == "CCRb" for p in p2023) == 4
+    # Vector's 2023 head-on variations: both cars at 50 or 70 km/h, the target centred
+    for test in ("CCFhos", "CCFhol"):
+        head_on = [(p.ego_speed_kmh, p.offset_m) for p in p2023 if p.test == test]
+        assert head_on == [(50, 0.0), (70, 0.0)]
     r152 = protocol_points(PROTOCOLS[2], SEDAN_WIDTH_M)
     # the M1 table's 12 relative speeds against a stationary target; against a target at
     # 20 km/h those up to a subject speed of 60 km/h (para. 5.2.1.3): 10-40 km/h, 7 rows
@@ -484,3 +493,36 @@ def test_every_protocol_point_is_in_the_design_range_the_10_kmh_ones_included():
         if p.test == "CCRs" and p.ego_speed_kmh == 10.0
     ]
     assert len(ccrs_10) == 7
+
+
+@pytest.mark.sumo
+def test_an_r152_run_that_leaves_its_lane_fails(tmp_path):
+    """R152 at 50 km/h against a stopped car: the eoam system changes lanes and avoids it with
+    its warning in time; leaving its lane alone makes the row fail (para. 5.2.1.4 is a speed
+    reduction by braking demand)."""
+    out = tmp_path / "r152"
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "eoam_sumo",
+            "protocol",
+            "unr152",
+            "--out",
+            str(out),
+            "--points",
+            "^R152mstationary_v50_",
+            "--system",
+            "eoam",
+            "--no-progress",
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    row = pd.read_csv(out / "results.csv").iloc[0]
+    assert row["manoeuvre"] == "S" and row["impact_speed_kmh"] == 0.0
+    assert row["warning"] == "pass"
+    assert row["max_lateral_offset_m"] > (row["lane_width_m"] - SEDAN_WIDTH_M) / 2
+    assert row["verdict"] == "fail" and "left its lane" in row["note"]

@@ -5,6 +5,7 @@ thick dashed border; a colour legend; the totals of the system and policy in the
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import pandas as pd
@@ -30,16 +31,32 @@ LEGEND = {
     "verdicts": ("pass", "fail", "undetermined", "not_run"),
     "unscored": ("unscored", "not_run"),
 }
+#: characters of the 7 pt footnote per inch of figure width (a spare panel's text wraps)
+FOOTNOTE_CHARS_PER_INCH = 18.0
 ROW_KEYS = ["ego_speed_kmh", "target_speed_kmh", "gap_m", "target_decel_mps2"]
+#: tests scored on the VUT's speed reduction (the cell shows it, not the impact speed)
+REDUCTION_TESTS = ("CCFhos", "CCFhol")
+
+
+def _r152_text(r) -> str:
+    """An R152 row: the impact, B/S, the lane (left it: fails) and the warning's lead."""
+    hit = "no contact" if not r.impact_speed_kmh else f"hit at {r.impact_speed_kmh:.1f} km/h"
+    lane = ", LEFT ITS LANE" if "left its lane" in str(r.note) else ""
+    lead = "no warning" if pd.isna(r.warning_lead_s) else f"warning {r.warning_lead_s:.2f} s"
+    late = " (< 0.8 s: late)" if r.warning == "fail" else ""
+    return f"{hit} {r.manoeuvre}{lane}; {lead}{late}"
 
 
 def _cell_text(r) -> str:
     """The cell's value (impact or, head-on, reduction km/h) and B/S; '-' not run."""
     if r.status != "ok":
         return "-"
-    value = r.speed_reduction_kmh if r.test == "CCFhos" else r.impact_speed_kmh
+    if str(r.test).startswith("R152"):
+        return _r152_text(r)
+    reduction = r.test in REDUCTION_TESTS
+    value = r.speed_reduction_kmh if reduction else r.impact_speed_kmh
     shown = "0" if pd.isna(value) else f"{value:.0f}"
-    if r.test == "CCFhos" and pd.isna(value):
+    if reduction and pd.isna(value):
         shown = "no hit"
     mark = f" {r.manoeuvre}" if isinstance(r.manoeuvre, str) else ""
     warning = {"pass": " W", "fail": " w!"}.get(r.warning, "") if isinstance(r.warning, str) else ""
@@ -47,14 +64,20 @@ def _cell_text(r) -> str:
 
 
 def _panel_title(test: str, own: pd.DataFrame, totals: dict) -> str:
+    """The test, its points (or R152 passes) and what its cells show."""
+    shows = "speed reduction [km/h]" if test in REDUCTION_TESTS else "impact speed [km/h]"
+    if test.startswith("R152"):
+        shows = "impact, manoeuvre, the warning's lead over the braking"
     t = next((x for x in totals.get("tests", []) if x["test"] == test), None)
     if t is not None:
         gated = "" if totals.get("gate_passed", True) else " before the gate"
-        return f"{test}: {t['points']:.2f} of {t['max_points']:.2f}{gated}"
-    if test.startswith("R152"):
+        head = f"{test}: {t['points']:.2f} of {t['max_points']:.2f} points{gated}"
+    elif test.startswith("R152"):
         passed = int((own["verdict"] == "pass").sum())
-        return f"{test}: {passed} of {len(own)} pass"
-    return test
+        head = f"{test}: {passed} of {len(own)} rows pass"
+    else:
+        head = test
+    return f"{head}\ncells: {shows}"
 
 
 def _draw_panel(ax, test: str, own: pd.DataFrame, totals: dict) -> None:
@@ -89,9 +112,11 @@ def _row_label(row: tuple) -> str:
 
 #: what a cell's text says, by the kind of protocol
 CELL_TEXT = {
-    "bands": "cell: impact km/h (CCFhos: speed reduction km/h); B braked in lane, S steered",
-    "verdicts": "cell: impact km/h; B braked in lane, S steered; W warning in time, w! late "
-    "or none",
+    "bands": "cell: impact km/h (CCFhos, CCFhol: speed reduction km/h); B braked in lane, "
+    "S steered",
+    "verdicts": "a row passes with its impact within R152's limit, its lane kept and the warning "
+    "at least 0.8 s before the braking (unverified: docs/protocols.md); B braked in lane, "
+    "S steered",
     "unscored": "cell: impact km/h; B braked in lane, S steered",
 }
 
@@ -141,6 +166,10 @@ def plot_scorecard(
     fig.tight_layout(rect=(0, 0.08 if spare or not footnote else 0.14, 1, 0.95))
     if footnote:  # placed after the layout, which it must not squeeze
         x, y = (spare[0].get_position().x0, spare[0].get_position().y1) if spare else (0.01, 0.13)
-        fig.text(x, y, footnote, va="top", ha="left", fontsize=7)
+        width = FOOTNOTE_CHARS_PER_INCH * width * (1.0 - x) if spare else 200
+        lines = [
+            textwrap.fill(line, int(width), subsequent_indent="  ") for line in footnote.split("\n")
+        ]
+        fig.text(x, y, "\n".join(lines), va="top", ha="left", fontsize=7)
     fig.savefig(path, dpi=130)
     return Path(path)

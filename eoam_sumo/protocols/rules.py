@@ -78,6 +78,15 @@ TOTAL_SCORES = {
 }
 #: Low Speed Collisions, car target (RATING_2026 ``TOTAL_SCORES``, standard range only)
 LSC_CAR_SCORES = {"CCCscp SfS": 3.0, "CCFtap SfS": 1.0}
+#: The motorcycle-target tests of the same "Car & PTW" subelement (RATING_2026 ``TOTAL_SCORES``):
+#: Frontal Collisions standard / extended / robustness, and Low Speed Collisions (standard)
+PTW_SCORES = {
+    "CMRs": {"standard": 1.2, "extended": 0.15, "robustness": 0.15},
+    "CMRb": {"standard": 1.6, "extended": 0.2, "robustness": 0.2},
+    "CMFtap": {"standard": 4.0, "extended": 0.5, "robustness": 0.5},
+    "CMCscp": {"standard": 6.0, "extended": 0.75, "robustness": 0.75},
+}
+LSC_PTW_SCORES = {"CMCscp SfS": 3.0, "CMFtap SfS": 3.0}
 
 
 def weight_total(test: str) -> float:

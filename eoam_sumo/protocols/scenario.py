@@ -6,7 +6,11 @@ opposite lane as its neighbour, so the EOAM can change lanes) plus, for every la
 offset, a one-lane edge under the ego lane: ``T<k>`` eastbound (the target ahead) and
 ``H<k>`` westbound (the head-on target), their lane centre at y = -1.75 + offset. SUMO keeps
 a vehicle on its lane's centre, so the offset lane places the target at its overlap; the
-radar and the contact test see it where it is (geometry, never lane ids).
+radar and the contact test see it where it is (geometry, never lane ids). A CCFhol point's
+target drives its own westbound edge ``L<n>`` whose shape is the scripted lane change
+(``lane_change.path_points``): it starts ``HOL_SHIFT_M`` left of its end offset and follows
+the path into the ego lane, so SUMO moves it along the path at its speed; the obstruction
+vehicle it pulls out from behind drives the opposite lane ``-E0``.
 
 The target's speed profile is a scripted stop (``eoam.aro_hold_s``, ``eoam.aro_decel_mps2``,
 docs/scenarios.md): stationary (departs at 0), constant (holds for the whole run) or braking
@@ -19,7 +23,18 @@ from pathlib import Path
 
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.netbuild import build_network
-from eoam_sumo.protocols.points import GVT_LENGTH_M, GVT_WIDTH_M, TestPoint
+from eoam_sumo.protocols.lane_change import path_points
+from eoam_sumo.protocols.points import (
+    FOREVER_S,
+    GVT_LENGTH_M,
+    GVT_WIDTH_M,
+    HEAD_ON_STARTUP_S,
+    HOL_SHIFT_M,
+    HOL_SOV_HEADWAY_S,
+    SOV_LENGTH_M,
+    SOV_WIDTH_M,
+    TestPoint,
+)
 
 ROAD_M = 4000.0
 EGO_LANE_Y_M = -1.75
@@ -33,7 +48,46 @@ def offset_edges(points: list[TestPoint]) -> dict[float, int]:
     return {off: k for k, off in enumerate(sorted({p.offset_m for p in points}))}
 
 
-def _network_sources(folder: Path, offsets: dict[float, int]) -> Path:
+def lane_change_edges(points: list[TestPoint]) -> dict[str, int]:
+    """Each CCFhol point's id -> the index n of its edge ``L<n>``."""
+    return {p.point_id: n for n, p in enumerate(p for p in points if p.lane_change)}
+
+
+def lane_change_start_x_m(point: TestPoint) -> float:
+    """Where the target's lane change begins: its front's start, 8 s of its speed on."""
+    return EGO_FRONT_X_M + point.gap_m - HEAD_ON_STARTUP_S * point.target_speed_kmh / 3.6
+
+
+def lane_change_shape(point: TestPoint) -> list[tuple[float, float]]:
+    """The CCFhol target's westbound path: straight HOL_SHIFT_M left of its end offset, the
+    lane change from ``lane_change_start_x_m`` on, then straight at the end offset."""
+    end_y = EGO_LANE_Y_M + point.offset_m
+    start_x = lane_change_start_x_m(point)
+    path = path_points(point.target_speed_kmh, HOL_SHIFT_M)
+    shape = [(ROAD_M, end_y + HOL_SHIFT_M)]
+    shape += [(start_x - along, end_y + HOL_SHIFT_M - left) for along, left in path]
+    return [*shape, (0.0, end_y)]
+
+
+def _lane_change_sources(points: list[TestPoint]) -> tuple[list[str], list[str]]:
+    """Nodes and edges of every CCFhol target's path."""
+    nodes, edges = [], []
+    for pid, n in lane_change_edges(points).items():
+        shape = lane_change_shape(next(p for p in points if p.point_id == pid))
+        (xe, ye), (xw, yw) = shape[0], shape[-1]
+        nodes += [
+            f'<node id="le{n}" x="{xe:.2f}" y="{ye:.4f}"/>',
+            f'<node id="lw{n}" x="{xw:.2f}" y="{yw:.4f}"/>',
+        ]
+        text = " ".join(f"{x:.3f},{y:.4f}" for x, y in shape)
+        edges.append(
+            f'<edge id="L{n}" from="le{n}" to="lw{n}" numLanes="1" speed="50.00" width="2.00"'
+            f' spreadType="center" shape="{text}"><lane index="0" friction="1.00"/></edge>'
+        )
+    return nodes, edges
+
+
+def _network_sources(folder: Path, offsets: dict[float, int], points: list[TestPoint]) -> Path:
     nodes = ['<node id="west" x="0.00" y="0.00"/>', f'<node id="east" x="{ROAD_M:.2f}" y="0.00"/>']
     edges = [
         '<edge id="E0" from="west" to="east" numLanes="1" speed="50.00" width="3.50">'
@@ -55,6 +109,8 @@ def _network_sources(folder: Path, offsets: dict[float, int]) -> Path:
                 f'<edge id="{eid}" from="{a}" to="{b}" numLanes="1" speed="50.00" width="2.00"'
                 f' spreadType="center"><lane index="0" friction="1.00"/></edge>'
             )
+    hol_nodes, hol_edges = _lane_change_sources(points)
+    nodes, edges = nodes + hol_nodes, edges + hol_edges
     head = '<?xml version="1.0" encoding="UTF-8"?>\n'
     write_atomic(
         folder / "protocol.nod.xml", head + "<nodes>\n" + "\n".join(nodes) + "\n</nodes>\n"
@@ -67,11 +123,16 @@ def _network_sources(folder: Path, offsets: dict[float, int]) -> Path:
 
 VTYPES = f"""<?xml version="1.0" encoding="UTF-8"?>
 <!-- ego: the sedan (scenarios/vtypes.add.xml); gvt: Euro NCAP's Global Vehicle Target,
-     {GVT_LENGTH_M} x {GVT_WIDTH_M} m (vectorgrp/OSC-NCAP-scenarios Vehicles.xosc). -->
+     {GVT_LENGTH_M} x {GVT_WIDTH_M} m; sov: CCFhol's obstruction vehicle
+     (vectorgrp/OSC-NCAP-scenarios Vehicles.xosc NCAP_GlobalVehicleTarget,
+     NCAP_ObstructionVehicle_Large). -->
 <additional>
     <vType id="ego" vClass="passenger" length="4.92" width="1.85" minGap="2.00" maxSpeed="60.00"
            accel="4.00" decel="9.00" emergencyDecel="12.00" sigma="0" speedDev="0"/>
     <vType id="gvt" vClass="passenger" length="{GVT_LENGTH_M}" width="{GVT_WIDTH_M}"
+           minGap="1.00" maxSpeed="50.00" accel="2.50" decel="10.00" emergencyDecel="12.00"
+           sigma="0" speedDev="0"/>
+    <vType id="sov" vClass="passenger" length="{SOV_LENGTH_M}" width="{SOV_WIDTH_M}"
            minGap="1.00" maxSpeed="50.00" accel="2.50" decel="10.00" emergencyDecel="12.00"
            sigma="0" speedDev="0"/>
 </additional>
@@ -92,10 +153,30 @@ SUMOCFG = """<?xml version="1.0" encoding="UTF-8"?>
 """
 
 
+def _obstruction(point: TestPoint) -> str:
+    """CCFhol's obstruction vehicle on the opposite lane, F ahead of the target (its rear F
+    before the target's front), at the target's speed for the whole run."""
+    if not point.lane_change:
+        return ""
+    tgt_mps = point.target_speed_kmh / 3.6
+    front_x = EGO_FRONT_X_M + point.gap_m - HOL_SOV_HEADWAY_S * tgt_mps - SOV_LENGTH_M
+    return f"""    <route id="sov_route" edges="-E0"/>
+    <vehicle id="obstruction" type="sov" route="sov_route" depart="{DEPART_S:.2f}"
+             departLane="0" departPos="{ROAD_M - front_x:.3f}" departSpeed="{tgt_mps:.6f}"
+             insertionChecks="none">
+        <param key="eoam.aro_hold_s" value="{FOREVER_S:g}"/>
+        <param key="eoam.aro_decel_mps2" value="{STOPPED_DECEL_MPS2:g}"/>
+    </vehicle>
+"""
+
+
 def _routes(point: TestPoint, k: int) -> str:
-    """The ego and the target of one point (SUMO places a vehicle by its front bumper)."""
+    """The ego and the target of one point (SUMO places a vehicle by its front bumper);
+    ``k``: the target's edge index (``L<k>`` for a lane change, else ``T<k>``/``H<k>``)."""
     ego_mps, tgt_mps = point.ego_speed_kmh / 3.6, point.target_speed_kmh / 3.6
-    if point.head_on:
+    if point.lane_change:
+        edge, pos = f"L{k}", ROAD_M - (EGO_FRONT_X_M + point.gap_m)
+    elif point.head_on:
         edge, pos = f"H{k}", ROAD_M - (EGO_FRONT_X_M + point.gap_m)
     else:
         edge, pos = f"T{k}", EGO_FRONT_X_M + point.gap_m + GVT_LENGTH_M
@@ -116,20 +197,21 @@ def _routes(point: TestPoint, k: int) -> str:
         <param key="eoam.aro_hold_s" value="{hold:g}"/>
         <param key="eoam.aro_decel_mps2" value="{decel:g}"/>
     </vehicle>
-</routes>
+{_obstruction(point)}</routes>
 """
 
 
 def write_scenarios(points: list[TestPoint], folder: Path) -> dict[str, Path]:
     """Build the network and write every point's files under ``folder``; point id -> sumocfg."""
     folder.mkdir(parents=True, exist_ok=True)
-    offsets = offset_edges(points)
-    net = build_network(_network_sources(folder, offsets))
+    offsets, hol = offset_edges(points), lane_change_edges(points)
+    net = build_network(_network_sources(folder, offsets, points))
     write_atomic(folder / "protocol_vtypes.add.xml", VTYPES)
     cfgs = {}
     for point in points:
         pid = point.point_id
-        write_atomic(folder / f"{pid}.rou.xml", _routes(point, offsets[point.offset_m]))
+        k = hol[pid] if point.lane_change else offsets[point.offset_m]
+        write_atomic(folder / f"{pid}.rou.xml", _routes(point, k))
         cfg = SUMOCFG.format(
             net=net.name, routes=f"{pid}.rou.xml", vtypes="protocol_vtypes.add.xml"
         )

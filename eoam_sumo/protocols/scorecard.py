@@ -32,13 +32,18 @@ class RunLabel:
         return f"{self.name}, system {self.system}{ours}, policy {self.policy}"
 
 
-#: What the CCFhos source says and what we did (the scorecard prints it)
+#: What the head-on sources say and what we did (the scorecard prints it)
 CCFHOS_TEXT = (
-    "CCFhos bands: the rating code scores the VUT's speed reduction (v_reduction) with "
-    "mitigation_scenarios_thresholds: <= 10 km/h red, <= 20 orange, <= 30 green, above 30 "
-    "red (FC v1.2 Figure 5-2, not held here). Read literally a full stop at 50/50 would score "
-    "red like no reaction; we score a reduction above 30 km/h green, and a run without "
-    "contact green, so the points never fall as the reduction grows."
+    "CCFhos and CCFhol bands: the rating code scores the VUT's speed reduction (v_reduction) "
+    "with mitigation_scenarios_thresholds: <= 10 km/h red, <= 20 orange, <= 30 green, above "
+    "30 red (FC v1.2 Figure 5-2, not held here). Read literally a full stop at 50/50 would "
+    "score red like no reaction; we score a reduction above 30 km/h green, and a run without "
+    "contact green, so the points never fall as the reduction grows.\n\n"
+    "CCFhol: the rating code gives it CCFhos's matrix (8 rows x 4 impact locations, the same "
+    "extended cells); its row speeds are not held, so we run CCFhos's rows. The target pulls "
+    "out from behind an obstruction vehicle and changes lanes along Vector's 2023 path "
+    "(3.5 m over 43 m at 50 km/h, 60 m at 70 km/h, the 70 km/h path stretched above) to end "
+    "at its impact location at a TTC of 1.5 s (docs/protocols.md)."
 )
 
 
@@ -55,6 +60,8 @@ def scorecard_markdown(frame: pd.DataFrame, run: RunLabel) -> str:
         f"Vehicle {run.vehicle}, friction {run.mu:g}, decision policy {run.policy}. Colours, "
         "points, B/S (braked / steered) per point in results.csv; docs/protocols.md.",
         "",
+        manoeuvre_line(rows) + ".",
+        "",
     ]
     if run.name == PROTOCOLS[1]:
         lines += fc_lines(rows, run) + not_built_lines() + [CCFHOS_TEXT, ""]
@@ -64,6 +71,15 @@ def scorecard_markdown(frame: pd.DataFrame, run: RunLabel) -> str:
         lines += unscored_lines(rows)
     lines += not_run_lines(rows, run) + short_lines(rows)
     return "\n".join(lines) + "\n"
+
+
+def manoeuvre_line(rows: list[dict]) -> str:
+    """What the runs did: braked in lane (B), steered (S), never intervened (-)."""
+    marks = [r["manoeuvre"] for r in rows if r["status"] == "ok"]
+    return (
+        f"Manoeuvres of the {len(marks)} runs: B (braked in lane) {marks.count('B')}, "
+        f"S (steered) {marks.count('S')}, - (never intervened) {marks.count('-')}"
+    )
 
 
 def fc_lines(rows: list[dict], run: RunLabel) -> list[str]:
@@ -118,7 +134,26 @@ def not_built_lines() -> list[str]:
             f"| {test} (Low Speed Collisions) | {rules.LSC_CAR_SCORES[test]:g} / - / - | "
             f"{rules.LSC_CAR_SCORES[test]:g} | {why} |"
         )
-    return [*lines, ""]
+    lines += [_ptw_line(test, why) for test, why in scoring.NOT_BUILT_PTW.items()]
+    return [
+        *lines,
+        "",
+        "The car-target tests count in the protocol's maximum above; the motorcycle-target "
+        "tests of the same Car & PTW subelement do not.",
+        "",
+    ]
+
+
+def _ptw_line(test: str, why: str) -> str:
+    """A motorcycle-target test's row: FC weights, or the LSC one (SfS)."""
+    if test in rules.LSC_PTW_SCORES:
+        w = rules.LSC_PTW_SCORES[test]
+        return f"| {test} (Low Speed Collisions, motorcycle) | {w:g} / - / - | {w:g} | {why} |"
+    parts = rules.PTW_SCORES[test]
+    return (
+        f"| {test} (FC, motorcycle) | {parts['standard']:g} / {parts['extended']:g} / "
+        f"{parts['robustness']:g} | {sum(parts.values()):g} | {why} |"
+    )
 
 
 def r152_lines(rows: list[dict]) -> list[str]:
@@ -150,7 +185,7 @@ def unscored_lines(rows: list[dict]) -> list[str]:
     return [
         *lines,
         "",
-        "Not built for 2023: CCFhos, CCFhol and CCFtap (their 2023 weights are not held; "
+        "Not built for 2023: CCFtap (its 2023 weight is not held; "
         "docs/protocols.md, tests not built).",
         "",
     ]
@@ -186,8 +221,9 @@ def short_lines(rows: list[dict]) -> list[str]:
     ]
     if not bad:
         return ["No point short of full marks among those run.", ""]
+    r152 = str(bad[0]["test"]).startswith("R152")
     lines = [
-        f"## Points short of full marks ({len(bad)})",
+        f"## {'Rows that do not pass' if r152 else 'Points short of full marks'} ({len(bad)})",
         "",
         "| point | impact km/h | reduction km/h | B/S | colour / verdict | cause |",
         "|---|---|---|---|---|---|",
@@ -207,13 +243,15 @@ def _num(value) -> str:
     return f"{float(value):.2f}"
 
 
-def picture_headline(run: RunLabel, totals: dict) -> str:
+def picture_headline(run: RunLabel, totals: dict, rows: list[dict]) -> str:
     """The picture's title: the run, and (2026) the overall points and the gate."""
-    head = f"{run.title}; {run.vehicle}, mu {run.mu:g}"
+    head = f"{run.title}; {run.vehicle}, mu {run.mu:g}\n{manoeuvre_line(rows)}"
     if run.name == PROTOCOLS[0]:
         return head + "\nunscored: the 2023 bands are not held"
     if run.name != PROTOCOLS[1]:
-        return head + "\nR152 rows: pass needs the speed limit, the lane kept and the warning"
+        return (
+            head + "\nR152 rows: pass needs the speed limit, the lane kept and the warning in time"
+        )
     gate = "passed" if totals["gate_passed"] else "FAILED: every FC point 0"
     return (
         f"{head}\noverall {totals['points']:.2f} of {totals['max_run']:.2f} for the tests run "
@@ -229,22 +267,26 @@ def plot(frame: pd.DataFrame, path, run: RunLabel) -> None:
     scored = run.name == PROTOCOLS[1]
     totals = scoring.fc_totals(frame.to_dict("records")) if scored else {}
     kind = {PROTOCOLS[0]: "unscored", PROTOCOLS[1]: "bands", PROTOCOLS[2]: "verdicts"}[run.name]
-    plot_scorecard(frame, path, picture_headline(run, totals), kind, totals, not_built_note(run))
+    headline = picture_headline(run, totals, frame.to_dict("records"))
+    plot_scorecard(frame, path, headline, kind, totals, not_built_note(run))
 
 
 def not_built_note(run: RunLabel) -> str:
     """The picture's list of the tests not built and their points at stake."""
     if run.name == PROTOCOLS[0]:
-        return "Not built for 2023: CCFhos, CCFhol, CCFtap (2023 weights not held)."
+        return "Not built for 2023: CCFtap (a junction test; 2023 weights not held)."
     if run.name != PROTOCOLS[1]:
         return ""
     fc = [f"{t} {rules.weight_total(t):g}" for t in scoring.NOT_BUILT]
     lsc = [f"{t} {rules.LSC_CAR_SCORES[t]:g}" for t in scoring.NOT_BUILT_LSC]
+    ptw = [f"{t} {sum(w.values()):g}" for t, w in rules.PTW_SCORES.items()]
+    ptw += [f"{t} {w:g}" for t, w in rules.LSC_PTW_SCORES.items()]
     return (
         "Tests not built (points at stake):\n"
         f"Frontal Collisions: {', '.join(fc)}\n"
         f"Low Speed Collisions: {', '.join(lsc)}\n"
-        "(CCFhol: scripted lane change not built; the others are junction tests, out of a "
-        "highway EOAM's scope; docs/protocols.md)\n"
+        f"Motorcycle target (not in the car maximum): {', '.join(ptw)}\n"
+        "(junction tests: out of a highway EOAM's scope; the motorcycle target is not "
+        "modelled; docs/protocols.md)\n"
         "Robustness layer: not assessed, 0 of its weight in every test"
     )

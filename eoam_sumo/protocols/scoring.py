@@ -184,9 +184,6 @@ def failure_cause(row: dict) -> str:
 
 #: The car-target FC tests not built here, and why (docs/protocols.md): test -> reason
 NOT_BUILT = {
-    "CCFhol": "the target's lane change along a scripted path is not built (our target "
-    "follows a SUMO lane at a fixed offset); the rating code gives CCFhol no verification "
-    "test either (a corner case in full)",
     "CCFtap": "a junction test (the VUT turns across an oncoming car): out of a highway "
     "EOAM's scope, no junction network here",
     "CCCscp": "a junction test (crossing straight paths): out of a highway EOAM's scope, no "
@@ -196,6 +193,15 @@ NOT_BUILT = {
 NOT_BUILT_LSC = {
     "CCCscp SfS": "junction, from standstill: out of scope (the EOAM works from 5 km/h)",
     "CCFtap SfS": "junction, from standstill: out of scope",
+}
+#: The motorcycle-target tests of the Car & PTW subelement (outside the car-target maximum)
+NOT_BUILT_PTW = {
+    "CMRs": "a motorcycle target (Euro NCAP's EMT) and its radar signature are not modelled",
+    "CMRb": "as CMRs",
+    "CMFtap": "a junction test with a motorcycle target: out of scope",
+    "CMCscp": "a junction test with a motorcycle target: out of scope",
+    "CMCscp SfS": "junction, from standstill, motorcycle target: out of scope",
+    "CMFtap SfS": "junction, from standstill, motorcycle target: out of scope",
 }
 
 
