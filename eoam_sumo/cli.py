@@ -18,6 +18,7 @@ from pathlib import Path
 
 from eoam_sumo import __version__
 from eoam_sumo.arguments import finite, mu, speed_kmh
+from eoam_sumo.drivers import DRIVERS
 from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import writable_dir
 from eoam_sumo.openscenario.command import (
@@ -90,9 +91,22 @@ def build_parser() -> argparse.ArgumentParser:
         vehicle_test_command.add_arguments,
         _protocol_arguments,
         add_scenario_arguments,
+        _r157_arguments,
     ):
         add_arguments(sub)
     return parser
+
+
+def _r157_arguments(sub) -> None:
+    from eoam_sumo.r157.command import add_arguments
+
+    add_arguments(sub)
+
+
+def _cmd_r157(args) -> int:
+    from eoam_sumo.r157.command import run
+
+    return run(args)
 
 
 def _protocol_arguments(sub) -> None:
@@ -169,6 +183,12 @@ def _run_arguments(sub) -> None:
         "occlusion, tracker; docs/sensing.md)",
     )
     p.add_argument("--seed", type=seed_argument, default=0, help="seed of every random model (0)")
+    p.add_argument(
+        "--driver",
+        choices=DRIVERS,
+        default="eoam",
+        help="the ego's controller: the EOAM or a reference driver (docs/reference-drivers.md)",
+    )
     _after_stop_argument(p)
     p.add_argument("--gui", action="store_true", help="run in sumo-gui through TraCI")
     _policy_arguments(p)
@@ -404,6 +424,7 @@ def _run_settings(args, out: Path):
         seed=args.seed,
         radar_model=parse_radar_model(args.radar_model),
         after_stop_s=args.after_stop_s,
+        driver=args.driver,
     )
     if args.radar_range_m is not None:
         settings = replace(settings, radar=RadarSettings(range_m=args.radar_range_m))
@@ -615,6 +636,7 @@ _COMMANDS = {
     "vehicle-test": vehicle_test_command.run,
     "protocol": _cmd_protocol,
     "scenario": cmd_scenario,
+    "r157-study": _cmd_r157,
 }
 
 

@@ -44,6 +44,7 @@ def _check(capsys, argv, needle):
         (["run", str(SCEN / "baseline.sumocfg"), "--oncoming-m", "far"], "far"),
         (["run", str(SCEN / "baseline.sumocfg"), "--speed-kmh", "300"], "300"),
         (["run", str(SCEN / "baseline.sumocfg"), "--frobnicate"], "--frobnicate"),
+        (["run", str(SCEN / "baseline.sumocfg"), "--driver", "human"], "human"),
         (["tables", "--jobs", "0"], "0"),
         (["batch", "missing.toml"], "missing.toml"),
         (["plot", "no_such_folder"], "no_such_folder"),

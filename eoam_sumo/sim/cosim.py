@@ -18,10 +18,10 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from pathlib import Path
 
+from eoam_sumo.drivers.controller import make_controller
 from eoam_sumo.eoam import (
     Command,
     EgoMeasurement,
-    EoamController,
     ObjectState,
     Perception,
 )
@@ -216,7 +216,9 @@ class CoSimulation:
         ).tolist()
         self.x_prev = self.x
         self.ax = self.ay = 0.0
-        self.ctrl = EoamController(self.params, self.tables, self.settings.eoam)
+        self.ctrl = make_controller(
+            self.settings.driver, self.params, self.tables, self.settings.eoam
+        )
         self.ctrl.reset(ego.speed_mps)
 
     def _set_up_sensing(self, session: SumoSession, ego: Body) -> None:

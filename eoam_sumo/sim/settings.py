@@ -8,6 +8,7 @@ from pathlib import Path
 
 from mypy_extensions import mypyc_attr
 
+from eoam_sumo.drivers import DRIVERS
 from eoam_sumo.eoam_settings import EoamSettings
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.sensing.next_lane import CornerRadarSettings
@@ -52,6 +53,8 @@ class RunSettings:
     # the vehicle as chosen: a catalogue name or a vehicle file; names its tables' folder
     # under ``tables_dir`` (``sim/vehicle.py``) and is the summary's ``vehicle``
     vehicle_id: str = DEFAULT_VEHICLE
+    # the ego's controller: the EOAM or a reference driver (drivers.controller.DRIVERS)
+    driver: str = "eoam"
 
     def __post_init__(self) -> None:
         ms = self.step_s * 1000.0
@@ -64,6 +67,8 @@ class RunSettings:
             raise ValueError(f"max_time_s={self.max_time_s} must be in (0, {MAX_TIME_LIMIT_S:g}]")
         if self.after_stop_s is not None and not self.after_stop_s >= 0.0:
             raise ValueError(f"after_stop_s={self.after_stop_s} must be >= 0")
+        if self.driver not in DRIVERS:
+            raise ValueError(f"driver={self.driver!r} is not one of {', '.join(DRIVERS)}")
         if self.v2x.enabled and self.eoam.policy.name != "safe":
             raise ValueError("V2X informs the safe policy only: set policy 'safe' or V2X range 0")
 
