@@ -17,7 +17,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from eoam_sumo import __version__
-from eoam_sumo.arguments import finite, mu, speed_kmh
+from eoam_sumo.arguments import finite, mu, speed_kmh, sumo_step_argument
 from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import writable_dir
 from eoam_sumo.openscenario.command import (
@@ -28,7 +28,7 @@ from eoam_sumo.openscenario.command import (
     xosc_arguments,
 )
 from eoam_sumo.seeds import seed_argument
-from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S, MAX_TIME_LIMIT_S
+from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S, MAX_TIME_LIMIT_S, check_sumo_step_s
 from eoam_sumo.traffic_levels.command import add_scenario_arguments, cmd_scenario
 from eoam_sumo.vehicle_tests import command as vehicle_test_command
 
@@ -170,6 +170,7 @@ def _run_arguments(sub) -> None:
     )
     p.add_argument("--seed", type=seed_argument, default=0, help="seed of every random model (0)")
     _after_stop_argument(p)
+    sumo_step_argument(p)
     p.add_argument("--gui", action="store_true", help="run in sumo-gui through TraCI")
     _policy_arguments(p)
     _gui_arguments(p)
@@ -259,6 +260,7 @@ def _batch_arguments(sub) -> None:
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     _after_stop_argument(p)
+    sumo_step_argument(p)
 
 
 def _plot_arguments(sub) -> None:
@@ -360,6 +362,8 @@ def _check_run_args(args) -> None:
         raise InputError(f"--radar-range-m {args.radar_range_m} must be > 0")
     if args.after_stop_s is not None and args.after_stop_s < 0:
         raise InputError(f"--after-stop-s {args.after_stop_s:g} must be >= 0")
+    if args.sumo_step_s is not None:
+        check_sumo_step_s(args.sumo_step_s, "--sumo-step-s")
     _check_v2x(args)
     refuse_params_for_sumocfg(args)
     if not args.gui and (args.gui_delay_ms is not None or args.gui_screenshot or args.gui_close):
@@ -394,6 +398,7 @@ def _run_settings(args, out: Path):
         seed=args.seed,
         radar_model=parse_radar_model(args.radar_model),
         after_stop_s=args.after_stop_s,
+        sumo_step_s=args.sumo_step_s,
     )
     if args.radar_range_m is not None:
         settings = replace(settings, radar=RadarSettings(range_m=args.radar_range_m))
@@ -452,7 +457,7 @@ def _cmd_batch(args) -> int:
     from eoam_sumo.outputs.staging import output_folder
 
     check_options(args.jobs, args.timeout_s, args.timeseries)
-    plan = plan_batch(args.matrix, after_stop_s=args.after_stop_s)
+    plan = plan_batch(args.matrix, after_stop_s=args.after_stop_s, sumo_step_s=args.sumo_step_s)
     with (
         _sigterm_interrupts(),
         output_folder(args.out, _batch_output(), in_place=args.resume) as out,

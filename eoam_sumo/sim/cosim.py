@@ -1,12 +1,15 @@
 """The co-simulation step loop: SUMO, radar, EOAM logic, plant and write-back, step by step.
 
-Two rates: SUMO and the EOAM decision/control run every ``step_s`` (10 ms by default); the
-plant integrates at ``plant_dt_s`` (1 ms) inside each SUMO step, all sub-steps in one compiled
-call. A step (:meth:`CoSimulation.step`) is a sequence of named phases: ``sense`` (the ego in
-the road frame, the radar on the road users SUMO reports near it), ``decide`` (EOAM decision
-and control), ``actuate`` (the plant), ``write_back`` (the ego's pose to SUMO with
-``moveToXY``, SUMO one step on), ``check_contact`` (oriented boxes at each plant sub-step),
-then the observers (time series, running extremes, anything added) and ``finished``.
+Three rates: the EOAM's decision/control every ``step_s`` (10 ms); SUMO every
+``sumo_step_s`` (by default the same 10 ms; up to 100 ms, the road users interpolated between
+its steps by :mod:`eoam_sumo.sim.interpolation`, the ego's pose written back at each); the
+plant at ``plant_dt_s`` (1 ms) inside each control step, all sub-steps in one compiled call
+(the automotive radar scans at its own cycle). A step (:meth:`CoSimulation.step`) is a
+sequence of named phases: ``sense`` (the ego in the road frame, the radar on the road users
+near it), ``decide`` (EOAM decision and control), ``actuate`` (the plant), ``write_back``
+(the ego's pose to SUMO with ``moveToXY``, SUMO one step on), ``check_contact`` (oriented
+boxes at each plant sub-step), then the observers (time series, running extremes, anything
+added) and ``finished``.
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ from eoam_sumo.sensing.friction import FrictionBelief
 from eoam_sumo.sensing.next_lane import NextLaneSensing
 from eoam_sumo.sensing.radar import RadarReport
 from eoam_sumo.sim.facts import collect_facts, collect_info
+from eoam_sumo.sim.interpolation import accelerations, advance_bodies
 from eoam_sumo.sim.margins import (
     EGO_STANDSTILL_MPS,
     Margins,
@@ -98,6 +102,8 @@ class CoSimulation:
     cmd: Command
     bodies: list
     bodies_before: list
+    #: each road user's acceleration over SUMO's last step (multi-rate runs; one rate: None)
+    sumo_accel_mps2: dict[str, float] | None
 
     def __init__(
         self,
@@ -160,10 +166,11 @@ class CoSimulation:
             self.cfg,
             self.overrides,
             ego_id=st.ego_id,
-            step_length_s=st.step_s,
+            step_length_s=st.sumo_step_length_s,
             gui=st.gui,
             use_traci=st.use_traci,
             gui_settings=st.gui_settings,
+            ballistic=st.sumo_every > 1,
         )
 
     # ----------------------------------------------------------------------------- set-up
@@ -269,6 +276,22 @@ class CoSimulation:
         self._stop_at: float | None = None
         self.t = self.t_start = session.time_s
         self.bodies = session.nearby(self._sense_radius_m)  # with their boxes
+        self._reset_rates()
+
+    def _reset_rates(self) -> None:
+        """A multi-rate run's state: control steps since SUMO's last step, SUMO's last report
+        and its time in ms, the road users' accelerations over SUMO's last step; the margin
+        the contact check allows for SUMO's report differing from the interpolation."""
+        st = self.settings
+        self._every = st.sumo_every
+        self._since_sumo = 0
+        self._sumo_bodies = self.bodies
+        self._sumo_ms = round(self.t * 1000.0)
+        self._step_ms = round(st.step_s * 1000.0)
+        self.sumo_accel_mps2 = None if self._every == 1 else {}
+        # 0.05 m of rounding; SUMO's next report is within 1.5 a T^2 of the interpolation
+        sumo_s = st.sumo_step_length_s
+        self._reach_pad_m = 0.05 if self._every == 1 else 0.05 + 15.0 * sumo_s * sumo_s
 
     def _check_departure(self) -> None:
         """Refuse a road user overlapping the ego's box at its departure."""
@@ -382,15 +405,39 @@ class CoSimulation:
 
     def write_back(self) -> None:
         """The ego's pose to SUMO (front bumper, navigation angle), SUMO one step on, and the
-        road users around the ego then."""
+        road users around the ego then; in a multi-rate run, between SUMO's steps, the road
+        users interpolated instead."""
         X, Y, yaw, vx = self.x[:4]
         self._cy, self._sy = cy, sy = math.cos(yaw), math.sin(yaw)
+        if self._every > 1:
+            self._since_sumo += 1
+            if self._since_sumo < self._every:
+                self._interpolate()
+                return
+            self._since_sumo = 0
         front = self._front
         session = self.session
         session.move_ego(X + front * cy, Y + front * sy, nav_angle_deg(yaw), max(vx, 0.0))
         session.step()
         self.t = session.time_s
         self.bodies_before, self.bodies = self.bodies, session.nearby(self._sense_radius_m)
+        if self._every > 1:
+            self._sumo_reported()
+
+    def _interpolate(self) -> None:
+        """The time and the road users ``_since_sumo`` control steps after SUMO's last
+        report (:func:`~eoam_sumo.sim.interpolation.advance_bodies`)."""
+        since_ms = self._since_sumo * self._step_ms
+        self.t = (self._sumo_ms + since_ms) / 1000.0
+        bodies = advance_bodies(self._sumo_bodies, self.sumo_accel_mps2 or {}, since_ms / 1000.0)
+        self.bodies_before, self.bodies = self.bodies, bodies
+
+    def _sumo_reported(self) -> None:
+        """SUMO's new report kept: the road users' accelerations over its step, and when."""
+        sumo_s = self.settings.sumo_step_length_s
+        self.sumo_accel_mps2 = accelerations(self._sumo_bodies, self.bodies, sumo_s)
+        self._sumo_bodies = self.bodies
+        self._sumo_ms = round(self.t * 1000.0)
 
     def check_contact(self) -> None:
         """Ground truth: oriented-box contact with every road user near the ego at every plant
@@ -413,7 +460,7 @@ class CoSimulation:
             centres_m = math.hypot(b.x_m - ego_cx, b.y_m - ego_cy)
             if centres_m > GAP_WATCH_M:
                 continue
-            reach_m = ego_move + b.speed_mps * step_s + 0.05
+            reach_m = ego_move + b.speed_mps * step_s + self._reach_pad_m
             # the bounding circles' gap is a lower bound of the boxes' gap
             circles_m = centres_m - ego_box_radius - b.box.radius_m - GAP_ROUNDING_M
             if circles_m > reach_m and circles_m >= min_gap_aro:
