@@ -291,6 +291,21 @@ def _bench_arguments(sub) -> None:
         help="instead: the plant's step and Table 2 batch against git revision REV, as ratios",
     )
     p.add_argument("--pairs", type=_positive_int, default=3, help="with --against: probes per tree")
+    p.add_argument(
+        "--studies",
+        action="store_true",
+        help="instead: per SUMO step the step loop's cost ratio against SUMO alone at that "
+        "step, Table 2's wall time and its changes against the first step, the load average",
+    )
+    p.add_argument(
+        "--sumo-steps",
+        type=finite,
+        nargs="+",
+        metavar="S",
+        default=(0.01, 0.05, 0.1),
+        help="with --studies: SUMO steps [s], the first the reference (0.01 0.05 0.1)",
+    )
+    p.add_argument("--jobs", type=_positive_int, default=2, help="with --studies: batch jobs")
 
 
 def _cmd_tables(args) -> int:
@@ -560,6 +575,11 @@ def _cmd_bench(args) -> int:
 
     if args.against is not None:
         return run_against_cli(writable_dir(args.out), args.against, args.quick, args.pairs)
+    if args.studies:
+        from eoam_sumo.bench import run_studies_cli
+
+        steps = tuple(check_sumo_step_s(s, "--sumo-steps") for s in args.sumo_steps)
+        return run_studies_cli(writable_dir(args.out), steps, args.jobs, args.quick)
     return run_bench_cli(writable_dir(args.out), quick=args.quick)
 
 

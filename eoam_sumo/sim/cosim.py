@@ -38,7 +38,7 @@ from eoam_sumo.sensing.friction import FrictionBelief
 from eoam_sumo.sensing.next_lane import NextLaneSensing
 from eoam_sumo.sensing.radar import RadarReport
 from eoam_sumo.sim.facts import collect_facts, collect_info
-from eoam_sumo.sim.interpolation import accelerations, advance_bodies
+from eoam_sumo.sim.interpolation import ego_ahead, interpolate_reports
 from eoam_sumo.sim.margins import (
     EGO_STANDSTILL_MPS,
     Margins,
@@ -102,8 +102,6 @@ class CoSimulation:
     cmd: Command
     bodies: list
     bodies_before: list
-    #: each road user's acceleration over SUMO's last step (multi-rate runs; one rate: None)
-    sumo_accel_mps2: dict[str, float] | None
 
     def __init__(
         self,
@@ -279,19 +277,17 @@ class CoSimulation:
         self._reset_rates()
 
     def _reset_rates(self) -> None:
-        """A multi-rate run's state: control steps since SUMO's last step, SUMO's last report
-        and its time in ms, the road users' accelerations over SUMO's last step; the margin
-        the contact check allows for SUMO's report differing from the interpolation."""
+        """A multi-rate run's state: control steps since SUMO's earlier report, that report
+        (SUMO's time then, in ms) and its later one; the margin the contact check allows for
+        a road user's move in a step beyond its speed's."""
         st = self.settings
         self._every = st.sumo_every
         self._since_sumo = 0
-        self._sumo_bodies = self.bodies
+        self._report0 = self._report1 = self.bodies
         self._sumo_ms = round(self.t * 1000.0)
         self._step_ms = round(st.step_s * 1000.0)
-        self.sumo_accel_mps2 = None if self._every == 1 else {}
-        # 0.05 m of rounding; SUMO's next report is within 1.5 a T^2 of the interpolation
-        sumo_s = st.sumo_step_length_s
-        self._reach_pad_m = 0.05 if self._every == 1 else 0.05 + 15.0 * sumo_s * sumo_s
+        self._sumo_step_ms = round(st.sumo_step_length_s * 1000.0)
+        self._reach_pad_m = 0.05 if self._every == 1 else 0.1
 
     def _check_departure(self) -> None:
         """Refuse a road user overlapping the ego's box at its departure."""
@@ -410,34 +406,40 @@ class CoSimulation:
         X, Y, yaw, vx = self.x[:4]
         self._cy, self._sy = cy, sy = math.cos(yaw), math.sin(yaw)
         if self._every > 1:
-            self._since_sumo += 1
-            if self._since_sumo < self._every:
-                self._interpolate()
-                return
-            self._since_sumo = 0
+            self._multi_rate_step()
+            return
         front = self._front
         session = self.session
         session.move_ego(X + front * cy, Y + front * sy, nav_angle_deg(yaw), max(vx, 0.0))
         session.step()
         self.t = session.time_s
         self.bodies_before, self.bodies = self.bodies, session.nearby(self._sense_radius_m)
-        if self._every > 1:
-            self._sumo_reported()
 
-    def _interpolate(self) -> None:
-        """The time and the road users ``_since_sumo`` control steps after SUMO's last
-        report (:func:`~eoam_sumo.sim.interpolation.advance_bodies`)."""
-        since_ms = self._since_sumo * self._step_ms
+    def _multi_rate_step(self) -> None:
+        """SUMO one step ahead of the control steps: at the first control step after SUMO's
+        earlier report, the ego's pose carried on to SUMO's next step
+        (:func:`~eoam_sumo.sim.interpolation.ego_ahead`) and SUMO one step on; the road users
+        between its two reports (:func:`~eoam_sumo.sim.interpolation.interpolate_reports`)."""
+        self._since_sumo = since = self._since_sumo + 1
+        session = self.session
+        if since == 1:
+            ahead_s = (self._sumo_step_ms - self._step_ms) / 1000.0
+            X, Y, yaw, speed = ego_ahead(self.x, self.ax, ahead_s)
+            front = self._front
+            session.move_ego(
+                X + front * math.cos(yaw), Y + front * math.sin(yaw), nav_angle_deg(yaw), speed
+            )
+            session.step()
+            self._report0, self._report1 = self._report1, session.nearby(self._sense_radius_m)
+        since_ms = since * self._step_ms
         self.t = (self._sumo_ms + since_ms) / 1000.0
-        bodies = advance_bodies(self._sumo_bodies, self.sumo_accel_mps2 or {}, since_ms / 1000.0)
-        self.bodies_before, self.bodies = self.bodies, bodies
-
-    def _sumo_reported(self) -> None:
-        """SUMO's new report kept: the road users' accelerations over its step, and when."""
-        sumo_s = self.settings.sumo_step_length_s
-        self.sumo_accel_mps2 = accelerations(self._sumo_bodies, self.bodies, sumo_s)
-        self._sumo_bodies = self.bodies
-        self._sumo_ms = round(self.t * 1000.0)
+        self.bodies_before = self.bodies
+        self.bodies = interpolate_reports(
+            self._report0, self._report1, since_ms / 1000.0, self._sumo_step_ms / 1000.0
+        )
+        if since == self._every:
+            self._since_sumo = 0
+            self._sumo_ms += self._sumo_step_ms
 
     def check_contact(self) -> None:
         """Ground truth: oriented-box contact with every road user near the ego at every plant

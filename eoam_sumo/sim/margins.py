@@ -271,20 +271,11 @@ class Margins(StepObserver):
             return
         if gap > 0.0:
             self.max_drac_rear_mps2 = max(self.max_drac_rear_mps2, closing * closing / (2.0 * gap))
-        decel = _decel_mps2(sim, b, self._step_s)
-        if decel is not None and decel > self.max_follower_decel_mps2:
-            self.max_follower_decel_mps2, self.follower_decel_id = decel, b.vid
-
-
-def _decel_mps2(sim: RunView, b: Body, step_s: float) -> float | None:
-    """A road user's deceleration over the last step (None: not seen before); in a
-    multi-rate run, over SUMO's last step (the interpolation's jump onto SUMO's next report
-    is not a deceleration)."""
-    accel = sim.sumo_accel_mps2
-    if accel is not None:
-        return -accel[b.vid] if b.vid in accel else None
-    before = next((o for o in sim.bodies_before if o.vid == b.vid), None)
-    return None if before is None else (before.speed_mps - b.speed_mps) / step_s
+        before = next((o for o in sim.bodies_before if o.vid == b.vid), None)
+        if before is not None:
+            decel = (before.speed_mps - b.speed_mps) / self._step_s
+            if decel > self.max_follower_decel_mps2:
+                self.max_follower_decel_mps2, self.follower_decel_id = decel, b.vid
 
 
 def _apart(

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
 from mypy_extensions import mypyc_attr
@@ -64,9 +64,6 @@ class RunView(Protocol):
     def bodies(self) -> Sequence[Any]: ...  # the road users near the ego now (``Body``)
     @property
     def bodies_before(self) -> Sequence[Any]: ...  # the road users at the last step's start
-    # multi-rate: each road user's acceleration over SUMO's last step; one rate: None
-    @property
-    def sumo_accel_mps2(self) -> Mapping[str, float] | None: ...
     @property
     def session(self) -> Any: ...  # the SUMO session (queries only)
     @property
