@@ -37,6 +37,7 @@ alternate between the trees, and the ratios of this tree's figures over ``REV``'
 from __future__ import annotations
 
 import json
+import math
 import os
 import statistics
 import subprocess
@@ -386,29 +387,35 @@ def load_average() -> list[float]:
         return []
 
 
+def _number(value) -> float | None:
+    """A figure of results.csv as a float (None: empty or not a number)."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return None
+    return v if math.isfinite(v) else None
+
+
 def table2_changes(reference, other) -> dict:
     """``other``'s Table 2 (results frame) against ``reference``'s, case by case: the cases
-    whose colour or contact partner changed, and each figure's largest absolute change."""
-    import pandas as pd
-
-    ref, got = reference.set_index("case_id"), other.set_index("case_id")
-    common = ref.index.intersection(got.index)
-    ref, got = ref.loc[common], got.loc[common]
+    whose colour or contact partner changed, and each figure's largest absolute change (a
+    figure empty on one side only is a colour or partner change, not a number)."""
+    ref = {r["case_id"]: r for r in reference.to_dict("records")}
+    got = {r["case_id"]: r for r in other.to_dict("records")}
+    common = [c for c in ref if c in got]
 
     def changed(col: str) -> list[str]:
         return [
-            f"{c}: {ref.at[c, col]} -> {got.at[c, col]}"
+            f"{c}: {ref[c][col]} -> {got[c][col]}"
             for c in common
-            if str(ref.at[c, col]) != str(got.at[c, col])
+            if str(ref[c][col]) != str(got[c][col])
         ]
 
-    deltas = {}
+    deltas: dict[str, float] = {}
     for col in TABLE2_FIGURES:
-        if col in ref and col in got:
-            d = (
-                pd.to_numeric(got[col], errors="coerce") - pd.to_numeric(ref[col], errors="coerce")
-            ).abs()
-            deltas[col] = float(d.max()) if d.notna().any() else 0.0
+        pairs = [(_number(ref[c].get(col)), _number(got[c].get(col))) for c in common]
+        diffs = [abs(b - a) for a, b in pairs if a is not None and b is not None]
+        deltas[col] = max(diffs, default=0.0)
     return {
         "cases": len(common),
         "colour_changes": changed("outcome"),

@@ -284,9 +284,13 @@ class CoSimulation:
         self._every = st.sumo_every
         self._since_sumo = 0
         self._report0 = self._report1 = self.bodies
-        self._sumo_ms = round(self.t * 1000.0)
         self._step_ms = round(st.step_s * 1000.0)
         self._sumo_step_ms = round(st.sumo_step_length_s * 1000.0)
+        # SUMO inserts the ego one of its steps after its departure: the run's clock is the
+        # 10 ms reference's, which starts one 10 ms step after it
+        self._sumo_ms = round(self.t * 1000.0) - (self._sumo_step_ms - self._step_ms)
+        if self._every > 1:
+            self.t = self.t_start = self._sumo_ms / 1000.0
         self._reach_pad_m = 0.05 if self._every == 1 else 0.1
 
     def _check_departure(self) -> None:
