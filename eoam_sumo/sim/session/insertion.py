@@ -260,18 +260,13 @@ def add_oncoming(
     overrides: ScenarioOverrides,
     ego: EgoStart,
     over_limit: dict,
-    insert_lag_s: float = 0.0,
 ) -> str:
     """Insert the oncoming car of ``overrides.oncoming_start_m`` in the lane opposite the
-    ego's, its front bumper that far ahead of the ego's along the road; its id. It moves in
-    its insertion step: ``insert_lag_s`` (a SUMO step longer than the 10 ms reference, less
-    10 ms) puts it as much farther back, so that it is where it is at the reference step."""
+    ego's, its front bumper that far ahead of the ego's along the road; its id."""
     distance = overrides.oncoming_start_m
     assert distance is not None  # called only when the overrides ask for an oncoming car
     px, py = _ahead_of_ego(ego, distance)
     edges, lane_id, pos = _opposite_start(api, files, ego, px, py)
-    if insert_lag_s > 0.0:
-        pos = max(0.0, pos - overrides.oncoming_speed_mps * insert_lag_s)
     _ensure_oncoming_type(api.vehicletype)
     vid, n = "oncoming", 0
     while vid in files.vehicles:

@@ -61,7 +61,7 @@ from eoam_sumo.sim.session.launch import (
     sumo_command,
     traci_connect,
 )
-from eoam_sumo.sim.session.scripts import REFERENCE_STEP_S, StopScripts
+from eoam_sumo.sim.session.scripts import StopScripts
 from eoam_sumo.sim.session.tracking import RoadUsers
 from eoam_sumo.world.bodies import PEDESTRIAN, Body
 
@@ -381,13 +381,7 @@ class SumoSession:
         self._ego_mu = self._friction(ego.lane_id)
         if self._overrides.oncoming_start_m is not None:
             self.oncoming_id = add_oncoming(
-                self._api,
-                self._errors,
-                self._files,
-                self._overrides,
-                ego,
-                self._over_limit,
-                max(0.0, self._dt - REFERENCE_STEP_S),
+                self._api, self._errors, self._files, self._overrides, ego, self._over_limit
             )
             self.roles[self.oncoming_id] = "oncoming"
         self._veh.subscribe(self.ego_id, self._users.ego_vars)
