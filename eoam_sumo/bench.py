@@ -80,17 +80,18 @@ def _cosim_and_sumo_only(repeats: int, sumo_step_s: float | None = None) -> dict
     """The co-simulation's step-loop figures and SUMO alone on the same scenario, measured in
     pairs (one co-simulation run, then SUMO alone for as long at the same SUMO step) so that
     both see the same machine load; medians over the repeats, the cost ratio the median of the
-    pairs' ratios. Per-step figures are per control step (10 ms)."""
+    pairs' ratios (also in CPU time, which other load disturbs far less). Per-step figures are
+    per control step (10 ms)."""
     from eoam_sumo.sim.cosim import CoSimulation
     from eoam_sumo.sim.observers import PhaseTimer
     from eoam_sumo.sim.scenario import ScenarioOverrides
     from eoam_sumo.sim.settings import RunSettings
 
     over = ScenarioOverrides(ego_speed_mps=SPEED_MPS, mu=1.0)
-    timer = PhaseTimer()
+    timer, loop_cpu = PhaseTimer(), _LoopCpu()
     settings = RunSettings(sumo_step_s=sumo_step_s)
-    sim = CoSimulation(BASELINE, over, settings, observers=[timer])
-    runs, sumo_rates = [], []
+    sim = CoSimulation(BASELINE, over, settings, observers=[timer, loop_cpu])
+    runs, sumo_rates, cpu_ratios = [], [], []
     for _ in range(repeats):
         summary, _log = sim.run()
         prof = {
@@ -101,11 +102,14 @@ def _cosim_and_sumo_only(repeats: int, sumo_step_s: float | None = None) -> dict
             "contact": timer.totals["check_contact"],
             "loop_wall_s": sim.loop_wall_s,
             "steps": timer.steps,
+            "loop_cpu_s": loop_cpu.cpu_s,
         }
         prof["sim_time_s"] = summary["sim_time_s"]
         prof["wall_time_s"] = summary["wall_time_s"]
         runs.append(prof)
-        sumo_rates.append(_sumo_only_rate(summary["sim_time_s"], settings.sumo_step_length_s))
+        rate, sumo_cpu_s = _sumo_only(summary["sim_time_s"], settings.sumo_step_length_s)
+        sumo_rates.append(rate)
+        cpu_ratios.append(loop_cpu.cpu_s / sumo_cpu_s)
     med = {k: statistics.median(r[k] for r in runs) for k in runs[0]}
     steps = med["steps"]
     substeps = sim.settings.substeps
@@ -123,12 +127,19 @@ def _cosim_and_sumo_only(repeats: int, sumo_step_s: float | None = None) -> dict
         "plant_substeps_per_s": substeps * steps / med["plant"],
         "sumo_only_realtime_factor": statistics.median(sumo_rates),
         "cosim_over_sumo_cost": statistics.median(ratios),
+        "loop_cpu_us_per_step": 1e6 * med["loop_cpu_s"] / steps,
+        "cosim_over_sumo_cpu_cost": statistics.median(cpu_ratios),
     }
 
 
 def _sumo_only_rate(sim_time_s: float, step_s: float) -> float:
     """Simulated seconds per wall second of SUMO alone stepping the scenario for
     ``sim_time_s`` at ``step_s`` (the ego driven by SUMO, no co-simulation work)."""
+    return _sumo_only(sim_time_s, step_s)[0]
+
+
+def _sumo_only(sim_time_s: float, step_s: float) -> tuple[float, float]:
+    """(:func:`_sumo_only_rate`, CPU time of those steps [s])."""
     from eoam_sumo.sim.scenario import ScenarioOverrides
     from eoam_sumo.sim.session import SumoSession
 
@@ -140,10 +151,11 @@ def _sumo_only_rate(sim_time_s: float, step_s: float) -> float:
         ballistic=step_s > 0.01 + 1e-9,  # as the co-simulation at that step
     )
     try:
-        t0 = time.perf_counter()
+        t0, cpu0 = time.perf_counter(), time.thread_time()
         for _ in range(steps):
             session.step()
-        return steps * step_s / (time.perf_counter() - t0)
+        cpu_s = time.thread_time() - cpu0
+        return steps * step_s / (time.perf_counter() - t0), cpu_s
     finally:
         session.close()
 
@@ -369,6 +381,8 @@ TABLE2_FIGURES = (
 )
 _LOOP_KEYS = (
     "cosim_over_sumo_cost",
+    "cosim_over_sumo_cpu_cost",
+    "loop_cpu_us_per_step",
     "realtime_factor",
     "sumo_only_realtime_factor",
     "sumo_us_per_step",
@@ -377,6 +391,15 @@ _LOOP_KEYS = (
     "plant_us_per_step",
     "contact_us_per_step",
 )
+
+
+def _process_tree_cpu_s() -> float:
+    """CPU time of this process and of its ended child processes (batch workers) [s]."""
+    import resource
+
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
 
 
 def load_average() -> list[float]:
@@ -432,7 +455,7 @@ def _study_step(sumo_step_s: float, out_dir: Path, repeats: int, jobs: int, quic
     loop = _cosim_and_sumo_only(repeats, sumo_step_s)
     row.update({k: loop[k] for k in _LOOP_KEYS})
     matrix = _quick_matrix(out_dir) if quick else TABLE2
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), _process_tree_cpu_s()
     results = run_batch(
         matrix,
         out_dir / f"table2_{round(sumo_step_s * 1000)}ms",
@@ -441,6 +464,7 @@ def _study_step(sumo_step_s: float, out_dir: Path, repeats: int, jobs: int, quic
         sumo_step_s=sumo_step_s,
     )
     row["table2_wall_s"] = time.perf_counter() - t0
+    row["table2_cpu_s"] = _process_tree_cpu_s() - cpu0
     row["table2_cases"] = len(results)
     row["load_avg_end"] = load_average()
     return {**row, "_results": results}
@@ -470,8 +494,9 @@ def format_studies(result: dict) -> str:
     lines = [
         f"step loop: {'compiled' if result['compiled'] else 'Python sources'}; "
         f"Table 2 with {result['jobs']} jobs",
-        "sumo step s | load avg (1 min) | Table 2 wall s | cost ratio | us/step: sumo sense "
-        "control plant contact | colour / partner changes | max |d| impact m/s, gap ARO m",
+        "sumo step s | load avg (1 min) | Table 2 wall s (CPU s) | cost ratio wall (CPU) | "
+        "us/step: sumo sense control plant contact (loop CPU) | colour / partner changes | "
+        "max |d| impact m/s, gap ARO m",
     ]
     for r in result["studies"]:
         cmp = r.get("table2_vs_reference")
@@ -485,10 +510,11 @@ def format_studies(result: dict) -> str:
         loads = (r["load_avg_start"][:1] + r["load_avg_end"][:1]) or ["-"]
         lines.append(
             f"{r['sumo_step_s']:g} | {'-'.join(f'{v:g}' for v in loads)} | "
-            f"{r['table2_wall_s']:.1f} | {r['cosim_over_sumo_cost']:.2f} | "
+            f"{r['table2_wall_s']:.1f} ({r['table2_cpu_s']:.1f}) | "
+            f"{r['cosim_over_sumo_cost']:.2f} ({r['cosim_over_sumo_cpu_cost']:.2f}) | "
             f"{r['sumo_us_per_step']:.1f} {r['sense_us_per_step']:.1f} "
             f"{r['control_us_per_step']:.1f} {r['plant_us_per_step']:.1f} "
-            f"{r['contact_us_per_step']:.1f} | {diff}"
+            f"{r['contact_us_per_step']:.1f} ({r['loop_cpu_us_per_step']:.1f}) | {diff}"
         )
     return "\n".join(lines)
 

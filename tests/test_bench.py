@@ -149,3 +149,35 @@ def _in_git_checkout() -> bool:
         check=False,
     )
     return done.returncode == 0
+
+
+def test_table2_changes_counts_colour_and_partner_changes_and_the_largest_figure_moves():
+    import pandas as pd
+
+    ref = pd.DataFrame(
+        {
+            "case_id": ["a", "b", "c"],
+            "outcome": ["green", "red", "yellow"],
+            "collision_with": ["none", "oncoming", "aro"],
+            "impact_speed_mps": [0.0, 20.0, 5.0],
+            "min_gap_aro_m": [4.0, float("nan"), 0.0],
+        }
+    )
+    got = ref.copy()
+    got.loc[1, ["outcome", "impact_speed_mps"]] = ["orange", 19.7]
+    got.loc[2, ["collision_with", "min_gap_aro_m"]] = ["none", 0.25]
+    got.loc[0, "min_gap_aro_m"] = 3.9
+    cmp = bench.table2_changes(ref, got)
+    assert cmp["cases"] == 3
+    assert cmp["colour_changes"] == ["b: red -> orange"]
+    assert cmp["partner_changes"] == ["c: aro -> none"]
+    assert cmp["max_abs_delta"]["impact_speed_mps"] == pytest.approx(0.3)
+    assert cmp["max_abs_delta"]["min_gap_aro_m"] == pytest.approx(0.25)  # nan left out
+    assert cmp["max_abs_delta"]["sim_time_s"] == 0.0  # not in the frames
+
+
+def test_studies_keys_are_documented():
+    text = PERFORMANCE.read_text(encoding="utf-8")
+    for key in ("bench-studies.json", "table2_wall_s", "load_avg_start", "table2_vs_reference"):
+        assert key in text, key
+    assert bench.load_average() == [] or len(bench.load_average()) == 3
