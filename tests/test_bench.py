@@ -181,3 +181,20 @@ def test_studies_keys_are_documented():
     for key in ("bench-studies.json", "table2_wall_s", "load_avg_start", "table2_vs_reference"):
         assert key in text, key
     assert bench.load_average() == [] or len(bench.load_average()) == 3
+
+
+@pytest.mark.sumo
+def test_quick_studies_write_each_step_and_the_changes_against_the_first(tmp_path):
+    result = bench.run_studies(tmp_path, (0.01, 0.1), jobs=1, quick=True)
+    saved = json.loads((tmp_path / "bench-studies.json").read_text())
+    assert saved == json.loads(json.dumps(result))
+    first, second = saved["studies"]
+    assert (first["sumo_step_s"], second["sumo_step_s"]) == (0.01, 0.1)
+    assert "table2_vs_reference" not in first
+    cmp = second["table2_vs_reference"]
+    assert cmp["cases"] == 2 and cmp["colour_changes"] == [] and cmp["partner_changes"] == []
+    for row in saved["studies"]:
+        assert row["table2_cases"] == 2 and row["table2_wall_s"] > 0 and row["table2_cpu_s"] > 0
+        assert row["cosim_over_sumo_cost"] > 0 and row["loop_cpu_us_per_step"] > 0
+    assert (tmp_path / "table2_100ms" / "results.csv").is_file()
+    assert "0.1 |" in bench.format_studies(result)
