@@ -53,6 +53,7 @@ COMPILED = [
     "eoam_sumo/sensing/coasting.py",
     "eoam_sumo/sim/cosim.py",
     "eoam_sumo/sim/facts.py",
+    "eoam_sumo/sim/interpolation.py",
     "eoam_sumo/world/geometry.py",
     "eoam_sumo/world/lanes.py",
     "eoam_sumo/sim/margins.py",

@@ -34,3 +34,14 @@ def speed_kmh(text: str) -> float:
     if value <= 0.0:
         raise argparse.ArgumentTypeError(f"speed {text} km/h must be > 0")
     return value
+
+
+def sumo_step_argument(p: argparse.ArgumentParser) -> None:
+    """``run``, ``batch`` and ``protocol``: SUMO's step in a multi-rate co-simulation."""
+    p.add_argument(
+        "--sumo-step-s",
+        type=finite,
+        metavar="S",
+        help="SUMO's step, 0.01 to 0.1 s (default 0.01, the reference): road users "
+        "interpolated between SUMO's steps, control at 100 Hz, plant at 1 kHz",
+    )

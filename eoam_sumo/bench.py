@@ -24,6 +24,11 @@ Figures:
   ``traffic_us_per_user_step``: the co-simulation's own cost per road user in SUMO per step
   (CPU time of the step loop less SUMO alone's for as many steps).
 
+``--studies`` measures instead each study's cost at SUMO steps (``run_studies``): per step the
+step loop's cost split and its cost ratio against SUMO alone at the same SUMO step, the Table 2
+batch's wall time, and its colours, contact partners and figures against the 10 ms reference,
+with the load average.
+
 ``--against REV`` measures instead this tree against git revision ``REV`` in one run
 (``compare_against``): the plant's step and the Table 2 batch, each in fresh interpreters that
 alternate between the trees, and the ratios of this tree's figures over ``REV``'s.
@@ -32,6 +37,7 @@ alternate between the trees, and the ratios of this tree's figures over ``REV``'
 from __future__ import annotations
 
 import json
+import math
 import os
 import statistics
 import subprocess
@@ -70,19 +76,22 @@ def _compiled() -> bool:
     return isinstance(getattr(cosim.__spec__, "loader", None), machinery.ExtensionFileLoader)
 
 
-def _cosim_and_sumo_only(repeats: int) -> dict:
+def _cosim_and_sumo_only(repeats: int, sumo_step_s: float | None = None) -> dict:
     """The co-simulation's step-loop figures and SUMO alone on the same scenario, measured in
-    pairs (one co-simulation run, then SUMO alone for as many steps) so that both see the same
-    machine load; medians over the repeats, the cost ratio the median of the pairs' ratios."""
+    pairs (one co-simulation run, then SUMO alone for as long at the same SUMO step) so that
+    both see the same machine load; medians over the repeats, the cost ratio the median of the
+    pairs' ratios (also in CPU time, which other load disturbs far less). Per-step figures are
+    per control step (10 ms)."""
     from eoam_sumo.sim.cosim import CoSimulation
     from eoam_sumo.sim.observers import PhaseTimer
     from eoam_sumo.sim.scenario import ScenarioOverrides
     from eoam_sumo.sim.settings import RunSettings
 
     over = ScenarioOverrides(ego_speed_mps=SPEED_MPS, mu=1.0)
-    timer = PhaseTimer()
-    sim = CoSimulation(BASELINE, over, RunSettings(), observers=[timer])
-    runs, sumo_rates = [], []
+    timer, loop_cpu = PhaseTimer(), _LoopCpu()
+    settings = RunSettings(sumo_step_s=sumo_step_s)
+    sim = CoSimulation(BASELINE, over, settings, observers=[timer, loop_cpu])
+    runs, sumo_rates, cpu_ratios = [], [], []
     for _ in range(repeats):
         summary, _log = sim.run()
         prof = {
@@ -93,11 +102,14 @@ def _cosim_and_sumo_only(repeats: int) -> dict:
             "contact": timer.totals["check_contact"],
             "loop_wall_s": sim.loop_wall_s,
             "steps": timer.steps,
+            "loop_cpu_s": loop_cpu.cpu_s,
         }
         prof["sim_time_s"] = summary["sim_time_s"]
         prof["wall_time_s"] = summary["wall_time_s"]
         runs.append(prof)
-        sumo_rates.append(_sumo_only_rate(summary["sim_time_s"], sim.settings.step_s))
+        rate, sumo_cpu_s = _sumo_only(summary["sim_time_s"], settings.sumo_step_length_s)
+        sumo_rates.append(rate)
+        cpu_ratios.append(loop_cpu.cpu_s / sumo_cpu_s)
     med = {k: statistics.median(r[k] for r in runs) for k in runs[0]}
     steps = med["steps"]
     substeps = sim.settings.substeps
@@ -115,24 +127,35 @@ def _cosim_and_sumo_only(repeats: int) -> dict:
         "plant_substeps_per_s": substeps * steps / med["plant"],
         "sumo_only_realtime_factor": statistics.median(sumo_rates),
         "cosim_over_sumo_cost": statistics.median(ratios),
+        "loop_cpu_us_per_step": 1e6 * med["loop_cpu_s"] / steps,
+        "cosim_over_sumo_cpu_cost": statistics.median(cpu_ratios),
     }
 
 
 def _sumo_only_rate(sim_time_s: float, step_s: float) -> float:
     """Simulated seconds per wall second of SUMO alone stepping the scenario for
     ``sim_time_s`` at ``step_s`` (the ego driven by SUMO, no co-simulation work)."""
+    return _sumo_only(sim_time_s, step_s)[0]
+
+
+def _sumo_only(sim_time_s: float, step_s: float) -> tuple[float, float]:
+    """(:func:`_sumo_only_rate`, CPU time of those steps [s])."""
     from eoam_sumo.sim.scenario import ScenarioOverrides
     from eoam_sumo.sim.session import SumoSession
 
     steps = max(1, round(sim_time_s / step_s))
     session = SumoSession.start(
-        BASELINE, ScenarioOverrides(ego_speed_mps=SPEED_MPS, mu=1.0), step_length_s=step_s
+        BASELINE,
+        ScenarioOverrides(ego_speed_mps=SPEED_MPS, mu=1.0),
+        step_length_s=step_s,
+        ballistic=step_s > 0.01 + 1e-9,  # as the co-simulation at that step
     )
     try:
-        t0 = time.perf_counter()
+        t0, cpu0 = time.perf_counter(), time.thread_time()
         for _ in range(steps):
             session.step()
-        return steps * step_s / (time.perf_counter() - t0)
+        cpu_s = time.thread_time() - cpu0
+        return steps * step_s / (time.perf_counter() - t0), cpu_s
     finally:
         session.close()
 
@@ -286,16 +309,20 @@ def _tables(out_dir: Path, quick: bool) -> float:
 def _batch(out_dir: Path, quick: bool) -> tuple[float, int]:
     from eoam_sumo.batch.runner import run_batch
 
-    matrix = TABLE2
-    if quick:
-        matrix = out_dir / "quick.toml"
-        matrix.write_text(
-            f'[scenario]\nsumocfg = "{BASELINE.as_posix()}"\nmax_time_s = 20.0\n'
-            "[sweep]\nego_speed_kmh = [120]\nmu = [1.0, 0.7]\n"
-        )
+    matrix = _quick_matrix(out_dir) if quick else TABLE2
     t0 = time.perf_counter()
     results = run_batch(matrix, out_dir / "batch", jobs=2, progress=False)
     return time.perf_counter() - t0, len(results)
+
+
+def _quick_matrix(out_dir: Path) -> Path:
+    """A two-case matrix for quick runs (tests)."""
+    matrix = out_dir / "quick.toml"
+    matrix.write_text(
+        f'[scenario]\nsumocfg = "{BASELINE.as_posix()}"\nmax_time_s = 20.0\n'
+        "[sweep]\nego_speed_kmh = [120]\nmu = [1.0, 0.7]\n"
+    )
+    return matrix
 
 
 def run_bench(out_dir: Path, quick: bool = False) -> dict:
@@ -335,6 +362,168 @@ def format_table(result: dict) -> str:
         mark = "" if tgt is None else f"{tgt['target']:<9} {'met' if tgt['met'] else 'MISSED'}"
         lines.append(f"{k:<{width}}  {v:<12.4g} {mark}")
     return "\n".join(lines)
+
+
+# --- the studies at SUMO steps (``eoam-sumo bench --studies``) --------------------------------
+
+#: The SUMO steps the studies are measured at unless given [s]; the first is the reference.
+STUDY_SUMO_STEPS_S = (0.01, 0.05, 0.1)
+#: Table 2's figures compared with the reference step's (the golden Table 2's key figures).
+TABLE2_FIGURES = (
+    "impact_speed_mps",
+    "min_gap_aro_m",
+    "max_lateral_offset_m",
+    "sim_time_s",
+    "contact_overlap",
+    "delta_v_ego_mps",
+    "min_gap_oncoming_m",
+    "min_ttc_oncoming_s",
+)
+_LOOP_KEYS = (
+    "cosim_over_sumo_cost",
+    "cosim_over_sumo_cpu_cost",
+    "loop_cpu_us_per_step",
+    "realtime_factor",
+    "sumo_only_realtime_factor",
+    "sumo_us_per_step",
+    "sense_us_per_step",
+    "control_us_per_step",
+    "plant_us_per_step",
+    "contact_us_per_step",
+)
+
+
+def _process_tree_cpu_s() -> float:
+    """CPU time of this process and of its ended child processes (batch workers) [s]."""
+    import resource
+
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+def load_average() -> list[float]:
+    """The 1, 5 and 15 minute load averages (``os.getloadavg``); [] where there are none."""
+    try:
+        return [round(v, 2) for v in os.getloadavg()]
+    except OSError:
+        return []
+
+
+def _number(value) -> float | None:
+    """A figure of results.csv as a float (None: empty or not a number)."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return None
+    return v if math.isfinite(v) else None
+
+
+def table2_changes(reference, other) -> dict:
+    """``other``'s Table 2 (results frame) against ``reference``'s, case by case: the cases
+    whose colour or contact partner changed, and each figure's largest absolute change (a
+    figure empty on one side only is a colour or partner change, not a number)."""
+    ref = {r["case_id"]: r for r in reference.to_dict("records")}
+    got = {r["case_id"]: r for r in other.to_dict("records")}
+    common = [c for c in ref if c in got]
+
+    def changed(col: str) -> list[str]:
+        return [
+            f"{c}: {ref[c][col]} -> {got[c][col]}"
+            for c in common
+            if str(ref[c][col]) != str(got[c][col])
+        ]
+
+    deltas: dict[str, float] = {}
+    for col in TABLE2_FIGURES:
+        pairs = [(_number(ref[c].get(col)), _number(got[c].get(col))) for c in common]
+        diffs = [abs(b - a) for a, b in pairs if a is not None and b is not None]
+        deltas[col] = max(diffs, default=0.0)
+    return {
+        "cases": len(common),
+        "colour_changes": changed("outcome"),
+        "partner_changes": changed("collision_with"),
+        "max_abs_delta": deltas,
+    }
+
+
+def _study_step(sumo_step_s: float, out_dir: Path, repeats: int, jobs: int, quick: bool) -> dict:
+    """One SUMO step: the step loop's figures (bench case) and the Table 2 batch, timed."""
+    from eoam_sumo.batch.runner import run_batch
+
+    row: dict[str, Any] = {"sumo_step_s": sumo_step_s, "load_avg_start": load_average()}
+    loop = _cosim_and_sumo_only(repeats, sumo_step_s)
+    row.update({k: loop[k] for k in _LOOP_KEYS})
+    matrix = _quick_matrix(out_dir) if quick else TABLE2
+    t0, cpu0 = time.perf_counter(), _process_tree_cpu_s()
+    results = run_batch(
+        matrix,
+        out_dir / f"table2_{round(sumo_step_s * 1000)}ms",
+        jobs=jobs,
+        progress=False,
+        sumo_step_s=sumo_step_s,
+    )
+    row["table2_wall_s"] = time.perf_counter() - t0
+    row["table2_cpu_s"] = _process_tree_cpu_s() - cpu0
+    row["table2_cases"] = len(results)
+    row["load_avg_end"] = load_average()
+    return {**row, "_results": results}
+
+
+def run_studies(
+    out_dir: Path,
+    steps_s: tuple[float, ...] = STUDY_SUMO_STEPS_S,
+    jobs: int = 2,
+    quick: bool = False,
+) -> dict:
+    """Each SUMO step's figures (:func:`_study_step`), Table 2 against the first step's
+    (:func:`table2_changes`); writes ``bench-studies.json`` and keeps each batch's folder."""
+    repeats = 1 if quick else 7
+    out_dir.mkdir(parents=True, exist_ok=True)
+    rows = [_study_step(s, out_dir, repeats, jobs, quick) for s in steps_s]
+    reference = rows[0].pop("_results")
+    for row in rows[1:]:
+        row["table2_vs_reference"] = table2_changes(reference, row.pop("_results"))
+    result = {"quick": quick, "jobs": jobs, "compiled": _compiled(), "studies": rows}
+    (out_dir / "bench-studies.json").write_text(json.dumps(result, indent=2) + "\n")
+    return result
+
+
+def format_studies(result: dict) -> str:
+    """The studies as a table, one row per SUMO step (per-step costs per 10 ms step)."""
+    lines = [
+        f"step loop: {'compiled' if result['compiled'] else 'Python sources'}; "
+        f"Table 2 with {result['jobs']} jobs",
+        "sumo step s | load avg (1 min) | Table 2 wall s (CPU s) | cost ratio wall (CPU) | "
+        "us/step: sumo sense control plant contact (loop CPU) | colour / partner changes | "
+        "max |d| impact m/s, gap ARO m",
+    ]
+    for r in result["studies"]:
+        cmp = r.get("table2_vs_reference")
+        diff = "reference"
+        if cmp is not None:
+            d = cmp["max_abs_delta"]
+            diff = (
+                f"{len(cmp['colour_changes'])} / {len(cmp['partner_changes'])} | "
+                f"{d.get('impact_speed_mps', 0.0):.3f}, {d.get('min_gap_aro_m', 0.0):.3f}"
+            )
+        loads = (r["load_avg_start"][:1] + r["load_avg_end"][:1]) or ["-"]
+        lines.append(
+            f"{r['sumo_step_s']:g} | {'-'.join(f'{v:g}' for v in loads)} | "
+            f"{r['table2_wall_s']:.1f} ({r['table2_cpu_s']:.1f}) | "
+            f"{r['cosim_over_sumo_cost']:.2f} ({r['cosim_over_sumo_cpu_cost']:.2f}) | "
+            f"{r['sumo_us_per_step']:.1f} {r['sense_us_per_step']:.1f} "
+            f"{r['control_us_per_step']:.1f} {r['plant_us_per_step']:.1f} "
+            f"{r['contact_us_per_step']:.1f} ({r['loop_cpu_us_per_step']:.1f}) | {diff}"
+        )
+    return "\n".join(lines)
+
+
+def run_studies_cli(out_dir: Path, steps_s: tuple[float, ...], jobs: int, quick: bool) -> int:
+    result = run_studies(out_dir, steps_s, jobs, quick)
+    print(format_studies(result))
+    print(f"written {out_dir / 'bench-studies.json'}")
+    return 0
 
 
 def run_bench_cli(out_dir: Path, quick: bool = False) -> int:

@@ -17,7 +17,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from eoam_sumo import __version__
-from eoam_sumo.arguments import finite, mu, speed_kmh
+from eoam_sumo.arguments import finite, mu, speed_kmh, sumo_step_argument
 from eoam_sumo.drivers import DRIVERS
 from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import writable_dir
@@ -29,7 +29,7 @@ from eoam_sumo.openscenario.command import (
     xosc_arguments,
 )
 from eoam_sumo.seeds import seed_argument
-from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S, MAX_TIME_LIMIT_S
+from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S, MAX_TIME_LIMIT_S, check_sumo_step_s
 from eoam_sumo.traffic_levels.command import add_scenario_arguments, cmd_scenario
 from eoam_sumo.vehicle_tests import command as vehicle_test_command
 
@@ -190,6 +190,7 @@ def _run_arguments(sub) -> None:
         help="the ego's controller: the EOAM or a reference driver (docs/reference-drivers.md)",
     )
     _after_stop_argument(p)
+    sumo_step_argument(p)
     p.add_argument("--gui", action="store_true", help="run in sumo-gui through TraCI")
     _policy_arguments(p)
     _gui_arguments(p)
@@ -281,6 +282,7 @@ def _batch_arguments(sub) -> None:
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     _after_stop_argument(p)
+    sumo_step_argument(p)
 
 
 def _plot_arguments(sub) -> None:
@@ -319,6 +321,21 @@ def _bench_arguments(sub) -> None:
         help="instead: the plant's step and Table 2 batch against git revision REV, as ratios",
     )
     p.add_argument("--pairs", type=_positive_int, default=3, help="with --against: probes per tree")
+    p.add_argument(
+        "--studies",
+        action="store_true",
+        help="instead: per SUMO step the step loop's cost ratio against SUMO alone at that "
+        "step, Table 2's wall time and its changes against the first step, the load average",
+    )
+    p.add_argument(
+        "--sumo-steps",
+        type=finite,
+        nargs="+",
+        metavar="S",
+        default=(0.01, 0.05, 0.1),
+        help="with --studies: SUMO steps [s], the first the reference (0.01 0.05 0.1)",
+    )
+    p.add_argument("--jobs", type=_positive_int, default=2, help="with --studies: batch jobs")
 
 
 def _cmd_tables(args) -> int:
@@ -390,6 +407,8 @@ def _check_run_args(args) -> None:
         raise InputError(f"--radar-range-m {args.radar_range_m} must be > 0")
     if args.after_stop_s is not None and args.after_stop_s < 0:
         raise InputError(f"--after-stop-s {args.after_stop_s:g} must be >= 0")
+    if args.sumo_step_s is not None:
+        check_sumo_step_s(args.sumo_step_s, "--sumo-step-s")
     _check_v2x(args)
     refuse_params_for_sumocfg(args)
     if not args.gui and (args.gui_delay_ms is not None or args.gui_screenshot or args.gui_close):
@@ -425,6 +444,7 @@ def _run_settings(args, out: Path):
         radar_model=parse_radar_model(args.radar_model),
         after_stop_s=args.after_stop_s,
         driver=args.driver,
+        sumo_step_s=args.sumo_step_s,
     )
     if args.radar_range_m is not None:
         settings = replace(settings, radar=RadarSettings(range_m=args.radar_range_m))
@@ -486,7 +506,7 @@ def _cmd_batch(args) -> int:
     check_options(args.jobs, args.timeout_s, args.timeseries)
     if is_xosc_batch(args.matrix):
         return _cmd_xosc_batch(args)
-    plan = plan_batch(args.matrix, after_stop_s=args.after_stop_s)
+    plan = plan_batch(args.matrix, after_stop_s=args.after_stop_s, sumo_step_s=args.sumo_step_s)
     with (
         _sigterm_interrupts(),
         output_folder(args.out, _batch_output(), in_place=args.resume) as out,
@@ -617,6 +637,11 @@ def _cmd_bench(args) -> int:
 
     if args.against is not None:
         return run_against_cli(writable_dir(args.out), args.against, args.quick, args.pairs)
+    if args.studies:
+        from eoam_sumo.bench import run_studies_cli
+
+        steps = tuple(check_sumo_step_s(s, "--sumo-steps") for s in args.sumo_steps)
+        return run_studies_cli(writable_dir(args.out), steps, args.jobs, args.quick)
     return run_bench_cli(writable_dir(args.out), quick=args.quick)
 
 

@@ -31,7 +31,7 @@ from eoam_sumo.seeds import check_seed
 from eoam_sumo.sensing.automotive import parse_radar_model
 from eoam_sumo.sensing.friction import parse_mu_belief
 from eoam_sumo.sim.scenario import ScenarioOverrides, check_scenario, scripted_stops
-from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S, MAX_TIME_LIMIT_S
+from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S, MAX_TIME_LIMIT_S, check_sumo_step_s
 from eoam_sumo.sim.vehicle import vehicle_name, vehicle_tables, vehicle_tables_dir
 from eoam_sumo.textfiles import not_utf8
 from eoam_sumo.traffic_levels.hcm import LEVELS
@@ -63,6 +63,7 @@ SCHEMA = {
         "radar_model",
         "seed",
         "after_stop_s",
+        "sumo_step_s",
         "vehicle",
         "abs",
         "esc",
@@ -134,6 +135,7 @@ class Case:
     radar_model: str = "ideal"
     seed: int = 0
     after_stop_s: float | None = None  # None: the run's default (RunSettings.after_stop_s)
+    sumo_step_s: float | None = None  # None: the run's default (RunSettings.sumo_step_s)
     # a generated scenario (None: the sumocfg's); its traffic seeded with ``seed``
     road: str | None = None
     los: str | None = None
@@ -195,6 +197,7 @@ class Matrix:
     seed: int = 0
     sample: Sample | None = None
     after_stop_s: float | None = None
+    sumo_step_s: float | None = None
     # the generated scenario's keys given, swept or sampled: (key, values), ``TRAFFIC_KEYS``
     # order; a sampled key's values are (None,)
     traffic_axes: tuple[tuple[str, tuple], ...] = ()
@@ -238,6 +241,7 @@ class Matrix:
             "radar_model": self.radar_model,
             "seed": self.seed,
             "after_stop_s": self.after_stop_s,
+            "sumo_step_s": self.sumo_step_s,
             "abs_fitted": self.abs_fitted,
             "esc_fitted": self.esc_fitted,
         }
@@ -540,6 +544,7 @@ def load_matrix(path: Path) -> Matrix:
         seed=seed,
         sample=sample,
         after_stop_s=_after_stop(path, scenario),
+        sumo_step_s=_sumo_step(path, scenario),
         traffic_axes=traffic_axes,
         vehicles=_vehicle_axis(path, doc, sampled, checks["vehicle"]),
         **_equipment(path, doc),
@@ -557,6 +562,14 @@ def _after_stop(path: Path, scenario: dict) -> float | None:
     if value is not None and (not _is_number(value) or value < 0):
         raise InputError(f"{path}: [scenario] after_stop_s = {value!r} must be a number >= 0")
     return None if value is None else float(value)
+
+
+def _sumo_step(path: Path, scenario: dict) -> float | None:
+    """[scenario] sumo_step_s (None: the run's default), 0.01 to 0.1 s in whole 10 ms."""
+    value = scenario.get("sumo_step_s")
+    if value is None:
+        return None
+    return check_sumo_step_s(value, f"{path}: [scenario] sumo_step_s")
 
 
 def _vehicle_check(path: Path):

@@ -149,3 +149,52 @@ def _in_git_checkout() -> bool:
         check=False,
     )
     return done.returncode == 0
+
+
+def test_table2_changes_counts_colour_and_partner_changes_and_the_largest_figure_moves():
+    import pandas as pd
+
+    ref = pd.DataFrame(
+        {
+            "case_id": ["a", "b", "c"],
+            "outcome": ["green", "red", "yellow"],
+            "collision_with": ["none", "oncoming", "aro"],
+            "impact_speed_mps": [0.0, 20.0, 5.0],
+            "min_gap_aro_m": [4.0, float("nan"), 0.0],
+        }
+    )
+    got = ref.copy()
+    got.loc[1, ["outcome", "impact_speed_mps"]] = ["orange", 19.7]
+    got.loc[2, ["collision_with", "min_gap_aro_m"]] = ["none", 0.25]
+    got.loc[0, "min_gap_aro_m"] = 3.9
+    cmp = bench.table2_changes(ref, got)
+    assert cmp["cases"] == 3
+    assert cmp["colour_changes"] == ["b: red -> orange"]
+    assert cmp["partner_changes"] == ["c: aro -> none"]
+    assert cmp["max_abs_delta"]["impact_speed_mps"] == pytest.approx(0.3)
+    assert cmp["max_abs_delta"]["min_gap_aro_m"] == pytest.approx(0.25)  # nan left out
+    assert cmp["max_abs_delta"]["sim_time_s"] == 0.0  # not in the frames
+
+
+def test_studies_keys_are_documented():
+    text = PERFORMANCE.read_text(encoding="utf-8")
+    for key in ("bench-studies.json", "table2_wall_s", "load_avg_start", "table2_vs_reference"):
+        assert key in text, key
+    assert bench.load_average() == [] or len(bench.load_average()) == 3
+
+
+@pytest.mark.sumo
+def test_quick_studies_write_each_step_and_the_changes_against_the_first(tmp_path):
+    result = bench.run_studies(tmp_path, (0.01, 0.1), jobs=1, quick=True)
+    saved = json.loads((tmp_path / "bench-studies.json").read_text())
+    assert saved == json.loads(json.dumps(result))
+    first, second = saved["studies"]
+    assert (first["sumo_step_s"], second["sumo_step_s"]) == (0.01, 0.1)
+    assert "table2_vs_reference" not in first
+    cmp = second["table2_vs_reference"]
+    assert cmp["cases"] == 2 and cmp["colour_changes"] == [] and cmp["partner_changes"] == []
+    for row in saved["studies"]:
+        assert row["table2_cases"] == 2 and row["table2_wall_s"] > 0 and row["table2_cpu_s"] > 0
+        assert row["cosim_over_sumo_cost"] > 0 and row["loop_cpu_us_per_step"] > 0
+    assert (tmp_path / "table2_100ms" / "results.csv").is_file()
+    assert "0.1 |" in bench.format_studies(result)

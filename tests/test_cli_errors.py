@@ -45,6 +45,9 @@ def _check(capsys, argv, needle):
         (["run", str(SCEN / "baseline.sumocfg"), "--speed-kmh", "300"], "300"),
         (["run", str(SCEN / "baseline.sumocfg"), "--frobnicate"], "--frobnicate"),
         (["run", str(SCEN / "baseline.sumocfg"), "--driver", "human"], "human"),
+        (["run", str(SCEN / "baseline.sumocfg"), "--sumo-step-s", "0.015"], "--sumo-step-s"),
+        (["batch", str(SCEN / "table2.toml"), "--sumo-step-s", "0.2"], "--sumo-step-s"),
+        (["bench", "--studies", "--sumo-steps", "0.01", "0.3"], "--sumo-steps"),
         (["tables", "--jobs", "0"], "0"),
         (["batch", "missing.toml"], "missing.toml"),
         (["plot", "no_such_folder"], "no_such_folder"),
@@ -53,6 +56,12 @@ def _check(capsys, argv, needle):
 )
 def test_bad_arguments(capsys, tmp_path, argv, needle):
     _check(capsys, argv + (["--out", str(tmp_path / "o")] if argv[0] == "run" else []), needle)
+
+
+def test_protocol_sumo_step_out_of_range_writes_nothing(capsys, tmp_path):
+    out = tmp_path / "p"
+    _check(capsys, ["protocol", "unr152", "--out", str(out), "--sumo-step-s", "0"], "--sumo-step-s")
+    assert not out.exists()
 
 
 def test_malformed_sumocfg(capsys, tmp_path):

@@ -124,6 +124,7 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
     "protocols": (
         {
             "params",
+            "arguments",
             "errors",
             "fileio",
             "outputs",

@@ -358,3 +358,14 @@ def test_a_matrix_sampling_every_swept_key_needs_no_sweep_table(tmp_path):
     half.write_text(scenario + sample.replace("mu = { choice = [0.3, 0.7] }\n", ""))
     with pytest.raises(InputError, match=r"half\.toml: missing table \[sweep\]"):
         load_matrix(half)
+
+
+def test_sumo_step_is_a_scenario_key_checked_and_carried_by_every_case(tmp_path):
+    path = _write(tmp_path, GOOD_SCENARIO + "sumo_step_s = 0.05\n" + GOOD_SWEEP)
+    cases = load_matrix(path).cases()
+    assert [c.sumo_step_s for c in cases] == [0.05]
+    assert load_matrix(_write(tmp_path, GOOD_SCENARIO + GOOD_SWEEP)).cases()[0].sumo_step_s is None
+    for bad in ("0.015", "0.2", "0", '"fast"'):
+        path = _write(tmp_path, GOOD_SCENARIO + f"sumo_step_s = {bad}\n" + GOOD_SWEEP)
+        with pytest.raises(InputError, match=r"m\.toml: \[scenario\] sumo_step_s"):
+            load_matrix(path)

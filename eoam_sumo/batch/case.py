@@ -70,6 +70,7 @@ class CaseParameters:
     radar_model: str  # ideal or automotive
     seed: int
     after_stop_s: float | None  # None: the run's default
+    sumo_step_s: float | None  # None: the run's default (one rate, 10 ms)
     road: str | None  # a generated scenario (None: the sumocfg's): rural or motorway
     los: str | None  # its level of service
     lanes: int | None
@@ -126,6 +127,7 @@ def case_settings(task: CaseTask) -> RunSettings:
             radar_model=case.radar_model,
             seed=case.seed,
             after_stop_s=case.after_stop_s,
+            sumo_step_s=case.sumo_step_s,
             vehicle=case_vehicle(case),
             vehicle_id=case.vehicle or DEFAULT_VEHICLE,
         ),

@@ -52,6 +52,7 @@ from eoam_sumo.batch.vehicles_report import sweeps_vehicles, write_vehicles_repo
 from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.matrix import Case, Matrix, check_matrix, load_matrix
+from eoam_sumo.sim.settings import check_sumo_step_s
 
 #: Exit status of ``eoam-sumo batch`` when at least one case failed (bad input is 2).
 EXIT_CASES_FAILED = 1
@@ -144,6 +145,7 @@ def run_batch(
     timeseries: str = "csv",
     after_stop_s: float | None = None,
     plan: BatchPlan | None = None,
+    sumo_step_s: float | None = None,
 ) -> pd.DataFrame:
     """Run every case of the matrix; return the final results (as :func:`read_results`).
 
@@ -160,12 +162,12 @@ def run_batch(
     (:func:`~eoam_sumo.matrix.load_matrix`), its scenario files and every swept speed and
     friction against the lookup tables in ``tables_dir`` (default: the co-simulation's,
     :func:`~eoam_sumo.matrix.check_matrix`). A case that fails is a ``failed`` row.
-    ``after_stop_s`` sets every case's (over the matrix's ``[scenario] after_stop_s``).
+    ``after_stop_s`` and ``sumo_step_s`` set every case's (over the matrix's ``[scenario]``).
     ``plan``: the matrix already checked by :func:`plan_batch` (the command line checks it
     before it takes the output folder).
     """
     check_options(jobs, timeout_s, timeseries)
-    plan = plan or plan_batch(matrix_path, tables_dir, after_stop_s)
+    plan = plan or plan_batch(matrix_path, tables_dir, after_stop_s, sumo_step_s)
     matrix, cases, paper = plan.matrix, plan.cases, plan.paper
     out_dir = _cases_folder(Path(out_dir))
     results = run_cases(
@@ -200,16 +202,23 @@ class BatchPlan:
 
 
 def plan_batch(
-    matrix_path: Path, tables_dir: Path | None = None, after_stop_s: float | None = None
+    matrix_path: Path,
+    tables_dir: Path | None = None,
+    after_stop_s: float | None = None,
+    sumo_step_s: float | None = None,
 ) -> BatchPlan:
     """The matrix loaded and checked (:func:`run_batch`'s bad input), nothing written."""
     if after_stop_s is not None and not after_stop_s >= 0.0:
         raise InputError(f"--after-stop-s {after_stop_s:g} must be >= 0")
+    if sumo_step_s is not None:
+        sumo_step_s = check_sumo_step_s(sumo_step_s, "--sumo-step-s")
     matrix: Matrix = load_matrix(Path(matrix_path))
     check_matrix(matrix, tables_dir)
     cases = matrix.cases()
     if after_stop_s is not None:
         cases = [replace(c, after_stop_s=after_stop_s) for c in cases]
+    if sumo_step_s is not None:
+        cases = [replace(c, sumo_step_s=sumo_step_s) for c in cases]
     return BatchPlan(matrix, cases, matrix.paper_outcomes())
 
 

@@ -7,11 +7,13 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from eoam_sumo.arguments import sumo_step_argument
 from eoam_sumo.errors import InputError
 from eoam_sumo.matrix import vehicle_params as matrix_vehicle_params
 from eoam_sumo.outputs.staging import OutputKind, output_folder
 from eoam_sumo.params import MU_MAX, VehicleParams
 from eoam_sumo.protocols.points import PROTOCOLS, TestPoint, protocol_points
+from eoam_sumo.sim.settings import check_sumo_step_s
 
 #: Runs end at this simulated time after the ego's departure [s]: the slowest approach
 #: (CCRm 30 km/h behind 20 km/h, 41.7 m at 2.8 m/s) meets the target after 15 s.
@@ -80,6 +82,7 @@ def add_arguments(subparsers) -> None:
     p.add_argument("--mu", type=float, default=1.0, help="friction of every lane (1.0)")
     p.add_argument("--points", help="run only the points whose id matches this regex")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    sumo_step_argument(p)
 
 
 def selected_points(args) -> list[TestPoint]:
@@ -122,6 +125,9 @@ def run(args) -> int:
     from eoam_sumo.protocols.runner import run_protocol
 
     points = selected_points(args)
+    sumo_step_s = args.sumo_step_s
+    if sumo_step_s is not None:
+        sumo_step_s = check_sumo_step_s(sumo_step_s, "--sumo-step-s")
     with output_folder(Path(args.out), PROTOCOL_OUTPUT) as out:
         summary = run_protocol(
             args.name,
@@ -137,6 +143,7 @@ def run(args) -> int:
             params=vehicle_params(args.vehicle, args.abs, args.esc),
             progress=not args.no_progress,
             max_time_s=MAX_TIME_S,
+            sumo_step_s=sumo_step_s,
         )
     print(summary.line(Path(args.out)))
     return 1 if summary.failed else 0

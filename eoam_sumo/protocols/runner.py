@@ -92,8 +92,10 @@ def _case(
     vehicle_id: str,
     params: VehicleParams,
     system: str = "aeb",
+    sumo_step_s: float | None = None,
 ) -> Case:
-    """The point's case; ``system`` aeb inhibits the EOAM's lane change."""
+    """The point's case; ``system`` aeb inhibits the EOAM's lane change; ``sumo_step_s``
+    SUMO's step (None: the run's default)."""
     return Case(
         point.point_id,
         cfg,
@@ -108,6 +110,7 @@ def _case(
         esc_fitted=params.esc_fitted,
         vehicle=None if vehicle_id == DEFAULT_VEHICLE else vehicle_id,
         steering_inhibited=system == "aeb",
+        sumo_step_s=sumo_step_s,
     )
 
 
@@ -127,6 +130,7 @@ def run_protocol(
     progress: bool = True,
     max_time_s: float = 40.0,
     tables_dir: Path | None = None,
+    sumo_step_s: float | None = None,
 ) -> ProtocolSummary:
     """Write the scenarios, run the points inside the design range, score every point."""
     params = params or ego_e_class_sedan()
@@ -134,7 +138,7 @@ def run_protocol(
     runnable = [p for p in points if p.ego_speed_kmh >= low - 1e-9]
     cfgs = write_scenarios(points, out / "scenarios")
     cases = [
-        _case(p, cfgs[p.point_id], policy, mu, max_time_s, vehicle_id, params, system)
+        _case(p, cfgs[p.point_id], policy, mu, max_time_s, vehicle_id, params, system, sumo_step_s)
         for p in runnable
     ]
     batch = run_cases(

@@ -1,12 +1,15 @@
 """The co-simulation step loop: SUMO, radar, EOAM logic, plant and write-back, step by step.
 
-Two rates: SUMO and the EOAM decision/control run every ``step_s`` (10 ms by default); the
-plant integrates at ``plant_dt_s`` (1 ms) inside each SUMO step, all sub-steps in one compiled
-call. A step (:meth:`CoSimulation.step`) is a sequence of named phases: ``sense`` (the ego in
-the road frame, the radar on the road users SUMO reports near it), ``decide`` (EOAM decision
-and control), ``actuate`` (the plant), ``write_back`` (the ego's pose to SUMO with
-``moveToXY``, SUMO one step on), ``check_contact`` (oriented boxes at each plant sub-step),
-then the observers (time series, running extremes, anything added) and ``finished``.
+Three rates: the EOAM's decision/control every ``step_s`` (10 ms); SUMO every
+``sumo_step_s`` (by default the same 10 ms; up to 100 ms, the road users interpolated between
+its steps by :mod:`eoam_sumo.sim.interpolation`, the ego's pose written back at each); the
+plant at ``plant_dt_s`` (1 ms) inside each control step, all sub-steps in one compiled call
+(the automotive radar scans at its own cycle). A step (:meth:`CoSimulation.step`) is a
+sequence of named phases: ``sense`` (the ego in the road frame, the radar on the road users
+near it), ``decide`` (EOAM decision and control), ``actuate`` (the plant), ``write_back``
+(the ego's pose to SUMO with ``moveToXY``, SUMO one step on), ``check_contact`` (oriented
+boxes at each plant sub-step), then the observers (time series, running extremes, anything
+added) and ``finished``.
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ from eoam_sumo.sensing.friction import FrictionBelief
 from eoam_sumo.sensing.next_lane import NextLaneSensing
 from eoam_sumo.sensing.radar import RadarReport
 from eoam_sumo.sim.facts import collect_facts, collect_info
+from eoam_sumo.sim.interpolation import ego_ahead, interpolate_reports
 from eoam_sumo.sim.margins import (
     EGO_STANDSTILL_MPS,
     Margins,
@@ -160,10 +164,11 @@ class CoSimulation:
             self.cfg,
             self.overrides,
             ego_id=st.ego_id,
-            step_length_s=st.step_s,
+            step_length_s=st.sumo_step_length_s,
             gui=st.gui,
             use_traci=st.use_traci,
             gui_settings=st.gui_settings,
+            ballistic=st.sumo_every > 1,
         )
 
     # ----------------------------------------------------------------------------- set-up
@@ -271,6 +276,24 @@ class CoSimulation:
         self._stop_at: float | None = None
         self.t = self.t_start = session.time_s
         self.bodies = session.nearby(self._sense_radius_m)  # with their boxes
+        self._reset_rates()
+
+    def _reset_rates(self) -> None:
+        """A multi-rate run's state: control steps since SUMO's earlier report, that report
+        (SUMO's time then, in ms) and its later one; the margin the contact check allows for
+        a road user's move in a step beyond its speed's."""
+        st = self.settings
+        self._every = st.sumo_every
+        self._since_sumo = 0
+        self._report0 = self._report1 = self.bodies
+        self._step_ms = round(st.step_s * 1000.0)
+        self._sumo_step_ms = round(st.sumo_step_length_s * 1000.0)
+        # SUMO inserts the ego one of its steps after its departure: the run's clock is the
+        # 10 ms reference's, which starts one 10 ms step after it
+        self._sumo_ms = round(self.t * 1000.0) - (self._sumo_step_ms - self._step_ms)
+        if self._every > 1:
+            self.t = self.t_start = self._sumo_ms / 1000.0
+        self._reach_pad_m = 0.05 if self._every == 1 else 0.1
 
     def _check_departure(self) -> None:
         """Refuse a road user overlapping the ego's box at its departure."""
@@ -384,15 +407,45 @@ class CoSimulation:
 
     def write_back(self) -> None:
         """The ego's pose to SUMO (front bumper, navigation angle), SUMO one step on, and the
-        road users around the ego then."""
+        road users around the ego then; in a multi-rate run, between SUMO's steps, the road
+        users interpolated instead."""
         X, Y, yaw, vx = self.x[:4]
         self._cy, self._sy = cy, sy = math.cos(yaw), math.sin(yaw)
+        if self._every > 1:
+            self._multi_rate_step()
+            return
         front = self._front
         session = self.session
         session.move_ego(X + front * cy, Y + front * sy, nav_angle_deg(yaw), max(vx, 0.0))
         session.step()
         self.t = session.time_s
         self.bodies_before, self.bodies = self.bodies, session.nearby(self._sense_radius_m)
+
+    def _multi_rate_step(self) -> None:
+        """SUMO one step ahead of the control steps: at the first control step after SUMO's
+        earlier report, the ego's pose carried on to SUMO's next step
+        (:func:`~eoam_sumo.sim.interpolation.ego_ahead`) and SUMO one step on; the road users
+        between its two reports (:func:`~eoam_sumo.sim.interpolation.interpolate_reports`)."""
+        self._since_sumo = since = self._since_sumo + 1
+        session = self.session
+        if since == 1:
+            ahead_s = (self._sumo_step_ms - self._step_ms) / 1000.0
+            X, Y, yaw, speed = ego_ahead(self.x, self.ax, ahead_s)
+            front = self._front
+            session.move_ego(
+                X + front * math.cos(yaw), Y + front * math.sin(yaw), nav_angle_deg(yaw), speed
+            )
+            session.step()
+            self._report0, self._report1 = self._report1, session.nearby(self._sense_radius_m)
+        since_ms = since * self._step_ms
+        self.t = (self._sumo_ms + since_ms) / 1000.0
+        self.bodies_before = self.bodies
+        self.bodies = interpolate_reports(
+            self._report0, self._report1, since_ms / 1000.0, self._sumo_step_ms / 1000.0
+        )
+        if since == self._every:
+            self._since_sumo = 0
+            self._sumo_ms += self._sumo_step_ms
 
     def check_contact(self) -> None:
         """Ground truth: oriented-box contact with every road user near the ego at every plant
@@ -415,7 +468,7 @@ class CoSimulation:
             centres_m = math.hypot(b.x_m - ego_cx, b.y_m - ego_cy)
             if centres_m > GAP_WATCH_M:
                 continue
-            reach_m = ego_move + b.speed_mps * step_s + 0.05
+            reach_m = ego_move + b.speed_mps * step_s + self._reach_pad_m
             # the bounding circles' gap is a lower bound of the boxes' gap
             circles_m = centres_m - ego_box_radius - b.box.radius_m - GAP_ROUNDING_M
             if circles_m > reach_m and circles_m >= min_gap_aro:

@@ -128,15 +128,18 @@ class Margins(StepObserver):
 
     def _opposite_gap(self, sim: RunView, x) -> float:
         """The smallest gap from the ego (plant state ``x``) to any opposite-direction road
-        user in the simulation (infinite when there is none)."""
+        user in the simulation (infinite when there is none); those near the ego as the step
+        has them (in a multi-rate run SUMO is up to a step ahead of the step's time)."""
         X, Y, yaw = x[0], x[1], x[2]
         road_yaw = sim.road.project(X, Y)[2]
         cr, sr = math.cos(road_yaw), math.sin(road_yaw)
         ego = OrientedBox.from_axis_point(X, Y, yaw, self.length_m, self.width_m, self.front_m)
+        near = {b.vid: b for b in sim.bodies}
+        users = [near.get(b.vid, b) for b in sim.session.road_users()]
         return min(
             (
                 box_distance(ego, b.box)
-                for b in sim.session.road_users()
+                for b in users
                 if not b.parked and b.box.cos_yaw * cr + b.box.sin_yaw * sr < 0.0
             ),
             default=math.inf,

@@ -3,6 +3,7 @@ the friction belief's, V2X's, the corner radars' and the GUI's settings."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -10,6 +11,7 @@ from mypy_extensions import mypyc_attr
 
 from eoam_sumo.drivers import DRIVERS
 from eoam_sumo.eoam_settings import EoamSettings
+from eoam_sumo.errors import InputError
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.sensing.next_lane import CornerRadarSettings
 from eoam_sumo.sensing.radar import RadarSettings
@@ -20,9 +22,25 @@ from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
 #: A run's simulated time limit unless set [s]: every Table 2 case ends well before it (the
 #: slowest, 55 km/h on mu 0.1, settles after 29.6 s).
 DEFAULT_MAX_TIME_S = 60.0
+#: SUMO's longest step in a multi-rate co-simulation [s] (its traffic models' default step).
+MAX_SUMO_STEP_S = 0.1
 #: The longest simulated time limit accepted [s]: a day of traffic (a larger one only
 #: overflows the step count; 1e308 did).
 MAX_TIME_LIMIT_S = 86400.0
+
+
+def check_sumo_step_s(value, label: str) -> float:
+    """A SUMO step [s] for a multi-rate run: whole 10 ms from 0.01 to ``MAX_SUMO_STEP_S``;
+    InputError naming ``label`` (the option or the file and key) otherwise."""
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    if ok:
+        n = value / 0.01
+        ok = 0.01 - 1e-9 <= value <= MAX_SUMO_STEP_S + 1e-9 and abs(n - round(n)) <= 1e-6
+    if not ok:
+        raise InputError(
+            f"{label} = {value!r} must be a multiple of 0.01 s from 0.01 to {MAX_SUMO_STEP_S:g}"
+        )
+    return round(value * 100.0) / 100.0
 
 
 @mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced
@@ -30,7 +48,10 @@ MAX_TIME_LIMIT_S = 86400.0
 class RunSettings:
     """Rates, limits and sub-settings of one co-simulation run."""
 
-    step_s: float = 0.01  # SUMO and decision/control step [s]; whole milliseconds in SUMO
+    step_s: float = 0.01  # decision/control step [s]; whole milliseconds
+    # SUMO's step [s], a whole multiple of ``step_s`` up to MAX_SUMO_STEP_S; None: ``step_s``
+    # (one rate). Between SUMO's steps the road users are interpolated (``sim/interpolation``)
+    sumo_step_s: float | None = None
     plant_dt_s: float = 0.001  # plant integration step [s]
     max_time_s: float = DEFAULT_MAX_TIME_S  # simulated time limit [s]
     settle_s: float = 2.0  # run on this long after the hand-back or a stop [s]
@@ -63,6 +84,15 @@ class RunSettings:
         n = self.step_s / self.plant_dt_s
         if self.plant_dt_s <= 0 or abs(n - round(n)) > 1e-9:
             raise ValueError(f"plant_dt_s={self.plant_dt_s} must divide step_s={self.step_s}")
+        if self.sumo_step_s is not None:
+            k = self.sumo_step_s / self.step_s
+            if not (k >= 1.0 - 1e-9 and abs(k - round(k)) <= 1e-9) or (
+                self.sumo_step_s > MAX_SUMO_STEP_S + 1e-9
+            ):
+                raise ValueError(
+                    f"sumo_step_s={self.sumo_step_s} must be a whole multiple of "
+                    f"step_s={self.step_s} up to {MAX_SUMO_STEP_S:g} s"
+                )
         if not 0 < self.max_time_s <= MAX_TIME_LIMIT_S:
             raise ValueError(f"max_time_s={self.max_time_s} must be in (0, {MAX_TIME_LIMIT_S:g}]")
         if self.after_stop_s is not None and not self.after_stop_s >= 0.0:
@@ -75,3 +105,13 @@ class RunSettings:
     @property
     def substeps(self) -> int:
         return round(self.step_s / self.plant_dt_s)
+
+    @property
+    def sumo_step_length_s(self) -> float:
+        """SUMO's step [s]: ``sumo_step_s``, or the control step."""
+        return self.step_s if self.sumo_step_s is None else self.sumo_step_s
+
+    @property
+    def sumo_every(self) -> int:
+        """Control steps per SUMO step (1: one rate)."""
+        return round(self.sumo_step_length_s / self.step_s)

@@ -54,12 +54,18 @@ def sumo_command(
     extra: tuple[str, ...],
     gui: bool,
     keep_gui_open: bool = False,
+    ballistic: bool = False,
 ) -> tuple[list[str], dict]:
     """(command line, overrides): SUMO started on ``cfg`` with the co-simulation's options,
     and option -> value of every one of them that changes what the sumocfg (``cfg_options``,
     its option elements) or SUMO's default gives. Options in ``extra`` win over both. sumo-gui
-    starts at once, and quits at the end unless ``keep_gui_open``."""
+    starts at once, and quits at the end unless ``keep_gui_open``. ``ballistic``: SUMO's
+    ballistic position update (constant acceleration over a step, as the multi-rate
+    co-simulation interpolates; SUMO's default Euler update moves a braking vehicle by its
+    new speed, half a step's travel short of the ballistic stop)."""
     wanted = [("step-length", f"{step_s:.3f}")]
+    if ballistic:
+        wanted.append(("step-method.ballistic", "true"))
     for option, value in ENFORCED_OPTIONS:
         if option in HONOURED_OPTIONS and option in cfg_options:
             continue

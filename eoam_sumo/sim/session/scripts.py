@@ -10,6 +10,11 @@ The hold is exact whatever the vehicle's type: its speed is commanded with SUMO'
 the lane-change model's cooperative slowing moves it off the departure speed or out of its
 lane. After the hold the stop keeps the safe speed (``SCRIPTED_SPEED_MODE``) and the
 vehicle's own lane-change mode is given back.
+
+SUMO inserts a vehicle one step after its departure time, and it moves from then on: at
+SUMO's 10 ms reference step it moves ``hold_s - 0.01`` s before its stop begins. At a longer
+SUMO step (a multi-rate run) the hold is lengthened by the later insertion, so that the
+vehicle moves as long, and stops where, it does at the reference step.
 """
 
 from __future__ import annotations
@@ -22,6 +27,7 @@ from eoam_sumo.sim.session.calls import StepCalls
 SCRIPTED_SPEED_MODE = 25  # safe speed, right of way, red lights; no accel/decel bound
 HOLD_SPEED_MODE = 32  # the commanded speed as it is: no safe speed, bounds or right of way
 NO_LANE_CHANGES = 0
+REFERENCE_STEP_S = 0.01  # the SUMO step whose insertion the holds are timed for [s]
 
 
 @dataclass
@@ -40,8 +46,10 @@ class _Script:
 class StopScripts:
     """The scripted stops of a run: waiting for their vehicle's departure, then running."""
 
-    def __init__(self, api, calls: StepCalls, constants, stops: dict) -> None:
+    def __init__(self, api, calls: StepCalls, constants, stops: dict, step_s: float) -> None:
         self._veh, self._calls, self._tc = api.vehicle, calls, constants
+        # the later insertion at a longer SUMO step (0.0 at the reference step)
+        self._insert_lag_s = max(0.0, step_s - REFERENCE_STEP_S)
         self._stops = stops  # vid -> (hold_s, decel_mps2)
         self.pending = set(stops)  # not yet departed
         self.running: dict[str, _Script] = {}
@@ -57,7 +65,10 @@ class StopScripts:
         veh = self._veh
         self.pending.discard(vid)
         self.running[vid] = _Script(
-            veh.getDeparture(vid) + hold, decel, veh.getSpeed(vid), veh.getLaneChangeMode(vid)
+            veh.getDeparture(vid) + hold + self._insert_lag_s,
+            decel,
+            veh.getSpeed(vid),
+            veh.getLaneChangeMode(vid),
         )
         veh.setSpeedMode(vid, HOLD_SPEED_MODE)
         veh.setLaneChangeMode(vid, NO_LANE_CHANGES)

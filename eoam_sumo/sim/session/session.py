@@ -222,7 +222,9 @@ class SumoSession:
         self._closed = False
         self._time_s = self._sim.getTime()
         self._mu_cache: dict[str, float] = {}
-        self._scripts = StopScripts(api, calls, constants, scripted_stops(files, overrides, ego_id))
+        self._scripts = StopScripts(
+            api, calls, constants, scripted_stops(files, overrides, ego_id), step_length_s
+        )
         self._puppets: Puppets | None = None  # road users an outside storyboard moves
         self._users = RoadUsers(api, calls, constants, ego_id, self._scripts.running)
         self._radius_m: float | None = None
@@ -247,17 +249,16 @@ class SumoSession:
         use_traci: bool = False,
         extra_args: tuple[str, ...] = (),
         gui_settings: GuiSettings = _GUI_DEFAULTS,
+        ballistic: bool = False,
     ) -> SumoSession:
-        """Check the files, start SUMO, advance it to the ego's departure and make the step
-        that inserts the ego at the requested speed; on return the ego is in SUMO and every
-        query answers. ``gui`` runs ``sumo-gui`` through TraCI (shown as ``gui_settings``
-        says), ``use_traci`` plain ``sumo`` through TraCI; otherwise libsumo (in-process, one
-        session per process)."""
+        """Check the files, start SUMO (``ballistic``: its ballistic update), advance it to
+        the ego's departure and make the step inserting the ego at the requested speed; then
+        every query answers. ``gui``: ``sumo-gui`` through TraCI (shown as ``gui_settings``
+        says), ``use_traci``: ``sumo`` through TraCI; else libsumo (in-process, one a process)."""
         step = _checked_step(overrides, step_length_s)
         extra = tuple(str(a) for a in extra_args)
         files = check_scenario(Path(cfg), ego_id)
         scripted = scripted_stops(files, overrides, ego_id)
-
         import sumo
         import sumolib
 
@@ -276,14 +277,13 @@ class SumoSession:
             extra,
             gui,
             keep_gui_open=gui_settings.keep_open,
+            ballistic=ballistic,
         )
         plan = handover_plan(files, ego_id, step, scripted, extra)
         first_cmd = cmd
         if plan is not None:  # sumo-gui too: a run watched in it is the run without it
-            coarse_cmd, _ = sumo_command(
-                binary, files.cfg, files.options, plan[0], error_log, extra, gui
-            )
-            first_cmd = [*coarse_cmd, *SAVE_STATE_OPTIONS]
+            coarse = sumo_command(binary, files.cfg, files.options, plan[0], error_log, extra, gui)
+            first_cmd = [*coarse[0], *SAVE_STATE_OPTIONS]
         try:
             started = _started(first_cmd, files, ego_id, error_log, workdir, via_traci)
             if plan is not None:
