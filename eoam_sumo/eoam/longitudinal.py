@@ -37,7 +37,10 @@ def longitudinal_control(
     if mode is UPDATE_BRAKE or mode is ONCOMING_BRAKE:  # limit braking without locking
         if mode is ONCOMING_BRAKE and shares_ellipse(parts, state, meas):
             floor = parts.settings.limit_brake_floor * state.friction_now().brake_limit_n
-            brake_lim = max(brake_lim, floor)
+            lock = long.wheel_lock_limit_n(
+                v, mu, lateral_use_mps2(parts, meas, lateral.steer_rad, False)
+            )
+            brake_lim = max(brake_lim, min(floor, lock))
         return LongitudinalOutput(0.0, brake_lim, -brake_lim / parts.params.mass_kg, 0.0)
     if tracking:
         drive, brake = long.track_accel(
@@ -93,8 +96,16 @@ def force_limits(
     """(drive, brake) limits from the friction ellipse with the lateral acceleration in use:
     measured, and outside the table's profile also the one this steering command asks for,
     so that the brake yields before a turning axle locks."""
-    v = meas.vx_mps
+    ay_use = lateral_use_mps2(parts, meas, steer_rad, tracking)
+    return parts.longitudinal.limits(
+        meas.vx_mps, meas.mu, ay_use, state.friction_now().brake_limit_n
+    )
+
+
+def lateral_use_mps2(parts: Parts, meas: EgoMeasurement, steer_rad: float, tracking: bool) -> float:
+    """|a_y| the brake limits leave friction for: measured, and outside the table's profile
+    also the one this steering command asks for."""
     ay_use = abs(meas.ay_mps2)
     if not tracking:
-        ay_use = max(ay_use, abs(parts.steering.lateral_accel(v, steer_rad)))
-    return parts.longitudinal.limits(v, meas.mu, ay_use, state.friction_now().brake_limit_n)
+        ay_use = max(ay_use, abs(parts.steering.lateral_accel(meas.vx_mps, steer_rad)))
+    return ay_use
