@@ -1,4 +1,4 @@
-"""The lane change on the chassis (issue 39): how far each Table 2 lane change runs off its
+"""The lane change on the chassis plant: how far each Table 2 lane change runs off its
 plan, and how close it passes the obstacle, for every catalogue vehicle with ABS on and off.
 
 For each vehicle x ABS x friction x speed of Table 2 (no oncoming car: the lane changes the
@@ -65,9 +65,7 @@ def measure(results: pd.DataFrame, out: Path) -> pd.DataFrame:
                 "abs": "on" if str(r["abs_fitted"]).lower() in ("true", "1") else "off",
                 "mu": r["mu"],
                 "ego_speed_kmh": r["ego_speed_kmh"],
-                "lane_change_error_m": lane_change_error_m(out / r["case_dir"])
-                if ok
-                else np.nan,
+                "lane_change_error_m": lane_change_error_m(out / r["case_dir"]) if ok else np.nan,
                 "min_gap_aro_m": r.get("min_gap_aro_m", np.nan),
                 "outcome": r.get("outcome", r["status"]),
                 "modes_visited": r.get("modes_visited", ""),

@@ -7,7 +7,7 @@ rolling resistance (a Coulomb torque at the wheel, ``plant.integrator.resist``),
 peak friction falls with load (PDX2, Pacejka 2012 eq. 4.E13), both wheels of an axle get the
 same line pressure while the lateral load transfer unloads the inner one, and cornering takes
 its share of the friction ellipse. Without ABS the EOAM's brake command must lock neither
-axle's inner wheel, or the front wheels it steers with slide straight on (issue 39). For a
+axle's inner wheel, or the front wheels it steers with slide straight on. For a
 wheel of axle share ``phi`` (front ``brake_front_share``, rear ``1 - phi``) and load
 
     Fz = m (g l_o +/- h a) / (2 L) - dFz_lat,   a = (F + R) / m_eq,

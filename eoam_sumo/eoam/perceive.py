@@ -69,7 +69,7 @@ def friction_at(parts: Parts, mu: float) -> Friction:
     """The limit braking force, the deceleration it delivers (the wheels spin down with the
     car: ``equivalent_mass_kg``) and the DMM boundaries at the sensed friction, B0 and Bb
     lengthened by as much as the wheel-lock cap (``wheel_lock_limit_n``, no ABS) takes off
-    limit braking on a straight road (issue 39)."""
+    limit braking on a straight road."""
     if not mu > 0.0:
         raise ValueError(f"friction mu={mu!r} must be > 0")
     decel = float(parts.tables.max_decel_mps2(mu))

@@ -79,7 +79,7 @@ class DesignSettings:
         "at the whole ellipse the plant's tyre is at its peak slip, where no force is left to "
         "correct with (measured: 0.92 m of tracking error at 55 km/h, mu 1.0; at 0.9 on the "
         "per-wheel chassis plant, whose inner wheels lose load and whose front slip envelope "
-        "keeps ~0.88 of the peak, 0.78 m; at 0.8, 0.15 m, issue 39)",
+        "keeps ~0.88 of the peak, 0.78 m; at 0.8, 0.15 m)",
     )
     continuation_steps: int = _p(
         4,

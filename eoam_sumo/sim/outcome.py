@@ -201,7 +201,7 @@ NEXT_LANE_CLOSED = "oncoming traffic or a standing car"
 
 def _manoeuvre_phrase(modes: set[int], lane_change: bool) -> str:
     """What the EOAM did, by the modes it visited: a run that entered mode 2 or 4 began a
-    lane change, whatever it braked before or after (issue 39, item 8)."""
+    lane change, whatever it braked before or after."""
     steered = bool(modes & {2, 4, 5})
     if lane_change:
         return "lane change"

@@ -61,7 +61,7 @@ def test_the_plant_locks_just_above_the_limit_and_not_below(params, plant_cache_
     high = brake_split.wheel_lock_brake_n(params, mu, 0.0, ctrl.resistance_n(V0_MPS), 0.0, m_eq)
     assert not _locked_while_moving(plant, mu, 0.99 * low)
     assert _locked_while_moving(plant, mu, 1.05 * high)
-    # eq. 33's no-lock force itself locks the front on ice (issue 39)
+    # eq. 33's no-lock force itself locks the front on ice
     assert _locked_while_moving(
         plant, 0.1, 0.95 * params.mass_kg * max_decel_no_lock_mps2(params, 0.1)
     )

@@ -34,7 +34,7 @@ FRONT_LOCKED, REAR_LOCKED = OUTPUT_NAMES.index("front_locked"), OUTPUT_NAMES.ind
         "at 165 km/h on mu 1.0 the lane change runs 0.27 m off its plan (limit 0.25 m; 55 km/h "
         "0.15 m, 165 km/h mu 0.3 0.17 m, planned within 0.8 of each axle's friction): the "
         "165 km/h plan drifts the car at up to 4 m/s of lateral body speed and asks for drive "
-        "at the rear while its inner tyre is near its peak (issue 39)"
+        "at the rear while its inner tyre is near its peak"
     ),
 )
 def test_lane_change_follows_its_plan(tmp_path):
@@ -60,7 +60,7 @@ def test_lane_change_follows_its_plan(tmp_path):
 
 
 def test_on_ice_the_lane_change_keeps_its_front_wheels_rolling():
-    """Issue 39: 90 km/h on mu 0.1 without ABS, the paper's Table 2 cell. Limit braking at
+    """90 km/h on mu 0.1 without ABS, the paper's Table 2 cell. Limit braking at
     0.95 of eq. 33 used to lock the front axle (rolling resistance and the tyre's load
     sensitivity on top of the split's share), so the lane change began on locked front
     wheels and ran 2.18 m off its plan into the obstacle. Now no wheel locks from the trigger

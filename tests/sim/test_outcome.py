@@ -137,7 +137,7 @@ def test_yellow_oncoming_seen_before_the_point_of_no_return():
 
 
 def test_the_reason_names_a_lane_change_begun_after_braking():
-    """Issue 39 item 8: modes 0-1-2 hit head on before the point of no return began a lane
+    """Modes 0-1-2 hit head on before the point of no return began a lane
     change; the reason must not read as limit braking chosen by the DMM."""
     out = _classify([0, 1, 2], 0.2, _hit("rear_end", speed=17.9), "aro")
     assert out.reason.startswith("lane change started but the point of no return not reached")
