@@ -26,6 +26,8 @@ class EoamSettings:
     settle_heading_rad: float = 0.02  # ... and |e_yaw| below this ...
     settle_dwell_s: float = 0.5  # ... for this long after the return path ended
     release_opening_speed_mps: float = 0.5  # mode 1 -> 0: obstacle pulls away faster than this
+    follow_after_brake: bool = True  # mode 1 -> 0: the object ahead sets the speed while
+    # sensed (False: the set speed, a plain cruise control; mode 3 -> 0 follows either way)
     coasted_margin_m: float = 2.0  # modes 0, 1: a coasted object within the stopping distance
     # plus this brakes (a standstill gap, as adaptive cruise keeps)
     min_steer_speed_mps: float = 20.0 / 3.6  # below it a STEER sector brakes instead

@@ -199,6 +199,10 @@ VEHICLE_RANGES: dict[str, tuple[float, float]] = {
 }
 #: FNOMIN of the plant's one tyre set, the PAC2002 235/60R16 (``plant.magic_formula``) [N].
 PLANT_TYRE_FNOMIN_N = 4850.0
+#: The plant tyre's longitudinal peak friction per unit load increment, PDX2 / PDX1 of the
+#: PAC2002 235/60R16 (``plant.magic_formula``): mu_x(Fz) = mu (1 + this (Fz - FNOMIN) / FNOMIN)
+#: (Pacejka 2012 eq. 4.E13 with LMUX = mu / PDX1) [-].
+PLANT_TYRE_PEAK_LOAD_SENSITIVITY = -0.16395 / 1.1739
 #: Static load per tyre the plant's tyre describes, as multiples of its FNOMIN: its
 #: load-variation terms (PDX2, PDY2) take its peak friction to zero near 6 x FNOMIN, and a
 #: limit manoeuvre's load transfer can double a tyre's load (docs/vehicles.md, the tyre).

@@ -26,6 +26,7 @@ from dataclasses import dataclass, fields
 
 from mypy_extensions import mypyc_attr
 
+from eoam_sumo.control.brake_split import wheel_lock_brake_n
 from eoam_sumo.params import AIR_DENSITY_KGPM3, G_MPS2, VehicleParams
 
 WHEELS = 4  # the plant's two axles of two wheels, each of ``wheel_inertia_kgm2``
@@ -53,13 +54,19 @@ class LongitudinalGains:
     speed_accel_limit_g: float = 0.25  # |demand| <= this * mu * g (comfort, traction) [-]
     ellipse_margin: float = 1.1  # |a_y| inflated by this in the friction-ellipse caps [-]
     traction_fraction: float = 0.8  # drive <= this * mu * static rear axle load [-]
+    wheel_lock_fraction: float = 0.95  # brake <= this * the split's wheel-lock force, no ABS [-]
 
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
             if not (math.isfinite(v) and v >= 0.0):
                 raise ValueError(f"longitudinal gain {f.name}={v!r} must be finite and >= 0")
-        for name in ("speed_accel_limit_g", "ellipse_margin", "traction_fraction"):
+        for name in (
+            "speed_accel_limit_g",
+            "ellipse_margin",
+            "traction_fraction",
+            "wheel_lock_fraction",
+        ):
             if getattr(self, name) <= 0.0:
                 raise ValueError(f"longitudinal gain {name} must be > 0")
 
@@ -101,12 +108,15 @@ class LongitudinalController:
     """Acceleration and speed PIDs producing (drive_force_n, brake_force_n)."""
 
     __slots__ = (
+        "_abs",
         "_accel",
         "_alim_g",
         "_drag",
         "_fmax",
+        "_lock",
         "_m",
         "_margin",
+        "_params",
         "_pmax",
         "_rear_n",
         "_res0",
@@ -133,6 +143,7 @@ class LongitudinalController:
             g.speed_kp_per_s, g.speed_ki_per_s2, g.speed_kd, g.speed_integral_limit_mps2
         )
         self._alim_g = g.speed_accel_limit_g * G_MPS2
+        self._params, self._abs, self._lock = params, params.abs_fitted, g.wheel_lock_fraction
 
     def reset(self) -> None:
         """Clear both integrators (called at every switch of longitudinal loop)."""
@@ -144,10 +155,22 @@ class LongitudinalController:
         v = speed_mps
         return self._res0 + self._drag * v * v if v > 0.0 else 0.0
 
+    def wheel_lock_limit_n(self, speed_mps: float, mu: float, lateral_accel_mps2: float) -> float:
+        """``wheel_lock_fraction`` of the brake command that locks an axle's inner wheel on
+        the fixed brake split at this lateral acceleration (``brake_split``); ``math.inf``
+        with ABS, which modulates a wheel's pressure at its peak slip itself."""
+        if self._abs:
+            return math.inf
+        q = self._margin * abs(lateral_accel_mps2) / mu
+        res = self.resistance_n(speed_mps)
+        lock = wheel_lock_brake_n(self._params, mu, lateral_accel_mps2, res, q, self._m)
+        return self._lock * lock
+
     def limits(
         self, speed_mps: float, mu: float, lateral_accel_mps2: float, no_lock_brake_n: float
     ) -> tuple[float, float]:
-        """(drive, brake) force limits at this speed, friction and lateral acceleration."""
+        """(drive, brake) force limits at this speed, friction and lateral acceleration: the
+        brake within the friction ellipse and below ``wheel_lock_limit_n``."""
         q = self._margin * abs(lateral_accel_mps2) / mu
         ellipse = math.sqrt(1.0 - q * q) if q < 1.0 else 0.0
         drive = self._fmax
@@ -155,7 +178,8 @@ class LongitudinalController:
             drive = min(drive, self._pmax / speed_mps)  # power-limited
         drive = min(drive, self._rear_n)  # traction-limited
         drive = mu * drive
-        return drive * ellipse, no_lock_brake_n * ellipse
+        lock = self.wheel_lock_limit_n(speed_mps, mu, lateral_accel_mps2)
+        return drive * ellipse, min(no_lock_brake_n * ellipse, lock)
 
     @staticmethod
     def split(net_force_n: float, drive_limit_n: float, brake_limit_n: float):

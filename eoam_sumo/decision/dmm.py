@@ -144,25 +144,30 @@ class BoundaryCurve:
     ``LOW_SPEED_SAMPLES`` speeds from 0 to the lowest of them, where the stopping distance is
     quadratic in v (eq. 33; linear blending between samples 1/24 of the lowest speed apart
     overestimates it by at most 1/4608 of B0 there); ``at`` and ``sector`` then cost a
-    bisection and a linear blend. Above the last speed the last row is used.
+    bisection and a linear blend. Above the last speed the last row is used. ``stop_scale``
+    (>= 1) lengthens the stopping distance B0 (and Bb by as much) where limit braking
+    delivers less than the tables' deceleration (eq. 33: B0 = v^2 / 2a scales with 1 / a).
     """
 
     __slots__ = ("_rows", "_speeds", "mu")
 
-    def __init__(self, boundaries, mu: float, speeds_mps):
+    def __init__(self, boundaries, mu: float, speeds_mps, stop_scale: float = 1.0):
         given = sorted({0.0, *(float(v) for v in speeds_mps)})
         if len(given) < 2 or given[0] < 0.0 or not math.isfinite(given[-1]):
             raise ValueError(f"bad boundary speeds: {speeds_mps!r}")
+        if not (math.isfinite(stop_scale) and stop_scale >= 1.0):
+            raise ValueError(f"stop_scale={stop_scale!r} must be finite and >= 1")
         n = LOW_SPEED_SAMPLES
         speeds = sorted({*given, *(given[1] * k / n for k in range(n))})
         rows = []
         for v in speeds:
             b = boundaries.at(mu, v)
+            longer = float(b.stop_m) * (stop_scale - 1.0)
             row = (  # plain tuples: indexing a tuple subclass is slower
                 float(b.clear_opt_m),
                 float(b.clear_buffered_m),
-                float(b.stop_m),
-                float(b.stop_buffered_m),
+                float(b.stop_m) + longer,
+                float(b.stop_buffered_m) + longer,
                 float(b.ttc_s),
             )
             if not all(math.isfinite(x) for x in row):

@@ -37,7 +37,9 @@ def longitudinal_control(
     if mode is UPDATE_BRAKE or mode is ONCOMING_BRAKE:  # limit braking without locking
         if mode is ONCOMING_BRAKE and shares_ellipse(parts, state, meas):
             floor = parts.settings.limit_brake_floor * state.friction_now().brake_limit_n
-            brake_lim = max(brake_lim, floor)
+            # the brake has priority (the steering takes the ellipse's rest), below what
+            # locks a wheel braking straight
+            brake_lim = max(brake_lim, min(floor, long.wheel_lock_limit_n(v, mu, 0.0)))
         return LongitudinalOutput(0.0, brake_lim, -brake_lim / parts.params.mass_kg, 0.0)
     if tracking:
         drive, brake = long.track_accel(
@@ -57,16 +59,24 @@ def longitudinal_control(
 #: speedometer" rule of thumb (a gap of half the speed in km/h, in metres).
 FOLLOW_GAP_S = 1.8
 FOLLOW_CLOSE_S = 3.0
+#: How long a track not sensed again is still followed [s]: then the set speed (it left the
+#: path or the sensor); the project's choice, 1 s of radar cycles.
+FOLLOW_TRACK_AGE_S = 1.0
 
 
 def following_speed_mps(parts: Parts, state: ControllerState, meas: EgoMeasurement) -> float:
-    """Mode 0's speed target: the set speed, or after mode 3 let a moving obstacle go
-    (``state.following``) at most the obstacle's speed plus the gap error beyond
-    ``FOLLOW_GAP_S`` of its speed, closed in ``FOLLOW_CLOSE_S`` (car-following, no standstill
-    behind a car that drives on)."""
+    """Mode 0's speed target: the set speed, or after mode 1 or 3 let a moving obstacle go
+    (``state.following``), while it is still sensed (``FOLLOW_TRACK_AGE_S``), at most the
+    obstacle's speed plus the gap error beyond ``FOLLOW_GAP_S`` of its speed, closed in
+    ``FOLLOW_CLOSE_S`` (car-following: the object ahead sets the speed, no stop-and-go
+    behind a road user that drives on slower than the set speed)."""
     target = state.initial_speed_mps
     obstacle = state.obstacle
-    if not state.following or obstacle is None:
+    if (
+        not state.following
+        or obstacle is None
+        or meas.time_s - obstacle.time_s > FOLLOW_TRACK_AGE_S
+    ):
         return target
     front_s, v_obs = obstacle.at(meas.time_s)
     gap = front_s - obstacle.length_m - meas.s_m - parts.params.cg_to_front_bumper_m
@@ -93,8 +103,16 @@ def force_limits(
     """(drive, brake) limits from the friction ellipse with the lateral acceleration in use:
     measured, and outside the table's profile also the one this steering command asks for,
     so that the brake yields before a turning axle locks."""
-    v = meas.vx_mps
+    ay_use = lateral_use_mps2(parts, meas, steer_rad, tracking)
+    return parts.longitudinal.limits(
+        meas.vx_mps, meas.mu, ay_use, state.friction_now().brake_limit_n
+    )
+
+
+def lateral_use_mps2(parts: Parts, meas: EgoMeasurement, steer_rad: float, tracking: bool) -> float:
+    """|a_y| the brake limits leave friction for: measured, and outside the table's profile
+    also the one this steering command asks for."""
     ay_use = abs(meas.ay_mps2)
     if not tracking:
-        ay_use = max(ay_use, abs(parts.steering.lateral_accel(v, steer_rad)))
-    return parts.longitudinal.limits(v, meas.mu, ay_use, state.friction_now().brake_limit_n)
+        ay_use = max(ay_use, abs(parts.steering.lateral_accel(meas.vx_mps, steer_rad)))
+    return ay_use

@@ -61,16 +61,25 @@ def check_measurement(state: ControllerState, meas: EgoMeasurement) -> None:
         raise ValueError(f"lane_width_m={meas.lane_width_m!r} must be > 0")
 
 
+#: The speed at which the DMM's stopping distance takes the no-lock cap (drag ~0) [m/s].
+_SLOW_MPS = 1.0
+
+
 def friction_at(parts: Parts, mu: float) -> Friction:
     """The limit braking force, the deceleration it delivers (the wheels spin down with the
-    car: ``equivalent_mass_kg``) and the DMM boundaries at the sensed friction."""
+    car: ``equivalent_mass_kg``) and the DMM boundaries at the sensed friction, B0 and Bb
+    lengthened by as much as the wheel-lock cap (``wheel_lock_limit_n``, no ABS) takes off
+    limit braking on a straight road."""
     if not mu > 0.0:
         raise ValueError(f"friction mu={mu!r} must be > 0")
     decel = float(parts.tables.max_decel_mps2(mu))
     brake_limit = parts.settings.limit_brake_fraction * parts.params.mass_kg * decel
+    # straight, slow (no drag): what the wheel-lock cap leaves of eq. 33's limit braking
+    straight = min(brake_limit, parts.longitudinal.wheel_lock_limit_n(_SLOW_MPS, mu, 0.0))
     delivered = brake_limit / equivalent_mass_kg(parts.params)
     bounds = parts.tables.boundaries
-    return Friction(mu, brake_limit, delivered, BoundaryCurve(bounds, mu, bounds.speed_grid_mps))
+    curve = BoundaryCurve(bounds, mu, bounds.speed_grid_mps, stop_scale=brake_limit / straight)
+    return Friction(mu, brake_limit, delivered, curve)
 
 
 def track_obstacle(

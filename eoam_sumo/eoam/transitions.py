@@ -8,6 +8,7 @@ from eoam_sumo.decision.modes import (
     ONCOMING_BRAKE,
     ONCOMING_STEER_BRAKE,
     RETURN,
+    UPDATE_BRAKE,
     UPDATE_STEER_BRAKE,
     Mode,
     next_mode,
@@ -132,7 +133,10 @@ def enter(parts: Parts, state: ControllerState, mode: Mode, meas: EgoMeasurement
     """Entry actions of a new mode (mode 4 keeps the lane change of mode 2 going)."""
     previous = state.mode
     state.arrest = 0.0
-    if mode is NORMAL and previous is ONCOMING_BRAKE:
+    if mode is NORMAL and (
+        previous is ONCOMING_BRAKE
+        or (previous is UPDATE_BRAKE and parts.settings.follow_after_brake)
+    ):
         state.following = True  # the obstacle drove on: follow it at a time gap
     if mode is UPDATE_STEER_BRAKE:  # the table lane change for the trigger speed and friction
         state.hold_speed_mps = None

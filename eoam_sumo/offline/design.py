@@ -72,12 +72,14 @@ class DesignSettings:
         "steering and sideslip are then the ones the plant needs (False: the paper's tyre)",
     )
     friction_use: float = _p(
-        0.9,
+        0.8,
         "-",
         DESIGN + ": each axle's planned tyre force stays within this share of its "
         "friction limit mu Fz (eqs. 25, 28: ellipse <= share^2); the rest is the tracking loop's: "
         "at the whole ellipse the plant's tyre is at its peak slip, where no force is left to "
-        "correct with (measured: 0.92 m of tracking error at 55 km/h, mu 1.0)",
+        "correct with (measured: 0.92 m of tracking error at 55 km/h, mu 1.0; at 0.9 on the "
+        "per-wheel chassis plant, whose inner wheels lose load and whose front slip envelope "
+        "keeps ~0.88 of the peak, 0.78 m; at 0.8, 0.15 m)",
     )
     continuation_steps: int = _p(
         4,

@@ -200,17 +200,18 @@ NEXT_LANE_CLOSED = "oncoming traffic or a standing car"
 
 
 def _manoeuvre_phrase(modes: set[int], lane_change: bool) -> str:
+    """What the EOAM did, by the modes it visited: a run that entered mode 2 or 4 began a
+    lane change, whatever it braked before or after."""
+    steered = bool(modes & {2, 4, 5})
     if lane_change:
         return "lane change"
     if 3 in modes:
-        return (
-            "limit braking chosen (next lane not free before the point of no return: "
-            f"{NEXT_LANE_CLOSED})"
-        )
+        chosen = "lane change aborted for limit braking" if steered else "limit braking chosen"
+        return f"{chosen} (next lane not free before the point of no return: {NEXT_LANE_CLOSED})"
+    if steered:
+        return "lane change started but the point of no return not reached"
     if 1 in modes:
         return "limit braking chosen by the DMM"
-    if modes & {2, 4, 5}:
-        return "lane change started but the point of no return not reached"
     return "no EOAM intervention"
 
 

@@ -8,6 +8,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from eoam_sumo.control import LongitudinalGains, equivalent_mass_kg
+from eoam_sumo.control.brake_split import wheel_lock_brake_n
 from eoam_sumo.decision import SECTOR_ORDER, Action, Mode, Sector, dmm_sector
 from eoam_sumo.decision.obstacle import ObstacleDecel
 from eoam_sumo.decision.policy import PolicySettings, SafePolicy
@@ -33,7 +35,7 @@ from eoam_sumo.eoam.strategies import (
 )
 from eoam_sumo.eoam.transitions import advance_mode
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
-from eoam_sumo.params import PONR_FRACTION, ego_e_class_sedan
+from eoam_sumo.params import AIR_DENSITY_KGPM3, PONR_FRACTION, ego_e_class_sedan
 
 P = ego_e_class_sedan()
 LANE = 3.5
@@ -63,8 +65,26 @@ def stage_inputs(tables, st_=None, mu=1.0, mode=Mode.NORMAL):
     return parts, state
 
 
-def near_a_boundary(tables, mu, range_m, closing_mps, tol_m=1e-6):
+def stop_scale(tables, mu):
+    """How much longer limit braking stops than eq. 33 says where the wheel-lock cap binds
+    (``control.brake_split``: straight, slow, 0.95 of the lock command, no ABS)."""
+    p = tables.params
+    eq33 = EoamSettings().limit_brake_fraction * p.mass_kg * tables.max_decel_mps2(mu)
+    rolling = p.rolling_resistance_coeff * p.mass_kg * 9.81
+    drag = 0.5 * AIR_DENSITY_KGPM3 * p.drag_area_m2  # at 1 m/s, as the controller takes it
+    lock = wheel_lock_brake_n(p, mu, 0.0, rolling + drag, 0.0, equivalent_mass_kg(p))
+    return eq33 / min(eq33, LongitudinalGains().wheel_lock_fraction * lock)
+
+
+def boundaries_at(tables, mu, closing_mps):
+    """The tables' boundaries with B0 and Bb lengthened by ``stop_scale``."""
     b = tables.boundaries.at(mu, closing_mps)
+    longer = b.stop_m * (stop_scale(tables, mu) - 1.0)
+    return b._replace(stop_m=b.stop_m + longer, stop_buffered_m=b.stop_buffered_m + longer)
+
+
+def near_a_boundary(tables, mu, range_m, closing_mps, tol_m=1e-6):
+    b = boundaries_at(tables, mu, closing_mps)
     lines = (b.clear_opt_m, b.clear_buffered_m, b.stop_m, b.stop_buffered_m, b.ttc_s * closing_mps)
     return any(abs(range_m - x) <= tol_m for x in lines)
 
@@ -88,7 +108,7 @@ def test_dmm_stage_places_a_steady_obstacle_in_the_tables_sector(
     meas = measurement(v=closing + obstacle_speed, mu=mu)
     situation = Situation(range_m, closing, 0.0, False, False, False)
     sector, action = sector_action(parts, state, meas, situation)
-    expected = dmm_sector(tables.boundaries.at(mu, closing), range_m, closing)
+    expected = dmm_sector(boundaries_at(tables, mu, closing), range_m, closing)
     assert sector is expected
     if expected.action is not Action.STEER or meas.vx_mps < EoamSettings().min_steer_speed_mps:
         assert action is (Action.BRAKE if expected.action is Action.STEER else expected.action)

@@ -1,6 +1,7 @@
 """Longitudinal controllers: force split, limits, PID convergence on a lagged point mass."""
 
 import math
+from dataclasses import replace
 
 import pytest
 
@@ -61,9 +62,17 @@ def test_force_limits_engine_traction_and_friction_ellipse():
     assert c.limits(20.0, 0.1, 0.0, 1.0)[0] == pytest.approx(0.1 * g.traction_fraction * rear_load)
     # lateral acceleration in use shrinks both by the friction ellipse
     ay = 0.5 * 9.81 / g.ellipse_margin
-    d2, b2 = c.limits(10.0, 1.0, ay, 12000.0)
-    assert b2 == pytest.approx(12000.0 * math.sqrt(0.75))
+    d2, b2 = c.limits(10.0, 1.0, ay, 5000.0)
+    assert b2 == pytest.approx(5000.0 * math.sqrt(0.75))
     assert d2 == pytest.approx(drive * math.sqrt(0.75))
+    # without ABS the brake also stays below what locks the unloaded inner front wheel
+    lock = c.wheel_lock_limit_n(10.0, 1.0, ay)
+    assert lock < 12000.0 * math.sqrt(0.75)
+    assert c.limits(10.0, 1.0, ay, 12000.0)[1] == pytest.approx(lock)
+    assert (
+        LongitudinalController(replace(P, abs_fitted=True)).wheel_lock_limit_n(10.0, 1.0, ay)
+        == math.inf
+    )
     # nothing left once the lateral acceleration uses all the friction
     assert c.limits(10.0, 0.3, 0.3 * 9.81, 12000.0) == (0.0, 0.0)
 

@@ -77,15 +77,18 @@ def test_stopping_distance_is_eq_33_and_above_the_friction_floor():
 
 
 def test_clearing_distances_respect_the_point_mass_floors():
-    """The optimum uses at most ``friction_use`` of the friction: its floor is that share's;
-    it is never longer than the constant-speed quintic (at 0.8 mu g) by more than 1 % (with
-    the 10 % reserve the two meet at 165-175 km/h on dry road)."""
+    """The optimum uses at most ``friction_use`` of the friction: its floor is that share's.
+    Planned within 0.9 of each axle's friction it was never longer than the constant-speed
+    quintic (at 0.8 mu g, kinematic) by more than 1 %; a clearing distance scales with
+    1 / sqrt(share), so within ``friction_use`` by at most 1.01 sqrt(0.9 / friction_use)
+    (0.8: 7.1 %; measured 6.1 %, dry road at 175 km/h)."""
     for (mu, kmh), r in ROWS.items():
         v = kmh / 3.6
         assert r["clear_distance_const_m"] >= v * math.sqrt(2 * W / (mu * G_MPS2))
         floor = v * math.sqrt(2 * W / (S.friction_use * mu * G_MPS2))
         assert r["clear_distance_opt_m"] >= floor - W
-        assert r["clear_distance_opt_m"] <= 1.01 * r["clear_distance_const_m"]
+        longest = 1.01 * math.sqrt(0.9 / S.friction_use) * r["clear_distance_const_m"]
+        assert r["clear_distance_opt_m"] <= longest
 
 
 def test_optimised_clearing_is_within_1_3_of_the_point_mass_bound_from_60_kmh():
@@ -194,7 +197,9 @@ def test_rows_past_the_end_hold_the_final_values():
                 assert np.all(data[name][i, j, end:] == 0.0)
             # and the manoeuvre itself ends in the next lane, parallel
             assert data["y_m"][i, j, end - 2] == pytest.approx(S.lane_change_m, abs=0.03)
-            assert abs(data["yaw_rad"][i, j, end - 2]) < 0.01
+            # (planned within 0.8 of the friction, mu 0.3 / 20 km/h turns straight in its last
+            # metre: 0.012 rad one sample before the end)
+            assert abs(data["yaw_rad"][i, j, end - 2]) < 0.015
 
 
 def test_path_yaw_and_curvature_tables_agree_with_the_path(tables):
@@ -207,7 +212,8 @@ def test_path_yaw_and_curvature_tables_agree_with_the_path(tables):
             dydx = np.gradient(y, step)
             assert np.abs(dydx - np.tan(yaw)).max() < 0.02
             dyaw = np.gradient(yaw, step)
-            assert np.abs(dyaw - k / np.cos(yaw))[2:-2].max() < 0.1 * np.abs(k).max()
+            # mu 1.0 / 45 km/h within 0.8 of the friction: 0.1000 near its end
+            assert np.abs(dyaw - k / np.cos(yaw))[2:-2].max() < 0.11 * np.abs(k).max()
 
 
 def test_max_decel_is_the_no_lock_limit(tables):

@@ -474,16 +474,43 @@ def test_the_ego_may_be_a_vehicle_with_a_scripted_stop(tmp_path):
 @pytest.mark.sumo
 def test_a_second_manoeuvre_soon_after_a_hand_back_runs_to_its_end(tmp_path):
     """An ARO braking gently: the EOAM brakes, hands back, then has to change lanes; the run
-    must not stop 2 s after the first hand-back, in the middle of the lane change."""
+    must not stop 2 s after the first hand-back, in the middle of the lane change. (With a
+    plain cruise control after the hand-back: following the ARO, the ego never needs the
+    second manoeuvre; ``test_after_a_hand_back_the_object_ahead_sets_the_speed``.)"""
     cfg = baseline_variant(
         tmp_path,
         '<param key="eoam.aro_decel_mps2" value="8.0"/>',
         '<param key="eoam.aro_decel_mps2" value="1.0"/>',
     )
-    summary, _ = _run(cfg, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0, max_time_s=40.0)
+    cruise = EoamSettings(follow_after_brake=False)
+    summary, _ = _run(cfg, tmp_path, cruise, ego_speed_mps=120 / 3.6, mu=1.0, max_time_s=40.0)
     assert summary["modes_visited"][:3] == [0, 1, 2]
     assert abs(summary["final_lateral_offset_m"]) < 0.5
     assert "returned to lane" in summary["reason"]
+
+
+@pytest.mark.sumo
+def test_after_a_hand_back_the_object_ahead_sets_the_speed(tmp_path):
+    """The same gently braking ARO with the default settings: after mode 1 hands back, the
+    ego follows it (its speed target at most the ARO's plus the gap error) instead of
+    speeding up towards its 120 km/h set speed and braking again."""
+    cfg = baseline_variant(
+        tmp_path,
+        '<param key="eoam.aro_decel_mps2" value="8.0"/>',
+        '<param key="eoam.aro_decel_mps2" value="1.0"/>',
+    )
+    summary, out = _run(cfg, tmp_path, ego_speed_mps=120 / 3.6, mu=1.0, max_time_s=40.0)
+    assert summary["collision_with"] == "none", summary["reason"]
+    assert summary["modes_visited"] == [0, 1]
+    ts = pd.read_csv(out / "timeseries.csv")
+    back = ts[(ts["mode"] == 0) & (ts["time_s"] > ts.loc[ts["mode"] == 1, "time_s"].max())]
+    back = back.dropna(subset=["speed_target_mps", "aro_range_m"])  # the end row has none
+    assert len(back) > 0
+    # the ARO's speed from the radar: ego speed + range rate; never set above it by more
+    # than the gap error closed in 3 s, and far below the set speed
+    aro_speed = back["vx_mps"] + back["aro_range_rate_mps"]
+    assert (back["speed_target_mps"] <= aro_speed + back["aro_range_m"] / 3.0 + 1e-6).all()
+    assert back["speed_target_mps"].max() < 0.5 * 120 / 3.6
 
 
 @pytest.mark.sumo

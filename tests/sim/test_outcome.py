@@ -131,9 +131,18 @@ def test_yellow_oncoming_seen_before_the_point_of_no_return():
     out = _classify(ONCOMING_ABORT, 0.6, _hit("rear_end", speed=7.2), "aro")
     assert (out.colour, out.collision_with, out.impact_speed_mps) == ("yellow", "aro", 7.2)
     assert out.reason == (
-        "limit braking chosen (next lane not free before the point of no return: oncoming "
-        "traffic or a standing car), front hit the ARO at 7.2 m/s"
+        "lane change aborted for limit braking (next lane not free before the point of no "
+        "return: oncoming traffic or a standing car), front hit the ARO at 7.2 m/s"
     )
+
+
+def test_the_reason_names_a_lane_change_begun_after_braking():
+    """Modes 0-1-2 hit head on before the point of no return began a lane
+    change; the reason must not read as limit braking chosen by the DMM."""
+    out = _classify([0, 1, 2], 0.2, _hit("rear_end", speed=17.9), "aro")
+    assert out.reason.startswith("lane change started but the point of no return not reached")
+    braked = _classify([0, 1, 3], 0.0, _hit("rear_end", speed=7.2), "aro")
+    assert braked.reason.startswith("limit braking chosen (next lane not free")
 
 
 def test_yellow_limit_braking_by_the_dmm_and_without_intervention():

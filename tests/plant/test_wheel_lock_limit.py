@@ -1,0 +1,67 @@
+"""The EOAM's no-lock brake limit on the fixed brake split (``control.brake_split``) against
+eq. 33's closed form and against the plant's own wheels.
+
+Independent truths: eq. 33's axle balance ``z = mu b / (phi L - mu h)`` (and the rear's),
+which the limit must reduce to without the chassis terms (rolling resistance, the tyre's load
+sensitivity, cornering); the plant, braked straight with that command, whose wheels must not
+lock below the limit and must lock a little above it.
+"""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from eoam_sumo.control import brake_split, equivalent_mass_kg
+from eoam_sumo.control.longitudinal import LongitudinalController
+from eoam_sumo.offline.boundaries import max_decel_no_lock_mps2
+from eoam_sumo.params import G_MPS2
+from eoam_sumo.plant import OUTPUT_NAMES, Plant, initial_state
+from eoam_sumo.vehicle_files import load_vehicle
+
+Y = {name: i for i, name in enumerate(OUTPUT_NAMES)}
+V0_MPS = 100.0 / 3.6
+
+
+@pytest.mark.parametrize("mu", [0.1, 0.3, 0.7, 1.0])
+@pytest.mark.parametrize("name", ["sedan", "sedan-r13h"])
+def test_without_the_chassis_terms_the_limit_is_eq_33(monkeypatch, name, mu):
+    monkeypatch.setattr(brake_split, "PLANT_TYRE_PEAK_LOAD_SENSITIVITY", 0.0)
+    p = dataclasses.replace(load_vehicle(name), rolling_resistance_coeff=0.0)
+    limit = brake_split.wheel_lock_brake_n(p, mu, 0.0, 0.0, 0.0, p.mass_kg)
+    assert limit == pytest.approx(p.mass_kg * max_decel_no_lock_mps2(p, mu), rel=1e-9)
+
+
+def test_cornering_and_load_transfer_lower_the_limit(params):
+    m_eq = equivalent_mass_kg(params)
+    straight = brake_split.wheel_lock_brake_n(params, 0.3, 0.0, 300.0, 0.0, m_eq)
+    turning = brake_split.wheel_lock_brake_n(params, 0.3, 1.5, 300.0, 0.5, m_eq)
+    assert 0.0 < turning < np.sqrt(1.0 - 0.5**2) * straight
+    assert brake_split.wheel_lock_brake_n(params, 0.3, 2.9, 300.0, 1.0, m_eq) == 0.0
+
+
+def _locked_while_moving(plant, mu, brake_n):
+    """True if an axle locks (the plant's flags) while vx > 3 m/s, braking straight."""
+    x = initial_state(0.0, 0.0, 0.0, V0_MPS, params=plant.params).tolist()
+    while x[3] > 3.0:
+        x, y = plant.advance(x, (0.0, 0.0, brake_n), mu)
+        if y[Y["front_locked"]] or y[Y["rear_locked"]]:
+            return True
+    return False
+
+
+@pytest.mark.parametrize("mu", [0.1, 0.3])
+def test_the_plant_locks_just_above_the_limit_and_not_below(params, plant_cache_dir, mu):
+    plant = Plant(params, cache_dir=plant_cache_dir)
+    ctrl = LongitudinalController(params)
+    rolling_n = params.rolling_resistance_coeff * params.mass_kg * G_MPS2
+    m_eq = equivalent_mass_kg(params)
+    # lowest where drag has gone (the slow end), highest at the start speed
+    low = brake_split.wheel_lock_brake_n(params, mu, 0.0, rolling_n, 0.0, m_eq)
+    high = brake_split.wheel_lock_brake_n(params, mu, 0.0, ctrl.resistance_n(V0_MPS), 0.0, m_eq)
+    assert not _locked_while_moving(plant, mu, 0.99 * low)
+    assert _locked_while_moving(plant, mu, 1.05 * high)
+    # eq. 33's no-lock force itself locks the front on ice
+    assert _locked_while_moving(
+        plant, 0.1, 0.95 * params.mass_kg * max_decel_no_lock_mps2(params, 0.1)
+    )
