@@ -32,7 +32,7 @@ pitch and roll response, and no algebraic loop between loads and tyre forces."""
 
 ABS_MIN_SPEED_MPS = 2.0  # ABS control ends below this speed (the wheel may then stop)
 ABS_SLIP_FACTOR = 1.0  # ABS dump threshold as a multiple of the tyre's peak slip
-ABS_SLIP_BAND = 1.0  # full dump at (1 + band) times the threshold
+ABS_SLIP_BAND = 0.5  # pulsed build from (1 - band) times the threshold
 ABS_BUILD_SHARE = 0.3  # share of the build rate ABS re-applies with (pulsed build)
 ESC_MIN_SPEED_MPS = 5.0  # ESC acts above this speed
 ESC_TORQUE_CUT_NM = 1500.0  # the drive force is cut fully at this corrective moment
@@ -161,19 +161,26 @@ def wheel_pressure_target(p_cmd_bar, esc_bar, wheel_mps, v_long, mu, p, ch: Chas
     return ops.fmin(p_cmd_bar + esc_bar, p.max_brake_pressure_bar)
 
 
-def pressure_rate(p_target_bar, p_bar, wheel_mps, v_long, mu, p: VehicleParams, ch: Chassis, ops):
+def pressure_rate(p_target_bar, p_bar, wheel_mps, v_long, mu, accel, p: VehicleParams, ch, ops):
     """One wheel's pressure rate [bar/s]: a first-order build to the target with the build and
-    dump rate limits; with ABS, the rate is cut from a slower build towards a dump as the
-    wheel's braking slip passes the tyre's peak slip on this road (``_slip_excess``,
-    ``ABS_BUILD_SHARE``)."""
+    dump rate limits. With ABS, the phases of a three-phase controller from what it measures,
+    the wheel's slip against its reference speed ``v_long`` and the friction estimate
+    ``mu`` (``_slip_excess``) and the wheel's acceleration ``accel`` [m/s^2]: past the
+    threshold, dump while the wheel still decelerates and hold once it spins up; below it,
+    a pulsed build (``ABS_BUILD_SHARE``) within ``ABS_SLIP_BAND`` below the threshold."""
     rate = (p_target_bar - p_bar) / p.brake_lag_s
     rate = ops.fmin(ops.fmax(rate, -p.brake_dump_rate_barps), p.brake_build_rate_barps)
     if not p.abs_fitted:
         return rate
     excess, on = _slip_excess(wheel_mps, v_long, mu, ch, ops)
-    build = ABS_BUILD_SHARE * p.brake_build_rate_barps
-    limit = build - (build + p.brake_dump_rate_barps) * excess
-    return ops.fmin(rate, ops.if_else(excess > 0.0, limit, rate) * on + rate * (1.0 - on))
+    near, _ = _slip_excess(wheel_mps, v_long, mu * (1.0 - ABS_SLIP_BAND), ch, ops)
+    past = ops.if_else(accel < 0.0, -p.brake_dump_rate_barps, 0.0)
+    limit = ops.if_else(
+        excess > 0.0,
+        past,
+        ops.if_else(near > 0.0, ABS_BUILD_SHARE * p.brake_build_rate_barps, rate),
+    )
+    return ops.fmin(rate, limit * on + rate * (1.0 - on))
 
 
 def front_drive_share(slip_front, slip_rear, p: VehicleParams, ch: Chassis, ops):

@@ -230,11 +230,12 @@ def _slip_rates(x, steer, p: VehicleParams, ch: Chassis, ops) -> list:
     return rates  # slips FL, FR, RL, RR, tan front, tan rear
 
 
-def _actuator_rates(x, u, steer, p: VehicleParams, ch: Chassis, ops) -> list:
+def _actuator_rates(x, u, steer, spins, p: VehicleParams, ch: Chassis, ops) -> list:
     """Rates of steer (rate limited lag), drive force (lag) and the four wheels' pressures:
     the driver's line pressure on each (equal on the two sides of an axle), plus the ESC's on
     one wheel (``chassis.esc_side_forces``), each through that wheel's ABS, which judges its
-    slip against the speed and friction estimates (``V_EST``, ``MU_EST``)."""
+    slip against the speed and friction estimates (``V_EST``, ``MU_EST``) and its
+    acceleration: ``spins`` (``_wheel_rates``) less the brake torque's."""
     steer_target = ops.fmin(ops.fmax(u[STEER_CMD], -p.max_steer_rad), p.max_steer_rad)
     steer_rate = ops.fmin(
         ops.fmax((steer_target - x[STEER]) / p.steer_lag_s, -p.max_steer_rate_radps),
@@ -251,8 +252,10 @@ def _actuator_rates(x, u, steer, p: VehicleParams, ch: Chassis, ops) -> list:
         wheel_mps = x[omega_i] * p.wheel_radius_m
         esc_bar = esc[i] / ch.wheel_brake_n_per_bar[i] if p.esc_fitted else 0.0
         target = ch_.wheel_pressure_target(p_cmd, esc_bar, wheel_mps, v_refs[i], mu_est, p, ch, ops)
+        braking = ch.wheel_brake_n_per_bar[i] * x[p_i] * p.wheel_radius_m / p.wheel_inertia_kgm2
+        accel = (spins[i] - braking) * p.wheel_radius_m
         pressures.append(
-            ch_.pressure_rate(target, x[p_i], wheel_mps, v_refs[i], mu_est, p, ch, ops)
+            ch_.pressure_rate(target, x[p_i], wheel_mps, v_refs[i], mu_est, accel, p, ch, ops)
         )
     return [steer_rate, (drive_target - x[DRIVE]) / p.drive_lag_s, *pressures]
 
@@ -313,6 +316,7 @@ def rhs(x, u, mu, params: VehicleParams, ops) -> list:
         ref_rate = ch_.esc_reference_rate(x[V_EST], x[STEER], x[ESC_REF], x[MU_EST], p, ch, ops)
     lag = ch_.LOAD_TRANSFER_LAG_S
     fx_tyres = (f.front.fx_n + f.rear.fx_n) / p.mass_kg
+    spins = _wheel_rates(x, f, p, ch, ops)
     return [
         vx * cos_yaw - vy * sin_yaw,
         vx * sin_yaw + vy * cos_yaw,
@@ -320,8 +324,8 @@ def rhs(x, u, mu, params: VehicleParams, ops) -> list:
         ax + vy * r,  # eq. 4
         ay - vx * r,  # eq. 5
         moment / p.yaw_inertia_kgm2,
-        *_actuator_rates(x, u, f.steer_rad, p, ch, ops),
-        *_wheel_rates(x, f, p, ch, ops),
+        *_actuator_rates(x, u, f.steer_rad, spins, p, ch, ops),
+        *spins,
         *slips,
         (fx_tyres - x[AX_LOAD]) / lag,
         (ay - x[AY_LOAD]) / lag,
