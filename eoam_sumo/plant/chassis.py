@@ -43,7 +43,8 @@ ESC_DEADBAND_ACCEL_MPS2 = 0.5  # the yaw dead band grows by this lateral acceler
 # pressure): its speed, friction and sideslip estimates (docs/chassis.md "Estimates").
 SPEED_EST_RISE_PER_S = 20.0  # the speed estimate is pulled up to the fastest wheel at once
 SPEED_EST_FALL_PER_S = 20.0  # ... and down to it, unbraked
-SPEED_EST_FALL_BRAKED_PER_S = 0.3  # braked, the accelerometer carries it (every wheel slips)
+SPEED_EST_FALL_BRAKED_PER_S = 0.1  # braked, the accelerometer carries it (every wheel slips)
+SPEED_EST_FALL_BRAKED_MPS2 = 0.3  # ... and it is pulled down by at most this, braked
 BRAKE_ON_BAR = 2.0  # mean wheel pressure from which the car counts as braked
 MU_EST_HIGH = 1.0  # the friction estimate starts at, and returns to, a dry road's
 MU_EST_MIN = 0.05  # the ABS and ESC thresholds use at least this friction estimate
@@ -206,7 +207,8 @@ def speed_estimate_rate(v_est, ax_meas, wheel_mps, r, steer, pressure_bar, p, op
     """Rate of the vehicle-speed estimate: the accelerometer's ``ax`` integrated, pulled to
     the fastest wheel (each wheel's speed referred to the centre of gravity, the inverse of
     ``estimated_wheel_speeds``): up at once, down at once unbraked, and only slowly while
-    braked (``pressure_bar`` the mean wheel pressure), when every wheel runs at some slip."""
+    braked (``pressure_bar`` the mean wheel pressure; at most ``SPEED_EST_FALL_BRAKED_MPS2``),
+    when every wheel runs at some slip."""
     half = 0.5 * p.track_m * r
     c, s = ops.cos(steer), ops.sin(steer)
     lat_f = p.cg_to_front_m * r * s
@@ -216,7 +218,10 @@ def speed_estimate_rate(v_est, ax_meas, wheel_mps, r, steer, pressure_bar, p, op
     braked = ops.fmin(ops.fmax(pressure_bar / BRAKE_ON_BAR, 0.0), 1.0)
     fall = SPEED_EST_FALL_PER_S + (SPEED_EST_FALL_BRAKED_PER_S - SPEED_EST_FALL_PER_S) * braked
     gap = fastest - v_est
-    return ax_meas + SPEED_EST_RISE_PER_S * ops.fmax(gap, 0.0) + fall * ops.fmin(gap, 0.0)
+    down = fall * ops.fmin(gap, 0.0)
+    down_unbraked = ops.fmin(down, 0.0) * (1.0 - braked)
+    down = ops.fmax(down, -SPEED_EST_FALL_BRAKED_MPS2) * braked + down_unbraked
+    return ax_meas + SPEED_EST_RISE_PER_S * ops.fmax(gap, 0.0) + down
 
 
 def mu_estimate_rate(mu_est, accel_g, active, ops):
