@@ -32,7 +32,8 @@ pitch and roll response, and no algebraic loop between loads and tyre forces."""
 
 ABS_MIN_SPEED_MPS = 2.0  # ABS control ends below this speed (the wheel may then stop)
 ABS_SLIP_FACTOR = 1.0  # ABS dump threshold as a multiple of the tyre's peak slip
-ABS_SLIP_BAND = 0.5  # pulsed build from (1 - band) times the threshold
+ABS_SLIP_BAND = 1.0  # ESC without ABS: its share cut fully at (1 + band) times the threshold
+ABS_BUILD_BAND = 0.5  # ABS: pulsed build from (1 - band) times the threshold
 ABS_BUILD_SHARE = 0.3  # share of the build rate ABS re-applies with (pulsed build)
 ESC_MIN_SPEED_MPS = 5.0  # ESC acts above this speed
 ESC_TORQUE_CUT_NM = 1500.0  # the drive force is cut fully at this corrective moment
@@ -168,13 +169,13 @@ def pressure_rate(p_target_bar, p_bar, wheel_mps, v_long, mu, accel, p: VehicleP
     the wheel's slip against its reference speed ``v_long`` and the friction estimate
     ``mu`` (``_slip_excess``) and the wheel's acceleration ``accel`` [m/s^2]: past the
     threshold, dump while the wheel still decelerates and hold once it spins up; below it,
-    a pulsed build (``ABS_BUILD_SHARE``) within ``ABS_SLIP_BAND`` below the threshold."""
+    a pulsed build (``ABS_BUILD_SHARE``) within ``ABS_BUILD_BAND`` below the threshold."""
     rate = (p_target_bar - p_bar) / p.brake_lag_s
     rate = ops.fmin(ops.fmax(rate, -p.brake_dump_rate_barps), p.brake_build_rate_barps)
     if not p.abs_fitted:
         return rate
     excess, on = _slip_excess(wheel_mps, v_long, mu, ch, ops)
-    near, _ = _slip_excess(wheel_mps, v_long, mu * (1.0 - ABS_SLIP_BAND), ch, ops)
+    near, _ = _slip_excess(wheel_mps, v_long, mu * (1.0 - ABS_BUILD_BAND), ch, ops)
     past = ops.if_else(accel < 0.0, -p.brake_dump_rate_barps, 0.0)
     limit = ops.if_else(
         excess > 0.0,
