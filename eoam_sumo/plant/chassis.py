@@ -39,7 +39,7 @@ ESC_MIN_SPEED_MPS = 5.0  # ESC acts above this speed
 ESC_TORQUE_CUT_NM = 1500.0  # the drive force is cut fully at this corrective moment
 ESC_YAW_LIMIT = 0.85  # yaw-rate reference limited to 0.85 mu g / v
 EAWD_MAX_FRONT_SHARE = 0.5  # eAWD moves torque to the front up to this share
-ESC_DEADBAND_ACCEL_MPS2 = 0.5  # the yaw dead band grows by this lateral acceleration / v
+ESC_DEADBAND_ACCEL_MPS2 = 0.2  # the yaw dead band grows by this lateral acceleration / v
 # What the control unit knows (wheel speeds, accelerometer, yaw rate, steering angle, brake
 # pressure): its speed, friction and sideslip estimates (docs/chassis.md "Estimates").
 SPEED_EST_RISE_PER_S = 20.0  # the speed estimate is pulled up to the fastest wheel at once
