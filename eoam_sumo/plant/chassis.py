@@ -7,6 +7,7 @@ sources: docs/chassis.md.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from typing import NamedTuple
@@ -83,7 +84,9 @@ def constants(p: VehicleParams) -> Chassis:
     """The ``Chassis`` of a parameter set."""
     from eoam_sumo.plant.ops import FLOAT_OPS
 
-    tyre = PAC2002_235_60R16.symmetric()
+    # MF 5.2's nominal-load scaling (LFZO, Pacejka 2012 sec. 4.3.2): the set's curves about
+    # the vehicle's own tyre's nominal load (the paper's sedans keep the set's 4850 N)
+    tyre = dataclasses.replace(PAC2002_235_60R16.symmetric(), fz0=p.tyre_nominal_load_n)
     fz_f, fz_r = _static_tyre_loads_n(p)
     k_f = cornering_stiffness_npr(fz_f, tyre, FLOAT_OPS)
     k_r = cornering_stiffness_npr(fz_r, tyre, FLOAT_OPS)
