@@ -46,11 +46,12 @@ ESC_DEADBAND_ACCEL_MPS2 = 0.2  # the yaw dead band grows by this lateral acceler
 SPEED_EST_RISE_PER_S = 20.0  # the speed estimate is pulled up to the fastest wheel at once
 SPEED_EST_FALL_PER_S = 20.0  # ... and down to it, unbraked
 SPEED_EST_FALL_BRAKED_PER_S = 0.1  # braked, the accelerometer carries it (every wheel slips)
-SPEED_EST_FALL_BRAKED_MPS2 = 0.3  # ... and it is pulled down by at most this, braked
+SPEED_EST_FALL_BRAKED_SHARE = 0.03  # ... by at most this share of the measured deceleration
 BRAKE_ON_BAR = 2.0  # mean wheel pressure from which the car counts as braked
 MU_EST_HIGH = 1.0  # the friction estimate starts at, and returns to, a dry road's
 MU_EST_MIN = 0.05  # the ABS and ESC thresholds use at least this friction estimate
-MU_EST_TAU_S = 0.1  # a wheel at its limit: the estimate follows |a| / g this fast
+MU_EST_TAU_S = 0.1  # the estimate rises to an achieved |a| / g above it this fast
+MU_EST_FALL_S = 0.5  # a wheel at its limit: it falls to the achieved |a| / g this slowly
 MU_EST_RECOVER_S = 3.0  # no wheel at its limit: the estimate returns to MU_EST_HIGH this slowly
 BETA_EST_LEAK_S = 2.0  # the kinematic sideslip estimate's integration leaks over this time
 
@@ -211,8 +212,9 @@ def speed_estimate_rate(v_est, ax_meas, wheel_mps, r, steer, pressure_bar, p, op
     """Rate of the vehicle-speed estimate: the accelerometer's ``ax`` integrated, pulled to
     the fastest wheel (each wheel's speed referred to the centre of gravity, the inverse of
     ``estimated_wheel_speeds``): up at once, down at once unbraked, and only slowly while
-    braked (``pressure_bar`` the mean wheel pressure; at most ``SPEED_EST_FALL_BRAKED_MPS2``),
-    when every wheel runs at some slip."""
+    braked (``pressure_bar`` the mean wheel pressure), when every wheel runs at some slip: by
+    at most ``SPEED_EST_FALL_BRAKED_SHARE`` of the measured deceleration, the accelerometer's
+    own error (gain, the body's pitch)."""
     half = 0.5 * p.track_m * r
     c, s = ops.cos(steer), ops.sin(steer)
     lat_f = p.cg_to_front_m * r * s
@@ -223,18 +225,18 @@ def speed_estimate_rate(v_est, ax_meas, wheel_mps, r, steer, pressure_bar, p, op
     fall = SPEED_EST_FALL_PER_S + (SPEED_EST_FALL_BRAKED_PER_S - SPEED_EST_FALL_PER_S) * braked
     gap = fastest - v_est
     down = fall * ops.fmin(gap, 0.0)
-    down_unbraked = ops.fmin(down, 0.0) * (1.0 - braked)
-    down = ops.fmax(down, -SPEED_EST_FALL_BRAKED_MPS2) * braked + down_unbraked
+    cap = SPEED_EST_FALL_BRAKED_SHARE * ops.fabs(ax_meas)
+    down = ops.fmax(down, -cap) * braked + down * (1.0 - braked)
     return ax_meas + SPEED_EST_RISE_PER_S * ops.fmax(gap, 0.0) + down
 
 
 def mu_estimate_rate(mu_est, accel_g, active, ops):
     """Rate of the friction estimate: while a tyre is at its limit (``active``: ABS slip past
-    its threshold, or ESC seeing understeer) it follows the acceleration the car achieves,
-    ``|a| / g`` from the accelerometer; otherwise it returns slowly to a dry road's; it rises
-    at once to any acceleration achieved above it."""
+    its threshold, or ESC seeing understeer) it falls to the acceleration the car achieves,
+    ``|a| / g`` from the accelerometer, averaging over the ABS's cycles; otherwise it returns
+    slowly to a dry road's; it rises at once to any acceleration achieved above it."""
     rise = ops.fmax(accel_g - mu_est, 0.0) / MU_EST_TAU_S
-    follow = active * (accel_g - mu_est) / MU_EST_TAU_S
+    follow = active * ops.fmin(accel_g - mu_est, 0.0) / MU_EST_FALL_S
     return follow + (1.0 - active) * (MU_EST_HIGH - mu_est) / MU_EST_RECOVER_S + rise
 
 

@@ -75,14 +75,14 @@ def test_abs_on_snow_uses_the_friction_and_locks_no_axle(abs_plant):
 @pytest.mark.parametrize("mu", [1.0, 0.3])
 def test_abs_estimates_follow_the_car(abs_plant, mu):
     """The control unit's speed estimate (wheels and accelerometer) stays within 5 % of the
-    initial speed above 15 km/h, and its friction estimate within 10 % of the road's on average once
-    braking has settled (after 1 s), within 30 % at every step (it dips as ABS dumps)."""
+    initial speed above 15 km/h, and its friction estimate within 15 % of the road's on average once
+    braking has settled (after 2 s), within 30 % at every step (it dips as ABS dumps)."""
     xs, _ = stop(abs_plant, mu, seconds=25.0)
     fast = xs[:, S["vx_mps"]] > LOCK_ALLOWED_BELOW_MPS
     error = xs[fast, S["speed_estimate_mps"]] - xs[fast, S["vx_mps"]]
     assert np.abs(error).max() < 0.05 * V100_MPS
-    settled = fast & (np.arange(len(xs)) >= 100)
-    assert xs[settled, S["mu_estimate"]].mean() == pytest.approx(mu, rel=0.1)
+    settled = fast & (np.arange(len(xs)) >= 200)
+    assert xs[settled, S["mu_estimate"]].mean() == pytest.approx(mu, rel=0.15)
     assert xs[settled, S["mu_estimate"]] == pytest.approx(mu, rel=0.3)
 
 
