@@ -92,7 +92,9 @@ class VehicleParams:
     # --- the chassis (plant only; the offline design does not use these, DESIGN_FIELDS) ---
     wheel_radius_m: float = _p(0.334, "m", PAC2002 + ": R0 less 3 % deflection")
     wheel_inertia_kgm2: float = _p(1.7, "kg m^2", "CommonRoad vehicle 2 (BMW 320i), I_y_w")
-    tyre_nominal_load_n: float = _p(4850.0, "N", PAC2002 + " (FNOMIN)")
+    tyre_nominal_load_n: float = _p(
+        4850.0, "N", PAC2002 + " (FNOMIN; the plant scales the set to it, MF 5.2 LFZO)"
+    )
     relaxation_length_long_m: float = _p(
         0.25, "m", PAC2002 + ": K_x/C_x at FNOMIN (Pacejka 2012 sec. 7.2)"
     )
@@ -197,7 +199,8 @@ VEHICLE_RANGES: dict[str, tuple[float, float]] = {
     "esc_sideslip_gain_nmprad": (0.0, 1.0e7),
     "esc_lag_s": (0.005, 2.0),
 }
-#: FNOMIN of the plant's one tyre set, the PAC2002 235/60R16 (``plant.magic_formula``) [N].
+#: FNOMIN of the plant's one tyre set, the PAC2002 235/60R16 (``plant.magic_formula``) [N];
+#: the plant scales it to each vehicle's ``tyre_nominal_load_n`` (MF 5.2's LFZO).
 PLANT_TYRE_FNOMIN_N = 4850.0
 #: The plant tyre's longitudinal peak friction per unit load increment, PDX2 / PDX1 of the
 #: PAC2002 235/60R16 (``plant.magic_formula``): mu_x(Fz) = mu (1 + this (Fz - FNOMIN) / FNOMIN)
@@ -271,13 +274,14 @@ def _check_relations(p: VehicleParams) -> None:
         )
     weight_n = p.mass_kg * G_MPS2
     for axle, share in (("front", p.cg_to_rear_m), ("rear", p.cg_to_front_m)):
-        load = 0.5 * weight_n * share / p.wheelbase_m / PLANT_TYRE_FNOMIN_N
+        load = 0.5 * weight_n * share / p.wheelbase_m / p.tyre_nominal_load_n
         if not TYRE_LOAD_RANGE[0] <= load <= TYRE_LOAD_RANGE[1]:
             raise VehicleValueError(
                 "mass_kg",
                 f"= {p.mass_kg!r} kg puts {load:.2f} x FNOMIN on each {axle} tyre, outside "
-                f"[{TYRE_LOAD_RANGE[0]:g}, {TYRE_LOAD_RANGE[1]:g}] x {PLANT_TYRE_FNOMIN_N:g} N, "
-                "what the plant's passenger-car tyre (PAC2002 235/60R16) describes",
+                f"[{TYRE_LOAD_RANGE[0]:g}, {TYRE_LOAD_RANGE[1]:g}] x "
+                f"tyre_nominal_load_n = {p.tyre_nominal_load_n:g} N, what the plant's "
+                "passenger-car tyre (PAC2002 235/60R16, scaled to that nominal load) describes",
             )
 
 

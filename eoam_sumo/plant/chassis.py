@@ -7,6 +7,7 @@ sources: docs/chassis.md.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from typing import NamedTuple
@@ -32,12 +33,27 @@ pitch and roll response, and no algebraic loop between loads and tyre forces."""
 
 ABS_MIN_SPEED_MPS = 2.0  # ABS control ends below this speed (the wheel may then stop)
 ABS_SLIP_FACTOR = 1.0  # ABS dump threshold as a multiple of the tyre's peak slip
-ABS_SLIP_BAND = 1.0  # full dump at (1 + band) times the threshold
+ABS_SLIP_BAND = 1.0  # ESC without ABS: its share cut fully at (1 + band) times the threshold
+ABS_BUILD_BAND = 0.5  # ABS: pulsed build from (1 - band) times the threshold
 ABS_BUILD_SHARE = 0.3  # share of the build rate ABS re-applies with (pulsed build)
 ESC_MIN_SPEED_MPS = 5.0  # ESC acts above this speed
 ESC_TORQUE_CUT_NM = 1500.0  # the drive force is cut fully at this corrective moment
 ESC_YAW_LIMIT = 0.85  # yaw-rate reference limited to 0.85 mu g / v
 EAWD_MAX_FRONT_SHARE = 0.5  # eAWD moves torque to the front up to this share
+ESC_DEADBAND_ACCEL_MPS2 = 0.2  # the yaw dead band grows by this lateral acceleration / v
+# What the control unit knows (wheel speeds, accelerometer, yaw rate, steering angle, brake
+# pressure): its speed, friction and sideslip estimates (docs/chassis.md "Estimates").
+SPEED_EST_RISE_PER_S = 20.0  # the speed estimate is pulled up to the fastest wheel at once
+SPEED_EST_FALL_PER_S = 20.0  # ... and down to it, unbraked
+SPEED_EST_FALL_BRAKED_PER_S = 0.1  # braked, the accelerometer carries it (every wheel slips)
+SPEED_EST_FALL_BRAKED_SHARE = 0.03  # ... by at most this share of the measured deceleration
+BRAKE_ON_BAR = 2.0  # mean wheel pressure from which the car counts as braked
+MU_EST_HIGH = 1.0  # the friction estimate starts at, and returns to, a dry road's
+MU_EST_MIN = 0.05  # the ABS and ESC thresholds use at least this friction estimate
+MU_EST_TAU_S = 0.1  # the estimate rises to an achieved |a| / g above it this fast
+MU_EST_FALL_S = 0.5  # a wheel at its limit: it falls to the achieved |a| / g this slowly
+MU_EST_RECOVER_S = 3.0  # no wheel at its limit: the estimate returns to MU_EST_HIGH this slowly
+BETA_EST_LEAK_S = 2.0  # the kinematic sideslip estimate's integration leaks over this time
 
 
 class Chassis(NamedTuple):
@@ -69,7 +85,9 @@ def constants(p: VehicleParams) -> Chassis:
     """The ``Chassis`` of a parameter set."""
     from eoam_sumo.plant.ops import FLOAT_OPS
 
-    tyre = PAC2002_235_60R16.symmetric()
+    # MF 5.2's nominal-load scaling (LFZO, Pacejka 2012 sec. 4.3.2): the set's curves about
+    # the vehicle's own tyre's nominal load (the paper's sedans keep the set's 4850 N)
+    tyre = dataclasses.replace(PAC2002_235_60R16.symmetric(), fz0=p.tyre_nominal_load_n)
     fz_f, fz_r = _static_tyre_loads_n(p)
     k_f = cornering_stiffness_npr(fz_f, tyre, FLOAT_OPS)
     k_r = cornering_stiffness_npr(fz_r, tyre, FLOAT_OPS)
@@ -119,13 +137,24 @@ def steer_compliance_rad_per_n(p: VehicleParams) -> float:
 
 
 def _slip_excess(wheel_mps, v_long, mu, ch: Chassis, ops):
-    """``(excess, on)``: how far a wheel's braking slip ``(omega r_w - v) / v`` is past the
-    tyre's peak slip on this road (``ABS_SLIP_FACTOR``), over ``ABS_SLIP_BAND``, in [0, 1];
+    """``(excess, on)``: how far a wheel's braking slip ``(omega r_w - v) / v`` against its
+    reference speed ``v_long`` (``estimated_wheel_speeds``) is past the tyre's peak slip at
+    the friction estimate ``mu`` (``ABS_SLIP_FACTOR``), over ``ABS_SLIP_BAND``, in [0, 1];
     and the control's fade-in above ``ABS_MIN_SPEED_MPS`` (over 1 m/s)."""
     slip = (wheel_mps - v_long) / ops.fmax(v_long, ABS_MIN_SPEED_MPS)
-    threshold = ABS_SLIP_FACTOR * ch.peak_slip_per_mu * mu
+    threshold = ABS_SLIP_FACTOR * ch.peak_slip_per_mu * ops.fmax(mu, MU_EST_MIN)
     excess = ops.fmin(ops.fmax((-slip - threshold) / (ABS_SLIP_BAND * threshold), 0.0), 1.0)
     return excess, ops.fmin(ops.fmax(v_long - ABS_MIN_SPEED_MPS, 0.0), 1.0)
+
+
+def abs_activity(wheel_mps, v_refs, mu_est, ch: Chassis, ops):
+    """1 while any wheel's braking slip is past its threshold (``_slip_excess``) above the
+    ABS's lowest speed, else 0: a wheel at the friction limit."""
+    active = 0.0
+    for w, v in zip(wheel_mps, v_refs):
+        excess, on = _slip_excess(w, v, mu_est, ch, ops)
+        active = ops.fmax(active, ops.if_else(excess > 0.0, 1.0, 0.0) * on)
+    return active
 
 
 def wheel_pressure_target(p_cmd_bar, esc_bar, wheel_mps, v_long, mu, p, ch: Chassis, ops):
@@ -138,19 +167,26 @@ def wheel_pressure_target(p_cmd_bar, esc_bar, wheel_mps, v_long, mu, p, ch: Chas
     return ops.fmin(p_cmd_bar + esc_bar, p.max_brake_pressure_bar)
 
 
-def pressure_rate(p_target_bar, p_bar, wheel_mps, v_long, mu, p: VehicleParams, ch: Chassis, ops):
+def pressure_rate(p_target_bar, p_bar, wheel_mps, v_long, mu, accel, p: VehicleParams, ch, ops):
     """One wheel's pressure rate [bar/s]: a first-order build to the target with the build and
-    dump rate limits; with ABS, the rate is cut from a slower build towards a dump as the
-    wheel's braking slip passes the tyre's peak slip on this road (``_slip_excess``,
-    ``ABS_BUILD_SHARE``)."""
+    dump rate limits. With ABS, the phases of a three-phase controller from what it measures,
+    the wheel's slip against its reference speed ``v_long`` and the friction estimate
+    ``mu`` (``_slip_excess``) and the wheel's acceleration ``accel`` [m/s^2]: past the
+    threshold, dump while the wheel still decelerates and hold once it spins up; below it,
+    a pulsed build (``ABS_BUILD_SHARE``) within ``ABS_BUILD_BAND`` below the threshold."""
     rate = (p_target_bar - p_bar) / p.brake_lag_s
     rate = ops.fmin(ops.fmax(rate, -p.brake_dump_rate_barps), p.brake_build_rate_barps)
     if not p.abs_fitted:
         return rate
     excess, on = _slip_excess(wheel_mps, v_long, mu, ch, ops)
-    build = ABS_BUILD_SHARE * p.brake_build_rate_barps
-    limit = build - (build + p.brake_dump_rate_barps) * excess
-    return ops.fmin(rate, ops.if_else(excess > 0.0, limit, rate) * on + rate * (1.0 - on))
+    near, _ = _slip_excess(wheel_mps, v_long, mu * (1.0 - ABS_BUILD_BAND), ch, ops)
+    past = ops.if_else(accel < 0.0, -p.brake_dump_rate_barps, 0.0)
+    limit = ops.if_else(
+        excess > 0.0,
+        past,
+        ops.if_else(near > 0.0, ABS_BUILD_SHARE * p.brake_build_rate_barps, rate),
+    )
+    return ops.fmin(rate, limit * on + rate * (1.0 - on))
 
 
 def front_drive_share(slip_front, slip_rear, p: VehicleParams, ch: Chassis, ops):
@@ -162,29 +198,94 @@ def front_drive_share(slip_front, slip_rear, p: VehicleParams, ch: Chassis, ops)
     return ops.fmin(ops.fmax(ch.front_share + moved, 0.0), EAWD_MAX_FRONT_SHARE)
 
 
-def esc_reference_rate(vx, steer, r_ref, mu, p: VehicleParams, ch: Chassis, ops):
+def estimated_wheel_speeds(v_est, r, steer, p: VehicleParams, ops):
+    """Each wheel's contact-patch speed (FL, FR, RL, RR) as the control unit reckons it from
+    its speed estimate, the yaw-rate sensor and the steering angle, with no lateral velocity
+    (it has no measure of it): ``model.wheel_velocities`` at ``vy = 0``."""
+    half = 0.5 * p.track_m * r
+    c, s = ops.cos(steer), ops.sin(steer)
+    lat_f = p.cg_to_front_m * r * s
+    return ((v_est - half) * c + lat_f, (v_est + half) * c + lat_f, v_est - half, v_est + half)
+
+
+def speed_estimate_rate(v_est, ax_meas, wheel_mps, r, steer, pressure_bar, p, ops):
+    """Rate of the vehicle-speed estimate: the accelerometer's ``ax`` integrated, pulled to
+    the fastest wheel (each wheel's speed referred to the centre of gravity, the inverse of
+    ``estimated_wheel_speeds``): up at once, down at once unbraked, and only slowly while
+    braked (``pressure_bar`` the mean wheel pressure), when every wheel runs at some slip: by
+    at most ``SPEED_EST_FALL_BRAKED_SHARE`` of the measured deceleration, the accelerometer's
+    own error (gain, the body's pitch)."""
+    half = 0.5 * p.track_m * r
+    c, s = ops.cos(steer), ops.sin(steer)
+    lat_f = p.cg_to_front_m * r * s
+    fl, fr, rl, rr = wheel_mps
+    refs = ((fl - lat_f) / c + half, (fr - lat_f) / c - half, rl + half, rr - half)
+    fastest = ops.fmax(ops.fmax(refs[0], refs[1]), ops.fmax(refs[2], refs[3]))
+    braked = ops.fmin(ops.fmax(pressure_bar / BRAKE_ON_BAR, 0.0), 1.0)
+    fall = SPEED_EST_FALL_PER_S + (SPEED_EST_FALL_BRAKED_PER_S - SPEED_EST_FALL_PER_S) * braked
+    gap = fastest - v_est
+    down = fall * ops.fmin(gap, 0.0)
+    cap = SPEED_EST_FALL_BRAKED_SHARE * ops.fabs(ax_meas)
+    down = ops.fmax(down, -cap) * braked + down * (1.0 - braked)
+    return ax_meas + SPEED_EST_RISE_PER_S * ops.fmax(gap, 0.0) + down
+
+
+def mu_estimate_rate(mu_est, accel_g, active, ops):
+    """Rate of the friction estimate: while a tyre is at its limit (``active``: ABS slip past
+    its threshold, or ESC seeing understeer) it falls to the acceleration the car achieves,
+    ``|a| / g`` from the accelerometer, averaging over the ABS's cycles; otherwise it returns
+    slowly to a dry road's; it rises at once to any acceleration achieved above it."""
+    rise = ops.fmax(accel_g - mu_est, 0.0) / MU_EST_TAU_S
+    follow = active * ops.fmin(accel_g - mu_est, 0.0) / MU_EST_FALL_S
+    return follow + (1.0 - active) * (MU_EST_HIGH - mu_est) / MU_EST_RECOVER_S + rise
+
+
+def sideslip_estimate_rate(beta_est, ay_meas, r, v_est, ops):
+    """Rate of the kinematic sideslip estimate ``beta' = ay / v - r`` (the accelerometer and
+    the yaw-rate sensor), its integration drift leaked over ``BETA_EST_LEAK_S``."""
+    v = ops.fmax(v_est, ESC_MIN_SPEED_MPS)
+    return ay_meas / v - r - beta_est / BETA_EST_LEAK_S
+
+
+def esc_deadband_radps(v_est, p: VehicleParams, ops):
+    """The ESC's yaw-rate dead band at the speed estimate: ``esc_yaw_deadband_radps`` plus a
+    lateral-acceleration error of ``ESC_DEADBAND_ACCEL_MPS2`` over v (wider at low speed)."""
+    return p.esc_yaw_deadband_radps + ESC_DEADBAND_ACCEL_MPS2 / ops.fmax(v_est, ESC_MIN_SPEED_MPS)
+
+
+def esc_understeer(v_est, r, r_ref, p: VehicleParams, ops):
+    """1 while the yaw rate falls short of the reference by more than the dead band (the
+    front tyres at their limit), else 0."""
+    error = r_ref - r
+    short = ops.if_else(r_ref * error > 0.0, 1.0, 0.0)
+    beyond = ops.if_else(ops.fabs(error) > esc_deadband_radps(v_est, p, ops), 1.0, 0.0)
+    return short * beyond * ops.fmin(ops.fmax(v_est - ESC_MIN_SPEED_MPS, 0.0), 1.0)
+
+
+def esc_reference_rate(v_est, steer, r_ref, mu_est, p: VehicleParams, ch: Chassis, ops):
     """Rate of the ESC's yaw-rate reference: the linear single-track steady state
-    ``v delta / (L + K v^2)``, limited to ``0.85 mu g / v``, through a first-order lag of the
-    car's own yaw time constant ``Iz v / (a^2 C_f + b^2 C_r)`` (Rajamani 2012 ch. 8: the
-    desired yaw rate of a yaw-dynamics reference model), so a car that follows its steering
-    as a linear car would is never corrected."""
-    v = ops.fmax(vx, ESC_MIN_SPEED_MPS)
+    ``v delta / (L + K v^2)``, limited to ``0.85 mu g / v`` at the friction estimate, through
+    a first-order lag of the car's own yaw time constant ``Iz v / (a^2 C_f + b^2 C_r)``
+    (Rajamani 2012 ch. 8: the desired yaw rate of a yaw-dynamics reference model), so a car
+    that follows its steering as a linear car would is never corrected."""
+    v = ops.fmax(v_est, ESC_MIN_SPEED_MPS)
     r_lin = v * steer / (p.wheelbase_m + ch.understeer_spmpm * v * v)
-    r_max = ESC_YAW_LIMIT * mu * G_MPS2 / v
+    r_max = ESC_YAW_LIMIT * ops.fmax(mu_est, MU_EST_MIN) * G_MPS2 / v
     tau = p.yaw_inertia_kgm2 * v / ch.yaw_damping_nmspr
     return (ops.fmin(ops.fmax(r_lin, -r_max), r_max) - r_ref) / tau
 
 
-def esc_target_moment_nm(vx, vy, r, r_ref, p: VehicleParams, ops):
+def esc_target_moment_nm(v_est, beta_est, r, r_ref, p: VehicleParams, ops):
     """The ESC's corrective yaw moment [N m]: the yaw-rate error to the reference
-    (``esc_reference_rate``) past a dead band, times ``Iz * esc_yaw_gain``; plus
-    ``esc_sideslip_gain`` times the sideslip past its threshold."""
-    v = ops.fmax(vx, ESC_MIN_SPEED_MPS)
+    (``esc_reference_rate``) past the speed-dependent dead band (``esc_deadband_radps``),
+    times ``Iz * esc_yaw_gain``; plus ``esc_sideslip_gain`` times the sideslip estimate past
+    its threshold."""
     error = r_ref - r
-    yaw_part = ops.sign(error) * ops.fmax(ops.fabs(error) - p.esc_yaw_deadband_radps, 0.0)
-    beta = ops.atan(vy / v)
+    band = esc_deadband_radps(v_est, p, ops)
+    yaw_part = ops.sign(error) * ops.fmax(ops.fabs(error) - band, 0.0)
+    beta = beta_est
     beta_part = ops.sign(beta) * ops.fmax(ops.fabs(beta) - p.esc_sideslip_threshold_rad, 0.0)
-    on = ops.fmin(ops.fmax(vx - ESC_MIN_SPEED_MPS, 0.0), 1.0)
+    on = ops.fmin(ops.fmax(v_est - ESC_MIN_SPEED_MPS, 0.0), 1.0)
     moment = p.yaw_inertia_kgm2 * p.esc_yaw_gain * yaw_part + p.esc_sideslip_gain_nmprad * beta_part
     return moment * on
 

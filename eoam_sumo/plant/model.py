@@ -57,6 +57,9 @@ STATE_NAMES = (
     "ay_load_mps2",
     "esc_moment_nm",
     "esc_reference_radps",
+    "speed_estimate_mps",
+    "mu_estimate",
+    "sideslip_estimate_rad",
 )
 INPUT_NAMES = ("steer_cmd_rad", "drive_force_cmd_n", "brake_force_cmd_n")
 OUTPUT_NAMES = (
@@ -99,6 +102,7 @@ PRESSURES = (8, 9, 10, 11)
 OMEGAS = (12, 13, 14, 15)
 SLIPS = (16, 17, 18, 19)
 (TAN_F, TAN_R, AX_LOAD, AY_LOAD, ESC, ESC_REF) = range(20, 26)
+(V_EST, MU_EST, BETA_EST) = range(26, 29)
 STEER_CMD, DRIVE_CMD, BRAKE_CMD = range(len(INPUT_NAMES))
 
 LOCK_SLIP = -0.5
@@ -226,10 +230,12 @@ def _slip_rates(x, steer, p: VehicleParams, ch: Chassis, ops) -> list:
     return rates  # slips FL, FR, RL, RR, tan front, tan rear
 
 
-def _actuator_rates(x, u, mu, steer, p: VehicleParams, ch: Chassis, ops) -> list:
+def _actuator_rates(x, u, steer, spins, p: VehicleParams, ch: Chassis, ops) -> list:
     """Rates of steer (rate limited lag), drive force (lag) and the four wheels' pressures:
     the driver's line pressure on each (equal on the two sides of an axle), plus the ESC's on
-    one wheel (``chassis.esc_side_forces``), each through that wheel's ABS."""
+    one wheel (``chassis.esc_side_forces``), each through that wheel's ABS, which judges its
+    slip against the speed and friction estimates (``V_EST``, ``MU_EST``) and its
+    acceleration: ``spins`` (``_wheel_rates``) less the brake torque's."""
     steer_target = ops.fmin(ops.fmax(u[STEER_CMD], -p.max_steer_rad), p.max_steer_rad)
     steer_rate = ops.fmin(
         ops.fmax((steer_target - x[STEER]) / p.steer_lag_s, -p.max_steer_rate_radps),
@@ -239,14 +245,41 @@ def _actuator_rates(x, u, mu, steer, p: VehicleParams, ch: Chassis, ops) -> list
     brake_target = ops.fmin(ops.fmax(u[BRAKE_CMD], 0.0), p.max_brake_force_n)
     p_cmd = brake_target / ch.brake_n_per_bar
     esc = ch_.esc_side_forces(x[ESC], x[YAW_RATE], p, ops) if p.esc_fitted else (0.0,) * 4
-    v_long, _ = wheel_velocities(x, steer, p, ops)
+    v_refs = ch_.estimated_wheel_speeds(x[V_EST], x[YAW_RATE], steer, p, ops)
+    mu_est = x[MU_EST]
     pressures = []
     for i, (p_i, omega_i) in enumerate(zip(PRESSURES, OMEGAS)):
         wheel_mps = x[omega_i] * p.wheel_radius_m
         esc_bar = esc[i] / ch.wheel_brake_n_per_bar[i] if p.esc_fitted else 0.0
-        target = ch_.wheel_pressure_target(p_cmd, esc_bar, wheel_mps, v_long[i], mu, p, ch, ops)
-        pressures.append(ch_.pressure_rate(target, x[p_i], wheel_mps, v_long[i], mu, p, ch, ops))
+        target = ch_.wheel_pressure_target(p_cmd, esc_bar, wheel_mps, v_refs[i], mu_est, p, ch, ops)
+        braking = ch.wheel_brake_n_per_bar[i] * x[p_i] * p.wheel_radius_m / p.wheel_inertia_kgm2
+        accel = (spins[i] - braking) * p.wheel_radius_m
+        pressures.append(
+            ch_.pressure_rate(target, x[p_i], wheel_mps, v_refs[i], mu_est, accel, p, ch, ops)
+        )
     return [steer_rate, (drive_target - x[DRIVE]) / p.drive_lag_s, *pressures]
+
+
+def _estimate_rates(x, ax, ay, steer, p: VehicleParams, ch: Chassis, ops) -> list:
+    """Rates of the control unit's estimates (speed, friction, sideslip) from what it
+    measures: wheel speeds, accelerometer ``(ax, ay)``, yaw rate, steering angle, pressures
+    (``chassis.speed_estimate_rate`` and after). Zero without ABS and ESC."""
+    if not (p.abs_fitted or p.esc_fitted):
+        return [0.0, 0.0, 0.0]
+    r, v_est, mu_est = x[YAW_RATE], x[V_EST], x[MU_EST]
+    wheel_mps = [x[i] * p.wheel_radius_m for i in OMEGAS]
+    pressure = 0.25 * (x[PRESSURES[0]] + x[PRESSURES[1]] + x[PRESSURES[2]] + x[PRESSURES[3]])
+    v_rate = ch_.speed_estimate_rate(v_est, ax, wheel_mps, r, steer, pressure, p, ops)
+    v_refs = ch_.estimated_wheel_speeds(v_est, r, steer, p, ops)
+    active = ch_.abs_activity(wheel_mps, v_refs, mu_est, ch, ops)
+    if p.esc_fitted:
+        active = ops.fmax(active, ch_.esc_understeer(v_est, r, x[ESC_REF], p, ops))
+    accel_g = ops.sqrt(ax * ax + ay * ay) / G_MPS2
+    return [
+        v_rate,
+        ch_.mu_estimate_rate(mu_est, accel_g, active, ops),
+        ch_.sideslip_estimate_rate(x[BETA_EST], ay, r, v_est, ops),
+    ]
 
 
 def _wheel_rates(x, f: _Forces, p: VehicleParams, ch: Chassis, ops) -> list:
@@ -271,18 +304,19 @@ def rhs(x, u, mu, params: VehicleParams, ops) -> list:
     ch = constants(p)
     f = _forces(x, mu, p, ops)
     vx, vy, yaw, r = x[VX], x[VY], x[YAW], x[YAW_RATE]
-    ax, ay = _body_accelerations(f, p)
+    ax, ay = _body_accelerations(f, p)  # also what the accelerometer reads
     cos_yaw, sin_yaw = ops.cos(yaw), ops.sin(yaw)
     moment = p.cg_to_front_m * f.front.fy_n - p.cg_to_rear_m * f.rear.fy_n
     moment = moment + f.front.moment_nm + f.rear.moment_nm
     slips = _slip_rates(x, f.steer_rad, p, ch, ops)
     esc_rate = ref_rate = 0.0
     if p.esc_fitted:
-        target = ch_.esc_target_moment_nm(vx, vy, r, x[ESC_REF], p, ops)
+        target = ch_.esc_target_moment_nm(x[V_EST], x[BETA_EST], r, x[ESC_REF], p, ops)
         esc_rate = (target - x[ESC]) / p.esc_lag_s
-        ref_rate = ch_.esc_reference_rate(vx, x[STEER], x[ESC_REF], mu, p, ch, ops)
+        ref_rate = ch_.esc_reference_rate(x[V_EST], x[STEER], x[ESC_REF], x[MU_EST], p, ch, ops)
     lag = ch_.LOAD_TRANSFER_LAG_S
     fx_tyres = (f.front.fx_n + f.rear.fx_n) / p.mass_kg
+    spins = _wheel_rates(x, f, p, ch, ops)
     return [
         vx * cos_yaw - vy * sin_yaw,
         vx * sin_yaw + vy * cos_yaw,
@@ -290,13 +324,14 @@ def rhs(x, u, mu, params: VehicleParams, ops) -> list:
         ax + vy * r,  # eq. 4
         ay - vx * r,  # eq. 5
         moment / p.yaw_inertia_kgm2,
-        *_actuator_rates(x, u, mu, f.steer_rad, p, ch, ops),
-        *_wheel_rates(x, f, p, ch, ops),
+        *_actuator_rates(x, u, f.steer_rad, spins, p, ch, ops),
+        *spins,
         *slips,
         (fx_tyres - x[AX_LOAD]) / lag,
         (ay - x[AY_LOAD]) / lag,
         esc_rate,
         ref_rate,
+        *_estimate_rates(x, ax, ay, f.steer_rad, p, ch, ops),
     ]
 
 

@@ -7,8 +7,20 @@ import math
 import numpy as np
 
 from eoam_sumo.params import AIR_DENSITY_KGPM3, G_MPS2, VehicleParams, ego_e_class_sedan
-from eoam_sumo.plant.chassis import constants
-from eoam_sumo.plant.model import DRIVE, OMEGAS, PRESSURES, STATE_NAMES, STEER, VX, YAW, X, Y
+from eoam_sumo.plant.chassis import MU_EST_HIGH, constants
+from eoam_sumo.plant.model import (
+    DRIVE,
+    MU_EST,
+    OMEGAS,
+    PRESSURES,
+    STATE_NAMES,
+    STEER,
+    V_EST,
+    VX,
+    YAW,
+    X,
+    Y,
+)
 
 MAX_DT_S = 0.002
 """Largest sub-step accepted: keeps the wheel-and-tyre mode (about 160 rad/s) and the slip
@@ -51,7 +63,8 @@ def initial_state(
 ) -> np.ndarray:
     """State vector (``STATE_NAMES`` order) of a vehicle at ``(x_m, y_m)`` heading ``yaw_rad``
     moving straight at ``speed_mps >= 0``, its wheels rolling (``params``: default the
-    paper's sedan); actuator states zero unless given (``brake_force_n`` as line pressure)."""
+    paper's sedan); actuator states zero unless given (``brake_force_n`` as line pressure);
+    the speed estimate the speed, the friction estimate a dry road's."""
     if not speed_mps >= 0.0:
         raise ValueError(f"speed_mps={speed_mps!r} must be >= 0")
     p = params or ego_e_class_sedan()
@@ -62,6 +75,7 @@ def initial_state(
         x[i] = brake_force_n / constants(p).brake_n_per_bar
     for i in OMEGAS:
         x[i] = speed_mps / p.wheel_radius_m
+    x[V_EST], x[MU_EST] = speed_mps, MU_EST_HIGH  # the control unit's estimates: a dry road
     return x
 
 

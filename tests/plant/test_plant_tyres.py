@@ -61,6 +61,8 @@ def test_casadi_form_of_the_model_equals_the_float_form(params, esc):
         lo = [-50, -50, -3, 0, -2, -0.8, -0.6, 0, *[0] * 8, *[-1] * 4, -0.5, -0.5, -9, -9, -5e3, -1]
         hi = [50, 50, 3, 45, 2, 0.8, 0.6, 7000, *[150] * 4, *[140] * 4, *[1] * 4, 0.5, 0.5, 9, 9]
         hi.extend([5e3, 1.0])
+        lo.extend([0.0, 0.05, -0.3])  # the estimates: speed, friction, sideslip
+        hi.extend([45.0, 1.2, 0.3])
         xv = rng.uniform(lo, hi)
         uv = rng.uniform([-0.7, 0, 0], [0.7, 7000, 22000])
         muv = rng.uniform(0.1, 1.2)
