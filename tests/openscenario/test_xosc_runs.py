@@ -46,8 +46,9 @@ def _bumper_headway_s(xosc: Path) -> float:
 
 
 def test_vector_ccr_files_match_the_protocol_points(tmp_path: Path) -> None:
-    """On mu 0.1 AEB cannot avoid any of the three (impact 35.8, 10.8 and 11.1 km/h): the
-    .xosc runs hit at the protocol's own points' speeds, within 0.5 km/h."""
+    """On mu 0.1 the .xosc runs end as the protocol's own points do: the same partner and the
+    impact speed within 0.5 km/h; CCRs at least is a real impact (AEB cannot stop from 50 km/h
+    on ice within its gap), so the comparison is not one of zeros only."""
     pattern = "^(" + "|".join(POINTS.values()) + ")$"
     out = tmp_path / "protocol"
     argv = ["protocol", "euroncap-aeb-c2c-2026", "--points", pattern, "--mu", "0.1"]
@@ -60,9 +61,9 @@ def test_vector_ccr_files_match_the_protocol_points(tmp_path: Path) -> None:
             argv += ["--param", f"Ego_initTimeHeadway={_bumper_headway_s(xosc):.6f}"]
         assert main(argv) == 0
         ours, theirs = _summary(run), rows[point]
-        assert float(theirs["impact_speed_kmh"]) > 5.0
         assert abs(ours["impact_speed_mps"] * 3.6 - float(theirs["impact_speed_kmh"])) <= 0.5
-        assert ours["collision_with"] == theirs["collision_with"] == "aro"
+        assert ours["collision_with"] == theirs["collision_with"]
+    assert float(rows[POINTS["CCRs"]]["impact_speed_kmh"]) > 5.0
 
 
 def test_alks_emergency_brake_runs_its_storyboard(tmp_path: Path) -> None:
