@@ -68,19 +68,17 @@ _SLOW_MPS = 1.0
 def friction_at(parts: Parts, mu: float) -> Friction:
     """The limit braking force, the deceleration it delivers (the wheels spin down with the
     car: ``equivalent_mass_kg``) and the DMM boundaries at the sensed friction, B0 and Bb
-    lengthened from eq. 33's deceleration (the tables') to the braking the EOAM commands on a
-    straight road: ``limit_brake_fraction`` of it, less what the wheel-lock cap
-    (``wheel_lock_limit_n``, no ABS) takes off."""
+    lengthened by as much as the wheel-lock cap (``wheel_lock_limit_n``, no ABS) takes off
+    limit braking on a straight road."""
     if not mu > 0.0:
         raise ValueError(f"friction mu={mu!r} must be > 0")
     decel = float(parts.tables.max_decel_mps2(mu))
-    eq33_n = parts.params.mass_kg * decel
-    brake_limit = parts.settings.limit_brake_fraction * eq33_n
-    # straight, slow (no drag): what the wheel-lock cap leaves of the limit braking
+    brake_limit = parts.settings.limit_brake_fraction * parts.params.mass_kg * decel
+    # straight, slow (no drag): what the wheel-lock cap leaves of eq. 33's limit braking
     straight = min(brake_limit, parts.longitudinal.wheel_lock_limit_n(_SLOW_MPS, mu, 0.0))
     delivered = brake_limit / equivalent_mass_kg(parts.params)
     bounds = parts.tables.boundaries
-    curve = BoundaryCurve(bounds, mu, bounds.speed_grid_mps, stop_scale=eq33_n / straight)
+    curve = BoundaryCurve(bounds, mu, bounds.speed_grid_mps, stop_scale=brake_limit / straight)
     return Friction(mu, brake_limit, delivered, curve)
 
 
