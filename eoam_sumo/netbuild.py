@@ -15,6 +15,7 @@ import subprocess
 import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from xml.sax.saxutils import quoteattr
 
 from eoam_sumo import __version__
 from eoam_sumo.errors import InputError
@@ -128,3 +129,33 @@ def main(argv: list[str] | None = None) -> int:
 
 if __name__ == "__main__":
     raise SystemExit(main())
+
+
+_SUMOCFG = """<?xml version="1.0" encoding="UTF-8"?>
+{comment}<configuration>
+    <input>
+        <net-file value={net}/>
+        <route-files value={routes}/>
+        <additional-files value={additional}/>
+    </input>
+    <time><begin value="0"/><end value="{end:g}"/><step-length value="0.01"/></time>
+    <processing><collision.action value="none"/><time-to-teleport value="-1"/></processing>
+    <random_number><seed value="42"/></random_number>
+    <report><no-step-log value="true"/></report>
+</configuration>
+"""
+
+
+def sumocfg_text(
+    net: str, routes: str, additional: str, end_s: float = 600.0, comment: str = ""
+) -> str:
+    """A generated scenario's sumocfg: its network, routes and vTypes, SUMO's 10 ms step,
+    no collision handling or teleports (the co-simulation judges contacts), seed 42."""
+    head = f"<!-- {comment} -->\n" if comment else ""
+    return _SUMOCFG.format(
+        comment=head,
+        net=quoteattr(net),
+        routes=quoteattr(routes),
+        additional=quoteattr(additional),
+        end=end_s,
+    )

@@ -141,3 +141,21 @@ class Response:
         self.cap = cap_mps2
         self.decel = min(rise, self.decel_max, cap_mps2)
         return -self.decel
+
+
+def gate_response(
+    resp: Response, t_s: float, unsafe: bool, lead: Lead | None, v_mps: float, braking_mps2: float
+) -> str:
+    """A safety-distance driver's response switched by its danger test (FSM, RSS): ``"off"``
+    (no intervention; the response ends once ``released``), ``"hold"`` (stopped: hold the
+    brake) or ``"on"`` (the response runs; started at the first unsafe step)."""
+    if not resp.active:
+        if not unsafe:
+            return "off"
+        resp.start(t_s)
+    if v_mps < STOPPED_MPS:
+        return "hold"
+    if not unsafe and released(lead, v_mps, braking_mps2):
+        resp.stop()
+        return "off"
+    return "on"

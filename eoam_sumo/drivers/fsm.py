@@ -11,7 +11,7 @@ brakes with the deceleration rising at the careful driver's jerk to the fuzzy de
 
 from __future__ import annotations
 
-from eoam_sumo.drivers.common import STOPPED_MPS, Lead, Response, released
+from eoam_sumo.drivers.common import Lead, Response, gate_response
 from eoam_sumo.drivers.params import FsmParams
 
 FSM = FsmParams()  # the published parameter set
@@ -83,15 +83,9 @@ class FsmDriver:
             self.cfs = cfs(lead.gap_m, v_mps, lead.speed_mps, a_mps2, p)
             self.pfs = pfs(lead.gap_m, v_mps, lead.speed_mps, p)
         unsafe = self.cfs + self.pfs > 0.0
-        if not resp.active:
-            if not unsafe:
-                return None
-            resp.start(t_s)
-        if v_mps < STOPPED_MPS:
-            return -p.decel_mps2
-        if not unsafe and released(lead, v_mps, p.lead_braking_mps2):
-            resp.stop()
-            return None
+        state = gate_response(resp, t_s, unsafe, lead, v_mps, p.lead_braking_mps2)
+        if state != "on":
+            return -p.decel_mps2 if state == "hold" else None
         if self.cfs > 0.0:
             demand = self.cfs * (p.br_max_mps2 - p.br_min_mps2) + p.br_min_mps2
         else:

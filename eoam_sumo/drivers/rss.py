@@ -10,7 +10,7 @@ slower nor braking and the distance is safe again, or the rear car stands."""
 
 from __future__ import annotations
 
-from eoam_sumo.drivers.common import STOPPED_MPS, Lead, Response, released
+from eoam_sumo.drivers.common import Lead, Response, gate_response
 from eoam_sumo.drivers.params import RssParams
 
 RSS = RssParams()  # the published parameter set
@@ -43,13 +43,7 @@ class RssDriver:
     def step(self, t_s: float, v_mps: float, a_mps2: float, lead: Lead | None, dt_s: float):
         p, resp = self.p, self.response
         unsafe = lead is not None and lead.gap_m < rss_safe_distance_m(v_mps, lead.speed_mps, p)
-        if not resp.active:
-            if not unsafe:
-                return None
-            resp.start(t_s)
-        if v_mps < STOPPED_MPS:
-            return -p.decel_mps2
-        if not unsafe and released(lead, v_mps, p.lead_braking_mps2):
-            resp.stop()
-            return None
+        state = gate_response(resp, t_s, unsafe, lead, v_mps, p.lead_braking_mps2)
+        if state != "on":
+            return -p.decel_mps2 if state == "hold" else None
         return resp.accel(t_s, dt_s)

@@ -14,6 +14,7 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 from eoam_sumo.fileio import write_atomic
+from eoam_sumo.netbuild import sumocfg_text
 from eoam_sumo.openscenario.geometry import LaneMap
 from eoam_sumo.openscenario.model import Body, Plan
 from eoam_sumo.openscenario.road import SumoLane, locate
@@ -29,20 +30,6 @@ EGO_VTYPE = (
     'maxSpeed="70.00" accel="4.00" decel="9.00" emergencyDecel="12.00" sigma="0" speedDev="0" '
     'speedFactor="4"/>'
 )
-SUMOCFG = """<?xml version="1.0" encoding="UTF-8"?>
-<!-- from {source} by eoam_sumo {version} -->
-<configuration>
-    <input>
-        <net-file value={net}/>
-        <route-files value="scenario.rou.xml"/>
-        <additional-files value="scenario_vtypes.add.xml"/>
-    </input>
-    <time><begin value="0"/><end value="{end:g}"/><step-length value="0.01"/></time>
-    <processing><collision.action value="none"/><time-to-teleport value="-1"/></processing>
-    <random_number><seed value="42"/></random_number>
-    <report><no-step-log value="true"/></report>
-</configuration>
-"""
 
 
 def _vtype(body: Body) -> str:
@@ -116,7 +103,11 @@ def write_sumo(plan: Plan, net_file: Path, lanes: LaneMap, folder: Path, source:
         folder / "scenario.rou.xml", head + "<routes>\n" + "\n".join(vehicles) + "\n</routes>\n"
     )
     end = 3600.0  # the run ends by the storyboard, its own criteria or --max-time-s
-    cfg = SUMOCFG.format(
-        source=source.name, version=__version__, net=quoteattr(str(net_file)), end=end
+    cfg = sumocfg_text(
+        str(net_file),
+        "scenario.rou.xml",
+        "scenario_vtypes.add.xml",
+        end_s=end,
+        comment=f"from {source.name} by eoam_sumo {__version__}",
     )
     return write_atomic(folder / "scenario.sumocfg", cfg)

@@ -22,7 +22,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from eoam_sumo.fileio import write_atomic
-from eoam_sumo.netbuild import build_network
+from eoam_sumo.netbuild import build_network, sumocfg_text
 from eoam_sumo.protocols.lane_change import path_points
 from eoam_sumo.protocols.points import (
     FOREVER_S,
@@ -138,20 +138,6 @@ VTYPES = f"""<?xml version="1.0" encoding="UTF-8"?>
 </additional>
 """
 
-SUMOCFG = """<?xml version="1.0" encoding="UTF-8"?>
-<configuration>
-    <input>
-        <net-file value="{net}"/>
-        <route-files value="{routes}"/>
-        <additional-files value="{vtypes}"/>
-    </input>
-    <time><begin value="0"/><end value="600"/><step-length value="0.01"/></time>
-    <processing><collision.action value="none"/><time-to-teleport value="-1"/></processing>
-    <random_number><seed value="42"/></random_number>
-    <report><no-step-log value="true"/></report>
-</configuration>
-"""
-
 
 def _obstruction(point: TestPoint) -> str:
     """CCFhol's obstruction vehicle on the opposite lane, F ahead of the target (its rear F
@@ -212,8 +198,6 @@ def write_scenarios(points: list[TestPoint], folder: Path) -> dict[str, Path]:
         pid = point.point_id
         k = hol[pid] if point.lane_change else offsets[point.offset_m]
         write_atomic(folder / f"{pid}.rou.xml", _routes(point, k))
-        cfg = SUMOCFG.format(
-            net=net.name, routes=f"{pid}.rou.xml", vtypes="protocol_vtypes.add.xml"
-        )
+        cfg = sumocfg_text(net.name, f"{pid}.rou.xml", "protocol_vtypes.add.xml")
         cfgs[pid] = write_atomic(folder / f"{pid}.sumocfg", cfg)
     return cfgs

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from eoam_sumo.fileio import write_atomic
-from eoam_sumo.netbuild import build_network
+from eoam_sumo.netbuild import build_network, sumocfg_text
 
 ROAD_M = 3000.0
 LANE_W_M = 3.5
@@ -126,20 +126,6 @@ VTYPES = """<?xml version="1.0" encoding="UTF-8"?>
 </additional>
 """
 
-SUMOCFG = """<?xml version="1.0" encoding="UTF-8"?>
-<configuration>
-    <input>
-        <net-file value="{net}"/>
-        <route-files value="{routes}"/>
-        <additional-files value="r157_vtypes.add.xml"/>
-    </input>
-    <time><begin value="0"/><end value="600"/><step-length value="0.01"/></time>
-    <processing><collision.action value="none"/><time-to-teleport value="-1"/></processing>
-    <random_number><seed value="42"/></random_number>
-    <report><no-step-log value="true"/></report>
-</configuration>
-"""
-
 
 def write_scenario(point: R157Point, folder: Path) -> Path:
     """The network, routes and sumocfg of one point in ``folder`` (its own); the sumocfg."""
@@ -158,5 +144,5 @@ def write_scenario(point: R157Point, folder: Path) -> Path:
     )
     write_atomic(folder / "r157.rou.xml", routes)
     write_atomic(folder / "r157_vtypes.add.xml", VTYPES)
-    cfg = SUMOCFG.format(net=net.name, routes="r157.rou.xml")
+    cfg = sumocfg_text(net.name, "r157.rou.xml", "r157_vtypes.add.xml")
     return write_atomic(folder / "r157.sumocfg", cfg)
