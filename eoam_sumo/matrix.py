@@ -24,6 +24,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from eoam_sumo.colours import OUTCOMES
+from eoam_sumo.drivers import DRIVERS
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import MU_MAX, VehicleParams, ego_e_class_sedan
 from eoam_sumo.sampling import Sample, parse_sample
@@ -55,6 +56,7 @@ SCHEMA = {
         "max_time_s",
         "radar_range_m",
         "policy",
+        "driver",
         "v2x_range_m",
         "v2x_latency_s",
         "v2x_loss",
@@ -81,6 +83,7 @@ SCHEMA = {
         "esc",
         "abs_esc",
         "policy",
+        "driver",
         *TRAFFIC_KEYS,
     ),
     "paper": ("table",),
@@ -127,6 +130,7 @@ class Case:
     max_time_s: float
     radar_range_m: float | None = None  # None: the radar's default range
     policy: str = "paper"
+    driver: str = "eoam"  # the ego's controller: the EOAM or a reference driver (``DRIVERS``)
     v2x_range_m: float = 0.0  # 0: no V2X
     v2x_latency_s: float = 0.1
     v2x_loss: float = 0.0
@@ -191,6 +195,7 @@ class Matrix:
     paper_table: Path | None = None
     radar_range_m: float | None = None
     policy: str = "paper"
+    driver: str = "eoam"
     v2x: tuple[float, float, float, float] = (0.0, 0.1, 0.0, 1.0)  # range, latency, loss, share
     mu_belief: str | float = "known"
     radar_model: str = "ideal"
@@ -209,6 +214,7 @@ class Matrix:
     # the swept equipment keys as (key, switch values), ``EQUIPMENT_KEYS`` order
     equipment: tuple[tuple[str, tuple[bool, ...]], ...] = ()
     policies: tuple[str, ...] = ()  # [sweep] policy; (): every case runs ``policy``
+    drivers: tuple[str, ...] = ()  # [sweep] driver; (): every case runs ``driver``
 
     def cases(self) -> list[Case]:
         """Every case, in the paper's Table 2 order (traffic, speed, friction, ARO stop),
@@ -219,6 +225,7 @@ class Matrix:
             *((("vehicle", self.vehicles),) if self.vehicles else ()),
             *self.equipment,
             *((("policy", self.policies),) if self.policies else ()),
+            *((("driver", self.drivers),) if self.drivers else ()),
             *self.traffic_axes,
             (
                 "oncoming_start_m",
@@ -233,6 +240,7 @@ class Matrix:
             "max_time_s": self.max_time_s,
             "radar_range_m": self.radar_range_m,
             "policy": self.policy,
+            "driver": self.driver,
             "v2x_range_m": self.v2x[0],
             "v2x_latency_s": self.v2x[1],
             "v2x_loss": self.v2x[2],
@@ -302,14 +310,13 @@ def _switch_text(on: bool) -> str:
 
 
 def _swept_tokens(values: dict) -> list[str]:
-    """The case-id tokens of the swept equipment and policy: ``abs-off``, ``esc-on`` (both
-    for ``abs_esc``), ``paper`` / ``safe``."""
+    """The case-id tokens of the swept equipment, policy and driver: ``abs-off``, ``esc-on``
+    (both for ``abs_esc``), ``paper`` / ``safe``, ``eoam`` / ``r157-cc``."""
     tokens = []
     for key, names in (("abs", ("abs",)), ("esc", ("esc",)), ("abs_esc", ("abs", "esc"))):
         if key in values:
             tokens += [f"{name}-{_switch_text(values[key])}" for name in names]
-    if "policy" in values:
-        tokens.append(values["policy"])
+    tokens += [values[key] for key in ("policy", "driver") if key in values]
     return tokens
 
 
@@ -453,10 +460,15 @@ def _checked(
     return check
 
 
-def _policy(value) -> str:
-    if value not in POLICIES:
-        raise InputError(f"policy {value!r} is not one of {', '.join(POLICIES)}")
-    return value
+def _one_of(key: str, choices: tuple[str, ...]):
+    """The check of one value of the choice ``key`` (policy, driver)."""
+
+    def check(value) -> str:
+        if value not in choices:
+            raise InputError(f"{key} {value!r} is not one of {', '.join(choices)}")
+        return value
+
+    return check
 
 
 def _road(value) -> str:
@@ -503,7 +515,8 @@ SAMPLED = {
     "radar_range_m": _checked(0.0, False),
     "mu_belief": parse_mu_belief,
     "radar_model": parse_radar_model,
-    "policy": _policy,
+    "policy": _one_of("policy", POLICIES),
+    "driver": _one_of("driver", DRIVERS),
     **{
         key: _checked(low, True, high, max_inclusive=high_in)
         for key, (_, low, high, high_in) in V2X_KEYS.items()
@@ -527,8 +540,8 @@ def load_matrix(path: Path) -> Matrix:
     traffic_axes = _traffic_axes(path, doc, sample)
     sumocfg = _scenario_file(path, scenario, traffic_axes)
     max_time, radar_range = _run_limits(path, scenario)
-    policy = _scenario_policy(path, scenario)
-    policies = _swept_policies(path, doc)
+    policy = _scenario_choice(path, scenario, "policy", POLICIES)
+    policies = _swept_choices(path, doc, "policy", POLICIES)
     v2x = _v2x_link(path, scenario, policy, bool(policies))
     paper = None
     if "table" in doc.get("paper", {}):
@@ -549,6 +562,8 @@ def load_matrix(path: Path) -> Matrix:
         vehicles=_vehicle_axis(path, doc, sampled, checks["vehicle"]),
         **_equipment(path, doc),
         policies=policies,
+        driver=_scenario_choice(path, scenario, "driver", DRIVERS),
+        drivers=_swept_choices(path, doc, "driver", DRIVERS),
         **_swept_values(path, doc.get("sweep", {}), sampled),
         paper_table=paper,
         policy=policy,
@@ -652,23 +667,24 @@ def _equipment(path: Path, doc: dict) -> dict:
     return fields
 
 
-def _swept_policies(path: Path, doc: dict) -> tuple[str, ...]:
-    """[sweep] policy: a non-empty list of distinct ``POLICIES`` (not also in [scenario])."""
-    if "policy" not in doc.get("sweep", {}):
+def _swept_choices(path: Path, doc: dict, key: str, choices: tuple[str, ...]) -> tuple[str, ...]:
+    """[sweep] ``key`` (policy, driver): a non-empty list of distinct ``choices`` (not also in
+    [scenario]); (): not swept."""
+    if key not in doc.get("sweep", {}):
         return ()
-    if "policy" in doc.get("scenario", {}):
-        raise InputError(f"{path}: 'policy' is in [scenario] and [sweep]; keep one")
-    listed = doc["sweep"]["policy"]
+    if key in doc.get("scenario", {}):
+        raise InputError(f"{path}: '{key}' is in [scenario] and [sweep]; keep one")
+    listed = doc["sweep"][key]
     if not isinstance(listed, list) or not listed:
-        raise InputError(f"{path}: [sweep] policy must be a non-empty list")
+        raise InputError(f"{path}: [sweep] {key} must be a non-empty list")
     for value in listed:
-        if value not in POLICIES:
+        if value not in choices:
             raise InputError(
-                f"{path}: [sweep] policy value {value!r} is not one of "
-                f"{', '.join(repr(p) for p in POLICIES)}"
+                f"{path}: [sweep] {key} value {value!r} is not one of "
+                f"{', '.join(repr(p) for p in choices)}"
             )
         if listed.count(value) > 1:
-            raise InputError(f"{path}: [sweep] policy lists {value!r} twice")
+            raise InputError(f"{path}: [sweep] {key} lists {value!r} twice")
     return tuple(listed)
 
 
@@ -813,15 +829,16 @@ def _run_limits(path: Path, scenario: dict) -> tuple[float, float | None]:
     return float(max_time), None if radar_range is None else float(radar_range)
 
 
-def _scenario_policy(path: Path, scenario: dict) -> str:
-    """[scenario] policy, one of ``POLICIES`` (default: the paper's)."""
-    policy = scenario.get("policy", "paper")
-    if policy not in POLICIES:
+def _scenario_choice(path: Path, scenario: dict, key: str, choices: tuple[str, ...]) -> str:
+    """[scenario] ``key`` (policy, driver), one of ``choices`` (default: the first, the
+    paper's policy and the EOAM)."""
+    value = scenario.get(key, choices[0])
+    if value not in choices:
         raise InputError(
-            f"{path}: [scenario] policy = {policy!r} must be one of "
-            f"{', '.join(repr(p) for p in POLICIES)}"
+            f"{path}: [scenario] {key} = {value!r} must be one of "
+            f"{', '.join(repr(p) for p in choices)}"
         )
-    return policy
+    return value
 
 
 def _v2x_link(

@@ -84,6 +84,7 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
             "offline",
             "sensing",
             "sim",
+            "drivers",
             "traffic_levels",
             "vehicle_files",
         },

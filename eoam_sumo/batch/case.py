@@ -62,6 +62,7 @@ class CaseParameters:
     max_time_s: float
     radar_range_m: float | None  # None: the radar's default range
     policy: str  # the decision policy: paper or safe
+    driver: str  # the ego's controller: eoam or a reference driver
     v2x_range_m: float  # 0: no V2X
     v2x_latency_s: float
     v2x_loss: float
@@ -128,6 +129,7 @@ def case_settings(task: CaseTask) -> RunSettings:
             seed=case.seed,
             after_stop_s=case.after_stop_s,
             sumo_step_s=case.sumo_step_s,
+            driver=case.driver,
             vehicle=case_vehicle(case),
             vehicle_id=case.vehicle or DEFAULT_VEHICLE,
         ),

@@ -23,11 +23,12 @@ COUNTED = ("green", "yellow", "orange", "red")
 #: The keys one row of the report stands for.
 GROUP = ("vehicle", "equipment", "policy")
 #: The columns whose variation makes a batch a vehicles experiment.
-VARIED = ("vehicle", "policy", "abs_fitted", "esc_fitted")
+VARIED = ("vehicle", "policy", "driver", "abs_fitted", "esc_fitted")
 
 
 def sweeps_vehicles(results: pd.DataFrame) -> bool:
-    """Whether the batch varies the vehicle, its ABS/ESC or the policy (``VARIED``)."""
+    """Whether the batch varies the vehicle, its ABS/ESC, the policy or the driver
+    (``VARIED``)."""
     return any(col in results and results[col].dropna().astype(str).nunique() > 1 for col in VARIED)
 
 
@@ -54,7 +55,8 @@ def cell_id(row) -> str:
 
 def labelled(results: pd.DataFrame) -> pd.DataFrame:
     """The frame with the report's columns: ``equipment``, ``colour`` (``failed`` for a case
-    that did not finish) and ``cell``."""
+    that did not finish) and ``cell``; ``policy`` names a reference driver's runs by the
+    driver (it has no decision policy: it only brakes in its lane)."""
     frame = results.copy()
     for col in VARIED:
         if col not in frame:
@@ -68,6 +70,8 @@ def labelled(results: pd.DataFrame) -> pd.DataFrame:
     frame["cell"] = [cell_id(row) for _, row in frame.iterrows()]
     frame["vehicle"] = frame["vehicle"].fillna("sedan")
     frame["policy"] = frame["policy"].fillna("paper")
+    driver = frame["driver"].fillna("eoam")
+    frame["policy"] = frame["policy"].where(driver == "eoam", driver)
     return frame
 
 
@@ -123,7 +127,7 @@ def changed_cells(results: pd.DataFrame) -> pd.DataFrame:
 def _counts_table(counts: pd.DataFrame, paper: dict[str, int]) -> list[str]:
     """The markdown table of the colour counts, the paper's row first."""
     colours = [c for c in counts.columns if c not in (*GROUP, "agree", "compared")]
-    head = "| vehicle | ABS/ESC | policy | " + " | ".join(
+    head = "| vehicle | ABS/ESC | policy or driver | " + " | ".join(
         f"{MARKERS.get(c, '')} {c}" for c in colours
     )
     lines = [head + " | agree with the paper |", "|---" * (len(colours) + 4) + "|"]

@@ -105,6 +105,7 @@ class RunInfo:
     wall times (the whole run's, and the step loop's)."""
 
     mu_belief: str | float
+    driver: str  # the ego's controller (``RunSettings.driver``)
     policy_record: dict  # the policy, V2X and sight-distance fields of the summary
     radar_model: str
     seed: int
@@ -213,6 +214,7 @@ def collect_info(sim: EndedRun, loop_wall_s: float) -> RunInfo:
     st = sim.settings
     return RunInfo(
         mu_belief=sim.belief.label,
+        driver=st.driver,
         policy_record=sim.policy_record(),
         radar_model=st.radar_model,
         seed=st.seed,

@@ -197,6 +197,10 @@ class Outcome:
 
 #: Why mode 3 found the next lane closed, unless the decision policy names the cause.
 NEXT_LANE_CLOSED = "oncoming traffic or a standing car"
+#: What the EOAM did, where the reason names it (``driver_wording`` words it for a reference
+#: driver, which only brakes in its lane: mode 1 while it brakes).
+DMM_BRAKING = "limit braking chosen by the DMM"
+NO_INTERVENTION = "no EOAM intervention"
 
 
 def _manoeuvre_phrase(modes: set[int], lane_change: bool) -> str:
@@ -211,8 +215,17 @@ def _manoeuvre_phrase(modes: set[int], lane_change: bool) -> str:
     if steered:
         return "lane change started but the point of no return not reached"
     if 1 in modes:
-        return "limit braking chosen by the DMM"
-    return "no EOAM intervention"
+        return DMM_BRAKING
+    return NO_INTERVENTION
+
+
+def driver_wording(reason: str, driver: str) -> str:
+    """``reason`` with what the EOAM did worded for the ego's controller ``driver`` (the EOAM:
+    unchanged)."""
+    if driver == "eoam":
+        return reason
+    reason = reason.replace(DMM_BRAKING, f"braking by the {driver} reference driver")
+    return reason.replace(NO_INTERVENTION, f"no intervention by the {driver} reference driver")
 
 
 def road_departure(

@@ -47,6 +47,7 @@ class RunSummary:
     trigger_time_s: float | None = _doc("when the EOAM first left normal driving (empty: never)")
     trigger_range_m: float | None = _doc("range to the obstacle then (empty: none seen)")
     mu_believed_at_trigger: float | None = _doc("the friction the EOAM believed then")
+    driver: str = _doc("the ego's controller: eoam or a reference driver (r157-cc, fsm, rss)")
     policy: str = _doc("the decision policy: paper or safe")
     v2x_range_m: float = _doc("V2X range (0: no V2X)")
     v2x_latency_s: float = _doc("V2X message latency")

@@ -10,7 +10,13 @@ from dataclasses import replace
 from typing import Any
 
 from eoam_sumo.sim.facts import RunFacts, RunInfo
-from eoam_sumo.sim.outcome import NEXT_LANE_CLOSED, Outcome, classify_outcome, left_road
+from eoam_sumo.sim.outcome import (
+    NEXT_LANE_CLOSED,
+    Outcome,
+    classify_outcome,
+    driver_wording,
+    left_road,
+)
 from eoam_sumo.sim.severity import Severity, contact_severity
 from eoam_sumo.sim.summary import RunSummary, finite_or_none, rounded
 
@@ -76,7 +82,9 @@ def summarise(facts: RunFacts, info: RunInfo) -> RunSummary:
 
 
 def named_cause(outcome: Outcome, info: RunInfo) -> Outcome:
-    """The outcome with the decision policy's cause of a closed next lane, when it gave one."""
+    """The outcome with the decision policy's cause of a closed next lane, when it gave one,
+    and what the ego's controller did in its own words (``outcome.driver_wording``)."""
+    outcome = replace(outcome, reason=driver_wording(outcome.reason, info.driver))
     why = info.policy_record.get("sight_reason")
     if not why or NEXT_LANE_CLOSED not in outcome.reason:
         return outcome
@@ -115,6 +123,7 @@ def _eoam_fields(facts: RunFacts, info: RunInfo) -> dict[str, Any]:
         "trigger_time_s": None if t is None else round(t, 6),
         "trigger_range_m": round(rng, 6) if t is not None and math.isfinite(rng) else None,
         "mu_believed_at_trigger": facts.mu_believed_at_trigger,
+        "driver": info.driver,
         **{k: v for k, v in info.policy_record.items() if k != "sight_reason"},
         "radar_model": info.radar_model,
         "seed": info.seed,

@@ -36,6 +36,7 @@ POLICY = {
 }
 INFO = RunInfo(
     mu_belief="known",
+    driver="eoam",
     policy_record=POLICY,
     radar_model="ideal",
     seed=0,
@@ -100,6 +101,24 @@ def test_a_square_hit_on_the_aro_after_limit_braking_is_yellow_with_its_delta_v(
     assert summary.delta_v_ego_mps == pytest.approx(8.0 * 1500.0 / (1500.0 + EGO_MASS_KG))
     assert summary.collision_with_mass_kg == 1500.0 and summary.contact_time_s == 12.5
     assert summary.near_miss is False  # a contact is never a near miss
+
+
+def test_a_reference_driver_s_braking_is_named_for_the_driver_not_the_dmm():
+    record = _record(_ahead(TOUCHING_M), "aro", ego_speed_mps=8.0)
+    facts = _facts(
+        modes_visited=(0, 1),
+        contact=record,
+        contact_sumo_mass_kg=1500.0,
+        end_cause="contact",
+    )
+    eoam = summarise(facts, INFO)
+    careful = summarise(facts, replace(INFO, driver="r157-cc"))
+    assert "chosen by the DMM" in eoam.reason and eoam.driver == "eoam"
+    assert careful.driver == "r157-cc" and "DMM" not in careful.reason
+    assert "braking by the r157-cc reference driver" in careful.reason
+    assert careful.outcome == eoam.outcome == "yellow"  # the same facts, the same colour
+    idle = summarise(replace(facts, modes_visited=(0,)), replace(INFO, driver="rss"))
+    assert idle.reason.startswith("no intervention by the rss reference driver")
 
 
 def test_an_offset_hit_on_the_aro_after_limit_braking_is_orange():
