@@ -134,7 +134,14 @@ class QuinticShift:
         failed, lengths = None, []
         while length <= top:
             traj = cls(y0_m, slope0, y1_m, length, curvature0_1pm)
-            if traj._check(_SEARCH_U)[1] <= OVERSHOOT_TOL_M and traj._margin(limit) <= 0.0:
+            # the full check's points include the coarse grid's, so its peak is at least the
+            # coarse one: a coarse peak over the budget misses it without the full check
+            coarse_peak, coarse_past = traj._check(_SEARCH_U)
+            if (
+                coarse_past <= OVERSHOOT_TOL_M
+                and coarse_peak / limit - 1.0 <= 0.0
+                and traj._margin(limit) <= 0.0
+            ):
                 return traj if failed is None else _first_within(cls, state, limit, failed, length)
             failed = length
             lengths.append(length)

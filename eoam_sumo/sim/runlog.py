@@ -131,13 +131,43 @@ class RunLog:
         return float(np.max(np.abs(col))) if col.size else 0.0
 
     def frame(self):
-        import pandas as pd
+        return table_frame(self.array())
 
-        df = pd.DataFrame(self.array(), columns=COLUMNS)
-        for c in _INT_COLUMNS:
-            df[c] = df[c].astype("Int64")
-        df["sector"] = [chr(int(v)) if np.isfinite(v) else "" for v in df["sector"]]
-        return df
+    def csv_text(self) -> str:
+        """timeseries.csv's text (:func:`csv_text`)."""
+        return csv_text(self.array())
+
+
+def table_frame(array: np.ndarray):
+    """The log's (n, len(COLUMNS)) array as a DataFrame: the integer columns as Int64 (empty
+    where NaN), ``sector`` as its letter ("" where NaN)."""
+    import pandas as pd
+
+    df = pd.DataFrame(array, columns=COLUMNS)
+    for c in _INT_COLUMNS:
+        df[c] = df[c].astype("Int64")
+    df["sector"] = [chr(int(v)) if np.isfinite(v) else "" for v in df["sector"]]
+    return df
+
+
+_SECTOR_INDEX = COLUMNS.index("sector")
+_INT_INDEX = [COLUMNS.index(c) for c in _INT_COLUMNS]
+_ROW_FORMAT = ",".join("%s" if c == "sector" else "%.9g" for c in COLUMNS)
+
+
+def csv_text(array: np.ndarray) -> str:
+    """The log's array as CSV text, byte for byte what ``table_frame(array).to_csv(index=False,
+    float_format="%.9g")`` writes, one ``%`` per row instead of pandas' per-value formatting:
+    numbers ``%.9g`` (an integer column's whole numbers print as integers, its -0 as 0), NaN
+    empty, ``sector`` its letter."""
+    lines = [",".join(COLUMNS)]
+    for row in array.tolist():
+        for i in _INT_INDEX:
+            row[i] += 0.0  # Int64 writes -0.0 as 0
+        code = row[_SECTOR_INDEX]
+        row[_SECTOR_INDEX] = chr(int(code)) if math.isfinite(code) else ""
+        lines.append((_ROW_FORMAT % tuple(row)).replace("nan", ""))
+    return "\n".join(lines) + "\n"
 
 
 #: Where each column comes from, by name: the plant state's index, or a field of the
@@ -293,8 +323,7 @@ def write_run(
     ``out_dir``."""
     out_dir.mkdir(parents=True, exist_ok=True)
     if timeseries == "csv":
-        csv = log.frame().to_csv(index=False, float_format="%.9g")
-        write_atomic(out_dir / "timeseries.csv", csv)
+        write_atomic(out_dir / "timeseries.csv", log.csv_text())
     elif timeseries == "parquet":
         data = log.frame().to_parquet(None, index=False, engine="pyarrow", compression="zstd")
         write_atomic(out_dir / "timeseries.parquet", data)
