@@ -33,9 +33,12 @@ pitch and roll response, and no algebraic loop between loads and tyre forces."""
 
 ABS_MIN_SPEED_MPS = 2.0  # ABS control ends below this speed (the wheel may then stop)
 ABS_SLIP_FACTOR = 1.0  # ABS dump threshold as a multiple of the tyre's peak slip
+ABS_SLIP_MIN_MPS = 0.1  # ... plus this wheel-speed difference (the speed estimate's error)
 ABS_SLIP_BAND = 1.0  # ESC without ABS: its share cut fully at (1 + band) times the threshold
 ABS_BUILD_BAND = 0.5  # ABS: pulsed build from (1 - band) times the threshold
 ABS_BUILD_SHARE = 0.3  # share of the build rate ABS re-applies with (pulsed build)
+ABS_VALVE_LAG_S = 0.01  # the ABS's phase reaches the wheel after this lag (assumed)
+ABS_LEAD_S = ABS_VALVE_LAG_S  # the ABS judges the slip this far ahead (wheel acceleration)
 ESC_MIN_SPEED_MPS = 5.0  # ESC acts above this speed
 ESC_TORQUE_CUT_NM = 1500.0  # the drive force is cut fully at this corrective moment
 ESC_YAW_LIMIT = 0.85  # yaw-rate reference limited to 0.85 mu g / v
@@ -43,10 +46,10 @@ EAWD_MAX_FRONT_SHARE = 0.5  # eAWD moves torque to the front up to this share
 ESC_DEADBAND_ACCEL_MPS2 = 0.2  # the yaw dead band grows by this lateral acceleration / v
 # What the control unit knows (wheel speeds, accelerometer, yaw rate, steering angle, brake
 # pressure): its speed, friction and sideslip estimates (docs/chassis.md "Estimates").
-SPEED_EST_RISE_PER_S = 20.0  # the speed estimate is pulled up to the fastest wheel at once
-SPEED_EST_FALL_PER_S = 20.0  # ... and down to it, unbraked
-SPEED_EST_FALL_BRAKED_PER_S = 0.1  # braked, the accelerometer carries it (every wheel slips)
-SPEED_EST_FALL_BRAKED_SHARE = 0.03  # ... by at most this share of the measured deceleration
+SPEED_EST_PER_S = 20.0  # unbraked, the speed estimate is pulled to the fastest wheel at once
+SPEED_EST_BRAKED_PER_S = 0.1  # braked, the accelerometer carries it (every wheel slips) ...
+SPEED_EST_BRAKED_SHARE = 0.03  # ... pulled by at most this share of the measured deceleration
+SPEED_EST_BRAKED_MIN_MPS2 = 0.02  # ... plus this (the accelerometer's offset), so never stuck
 BRAKE_ON_BAR = 2.0  # mean wheel pressure from which the car counts as braked
 MU_EST_HIGH = 1.0  # the friction estimate starts at, and returns to, a dry road's
 MU_EST_MIN = 0.05  # the ABS and ESC thresholds use at least this friction estimate
@@ -136,25 +139,29 @@ def steer_compliance_rad_per_n(p: VehicleParams) -> float:
     return (1.0 / c - 1.0) / p.cornering_stiffness_front_npr
 
 
+def abs_threshold_slip(mu, ch: Chassis, ops):
+    """The ABS's dump threshold on a wheel's braking slip: the tyre's peak slip at the
+    friction estimate ``mu`` (at least ``MU_EST_MIN``) times ``ABS_SLIP_FACTOR``."""
+    return ABS_SLIP_FACTOR * ch.peak_slip_per_mu * ops.fmax(mu, MU_EST_MIN)
+
+
 def _slip_excess(wheel_mps, v_long, mu, ch: Chassis, ops):
     """``(excess, on)``: how far a wheel's braking slip ``(omega r_w - v) / v`` against its
     reference speed ``v_long`` (``estimated_wheel_speeds``) is past the tyre's peak slip at
     the friction estimate ``mu`` (``ABS_SLIP_FACTOR``), over ``ABS_SLIP_BAND``, in [0, 1];
     and the control's fade-in above ``ABS_MIN_SPEED_MPS`` (over 1 m/s)."""
-    slip = (wheel_mps - v_long) / ops.fmax(v_long, ABS_MIN_SPEED_MPS)
-    threshold = ABS_SLIP_FACTOR * ch.peak_slip_per_mu * ops.fmax(mu, MU_EST_MIN)
+    speed = ops.fmax(v_long, ABS_MIN_SPEED_MPS)
+    slip = (wheel_mps - v_long) / speed
+    threshold = abs_threshold_slip(mu, ch, ops) + ABS_SLIP_MIN_MPS / speed
     excess = ops.fmin(ops.fmax((-slip - threshold) / (ABS_SLIP_BAND * threshold), 0.0), 1.0)
     return excess, ops.fmin(ops.fmax(v_long - ABS_MIN_SPEED_MPS, 0.0), 1.0)
 
 
-def abs_activity(wheel_mps, v_refs, mu_est, ch: Chassis, ops):
-    """1 while any wheel's braking slip is past its threshold (``_slip_excess``) above the
-    ABS's lowest speed, else 0: a wheel at the friction limit."""
-    active = 0.0
-    for w, v in zip(wheel_mps, v_refs):
-        excess, on = _slip_excess(w, v, mu_est, ch, ops)
-        active = ops.fmax(active, ops.if_else(excess > 0.0, 1.0, 0.0) * on)
-    return active
+def slip_past(wheel_mps, v_long, mu, ch: Chassis, ops):
+    """``(past, on)``: 1 while the wheel's braking slip is past its threshold
+    (``_slip_excess``), else 0; and the control's fade-in."""
+    excess, on = _slip_excess(wheel_mps, v_long, mu, ch, ops)
+    return ops.if_else(excess > 0.0, 1.0, 0.0), on
 
 
 def wheel_pressure_target(p_cmd_bar, esc_bar, wheel_mps, v_long, mu, p, ch: Chassis, ops):
@@ -167,26 +174,36 @@ def wheel_pressure_target(p_cmd_bar, esc_bar, wheel_mps, v_long, mu, p, ch: Chas
     return ops.fmin(p_cmd_bar + esc_bar, p.max_brake_pressure_bar)
 
 
-def pressure_rate(p_target_bar, p_bar, wheel_mps, v_long, mu, accel, p: VehicleParams, ch, ops):
+def pressure_rate(p_target_bar, p_bar, cut_barps, p: VehicleParams, ops):
     """One wheel's pressure rate [bar/s]: a first-order build to the target with the build and
-    dump rate limits. With ABS, the phases of a three-phase controller from what it measures,
-    the wheel's slip against its reference speed ``v_long`` and the friction estimate
-    ``mu`` (``_slip_excess``) and the wheel's acceleration ``accel`` [m/s^2]: past the
-    threshold, dump while the wheel still decelerates and hold once it spins up; below it,
-    a pulsed build (``ABS_BUILD_SHARE``) within ``ABS_BUILD_BAND`` below the threshold."""
+    dump rate limits; with ABS, at most the build rate less the ABS's cut ``cut_barps`` (the
+    lagged valve command, ``abs_cut_target``)."""
     rate = (p_target_bar - p_bar) / p.brake_lag_s
     rate = ops.fmin(ops.fmax(rate, -p.brake_dump_rate_barps), p.brake_build_rate_barps)
     if not p.abs_fitted:
         return rate
-    excess, on = _slip_excess(wheel_mps, v_long, mu, ch, ops)
-    near, _ = _slip_excess(wheel_mps, v_long, mu * (1.0 - ABS_BUILD_BAND), ch, ops)
+    return ops.fmin(rate, p.brake_build_rate_barps - cut_barps)
+
+
+def abs_cut_target(wheel_mps, v_long, mu, accel, ax_meas, p: VehicleParams, ch, ops):
+    """What one wheel's ABS asks of its valves, as a cut [bar/s] below the build rate: the
+    phases of a three-phase controller from what it measures, the wheel's slip against its
+    reference speed ``v_long`` and the friction estimate ``mu`` (``_slip_excess``) and the
+    wheel's acceleration ``accel`` [m/s^2]. Past the threshold, dump while the wheel still
+    decelerates (a locked wheel too) and hold once it spins up; below it, a pulsed build
+    (``ABS_BUILD_SHARE``) within ``ABS_BUILD_BAND`` below the threshold; else no cut. The
+    valves follow it with ``ABS_VALVE_LAG_S``, so the slip is judged ``ABS_LEAD_S`` ahead
+    (a wheel-deceleration threshold in effect). Returns ``(cut, near)``: ``near`` 1 while the
+    wheel is within the build band or past the threshold (at the friction limit:
+    ``mu_estimate_rate``'s ``active``)."""
+    build = p.brake_build_rate_barps
+    wheel_ahead = wheel_mps + ABS_LEAD_S * accel
+    v_ahead = v_long + ABS_LEAD_S * ax_meas
+    excess, on = _slip_excess(wheel_ahead, v_ahead, mu, ch, ops)
+    near, _ = _slip_excess(wheel_ahead, v_ahead, mu * (1.0 - ABS_BUILD_BAND), ch, ops)
     past = ops.if_else(accel < 0.0, -p.brake_dump_rate_barps, 0.0)
-    limit = ops.if_else(
-        excess > 0.0,
-        past,
-        ops.if_else(near > 0.0, ABS_BUILD_SHARE * p.brake_build_rate_barps, rate),
-    )
-    return ops.fmin(rate, limit * on + rate * (1.0 - on))
+    limit = ops.if_else(excess > 0.0, past, ops.if_else(near > 0.0, ABS_BUILD_SHARE * build, build))
+    return (build - limit) * on, ops.if_else(near > 0.0, 1.0, 0.0) * on
 
 
 def front_drive_share(slip_front, slip_rear, p: VehicleParams, ch: Chassis, ops):
@@ -208,13 +225,17 @@ def estimated_wheel_speeds(v_est, r, steer, p: VehicleParams, ops):
     return ((v_est - half) * c + lat_f, (v_est + half) * c + lat_f, v_est - half, v_est + half)
 
 
-def speed_estimate_rate(v_est, ax_meas, wheel_mps, r, steer, pressure_bar, p, ops):
+def speed_estimate_rate(v_est, ax_meas, wheel_mps, r, steer, pressure_bar, mu_est, p, ch, ops):
     """Rate of the vehicle-speed estimate: the accelerometer's ``ax`` integrated, pulled to
     the fastest wheel (each wheel's speed referred to the centre of gravity, the inverse of
-    ``estimated_wheel_speeds``): up at once, down at once unbraked, and only slowly while
-    braked (``pressure_bar`` the mean wheel pressure), when every wheel runs at some slip: by
-    at most ``SPEED_EST_FALL_BRAKED_SHARE`` of the measured deceleration, the accelerometer's
-    own error (gain, the body's pitch)."""
+    ``estimated_wheel_speeds``) at once unbraked. Braked (``pressure_bar`` the mean wheel
+    pressure) every wheel runs at some slip, the fastest one (the ABS's recovered wheel)
+    within the ABS's threshold slip at the friction estimate ``mu_est``: the estimate is
+    pulled up while below the fastest wheel and down while even the fastest wheel is beyond
+    that slip, slowly and by at most ``SPEED_EST_BRAKED_SHARE`` of the measured deceleration
+    plus ``SPEED_EST_BRAKED_MIN_MPS2`` (the accelerometer's own error: gain, the body's pitch,
+    its offset; a wheel spinning up past the car for a moment does not carry the estimate
+    with it)."""
     half = 0.5 * p.track_m * r
     c, s = ops.cos(steer), ops.sin(steer)
     lat_f = p.cg_to_front_m * r * s
@@ -222,21 +243,21 @@ def speed_estimate_rate(v_est, ax_meas, wheel_mps, r, steer, pressure_bar, p, op
     refs = ((fl - lat_f) / c + half, (fr - lat_f) / c - half, rl + half, rr - half)
     fastest = ops.fmax(ops.fmax(refs[0], refs[1]), ops.fmax(refs[2], refs[3]))
     braked = ops.fmin(ops.fmax(pressure_bar / BRAKE_ON_BAR, 0.0), 1.0)
-    fall = SPEED_EST_FALL_PER_S + (SPEED_EST_FALL_BRAKED_PER_S - SPEED_EST_FALL_PER_S) * braked
-    gap = fastest - v_est
-    down = fall * ops.fmin(gap, 0.0)
-    cap = SPEED_EST_FALL_BRAKED_SHARE * ops.fabs(ax_meas)
-    down = ops.fmax(down, -cap) * braked + down * (1.0 - braked)
-    return ax_meas + SPEED_EST_RISE_PER_S * ops.fmax(gap, 0.0) + down
+    slack = braked * abs_threshold_slip(mu_est, ch, ops) * ops.fmax(v_est, 0.0)
+    gap = ops.fmax(fastest - v_est, 0.0) + ops.fmin(fastest + slack - v_est, 0.0)
+    cap = SPEED_EST_BRAKED_SHARE * ops.fabs(ax_meas) + SPEED_EST_BRAKED_MIN_MPS2
+    slow = ops.fmin(ops.fmax(SPEED_EST_BRAKED_PER_S * gap, -cap), cap)
+    return ax_meas + braked * slow + (1.0 - braked) * SPEED_EST_PER_S * gap
 
 
 def mu_estimate_rate(mu_est, accel_g, active, ops):
     """Rate of the friction estimate: while a tyre is at its limit (``active``: ABS slip past
     its threshold, or ESC seeing understeer) it falls to the acceleration the car achieves,
-    ``|a| / g`` from the accelerometer, averaging over the ABS's cycles; otherwise it returns
+    ``|a| / g`` from the accelerometer (at least ``MU_EST_MIN``), averaging over the ABS's
+    cycles; otherwise it returns
     slowly to a dry road's; it rises at once to any acceleration achieved above it."""
     rise = ops.fmax(accel_g - mu_est, 0.0) / MU_EST_TAU_S
-    follow = active * ops.fmin(accel_g - mu_est, 0.0) / MU_EST_FALL_S
+    follow = active * ops.fmin(ops.fmax(accel_g, MU_EST_MIN) - mu_est, 0.0) / MU_EST_FALL_S
     return follow + (1.0 - active) * (MU_EST_HIGH - mu_est) / MU_EST_RECOVER_S + rise
 
 

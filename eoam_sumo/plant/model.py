@@ -60,6 +60,7 @@ STATE_NAMES = (
     "speed_estimate_mps",
     "mu_estimate",
     "sideslip_estimate_rad",
+    *(f"abs_cut_{w}_barps" for w in WHEELS),
 )
 INPUT_NAMES = ("steer_cmd_rad", "drive_force_cmd_n", "brake_force_cmd_n")
 OUTPUT_NAMES = (
@@ -103,6 +104,7 @@ OMEGAS = (12, 13, 14, 15)
 SLIPS = (16, 17, 18, 19)
 (TAN_F, TAN_R, AX_LOAD, AY_LOAD, ESC, ESC_REF) = range(20, 26)
 (V_EST, MU_EST, BETA_EST) = range(26, 29)
+ABS_CUTS = (29, 30, 31, 32)
 STEER_CMD, DRIVE_CMD, BRAKE_CMD = range(len(INPUT_NAMES))
 
 LOCK_SLIP = -0.5
@@ -230,12 +232,14 @@ def _slip_rates(x, steer, p: VehicleParams, ch: Chassis, ops) -> list:
     return rates  # slips FL, FR, RL, RR, tan front, tan rear
 
 
-def _actuator_rates(x, u, steer, spins, p: VehicleParams, ch: Chassis, ops) -> list:
+def _actuator_rates(x, u, f: _Forces, spins, p: VehicleParams, ch: Chassis, ops):
     """Rates of steer (rate limited lag), drive force (lag) and the four wheels' pressures:
     the driver's line pressure on each (equal on the two sides of an axle), plus the ESC's on
-    one wheel (``chassis.esc_side_forces``), each through that wheel's ABS, which judges its
-    slip against the speed and friction estimates (``V_EST``, ``MU_EST``) and its
-    acceleration: ``spins`` (``_wheel_rates``) less the brake torque's."""
+    one wheel (``chassis.esc_side_forces``), each through that wheel's ABS; and of the ABS's
+    lagged valve cuts (``ABS_CUTS``): each wheel's ABS judges its slip against the speed and
+    friction estimates (``V_EST``, ``MU_EST``) and its acceleration: ``spins``
+    (``_wheel_rates``) less the brake's and the rolling resistance's torques
+    (``integrator.resist``; a locked wheel's is negative, not 0)."""
     steer_target = ops.fmin(ops.fmax(u[STEER_CMD], -p.max_steer_rad), p.max_steer_rad)
     steer_rate = ops.fmin(
         ops.fmax((steer_target - x[STEER]) / p.steer_lag_s, -p.max_steer_rate_radps),
@@ -245,33 +249,42 @@ def _actuator_rates(x, u, steer, spins, p: VehicleParams, ch: Chassis, ops) -> l
     brake_target = ops.fmin(ops.fmax(u[BRAKE_CMD], 0.0), p.max_brake_force_n)
     p_cmd = brake_target / ch.brake_n_per_bar
     esc = ch_.esc_side_forces(x[ESC], x[YAW_RATE], p, ops) if p.esc_fitted else (0.0,) * 4
-    v_refs = ch_.estimated_wheel_speeds(x[V_EST], x[YAW_RATE], steer, p, ops)
+    v_refs = ch_.estimated_wheel_speeds(x[V_EST], x[YAW_RATE], f.steer_rad, p, ops)
     mu_est = x[MU_EST]
-    pressures = []
+    ax, _ = _body_accelerations(f, p)
+    pressures, cuts, active = [], [], 0.0
     for i, (p_i, omega_i) in enumerate(zip(PRESSURES, OMEGAS)):
         wheel_mps = x[omega_i] * p.wheel_radius_m
         esc_bar = esc[i] / ch.wheel_brake_n_per_bar[i] if p.esc_fitted else 0.0
         target = ch_.wheel_pressure_target(p_cmd, esc_bar, wheel_mps, v_refs[i], mu_est, p, ch, ops)
-        braking = ch.wheel_brake_n_per_bar[i] * x[p_i] * p.wheel_radius_m / p.wheel_inertia_kgm2
-        accel = (spins[i] - braking) * p.wheel_radius_m
-        pressures.append(
-            ch_.pressure_rate(target, x[p_i], wheel_mps, v_refs[i], mu_est, accel, p, ch, ops)
-        )
-    return [steer_rate, (drive_target - x[DRIVE]) / p.drive_lag_s, *pressures]
+        pressures.append(ch_.pressure_rate(target, x[p_i], x[ABS_CUTS[i]], p, ops))
+        if not p.abs_fitted:
+            cuts.append(0.0)
+            past, on = ch_.slip_past(wheel_mps, v_refs[i], mu_est, ch, ops)
+            active = ops.fmax(active, past * on)
+            continue
+        resisting = ch.wheel_brake_n_per_bar[i] * x[p_i] + p.rolling_resistance_coeff * f.loads[i]
+        accel = (spins[i] - resisting * p.wheel_radius_m / p.wheel_inertia_kgm2) * p.wheel_radius_m
+        cut, past = ch_.abs_cut_target(wheel_mps, v_refs[i], mu_est, accel, ax, p, ch, ops)
+        cuts.append((cut - x[ABS_CUTS[i]]) / ch_.ABS_VALVE_LAG_S)
+        active = ops.fmax(active, past)
+    return [steer_rate, (drive_target - x[DRIVE]) / p.drive_lag_s, *pressures], cuts, active
 
 
-def _estimate_rates(x, ax, ay, steer, p: VehicleParams, ch: Chassis, ops) -> list:
+def _estimate_rates(x, u, accel, steer, abs_active, p: VehicleParams, ops) -> list:
     """Rates of the control unit's estimates (speed, friction, sideslip) from what it
-    measures: wheel speeds, accelerometer ``(ax, ay)``, yaw rate, steering angle, pressures
-    (``chassis.speed_estimate_rate`` and after). Zero without ABS and ESC."""
+    measures: wheel speeds, accelerometer ``accel = (ax, ay)``, yaw rate, steering angle,
+    the driver's line pressure (``chassis.speed_estimate_rate`` and after); ``abs_active``: a
+    wheel at its limit (``_actuator_rates``). Zero without ABS and ESC."""
     if not (p.abs_fitted or p.esc_fitted):
         return [0.0, 0.0, 0.0]
+    ch = constants(p)
+    ax, ay = accel
     r, v_est, mu_est = x[YAW_RATE], x[V_EST], x[MU_EST]
     wheel_mps = [x[i] * p.wheel_radius_m for i in OMEGAS]
-    pressure = 0.25 * (x[PRESSURES[0]] + x[PRESSURES[1]] + x[PRESSURES[2]] + x[PRESSURES[3]])
-    v_rate = ch_.speed_estimate_rate(v_est, ax, wheel_mps, r, steer, pressure, p, ops)
-    v_refs = ch_.estimated_wheel_speeds(v_est, r, steer, p, ops)
-    active = ch_.abs_activity(wheel_mps, v_refs, mu_est, ch, ops)
+    pressure = ops.fmin(ops.fmax(u[BRAKE_CMD], 0.0), p.max_brake_force_n) / ch.brake_n_per_bar
+    v_rate = ch_.speed_estimate_rate(v_est, ax, wheel_mps, r, steer, pressure, mu_est, p, ch, ops)
+    active = abs_active
     if p.esc_fitted:
         active = ops.fmax(active, ch_.esc_understeer(v_est, r, x[ESC_REF], p, ops))
     accel_g = ops.sqrt(ax * ax + ay * ay) / G_MPS2
@@ -317,6 +330,7 @@ def rhs(x, u, mu, params: VehicleParams, ops) -> list:
     lag = ch_.LOAD_TRANSFER_LAG_S
     fx_tyres = (f.front.fx_n + f.rear.fx_n) / p.mass_kg
     spins = _wheel_rates(x, f, p, ch, ops)
+    actuators, cuts, abs_active = _actuator_rates(x, u, f, spins, p, ch, ops)
     return [
         vx * cos_yaw - vy * sin_yaw,
         vx * sin_yaw + vy * cos_yaw,
@@ -324,14 +338,15 @@ def rhs(x, u, mu, params: VehicleParams, ops) -> list:
         ax + vy * r,  # eq. 4
         ay - vx * r,  # eq. 5
         moment / p.yaw_inertia_kgm2,
-        *_actuator_rates(x, u, f.steer_rad, spins, p, ch, ops),
+        *actuators,
         *spins,
         *slips,
         (fx_tyres - x[AX_LOAD]) / lag,
         (ay - x[AY_LOAD]) / lag,
         esc_rate,
         ref_rate,
-        *_estimate_rates(x, ax, ay, f.steer_rad, p, ch, ops),
+        *_estimate_rates(x, u, (ax, ay), f.steer_rad, abs_active, p, ops),
+        *cuts,
     ]
 
 

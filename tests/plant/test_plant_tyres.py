@@ -63,6 +63,8 @@ def test_casadi_form_of_the_model_equals_the_float_form(params, esc):
         hi.extend([5e3, 1.0])
         lo.extend([0.0, 0.05, -0.3])  # the estimates: speed, friction, sideslip
         hi.extend([45.0, 1.2, 0.3])
+        lo.extend([0.0] * 4)  # the ABS valves' cuts
+        hi.extend([4500.0] * 4)
         xv = rng.uniform(lo, hi)
         uv = rng.uniform([-0.7, 0, 0], [0.7, 7000, 22000])
         muv = rng.uniform(0.1, 1.2)
