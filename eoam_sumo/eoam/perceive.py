@@ -66,20 +66,20 @@ _SLOW_MPS = 1.0
 
 
 def friction_at(parts: Parts, mu: float) -> Friction:
-    """The limit braking force, the deceleration it delivers (the wheels spin down with the
-    car: ``equivalent_mass_kg``) and the DMM boundaries at the sensed friction, B0 and Bb
-    lengthened by as much as the wheel-lock cap (``wheel_lock_limit_n``, no ABS) takes off
-    limit braking on a straight road."""
+    """The limit braking force, the deceleration it delivers and the DMM boundaries at the
+    sensed friction. The command is the tables' limit braking deceleration (whose stopping
+    distance is their B0, eq. 33) times ``equivalent_mass_kg`` (the wheels spin down with the
+    car), so B0 and Bb are the tables' own, lengthened only by as much as the wheel-lock cap
+    (``wheel_lock_limit_n``, no ABS) takes off it on a straight road."""
     if not mu > 0.0:
         raise ValueError(f"friction mu={mu!r} must be > 0")
-    decel = float(parts.tables.max_decel_mps2(mu))
-    brake_limit = parts.settings.limit_brake_fraction * parts.params.mass_kg * decel
-    # straight, slow (no drag): what the wheel-lock cap leaves of eq. 33's limit braking
+    m_eq = equivalent_mass_kg(parts.params)
+    brake_limit = m_eq * float(parts.tables.limit_brake_decel_mps2(mu))
+    # straight, slow (no drag): what the wheel-lock cap leaves of limit braking
     straight = min(brake_limit, parts.longitudinal.wheel_lock_limit_n(_SLOW_MPS, mu, 0.0))
-    delivered = brake_limit / equivalent_mass_kg(parts.params)
     bounds = parts.tables.boundaries
     curve = BoundaryCurve(bounds, mu, bounds.speed_grid_mps, stop_scale=brake_limit / straight)
-    return Friction(mu, brake_limit, delivered, curve)
+    return Friction(mu, brake_limit, brake_limit / m_eq, curve)
 
 
 def track_obstacle(

@@ -119,7 +119,7 @@ def _solve_friction(
         resim = resimulate(sol, params, 0.5 * settings.dx_step_m)
         audit(sol, resim, params, settings)
         v = sol.speed_mps
-        stop = stop_distance_m(v, decel)
+        stop = stop_distance_m(v, settings.limit_brake_fraction * decel)
         clear_opt = clearing_distance_m(
             resim.states[:, 0],
             resim.states[:, 2],

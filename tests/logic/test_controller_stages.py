@@ -66,10 +66,10 @@ def stage_inputs(tables, st_=None, mu=1.0, mode=Mode.NORMAL):
 
 
 def stop_scale(tables, mu):
-    """How much longer limit braking stops than eq. 33 says where the wheel-lock cap binds
+    """How much longer limit braking stops than the tables' B0 says where the wheel-lock cap binds
     (``control.brake_split``: straight, slow, 0.95 of the lock command, no ABS)."""
     p = tables.params
-    eq33 = EoamSettings().limit_brake_fraction * p.mass_kg * tables.max_decel_mps2(mu)
+    eq33 = equivalent_mass_kg(p) * tables.limit_brake_decel_mps2(mu)
     rolling = p.rolling_resistance_coeff * p.mass_kg * 9.81
     drag = 0.5 * AIR_DENSITY_KGPM3 * p.drag_area_m2  # at 1 m/s, as the controller takes it
     lock = wheel_lock_brake_n(p, mu, 0.0, rolling + drag, 0.0, equivalent_mass_kg(p))
