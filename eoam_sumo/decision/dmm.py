@@ -4,7 +4,9 @@ The phase diagram (paper sec. 5-6, Figures 11, 14, 15) places the ego-obstacle p
 relative distance d and relative closing speed v. Its boundaries at v, from the offline
 tables, are the minimum clearing distance with the optimised acceleration profile S (eq. 32),
 its buffered version Sb, the stopping distance B0 (eq. 33), its buffered version Bb, and the
-time-to-collision line T = TTC * v (eq. 34). The sectors are:
+time-to-collision line T = TTC * v (eq. 34). The warning line W = max(T, max(Sb, Bb) +
+``FCW_LEAD_S`` v) is T, moved out where T would warn less than ``FCW_LEAD_S`` before the
+braking or steering begins (at a steady closing speed). The sectors are:
 
 ====== ================================ ============ =========================================
 sector region                           action       meaning
@@ -14,7 +16,7 @@ C      d <= S and d > B0                BRAKE        braking alone still stops i
 F      S < d <= Sb and d <= Bb          STEER        steer (braking would need its buffer)
 B      S < d <= Sb and d > Bb           STEER        steer with the steering buffer
 D      d > Sb and d <= Bb               BRAKE        brake to soften the steer to come
-E      d > Sb, d > Bb and d <= T        FCW          forward-collision warning only
+E      d > Sb, d > Bb and d <= W        FCW          forward-collision warning only
 G      otherwise (or v <= 0)            NONE         nothing to do
 ====== ================================ ============ =========================================
 
@@ -78,6 +80,14 @@ for _sector in Sector:
 NONE, FCW, BRAKE, STEER, LIMIT_BRAKE = Action
 A, B, C, D, E, F, G = Sector
 
+#: The forward-collision warning's least lead over the braking or steering that follows at a
+#: steady closing speed [s]: UN R152 para. 5.2.1.1, the collision warning at the latest 0.8 s
+#: before the start of emergency braking (as secondary sources quote it: docs/protocols.md),
+#: and 0.05 s (5 DMM steps) so that the warning's and the braking's first steps, each
+#: quantised to the step, keep 0.8 s between them. The paper's T = TTC v (eq. 34) alone gives
+#: 0.56-0.74 s at 10-25 km/h of closing speed, where the constant buffers c_s, c_b dominate.
+FCW_LEAD_S = 0.85
+
 #: Sectors in order of increasing distance for a fixed closing speed (A most urgent, G least).
 SECTOR_ORDER = (Sector.A, Sector.C, Sector.F, Sector.B, Sector.D, Sector.E, Sector.G)
 
@@ -90,8 +100,10 @@ def classify(
     stop_m: float,
     stop_buffered_m: float,
     ttc_s: float,
+    warn_lead_s: float = FCW_LEAD_S,
 ) -> Sector:
-    """Sector of the phase point (range, closing speed) given the boundaries at that speed.
+    """Sector of the phase point (range, closing speed) given the boundaries at that speed;
+    the warning line is max(T, max(Sb, Bb) + ``warn_lead_s`` v).
 
     A non-finite range or closing speed, or one that is not closing (v <= 0), is sector G.
     """
@@ -104,7 +116,7 @@ def classify(
         return F if d <= stop_buffered_m else B
     if d <= stop_buffered_m:
         return D
-    if d <= ttc_s * v:
+    if d <= ttc_s * v or d <= max(clear_buffered_m, stop_buffered_m) + warn_lead_s * v:
         return E
     return G
 
