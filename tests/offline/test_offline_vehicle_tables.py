@@ -11,6 +11,7 @@ from eoam_sumo.errors import InputError
 from eoam_sumo.offline.boundaries import max_decel_no_lock_mps2
 from eoam_sumo.offline.braking import abs_decel_mps2, braking_decel_mps2
 from eoam_sumo.offline.build import build_tables
+from eoam_sumo.offline.design import DesignSettings
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir, vehicle_digest
 from eoam_sumo.params import G_MPS2, ego_e_class_sedan
 
@@ -60,7 +61,10 @@ def test_an_abs_build_records_the_vehicle_and_its_abs_braking(abs_tables):
     for mu in (0.3, 1.0):
         assert tables.max_decel_mps2(mu) == pytest.approx(abs_decel_mps2(WITH_ABS, mu))
         row = tables.boundaries.at(mu, 100 / 3.6)
-        assert row.stop_m == pytest.approx((100 / 3.6) ** 2 / (2 * abs_decel_mps2(WITH_ABS, mu)))
+        # B0 at limit braking: the design's share of what the ABS achieves
+        braking = DesignSettings().limit_brake_fraction * abs_decel_mps2(WITH_ABS, mu)
+        assert tables.limit_brake_decel_mps2(mu) == pytest.approx(braking)
+        assert row.stop_m == pytest.approx((100 / 3.6) ** 2 / (2 * braking))
     mid = 0.5 * (abs_decel_mps2(WITH_ABS, 0.3) + abs_decel_mps2(WITH_ABS, 1.0))
     assert tables.max_decel_mps2(0.65) == pytest.approx(mid)
 
