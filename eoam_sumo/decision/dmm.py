@@ -159,9 +159,11 @@ class BoundaryCurve:
     bisection and a linear blend. Above the last speed the last row is used. ``stop_scale``
     (>= 1) lengthens the stopping distance B0 (and Bb by as much) where limit braking
     delivers less than the tables' deceleration (eq. 33: B0 = v^2 / 2a scales with 1 / a).
+    ``lateral_stop_factor`` (>= 1, set at each step) lengthens B0 (and Bb by as much) further
+    where a curve's lateral acceleration takes part of the friction ellipse.
     """
 
-    __slots__ = ("_rows", "_speeds", "mu")
+    __slots__ = ("_rows", "_speeds", "lateral_stop_factor", "mu")
 
     def __init__(self, boundaries, mu: float, speeds_mps, stop_scale: float = 1.0):
         given = sorted({0.0, *(float(v) for v in speeds_mps)})
@@ -187,13 +189,24 @@ class BoundaryCurve:
             rows.append(row)
         self.mu = mu
         self._speeds, self._rows = speeds, rows
+        self.lateral_stop_factor = 1.0
 
     def at(self, rel_speed_mps: float) -> BoundaryRow:
         """The boundaries at a closing speed (held at the ends of the speed range)."""
         return BoundaryRow._make(self._blend(rel_speed_mps))
 
     def _blend(self, rel_speed_mps: float) -> tuple[float, float, float, float, float]:
-        """``at`` as a plain tuple (for ``sector``, at every step with an obstacle in range)."""
+        """``at`` as a plain tuple (for ``sector``, at every step with an obstacle in range),
+        B0 and Bb lengthened by ``lateral_stop_factor``."""
+        row = self._straight(rel_speed_mps)
+        k = self.lateral_stop_factor
+        if k == 1.0:
+            return row
+        longer = row[2] * (k - 1.0)
+        return (row[0], row[1], row[2] + longer, row[3] + longer, row[4])
+
+    def _straight(self, rel_speed_mps: float) -> tuple[float, float, float, float, float]:
+        """The boundaries on a straight road at a closing speed (blended between samples)."""
         speeds = self._speeds
         j = bisect_right(speeds, rel_speed_mps)
         if j <= 0:
