@@ -92,6 +92,14 @@ FCW_LEAD_S = 0.85
 SECTOR_ORDER = (Sector.A, Sector.C, Sector.F, Sector.B, Sector.D, Sector.E, Sector.G)
 
 
+def warning_line_m(
+    rel_speed_mps: float, clear_buffered_m: float, stop_buffered_m: float, ttc_s: float
+) -> float:
+    """The warning line W = max(T, max(Sb, Bb) + ``FCW_LEAD_S`` v) at a closing speed."""
+    v = rel_speed_mps
+    return max(ttc_s * v, max(clear_buffered_m, stop_buffered_m) + FCW_LEAD_S * v)
+
+
 def classify(
     range_m: float,
     rel_speed_mps: float,
