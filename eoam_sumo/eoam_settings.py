@@ -31,7 +31,6 @@ class EoamSettings:
     coasted_margin_m: float = 2.0  # modes 0, 1: a coasted object within the stopping distance
     # plus this brakes (a standstill gap, as adaptive cruise keeps)
     min_steer_speed_mps: float = 20.0 / 3.6  # below it a STEER sector brakes instead
-    limit_brake_fraction: float = 0.95  # share of the no-lock brake force used as limit braking
     limit_brake_floor: float = 0.5  # mode 3 (not arresting): the brake keeps at least this share
     # of the limit, the steering the rest of the friction ellipse (eqs. 25, 28); 0: none
     limit_brake_floor_speed_mps: float = 2.0  # ... above walking speed
@@ -87,8 +86,6 @@ class EoamSettings:
                 raise ValueError(f"EOAM setting {f.name}={v!r} must be finite and >= 0")
         if not 0.0 < self.ponr_fraction < 1.0:
             raise ValueError(f"ponr_fraction={self.ponr_fraction} must be in (0, 1)")
-        if not 0.0 < self.limit_brake_fraction <= 1.0:
-            raise ValueError(f"limit_brake_fraction={self.limit_brake_fraction} must be in (0, 1]")
         for name in (
             "manoeuvre_time_s",
             "reference_step_m",

@@ -294,6 +294,15 @@ class BodyDims:
     width_m: float = _p(1.8, "m", ASSUMED)
 
 
+WHEELS = 4  # the plant's two axles of two wheels, each of ``wheel_inertia_kgm2``
+
+
+def equivalent_mass_kg(params: VehicleParams) -> float:
+    """``m + 4 J_w / r_w^2`` [kg]: the mass a longitudinal force at the road accelerates with
+    the wheels rolling (Gillespie 1992, eq. 2-5, the rotating-inertia mass factor)."""
+    return params.mass_kg + WHEELS * params.wheel_inertia_kgm2 / params.wheel_radius_m**2
+
+
 def ego_e_class_sedan() -> VehicleParams:
     """The paper's ego: E-class sedan, front steer, rear drive, no ABS, no ESC (sec. 4.1)."""
     return VehicleParams()

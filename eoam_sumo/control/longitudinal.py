@@ -27,15 +27,12 @@ from dataclasses import dataclass, fields
 from mypy_extensions import mypyc_attr
 
 from eoam_sumo.control.brake_split import wheel_lock_brake_n
-from eoam_sumo.params import AIR_DENSITY_KGPM3, G_MPS2, VehicleParams
-
-WHEELS = 4  # the plant's two axles of two wheels, each of ``wheel_inertia_kgm2``
-
-
-def equivalent_mass_kg(params: VehicleParams) -> float:
-    """``m + 4 J_w / r_w^2`` [kg]: the mass a longitudinal force at the road accelerates with
-    the wheels rolling (Gillespie 1992, eq. 2-5, the rotating-inertia mass factor)."""
-    return params.mass_kg + WHEELS * params.wheel_inertia_kgm2 / params.wheel_radius_m**2
+from eoam_sumo.params import (
+    AIR_DENSITY_KGPM3,
+    G_MPS2,
+    VehicleParams,
+    equivalent_mass_kg,
+)
 
 
 @mypyc_attr(native_class=False)  # a Python dataclass: pickled, replaced

@@ -4,7 +4,9 @@ The phase diagram (paper sec. 5-6, Figures 11, 14, 15) places the ego-obstacle p
 relative distance d and relative closing speed v. Its boundaries at v, from the offline
 tables, are the minimum clearing distance with the optimised acceleration profile S (eq. 32),
 its buffered version Sb, the stopping distance B0 (eq. 33), its buffered version Bb, and the
-time-to-collision line T = TTC * v (eq. 34). The sectors are:
+time-to-collision line T = TTC * v (eq. 34). The warning line W = max(T, max(Sb, Bb) +
+``FCW_LEAD_S`` v) is T, moved out where T would warn less than ``FCW_LEAD_S`` before the
+braking or steering begins (at a steady closing speed). The sectors are:
 
 ====== ================================ ============ =========================================
 sector region                           action       meaning
@@ -14,7 +16,7 @@ C      d <= S and d > B0                BRAKE        braking alone still stops i
 F      S < d <= Sb and d <= Bb          STEER        steer (braking would need its buffer)
 B      S < d <= Sb and d > Bb           STEER        steer with the steering buffer
 D      d > Sb and d <= Bb               BRAKE        brake to soften the steer to come
-E      d > Sb, d > Bb and d <= T        FCW          forward-collision warning only
+E      d > Sb, d > Bb and d <= W        FCW          forward-collision warning only
 G      otherwise (or v <= 0)            NONE         nothing to do
 ====== ================================ ============ =========================================
 
@@ -78,8 +80,24 @@ for _sector in Sector:
 NONE, FCW, BRAKE, STEER, LIMIT_BRAKE = Action
 A, B, C, D, E, F, G = Sector
 
+#: The forward-collision warning's least lead over the braking or steering that follows at a
+#: steady closing speed [s]: UN R152 para. 5.2.1.1, the collision warning at the latest 0.8 s
+#: before the start of emergency braking (as secondary sources quote it: docs/protocols.md),
+#: and 0.05 s (5 DMM steps) so that the warning's and the braking's first steps, each
+#: quantised to the step, keep 0.8 s between them. The paper's T = TTC v (eq. 34) alone gives
+#: 0.56-0.74 s at 10-25 km/h of closing speed, where the constant buffers c_s, c_b dominate.
+FCW_LEAD_S = 0.85
+
 #: Sectors in order of increasing distance for a fixed closing speed (A most urgent, G least).
 SECTOR_ORDER = (Sector.A, Sector.C, Sector.F, Sector.B, Sector.D, Sector.E, Sector.G)
+
+
+def warning_line_m(
+    rel_speed_mps: float, clear_buffered_m: float, stop_buffered_m: float, ttc_s: float
+) -> float:
+    """The warning line W = max(T, max(Sb, Bb) + ``FCW_LEAD_S`` v) at a closing speed."""
+    v = rel_speed_mps
+    return max(ttc_s * v, max(clear_buffered_m, stop_buffered_m) + FCW_LEAD_S * v)
 
 
 def classify(
@@ -90,8 +108,10 @@ def classify(
     stop_m: float,
     stop_buffered_m: float,
     ttc_s: float,
+    warn_lead_s: float = FCW_LEAD_S,
 ) -> Sector:
-    """Sector of the phase point (range, closing speed) given the boundaries at that speed.
+    """Sector of the phase point (range, closing speed) given the boundaries at that speed;
+    the warning line is max(T, max(Sb, Bb) + ``warn_lead_s`` v).
 
     A non-finite range or closing speed, or one that is not closing (v <= 0), is sector G.
     """
@@ -104,7 +124,7 @@ def classify(
         return F if d <= stop_buffered_m else B
     if d <= stop_buffered_m:
         return D
-    if d <= ttc_s * v:
+    if d <= ttc_s * v or d <= max(clear_buffered_m, stop_buffered_m) + warn_lead_s * v:
         return E
     return G
 
@@ -147,9 +167,11 @@ class BoundaryCurve:
     bisection and a linear blend. Above the last speed the last row is used. ``stop_scale``
     (>= 1) lengthens the stopping distance B0 (and Bb by as much) where limit braking
     delivers less than the tables' deceleration (eq. 33: B0 = v^2 / 2a scales with 1 / a).
+    ``lateral_stop_factor`` (>= 1, set at each step) lengthens B0 (and Bb by as much) further
+    where a curve's lateral acceleration takes part of the friction ellipse.
     """
 
-    __slots__ = ("_rows", "_speeds", "mu")
+    __slots__ = ("_rows", "_speeds", "lateral_stop_factor", "mu")
 
     def __init__(self, boundaries, mu: float, speeds_mps, stop_scale: float = 1.0):
         given = sorted({0.0, *(float(v) for v in speeds_mps)})
@@ -175,13 +197,24 @@ class BoundaryCurve:
             rows.append(row)
         self.mu = mu
         self._speeds, self._rows = speeds, rows
+        self.lateral_stop_factor = 1.0
 
     def at(self, rel_speed_mps: float) -> BoundaryRow:
         """The boundaries at a closing speed (held at the ends of the speed range)."""
         return BoundaryRow._make(self._blend(rel_speed_mps))
 
     def _blend(self, rel_speed_mps: float) -> tuple[float, float, float, float, float]:
-        """``at`` as a plain tuple (for ``sector``, at every step with an obstacle in range)."""
+        """``at`` as a plain tuple (for ``sector``, at every step with an obstacle in range),
+        B0 and Bb lengthened by ``lateral_stop_factor``."""
+        row = self._straight(rel_speed_mps)
+        k = self.lateral_stop_factor
+        if k == 1.0:
+            return row
+        longer = row[2] * (k - 1.0)
+        return (row[0], row[1], row[2] + longer, row[3] + longer, row[4])
+
+    def _straight(self, rel_speed_mps: float) -> tuple[float, float, float, float, float]:
+        """The boundaries on a straight road at a closing speed (blended between samples)."""
         speeds = self._speeds
         j = bisect_right(speeds, rel_speed_mps)
         if j <= 0:

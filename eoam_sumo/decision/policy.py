@@ -531,7 +531,7 @@ class SafePolicy:
             self.tie_break = self.tie_break or "continue"
             return False
         dv_on = head_on_delta_v_mps(closing)
-        decel = self.eoam.limit_brake_fraction * float(self.tables.max_decel_mps2(mu))
+        decel = float(self.tables.limit_brake_decel_mps2(mu))
         if escape_time_s(out_m, mu) >= t_meet:
             dv_brake = head_on_delta_v_mps(closing - decel * t_meet)
         else:

@@ -30,6 +30,7 @@ def perceive(
     check_measurement(state, meas)
     if state.friction is None or meas.mu != state.friction.mu:
         state.friction = friction_at(parts, meas.mu)
+    state.friction.curve.lateral_stop_factor = curve_stop_factor(parts, state, meas)
     rng = perception.aro_range_m
     rate = perception.aro_range_rate_mps
     sensed: float | None = None
@@ -66,20 +67,55 @@ _SLOW_MPS = 1.0
 
 
 def friction_at(parts: Parts, mu: float) -> Friction:
-    """The limit braking force, the deceleration it delivers (the wheels spin down with the
-    car: ``equivalent_mass_kg``) and the DMM boundaries at the sensed friction, B0 and Bb
-    lengthened by as much as the wheel-lock cap (``wheel_lock_limit_n``, no ABS) takes off
-    limit braking on a straight road."""
+    """The limit braking force, the deceleration it delivers and the DMM boundaries at the
+    sensed friction. The command is the tables' limit braking deceleration (whose stopping
+    distance is their B0, eq. 33) times ``equivalent_mass_kg`` (the wheels spin down with the
+    car), so B0 and Bb are the tables' own, lengthened only by as much as the wheel-lock cap
+    (``wheel_lock_limit_n``, no ABS) takes off it on a straight road."""
     if not mu > 0.0:
         raise ValueError(f"friction mu={mu!r} must be > 0")
-    decel = float(parts.tables.max_decel_mps2(mu))
-    brake_limit = parts.settings.limit_brake_fraction * parts.params.mass_kg * decel
-    # straight, slow (no drag): what the wheel-lock cap leaves of eq. 33's limit braking
+    m_eq = equivalent_mass_kg(parts.params)
+    brake_limit = m_eq * float(parts.tables.limit_brake_decel_mps2(mu))
+    # straight, slow (no drag): what the wheel-lock cap leaves of limit braking
     straight = min(brake_limit, parts.longitudinal.wheel_lock_limit_n(_SLOW_MPS, mu, 0.0))
-    delivered = brake_limit / equivalent_mass_kg(parts.params)
     bounds = parts.tables.boundaries
     curve = BoundaryCurve(bounds, mu, bounds.speed_grid_mps, stop_scale=brake_limit / straight)
-    return Friction(mu, brake_limit, delivered, curve)
+    return Friction(mu, brake_limit, brake_limit / m_eq, curve)
+
+
+#: Below this lateral acceleration of the road's curve the boundaries stay a straight road's
+#: [m/s^2] (a 6 km radius at 20 m/s; the ellipse then costs under 0.1 % of the braking).
+_CURVE_MIN_MPS2 = 0.05
+#: Midpoints in v^2 of the stopping integral on a curve; the factor's cap (a curve taking the
+#: whole ellipse leaves no braking: the boundaries are then far beyond any range).
+_CURVE_SAMPLES = 8
+_CURVE_FACTOR_CAP = 10.0
+
+
+def curve_stop_factor(parts: Parts, state: ControllerState, meas: EgoMeasurement) -> float:
+    """How much longer limit braking stops on the road's curve than on a straight road, from
+    the ego's speed V to a standstill following the curve (curvature k): the brake limit the
+    longitudinal stage applies (``LongitudinalController.limits``: the friction ellipse at
+    the lateral acceleration k v^2 and, without ABS, the wheel-lock cap) integrated as
+    s = 1/2 int_0^{V^2} m_eq / F(v) d(v^2), against the same at k = 0 (paper eqs. 25, 28's
+    ellipse; eq. 33 on a straight road). For a moving obstacle it is the same ratio (the ego
+    slows less, so its lateral acceleration stays higher: a slight underestimate)."""
+    kappa = abs(meas.road_curvature_1pm)
+    v2 = meas.vx_mps * meas.vx_mps
+    if kappa * v2 < _CURVE_MIN_MPS2:
+        return 1.0
+    limit_n = state.friction_now().brake_limit_n
+    limits, mu = parts.longitudinal.limits, meas.mu
+    curve_s = straight_s = 0.0
+    for k in range(_CURVE_SAMPLES):
+        u = (k + 0.5) / _CURVE_SAMPLES * v2
+        speed = math.sqrt(u)
+        brake_n = limits(speed, mu, kappa * u, limit_n)[1]
+        if not brake_n > 0.0:
+            return _CURVE_FACTOR_CAP
+        curve_s += 1.0 / brake_n
+        straight_s += 1.0 / limits(speed, mu, 0.0, limit_n)[1]
+    return min(max(curve_s / straight_s, 1.0), _CURVE_FACTOR_CAP)
 
 
 def track_obstacle(

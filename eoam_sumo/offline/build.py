@@ -34,9 +34,8 @@ from eoam_sumo.offline.boundaries import (
     constant_speed_clearing_distance_m,
     steer_buffered_m,
     stop_buffered_m,
-    stop_distance_m,
 )
-from eoam_sumo.offline.braking import braking_decel_mps2, braking_model
+from eoam_sumo.offline.braking import braking_decel_mps2, braking_model, braking_stop_m
 from eoam_sumo.offline.design import DesignSettings
 from eoam_sumo.offline.ocp import LaneChangeOcp, solve_chain, solver_options
 from eoam_sumo.offline.resim import Resimulation, audit, resimulate
@@ -119,7 +118,7 @@ def _solve_friction(
         resim = resimulate(sol, params, 0.5 * settings.dx_step_m)
         audit(sol, resim, params, settings)
         v = sol.speed_mps
-        stop = stop_distance_m(v, decel)
+        stop = braking_stop_m(params, mu, v, settings.limit_brake_fraction)
         clear_opt = clearing_distance_m(
             resim.states[:, 0],
             resim.states[:, 2],

@@ -155,6 +155,14 @@ class DesignSettings:
         0.3, "s", DESIGN + ": DMM step + brake build-up (lag 0.1 s, about 3 time constants)"
     )
     brake_buffer_m: float = _p(2.0, "m", DESIGN + ": stop about 2 m short of the obstacle")
+    limit_brake_fraction: float = _p(
+        0.95,
+        "-",
+        DESIGN + ": limit braking's deceleration as a share of eq. 33's (its tyre force 5 % "
+        "below the no-lock limit or the ABS's mean deceleration); the EOAM commands it "
+        "(m_eq times it, the wheels spinning down with the car) and B0 (eq. 33) is its "
+        "stopping distance",
+    )
     ttc_mus: tuple = _p((0.1, 0.3, 0.7, 1.0), "-", PAPER + ", sec. 6.2")
     ttc_values_s: tuple = _p(
         (20.0, 5.0, 2.5, 2.5), "s", PAPER + ", sec. 6.2 (linear in mu between, clamped outside)"
@@ -230,6 +238,10 @@ class DesignSettings:
             v = getattr(self, name)
             if not (isinstance(v, int) and v >= 1):
                 raise ValueError(f"design setting {name}={v!r} must be an integer >= 1")
+        if not 0.0 < self.limit_brake_fraction <= 1.0:
+            raise ValueError(
+                f"limit_brake_fraction={self.limit_brake_fraction!r} must be in (0, 1]"
+            )
         if not (math.isfinite(self.chain_step_kmh) and self.chain_step_kmh > 0.0):
             raise ValueError(f"chain_step_kmh={self.chain_step_kmh!r} must be finite and > 0")
         if not (isinstance(self.speed_halvings, int) and self.speed_halvings >= 0):

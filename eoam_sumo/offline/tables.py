@@ -224,6 +224,9 @@ class LookupTables:
         braking = metadata.get("braking", {})
         self._braking_mus = [float(m) for m in braking.get("mu", [])]
         self._braking_decels = [float(a) for a in braking.get("decel_mps2", [])]
+        # tables from before the setting: B0 at eq. 33's deceleration itself
+        share = metadata.get("design", {}).get("limit_brake_fraction", {}).get("value", 1.0)
+        self.limit_brake_fraction = float(share)
 
     @classmethod
     def load(cls, directory=None, params: VehicleParams | None = None) -> LookupTables:
@@ -329,6 +332,11 @@ class LookupTables:
             return max_decel_no_lock_mps2(self.params, mu)
         i, j, w = _bracket(self._braking_mus, mu)
         return self._braking_decels[i] + w * (self._braking_decels[j] - self._braking_decels[i])
+
+    def limit_brake_decel_mps2(self, mu: float) -> float:
+        """The deceleration of limit braking, whose stopping distance is the tables' B0: the
+        design's ``limit_brake_fraction`` of eq. 33's (``max_decel_mps2``)."""
+        return self.limit_brake_fraction * self.max_decel_mps2(mu)
 
     def trajectory(self, mu: float, speed_mps: float) -> Trajectory:
         """The manoeuvre reference for this friction and entry speed (bilinear blend, once)."""

@@ -13,7 +13,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 
-from eoam_sumo.decision.dmm import Sector, dmm_sector
+from eoam_sumo.decision.dmm import FCW_LEAD_S, Sector, dmm_sector, warning_line_m
 from eoam_sumo.offline.tables import NPZ_NAME, PhaseBoundaries
 
 _SECTORS = (Sector.A, Sector.B, Sector.C, Sector.D, Sector.E, Sector.F, Sector.G)
@@ -88,6 +88,17 @@ def _draw_curves(ax, rows: list, speeds: np.ndarray, kmh: np.ndarray) -> None:
         color="#455a64",
         lw=1.4,
         label=f"TTC = {rows[-1].ttc_s:g} s (eq. 34)",
+    )
+    ax.plot(
+        [
+            warning_line_m(v, b.clear_buffered_m, b.stop_buffered_m, b.ttc_s)
+            for b, v in zip(rows, speeds)
+        ],
+        kmh,
+        "-",
+        color="#455a64",
+        lw=0.9,
+        label=f"W: warning line (T, or {FCW_LEAD_S:g} s before Sb, Bb)",
     )
 
 

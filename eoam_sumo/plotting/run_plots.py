@@ -27,6 +27,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from eoam_sumo.batch.report import mu_text
+from eoam_sumo.decision.dmm import FCW_LEAD_S, warning_line_m
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import G_MPS2, ego_e_class_sedan
 from eoam_sumo.plotting.figures import save
@@ -422,6 +423,18 @@ def _draw_boundaries(ax, bounds: list, vs: np.ndarray) -> None:
         )
     ttc = np.array([b.ttc_s for b in bounds])
     ax.plot(vs, ttc * vs, ":", color="#6d4c41", linewidth=1.4, label=f"T: TTC line ({ttc[-1]:g} s)")
+    warn = [
+        warning_line_m(v, b.clear_buffered_m, b.stop_buffered_m, b.ttc_s)
+        for b, v in zip(bounds, vs)
+    ]
+    ax.plot(
+        vs,
+        warn,
+        "-",
+        color="#6d4c41",
+        linewidth=0.9,
+        label=f"W: warning line ({FCW_LEAD_S:g} s lead)",
+    )
 
 
 def _draw_trace(ax, seen: pd.DataFrame, closing: pd.Series) -> None:

@@ -11,6 +11,8 @@ import math
 import pytest
 
 from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, Perception
+from eoam_sumo.eoam.parts import build_parts
+from eoam_sumo.eoam.perceive import friction_at
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import AIR_DENSITY_KGPM3, aro_d_class_minivan, ego_e_class_sedan
 from eoam_sumo.plant import OUTPUT_NAMES, Plant, initial_state
@@ -152,10 +154,16 @@ def test_lane_change_120kmh_snow(tables, plant):
 
 
 def test_braking_stops_behind_the_obstacle(tables, plant):
-    """80 km/h on snow (mu 0.3), seen at 100 m: sector D brakes; steering sectors met later
-    while braking still stops short (d > B0) do not start a lane change: a stop behind it."""
-    speed, mu, rear = 80 / 3.6, 0.3, 140.0
-    log, ctrl = simulate(tables, plant, speed, mu, rear, 100.0, seconds=15.0)
+    """80 km/h on snow (mu 0.3), seen 2 m inside the DMM's buffered braking boundary Bb (at
+    the braking the EOAM commands, 110 m): sector D brakes; steering sectors met later while
+    braking still stops short (d > B0) do not start a lane change: a stop behind it. (Seen
+    at 100 m, inside B0 = 104 m, limit braking stops 0.06 m short, without its buffer: the
+    DMM then rightly steers.)"""
+    speed, mu, rear = 80 / 3.6, 0.3, 150.0
+    curve = friction_at(build_parts(P, tables, EoamSettings()), mu).curve
+    detect = curve.at(speed).stop_buffered_m - 2.0
+    assert curve.at(speed).clear_buffered_m < detect < 112.0
+    log, ctrl = simulate(tables, plant, speed, mu, rear, detect, seconds=15.0)
     assert not any(r["hit"] for r in log), "the ego hit the obstacle"
     assert ctrl.modes_visited == [0, 1] and ctrl.fcw_raised
     sectors = {r["cmd"].sector for r in log}
@@ -168,7 +176,7 @@ def test_braking_stops_behind_the_obstacle(tables, plant):
     assert not any(r["locked"] for r in log if r["vx"] > 0.5)
     # limit braking: the share of the no-lock deceleration (plus drag), never beyond it
     a_lim = tables.max_decel_mps2(mu)
-    share = EoamSettings().limit_brake_fraction
+    share = tables.limit_brake_fraction
     braking = [r["ax"] for r in log if r["mode"] == 1 and r["vx"] > 3.0]
     assert min(braking) >= -(a_lim + 0.1)
     assert sorted(braking)[len(braking) // 2] == pytest.approx(-share * a_lim, abs=0.15)

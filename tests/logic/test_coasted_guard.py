@@ -3,7 +3,6 @@ keeps the EOAM braking: no hand-back to NORMAL, no speeding up (docs/sensing.md)
 
 import pytest
 
-from eoam_sumo.control import equivalent_mass_kg
 from eoam_sumo.decision import Mode
 from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, Perception
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
@@ -22,8 +21,7 @@ def tables():
 def stopping_m(tables, v_mps: float) -> float:
     """The ego's limit-braking stopping distance (the brake limit the EOAM uses, on the car
     and its spinning wheels)."""
-    decel = EoamSettings().limit_brake_fraction * float(tables.max_decel_mps2(MU))
-    decel *= P.mass_kg / equivalent_mass_kg(P)
+    decel = float(tables.limit_brake_decel_mps2(MU))
     return v_mps * v_mps / (2.0 * decel)
 
 

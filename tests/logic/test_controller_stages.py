@@ -16,7 +16,7 @@ from eoam_sumo.decision.policy import PolicySettings, SafePolicy
 from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, Perception
 from eoam_sumo.eoam.decide import decide, sector_action
 from eoam_sumo.eoam.parts import build_parts
-from eoam_sumo.eoam.perceive import friction_at
+from eoam_sumo.eoam.perceive import curve_stop_factor, friction_at
 from eoam_sumo.eoam.state import ControllerState, Decision, Situation
 from eoam_sumo.eoam.strategies import (
     ArrestFirst,
@@ -36,6 +36,7 @@ from eoam_sumo.eoam.strategies import (
 from eoam_sumo.eoam.transitions import advance_mode
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import AIR_DENSITY_KGPM3, PONR_FRACTION, ego_e_class_sedan
+from eoam_sumo.sim.vehicle import vehicle_tables
 
 P = ego_e_class_sedan()
 LANE = 3.5
@@ -66,10 +67,10 @@ def stage_inputs(tables, st_=None, mu=1.0, mode=Mode.NORMAL):
 
 
 def stop_scale(tables, mu):
-    """How much longer limit braking stops than eq. 33 says where the wheel-lock cap binds
+    """How much longer limit braking stops than the tables' B0 says where the wheel-lock cap binds
     (``control.brake_split``: straight, slow, 0.95 of the lock command, no ABS)."""
     p = tables.params
-    eq33 = EoamSettings().limit_brake_fraction * p.mass_kg * tables.max_decel_mps2(mu)
+    eq33 = equivalent_mass_kg(p) * tables.limit_brake_decel_mps2(mu)
     rolling = p.rolling_resistance_coeff * p.mass_kg * 9.81
     drag = 0.5 * AIR_DENSITY_KGPM3 * p.drag_area_m2  # at 1 m/s, as the controller takes it
     lock = wheel_lock_brake_n(p, mu, 0.0, rolling + drag, 0.0, equivalent_mass_kg(p))
@@ -237,3 +238,45 @@ def test_reset_starts_a_new_state_and_the_properties_read_it(tables):
     assert ctrl.state is not before and ctrl.mode is Mode.NORMAL
     assert ctrl.modes_visited == [0] and not ctrl.fcw_raised and ctrl.sector == ""
     assert math.isfinite(ctrl.state.initial_speed_mps)
+
+
+def _curve_factor(tables, params, kappa_1pm, speed_mps, mu=1.0):
+    parts = build_parts(params, tables, EoamSettings())
+    state = ControllerState(ObstacleDecel(), speed_mps)
+    state.friction = friction_at(parts, mu)
+    meas = EgoMeasurement(0.0, speed_mps, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, kappa_1pm, mu, LANE)
+    return curve_stop_factor(parts, state, meas)
+
+
+def test_on_a_curve_the_stopping_distance_grows_by_what_the_ellipse_takes():
+    """With ABS (no wheel-lock cap) the brake limit on a curve of curvature k is the straight
+    one times sqrt(1 - q^2), q = 1.1 k v^2 / (mu g) (``ellipse_margin``): stopping from V
+    following the curve, s = int v dv / a(v) = B0 arcsin(x) / x with x = q(V)."""
+    abs_params = replace(P, abs_fitted=True)
+    abs_tables = vehicle_tables("sedan", abs_params)
+    v, mu = 130 / 3.6, 1.0
+    for radius in (600.0, 300.0):
+        x = LongitudinalGains().ellipse_margin * v * v / radius / (mu * 9.81)
+        factor = _curve_factor(abs_tables, abs_params, 1.0 / radius, v, mu)
+        assert factor == pytest.approx(math.asin(x) / x, rel=2e-3)
+    assert _curve_factor(abs_tables, abs_params, 0.0, v, mu) == 1.0
+
+
+def test_without_abs_the_curve_factor_also_carries_the_wheel_lock_cap(tables):
+    """Without ABS the inner wheels' lock (lateral load transfer) cuts the brake further on a
+    curve: the factor is above the ellipse's alone, grows with the curvature, is 1 on a
+    straight road (either turning direction the same), and on this 600 m curve at 130 km/h
+    lengthens B0 by 7 % (6.3 m at 84 m), more than the 4.5 m a straight road's boundary left."""
+    v = 130 / 3.6
+    x = LongitudinalGains().ellipse_margin * v * v / 600.0 / 9.81
+    f600 = _curve_factor(tables, P, 1.0 / 600.0, v)
+    assert f600 > math.asin(x) / x
+    assert _curve_factor(tables, P, -1.0 / 600.0, v) == f600
+    assert (
+        1.0
+        < _curve_factor(tables, P, 1.0 / 2000.0, v)
+        < f600
+        < _curve_factor(tables, P, 1.0 / 400.0, v)
+    )
+    assert _curve_factor(tables, P, 0.0, v) == 1.0
+    assert 1.05 < f600 < 1.10

@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from eoam_sumo.decision import SECTOR_ORDER, Action, BoundaryCurve, Sector, classify, dmm_sector
+from eoam_sumo.decision.dmm import FCW_LEAD_S
 
 # S, Sb, B0, Bb, ttc at some closing speed: steering needs less than braking (high speed)
 HIGH = {
@@ -42,7 +43,26 @@ LOW = {
     ],
 )
 def test_each_sector_region(bounds, range_m, speed, sector):
-    assert classify(range_m, speed, **bounds) is sector
+    """The paper's rules (Figure 14): the warning line is T alone."""
+    assert classify(range_m, speed, **bounds, warn_lead_s=0.0) is sector
+
+
+@pytest.mark.parametrize(
+    ("bounds", "speed", "last_e_m"),
+    [
+        (HIGH, 35.0, 70.0 + FCW_LEAD_S * 35.0),  # Bb + 0.85 s v = 99.75 m beyond T = 87.5 m
+        (LOW, 10.0, 25.0 + FCW_LEAD_S * 10.0),  # Sb + 0.85 s v = 33.5 m beyond T = 25 m
+        (dict(LOW, ttc_s=5.0), 10.0, 50.0),  # T = 50 m already leads Sb by 2.5 s
+    ],
+)
+def test_the_warning_leads_the_braking_or_steering_by_fcw_lead_s(bounds, speed, last_e_m):
+    """W = max(T, max(Sb, Bb) + FCW_LEAD_S v): at a steady closing speed the FCW comes at
+    least 0.8 s before sector D, B or F (UN R152 para. 5.2.1.1), with a margin."""
+    assert FCW_LEAD_S >= 0.8
+    assert classify(last_e_m, speed, **bounds) is Sector.E
+    assert classify(last_e_m + 0.01, speed, **bounds) is Sector.G
+    edge = max(bounds["clear_buffered_m"], bounds["stop_buffered_m"])
+    assert (last_e_m - edge) / speed >= FCW_LEAD_S - 1e-12
 
 
 def test_fcw_band_and_boundaries_inclusive():

@@ -8,11 +8,11 @@ import math
 
 import pytest
 
-from eoam_sumo.control import SteeringController
+from eoam_sumo.control import SteeringController, equivalent_mass_kg
 from eoam_sumo.decision import Mode
 from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, ObjectState, Perception
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
-from eoam_sumo.params import ego_e_class_sedan
+from eoam_sumo.params import AIR_DENSITY_KGPM3, ego_e_class_sedan
 
 P = ego_e_class_sedan()
 DT = 0.01
@@ -120,8 +120,13 @@ def test_0_to_1_on_braking_sectors(tables, sector):
     assert cmd.sector == sector and drive.mode is Mode.UPDATE_BRAKE and cmd.fcw
     # pure braking at the no-lock limit, no drive
     assert cmd.drive_force_cmd_n == 0.0
-    share = EoamSettings().limit_brake_fraction
-    assert cmd.brake_force_cmd_n == pytest.approx(share * P.mass_kg * tables.max_decel_mps2(1.0))
+    # the tables' limit braking (B0's deceleration) on the car and its spinning wheels, less
+    # at most the drag and rolling resistance where the wheel-lock cap takes them off
+    limit = equivalent_mass_kg(P) * tables.limit_brake_decel_mps2(1.0)
+    assert limit == pytest.approx(0.95 * equivalent_mass_kg(P) * tables.max_decel_mps2(1.0))
+    rolling = P.rolling_resistance_coeff * P.mass_kg * 9.81
+    resistance = rolling + 0.5 * AIR_DENSITY_KGPM3 * P.drag_area_m2 * v * v
+    assert limit - resistance <= cmd.brake_force_cmd_n <= limit + 1e-6
 
 
 @pytest.mark.parametrize("sector", ["F", "B"])

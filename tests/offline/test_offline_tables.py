@@ -68,11 +68,13 @@ def test_committed_grid_is_the_default_grid():
 
 
 def test_stopping_distance_is_eq_33_and_above_the_friction_floor():
+    """B0 is eq. 33 at limit braking's deceleration, the design's share of the no-lock one."""
     for (mu, kmh), r in ROWS.items():
         v = kmh / 3.6
         decel = max_decel_no_lock_mps2(P, mu)
         assert r["max_decel_mps2"] == pytest.approx(decel, abs=1e-4)
-        assert r["stop_distance_m"] == pytest.approx(v * v / (2 * decel), abs=2e-4)
+        braking = S.limit_brake_fraction * decel
+        assert r["stop_distance_m"] == pytest.approx(v * v / (2 * braking), abs=2e-4)
         assert r["stop_distance_m"] >= v * v / (2 * mu * G_MPS2)
 
 
@@ -245,11 +247,11 @@ def test_missing_or_broken_tables_are_input_errors(tmp_path):
 @pytest.mark.parametrize("mu", [1.0, 0.7, 0.3, 0.1])
 @pytest.mark.parametrize("kmh", [5.0, 10.0, 15.0, 19.0])
 def test_braking_boundaries_below_the_grid_are_the_closed_form(tables, mu, kmh):
-    """Below 20 km/h of closing speed: B0 = v^2 / (2 a) (eq. 33) with the csv's deceleration
-    at this mu, Bb = B0 + t_b v + c_b (sec. 6.2) with the design's buffers; the DMM's curve
-    agrees."""
+    """Below 20 km/h of closing speed: B0 = v^2 / (2 a) (eq. 33) with limit braking's share of
+    the csv's deceleration at this mu, Bb = B0 + t_b v + c_b (sec. 6.2) with the design's
+    buffers; the DMM's curve agrees."""
     v = kmh / 3.6
-    stop = v * v / (2.0 * ROWS[(mu, 20.0)]["max_decel_mps2"])
+    stop = v * v / (2.0 * S.limit_brake_fraction * ROWS[(mu, 20.0)]["max_decel_mps2"])
     buffered = stop + S.brake_buffer_time_s * v + S.brake_buffer_m
     got = tables.boundaries.at(mu, v)
     assert got.stop_m == pytest.approx(stop, rel=1e-3)

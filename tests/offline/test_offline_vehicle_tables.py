@@ -9,8 +9,9 @@ import pytest
 from eoam_sumo.cli import main
 from eoam_sumo.errors import InputError
 from eoam_sumo.offline.boundaries import max_decel_no_lock_mps2
-from eoam_sumo.offline.braking import abs_decel_mps2, braking_decel_mps2
+from eoam_sumo.offline.braking import abs_decel_mps2, braking_decel_mps2, limit_braking_stop_m
 from eoam_sumo.offline.build import build_tables
+from eoam_sumo.offline.design import DesignSettings
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir, vehicle_digest
 from eoam_sumo.params import G_MPS2, ego_e_class_sedan
 
@@ -23,7 +24,15 @@ def test_without_abs_the_braking_limit_is_the_no_lock_limit():
         assert braking_decel_mps2(P, mu) == max_decel_no_lock_mps2(P, mu)
 
 
-@pytest.mark.parametrize("mu", [1.0, 0.3, 0.1])
+ICE_ABS = pytest.mark.xfail(
+    strict=True,
+    reason="ABS on its speed estimate: on mu 0.1 the estimate's error (1.5 % of the speed) "
+    "exceeds the tyre's peak slip (1.3 %); its deceleration 0.83 m/s^2 is below the fixed "
+    "split's constant-friction no-lock limit (docs/chassis.md, what the control unit knows)",
+)
+
+
+@pytest.mark.parametrize("mu", [1.0, 0.3, pytest.param(0.1, marks=ICE_ABS)])
 def test_with_abs_the_braking_limit_is_near_the_friction_and_above_no_lock(mu):
     decel = braking_decel_mps2(WITH_ABS, mu)
     assert decel == abs_decel_mps2(WITH_ABS, mu)
@@ -52,8 +61,16 @@ def test_an_abs_build_records_the_vehicle_and_its_abs_braking(abs_tables):
     for mu in (0.3, 1.0):
         assert tables.max_decel_mps2(mu) == pytest.approx(abs_decel_mps2(WITH_ABS, mu))
         row = tables.boundaries.at(mu, 100 / 3.6)
-        stop_m = (100 / 3.6) ** 2 / (2 * abs_decel_mps2(WITH_ABS, mu))
-        assert row.stop_m == pytest.approx(stop_m, abs=5.1e-5)  # the CSV's 4 decimals
+        # B0 at limit braking: what the plant needs to stop under the command (the design's
+        # share of what the ABS achieves), less the brake's build-up; never below the
+        # closed form
+        share = DesignSettings().limit_brake_fraction
+        braking = share * abs_decel_mps2(WITH_ABS, mu)
+        assert tables.limit_brake_decel_mps2(mu) == pytest.approx(braking)
+        closed = (100 / 3.6) ** 2 / (2 * braking)
+        simulated = limit_braking_stop_m(WITH_ABS, mu, 100 / 3.6, share)
+        assert row.stop_m == pytest.approx(simulated, abs=2e-4)
+        assert closed <= simulated <= 1.1 * closed
     mid = 0.5 * (abs_decel_mps2(WITH_ABS, 0.3) + abs_decel_mps2(WITH_ABS, 1.0))
     assert tables.max_decel_mps2(0.65) == pytest.approx(mid)
 
@@ -99,3 +116,17 @@ def test_tables_command_refuses_an_unknown_vehicle_in_one_line(tmp_path, capsys)
     err = capsys.readouterr().err
     assert status == 2 and "no-such-car" in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "t").exists()
+
+
+def test_with_abs_the_stop_is_the_plants_under_the_command_per_speed_and_friction():
+    """With ABS, B0 is the plant's stop from v under the EOAM's command (m_eq x 0.95 x the
+    100 km/h ABS deceleration), less the brake's 0.1 s build-up: on mu 0.3 at 55 km/h 7 %
+    beyond the closed form of the 100 km/h figure (measured 1.071: the one figure
+    overpromised there), on mu 0.7 within 0.5 %; at walking pace the closed form."""
+    share = 0.95
+    for mu, kmh, low, high in ((0.3, 55.0, 1.04, 1.10), (0.7, 55.0, 1.0, 1.005)):
+        v = kmh / 3.6
+        closed = v * v / (2 * share * abs_decel_mps2(WITH_ABS, mu))
+        assert low * closed <= limit_braking_stop_m(WITH_ABS, mu, v, share) <= high * closed
+    no_abs = limit_braking_stop_m(WITH_ABS, 0.3, 0.5, share)  # walking pace: the closed form
+    assert no_abs == pytest.approx(0.25 / (2 * share * abs_decel_mps2(WITH_ABS, 0.3)))

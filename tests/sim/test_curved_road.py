@@ -161,3 +161,55 @@ def test_a_straight_edge_then_a_curve_keeps_the_lane_centre(tmp_path):
     ts = pd.read_csv(out / "timeseries.csv")
     assert ts["s_m"].iloc[-1] > 1300.0  # well into the curve
     assert ts["lateral_offset_m"].abs().max() < 0.15
+
+
+def _arc(radius_m: float, length_m: float, reverse: bool = False) -> str:
+    n = math.ceil(length_m / 20.0)
+    xy = [
+        (radius_m * math.sin(s / radius_m), radius_m * (1 - math.cos(s / radius_m)))
+        for s in (length_m * k / n for k in range(n + 1))
+    ]
+    return " ".join(f"{x:.3f},{y:.3f}" for x, y in (reversed(xy) if reverse else xy))
+
+
+def test_a_queue_on_a_600_m_curve_at_130_kmh_is_stopped_for(tmp_path):
+    """A 600 m left curve at 130 km/h on mu 1.0, a car halted in the ego's lane and one beside
+    it in the opposite lane (no lane to change into): first seen at the radar's 100 m, which
+    is inside the curve's braking boundary (the lateral 2.2 m/s^2 takes part of the friction
+    ellipse and, without ABS, the inner wheels lock sooner: B0 x 1.07). The ego brakes at
+    once and stops short; with the straight road's boundaries it braked 3 m later and hit at
+    2.5 m/s."""
+    radius, length, pos = 600.0, 1000.0, 600.0
+    end = (radius * math.sin(length / radius), radius * (1 - math.cos(length / radius)))
+    network(
+        tmp_path,
+        "arc",
+        f'<nodes><node id="a" x="0" y="0"/><node id="b" x="{end[0]:.3f}" y="{end[1]:.3f}"/>'
+        "</nodes>",
+        f'<edges><edge id="fwd" from="a" to="b" numLanes="1" speed="50" width="3.5" '
+        f'shape="{_arc(radius, length)}"><lane index="0"><neigh lane="bwd_0"/></lane></edge>'
+        f'<edge id="bwd" from="b" to="a" numLanes="1" speed="50" width="3.5" '
+        f'shape="{_arc(radius, length, True)}"><lane index="0"><neigh lane="fwd_0"/></lane>'
+        "</edge></edges>",
+    )
+    (tmp_path / "arc.rou.xml").write_text(
+        f'<routes><vType id="car" length="4.6" width="1.8" decel="9" sigma="0"/>'
+        f'<vehicle id="stalled" type="car" depart="0" departPos="{pos}" departSpeed="0">'
+        f'<route edges="fwd"/><stop lane="fwd_0" endPos="{pos + 5}" duration="1000"/></vehicle>'
+        f'<vehicle id="beside" type="car" depart="0" departPos="{length - pos - 5}" '
+        f'departSpeed="0"><route edges="bwd"/>'
+        f'<stop lane="bwd_0" endPos="{length - pos}" duration="1000"/></vehicle>'
+        '<vehicle id="ego" type="car" depart="0" departPos="100" departSpeed="30">'
+        '<route edges="fwd"/></vehicle></routes>'
+    )
+    cfg = write_sumocfg(tmp_path / "arc.sumocfg", "arc.net.xml", "arc.rou.xml")
+    summary = run_case(
+        cfg,
+        ScenarioOverrides(ego_speed_mps=130 / 3.6, mu=1.0),
+        tmp_path / "run",
+        RunSettings(max_time_s=20.0),
+    )
+    assert summary["collision_with"] == "none", summary["reason"]
+    assert summary["min_gap_aro_m"] > 0.3
+    assert summary["modes_visited"][:2] == [0, 1]
+    assert summary["trigger_range_m"] > 99.0  # braked as soon as it was seen
