@@ -9,6 +9,11 @@ the smallest gap to the obstacle (``min_gap_aro_m``), the colour and the modes v
 where no lane change was begun) in ``--out``.
 
     python -m tests.tracking_table --out /tmp/tracking [--vehicles sedan compact] [--jobs 1]
+    python -m tests.tracking_table --summary DIR1/tracking.csv DIR2/tracking.csv ...
+
+``--summary`` prints, from the ``tracking.csv`` of earlier runs (one vehicle each, say), the
+table docs/control.md shows: per vehicle x ABS x friction, the worst lane change's error (and
+its speed) and the least gap to the obstacle over the lane changes.
 
 One run takes a few seconds; the whole table (6 vehicles x 2 x 16) about a quarter of an hour
 of one core. Tables are looked up as a run does (``tables/NAME``, ``-abs``/``-noabs``).
@@ -98,14 +103,49 @@ def markdown(table: pd.DataFrame) -> str:
     return "\n".join(lines) + "\n"
 
 
+def summary(table: pd.DataFrame) -> str:
+    """Rows vehicle x ABS, columns the frictions; a cell: worst error [m] (its speed, the
+    number of lane changes) / least gap [m] over that friction's lane changes (- none)."""
+    mus = sorted(table["mu"].unique(), reverse=True)
+    head = "| vehicle | ABS | " + " | ".join(f"mu {m:g}" for m in mus) + " | worst |"
+    lines = [head, "|" + "---|" * (3 + len(mus))]
+    for (veh, abs_), grp in table.groupby(["vehicle", "abs"], sort=False):
+        cells = [_summary_cell(grp[grp["mu"] == m]) for m in mus]
+        lines.append(f"| {veh} | {abs_} | " + " | ".join(cells) + f" | {_summary_cell(grp)} |")
+    lines.append("")
+    lines.append(
+        "A cell: worst mode-2 |lateral error| [m] (at km/h, of n lane changes) / least gap "
+        "to the obstacle [m] over those lane changes; bold: over 0.25 m."
+    )
+    return "\n".join(lines) + "\n"
+
+
+def _summary_cell(rows: pd.DataFrame) -> str:
+    changes = rows[np.isfinite(rows["lane_change_error_m"].astype(float))]
+    if changes.empty:
+        return "-"
+    worst = changes.loc[changes["lane_change_error_m"].idxmax()]
+    err = f"{worst['lane_change_error_m']:.2f}"
+    if worst["lane_change_error_m"] > 0.25:
+        err = f"**{err}**"
+    gap = changes["min_gap_aro_m"].min()
+    return f"{err} ({worst['ego_speed_kmh']:g}, {len(changes)}) / {gap:.2f}"
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", type=Path, required=True)
+    ap.add_argument("--out", type=Path)
+    ap.add_argument("--summary", nargs="+", type=Path, metavar="CSV")
     ap.add_argument("--vehicles", nargs="+", default=list(VEHICLES))
     ap.add_argument("--speeds-kmh", nargs="+", type=float, default=list(SPEEDS_KMH))
     ap.add_argument("--mu", nargs="+", type=float, default=list(MUS))
     ap.add_argument("--jobs", type=int, default=1)
     args = ap.parse_args(argv)
+    if args.summary:
+        print(summary(pd.concat([pd.read_csv(f) for f in args.summary])), end="")
+        return 0
+    if args.out is None:
+        ap.error("--out is required (or --summary)")
     args.out.mkdir(parents=True, exist_ok=True)
     matrix = write_matrix(args.out / "tracking.toml", args.vehicles, args.speeds_kmh, args.mu)
     runs = args.out / "runs"

@@ -21,19 +21,15 @@ from __future__ import annotations
 
 import math
 
-from eoam_sumo.params import (
-    G_MPS2,
-    PLANT_TYRE_FNOMIN_N,
-    PLANT_TYRE_PEAK_LOAD_SENSITIVITY,
-    VehicleParams,
-)
+from eoam_sumo.params import G_MPS2, PLANT_TYRE_PEAK_LOAD_SENSITIVITY, VehicleParams
 
 _PASSES = 2  # fixed-point passes for the load-sensitive peak (converged to < 0.1 %)
 
 
-def peak_friction(mu: float, load_n: float) -> float:
-    """The plant tyre's longitudinal peak friction at this load (Pacejka 2012 eq. 4.E13)."""
-    dfz = (load_n - PLANT_TYRE_FNOMIN_N) / PLANT_TYRE_FNOMIN_N
+def peak_friction(mu: float, load_n: float, nominal_load_n: float) -> float:
+    """The plant tyre's longitudinal peak friction at this load (Pacejka 2012 eq. 4.E13), its
+    curves scaled to the vehicle's own tyre's nominal load (LFZO, as the plant's)."""
+    dfz = (load_n - nominal_load_n) / nominal_load_n
     return mu * (1.0 + PLANT_TYRE_PEAK_LOAD_SENSITIVITY * dfz)
 
 
@@ -86,7 +82,10 @@ def _inner_wheel_limit_n(
     load = static + per_force * resistance_n
     limit = math.inf
     for _ in range(_PASSES):
-        k = peak_friction(mu, max(load, 0.0)) * ellipse - p.rolling_resistance_coeff
+        k = (
+            peak_friction(mu, max(load, 0.0), p.tyre_nominal_load_n) * ellipse
+            - p.rolling_resistance_coeff
+        )
         if k <= 0.0:
             return 0.0
         slope = share - k * per_force

@@ -65,3 +65,20 @@ def test_the_plant_locks_just_above_the_limit_and_not_below(params, plant_cache_
     assert _locked_while_moving(
         plant, 0.1, 0.95 * params.mass_kg * max_decel_no_lock_mps2(params, 0.1)
     )
+
+
+@pytest.mark.parametrize("mu", [0.3, 0.7])
+def test_a_light_car_s_limit_uses_its_own_tyre(plant_cache_dir, mu):
+    """The compact's tyres are scaled to 3010 N (the plant's MF nominal load, LFZO): taken at
+    the set's 4850 N its loaded front tyres would look 4 % grippier than they are, and the
+    command at 0.99 of that limit locked its front axle on mu 0.7 (Table 2's lane changes
+    began on locked front wheels)."""
+    params = dataclasses.replace(load_vehicle("compact"), abs_fitted=False, esc_fitted=False)
+    plant = Plant(params, cache_dir=plant_cache_dir)
+    ctrl = LongitudinalController(params)
+    rolling_n = params.rolling_resistance_coeff * params.mass_kg * G_MPS2
+    m_eq = equivalent_mass_kg(params)
+    low = brake_split.wheel_lock_brake_n(params, mu, 0.0, rolling_n, 0.0, m_eq)
+    high = brake_split.wheel_lock_brake_n(params, mu, 0.0, ctrl.resistance_n(V0_MPS), 0.0, m_eq)
+    assert not _locked_while_moving(plant, mu, 0.99 * low)
+    assert _locked_while_moving(plant, mu, 1.05 * high)
