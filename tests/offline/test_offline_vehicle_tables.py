@@ -24,15 +24,7 @@ def test_without_abs_the_braking_limit_is_the_no_lock_limit():
         assert braking_decel_mps2(P, mu) == max_decel_no_lock_mps2(P, mu)
 
 
-ICE_ABS = pytest.mark.xfail(
-    strict=True,
-    reason="ABS on its speed estimate: on mu 0.1 the estimate's error (1.5 % of the speed) "
-    "exceeds the tyre's peak slip (1.3 %); its deceleration 0.83 m/s^2 is below the fixed "
-    "split's constant-friction no-lock limit (docs/chassis.md, what the control unit knows)",
-)
-
-
-@pytest.mark.parametrize("mu", [1.0, 0.3, pytest.param(0.1, marks=ICE_ABS)])
+@pytest.mark.parametrize("mu", [1.0, 0.3, 0.1])
 def test_with_abs_the_braking_limit_is_near_the_friction_and_above_no_lock(mu):
     decel = braking_decel_mps2(WITH_ABS, mu)
     assert decel == abs_decel_mps2(WITH_ABS, mu)
