@@ -36,12 +36,14 @@ def speed_kmh(text: str) -> float:
     return value
 
 
-def sumo_step_argument(p: argparse.ArgumentParser) -> None:
-    """``run``, ``batch`` and ``protocol``: SUMO's step in a multi-rate co-simulation."""
+def sumo_step_argument(p: argparse.ArgumentParser, study: bool = False) -> None:
+    """``run``, ``batch`` and ``protocol``: SUMO's step in a multi-rate co-simulation (a
+    ``study``'s default is ``STUDY_SUMO_STEP_S``, a run's the 10 ms reference)."""
+    default = "0.05 for a study" if study else "0.01, the reference"
     p.add_argument(
         "--sumo-step-s",
         type=finite,
         metavar="S",
-        help="SUMO's step, 0.01 to 0.1 s (default 0.01, the reference): road users "
+        help=f"SUMO's step, 0.01 to 0.1 s (default {default}): road users "
         "interpolated between SUMO's steps, control at 100 Hz, plant at 1 kHz",
     )

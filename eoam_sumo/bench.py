@@ -148,7 +148,6 @@ def _sumo_only(sim_time_s: float, step_s: float) -> tuple[float, float]:
         BASELINE,
         ScenarioOverrides(ego_speed_mps=SPEED_MPS, mu=1.0),
         step_length_s=step_s,
-        ballistic=step_s > 0.01 + 1e-9,  # as the co-simulation at that step
     )
     try:
         t0, cpu0 = time.perf_counter(), time.thread_time()

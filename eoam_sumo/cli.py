@@ -29,7 +29,12 @@ from eoam_sumo.openscenario.command import (
     xosc_arguments,
 )
 from eoam_sumo.seeds import seed_argument
-from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S, MAX_TIME_LIMIT_S, check_sumo_step_s
+from eoam_sumo.sim.settings import (
+    DEFAULT_MAX_TIME_S,
+    MAX_TIME_LIMIT_S,
+    STUDY_SUMO_STEP_S,
+    check_sumo_step_s,
+)
 from eoam_sumo.traffic_levels.command import add_scenario_arguments, cmd_scenario
 from eoam_sumo.vehicle_tests import command as vehicle_test_command
 
@@ -282,7 +287,7 @@ def _batch_arguments(sub) -> None:
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     _after_stop_argument(p)
-    sumo_step_argument(p)
+    sumo_step_argument(p, study=True)
 
 
 def _plot_arguments(sub) -> None:
@@ -506,7 +511,12 @@ def _cmd_batch(args) -> int:
     check_options(args.jobs, args.timeout_s, args.timeseries)
     if is_xosc_batch(args.matrix):
         return _cmd_xosc_batch(args)
-    plan = plan_batch(args.matrix, after_stop_s=args.after_stop_s, sumo_step_s=args.sumo_step_s)
+    plan = plan_batch(
+        args.matrix,
+        after_stop_s=args.after_stop_s,
+        sumo_step_s=args.sumo_step_s,
+        default_sumo_step_s=STUDY_SUMO_STEP_S,
+    )
     with (
         _sigterm_interrupts(),
         output_folder(args.out, _batch_output(), in_place=args.resume) as out,

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, get_type_hints
 
 from eoam_sumo.matrix import Case, vehicle_params
 from eoam_sumo.params import VehicleParams
+from eoam_sumo.sim.settings import REFERENCE_SUMO_STEP_S
 from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
 
 if TYPE_CHECKING:
@@ -71,7 +72,7 @@ class CaseParameters:
     radar_model: str  # ideal or automotive
     seed: int
     after_stop_s: float | None  # None: the run's default
-    sumo_step_s: float | None  # None: the run's default (one rate, 10 ms)
+    sumo_step_s: float  # SUMO's step the case ran at [s]
     road: str | None  # a generated scenario (None: the sumocfg's): rural or motorway
     los: str | None  # its level of service
     lanes: int | None
@@ -83,11 +84,12 @@ class CaseParameters:
 
     @classmethod
     def of(cls, case: Case) -> CaseParameters:
-        own = ("sumocfg", "vehicle")
+        own = ("sumocfg", "vehicle", "sumo_step_s")
         return cls(
             **{f.name: getattr(case, f.name) for f in fields(cls) if f.name not in own},
             sumocfg=str(case.sumocfg),
             vehicle=case.vehicle or DEFAULT_VEHICLE,
+            sumo_step_s=case.sumo_step_s or REFERENCE_SUMO_STEP_S,  # the step the case ran
         )
 
 

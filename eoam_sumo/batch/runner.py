@@ -206,8 +206,11 @@ def plan_batch(
     tables_dir: Path | None = None,
     after_stop_s: float | None = None,
     sumo_step_s: float | None = None,
+    default_sumo_step_s: float | None = None,
 ) -> BatchPlan:
-    """The matrix loaded and checked (:func:`run_batch`'s bad input), nothing written."""
+    """The matrix loaded and checked (:func:`run_batch`'s bad input), nothing written.
+    ``sumo_step_s`` sets every case's SUMO step; ``default_sumo_step_s`` only the cases the
+    matrix leaves without one (None: the run's default, the 10 ms reference)."""
     if after_stop_s is not None and not after_stop_s >= 0.0:
         raise InputError(f"--after-stop-s {after_stop_s:g} must be >= 0")
     if sumo_step_s is not None:
@@ -219,6 +222,8 @@ def plan_batch(
         cases = [replace(c, after_stop_s=after_stop_s) for c in cases]
     if sumo_step_s is not None:
         cases = [replace(c, sumo_step_s=sumo_step_s) for c in cases]
+    elif default_sumo_step_s is not None:
+        cases = [c if c.sumo_step_s else replace(c, sumo_step_s=default_sumo_step_s) for c in cases]
     return BatchPlan(matrix, cases, matrix.paper_outcomes())
 
 

@@ -13,7 +13,7 @@ from eoam_sumo.matrix import vehicle_params as matrix_vehicle_params
 from eoam_sumo.outputs.staging import OutputKind, output_folder
 from eoam_sumo.params import MU_MAX, VehicleParams
 from eoam_sumo.protocols.points import PROTOCOLS, TestPoint, protocol_points
-from eoam_sumo.sim.settings import check_sumo_step_s
+from eoam_sumo.sim.settings import STUDY_SUMO_STEP_S, check_sumo_step_s
 
 #: Runs end at this simulated time after the ego's departure [s]: the slowest approach
 #: (CCRm 30 km/h behind 20 km/h, 41.7 m at 2.8 m/s) meets the target after 15 s.
@@ -82,7 +82,7 @@ def add_arguments(subparsers) -> None:
     p.add_argument("--mu", type=float, default=1.0, help="friction of every lane (1.0)")
     p.add_argument("--points", help="run only the points whose id matches this regex")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    sumo_step_argument(p)
+    sumo_step_argument(p, study=True)
 
 
 def selected_points(args) -> list[TestPoint]:
@@ -125,9 +125,9 @@ def run(args) -> int:
     from eoam_sumo.protocols.runner import run_protocol
 
     points = selected_points(args)
-    sumo_step_s = args.sumo_step_s
-    if sumo_step_s is not None:
-        sumo_step_s = check_sumo_step_s(sumo_step_s, "--sumo-step-s")
+    sumo_step_s = STUDY_SUMO_STEP_S
+    if args.sumo_step_s is not None:
+        sumo_step_s = check_sumo_step_s(args.sumo_step_s, "--sumo-step-s")
     with output_folder(Path(args.out), PROTOCOL_OUTPUT) as out:
         summary = run_protocol(
             args.name,

@@ -168,7 +168,6 @@ class CoSimulation:
             gui=st.gui,
             use_traci=st.use_traci,
             gui_settings=st.gui_settings,
-            ballistic=st.sumo_every > 1,
         )
 
     # ----------------------------------------------------------------------------- set-up

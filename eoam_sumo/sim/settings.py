@@ -24,6 +24,13 @@ from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
 DEFAULT_MAX_TIME_S = 60.0
 #: SUMO's longest step in a multi-rate co-simulation [s] (its traffic models' default step).
 MAX_SUMO_STEP_S = 0.1
+#: SUMO's step of the reference run [s]: one rate with the control step (``run``, the golden).
+REFERENCE_SUMO_STEP_S = 0.01
+#: SUMO's step for studies (``batch``, ``protocol``) unless ``--sumo-step-s`` or the matrix's
+#: ``[scenario] sumo_step_s`` sets one [s]: the longest step at which Table 2 keeps the
+#: reference's colours and contact partners and its figures within the golden tolerances
+#: (``tests/golden/step_check.py``; docs/performance.md).
+STUDY_SUMO_STEP_S = 0.05
 #: The longest simulated time limit accepted [s]: a day of traffic (a larger one only
 #: overflows the step count; 1e308 did).
 MAX_TIME_LIMIT_S = 86400.0

@@ -104,10 +104,15 @@ class Table2Run:
 
 
 def run_table2(out_dir: Path, jobs: int = 2) -> Table2Run:
-    """Run the Table 2 matrix into ``out_dir``."""
+    """Run the Table 2 matrix into ``out_dir`` at the 10 ms reference step (a study's default
+    is a longer one: ``tests/golden/step_check.py`` compares it)."""
     from eoam_sumo.batch.runner import run_batch
+    from eoam_sumo.sim.settings import REFERENCE_SUMO_STEP_S
 
-    return Table2Run(out_dir, run_batch(MATRIX, out_dir, jobs=jobs, progress=False))
+    results = run_batch(
+        MATRIX, out_dir, jobs=jobs, progress=False, sumo_step_s=REFERENCE_SUMO_STEP_S
+    )
+    return Table2Run(out_dir, results)
 
 
 def _figure(value) -> str:

@@ -90,6 +90,7 @@ def test_options_the_sumocfg_sets_otherwise_are_named_as_overrides():
     )
     assert over == {
         "step-length": "0.010",
+        "step-method.ballistic": "true",
         "collision.action": "none",
         "no-warnings": "true",
         "route-steps": "0",
@@ -99,6 +100,7 @@ def test_options_the_sumocfg_sets_otherwise_are_named_as_overrides():
     _, over = _command(
         {
             "step-length": "0.010",
+            "step-method.ballistic": "x",
             "collision.action": "none",
             "time-to-teleport": "-1.0",
             "no-warnings": "yes",

@@ -15,9 +15,14 @@ from pathlib import Path
 #: co-simulation is the ground truth; the ego moved by moveToXY overlaps others by design),
 #: and must load every route at the start (by default SUMO may read a vehicle listed after
 #: another with the same departure only in its departure step, too late to re-insert it as
-#: the ego). ``no-warnings`` and ``no-step-log`` keep the terminal quiet; a sumocfg that
-#: turns warnings on (``no-warnings`` false) keeps them.
+#: the ego). SUMO's ballistic update at every step (constant acceleration over a step, as the
+#: multi-rate co-simulation interpolates; SUMO's default Euler update moves a braking vehicle
+#: by its new speed, stopping it ``v dt / 2`` short: SUMO user documentation, Simulation/Basic
+#: Definition, "Defining the Integration Method"), so every SUMO step runs one physics.
+#: ``no-warnings`` and ``no-step-log`` keep the terminal quiet; a sumocfg that turns warnings
+#: on (``no-warnings`` false) keeps them.
 ENFORCED_OPTIONS = (
+    ("step-method.ballistic", "true"),
     ("collision.action", "none"),
     ("time-to-teleport", "-1"),
     ("no-warnings", "true"),
@@ -54,18 +59,12 @@ def sumo_command(
     extra: tuple[str, ...],
     gui: bool,
     keep_gui_open: bool = False,
-    ballistic: bool = False,
 ) -> tuple[list[str], dict]:
     """(command line, overrides): SUMO started on ``cfg`` with the co-simulation's options,
     and option -> value of every one of them that changes what the sumocfg (``cfg_options``,
     its option elements) or SUMO's default gives. Options in ``extra`` win over both. sumo-gui
-    starts at once, and quits at the end unless ``keep_gui_open``. ``ballistic``: SUMO's
-    ballistic position update (constant acceleration over a step, as the multi-rate
-    co-simulation interpolates; SUMO's default Euler update moves a braking vehicle by its
-    new speed, half a step's travel short of the ballistic stop)."""
+    starts at once, and quits at the end unless ``keep_gui_open``."""
     wanted = [("step-length", f"{step_s:.3f}")]
-    if ballistic:
-        wanted.append(("step-method.ballistic", "true"))
     for option, value in ENFORCED_OPTIONS:
         if option in HONOURED_OPTIONS and option in cfg_options:
             continue

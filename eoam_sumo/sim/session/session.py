@@ -249,12 +249,11 @@ class SumoSession:
         use_traci: bool = False,
         extra_args: tuple[str, ...] = (),
         gui_settings: GuiSettings = _GUI_DEFAULTS,
-        ballistic: bool = False,
     ) -> SumoSession:
-        """Check the files, start SUMO (``ballistic``: its ballistic update), advance it to
-        the ego's departure and make the step inserting the ego at the requested speed; then
-        every query answers. ``gui``: ``sumo-gui`` through TraCI (shown as ``gui_settings``
-        says), ``use_traci``: ``sumo`` through TraCI; else libsumo (in-process, one a process)."""
+        """Check the files, start SUMO, advance it to the ego's departure and make the step
+        inserting the ego at the requested speed; then every query answers. ``gui``:
+        ``sumo-gui`` through TraCI (shown as ``gui_settings`` says), ``use_traci``: ``sumo``
+        through TraCI; else libsumo (in-process, one a process)."""
         step = _checked_step(overrides, step_length_s)
         extra = tuple(str(a) for a in extra_args)
         files = check_scenario(Path(cfg), ego_id)
@@ -277,7 +276,6 @@ class SumoSession:
             extra,
             gui,
             keep_gui_open=gui_settings.keep_open,
-            ballistic=ballistic,
         )
         plan = handover_plan(files, ego_id, step, scripted, extra)
         first_cmd = cmd
