@@ -12,7 +12,8 @@ braking or steering begins (at a steady closing speed). The sectors are:
 sector region                           action       meaning
 ====== ================================ ============ =========================================
 A      d <= S and d <= B0               LIMIT_BRAKE  imminent: neither steer nor brake avoids
-C      d <= S and d > B0                BRAKE        braking alone still stops in time
+C      d <= S and d > B0, or d <= Sb    BRAKE        braking alone still stops in time
+       where B0 <= S
 F      S < d <= Sb and d <= Bb          STEER        steer (braking would need its buffer)
 B      S < d <= Sb and d > Bb           STEER        steer with the steering buffer
 D      d > Sb and d <= Bb               BRAKE        brake to soften the steer to come
@@ -22,6 +23,11 @@ G      otherwise (or v <= 0)            NONE         nothing to do
 
 For any fixed v the sectors follow each other in the order A, C, F, B, D, E, G as d grows
 (some may be empty), so the urgency never increases with distance.
+
+Where stopping is shorter than clearing (B0 <= S: low closing speeds), the steering sectors F
+and B are braking sector C: a lane change begun there would clear the obstacle later than
+limit braking stops the ego short of it, so it never is the last resort. The paper draws its
+phase diagrams for highway speeds, where B0 > S, and leaves this range open.
 """
 
 from __future__ import annotations
@@ -121,6 +127,8 @@ def classify(
     if d <= clear_m:
         return A if d <= stop_m else C
     if d <= clear_buffered_m:
+        if stop_m <= clear_m:  # stopping is shorter than clearing: braking stops first
+            return C
         return F if d <= stop_buffered_m else B
     if d <= stop_buffered_m:
         return D

@@ -18,6 +18,14 @@ HIGH = {
     "stop_buffered_m": 70.0,
     "ttc_s": 2.5,
 }
+# steering needs less than braking, but its buffer more than braking's (a B sector)
+MID = {
+    "clear_m": 30.0,
+    "clear_buffered_m": 50.0,
+    "stop_m": 35.0,
+    "stop_buffered_m": 45.0,
+    "ttc_s": 2.5,
+}
 # braking needs less than steering (low speed)
 LOW = {
     "clear_m": 20.0,
@@ -34,16 +42,20 @@ LOW = {
         (HIGH, 29.0, 35.0, Sector.A),  # d <= S, d <= B0
         (LOW, 15.0, 10.0, Sector.C),  # d <= S, d > B0
         (HIGH, 35.0, 35.0, Sector.F),  # S < d <= Sb, d <= Bb
-        (LOW, 22.0, 10.0, Sector.B),  # S < d <= Sb, d > Bb
+        (MID, 48.0, 20.0, Sector.B),  # S < d <= Sb, d > Bb
+        (MID, 40.0, 20.0, Sector.F),  # S < d <= Sb, d <= Bb
+        (MID, 29.0, 20.0, Sector.A),  # d <= S, d <= B0
+        (LOW, 22.0, 10.0, Sector.C),  # S < d <= Sb, but B0 <= S: braking stops first
         (HIGH, 50.0, 35.0, Sector.D),  # d > Sb, d <= Bb
         (HIGH, 80.0, 35.0, Sector.E),  # d > Sb, Bb; d <= 2.5 * 35
         (HIGH, 90.0, 35.0, Sector.G),  # beyond the TTC line
-        (LOW, 24.9, 10.0, Sector.B),
+        (LOW, 24.9, 10.0, Sector.C),
         (LOW, 25.1, 10.0, Sector.G),  # d > Sb, Bb and beyond 2.5 s * 10 m/s = 25 m
     ],
 )
 def test_each_sector_region(bounds, range_m, speed, sector):
-    """The paper's rules (Figure 14): the warning line is T alone."""
+    """The paper's rules (Figure 14), and braking where stopping is shorter than clearing
+    (B0 <= S, which the paper leaves open); the warning line is T alone."""
     assert classify(range_m, speed, **bounds, warn_lead_s=0.0) is sector
 
 
