@@ -422,8 +422,9 @@ def test_the_same_protocol_twice_gives_the_same_results(tmp_path):
 
 @pytest.mark.sumo
 def test_aeb_brakes_in_lane_where_the_eoam_changes_lanes(tmp_path):
-    """CCRs 30 km/h at 50 %: the EOAM changes lanes (S); with --system aeb it brakes in its
-    lane (B: no lane-change mode, no time in the next lane) and stops short."""
+    """CCRs 60 km/h at 50 % (where limit braking needs more room than the lane change): the
+    EOAM changes lanes (S); with --system aeb it brakes in its lane (B: no lane-change mode,
+    no time in the next lane) and stops short."""
 
     def run(system):
         out = tmp_path / system
@@ -437,7 +438,7 @@ def test_aeb_brakes_in_lane_where_the_eoam_changes_lanes(tmp_path):
                 "--out",
                 str(out),
                 "--points",
-                "^CCRs_v30_t0_o50_",
+                "^CCRs_v60_t0_o50_",
                 "--system",
                 system,
                 "--no-progress",

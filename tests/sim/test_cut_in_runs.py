@@ -64,7 +64,10 @@ def test_a_car_cutting_in_and_driving_on_is_followed_not_stopped_for(tmp_path, m
     summary = run_case(cfg, ScenarioOverrides(mu=mu), tmp_path / "out", settings)
     ts = pd.read_csv(tmp_path / "out" / "timeseries.csv")
     assert summary["collision_with"] == "none", summary["reason"]
-    assert 3 in summary["modes_visited"]  # the lane change refused: braked in lane
+    modes = set(summary["modes_visited"])
+    # braked in its lane: the lane change refused (mode 3), or never asked for where stopping
+    # is shorter than clearing at the closing speed (mode 1 alone)
+    assert modes & {1, 3} and not modes & {2, 4}
     assert ts["mode"].iloc[-1] == 0  # handed back once the car drove away
     assert ts["vx_mps"].min() > 0.5 * CUT_MPS  # never near a standstill
     assert "stopped" not in summary["reason"]
