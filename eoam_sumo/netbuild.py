@@ -127,10 +127,6 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    raise SystemExit(main())
-
-
 _SUMOCFG = """<?xml version="1.0" encoding="UTF-8"?>
 {comment}<configuration>
     <input>
@@ -159,3 +155,7 @@ def sumocfg_text(
         additional=quoteattr(additional),
         end=end_s,
     )
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -99,11 +99,15 @@ SECTOR_ORDER = (Sector.A, Sector.C, Sector.F, Sector.B, Sector.D, Sector.E, Sect
 
 
 def warning_line_m(
-    rel_speed_mps: float, clear_buffered_m: float, stop_buffered_m: float, ttc_s: float
+    rel_speed_mps: float,
+    clear_buffered_m: float,
+    stop_buffered_m: float,
+    ttc_s: float,
+    lead_s: float = FCW_LEAD_S,
 ) -> float:
-    """The warning line W = max(T, max(Sb, Bb) + ``FCW_LEAD_S`` v) at a closing speed."""
+    """The warning line W = max(T, max(Sb, Bb) + ``lead_s`` v) at a closing speed."""
     v = rel_speed_mps
-    return max(ttc_s * v, max(clear_buffered_m, stop_buffered_m) + FCW_LEAD_S * v)
+    return max(ttc_s * v, max(clear_buffered_m, stop_buffered_m) + lead_s * v)
 
 
 def classify(
@@ -117,7 +121,7 @@ def classify(
     warn_lead_s: float = FCW_LEAD_S,
 ) -> Sector:
     """Sector of the phase point (range, closing speed) given the boundaries at that speed;
-    the warning line is max(T, max(Sb, Bb) + ``warn_lead_s`` v).
+    the warning line is ``warning_line_m`` with the lead ``warn_lead_s``.
 
     A non-finite range or closing speed, or one that is not closing (v <= 0), is sector G.
     """
@@ -132,7 +136,7 @@ def classify(
         return F if d <= stop_buffered_m else B
     if d <= stop_buffered_m:
         return D
-    if d <= ttc_s * v or d <= max(clear_buffered_m, stop_buffered_m) + warn_lead_s * v:
+    if d <= warning_line_m(v, clear_buffered_m, stop_buffered_m, ttc_s, warn_lead_s):
         return E
     return G
 

@@ -15,7 +15,7 @@ import pytest
 from eoam_sumo.control import brake_split, equivalent_mass_kg
 from eoam_sumo.control.longitudinal import LongitudinalController
 from eoam_sumo.offline.boundaries import max_decel_no_lock_mps2
-from eoam_sumo.params import G_MPS2
+from eoam_sumo.params import G_MPS2, PLANT_TYRE_FNOMIN_N
 from eoam_sumo.plant import OUTPUT_NAMES, Plant, initial_state
 from eoam_sumo.vehicle_files import load_vehicle
 
@@ -50,17 +50,22 @@ def _locked_while_moving(plant, mu, brake_n):
     return False
 
 
-@pytest.mark.parametrize("mu", [0.1, 0.3])
-def test_the_plant_locks_just_above_the_limit_and_not_below(params, plant_cache_dir, mu):
-    plant = Plant(params, cache_dir=plant_cache_dir)
+def _assert_the_limit_is_sharp(plant, params, mu):
+    """No lock at 0.99 of the lowest limit (the slow end, where drag has gone), a lock at 1.05
+    of the highest (at the start speed)."""
     ctrl = LongitudinalController(params)
     rolling_n = params.rolling_resistance_coeff * params.mass_kg * G_MPS2
     m_eq = equivalent_mass_kg(params)
-    # lowest where drag has gone (the slow end), highest at the start speed
     low = brake_split.wheel_lock_brake_n(params, mu, 0.0, rolling_n, 0.0, m_eq)
     high = brake_split.wheel_lock_brake_n(params, mu, 0.0, ctrl.resistance_n(V0_MPS), 0.0, m_eq)
     assert not _locked_while_moving(plant, mu, 0.99 * low)
     assert _locked_while_moving(plant, mu, 1.05 * high)
+
+
+@pytest.mark.parametrize("mu", [0.1, 0.3])
+def test_the_plant_locks_just_above_the_limit_and_not_below(params, plant_cache_dir, mu):
+    plant = Plant(params, cache_dir=plant_cache_dir)
+    _assert_the_limit_is_sharp(plant, params, mu)
     # eq. 33's no-lock force itself locks the front on ice
     assert _locked_while_moving(
         plant, 0.1, 0.95 * params.mass_kg * max_decel_no_lock_mps2(params, 0.1)
@@ -69,16 +74,10 @@ def test_the_plant_locks_just_above_the_limit_and_not_below(params, plant_cache_
 
 @pytest.mark.parametrize("mu", [0.3, 0.7])
 def test_a_light_car_s_limit_uses_its_own_tyre(plant_cache_dir, mu):
-    """The compact's tyres are scaled to 3010 N (the plant's MF nominal load, LFZO): taken at
-    the set's 4850 N its loaded front tyres would look 4 % grippier than they are, and the
-    command at 0.99 of that limit locked its front axle on mu 0.7 (Table 2's lane changes
-    began on locked front wheels)."""
+    """The compact's tyres are scaled to its own nominal load (the plant's MF LFZO), not the
+    set's 4850 N: taken about 4850 N its loaded front tyres would look grippier than they are,
+    and the command at 0.99 of that limit locked its front axle (with its 3010 N tyre then:
+    Table 2's lane changes began on locked front wheels)."""
     params = dataclasses.replace(load_vehicle("compact"), abs_fitted=False, esc_fitted=False)
-    plant = Plant(params, cache_dir=plant_cache_dir)
-    ctrl = LongitudinalController(params)
-    rolling_n = params.rolling_resistance_coeff * params.mass_kg * G_MPS2
-    m_eq = equivalent_mass_kg(params)
-    low = brake_split.wheel_lock_brake_n(params, mu, 0.0, rolling_n, 0.0, m_eq)
-    high = brake_split.wheel_lock_brake_n(params, mu, 0.0, ctrl.resistance_n(V0_MPS), 0.0, m_eq)
-    assert not _locked_while_moving(plant, mu, 0.99 * low)
-    assert _locked_while_moving(plant, mu, 1.05 * high)
+    assert params.tyre_nominal_load_n != PLANT_TYRE_FNOMIN_N  # the case this test is about
+    _assert_the_limit_is_sharp(Plant(params, cache_dir=plant_cache_dir), params, mu)
