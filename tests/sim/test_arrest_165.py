@@ -2,7 +2,8 @@
 onc-300_v165_mu0.7), the compact with ABS: seen 0.7 m into its lane change, moving left at
 2.5 m/s, the ego aborts (mode 3) and cannot stop before the obstacle 32 m ahead.
 
-* The default arrest (the front slip envelope's edge): the ego's front hits the obstacle
+* The default arrest (the front slip envelope's edge; braking in place is predicted to meet
+  the oncoming car, so the decision aborts): the ego's front hits the obstacle
   below its entry speed, never the oncoming car and never with its side, and it keeps its
   heading (no spin), though its yaw rate is 2-3 times the mu g / v the tyres sustain.
 * The arrest along a turn the tyres sustain (``arrest_lateral_g``): its yaw rate stays near
@@ -41,7 +42,7 @@ def _run(eoam: EoamSettings):
     frame = log.frame()
     arrest = frame[frame["mode"] == 3]
     assert len(arrest) > 20, summary["modes_visited"]  # the abort ran
-    return summary, arrest
+    return summary, arrest, sim.ctrl.oncoming_choice
 
 
 def _yaw_rate_ratio(arrest) -> float:
@@ -51,8 +52,11 @@ def _yaw_rate_ratio(arrest) -> float:
 
 
 def test_the_default_arrest_hits_the_obstacle_front_first_below_its_entry_speed():
-    summary, arrest = _run(EoamSettings())
+    summary, arrest, choice = _run(EoamSettings())
     assert summary["modes_visited"] == [0, 1, 2, 3]
+    # braking in place would hold the ego in the oncoming car's path: the abort is taken
+    assert choice.hold is not None and choice.hold.head_on
+    assert not (choice.pass_on or choice.hold_in_place)
     assert summary["collision_with"] == "aro"
     assert summary["contact_kind"] != "side"  # the ego's front, not a swing into its side
     assert summary["impact_speed_mps"] < arrest["vx_mps"].iloc[0] - 2.0
@@ -61,7 +65,7 @@ def test_the_default_arrest_hits_the_obstacle_front_first_below_its_entry_speed(
 
 
 def test_the_sustained_turn_keeps_the_yaw_rate_and_the_friction_circle():
-    summary, arrest = _run(EoamSettings(arrest_lateral_g=0.9))
+    summary, arrest, _ = _run(EoamSettings(arrest_lateral_g=0.9))
     assert summary["collision_with"] != "aro" or summary["contact_kind"] != "side"
     assert _yaw_rate_ratio(arrest) < 1.6  # the lane change's own yaw rate at entry is 1.1
     total = np.hypot(arrest["ax_mps2"].to_numpy(), arrest["ay_mps2"].to_numpy())
