@@ -52,6 +52,9 @@ class EoamSettings:
     # jerk-limited time-optimal shifts (manoeuvre.min_time_shift; False: the shortest quintics)
     arrest_first: bool = True  # mode 3 from a lane change: a lateral motion away from the
     # lane centre is first arrested at the front tyre's slip envelope, then the shift back
+    arrest_lateral_g: float | None = None  # ... at the front slip envelope's edge (None),
+    # or along a turn at this / (mu g), its yaw rate a_y / v within what the tyres sustain and
+    # the brake given the friction ellipse's rest (docs/control.md, the 165 km/h arrest)
     arrest_min_speed_mps: float = 0.5  # ... when it is at least this fast (a lane change's,
     # not a lane-keeping drift: the arrest steers hard)
     arrest_return_g: float = 0.6  # ... within this / (mu g): the body leaves the arrest
@@ -84,6 +87,9 @@ class EoamSettings:
             v = getattr(self, f.name)
             if isinstance(v, float) and not (math.isfinite(v) and v >= 0.0):
                 raise ValueError(f"EOAM setting {f.name}={v!r} must be finite and >= 0")
+        g = self.arrest_lateral_g
+        if g is not None and not 0.0 < g <= 1.0:
+            raise ValueError(f"arrest_lateral_g={g!r} must be None or in (0, 1]")
         if not 0.0 < self.ponr_fraction < 1.0:
             raise ValueError(f"ponr_fraction={self.ponr_fraction} must be in (0, 1)")
         for name in (

@@ -12,6 +12,9 @@ taken:
   stops, and from there one within the (gentler) budget of the shift back after an arrest;
   braking at the limit with what the friction ellipse leaves during the shifts and at the
   full limit after them;
+* **brake in place** (mode 3, ``predict_hold``): the same arrest, then the offset held where it
+  ends and limit braking; taken over the abort only when it is predicted out of the oncoming
+  road user's path and of lower delta-v (it hits the obstacle slower, or passes beside it);
 * **pass** (mode 4): go on to just past the obstacle's side (its left edge + half the ego +
   the side clearance), hold the speed until the ego's rear is past the obstacle's front, then
   the same time-optimal shift back from there.
@@ -25,7 +28,9 @@ left side short of the other's right side; 1.67 m with 3.5 m lanes, a 1.85 m ego
 plastic impact with a body of equal mass, half the closing speed (``policy``'s tie-breaker):
 a head-on at the closing speed then (less what braking took off), a hit on the obstacle at the
 relative speed left after braking over the gap (both bodies braking to their stops).
-Ties go to aborting (the paper's choice before its point of no return).
+No contact comes first; a side contact with the obstacle counts as a front one, by the
+relative speed. Ties go to aborting (the paper's choice before its point of no return), then
+to braking in place.
 """
 
 from __future__ import annotations
@@ -113,11 +118,13 @@ class Option(NamedTuple):
 
 
 class Choice(NamedTuple):
-    """The option taken and both predictions."""
+    """The option taken and the predictions."""
 
     pass_on: bool
     abort: Option
     passing: Option
+    hold: Option | None = None  # braking in place (None: not predicted)
+    hold_in_place: bool = False  # the abort holds the offset where its arrest ends
 
 
 def _out_line_m(oncoming: Tracked, b: Budget) -> float:
@@ -206,6 +213,38 @@ def predict_abort(
     return Option(False, 0.5 * impact, out, meet)
 
 
+def _arrest(lat: Lateral, v_mps: float, b: Budget) -> tuple[float, float]:
+    """(offset where an arrest of the lateral motion away from the lane centre ends, when)
+    as ``predict_abort`` has it; the offset now and 0 when nothing is arrested."""
+    escape = _escape(lat, 0.0, v_mps, b)
+    turn = escape.turn_s()
+    if turn > 0.0 and abs(lat.v_mps) >= b.arrest_min_mps:
+        return escape.state_at(turn)[0], b.lag_s + turn
+    return lat.d_m, 0.0
+
+
+def predict_hold(
+    lat: Lateral, v_mps: float, obstacle: Tracked | None, oncoming: Tracked, b: Budget
+) -> Option:
+    """Brake in place: the arrest of ``predict_abort``, then the offset held where it ends
+    and limit braking (with what the friction ellipse leaves during the arrest). The ego hits
+    the obstacle (front or side: counted alike, by the relative speed) while its side is
+    inside the obstacle's; it meets the oncoming road user while inside its path."""
+    d_hold, t_lat = _arrest(lat, v_mps, b)
+    share = math.sqrt(max(1.0 - (b.lateral_mps2 / b.mu_g_mps2) ** 2, 0.0))
+
+    def decel(t: float) -> float:
+        return b.brake_mps2 * (share if t < t_lat else 1.0)
+
+    beside = obstacle is not None and d_hold - 0.5 * b.width_m >= obstacle.near_edge_m
+    meet, closing, impact = _braking(v_mps, decel, None if beside else obstacle, oncoming)
+    if max(d_hold, lat.d_m) > _out_line_m(oncoming, b):
+        return Option(True, 0.5 * closing, math.inf, meet)
+    if beside and obstacle is not None:  # passes beside it: the oncoming road user decides
+        return Option(False, 0.0, 0.0, meet)
+    return Option(False, 0.5 * impact, 0.0, meet)
+
+
 def predict_pass(
     lat: Lateral, v_mps: float, obstacle: Tracked | None, oncoming: Tracked, b: Budget
 ) -> Option:
@@ -249,12 +288,18 @@ def time_to_pass_s(v_mps: float, to_pass_m: float, obstacle: Tracked) -> float:
 def choose(
     lat: Lateral, v_mps: float, obstacle: Tracked | None, oncoming: Tracked, b: Budget, passed: bool
 ) -> Choice:
-    """Pass on or abort, by the lower predicted delta-v (ties: abort). ``passed``: the ego's
-    rear is already past the obstacle's front, so passing on is the escape alone (taken)."""
-    abort = predict_abort(lat, v_mps, None if passed else obstacle, oncoming, b)
-    passing = predict_pass(lat, v_mps, None if passed else obstacle, oncoming, b)
-    pass_on = passed or passing.delta_v_mps < abort.delta_v_mps
-    return Choice(pass_on, abort, passing)
+    """Abort back into the lane, brake in place or pass on, by the lower predicted delta-v
+    (no contact first; ties in that order: the paper aborts before its point of no return).
+    ``passed``: the ego's rear is already past the obstacle's front, so passing on is the
+    escape alone (taken)."""
+    ahead = None if passed else obstacle
+    abort = predict_abort(lat, v_mps, ahead, oncoming, b)
+    passing = predict_pass(lat, v_mps, ahead, oncoming, b)
+    hold = predict_hold(lat, v_mps, ahead, oncoming, b)
+    pass_on = passed or passing.delta_v_mps < min(abort.delta_v_mps, hold.delta_v_mps)
+    # never held in the oncoming road user's path: an abort at least leaves it
+    hold_in_place = not (pass_on or hold.head_on) and hold.delta_v_mps < abort.delta_v_mps
+    return Choice(pass_on, abort, passing, hold, hold_in_place)
 
 
 def commit_choice(meas, oncoming, obstacle: ObstacleTrack, b: Budget) -> Choice:

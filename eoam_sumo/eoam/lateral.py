@@ -42,8 +42,11 @@ def lateral_control(parts: Parts, state: ControllerState, meas: EgoMeasurement) 
     ref = reference(parts, path, meas, dx, rate)
     steer = parts.planned_steering if ref.planned else parts.steering
     v, d, mu = meas.vx_mps, meas.d_m, meas.mu
-    if state.arrest:  # the most lateral force against the motion the envelope allows
-        delta = steer.envelope_edge(v, meas.yaw_rate_radps, meas.vy_mps, mu, -state.arrest)
+    if state.arrest:  # against the motion: the envelope's edge, or a turn the tyres sustain
+        if parts.settings.arrest_lateral_g is None:
+            delta = steer.envelope_edge(v, meas.yaw_rate_radps, meas.vy_mps, mu, -state.arrest)
+        else:
+            delta = arrest_steer(parts, meas, state.arrest, parts.settings.arrest_lateral_g)
         return LateralOutput(
             delta, d, dx, 0.0, 0.0, delta, 0.0, 0.0, ref.in_path, ref.ax_mps2, ref.speed_mps
         )
@@ -66,6 +69,22 @@ def lateral_control(parts: Parts, state: ControllerState, meas: EgoMeasurement) 
     return LateralOutput(
         delta, ref.y_m, dx, e_lat, e_la, ff, fb, yd, ref.in_path, ref.ax_mps2, ref.speed_mps
     )
+
+
+def arrest_steer(parts: Parts, meas: EgoMeasurement, arrest: float, lateral_g: float) -> float:
+    """Mode 3's arrest of a lateral motion (``arrest``: its sign) along a turn against it at
+    ``lateral_g`` mu g: the steady-state steer for that lateral acceleration plus the steering
+    law's yaw-rate gain (eq. 38's k_r) on the error to its yaw rate a_y / v (<= mu g / v, what
+    the tyres sustain at this speed), never past the front slip envelope's edge; the brake
+    takes the friction ellipse's rest (``longitudinal.force_limits``)."""
+    v = max(meas.vx_mps, parts.settings.limit_brake_floor_speed_mps)
+    ay = -arrest * lateral_g * meas.mu * G_MPS2
+    steer = parts.steering
+    k_r = steer.gains_at(v, meas.mu)[1]
+    r_target = ay / v + v * meas.road_curvature_1pm
+    delta = steer.steer_for_lateral_accel(v, ay) - k_r * (meas.yaw_rate_radps - r_target)
+    edge = steer.envelope_edge(v, meas.yaw_rate_radps, meas.vy_mps, meas.mu, -arrest)
+    return max(delta, edge) if arrest > 0.0 else min(delta, edge)
 
 
 def steering_share(parts: Parts, steer, speed_mps: float, mu: float, delta_rad: float) -> float:

@@ -13,6 +13,7 @@ from eoam_sumo.decision.modes import (
 from eoam_sumo.eoam.parts import Parts
 from eoam_sumo.eoam.state import ControllerState, LateralOutput, LongitudinalOutput
 from eoam_sumo.eoam_messages import EgoMeasurement
+from eoam_sumo.params import G_MPS2
 
 _STEERING = (UPDATE_STEER_BRAKE, ONCOMING_STEER_BRAKE)
 
@@ -104,6 +105,9 @@ def force_limits(
     measured, and outside the table's profile also the one this steering command asks for,
     so that the brake yields before a turning axle locks."""
     ay_use = lateral_use_mps2(parts, meas, steer_rad, tracking)
+    arrest_g = parts.settings.arrest_lateral_g
+    if state.arrest and arrest_g is not None:  # the arrest's lateral share kept for it
+        ay_use = max(ay_use, arrest_g * meas.mu * G_MPS2)
     return parts.longitudinal.limits(
         meas.vx_mps, meas.mu, ay_use, state.friction_now().brake_limit_n
     )

@@ -299,8 +299,8 @@ class MinTimeEscapes(QuinticEscapes):
         self, state: ControllerState, meas: EgoMeasurement, path: PathReference | None, dx_m: float
     ) -> QuinticShift | MinTimeShift | None:
         if state.arrest and lateral_state(meas)[0] * state.arrest <= 0.0:
-            state.arrest = 0.0  # lateral motion arrested: back to the lane centre
-            return self.shift(0.0, meas, self.settings.arrest_return_g)
+            state.arrest = 0.0  # lateral motion arrested: back to the lane centre or held
+            return self.shift(abort_target_m(state, meas), meas, self.settings.arrest_return_g)
         return None
 
 
@@ -317,7 +317,14 @@ class ArrestFirst(MinTimeEscapes):
         if v_lat * meas.d_m > 0.0 and abs(v_lat) >= self.settings.arrest_min_speed_mps:
             state.arrest = math.copysign(1.0, v_lat)
             return None
-        return self.shift(0.0, meas, self.settings.evasive_lateral_g)
+        return self.shift(abort_target_m(state, meas), meas, self.settings.evasive_lateral_g)
+
+
+def abort_target_m(state: ControllerState, meas: EgoMeasurement) -> float:
+    """Mode 3's lateral target: the lane centre, or the offset reached when the commit/abort
+    decision chose to brake in place (``decision.oncoming.Choice.hold_in_place``)."""
+    choice = state.oncoming_choice
+    return meas.d_m if choice is not None and choice.hold_in_place else 0.0
 
 
 # --------------------------------------------------------------------------- early return

@@ -18,6 +18,7 @@ from eoam_sumo.decision.oncoming import (
     Tracked,
     choose,
     predict_abort,
+    predict_hold,
     predict_pass,
     return_clears,
     time_to_pass_s,
@@ -155,3 +156,40 @@ def test_return_after_passing_waits_until_it_keeps_the_side_clear():
     assert not return_clears(_ego(2.8), obstacle(gain + 1.0), BUDGET)
     assert return_clears(_ego(2.8), obstacle(gain - 1.0), BUDGET)
     assert return_clears(_ego(1.2), obstacle(-2.0), BUDGET)  # already past it
+
+
+# ------------------------------------------------------------------ braking in place (hold)
+def test_holding_in_place_hits_the_obstacle_slower_than_returning_and_is_chosen():
+    """A small drift (0.3 m out, 0.8 m/s left), a standing car 30 m ahead, the oncoming car
+    100 m off (passing meets it head-on): the abort and the hold stay out of its path and hit
+    the obstacle, the hold at the lower speed (no shift back to share the ellipse with), at
+    least the full limit's sqrt(v^2 - 2 a gap)."""
+    lat, obs, onc = Lateral(0.3, 0.8, 0.0), standing(30.0), oncoming(100.0)
+    hold = predict_hold(lat, V, obs, onc, BUDGET)
+    abort = predict_abort(lat, V, obs, onc, BUDGET)
+    assert not hold.head_on and not abort.head_on
+    floor = 0.5 * math.sqrt(V * V - 2.0 * BUDGET.brake_mps2 * 30.0)
+    assert floor - 0.05 <= hold.delta_v_mps < abort.delta_v_mps
+    choice = choose(lat, V, obs, onc, BUDGET, passed=False)
+    assert choice.passing.head_on
+    assert choice.hold_in_place and not choice.pass_on and choice.hold == hold
+
+
+def test_an_arrest_ending_in_the_oncoming_path_is_never_held():
+    """2.5 m/s left at 1.2 m out: the arrest ends past the line, so holding there meets the
+    oncoming car (head-on), whatever its predicted delta-v; the abort is taken."""
+    lat, obs, onc = Lateral(1.2, 2.5, 0.0), standing(30.0), oncoming(150.0)
+    hold = predict_hold(lat, V, obs, onc, BUDGET)
+    assert hold.head_on and hold.out_s == math.inf
+    choice = choose(lat, V, obs, onc, BUDGET, passed=False)
+    assert not choice.hold_in_place
+
+
+def test_holding_beside_a_narrow_obstacle_has_no_contact():
+    """An obstacle whose left side is 0.4 m right of the lane centre (a cyclist at the kerb):
+    held at 0.8 m the ego's side is clear of it and of the oncoming path, no contact."""
+    obs = Tracked(30.0, 0.0, 0.0, 1.8, -0.4)
+    lat = Lateral(0.5, 1.0, 0.0)
+    hold = predict_hold(lat, V, obs, oncoming(100.0), BUDGET)
+    assert not hold.head_on and hold.delta_v_mps == 0.0
+    assert choose(lat, V, obs, oncoming(100.0), BUDGET, passed=False).hold_in_place
