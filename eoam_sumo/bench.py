@@ -489,14 +489,14 @@ def _matrix_study(study: Study, out: Path, step_s: float, jobs: int, quick: bool
     study, results frame)."""
     from dataclasses import replace
 
+    from eoam_sumo.batch.output import BATCH_OUTPUT
     from eoam_sumo.batch.runner import plan_batch, run_batch
-    from eoam_sumo.cli import batch_output_kind
     from eoam_sumo.outputs.staging import output_folder
 
     plan = plan_batch(Path(study.source), sumo_step_s=step_s)
     total = len(plan.cases)
     plan = replace(plan, cases=_spread(plan.cases, quick))
-    with output_folder(out, batch_output_kind()) as folder:
+    with output_folder(out, BATCH_OUTPUT) as folder:
         results = run_batch(
             Path(study.source),
             folder,
@@ -509,21 +509,24 @@ def _matrix_study(study: Study, out: Path, step_s: float, jobs: int, quick: bool
 
 
 def _protocol_study(study: Study, out: Path, step_s: float, jobs: int, quick: bool):
-    """A protocol study as ``eoam-sumo protocol NAME`` runs it: (points in the protocol,
-    results frame)."""
-    import pandas as pd
+    """A protocol study as ``eoam-sumo protocol NAME`` runs it (its own options): (points in
+    the protocol, the rows of its results.csv)."""
+    import argparse
+    import csv
 
-    from eoam_sumo.cli import build_parser
     from eoam_sumo.outputs.staging import output_folder
-    from eoam_sumo.protocols.command import PROTOCOL_OUTPUT, run_points, selected_points
+    from eoam_sumo.protocols import command
     from eoam_sumo.protocols.runner import RESULTS_FILE
 
+    parser = argparse.ArgumentParser(prog="eoam-sumo")
+    command.add_arguments(parser.add_subparsers())
     argv = ["protocol", study.source, "--out", str(out), "--jobs", str(jobs)]
-    args = build_parser().parse_args([*argv, "--sumo-step-s", str(step_s), "--no-progress"])
-    points = selected_points(args)
-    with output_folder(out, PROTOCOL_OUTPUT) as folder:
-        run_points(args, _spread(points, quick), folder)
-    return len(points), pd.read_csv(out / RESULTS_FILE)
+    args = parser.parse_args([*argv, "--sumo-step-s", str(step_s), "--no-progress"])
+    points = command.selected_points(args)
+    with output_folder(out, command.PROTOCOL_OUTPUT) as folder:
+        command.run_points(args, _spread(points, quick), folder)
+    with (out / RESULTS_FILE).open(encoding="utf-8", newline="") as f:
+        return len(points), list(csv.DictReader(f))
 
 
 def _study_row(name: str, step_s: float, out_dir: Path, jobs: int, quick: bool) -> dict:

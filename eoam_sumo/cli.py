@@ -528,7 +528,7 @@ def _cmd_batch(args) -> int:
     )
     with (
         _sigterm_interrupts(),
-        output_folder(args.out, batch_output_kind(), in_place=args.resume) as out,
+        output_folder(args.out, _batch_output(), in_place=args.resume) as out,
     ):
         results = run_batch(
             args.matrix,
@@ -577,14 +577,11 @@ def _cmd_xosc_batch(args) -> int:
     return 1 if failed else 0
 
 
-def batch_output_kind():
+def _batch_output():
     """A batch's output folder: what shows a folder holds one."""
-    from eoam_sumo.batch.probabilities import PROBABILITIES_FILE
-    from eoam_sumo.batch.report import TABLE_MD
-    from eoam_sumo.batch.results import CASES_DIR, RESULTS_FILE
-    from eoam_sumo.outputs.staging import OutputKind
+    from eoam_sumo.batch.output import BATCH_OUTPUT
 
-    return OutputKind("batch", (RESULTS_FILE, CASES_DIR, TABLE_MD, PROBABILITIES_FILE))
+    return BATCH_OUTPUT
 
 
 def _raise_interrupt(signum, frame):
