@@ -24,10 +24,11 @@ Figures:
   ``traffic_us_per_user_step``: the co-simulation's own cost per road user in SUMO per step
   (CPU time of the step loop less SUMO alone's for as many steps).
 
-``--studies`` measures instead each study's cost at SUMO steps (``run_studies``): per step the
-step loop's cost split and its cost ratio against SUMO alone at the same SUMO step, the Table 2
-batch's wall time, and its colours, contact partners and figures against the 10 ms reference,
-with the load average.
+``--studies`` measures instead each study (:data:`STUDIES`: Table 2, the 2026 protocol, the
+traffic levels, the vehicles, the 10 000-draw Monte Carlo) at SUMO steps (``run_studies``):
+its wall and CPU time and the load average, and per step the step loop's cost split and its
+cost ratio against SUMO alone at the same SUMO step; Table 2's colours, contact partners and
+figures against the first step's.
 
 ``--against REV`` measures instead this tree against git revision ``REV`` in one run
 (``compare_against``): the plant's step and the Table 2 batch, each in fresh interpreters that
@@ -449,8 +450,8 @@ def table2_changes(reference, other) -> dict:
 
 @dataclass(frozen=True)
 class Study:
-    """One study of issue 43's table: a matrix file or a protocol, run as its command runs it,
-    and the issue's goal for its wall time (2 cores) [s]."""
+    """One study users run: a matrix file or a protocol, run as its command runs it, and the
+    goal for its wall time on 2 cores [s] (docs/performance.md)."""
 
     source: str  # the matrix file, or the protocol's name
     goal_wall_s: float
@@ -458,7 +459,7 @@ class Study:
     timeseries: str = "csv"
 
 
-#: The studies ``bench --studies`` runs (``--study NAME``), in the issue's order.
+#: The studies ``bench --studies`` runs (``--study NAME``), the fewest runs first.
 STUDIES = {
     "table2": Study(str(TABLE2), 5.0),
     "protocol": Study("euroncap-aeb-c2c-2026", 20.0, protocol=True),
@@ -606,7 +607,7 @@ def _loads(row: dict) -> str:
 
 
 def format_study_table(result: dict) -> str:
-    """The studies as one table (issue 43's): one row per study and SUMO step."""
+    """The studies as one table (docs/performance.md): one row per study and SUMO step."""
     lines = [
         f"step loop: {'compiled' if result['compiled'] else 'Python sources'}"
         + (f"; --quick: {QUICK_RUNS} runs of each study" if result["quick"] else ""),

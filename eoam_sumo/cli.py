@@ -329,7 +329,7 @@ def _bench_arguments(sub) -> None:
     p.add_argument(
         "--studies",
         action="store_true",
-        help="instead: each study (issue 43's) timed at each SUMO step, with the step loop's "
+        help="instead: each study timed at each SUMO step, with the step loop's "
         "cost ratio against SUMO alone at that step and the load average",
     )
     p.add_argument(
