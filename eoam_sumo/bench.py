@@ -24,10 +24,11 @@ Figures:
   ``traffic_us_per_user_step``: the co-simulation's own cost per road user in SUMO per step
   (CPU time of the step loop less SUMO alone's for as many steps).
 
-``--studies`` measures instead each study's cost at SUMO steps (``run_studies``): per step the
-step loop's cost split and its cost ratio against SUMO alone at the same SUMO step, the Table 2
-batch's wall time, and its colours, contact partners and figures against the 10 ms reference,
-with the load average.
+``--studies`` measures instead each study (:data:`STUDIES`: Table 2, the 2026 protocol, the
+traffic levels, the vehicles, the 10 000-draw Monte Carlo) at SUMO steps (``run_studies``):
+its wall and CPU time and the load average, and per step the step loop's cost split and its
+cost ratio against SUMO alone at the same SUMO step; Table 2's colours, contact partners and
+figures against the first step's.
 
 ``--against REV`` measures instead this tree against git revision ``REV`` in one run
 (``compare_against``): the plant's step and the Table 2 batch, each in fresh interpreters that
@@ -44,15 +45,18 @@ import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.sim.observers import StepObserver
+from eoam_sumo.sim.settings import STUDY_SUMO_STEP_S
 
 ROOT = Path(__file__).resolve().parents[1]
 BASELINE = ROOT / "scenarios" / "baseline.sumocfg"
-TABLE2 = ROOT / "scenarios" / "table2.toml"
+SCENARIOS = ROOT / "scenarios"
+TABLE2 = SCENARIOS / "table2.toml"
 SPEED_MPS = 120 / 3.6
 TARGETS = {
     "realtime_factor": (">=", 100.0),
@@ -365,8 +369,6 @@ def format_table(result: dict) -> str:
 
 # --- the studies at SUMO steps (``eoam-sumo bench --studies``) --------------------------------
 
-#: The SUMO steps the studies are measured at unless given [s]; the first is the reference.
-STUDY_SUMO_STEPS_S = (0.01, 0.05, 0.1)
 #: Table 2's figures compared with the reference step's (the golden Table 2's key figures).
 TABLE2_FIGURES = (
     "impact_speed_mps",
@@ -446,70 +448,202 @@ def table2_changes(reference, other) -> dict:
     }
 
 
-def _study_step(sumo_step_s: float, out_dir: Path, repeats: int, jobs: int, quick: bool) -> dict:
-    """One SUMO step: the step loop's figures (bench case) and the Table 2 batch, timed."""
-    from eoam_sumo.batch.runner import run_batch
+@dataclass(frozen=True)
+class Study:
+    """One study users run: a matrix file or a protocol, run as its command runs it, and the
+    goal for its wall time on 2 cores [s] (docs/performance.md)."""
 
-    row: dict[str, Any] = {"sumo_step_s": sumo_step_s, "load_avg_start": load_average()}
-    loop = _cosim_and_sumo_only(repeats, sumo_step_s)
-    row.update({k: loop[k] for k in _LOOP_KEYS})
-    matrix = _quick_matrix(out_dir) if quick else TABLE2
+    source: str  # the matrix file, or the protocol's name
+    goal_wall_s: float
+    protocol: bool = False
+    timeseries: str = "csv"
+
+
+#: The studies ``bench --studies`` runs (``--study NAME``), the fewest runs first.
+STUDIES = {
+    "table2": Study(str(TABLE2), 5.0),
+    "protocol": Study("euroncap-aeb-c2c-2026", 20.0, protocol=True),
+    "traffic-levels": Study(str(SCENARIOS / "traffic_levels.toml"), 180.0, timeseries="none"),
+    "vehicles": Study(str(SCENARIOS / "vehicles.toml"), 120.0),
+    "monte-carlo": Study(str(SCENARIOS / "monte_carlo.toml"), 300.0, timeseries="none"),
+}
+#: ``--quick``: this many runs of each study, spread evenly over it (every len/N-th run).
+QUICK_RUNS = 2
+
+
+def check_studies(names) -> tuple[str, ...]:
+    """The studies asked for, in order, without repeats (none: every study); InputError
+    naming an unknown one."""
+    for name in names:
+        if name not in STUDIES:
+            raise InputError(f"--study {name!r} is not one of {', '.join(STUDIES)}")
+    return tuple(dict.fromkeys(names)) or tuple(STUDIES)
+
+
+def _spread(items: list, quick: bool) -> list:
+    """``items``, or with ``quick`` :data:`QUICK_RUNS` of them spread evenly."""
+    return items[:: max(1, len(items) // QUICK_RUNS)][:QUICK_RUNS] if quick else items
+
+
+def _matrix_study(study: Study, out: Path, step_s: float, jobs: int, quick: bool):
+    """A matrix study as ``eoam-sumo batch`` runs it (its figures not drawn): (runs in the
+    study, results frame)."""
+    from dataclasses import replace
+
+    from eoam_sumo.batch.output import BATCH_OUTPUT
+    from eoam_sumo.batch.runner import plan_batch, run_batch
+    from eoam_sumo.outputs.staging import output_folder
+
+    plan = plan_batch(Path(study.source), sumo_step_s=step_s)
+    total = len(plan.cases)
+    plan = replace(plan, cases=_spread(plan.cases, quick))
+    with output_folder(out, BATCH_OUTPUT) as folder:
+        results = run_batch(
+            Path(study.source),
+            folder,
+            jobs=jobs,
+            progress=False,
+            timeseries=study.timeseries,
+            plan=plan,
+        )
+    return total, results
+
+
+def _protocol_study(study: Study, out: Path, step_s: float, jobs: int, quick: bool):
+    """A protocol study as ``eoam-sumo protocol NAME`` runs it (its own options): (points in
+    the protocol, the rows of its results.csv)."""
+    import argparse
+    import csv
+
+    from eoam_sumo.outputs.staging import output_folder
+    from eoam_sumo.protocols import command
+    from eoam_sumo.protocols.runner import RESULTS_FILE
+
+    parser = argparse.ArgumentParser(prog="eoam-sumo")
+    command.add_arguments(parser.add_subparsers())
+    argv = ["protocol", study.source, "--out", str(out), "--jobs", str(jobs)]
+    args = parser.parse_args([*argv, "--sumo-step-s", str(step_s), "--no-progress"])
+    points = command.selected_points(args)
+    with output_folder(out, command.PROTOCOL_OUTPUT) as folder:
+        command.run_points(args, _spread(points, quick), folder)
+    with (out / RESULTS_FILE).open(encoding="utf-8", newline="") as f:
+        return len(points), list(csv.DictReader(f))
+
+
+def _study_row(name: str, step_s: float, out_dir: Path, jobs: int, quick: bool) -> dict:
+    """One study at one SUMO step, timed (wall, and CPU of this process and its ended
+    workers), with the load average before and after; its folder kept in ``out_dir``."""
+    study = STUDIES[name]
+    run = _protocol_study if study.protocol else _matrix_study
+    out = out_dir / f"{name}_{round(step_s * 1000)}ms"
+    row: dict[str, Any] = {"study": name, "sumo_step_s": step_s, "jobs": jobs}
+    row["load_avg_start"] = load_average()
     t0, cpu0 = time.perf_counter(), _process_tree_cpu_s()
-    results = run_batch(
-        matrix,
-        out_dir / f"table2_{round(sumo_step_s * 1000)}ms",
-        jobs=jobs,
-        progress=False,
-        sumo_step_s=sumo_step_s,
-    )
-    row["table2_wall_s"] = time.perf_counter() - t0
-    row["table2_cpu_s"] = _process_tree_cpu_s() - cpu0
-    row["table2_cases"] = len(results)
+    total, results = run(study, out, step_s, jobs, quick)
+    row["wall_s"] = time.perf_counter() - t0
+    row["cpu_s"] = _process_tree_cpu_s() - cpu0
     row["load_avg_end"] = load_average()
+    row["runs"], row["study_runs"] = len(results), total
+    row["cpu_s_per_run"] = row["cpu_s"] / max(1, len(results))
+    row["goal_wall_s"] = study.goal_wall_s
+    row["out"] = str(out)
     return {**row, "_results": results}
+
+
+def _study_step(
+    sumo_step_s: float, out_dir: Path, repeats: int, jobs: int, quick: bool, names
+) -> tuple[dict, list[dict]]:
+    """One SUMO step: the step loop's figures (bench case) and its cost ratio against SUMO
+    alone at that step, then each study, timed (:func:`_study_row`)."""
+    step: dict[str, Any] = {"sumo_step_s": sumo_step_s, "load_avg_start": load_average()}
+    loop = _cosim_and_sumo_only(repeats, sumo_step_s)
+    step.update({k: loop[k] for k in _LOOP_KEYS})
+    rows = [_study_row(n, sumo_step_s, out_dir, jobs, quick) for n in names]
+    for row in rows:
+        row["cosim_over_sumo_cost"] = loop["cosim_over_sumo_cost"]
+        row["cosim_over_sumo_cpu_cost"] = loop["cosim_over_sumo_cpu_cost"]
+        if row["study"] == "table2":
+            step["table2_wall_s"], step["table2_cpu_s"] = row["wall_s"], row["cpu_s"]
+            step["table2_cases"], step["_results"] = row["runs"], row["_results"]
+        row.pop("_results")
+    step["load_avg_end"] = load_average()
+    return step, rows
 
 
 def run_studies(
     out_dir: Path,
-    steps_s: tuple[float, ...] = STUDY_SUMO_STEPS_S,
+    steps_s: tuple[float, ...] = (STUDY_SUMO_STEP_S,),
     jobs: int = 2,
     quick: bool = False,
+    studies: tuple[str, ...] = (),
 ) -> dict:
-    """Each SUMO step's figures (:func:`_study_step`), Table 2 against the first step's
-    (:func:`table2_changes`); writes ``bench-studies.json`` and keeps each batch's folder."""
+    """Each study (:data:`STUDIES`; none named: all) at each SUMO step (:func:`_study_step`),
+    Table 2 against the first step's (:func:`table2_changes`); writes ``bench-studies.json``
+    and keeps each study's folder."""
+    names = check_studies(studies)
     repeats = 1 if quick else 7
     out_dir.mkdir(parents=True, exist_ok=True)
-    rows = [_study_step(s, out_dir, repeats, jobs, quick) for s in steps_s]
-    reference = rows[0].pop("_results")
-    for row in rows[1:]:
-        row["table2_vs_reference"] = table2_changes(reference, row.pop("_results"))
-    result = {"quick": quick, "jobs": jobs, "compiled": _compiled(), "studies": rows}
+    done = [_study_step(s, out_dir, repeats, jobs, quick, names) for s in steps_s]
+    steps = [step for step, _rows in done]
+    if "table2" in names:
+        reference = steps[0].pop("_results")
+        for step in steps[1:]:
+            step["table2_vs_reference"] = table2_changes(reference, step.pop("_results"))
+    result = {
+        "quick": quick,
+        "jobs": jobs,
+        "compiled": _compiled(),
+        "studies": steps,
+        "study_rows": [row for _step, rows in done for row in rows],
+    }
     (out_dir / "bench-studies.json").write_text(json.dumps(result, indent=2) + "\n")
     return result
 
 
-def format_studies(result: dict) -> str:
-    """The studies as a table, one row per SUMO step (per-step costs per 10 ms step)."""
+def _loads(row: dict) -> str:
+    """The 1-minute load average before and after, as ``a-b``."""
+    loads = row["load_avg_start"][:1] + row["load_avg_end"][:1]
+    return "-".join(f"{v:g}" for v in loads) or "-"
+
+
+def format_study_table(result: dict) -> str:
+    """The studies as one table (docs/performance.md): one row per study and SUMO step."""
     lines = [
-        f"step loop: {'compiled' if result['compiled'] else 'Python sources'}; "
-        f"Table 2 with {result['jobs']} jobs",
-        "sumo step s | load avg (1 min) | Table 2 wall s (CPU s) | cost ratio wall (CPU) | "
-        "us/step: sumo sense control plant contact (loop CPU) | colour / partner changes | "
-        "max |d| impact m/s, gap ARO m",
+        f"step loop: {'compiled' if result['compiled'] else 'Python sources'}"
+        + (f"; --quick: {QUICK_RUNS} runs of each study" if result["quick"] else ""),
+        "study | runs | sumo step s | jobs | wall s | goal s | CPU s | CPU s per run | "
+        "load avg (1 min) | cost ratio wall (CPU)",
+    ]
+    for r in result["study_rows"]:
+        runs = f"{r['runs']}" + (f" of {r['study_runs']}" if r["runs"] != r["study_runs"] else "")
+        lines.append(
+            f"{r['study']} | {runs} | {r['sumo_step_s']:g} | {r['jobs']} | {r['wall_s']:.1f} | "
+            f"<= {r['goal_wall_s']:g} | {r['cpu_s']:.1f} | {r['cpu_s_per_run']:.2f} | "
+            f"{_loads(r)} | "
+            f"{r['cosim_over_sumo_cost']:.2f} ({r['cosim_over_sumo_cpu_cost']:.2f})"
+        )
+    return "\n".join(lines)
+
+
+def format_studies(result: dict) -> str:
+    """The step loop at each SUMO step (per-step costs per 10 ms step), Table 2 against the
+    first step where Table 2 ran at more than one."""
+    lines = [
+        "sumo step s | load avg (1 min) | cost ratio wall (CPU) | "
+        "us/step: sumo sense control plant contact (loop CPU) | Table 2 colour / partner "
+        "changes | max |d| impact m/s, gap ARO m",
     ]
     for r in result["studies"]:
         cmp = r.get("table2_vs_reference")
-        diff = "reference"
+        diff = "reference" if "table2_cases" in r else "-"
         if cmp is not None:
             d = cmp["max_abs_delta"]
             diff = (
                 f"{len(cmp['colour_changes'])} / {len(cmp['partner_changes'])} | "
                 f"{d.get('impact_speed_mps', 0.0):.3f}, {d.get('min_gap_aro_m', 0.0):.3f}"
             )
-        loads = (r["load_avg_start"][:1] + r["load_avg_end"][:1]) or ["-"]
         lines.append(
-            f"{r['sumo_step_s']:g} | {'-'.join(f'{v:g}' for v in loads)} | "
-            f"{r['table2_wall_s']:.1f} ({r['table2_cpu_s']:.1f}) | "
+            f"{r['sumo_step_s']:g} | {_loads(r)} | "
             f"{r['cosim_over_sumo_cost']:.2f} ({r['cosim_over_sumo_cpu_cost']:.2f}) | "
             f"{r['sumo_us_per_step']:.1f} {r['sense_us_per_step']:.1f} "
             f"{r['control_us_per_step']:.1f} {r['plant_us_per_step']:.1f} "
@@ -518,8 +652,11 @@ def format_studies(result: dict) -> str:
     return "\n".join(lines)
 
 
-def run_studies_cli(out_dir: Path, steps_s: tuple[float, ...], jobs: int, quick: bool) -> int:
-    result = run_studies(out_dir, steps_s, jobs, quick)
+def run_studies_cli(
+    out_dir: Path, steps_s: tuple[float, ...], jobs: int, quick: bool, studies: tuple[str, ...]
+) -> int:
+    result = run_studies(out_dir, steps_s, jobs, quick, studies)
+    print(format_study_table(result))
     print(format_studies(result))
     print(f"written {out_dir / 'bench-studies.json'}")
     return 0

@@ -329,16 +329,25 @@ def _bench_arguments(sub) -> None:
     p.add_argument(
         "--studies",
         action="store_true",
-        help="instead: per SUMO step the step loop's cost ratio against SUMO alone at that "
-        "step, Table 2's wall time and its changes against the first step, the load average",
+        help="instead: each study timed at each SUMO step, with the step loop's "
+        "cost ratio against SUMO alone at that step and the load average",
+    )
+    p.add_argument(
+        "--study",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="with --studies (implied): this study only, repeatable (table2, protocol, "
+        "traffic-levels, vehicles, monte-carlo; default: all)",
     )
     p.add_argument(
         "--sumo-steps",
         type=finite,
         nargs="+",
         metavar="S",
-        default=(0.01, 0.05, 0.1),
-        help="with --studies: SUMO steps [s], the first the reference (0.01 0.05 0.1)",
+        default=(STUDY_SUMO_STEP_S,),
+        help="with --studies: SUMO steps [s], the first Table 2's reference "
+        f"(default {STUDY_SUMO_STEP_S:g})",
     )
     p.add_argument("--jobs", type=_positive_int, default=2, help="with --studies: batch jobs")
 
@@ -570,12 +579,9 @@ def _cmd_xosc_batch(args) -> int:
 
 def _batch_output():
     """A batch's output folder: what shows a folder holds one."""
-    from eoam_sumo.batch.probabilities import PROBABILITIES_FILE
-    from eoam_sumo.batch.report import TABLE_MD
-    from eoam_sumo.batch.results import CASES_DIR, RESULTS_FILE
-    from eoam_sumo.outputs.staging import OutputKind
+    from eoam_sumo.batch.output import BATCH_OUTPUT
 
-    return OutputKind("batch", (RESULTS_FILE, CASES_DIR, TABLE_MD, PROBABILITIES_FILE))
+    return BATCH_OUTPUT
 
 
 def _raise_interrupt(signum, frame):
@@ -647,11 +653,12 @@ def _cmd_bench(args) -> int:
 
     if args.against is not None:
         return run_against_cli(writable_dir(args.out), args.against, args.quick, args.pairs)
-    if args.studies:
-        from eoam_sumo.bench import run_studies_cli
+    if args.studies or args.study:
+        from eoam_sumo.bench import check_studies, run_studies_cli
 
+        studies = check_studies(args.study)
         steps = tuple(check_sumo_step_s(s, "--sumo-steps") for s in args.sumo_steps)
-        return run_studies_cli(writable_dir(args.out), steps, args.jobs, args.quick)
+        return run_studies_cli(writable_dir(args.out), steps, args.jobs, args.quick, studies)
     return run_bench_cli(writable_dir(args.out), quick=args.quick)
 
 

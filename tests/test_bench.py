@@ -178,14 +178,74 @@ def test_table2_changes_counts_colour_and_partner_changes_and_the_largest_figure
 
 def test_studies_keys_are_documented():
     text = PERFORMANCE.read_text(encoding="utf-8")
-    for key in ("bench-studies.json", "table2_wall_s", "load_avg_start", "table2_vs_reference"):
+    keys = ("bench-studies.json", "table2_wall_s", "load_avg_start", "table2_vs_reference")
+    for key in (*keys, "study_rows", *STUDY_ROW_KEYS, *bench.STUDIES):
         assert key in text, key
     assert bench.load_average() == [] or len(bench.load_average()) == 3
 
 
+STUDY_ROW_KEYS = (
+    "study",
+    "runs",
+    "study_runs",
+    "sumo_step_s",
+    "jobs",
+    "wall_s",
+    "cpu_s",
+    "cpu_s_per_run",
+    "load_avg_end",
+    "goal_wall_s",
+    "cosim_over_sumo_cost",
+    "cosim_over_sumo_cpu_cost",
+    "out",
+)
+
+
+def test_every_study_names_an_existing_matrix_or_protocol():
+    from eoam_sumo.matrix import load_matrix
+    from eoam_sumo.protocols.points import PROTOCOLS
+
+    for name, study in bench.STUDIES.items():
+        if study.protocol:
+            assert study.source in PROTOCOLS, name
+        else:
+            assert load_matrix(Path(study.source)).cases(), name
+    sizes = {n: len(load_matrix(Path(s.source)).cases()) for n, s in bench.STUDIES.items()
+             if not s.protocol}  # fmt: skip
+    assert sizes == {"table2": 64, "traffic-levels": 312, "vehicles": 1536, "monte-carlo": 10000}
+
+
+def test_quick_takes_runs_spread_over_the_study():
+    assert bench._spread(list(range(10)), quick=True) == [0, 5]
+    assert bench._spread([7], quick=True) == [7]
+    assert bench._spread(list(range(10)), quick=False) == list(range(10))
+
+
+def test_an_unknown_study_is_one_line_and_exit_2(tmp_path):
+    out = tmp_path / "out"
+    done = subprocess.run(
+        [sys.executable, "-m", "eoam_sumo", "bench", "--study", "tabel2", "--out", str(out)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1 and "'tabel2'" in done.stderr
+    assert "monte-carlo" in done.stderr and "Traceback" not in done.stderr
+    assert not out.exists()
+    assert bench.check_studies([]) == tuple(bench.STUDIES)
+    assert bench.check_studies(["vehicles", "table2", "vehicles"]) == ("vehicles", "table2")
+
+
+def _rows_written(folder: Path) -> int:
+    import pandas as pd
+
+    return len(pd.read_csv(folder / "results.csv"))
+
+
 @pytest.mark.sumo
 def test_quick_studies_write_each_step_and_the_changes_against_the_first(tmp_path):
-    result = bench.run_studies(tmp_path, (0.01, 0.1), jobs=1, quick=True)
+    result = bench.run_studies(tmp_path, (0.01, 0.1), 1, True, ("table2", "protocol"))
     saved = json.loads((tmp_path / "bench-studies.json").read_text())
     assert saved == json.loads(json.dumps(result))
     first, second = saved["studies"]
@@ -196,5 +256,23 @@ def test_quick_studies_write_each_step_and_the_changes_against_the_first(tmp_pat
     for row in saved["studies"]:
         assert row["table2_cases"] == 2 and row["table2_wall_s"] > 0 and row["table2_cpu_s"] > 0
         assert row["cosim_over_sumo_cost"] > 0 and row["loop_cpu_us_per_step"] > 0
+    rows = saved["study_rows"]
+    assert [(r["study"], r["sumo_step_s"]) for r in rows] == [
+        ("table2", 0.01),
+        ("protocol", 0.01),
+        ("table2", 0.1),
+        ("protocol", 0.1),
+    ]
+    for row in rows:
+        assert set(STUDY_ROW_KEYS) <= set(row)
+        assert row["runs"] == bench.QUICK_RUNS == _rows_written(Path(row["out"]))
+        assert row["study_runs"] == {"table2": 64, "protocol": 274}[row["study"]]
+        assert row["cpu_s_per_run"] == pytest.approx(row["cpu_s"] / row["runs"])
+        step = next(s for s in saved["studies"] if s["sumo_step_s"] == row["sumo_step_s"])
+        assert row["cosim_over_sumo_cost"] == step["cosim_over_sumo_cost"]
     assert (tmp_path / "table2_100ms" / "results.csv").is_file()
+    assert (tmp_path / "protocol_10ms" / "scorecard.md").is_file()
+    table = bench.format_study_table(result).splitlines()
+    assert table[1].split(" | ")[:6] == ["study", "runs", "sumo step s", "jobs", "wall s", "goal s"]
+    assert table[2].startswith("table2 | 2 of 64 | 0.01 | 1 | ") and len(table) == 6
     assert "0.1 |" in bench.format_studies(result)

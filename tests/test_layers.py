@@ -101,6 +101,7 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
             "sensing",
             "sim",
             "matrix",
+            "outputs",
             "traffic_levels",
             "vehicle_files",
         },
@@ -119,7 +120,18 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
     "openscenario": ({"params", "errors", "fileio", "netbuild", "sim", "batch"}, {"sumolib"}),
     "traffic_levels": ({"errors", "seeds", "netbuild", "outputs"}, {"numpy", "libsumo"}),
     "bench": (
-        {"params", "errors", "plant", "offline", "sensing", "sim", "batch", "traffic_scenario"},
+        {
+            "params",
+            "errors",
+            "plant",
+            "offline",
+            "sensing",
+            "sim",
+            "batch",
+            "outputs",
+            "protocols",
+            "traffic_scenario",
+        },
         {"libsumo", "sumolib"},
     ),
     "protocols": (

@@ -91,6 +91,7 @@ def selected_points(args) -> list[TestPoint]:
         raise InputError(f"--mu {args.mu:g} is outside (0, {MU_MAX:g}]")
     if args.jobs < 1:
         raise InputError(f"--jobs {args.jobs} must be >= 1")
+    _sumo_step_s(args)
     params = vehicle_params(args.vehicle, args.abs, args.esc)
     _check_mu_in_tables(args, params)
     points = protocol_points(args.name, params.width_m)
@@ -122,28 +123,38 @@ def run(args) -> int:
     """Run the protocol; 0 when every point ran, 1 when one failed. The output folder is
     written by this process alone; a re-run over an earlier one writes a staging folder that
     replaces it once complete (:mod:`eoam_sumo.outputs.staging`)."""
-    from eoam_sumo.protocols.runner import run_protocol
-
     points = selected_points(args)
-    sumo_step_s = STUDY_SUMO_STEP_S
-    if args.sumo_step_s is not None:
-        sumo_step_s = check_sumo_step_s(args.sumo_step_s, "--sumo-step-s")
     with output_folder(Path(args.out), PROTOCOL_OUTPUT) as out:
-        summary = run_protocol(
-            args.name,
-            points,
-            out,
-            jobs=args.jobs,
-            scheduler=args.scheduler,
-            policy=args.policy,
-            system=args.system,
-            mu=args.mu,
-            vehicle=vehicle_label(args),
-            vehicle_id=args.vehicle,
-            params=vehicle_params(args.vehicle, args.abs, args.esc),
-            progress=not args.no_progress,
-            max_time_s=MAX_TIME_S,
-            sumo_step_s=sumo_step_s,
-        )
+        summary = run_points(args, points, out)
     print(summary.line(Path(args.out)))
     return 1 if summary.failed else 0
+
+
+def run_points(args, points: list[TestPoint], out: Path):
+    """Run and score ``points`` (:func:`selected_points`) into the folder ``out`` with the
+    ``protocol`` options ``args``; the run's ``ProtocolSummary``."""
+    from eoam_sumo.protocols.runner import run_protocol
+
+    return run_protocol(
+        args.name,
+        points,
+        out,
+        jobs=args.jobs,
+        scheduler=args.scheduler,
+        policy=args.policy,
+        system=args.system,
+        mu=args.mu,
+        vehicle=vehicle_label(args),
+        vehicle_id=args.vehicle,
+        params=vehicle_params(args.vehicle, args.abs, args.esc),
+        progress=not args.no_progress,
+        max_time_s=MAX_TIME_S,
+        sumo_step_s=_sumo_step_s(args),
+    )
+
+
+def _sumo_step_s(args) -> float:
+    """``--sumo-step-s`` checked, else the studies' default step."""
+    if args.sumo_step_s is None:
+        return STUDY_SUMO_STEP_S
+    return check_sumo_step_s(args.sumo_step_s, "--sumo-step-s")
