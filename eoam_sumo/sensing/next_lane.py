@@ -291,15 +291,16 @@ class NextLaneSensing:
             if math.hypot(b.x_m - fx, b.y_m - fy) > reach + b.box.radius_m:
                 continue  # beyond both corner radars and not beside the body
             s, d, ryaw = self._project(road, b)
+            # the cheap tests first (all are pure): in the lane, not the obstacle, then seen
+            if not self._in_lane(d, b.width_m, lane_lo, lane_hi):
+                continue
+            if in_path is not None and _same(s, b.length_m, in_path.s_m, in_path.length_m):
+                continue
             beside = (
                 s - 0.5 * b.length_m <= s_f + BESIDE_M
                 and s + 0.5 * b.length_m >= s_f - self.ego_length_m - BESIDE_M
             )
             if not beside and not any(self._corner_sees(b, *corner) for corner in corners):
-                continue
-            if not self._in_lane(d, b.width_m, lane_lo, lane_hi):
-                continue
-            if in_path is not None and _same(s, b.length_m, in_path.s_m, in_path.length_m):
                 continue
             if any(
                 _same(s, b.length_m, q[0], q[3]) and abs(d - q[1]) < FUSION_GATE_M

@@ -207,37 +207,48 @@ class Margins(StepObserver):
         by the heading relative to the road, give the time to contact
         (``geometry.time_to_contact``)."""
         ego, ego_v = self._ego_in_frame(sim)
-        follower: tuple[float, Body, OrientedBox, tuple[float, float]] | None = None
+        follower: tuple[float, Body, float, tuple[float, float]] | None = None
+        project, band = self._frame.project, self._band_m
         for b in sim.bodies:
             if b.parked:
                 continue
-            box, v = self._in_frame(b)
-            if box.cos_yaw < 0.0:  # opposite direction
+            st, d, road_yaw = project(b.x_m, b.y_m)
+            rel = b.yaw_rad - road_yaw
+            if math.cos(rel) < 0.0:  # opposite direction
+                v = self._rates(b, st, d, rel)
+                radius = math.hypot(0.5 * b.length_m, 0.5 * b.width_m)
+                if _apart(ego, st, d, radius, ego_v, v, self.min_ttc_oncoming_s):
+                    continue  # never on a collision course within the smallest yet
+                box = OrientedBox(st, d, rel, b.length_m, b.width_m)
                 ttc = time_to_contact(ego, box, ego_v, v, self.min_ttc_oncoming_s)
                 self.min_ttc_oncoming_s = min(self.min_ttc_oncoming_s, ttc)
                 self.min_ttc_s = min(self.min_ttc_s, ttc)
                 continue
-            behind_m = ego.x_m - box.x_m
-            if behind_m < 0.0 and abs(box.y_m) < self._band_m:
+            behind_m = ego.x_m - st
+            if behind_m < 0.0 and abs(d) < band:
                 continue  # the obstacle ahead in the ego's lane: its margin is the gap
             horizon = min(self.min_ttc_s, TTC_HORIZON_S)
             if behind_m > 0.0:
                 horizon = max(horizon, min(self.min_ttc_rear_s, TTC_HORIZON_S))
-            if _apart(ego, box, ego_v, v, horizon):
+            v = self._rates(b, st, d, rel)
+            # the box in the frame only when its bounding circle may meet the ego's
+            radius = math.hypot(0.5 * b.length_m, 0.5 * b.width_m)
+            if _apart(ego, st, d, radius, ego_v, v, horizon):
                 ttc = math.inf
             else:
+                box = OrientedBox(st, d, rel, b.length_m, b.width_m)
                 ttc = time_to_contact(ego, box, ego_v, v, horizon)
             self.min_ttc_s = min(self.min_ttc_s, ttc)
             if behind_m <= 0.0:
                 continue
             self.min_ttc_rear_s = min(self.min_ttc_rear_s, ttc)
-            overlap = abs(box.y_m - ego.y_m) < 0.5 * (self.width_m + b.width_m)
+            overlap = abs(d - ego.y_m) < 0.5 * (self.width_m + b.width_m)
             if (
                 overlap
                 and behind_m < FOLLOWER_REACH_M
                 and (follower is None or behind_m < follower[0])
             ):
-                follower = (behind_m, b, box, v)
+                follower = (behind_m, b, st, v)
         if follower is not None:
             self._follower(sim, ego, ego_v, follower[1], follower[2], follower[3])
 
@@ -253,13 +264,11 @@ class Margins(StepObserver):
         v = ((vx * cr - vy * sr) / stretch, vx * sr + vy * cr)
         return OrientedBox(st, d, rel, self.length_m, self.width_m), v
 
-    def _in_frame(self, b: Body) -> tuple[OrientedBox, tuple[float, float]]:
-        """A road user's box in the road frame, and its rates (s', d')."""
-        st, d, road_yaw = self._frame.project(b.x_m, b.y_m)
-        rel = b.yaw_rad - road_yaw
+    def _rates(self, b: Body, st: float, d: float, rel: float) -> tuple[float, float]:
+        """A road user's rates (s', d') in the road frame, at station ``st``, offset ``d``,
+        heading ``rel`` to the road."""
         stretch = 1.0 - self._frame.curvature_at(st) * d
-        v = (b.speed_mps * math.cos(rel) / stretch, b.speed_mps * math.sin(rel))
-        return OrientedBox(st, d, rel, b.length_m, b.width_m), v
+        return (b.speed_mps * math.cos(rel) / stretch, b.speed_mps * math.sin(rel))
 
     def _follower(
         self,
@@ -267,7 +276,7 @@ class Margins(StepObserver):
         ego: OrientedBox,
         ego_v: tuple[float, float],
         b: Body,
-        box: OrientedBox,
+        station_m: float,
         v: tuple[float, float],
     ) -> None:
         """The nearest road user behind the ego overlapping its width (the ego is its
@@ -276,7 +285,7 @@ class Margins(StepObserver):
         within ``LEADER_HEADWAY_S`` of its own travel behind the ego (forced by the ego: a car
         the ego cut in front of brakes though it is slower; one falling back farther, or a
         scripted stop such as an obstacle the ego passed, is not)."""
-        gap = ego.x_m - 0.5 * ego.length_m - (box.x_m + 0.5 * b.length_m)
+        gap = ego.x_m - 0.5 * ego.length_m - (station_m + 0.5 * b.length_m)
         self.min_gap_rear_m = min(self.min_gap_rear_m, max(gap, 0.0))
         closing = v[0] - ego_v[0]
         if closing > 0.0 and gap > 0.0:
@@ -291,16 +300,32 @@ class Margins(StepObserver):
 
 
 def _apart(
-    a: OrientedBox, b: OrientedBox, va: tuple[float, float], vb: tuple[float, float], t_s: float
+    a: OrientedBox,
+    x_m: float,
+    y_m: float,
+    radius_m: float,
+    va: tuple[float, float],
+    vb: tuple[float, float],
+    t_s: float,
 ) -> bool:
-    """Whether two boxes moving at these rates cannot touch within ``t_s``: along either
-    axis of the frame their centres are farther apart than their bounding circles plus what
-    the rate between them closes in that time."""
-    reach = a.radius_m + b.radius_m + GAP_ROUNDING_M
-    return (
-        abs(b.x_m - a.x_m) - reach > abs(vb[0] - va[0]) * t_s
-        or abs(b.y_m - a.y_m) - reach > abs(vb[1] - va[1]) * t_s
+    """Whether a box and a road user centred at (``x_m``, ``y_m``) within ``radius_m``,
+    moving at these rates, cannot touch within ``t_s`` (infinite: ever): along either axis
+    of the frame their centres are farther apart than their bounding circles, by more than
+    the rate between them closes in that time (not at all when it opens or holds)."""
+    reach = a.radius_m + radius_m + GAP_ROUNDING_M
+    return _axis_apart(x_m - a.x_m, vb[0] - va[0], reach, t_s) or _axis_apart(
+        y_m - a.y_m, vb[1] - va[1], reach, t_s
     )
+
+
+def _axis_apart(offset_m: float, rate_mps: float, reach_m: float, t_s: float) -> bool:
+    """Centres ``offset_m`` apart on an axis, the offset changing at ``rate_mps``: farther
+    than ``reach_m`` for the whole of ``t_s``."""
+    gap = abs(offset_m) - reach_m
+    if gap <= 0.0:
+        return False
+    closing = -rate_mps if offset_m > 0.0 else rate_mps
+    return closing <= 0.0 or closing * t_s < gap
 
 
 def road_user_close_ahead(
