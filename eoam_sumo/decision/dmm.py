@@ -176,14 +176,16 @@ class BoundaryCurve:
     ``LOW_SPEED_SAMPLES`` speeds from 0 to the lowest of them, where the stopping distance is
     quadratic in v (eq. 33; linear blending between samples 1/24 of the lowest speed apart
     overestimates it by at most 1/4608 of B0 there); ``at`` and ``sector`` then cost a
-    bisection and a linear blend. Above the last speed the last row is used. ``stop_scale``
+    bisection and a linear blend. A row is looked up at its first use (an estimated friction
+    changes the curve every few steps, which then reads two or three of its rows). Above the
+    last speed the last row is used. ``stop_scale``
     (>= 1) lengthens the stopping distance B0 (and Bb by as much) where limit braking
     delivers less than the tables' deceleration (eq. 33: B0 = v^2 / 2a scales with 1 / a).
     ``lateral_stop_factor`` (>= 1, set at each step) lengthens B0 (and Bb by as much) further
     where a curve's lateral acceleration takes part of the friction ellipse.
     """
 
-    __slots__ = ("_rows", "_speeds", "lateral_stop_factor", "mu")
+    __slots__ = ("_boundaries", "_rows", "_speeds", "_stop_scale", "lateral_stop_factor", "mu")
 
     def __init__(self, boundaries, mu: float, speeds_mps, stop_scale: float = 1.0):
         given = sorted({0.0, *(float(v) for v in speeds_mps)})
@@ -193,23 +195,31 @@ class BoundaryCurve:
             raise ValueError(f"stop_scale={stop_scale!r} must be finite and >= 1")
         n = LOW_SPEED_SAMPLES
         speeds = sorted({*given, *(given[1] * k / n for k in range(n))})
-        rows = []
-        for v in speeds:
-            b = boundaries.at(mu, v)
-            longer = float(b.stop_m) * (stop_scale - 1.0)
-            row = (  # plain tuples: indexing a tuple subclass is slower
-                float(b.clear_opt_m),
-                float(b.clear_buffered_m),
-                float(b.stop_m) + longer,
-                float(b.stop_buffered_m) + longer,
-                float(b.ttc_s),
-            )
-            if not all(math.isfinite(x) for x in row):
-                raise ValueError(f"non-finite DMM boundary at mu={mu}, v={v}")
-            rows.append(row)
         self.mu = mu
-        self._speeds, self._rows = speeds, rows
+        self._boundaries, self._stop_scale = boundaries, stop_scale
+        self._speeds = speeds
+        self._rows: list[tuple[float, float, float, float, float] | None] = [None] * len(speeds)
         self.lateral_stop_factor = 1.0
+
+    def _row(self, i: int) -> tuple[float, float, float, float, float]:
+        """The boundaries at ``self._speeds[i]`` (looked up once, at the first use)."""
+        row = self._rows[i]
+        if row is not None:
+            return row
+        mu, v = self.mu, self._speeds[i]
+        b = self._boundaries.at(mu, v)
+        longer = float(b.stop_m) * (self._stop_scale - 1.0)
+        row = (  # plain tuples: indexing a tuple subclass is slower
+            float(b.clear_opt_m),
+            float(b.clear_buffered_m),
+            float(b.stop_m) + longer,
+            float(b.stop_buffered_m) + longer,
+            float(b.ttc_s),
+        )
+        if not all(math.isfinite(x) for x in row):
+            raise ValueError(f"non-finite DMM boundary at mu={mu}, v={v}")
+        self._rows[i] = row
+        return row
 
     def at(self, rel_speed_mps: float) -> BoundaryRow:
         """The boundaries at a closing speed (held at the ends of the speed range)."""
@@ -230,12 +240,12 @@ class BoundaryCurve:
         speeds = self._speeds
         j = bisect_right(speeds, rel_speed_mps)
         if j <= 0:
-            return self._rows[0]
+            return self._row(0)
         if j >= len(speeds):
-            return self._rows[-1]
+            return self._row(len(speeds) - 1)
         v0 = speeds[j - 1]
         w = (rel_speed_mps - v0) / (speeds[j] - v0)
-        a, b = self._rows[j - 1], self._rows[j]
+        a, b = self._row(j - 1), self._row(j)
         return (
             a[0] + w * (b[0] - a[0]),
             a[1] + w * (b[1] - a[1]),

@@ -39,8 +39,9 @@ def longitudinal_control(
         if mode is ONCOMING_BRAKE and shares_ellipse(parts, state, meas):
             floor = parts.settings.limit_brake_floor * state.friction_now().brake_limit_n
             # the brake has priority (the steering takes the ellipse's rest), below what
-            # locks a wheel braking straight
-            brake_lim = max(brake_lim, min(floor, long.wheel_lock_limit_n(v, mu, 0.0)))
+            # locks a wheel braking straight (only looked up when the floor would raise it)
+            if not floor <= brake_lim:
+                brake_lim = max(brake_lim, min(floor, long.wheel_lock_limit_n(v, mu, 0.0)))
         return LongitudinalOutput(0.0, brake_lim, -brake_lim / parts.params.mass_kg, 0.0)
     if tracking:
         drive, brake = long.track_accel(
