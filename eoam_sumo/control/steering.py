@@ -15,7 +15,9 @@
 
 On a planned manoeuvre (the lookup tables' lane change, planned with the plant's tyre) the
 feedforward is the plan's own road-wheel angle taken a little ahead and the reference sideslip
-is the plan's (``command``'s ``planned_steer_rad``, ``sideslip_rad``).
+is the plan's (``command``'s ``planned_steer_rad``, ``sideslip_rad``); the curvature it is given
+is then the plan's body yaw per metre (``PathReference``), so v kappa is the plan's body yaw
+rate, its course rate less its sideslip's rate.
 
 Gains by pole placement (Ackermann's formula) on the linear single-track model with states
 (vy, r, psi, e) at each speed: the path-following pair at s^2 + 2 zeta omega s + omega^2 with
