@@ -15,7 +15,9 @@
 
 On a planned manoeuvre (the lookup tables' lane change, planned with the plant's tyre) the
 feedforward is the plan's own road-wheel angle taken a little ahead and the reference sideslip
-is the plan's (``command``'s ``planned_steer_rad``, ``sideslip_rad``).
+is the plan's (``command``'s ``planned_steer_rad``, ``sideslip_rad``); the curvature it is given
+is then the plan's body yaw per metre (``PathReference``), so v kappa is the plan's body yaw
+rate, its course rate less its sideslip's rate.
 
 Gains by pole placement (Ackermann's formula) on the linear single-track model with states
 (vy, r, psi, e) at each speed: the path-following pair at s^2 + 2 zeta omega s + omega^2 with
@@ -149,6 +151,7 @@ class SteeringController:
         "_kus",
         "_max",
         "_params",
+        "_preview_s",
         "_slip_frac",
         "_slip_k",
         "_speeds",
@@ -157,8 +160,16 @@ class SteeringController:
         "_vmin",
     )
 
-    def __init__(self, params: VehicleParams, gains: SteeringGains = SteeringGains()):
+    def __init__(
+        self,
+        params: VehicleParams,
+        gains: SteeringGains = SteeringGains(),
+        preview_time_s: float = 0.0,
+    ):
+        """``preview_time_s``: how far ahead ``command``'s preview curvature is taken (0:
+        the yaw-rate reference leaves out the steady sideslip's rate)."""
         self._params = params
+        self._preview_s = preview_time_s
         self._gains = gains
         self._L = params.wheelbase_m
         self._kus = understeer_gradient(params)
@@ -288,15 +299,24 @@ class SteeringController:
         feedforward to make up for the steering and tyre lags. A planned manoeuvre (the
         tables' lane change) adds its own road-wheel angle ``planned_steer_rad`` to the
         feedforward (its path's curvature then left out of ``preview_curvature_1pm``) and
-        gives its body sideslip ``sideslip_rad`` in place of the steady-state one.
+        gives its body sideslip ``sideslip_rad`` in place of the steady-state one. The
+        yaw-rate reference is the body's: v kappa less the sideslip's rate (the plan's is in
+        its curvature; the steady one's is taken from the preview curvature).
         """
         v = max(0.0, speed_mps)  # 0 for -0.0 and NaN too
         k_vy, k_r, k_psi, k_e = self.gains_at(v, mu)
-        beta = self.steady_sideslip(v, curvature_1pm) if sideslip_rad is None else sideslip_rad
+        yaw_kappa = curvature_1pm  # the body's yaw per metre the reference asks for
+        if sideslip_rad is None:
+            beta = self.steady_sideslip(v, curvature_1pm)
+            if self._preview_s > 0.0 and v > 1.0:  # less the steady sideslip's rate
+                ahead = self.steady_sideslip(v, preview_curvature_1pm)
+                yaw_kappa -= (ahead - beta) / (v * self._preview_s)
+        else:
+            beta = sideslip_rad
         psi = heading_error_rad + beta
         ff = (self._L + self._kus * v * v) * preview_curvature_1pm + planned_steer_rad
         fb = -(k_e * lateral_error_m + k_psi * psi)
-        yd = -(k_vy * (lateral_speed_mps - v * beta) + k_r * (yaw_rate_radps - v * curvature_1pm))
+        yd = -(k_vy * (lateral_speed_mps - v * beta) + k_r * (yaw_rate_radps - v * yaw_kappa))
         delta = ff + fb + yd
         # front slip envelope: the front tyre's slip stays short of where its force peaks
         if v > 1.0:

@@ -59,7 +59,7 @@ def build_parts(params: VehicleParams, tables: Any, settings: EoamSettings) -> P
         params,
         tables,
         st,
-        SteeringController(params, st.steering),
+        SteeringController(params, st.steering, st.preview_time_s),
         SteeringController(params, st.planned_steering),
         LongitudinalController(params, st.longitudinal),
         BrakingObstaclePlacement() if st.obstacle_decel_in_dmm else PaperPlacement(),

@@ -88,6 +88,7 @@ class PathReference:
         if self.planned_steering:
             self._steer = [scale * float(s.steer_rad) for s in samples]
             self._beta = [scale * float(s.sideslip_rad) for s in samples]
+            self._k = body_yaw_curvature(self._k, self._beta, step)
         else:
             self._steer = self._beta = [0.0] * (n + 1)
         v2 = speed_mps * speed_mps
@@ -156,6 +157,22 @@ class PathReference:
             self._steer[i],
             self._beta[i],
         )
+
+
+def body_yaw_curvature(curvature_1pm: list[float], sideslip_rad: list[float], step_m: float):
+    """The body's yaw angle per metre along a planned path, psi' = theta' - beta' (the
+    course's curvature less the sideslip's rate, central differences on the uniform grid):
+    v times it is the plan's body yaw rate, the steering law's yaw-rate reference. The
+    course's rate v kappa alone differs from it by the sideslip's rate, up to 0.3 rad/s at
+    165 km/h, and the yaw-rate feedback then steered against the plan's rotation."""
+    n = len(sideslip_rad) - 1
+    if n < 1:
+        return list(curvature_1pm)
+    out = []
+    for i, k in enumerate(curvature_1pm):
+        lo, hi = max(i - 1, 0), min(i + 1, n)
+        out.append(k - (sideslip_rad[hi] - sideslip_rad[lo]) / ((hi - lo) * step_m))
+    return out
 
 
 def retimed(point: PathPoint, rate: float) -> PathPoint:

@@ -23,7 +23,8 @@ class PathPoint(NamedTuple):
 
     y_m: float  # lateral position (road frame, left positive)
     yaw_rad: float  # path direction of travel relative to the road
-    curvature_1pm: float  # signed path curvature, left positive
+    curvature_1pm: float  # signed path curvature, left positive; a planned lane change's
+    # (planned sideslip) is its body's yaw per metre, the course's less the sideslip's rate
     ax_mps2: float  # planned longitudinal acceleration
     speed_mps: float  # planned speed
     steer_rad: float  # planned road-wheel angle (0: not planned)

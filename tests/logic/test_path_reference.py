@@ -64,11 +64,26 @@ def test_planned_steering_and_sideslip_scale_with_the_path():
     k = 3.0 / H_TABLE
     assert ref.planned_steering
     for dx in (0.0, 12.5, 33.3):
-        _, yaw, curv, _, _, steer, beta = ref.at(dx)
-        assert steer == pytest.approx(0.5 * curv, abs=1e-6)
+        _, yaw, _, _, _, steer, beta = ref.at(dx)
         assert beta == pytest.approx(-0.2 * yaw, abs=1e-6)
         assert steer == pytest.approx(k * PlannedTrajectory().at(dx).steer_rad, abs=1e-6)
     assert ref.at(LENGTH + 5.0)[5:] == pytest.approx((0.0, 0.0), abs=1e-9)
+
+
+@pytest.mark.parametrize("dx", [0.0, 6.0, 12.5, 30.0, 47.1, LENGTH])
+def test_planned_curvature_is_the_body_yaw_per_metre(dx):
+    """With a planned sideslip beta (course less body yaw), the reference's curvature is the
+    body's yaw per metre, d(theta - beta)/dx: here beta = -0.2 theta, so 1.2 theta'(x), with
+    theta = atan(y') and theta' = y'' / (1 + y'^2). The steering law's yaw-rate reference
+    v kappa is then the plan's body yaw rate."""
+    ref = PathReference(
+        PlannedTrajectory(), start_offset_m=0.2, height_m=3.0, speed_mps=25.0, step_m=0.25
+    )
+    u = dx / LENGTH
+    dy = H_TABLE * (30 * u**2 - 60 * u**3 + 30 * u**4) / LENGTH
+    ddy = H_TABLE * (60 * u - 180 * u**2 + 120 * u**3) / LENGTH**2
+    body = 3.0 / H_TABLE * 1.2 * ddy / (1.0 + dy * dy)
+    assert ref.at(dx).curvature_1pm == pytest.approx(body, abs=5e-5)
 
 
 def test_speed_profile_stops_at_zero():

@@ -74,6 +74,22 @@ def test_feedforward_uses_the_preview_curvature():
     assert ctrl.lateral_accel(v, cmd.feedforward_rad) == pytest.approx(v * v * k_ahead, rel=1e-9)
 
 
+@pytest.mark.parametrize("v", [15.0, 33.3, 45.8])
+def test_yaw_rate_reference_is_the_body_yaw_rate_on_a_curvature_ramp(v):
+    """Entering a curve, kappa 0 -> 0.004 1/m over the 0.3 s preview: the body of a car on the
+    reference yaws at v kappa less the rate of its steady sideslip (``steady_sideslip``, its
+    own test above), and the yaw-rate feedback does not act on that yaw rate; without the
+    preview time (the sideslip's rate left out) it would steer against it."""
+    preview_s, k_now, k_ahead = 0.3, 0.0, 0.004
+    beta_now = 0.0  # straight now
+    beta_ahead = steady_state(v, 1.0 / k_ahead)[1]
+    r_body = v * k_now - (beta_ahead - beta_now) / preview_s
+    args = (v, r_body, v * beta_now, 0.0, -beta_now, k_now, k_ahead, 1.0)
+    ctrl = SteeringController(P, preview_time_s=preview_s)
+    assert ctrl.command(*args).body_feedback_rad == pytest.approx(0.0, abs=1e-12)
+    assert abs(SteeringController(P).command(*args).body_feedback_rad) > 1e-4
+
+
 def test_understeer_gradient_sign_and_value():
     # b / Cf > a / Cr for this car: mildly understeering, about 0.04 deg/(m/s^2)
     k = understeer_gradient(P)

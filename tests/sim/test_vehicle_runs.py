@@ -149,7 +149,9 @@ def test_the_tall_car_rolls_over_in_its_lane_change_with_its_own_box(tmp_path, t
     assert 2 in summary["modes_visited"]  # the lane change had begun
     assert summary["outcome"] == "orange" and summary["collision_with"] == "none"
     assert "rollover: both inner" in summary["reason"] or "static stability" in summary["reason"]
-    assert summary["end_cause"] == "rollover" and summary["min_tyre_load_n"] == 0.0
+    assert summary["end_cause"] == "rollover", summary["reason"]
+    # both inner wheels lifted (no load left), or the static stability limit passed first
+    assert summary["min_tyre_load_n"] == 0.0 or "static stability" in summary["reason"]
     assert summary["rollover_time_s"] is not None
 
 
