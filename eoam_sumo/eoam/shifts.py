@@ -6,6 +6,8 @@ the active ``PathReference``.
 
 from __future__ import annotations
 
+import math
+
 from eoam_sumo.decision.obstacle import ObstacleTrack
 from eoam_sumo.eoam_messages import EgoMeasurement
 from eoam_sumo.eoam_settings import EoamSettings
@@ -78,9 +80,24 @@ def clearing_offset_m(
     meas: EgoMeasurement,
 ) -> float:
     """The ego's offset that clears the obstacle's box (its left side, or the ego's lane's
-    edge without a track) by ``side_clearance_m``."""
+    edge without a track) by ``side_clearance_m``, its body yawed as it may be alongside
+    (``yawed_body_reach_m``)."""
     left_edge = obstacle.left_edge_m if obstacle is not None else 0.5 * meas.lane_width_m
-    return left_edge + 0.5 * params.width_m + settings.side_clearance_m
+    reach = 0.5 * params.width_m + yawed_body_reach_m(params, meas)
+    return left_edge + reach + settings.side_clearance_m
+
+
+def yawed_body_reach_m(params: VehicleParams, meas: EgoMeasurement) -> float:
+    """How much nearer than half its width a corner of the ego's body comes to a road user
+    alongside when the body is yawed against its course: a lane change's course straightens
+    before its body does, which is then yawed towards what it passes by up to the rear
+    axle's slip angle. That is bounded by the slip at which the rear tyres' linear force
+    reaches their friction, beta = mu g m l_f / (C_r L) (single-track, the rear axle's load
+    m g l_f / L), the corner half a length from the centre: 0.5 L |sin beta|."""
+    l_f, l_r = params.cg_to_front_m, params.cg_to_rear_m
+    rear_load_n = params.mass_kg * G_MPS2 * l_f / (l_f + l_r)
+    beta = meas.mu * rear_load_n / params.cornering_stiffness_rear_npr
+    return 0.5 * params.length_m * abs(math.sin(beta))
 
 
 def lane_change_height_m(

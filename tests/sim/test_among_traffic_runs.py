@@ -101,16 +101,6 @@ def _truck_road(folder: Path, over_line_m: float) -> Path:
     return _road(folder, _ego(120 / 3.6) + truck, '<lateral-resolution value="0.2"/>')
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        "passes the truck 0.235 m apart (was 0.348 m): the lane change now follows its plan "
-        "(0.15 m off, was 0.26 m past it outwards), and the plan's body, drifting at the "
-        "lane change's end, is yawed 0.05 rad towards the truck while alongside it; the "
-        "passing offset (side clearance 0.5 m) counts the centre's offset, not the yawed "
-        "body's corners"
-    ),
-)
 def test_a_truck_over_the_line_is_passed_with_the_offset_that_clears_it(tmp_path):
     over_m = 0.82
     summary, ts, traffic = _run(_truck_road(tmp_path / "road", over_m), tmp_path / "out")
