@@ -80,11 +80,9 @@ def clearing_offset_m(
     meas: EgoMeasurement,
 ) -> float:
     """The ego's offset that clears the obstacle's box (its left side, or the ego's lane's
-    edge without a track) by ``side_clearance_m``, its body yawed as it may be alongside
-    (``yawed_body_reach_m``)."""
+    edge without a track) by ``side_clearance_m``."""
     left_edge = obstacle.left_edge_m if obstacle is not None else 0.5 * meas.lane_width_m
-    reach = 0.5 * params.width_m + yawed_body_reach_m(params, meas)
-    return left_edge + reach + settings.side_clearance_m
+    return left_edge + 0.5 * params.width_m + settings.side_clearance_m
 
 
 def yawed_body_reach_m(params: VehicleParams, meas: EgoMeasurement) -> float:
@@ -109,10 +107,12 @@ def lane_change_height_m(
 ) -> float | None:
     """Mode 2's lateral travel: to the target lane's centre (``target_offset_m``; 0: a lane
     width), or farther where the obstacle reaches so far into the target lane that its centre
-    does not clear it (``clearing_offset_m``), as long as the ego's body stays inside the
-    target lane; None: no offset within it clears the obstacle (brake in lane)."""
+    does not clear it (``clearing_offset_m``) by the side clearance from the body's corner,
+    yawed as a lane change's body ends (``yawed_body_reach_m``), as long as the ego's body
+    stays inside the target lane; None: no offset within it clears the obstacle (brake in
+    lane)."""
     centre = target_offset_m or meas.lane_width_m
-    need = clearing_offset_m(params, settings, obstacle, meas)
+    need = clearing_offset_m(params, settings, obstacle, meas) + yawed_body_reach_m(params, meas)
     if need <= centre:
         return centre
     target_width = 2.0 * centre - meas.lane_width_m  # centre to centre = half of both widths

@@ -11,12 +11,18 @@ import pytest
 from eoam_sumo.control import SteeringController, equivalent_mass_kg
 from eoam_sumo.decision import Mode
 from eoam_sumo.eoam import EgoMeasurement, EoamController, EoamSettings, ObjectState, Perception
+from eoam_sumo.eoam.shifts import lane_change_height_m
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import AIR_DENSITY_KGPM3, ego_e_class_sedan
 
 P = ego_e_class_sedan()
 DT = 0.01
 LANE = 3.5
+#: mode 2's travel in a 3.0 m lane without an obstacle track (the ego's lane taken as full):
+#: its centre, or the clearing offset where that is farther (the yawed body's reach at mu 1)
+HEIGHT_3M = lane_change_height_m(
+    P, EoamSettings(), None, EgoMeasurement(0.0, 30.0, 0, 0, 0, 0, 0, 0, 0, 0, 1.0, 3.0)
+)
 
 
 @pytest.fixture(scope="module")
@@ -227,8 +233,8 @@ def start_steer(tables, lane_m=LANE, settings=None):
         (3.5, 1.04, Mode.ONCOMING_BRAKE),
         (3.5, 1.06, Mode.ONCOMING_STEER_BRAKE),
         (3.5, 2.50, Mode.ONCOMING_STEER_BRAKE),
-        (3.0, 0.89, Mode.ONCOMING_BRAKE),  # point of no return 0.3 x 3.0 m = 0.9 m
-        (3.0, 0.91, Mode.ONCOMING_STEER_BRAKE),
+        (3.0, 0.3 * HEIGHT_3M - 0.01, Mode.ONCOMING_BRAKE),  # point of no return 0.3 x travel
+        (3.0, 0.3 * HEIGHT_3M + 0.01, Mode.ONCOMING_STEER_BRAKE),
     ],
 )
 def test_2_to_3_or_4_around_the_point_of_no_return(tables, lane_m, travel_m, expected):
@@ -241,7 +247,11 @@ def test_2_to_3_or_4_around_the_point_of_no_return(tables, lane_m, travel_m, exp
 
 @pytest.mark.parametrize(
     ("width_m", "target_m"),
-    [(1.9, 0.95 + 0.5 * P.width_m + 0.5), (2.6, 1.3 + 0.5 * P.width_m + 0.5), (4.4, LANE)],
+    [
+        (1.9, 0.95 + 0.5 * P.width_m + 0.5),
+        (2.6, 1.3 + 0.5 * P.width_m + 0.5),
+        (4.4, LANE),
+    ],
 )
 def test_4_aims_just_past_the_obstacle_side_then_5_once_past_it(tables, width_m, target_m):
     v = speed_with(tables, 1.0, "F")
