@@ -108,14 +108,15 @@ def lane_change_height_m(
     """Mode 2's lateral travel: to the target lane's centre (``target_offset_m``; 0: a lane
     width), or farther where the obstacle reaches so far into the target lane that its centre
     does not clear it (``clearing_offset_m``) by the side clearance from the body's corner,
-    yawed as a lane change's body ends (``yawed_body_reach_m``), as long as the ego's body
-    stays inside the target lane; None: no offset within it clears the obstacle (brake in
-    lane)."""
+    yawed as a lane change's body ends (``yawed_body_reach_m``), as long as the ego's body,
+    its other corner as far out, stays inside the target lane; None: no offset within it
+    clears the obstacle (brake in lane)."""
     centre = target_offset_m or meas.lane_width_m
-    need = clearing_offset_m(params, settings, obstacle, meas) + yawed_body_reach_m(params, meas)
+    reach = yawed_body_reach_m(params, meas)  # a front corner in, the rear one out
+    need = clearing_offset_m(params, settings, obstacle, meas) + reach
     if need <= centre:
         return centre
     target_width = 2.0 * centre - meas.lane_width_m  # centre to centre = half of both widths
-    if need + 0.5 * params.width_m <= centre + 0.5 * target_width + 1e-9:
+    if need + 0.5 * params.width_m + reach <= centre + 0.5 * target_width + 1e-9:
         return need
     return None

@@ -36,20 +36,21 @@ def test_an_obstacle_inside_its_lane_is_passed_at_the_target_lane_centre():
     assert lane_change_height_m(P, ST, None, _meas()) == pytest.approx(LANE)
 
 
-@pytest.mark.parametrize("over_m", [0.37, 0.82, 0.9])
+@pytest.mark.parametrize("over_m", [0.37, 0.82, 0.84])
 def test_a_truck_over_the_line_is_cleared_by_the_side_clearance_within_the_lane(over_m):
     height = lane_change_height_m(P, ST, _truck(over_m), _meas())
     clearance = height - 0.5 * P.width_m - _reach() - (0.5 * LANE + over_m)
     if height > LANE:  # moved over: exactly the clearance
         assert clearance == pytest.approx(ST.side_clearance_m)
     assert clearance >= ST.side_clearance_m - 1e-9
-    assert height + 0.5 * P.width_m <= 1.5 * LANE + 1e-9  # the body within the target lane
+    # the body, its yawed corners included, within the target lane
+    assert height + 0.5 * P.width_m + _reach() <= 1.5 * LANE + 1e-9
 
 
 def test_a_truck_reaching_too_far_into_the_target_lane_makes_the_ego_brake():
     # the body cannot both clear it (its yawed corner by the side clearance) and stay in the
-    # target lane
-    too_far = 1.5 * LANE - P.width_m - _reach() - ST.side_clearance_m - 0.5 * LANE + 0.05
+    # target lane (its other yawed corner as far out)
+    too_far = 1.5 * LANE - P.width_m - 2.0 * _reach() - ST.side_clearance_m - 0.5 * LANE + 0.05
     assert lane_change_height_m(P, ST, _truck(too_far), _meas()) is None
     assert lane_change_height_m(P, ST, _truck(too_far - 0.1), _meas()) is not None
 
