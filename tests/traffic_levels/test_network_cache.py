@@ -12,7 +12,7 @@ pytestmark = pytest.mark.sumo
 
 
 def test_a_reused_network_is_netconverts_build(tmp_path, monkeypatch):
-    monkeypatch.setattr(network, "_BUILT", {})
+    network._network_text.cache_clear()
     built = []
     real = network.build_network
     monkeypatch.setattr(network, "build_network", lambda nod: built.append(nod) or real(nod))
@@ -25,9 +25,10 @@ def test_a_reused_network_is_netconverts_build(tmp_path, monkeypatch):
     (tmp_path / "other").mkdir()
     network.write_network(straight, tmp_path / "other")
     assert len(built) == 2  # other sources, another build
-    monkeypatch.setattr(network, "_BUILT", {})
+    network._network_text.cache_clear()
     (tmp_path / "fresh").mkdir()
     network.write_network(curved, tmp_path / "fresh")
     fresh = (tmp_path / "fresh" / "road.net.xml").read_bytes()
     assert (tmp_path / "again" / "road.net.xml").read_bytes() == fresh
     assert (tmp_path / "other" / "road.net.xml").read_bytes() != fresh
+    network._network_text.cache_clear()
