@@ -48,6 +48,8 @@ class EoamSettings:
     # (decision.oncoming; False: the point of no return above)
     oncoming_margin_m: float = 0.2  # ... the ego's side this far short of the other's path
     oncoming_margin_s: float = 0.2  # ... that long before the fronts meet
+    oncoming_margin_min_s: float = 0.1  # ... or this long where every option with the
+    # margin above ends in contact (docs/control.md, the 165 km/h arrest)
     min_time_escapes: bool = True  # modes 3, 4 and the returns from oncoming traffic:
     # jerk-limited time-optimal shifts (manoeuvre.min_time_shift; False: the shortest quintics)
     arrest_first: bool = True  # mode 3 from a lane change: a lateral motion away from the

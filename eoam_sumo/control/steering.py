@@ -328,6 +328,25 @@ class SteeringController:
         delta = min(delta, self._max)
         return SteeringCommand(delta, ff, fb, yd, -fb / k_e)
 
+    def share_edges(
+        self,
+        speed_mps: float,
+        yaw_rate_radps: float,
+        lateral_speed_mps: float,
+        mu: float,
+        share: float,
+    ) -> tuple[float, float]:
+        """(right, left) road-wheel angles at which the front tyres' lateral force is
+        ``share`` of its peak, about the body's own motion as :meth:`envelope_edge` takes it,
+        never past that edge: a Fiala tyre gives 1 - (1 - x)^3 of its peak force at x of its
+        peak slip, so ``share`` at x = 1 - (1 - share)^(1/3)."""
+        x = 1.0 - (1.0 - min(max(share, 0.0), 1.0)) ** (1.0 / 3.0)
+        scale = mu * min(x / self._gains.front_slip_fraction, 1.0)
+        return (
+            self.envelope_edge(speed_mps, yaw_rate_radps, lateral_speed_mps, scale, -1.0),
+            self.envelope_edge(speed_mps, yaw_rate_radps, lateral_speed_mps, scale, 1.0),
+        )
+
     def envelope_edge(
         self,
         speed_mps: float,

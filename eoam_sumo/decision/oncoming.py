@@ -84,6 +84,8 @@ class Budget(NamedTuple):
     margin_s: float  # time margin before the fronts meet
     return_mps2: float  # lateral budget of the shift back after an arrest
     arrest_min_mps: float  # the least lateral speed away from the lane centre arrested
+    margin_min_s: float = 0.1  # the time margin where every option with ``margin_s`` ends
+    # in contact
 
     @classmethod
     def of(cls, params, settings, mu: float, brake_mps2: float) -> Budget:
@@ -105,6 +107,7 @@ class Budget(NamedTuple):
             st.oncoming_margin_s,
             st.arrest_return_g * mu_g,
             arrest_min,
+            st.oncoming_margin_min_s,
         )
 
 
@@ -125,6 +128,7 @@ class Choice(NamedTuple):
     passing: Option
     hold: Option | None = None  # braking in place (None: not predicted)
     hold_in_place: bool = False  # the abort holds the offset where its arrest ends
+    least_margin: bool = False  # taken with ``margin_min_s``, not ``margin_s`` (``choose``)
 
 
 def _out_line_m(oncoming: Tracked, b: Budget) -> float:
@@ -286,6 +290,32 @@ def time_to_pass_s(v_mps: float, to_pass_m: float, obstacle: Tracked) -> float:
 
 
 def choose(
+    lat: Lateral, v_mps: float, obstacle: Tracked | None, oncoming: Tracked, b: Budget, passed: bool
+) -> Choice:
+    """The option of lower predicted delta-v (``weigh``). The time margin ``margin_s`` covers
+    the prediction's error where it keeps some option clear of contact. Where every option
+    ends in contact with it, an option clear of contact with the smaller ``margin_min_s``
+    is taken instead, if any (``Choice.least_margin``): the margin would otherwise only rank
+    contacts that are certain against one the predictions give a margin to."""
+    choice = weigh(lat, v_mps, obstacle, oncoming, b, passed)
+    if passed or b.margin_s <= b.margin_min_s or _clear(choice):
+        return choice
+    least = weigh(lat, v_mps, obstacle, oncoming, b._replace(margin_s=b.margin_min_s), passed)
+    return least._replace(least_margin=True) if _clear(least) else choice
+
+
+def _clear(choice: Choice) -> bool:
+    """Whether the option taken is predicted to end without contact."""
+    if choice.pass_on:
+        taken = choice.passing
+    elif choice.hold_in_place and choice.hold is not None:
+        taken = choice.hold
+    else:
+        taken = choice.abort
+    return not taken.head_on and taken.delta_v_mps <= 0.0
+
+
+def weigh(
     lat: Lateral, v_mps: float, obstacle: Tracked | None, oncoming: Tracked, b: Budget, passed: bool
 ) -> Choice:
     """Abort back into the lane, brake in place or pass on, by the lower predicted delta-v

@@ -65,7 +65,7 @@ def lateral_control(parts: Parts, state: ControllerState, meas: EgoMeasurement) 
         ref.sideslip_rad,
     )
     if state.mode is ONCOMING_BRAKE and shares_ellipse(parts, state, meas):
-        delta = steering_share(parts, steer, v, mu, delta)
+        delta = steering_share(parts, steer, meas, delta)
     return LateralOutput(
         delta, ref.y_m, dx, e_lat, e_la, ff, fb, yd, ref.in_path, ref.ax_mps2, ref.speed_mps
     )
@@ -87,14 +87,21 @@ def arrest_steer(parts: Parts, meas: EgoMeasurement, arrest: float, lateral_g: f
     return max(delta, edge) if arrest > 0.0 else min(delta, edge)
 
 
-def steering_share(parts: Parts, steer, speed_mps: float, mu: float, delta_rad: float) -> float:
+def steering_share(parts: Parts, steer, meas: EgoMeasurement, delta_rad: float) -> float:
     """``delta_rad`` within the lateral share of the friction ellipse the brake's floor
-    leaves: |a_y| <= sqrt(1 - floor^2) mu g / ellipse margin (eqs. 25, 28)."""
+    leaves, sqrt(1 - floor^2) of mu Fz over the ellipse margin (eqs. 25, 28), as the front
+    tyres' slip about the body's own motion (``share_edges``): a sliding body is steered
+    against its slide, not held at a steady-state angle that may push it further."""
     st = parts.settings
     share = math.sqrt(max(1.0 - st.limit_brake_floor * st.limit_brake_floor, 0.0))
-    ay_cap = share * mu * G_MPS2 / st.longitudinal.ellipse_margin
-    cap = steer.steer_for_lateral_accel(speed_mps, ay_cap)
-    return max(-cap, min(cap, delta_rad))
+    right, left = steer.share_edges(
+        meas.vx_mps,
+        meas.yaw_rate_radps,
+        meas.vy_mps,
+        meas.mu,
+        share / st.longitudinal.ellipse_margin,
+    )
+    return max(right, min(left, delta_rad))
 
 
 def reference(

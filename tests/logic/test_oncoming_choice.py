@@ -22,6 +22,7 @@ from eoam_sumo.decision.oncoming import (
     predict_pass,
     return_clears,
     time_to_pass_s,
+    weigh,
 )
 from eoam_sumo.eoam_messages import EgoMeasurement
 from eoam_sumo.manoeuvre.min_time_shift import MinTimeShift
@@ -109,13 +110,73 @@ def test_seeing_the_oncoming_car_later_never_makes_an_option_safer(d, v_lat, gap
 
 def test_choice_is_the_lower_predicted_delta_v():
     lat = Lateral(0.65, 2.4, 5.3)  # early in a lane change at 165 km/h, mu 0.7
-    # seen 1.74 s before the fronts meet: the abort (arrested, then back at 0.6 mu g) leaves
-    # the oncoming path in time, passing does not
-    seen_late = choose(lat, V, standing(31.0), oncoming(104.0), BUDGET, passed=False)
+    # seen 1.74 s before the fronts meet: with the time margin, the abort (arrested, then
+    # back at 0.6 mu g) leaves the oncoming path in time, passing does not
+    seen_late = weigh(lat, V, standing(31.0), oncoming(104.0), BUDGET, passed=False)
     assert seen_late.passing.head_on and not seen_late.abort.head_on
     assert not seen_late.pass_on  # a hit on the obstacle is softer than the head-on
     seen_early = choose(lat, V, standing(31.0), oncoming(400.0), BUDGET, passed=False)
     assert not seen_early.passing.head_on and seen_early.pass_on  # passing ends clean
+    assert not seen_early.least_margin
+
+
+def _slack_s(option) -> float:
+    return option.meet_s - option.out_s
+
+
+def test_the_time_margin_ranks_only_where_an_option_keeps_clear_with_it():
+    """Seen 1.74 s before the fronts meet, passing leaves the oncoming path 0.18 s before
+    they meet: inside the 0.2 s margin, so with it every option ends in contact (the abort
+    hits the obstacle 31 m ahead at 37.7 m/s). Passing is clear with the least margin
+    (0.1 s) and is taken; where some option keeps the full margin, nothing changes."""
+    lat, obs, onc = Lateral(0.65, 2.4, 5.3), standing(31.0), oncoming(104.0)
+    with_margin = weigh(lat, V, obs, onc, BUDGET, passed=False)
+    assert with_margin.passing.head_on and with_margin.abort.delta_v_mps > 15.0
+    assert not with_margin.pass_on
+    choice = choose(lat, V, obs, onc, BUDGET, passed=False)
+    assert choice.pass_on and choice.least_margin
+    assert not choice.passing.head_on and choice.passing.delta_v_mps == 0.0
+    assert BUDGET.margin_min_s <= _slack_s(choice.passing) < BUDGET.margin_s
+    # a stretch of road ahead long enough to stop in: the abort keeps clear, with the margin
+    far_obstacle = standing(V * V / (2.0 * BUDGET.brake_mps2) + 5.0)
+    kept = choose(lat, V, far_obstacle, onc, BUDGET, passed=False)
+    assert kept == weigh(lat, V, far_obstacle, onc, BUDGET, passed=False)
+
+
+def test_passing_inside_the_least_margin_is_not_taken():
+    """Seen 1.6 s before the fronts meet, passing leaves the oncoming path 0.03 s before
+    they meet: within the prediction's error, so the abort stays."""
+    lat, obs, onc = Lateral(0.65, 2.4, 5.3), standing(31.0), oncoming(95.0)
+    passing = predict_pass(lat, V, obs, onc, BUDGET._replace(margin_s=0.0))
+    assert 0.0 < _slack_s(passing) < BUDGET.margin_min_s
+    choice = choose(lat, V, obs, onc, BUDGET, passed=False)
+    assert not choice.pass_on and not choice.least_margin
+
+
+def _taken(choice):
+    if choice.pass_on:
+        return choice.passing
+    return choice.hold if choice.hold_in_place else choice.abort
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(0.0, 1.5), st.floats(-1.0, 3.0), st.floats(20.0, 90.0), st.floats(60.0, 300.0))
+def test_the_least_margin_only_where_every_option_with_the_margin_ends_in_contact(
+    d, v_lat, obs, gap
+):
+    lat = Lateral(d, v_lat, 0.0)
+    with_margin = weigh(lat, V, standing(obs), oncoming(gap), BUDGET, passed=False)
+    choice = choose(lat, V, standing(obs), oncoming(gap), BUDGET, passed=False)
+    if not choice.least_margin:
+        assert choice == with_margin
+        return
+    taken = _taken(with_margin)
+    assert taken.head_on or taken.delta_v_mps > 0.0  # contact with the margin
+    least = _taken(choice)
+    assert not least.head_on and least.delta_v_mps == 0.0  # none with the least one
+    assert choice == weigh(
+        lat, V, standing(obs), oncoming(gap), BUDGET._replace(margin_s=BUDGET.margin_min_s), False
+    )._replace(least_margin=True)
 
 
 def test_past_the_obstacle_the_escape_is_taken():

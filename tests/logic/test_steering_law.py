@@ -139,6 +139,32 @@ def test_envelope_edge_is_the_front_slip_limit_the_law_clips_to(v, vy, r, mu, si
     assert clipped == pytest.approx(edge, rel=1e-9, abs=1e-12)
 
 
+@settings(max_examples=50, deadline=None)
+@given(
+    st.floats(5.0, 50.0),
+    st.floats(-4.0, 4.0),
+    st.floats(-0.5, 0.5),
+    st.floats(0.1, 1.2),
+    st.floats(0.05, 0.95),
+)
+def test_share_edges_give_the_fiala_force_share_about_the_body_motion(v, vy, r, mu, share):
+    """At either edge the front slip about the front axle's course is the one at which a
+    Fiala tyre gives ``share`` of its peak force, 1 - (1 - alpha / alpha_peak)^3, with
+    alpha_peak = 3 mu Fz / C_f; at 7/8 of the peak it is the envelope's edge."""
+    ctrl = SteeringController(P)
+    fz = P.mass_kg * 9.81 * P.cg_to_rear_m / P.wheelbase_m
+    alpha_peak = 3.0 * mu * fz / P.cornering_stiffness_front_npr
+    course_f = (vy + P.cg_to_front_m * r) / v
+    assume(abs(course_f) + alpha_peak < P.max_steer_rad)
+    right, left = ctrl.share_edges(v, r, vy, mu, share)
+    for edge, side in ((right, -1.0), (left, 1.0)):
+        x = side * (edge - course_f) / alpha_peak
+        assert 1.0 - (1.0 - x) ** 3 == pytest.approx(min(share, 0.875), rel=1e-9)
+    full = ctrl.share_edges(v, r, vy, mu, 0.875)
+    envelope = (ctrl.envelope_edge(v, r, vy, mu, -1.0), ctrl.envelope_edge(v, r, vy, mu, 1.0))
+    assert full == pytest.approx(envelope, rel=1e-9, abs=1e-12)
+
+
 GAINS = {"default": SteeringGains(), "planned": EoamSettings().planned_steering}
 
 
