@@ -34,6 +34,7 @@ class ObjectState(NamedTuple):
     speed_mps: float  # along the road
     length_m: float
     width_m: float
+    time_s: float | None = None  # when this state held (a sensor's latency; None: now)
 
 
 class Perception(NamedTuple):

@@ -334,7 +334,10 @@ def weigh(
 
 def commit_choice(meas, oncoming, obstacle: ObstacleTrack, b: Budget) -> Choice:
     """``choose`` from an ``EgoMeasurement``, the oncoming road user as an ``ObjectState``
-    (a sensor's object) and the obstacle's track."""
+    (a sensor's object) and the obstacle's track. A state of an earlier time (a tracked
+    sensor's, ``ObjectState.time_s``) is carried on to now, and its noise is not in the
+    prediction, so the least time margin is not taken on it (``Budget.margin_min_s``, sized
+    on exact states)."""
     v_lat, a_lat, along = lateral_state(meas)
     front = meas.s_m + b.cg_to_front_m
     obs_front, obs_speed = obstacle.at(meas.time_s)
@@ -343,14 +346,24 @@ def commit_choice(meas, oncoming, obstacle: ObstacleTrack, b: Budget) -> Choice:
         obs_front - length - front, obs_speed, obstacle.decel_mps2, length, obstacle.left_edge_m
     )
     onc = Tracked(
-        oncoming.s_m - 0.5 * oncoming.length_m - front,
+        _station_now_m(oncoming, meas.time_s) - 0.5 * oncoming.length_m - front,
         oncoming.speed_mps,
         0.0,
         oncoming.length_m,
         oncoming.d_m - 0.5 * oncoming.width_m,
     )
     passed = front - b.length_m - obs_front >= b.pass_margin_m
+    if oncoming.time_s is not None:  # a tracked sensor's state: the full margin only
+        b = b._replace(margin_min_s=b.margin_s)
     return choose(Lateral(meas.d_m, v_lat, a_lat), along, obs, onc, b, passed)
+
+
+def _station_now_m(obj, time_s: float) -> float:
+    """An object's station at ``time_s``: a sensor's state of an earlier time (its latency,
+    ``ObjectState.time_s``) carried on at its speed."""
+    if obj.time_s is None or not time_s > obj.time_s:
+        return obj.s_m
+    return obj.s_m + obj.speed_mps * (time_s - obj.time_s)
 
 
 def return_clears(meas, obstacle: ObstacleTrack, b: Budget) -> bool:

@@ -9,7 +9,8 @@ visible target is detected with probability ``detection_probability``; a detecti
 range, azimuth and range rate with Gaussian errors. The cycle's detections reach the
 tracker ``latency_s`` later; the tracker (:mod:`eoam_sumo.sensing.tracker`) turns them into
 confirmed tracks, and the report the EOAM reads is built from those tracks, as of the scan
-they last saw (no latency compensation): the same :class:`~eoam_sumo.sensing.radar.RadarReport`
+they last saw (no latency compensation; the report's ``time_s`` is that scan's time, so a
+user of it can carry its states on): the same :class:`~eoam_sumo.sensing.radar.RadarReport`
 as the ideal radar, classified by the same rules on the tracked position and velocity.
 
 Defaults (``AutomotiveRadarSettings``) from the data sheet of the Continental ARS 408-21
@@ -262,7 +263,7 @@ class AutomotiveRadar:
                     self._geometry.head_on(category, ahead, d, band_m),
                 )
             )
-        return report_of(detections)
+        return report_of(detections)._replace(time_s=scan.t)
 
 
 def _blocked(nearer, ox, oy, px, py, r) -> bool:

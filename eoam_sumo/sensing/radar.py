@@ -144,6 +144,7 @@ class RadarReport(NamedTuple):
     in_path: Detection | None = None  # the nearest in-path detection itself
     next_lane_range_m: float | None = None  # nearest standing object in the next lane
     coasted: Detection | None = None  # an in-path object out of view, predicted (not measured)
+    time_s: float | None = None  # when its detections' states held (None: at the scan)
 
 
 _range_of = attrgetter("range_m")

@@ -742,5 +742,7 @@ def _nearest_oncoming(report: RadarReport) -> ObjectState | None:
     """The nearest detection classed oncoming, as an object (detections are sorted by range)."""
     for det in report.detections:
         if det.category == "oncoming":
-            return ObjectState(det.s_m, det.d_m, det.road_speed_mps, det.length_m, det.width_m)
+            return ObjectState(
+                det.s_m, det.d_m, det.road_speed_mps, det.length_m, det.width_m, report.time_s
+            )
     return None
