@@ -274,13 +274,14 @@ class TrafficLog(StepObserver):
 
         path = Path(path)
         cols = self.columns()
-        table = pa.table(
-            {
-                name: np.round(cols[name], _DECIMALS[name]) + 0.0
+        table = pa.Table.from_arrays(
+            [
+                _float_array(np.round(cols[name], _DECIMALS[name]) + 0.0)
                 if name in _DECIMALS
-                else cols[name]
+                else _text_array(cols[name])
                 for name in TRAFFIC_COLUMNS
-            }
+            ],
+            names=list(TRAFFIC_COLUMNS),
         )
         sink = pa.BufferOutputStream()
         if path.suffix == ".parquet":
@@ -293,6 +294,29 @@ class TrafficLog(StepObserver):
                 sink = pa.BufferOutputStream()
                 pa_csv.write_csv(table, sink, pa_csv.WriteOptions(quoting_header="none"))
         write_atomic(path, sink.getvalue().to_pybytes())
+
+
+def _float_array(values: np.ndarray):
+    """A pyarrow float64 array over the values' own buffer (NaN kept as a value, as
+    ``pa.array`` keeps it). Built from buffers because ``pa.array`` imports pandas (0.2 s a
+    worker) to ask whether its argument is a pandas object."""
+    import pyarrow as pa
+
+    values = np.ascontiguousarray(values, dtype=np.float64)
+    return pa.Array.from_buffers(pa.float64(), len(values), [None, pa.py_buffer(values)])
+
+
+def _text_array(texts: list[str]):
+    """A pyarrow string array of ``texts`` (UTF-8 bytes and their offsets; see
+    ``_float_array``)."""
+    import pyarrow as pa
+
+    data = [t.encode() for t in texts]
+    offsets = np.zeros(len(data) + 1, dtype=np.int32)
+    np.cumsum([len(d) for d in data], out=offsets[1:])
+    return pa.Array.from_buffers(
+        pa.string(), len(data), [None, pa.py_buffer(offsets), pa.py_buffer(b"".join(data))]
+    )
 
 
 def read_traffic(path: Path):
