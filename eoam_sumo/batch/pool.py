@@ -268,7 +268,9 @@ _warm: list[_Worker] = []
 def warm_workers(jobs: int, preload: Sequence[str] = ()) -> Generator[None, None, None]:
     """Start ``jobs`` workers now, for the :func:`run_local` calls inside the block (with the
     same ``preload``) to take before starting their own: a worker imports its modules while
-    the caller still prepares its tasks. Those not taken are closed when the block ends."""
+    the caller still prepares its tasks. Those not taken (no task left, or bad input found
+    meanwhile) are killed when the block ends: they hold no task, and waiting for one still
+    importing would keep a refusal waiting."""
     _check(jobs, 1.0)
     started = [_Worker(preload) for _ in range(jobs)]
     _warm.extend(started)
@@ -278,6 +280,7 @@ def warm_workers(jobs: int, preload: Sequence[str] = ()) -> Generator[None, None
         for w in started:
             if w in _warm:
                 _warm.remove(w)
+                w.kill()
                 w.close()
 
 
