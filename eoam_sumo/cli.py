@@ -513,13 +513,28 @@ def _cmd_batch(args) -> int:
     and then the count on stderr). Bad input raises InputError before any case runs (exit
     status 2 in :func:`main`).
     """
-    from eoam_sumo.batch.runner import check_options, plan_batch, run_batch
     from eoam_sumo.openscenario.variations import is_xosc_batch
+
+    if is_xosc_batch(args.matrix):
+        from eoam_sumo.batch.runner import check_options
+
+        check_options(args.jobs, args.timeout_s, args.timeseries)
+        return _cmd_xosc_batch(args)
+    if args.scheduler is not None:
+        return _run_matrix_batch(args)
+    from eoam_sumo.batch.case import PRELOAD
+    from eoam_sumo.batch.pool import warm_workers
+
+    with warm_workers(args.jobs, PRELOAD):  # they import while this process plans the batch
+        return _run_matrix_batch(args)
+
+
+def _run_matrix_batch(args) -> int:
+    """``_cmd_batch`` of a TOML matrix: check it, run it, draw its images."""
+    from eoam_sumo.batch.runner import check_options, plan_batch, run_batch
     from eoam_sumo.outputs.staging import output_folder
 
     check_options(args.jobs, args.timeout_s, args.timeseries)
-    if is_xosc_batch(args.matrix):
-        return _cmd_xosc_batch(args)
     plan = plan_batch(
         args.matrix,
         after_stop_s=args.after_stop_s,

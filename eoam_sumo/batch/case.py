@@ -34,8 +34,10 @@ ALL_CASE_FILES = (
     "road.csv",
     "summary.json",
 )
-#: Modules a worker imports before its first case, so start-up is not charged to a case.
-PRELOAD = ("eoam_sumo.sim.cosim",)
+#: Modules a worker imports before its first case, so start-up is not charged to a case:
+#: the co-simulation, SUMO's library and the root finders of the quintic shift (which
+#: imports them at its first use, so that the command line's process never does).
+PRELOAD = ("eoam_sumo.sim.cosim", "libsumo", "scipy.optimize")
 
 
 @dataclass(frozen=True)

@@ -87,6 +87,7 @@ class _Worker:
     """One worker process as seen by the parent: start, dispatch, receive, kill."""
 
     def __init__(self, preload: Sequence[str]):
+        self.preload = tuple(preload)
         self.log = tempfile.TemporaryFile()  # noqa: SIM115 - lives as long as the worker
         self.proc = subprocess.Popen(
             [sys.executable, "-c", "from eoam_sumo.batch.pool import _child_main; _child_main()"],
@@ -230,7 +231,7 @@ def run_local(
         while pending or any(w.busy for w in workers):
             want = min(jobs, sum(w.busy for w in workers) + len(pending))
             while len(workers) < want:
-                workers.append(_Worker(preload))
+                workers.append(_warm_worker(preload) or _Worker(preload))
             for w in workers:
                 if w.ready and not w.busy and pending:
                     key, payload = pending.popleft()
@@ -258,6 +259,40 @@ def run_local(
     finally:
         for w in workers:
             w.close()
+
+
+_warm: list[_Worker] = []
+
+
+@contextlib.contextmanager
+def warm_workers(jobs: int, preload: Sequence[str] = ()) -> Generator[None, None, None]:
+    """Start ``jobs`` workers now, for the :func:`run_local` calls inside the block (with the
+    same ``preload``) to take before starting their own: a worker imports its modules while
+    the caller still prepares its tasks. Those not taken (no task left, or bad input found
+    meanwhile) are killed when the block ends: they hold no task, and waiting for one still
+    importing would keep a refusal waiting."""
+    _check(jobs, 1.0)
+    started = [_Worker(preload) for _ in range(jobs)]
+    _warm.extend(started)
+    try:
+        yield
+    finally:
+        for w in started:
+            if w in _warm:
+                _warm.remove(w)
+                w.kill()
+                w.close()
+
+
+def _warm_worker(preload: Sequence[str]) -> _Worker | None:
+    """A warm worker started with ``preload`` and still alive (taken off the list), or None."""
+    for w in list(_warm):
+        if w.preload == tuple(preload):
+            _warm.remove(w)
+            if w.alive:
+                return w
+            w.close()
+    return None
 
 
 def _check(jobs: int, timeout_s: float) -> None:

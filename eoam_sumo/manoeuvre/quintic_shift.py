@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
 
 from eoam_sumo.manoeuvre.points import TrajectoryPoint
 
@@ -219,6 +218,8 @@ def _first_within(cls, state: tuple, limit: float, lo: float, hi: float) -> Quin
     """The shortest length in (lo, hi] within the budget (``_margin`` <= 0), by Brent's method
     on the margin (lo misses the budget, hi meets it), to ``LENGTH_TOL_M``; the bracket's upper
     end where the root itself misses by its last bits."""
+    from scipy.optimize import brentq  # at first use: a command that plans no shift skips it
+
     y0, slope0, y1, kappa0 = state
 
     def margin(length: float) -> float:
@@ -265,6 +266,8 @@ def _refined_least_peak(cls, state: tuple, lengths: list, peaks: list) -> Quinti
         return peak if past <= OVERSHOOT_TOL_M else _PASSES
 
     if hi > lo:
+        from scipy.optimize import minimize_scalar
+
         found = minimize_scalar(
             peak_of, bounds=(lo, hi), method="bounded", options={"xatol": LENGTH_TOL_M}
         )

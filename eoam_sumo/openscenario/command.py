@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import sys
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 from eoam_sumo.errors import InputError
-from eoam_sumo.openscenario.runner import Loaded, load, run_loaded
+
+if TYPE_CHECKING:
+    from eoam_sumo.openscenario.runner import Loaded
 
 
 def xosc_arguments(p) -> None:
@@ -47,6 +50,8 @@ def prepare_command(args) -> Loaded:
     for flag, value in (("--speed-kmh", args.speed_kmh), ("--oncoming-m", args.oncoming_m)):
         if value is not None:
             raise InputError(f"{flag} does not apply to an .xosc (set its parameters: --param)")
+    from eoam_sumo.openscenario.runner import load  # the engine: only for an .xosc
+
     return load(args.cfg, parse_params(args.param), args.ego)
 
 
@@ -56,6 +61,8 @@ def run_xosc_command(args, loaded: Loaded, out, settings) -> dict:
         print(f"eoam-sumo: {args.cfg.name}: {note}", file=sys.stderr)
     if args.system == "aeb":
         settings = replace(settings, eoam=replace(settings.eoam, steering_inhibited=True))
+    from eoam_sumo.openscenario.runner import run_loaded
+
     return run_loaded(loaded, out, settings, args.mu)
 
 

@@ -4,6 +4,7 @@ batch, scored into ``results.csv``, ``scorecard.md`` and ``scorecard.png``
 
 from __future__ import annotations
 
+import contextlib
 import re
 from pathlib import Path
 
@@ -123,8 +124,15 @@ def run(args) -> int:
     """Run the protocol; 0 when every point ran, 1 when one failed. The output folder is
     written by this process alone; a re-run over an earlier one writes a staging folder that
     replaces it once complete (:mod:`eoam_sumo.outputs.staging`)."""
+    from eoam_sumo.batch.case import PRELOAD
+    from eoam_sumo.batch.pool import warm_workers
+
     points = selected_points(args)
-    with output_folder(Path(args.out), PROTOCOL_OUTPUT) as out:
+    local = args.scheduler is None  # its workers import while the scenarios are written
+    with (
+        warm_workers(args.jobs, PRELOAD) if local else contextlib.nullcontext(),
+        output_folder(Path(args.out), PROTOCOL_OUTPUT) as out,
+    ):
         summary = run_points(args, points, out)
     print(summary.line(Path(args.out)))
     return 1 if summary.failed else 0

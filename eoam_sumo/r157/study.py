@@ -18,7 +18,6 @@ from pathlib import Path
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.r157.scenario import R157Point, write_scenario
 from eoam_sumo.sensing.radar import RadarSettings
-from eoam_sumo.sim.cosim import run_case
 from eoam_sumo.sim.settings import RunSettings
 
 SPEEDS_KMH = (60.0, 100.0, 130.0)
@@ -86,6 +85,8 @@ def run_study(
 ) -> list[dict]:
     """Run every point for every driver under ``out``; write and return the rows (each run's
     summary.json, and with ``timeseries`` csv its time series and traffic log)."""
+    from eoam_sumo.sim.cosim import run_case  # here: the command's parser needs none of it
+
     base = settings or RunSettings(max_time_s=MAX_TIME_S, radar=STUDY_RADAR)
     rows = []
     for point in points:

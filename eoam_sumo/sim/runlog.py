@@ -222,11 +222,49 @@ _ROAD_MU = "mu"  # the road's friction under the ego
 
 
 def _table(rows: list, brake_gains: tuple[float, ...]) -> np.ndarray:
-    """The (n, len(COLUMNS)) float array of logged steps, each column filled by name."""
+    """The (n, len(COLUMNS)) float array of logged steps, each column filled by name: from
+    each kind of logged value transposed once (``_transposed``), the rest by ``_column``."""
     out = np.full((len(rows), len(COLUMNS)), _NAN)
+    whole = _transposed(rows, brake_gains) if rows else {}
     for i, name in enumerate(COLUMNS):
-        out[:, i] = _column(rows, name, brake_gains)
+        col = whole.get(name)
+        out[:, i] = _column(rows, name, brake_gains) if col is None else col
     return out
+
+
+def _transposed(rows: list, brake_gains: tuple[float, ...]) -> dict[str, np.ndarray]:
+    """The columns ``_column`` would give of the plant state, the brake force, the
+    measurement, the command (but its mode and sector) and the radar's view, from one
+    transpose of each (a kind whose values are not all of one named-tuple type is left out)."""
+    state = list(zip(*[r[1] for r in rows]))
+    cols = {name: np.array(state[k], dtype=float) for name, k in _FROM_STATE.items()}
+    brake = np.zeros(len(rows))  # summed in sum()'s order: 0, then each wheel's force
+    for g, i in zip(brake_gains, _BRAKE_PRESSURES):
+        brake = brake + g * np.array(state[i], dtype=float)
+    cols["brake_force_n"] = brake
+    for names, fields in (
+        (_FROM_MEAS, _fields_of([r[0] for r in rows])),
+        (_FROM_PERCEPTION, _fields_of([r[3] for r in rows])),
+        (
+            {n: f for n, f in _FROM_CMD.items() if f not in InForce._fields},
+            _fields_of([None if isinstance(r[2], InForce) else r[2] for r in rows]),
+        ),
+    ):
+        if fields is not None:
+            cols.update((n, np.array(fields[f], dtype=float)) for n, f in names.items())
+    return cols
+
+
+def _fields_of(values: list) -> dict[str, tuple] | None:
+    """The fields of ``values`` by name, each a tuple over the rows (a None value: None in
+    every field, which ``np.array(..., dtype=float)`` makes NaN); None unless every value
+    that is not None is a named tuple of one type."""
+    kind = next((type(v) for v in values if v is not None), None)
+    names = getattr(kind, "_fields", None)
+    if names is None or any(v is not None and type(v) is not kind for v in values):
+        return None
+    blank = (None,) * len(names)
+    return dict(zip(names, zip(*[blank if v is None else v for v in values])))
 
 
 def _column(rows: list, name: str, brake_gains: tuple[float, ...]) -> np.ndarray:

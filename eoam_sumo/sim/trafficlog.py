@@ -162,14 +162,20 @@ class TrafficLog(StepObserver):
         return self._columns
 
     def _lay_out(self) -> dict:
+        """The rows as columns. A road user's row is its ``Body`` itself (its first nine
+        fields: vid, vclass, x, y, yaw, speed, length, width, parked), the ego's a tuple of the
+        same nine, so the transpose builds no tuple per row."""
         r2, to_centre = self._r2, self._to_centre
         length, width = self._ego_size
-        rows = []
-        for i, (ti, ex, ey, yaw, vx, bodies) in enumerate(self._steps):
+        rows: list = []
+        times: list[float] = []
+        counts: list[int] = []
+        for ti, ex, ey, yaw, vx, bodies in self._steps:
+            near = [
+                b for b in bodies if (b.x_m - ex) * (b.x_m - ex) + (b.y_m - ey) * (b.y_m - ey) <= r2
+            ]
             rows.append(
                 (
-                    ti,
-                    i,
                     self.ego_id,
                     self.ego_vclass,
                     ex + to_centre * math.cos(yaw),
@@ -181,36 +187,17 @@ class TrafficLog(StepObserver):
                     False,
                 )
             )
-            rows += [
-                (
-                    ti,
-                    i,
-                    b.vid,
-                    b.vclass,
-                    b.x_m,
-                    b.y_m,
-                    b.yaw_rad,
-                    b.speed_mps,
-                    b.length_m,
-                    b.width_m,
-                    b.parked,
-                )
-                for b in bodies
-                if (b.x_m - ex) * (b.x_m - ex) + (b.y_m - ey) * (b.y_m - ey) <= r2
-            ]
-        rows_t = list(zip(*rows)) if rows else [()] * 11
-        t, step_of, ids, vclasses, *nums, parked = rows_t
-        num = np.array(nums, dtype=float).reshape(6, -1).T  # x, y, heading, speed, L, W
-        ego_rows = np.flatnonzero(np.diff(np.asarray(step_of, dtype=np.int64), prepend=-1))
-        roles = self._roles(
-            list(ids),
-            num,
-            np.array(parked, dtype=bool),
-            ego_rows,
-            np.asarray(step_of, dtype=np.int64),
-        )
+            rows += near
+            times.append(ti)
+            counts.append(1 + len(near))
+        ids, vclasses, *nums, parked = list(zip(*rows)) if rows else [()] * 9
+        num = np.array(nums[:6], dtype=float).reshape(6, -1).T  # x, y, heading, speed, L, W
+        step_of = np.repeat(np.arange(len(counts), dtype=np.int64), counts)
+        ego_rows = np.flatnonzero(np.diff(step_of, prepend=-1))
+        t = np.repeat(np.array(times, dtype=float), counts)
+        roles = self._roles(list(ids), num, np.array(parked, dtype=bool), ego_rows, step_of)
         return {
-            "time_s": np.array(t, dtype=float),
+            "time_s": t,
             "id": list(ids),
             "vclass": list(vclasses),
             "role": roles,
@@ -231,33 +218,39 @@ class TrafficLog(StepObserver):
         step_of: np.ndarray,
     ) -> list[str]:
         """Role of every row (module doc): the ego's station at each step first, then each
-        road user's rows in time order, so the road frame's walk moves a little at a time."""
+        road user's rows in time order, so the road frame's walk moves a little at a time.
+        (The numbers as Python floats: the same doubles, without numpy's per-scalar cost.)"""
         roles = ["other"] * len(ids)
         if not ids:
             return roles
+        xs: list[float] = num[:, 0].tolist()
+        ys: list[float] = num[:, 1].tolist()
+        yaws: list[float] = num[:, 2].tolist()
+        speeds: list[float] = num[:, 3].tolist()
         road = RoadFrame(self._centreline)
-        ego_s = np.empty(len(ego_rows))
-        road.locate(num[ego_rows[0], 0], num[ego_rows[0], 1])
-        for i, k in enumerate(ego_rows):
-            ego_s[i] = road.project(num[k, 0], num[k, 1])[0]
+        road.locate(xs[ego_rows[0]], ys[ego_rows[0]])
+        ego_s: list[float] = []
+        for k in ego_rows.tolist():
+            ego_s.append(road.project(xs[k], ys[k])[0])
             roles[k] = "ego"
         band = lane_band_m(self._lane_width)
         others = np.flatnonzero(~parked)
         others = others[np.isin(others, ego_rows, invert=True)]
-        for k in np.flatnonzero(parked):
+        for k in np.flatnonzero(parked).tolist():
             roles[k] = "parked"
         by_id = sorted(others.tolist(), key=lambda k: (ids[k], k))
+        step_at = step_of.tolist()
         previous, met_ahead = None, None
         for k in by_id:
-            x, y, yaw, speed = num[k, :4]
+            x, y = xs[k], ys[k]
             if ids[k] != previous:
                 road.locate(x, y)
                 previous, met_ahead = ids[k], None
             s, d, road_yaw = road.project(x, y)
-            if speed * math.cos(yaw - road_yaw) < -ONCOMING_SPEED_MPS and d > -band:
+            if speeds[k] * math.cos(yaws[k] - road_yaw) < -ONCOMING_SPEED_MPS and d > -band:
                 roles[k] = "oncoming"
             elif abs(d) < band:
-                ahead = s > ego_s[step_of[k]]
+                ahead = s > ego_s[step_at[k]]
                 met_ahead = ahead if met_ahead is None else met_ahead
                 if ahead or met_ahead:
                     roles[k] = "aro"
@@ -274,13 +267,14 @@ class TrafficLog(StepObserver):
 
         path = Path(path)
         cols = self.columns()
-        table = pa.table(
-            {
-                name: np.round(cols[name], _DECIMALS[name]) + 0.0
+        table = pa.Table.from_arrays(
+            [
+                _float_array(np.round(cols[name], _DECIMALS[name]) + 0.0)
                 if name in _DECIMALS
-                else cols[name]
+                else _text_array(cols[name])
                 for name in TRAFFIC_COLUMNS
-            }
+            ],
+            names=list(TRAFFIC_COLUMNS),
         )
         sink = pa.BufferOutputStream()
         if path.suffix == ".parquet":
@@ -293,6 +287,29 @@ class TrafficLog(StepObserver):
                 sink = pa.BufferOutputStream()
                 pa_csv.write_csv(table, sink, pa_csv.WriteOptions(quoting_header="none"))
         write_atomic(path, sink.getvalue().to_pybytes())
+
+
+def _float_array(values: np.ndarray):
+    """A pyarrow float64 array over the values' own buffer (NaN kept as a value, as
+    ``pa.array`` keeps it). Built from buffers because ``pa.array`` imports pandas (0.2 s a
+    worker) to ask whether its argument is a pandas object."""
+    import pyarrow as pa
+
+    values = np.ascontiguousarray(values, dtype=np.float64)
+    return pa.Array.from_buffers(pa.float64(), len(values), [None, pa.py_buffer(values)])
+
+
+def _text_array(texts: list[str]):
+    """A pyarrow string array of ``texts`` (UTF-8 bytes and their offsets; see
+    ``_float_array``)."""
+    import pyarrow as pa
+
+    data = [t.encode() for t in texts]
+    offsets = np.zeros(len(data) + 1, dtype=np.int32)
+    np.cumsum([len(d) for d in data], out=offsets[1:])
+    return pa.Array.from_buffers(
+        pa.string(), len(data), [None, pa.py_buffer(offsets), pa.py_buffer(b"".join(data))]
+    )
 
 
 def read_traffic(path: Path):

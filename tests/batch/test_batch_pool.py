@@ -12,7 +12,8 @@ import time
 
 import pytest
 
-from eoam_sumo.batch.pool import TaskResult, run_local
+from eoam_sumo.batch import pool
+from eoam_sumo.batch.pool import TaskResult, run_local, warm_workers
 
 
 def square_with_pid(payload):
@@ -83,6 +84,19 @@ def test_hung_task_is_killed_at_its_timeout_and_the_rest_run():
     results = _by_key(run_local(misbehave, tasks, jobs=2, timeout_s=3.0))
     assert results["hang"].error == "timed out after 3 s (worker killed)"
     assert results["x"].value["value"] == 1 and results["y"].value["value"] == 2
+
+
+def test_warm_workers_run_the_tasks_and_those_not_taken_are_closed():
+    with warm_workers(3):
+        warm = {w.proc.pid: w.proc for w in pool._warm}
+        results = _by_key(run_local(square_with_pid, [("a", 2), ("b", 3)], jobs=1))
+        assert results["a"].value["square"] == 4 and results["b"].value["square"] == 9
+        assert results["a"].value["pid"] in warm  # a worker started before run_local
+        assert results["a"].value["pid"] == results["b"].value["pid"]
+        others = [p for pid, p in warm.items() if pid != results["a"].value["pid"]]
+        assert all(p.poll() is None for p in others)  # not taken: still there in the block
+    assert all(p.poll() is not None for p in warm.values())  # and closed after it
+    assert not pool._warm
 
 
 def test_worker_that_cannot_start_raises():
