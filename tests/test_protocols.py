@@ -418,6 +418,9 @@ def test_the_same_protocol_twice_gives_the_same_results(tmp_path):
     assert "Not run" not in (tmp_path / "a" / "scorecard.md").read_text()
     assert not math.isnan(first["impact_speed_kmh"].iloc[1])
     assert set(first["system"]) == {"aeb"}
+    # the step each point ran at: the study default, as the batch's own rows say
+    batch = pd.read_csv(tmp_path / "a" / "batch" / "results.csv")
+    assert list(first["sumo_step_s"]) == [0.05] * 3 == list(batch["sumo_step_s"])
 
 
 @pytest.mark.sumo

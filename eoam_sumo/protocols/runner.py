@@ -32,6 +32,7 @@ PROTOCOL_COLUMNS = (
     "protocol",
     "system",
     "policy",
+    "sumo_step_s",
     "test",
     "ego_speed_kmh",
     "target_speed_kmh",
@@ -200,6 +201,7 @@ def _row(point: TestPoint, run: dict | None, label: RunLabel, out: Path) -> dict
         row = scoring.point_row(point, None, note)
         return {**row, **head, "status": "not_run", "error": "", "case_dir": ""}
     summary = {c: run.get(c) for c in SUMMARY_COLUMNS}
+    head["sumo_step_s"] = run.get("sumo_step_s")
     case_dir = f"{BATCH_DIR}/{run['case_dir']}"
     if run["status"] != "ok":
         row = scoring.point_row(point, None, "the run failed: " + str(run["error"]))
