@@ -195,7 +195,7 @@ def _facts(run: dict, width_m: float) -> scoring.RunFacts:
 
 
 def _row(point: TestPoint, run: dict | None, label: RunLabel, out: Path) -> dict:
-    head = {"point_id": point.point_id, "system": label.system, "policy": label.policy}
+    head: dict = {"point_id": point.point_id, "system": label.system, "policy": label.policy}
     if run is None:
         note = scoring.OUTSIDE_DESIGN.format(v=point.ego_speed_kmh, low=label.low_kmh)
         row = scoring.point_row(point, None, note)
