@@ -30,7 +30,8 @@ a head-on at the closing speed then (less what braking took off), a hit on the o
 relative speed left after braking over the gap (both bodies braking to their stops).
 No contact comes first; a side contact with the obstacle counts as a front one, by the
 relative speed. Ties go to aborting (the paper's choice before its point of no return), then
-to braking in place.
+to braking in place. Where every option ends in contact with ``margin_s``, the one clear with
+the smaller ``margin_min_s`` is taken, if any (``choose``; on exact states only).
 """
 
 from __future__ import annotations

@@ -195,13 +195,12 @@ def _facts(run: dict, width_m: float) -> scoring.RunFacts:
 
 
 def _row(point: TestPoint, run: dict | None, label: RunLabel, out: Path) -> dict:
-    head: dict = {"point_id": point.point_id, "system": label.system, "policy": label.policy}
+    head = {"point_id": point.point_id, "system": label.system, "policy": label.policy}
     if run is None:
         note = scoring.OUTSIDE_DESIGN.format(v=point.ego_speed_kmh, low=label.low_kmh)
         row = scoring.point_row(point, None, note)
         return {**row, **head, "status": "not_run", "error": "", "case_dir": ""}
     summary = {c: run.get(c) for c in SUMMARY_COLUMNS}
-    head["sumo_step_s"] = run.get("sumo_step_s")
     case_dir = f"{BATCH_DIR}/{run['case_dir']}"
     if run["status"] != "ok":
         row = scoring.point_row(point, None, "the run failed: " + str(run["error"]))
@@ -215,6 +214,7 @@ def _row(point: TestPoint, run: dict | None, label: RunLabel, out: Path) -> dict
         **summary,
         **row,
         **head,
+        "sumo_step_s": run.get("sumo_step_s"),
         "status": run["status"],
         "error": run.get("error") or "",
         "case_dir": case_dir,

@@ -117,20 +117,30 @@ def test_clipped_to_the_front_slip_envelope_and_the_lock():
     assert ctrl.command(0.5, 0.0, 0.0, 50.0, 0.0, 0.0, 0.0, 1.0).steer_rad == -P.max_steer_rad
 
 
+def _motion(lateral_speed_mps: float):
+    """(speed, lateral speed, yaw rate, mu) of a body in motion."""
+    return st.tuples(
+        st.floats(5.0, 50.0),
+        st.floats(-lateral_speed_mps, lateral_speed_mps),
+        st.floats(-0.5, 0.5),
+        st.floats(0.1, 1.2),
+    )
+
+
+def _peak_slip_per_mu() -> float:
+    """The Fiala front tyre's peak slip per unit of mu, 3 Fz_f / C_f."""
+    fz = P.mass_kg * 9.81 * P.cg_to_rear_m / P.wheelbase_m
+    return 3.0 * fz / P.cornering_stiffness_front_npr
+
+
 @settings(max_examples=50, deadline=None)
-@given(
-    st.floats(5.0, 50.0),
-    st.floats(-2.0, 2.0),
-    st.floats(-0.5, 0.5),
-    st.floats(0.1, 1.2),
-    st.sampled_from((1.0, -1.0)),
-)
-def test_envelope_edge_is_the_front_slip_limit_the_law_clips_to(v, vy, r, mu, side):
+@given(_motion(2.0), st.sampled_from((1.0, -1.0)))
+def test_envelope_edge_is_the_front_slip_limit_the_law_clips_to(motion, side):
     """The edge's front slip (delta less the front axle's course) is the envelope's, on the
     side asked for, and the law's largest error towards that side lands on it."""
+    v, vy, r, mu = motion
     ctrl = SteeringController(P)
-    fz = P.mass_kg * 9.81 * P.cg_to_rear_m / P.wheelbase_m
-    envelope = SteeringGains().front_slip_fraction * 3.0 * fz / P.cornering_stiffness_front_npr
+    envelope = SteeringGains().front_slip_fraction * _peak_slip_per_mu()
     edge = ctrl.envelope_edge(v, r, vy, mu, side)
     course_f = (vy + P.cg_to_front_m * r) / v
     assume(abs(course_f) + envelope * mu < P.max_steer_rad)
@@ -140,20 +150,14 @@ def test_envelope_edge_is_the_front_slip_limit_the_law_clips_to(v, vy, r, mu, si
 
 
 @settings(max_examples=50, deadline=None)
-@given(
-    st.floats(5.0, 50.0),
-    st.floats(-4.0, 4.0),
-    st.floats(-0.5, 0.5),
-    st.floats(0.1, 1.2),
-    st.floats(0.05, 0.95),
-)
-def test_share_edges_give_the_fiala_force_share_about_the_body_motion(v, vy, r, mu, share):
+@given(_motion(4.0), st.floats(0.05, 0.95))
+def test_share_edges_give_the_fiala_force_share_about_the_body_motion(motion, share):
     """At either edge the front slip about the front axle's course is the one at which a
     Fiala tyre gives ``share`` of its peak force, 1 - (1 - alpha / alpha_peak)^3, with
     alpha_peak = 3 mu Fz / C_f; at 7/8 of the peak it is the envelope's edge."""
+    v, vy, r, mu = motion
     ctrl = SteeringController(P)
-    fz = P.mass_kg * 9.81 * P.cg_to_rear_m / P.wheelbase_m
-    alpha_peak = 3.0 * mu * fz / P.cornering_stiffness_front_npr
+    alpha_peak = mu * _peak_slip_per_mu()
     course_f = (vy + P.cg_to_front_m * r) / v
     assume(abs(course_f) + alpha_peak < P.max_steer_rad)
     right, left = ctrl.share_edges(v, r, vy, mu, share)
