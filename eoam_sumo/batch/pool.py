@@ -64,8 +64,7 @@ def _child_main() -> None:
     os.dup2(2, 1)  # native prints now go to the stderr log, not into the message stream
     inp = Connection(os.dup(0), writable=False)
     try:
-        _, sys_path, preload = inp.recv()
-        sys.path[:] = sys_path
+        _, preload = inp.recv()
         for module in preload:
             __import__(module)
         out.send(("ready",))
@@ -83,6 +82,25 @@ def _child_main() -> None:
         return
 
 
+def _child_command() -> str:
+    """The worker's program: the parent's package and ``sys.path`` set before anything of
+    ours is imported.
+
+    Python started with ``-c`` puts its working folder first on the path (``-P`` stops that),
+    so a worker started in a source checkout would otherwise import the checkout's package,
+    not the parent's (e.g. a compiled build on ``PYTHONPATH``). The folder holding the
+    parent's package comes first, then the parent's path with the working folder made absolute.
+    """
+    import eoam_sumo
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(eoam_sumo.__file__)))
+    path = [root] + [os.path.abspath(p) if p else os.getcwd() for p in sys.path]
+    return (
+        f"import sys; sys.path[:] = {path!r}; "
+        "from eoam_sumo.batch.pool import _child_main; _child_main()"
+    )
+
+
 class _Worker:
     """One worker process as seen by the parent: start, dispatch, receive, kill."""
 
@@ -90,7 +108,7 @@ class _Worker:
         self.preload = tuple(preload)
         self.log = tempfile.TemporaryFile()  # noqa: SIM115 - lives as long as the worker
         self.proc = subprocess.Popen(
-            [sys.executable, "-c", "from eoam_sumo.batch.pool import _child_main; _child_main()"],
+            [sys.executable, "-P", "-c", _child_command()],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             stderr=self.log,
@@ -108,7 +126,7 @@ class _Worker:
         self.deadline = time.monotonic() + STARTUP_TIMEOUT_S
         # died at once: end of file on its pipe reports it
         with contextlib.suppress(OSError):
-            self.send_conn.send(("init", list(sys.path), tuple(preload)))
+            self.send_conn.send(("init", tuple(preload)))
 
     @property
     def busy(self) -> bool:

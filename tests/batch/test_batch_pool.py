@@ -108,3 +108,23 @@ def test_worker_that_cannot_start_raises():
 def test_bad_settings_are_rejected(kwargs):
     with pytest.raises(ValueError):
         list(run_local(square_with_pid, [("t", 1)], **kwargs))
+
+
+def package_file(_payload):
+    import eoam_sumo
+
+    return eoam_sumo.__file__
+
+
+def test_workers_import_the_parents_package_wherever_they_start(tmp_path, monkeypatch):
+    """A worker started in a folder holding another ``eoam_sumo`` (a source checkout beside a
+    compiled build) imports the parent's package, not that one."""
+    decoy = tmp_path / "eoam_sumo"
+    decoy.mkdir()
+    (decoy / "__init__.py").write_text("raise ImportError('the decoy package was imported')\n")
+    monkeypatch.chdir(tmp_path)
+    import eoam_sumo
+
+    results = _by_key(run_local(package_file, [("a", None)], jobs=1, timeout_s=120))
+    assert results["a"].ok, results["a"].error
+    assert results["a"].value == eoam_sumo.__file__
