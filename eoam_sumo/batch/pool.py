@@ -22,6 +22,7 @@ Two drivers share the worker: :func:`run_local` (N workers on this machine) and
 from __future__ import annotations
 
 import contextlib
+import gc
 import os
 import signal
 import subprocess
@@ -36,6 +37,15 @@ from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from typing import Any
 
+#: Native thread pools a worker runs with one thread each, unless the caller's environment
+#: says otherwise: the workers are the parallelism, and OpenBLAS's idle threads spin on the
+#: cores the other workers need.
+SINGLE_THREADED = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+#: A worker's cyclic garbage collector: its first generation collected every this many net
+#: allocations (Python's default is 700), the modules it preloaded frozen out of every
+#: collection. A step of the co-simulation allocates thousands of short-lived objects and
+#: frees nearly all of them by reference counting.
+GC_THRESHOLDS = (50_000, 20, 100)
 #: Longest wait for a new worker to import its modules and say it is ready [s].
 STARTUP_TIMEOUT_S = 180.0
 _STDERR_TAIL_BYTES = 4000
@@ -67,6 +77,9 @@ def _child_main() -> None:
         _, preload = inp.recv()
         for module in preload:
             __import__(module)
+        gc.collect()
+        gc.freeze()
+        gc.set_threshold(*GC_THRESHOLDS)
         out.send(("ready",))
         while True:
             try:
@@ -80,6 +93,15 @@ def _child_main() -> None:
                 out.send(("error", _one_line(f"{type(exc).__name__}: {exc}")))
     except (EOFError, BrokenPipeError):
         return
+
+
+def _child_environment() -> dict[str, str]:
+    """The worker's environment: the parent's, native thread pools single-threaded unless
+    set there (:data:`SINGLE_THREADED`)."""
+    env = dict(os.environ)
+    for name in SINGLE_THREADED:
+        env.setdefault(name, "1")
+    return env
 
 
 def _child_command() -> str:
@@ -112,6 +134,7 @@ class _Worker:
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             stderr=self.log,
+            env=_child_environment(),
         )
         stdin, stdout = self.proc.stdin, self.proc.stdout
         assert stdin is not None and stdout is not None  # both are pipes

@@ -128,3 +128,14 @@ def test_workers_import_the_parents_package_wherever_they_start(tmp_path, monkey
     results = _by_key(run_local(package_file, [("a", None)], jobs=1, timeout_s=120))
     assert results["a"].ok, results["a"].error
     assert results["a"].value == eoam_sumo.__file__
+
+
+def test_workers_run_native_thread_pools_single_threaded_unless_told(monkeypatch):
+    """Workers are the parallelism: OpenBLAS and OpenMP get one thread each in a worker,
+    unless the caller's environment sets them."""
+    monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)
+    monkeypatch.setenv("OMP_NUM_THREADS", "3")
+    tasks = [("blas", "OPENBLAS_NUM_THREADS"), ("omp", "OMP_NUM_THREADS")]
+    results = _by_key(run_local(os.getenv, tasks, jobs=1, timeout_s=120))
+    assert results["blas"].value == "1"
+    assert results["omp"].value == "3"
