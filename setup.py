@@ -31,6 +31,7 @@ COMPILED = [
     "eoam_sumo/eoam/strategies.py",
     "eoam_sumo/eoam/transitions.py",
     "eoam_sumo/eoam_messages.py",
+    "eoam_sumo/control/brake_split.py",
     "eoam_sumo/control/longitudinal.py",
     "eoam_sumo/control/steering.py",
     "eoam_sumo/decision/dmm.py",

@@ -41,6 +41,10 @@ EGO_LANE_Y_M = -1.75
 EGO_FRONT_X_M = 100.0
 DEPART_S = 1.0
 STOPPED_DECEL_MPS2 = 10.0  # a stationary target's script: held at 0 from its departure
+#: The ego's SUMO class: the targets' edges disallow it, so that SUMO's placing of the ego
+#: (``moveToXY``, which measures the distance to every lane the ego may use within 100 m)
+#: looks only at the road's two lanes, not at the targets' rails under the ego lane.
+EGO_VCLASS = "custom1"
 
 
 def offset_edges(points: list[TestPoint]) -> dict[float, int]:
@@ -82,7 +86,8 @@ def _lane_change_sources(points: list[TestPoint]) -> tuple[list[str], list[str]]
         text = " ".join(f"{x:.3f},{y:.4f}" for x, y in shape)
         edges.append(
             f'<edge id="L{n}" from="le{n}" to="lw{n}" numLanes="1" speed="50.00" width="2.00"'
-            f' spreadType="center" shape="{text}"><lane index="0" friction="1.00"/></edge>'
+            f' spreadType="center" disallow="{EGO_VCLASS}" shape="{text}">'
+            '<lane index="0" friction="1.00"/></edge>'
         )
     return nodes, edges
 
@@ -107,7 +112,8 @@ def _network_sources(folder: Path, offsets: dict[float, int], points: list[TestP
         for eid, a, b in ((f"T{k}", f"tw{k}", f"te{k}"), (f"H{k}", f"he{k}", f"hw{k}")):
             edges.append(
                 f'<edge id="{eid}" from="{a}" to="{b}" numLanes="1" speed="50.00" width="2.00"'
-                f' spreadType="center"><lane index="0" friction="1.00"/></edge>'
+                f' spreadType="center" disallow="{EGO_VCLASS}"><lane index="0" friction="1.00"/>'
+                "</edge>"
             )
     hol_nodes, hol_edges = _lane_change_sources(points)
     nodes, edges = nodes + hol_nodes, edges + hol_edges
@@ -127,7 +133,7 @@ VTYPES = f"""<?xml version="1.0" encoding="UTF-8"?>
      (vectorgrp/OSC-NCAP-scenarios Vehicles.xosc NCAP_GlobalVehicleTarget,
      NCAP_ObstructionVehicle_Large). -->
 <additional>
-    <vType id="ego" vClass="passenger" length="4.92" width="1.85" minGap="2.00" maxSpeed="60.00"
+    <vType id="ego" vClass="{EGO_VCLASS}" length="4.92" width="1.85" minGap="2.00" maxSpeed="60.00"
            accel="4.00" decel="9.00" emergencyDecel="12.00" sigma="0" speedDev="0"/>
     <vType id="gvt" vClass="passenger" length="{GVT_LENGTH_M}" width="{GVT_WIDTH_M}"
            minGap="1.00" maxSpeed="50.00" accel="2.50" decel="10.00" emergencyDecel="12.00"
