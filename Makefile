@@ -17,7 +17,7 @@ TREE_FILES = git ls-files --cached --others --exclude-standard -- \
 	| while read -r f; do [ -e "$$f" ] && echo "$$f"; done
 RUN_COMPILED := PYTHONPATH=$(CURDIR)/$(COMPILED_TREE)
 
-.PHONY: run test test-fast test-compiled golden-strict golden-update tables bench lint network \
+.PHONY: run study test test-fast test-compiled golden-strict golden-update tables bench lint network \
 	lock compiled clean readme-pictures
 
 $(STAMP): pyproject.toml setup.py $(LOCK)
@@ -34,6 +34,11 @@ run: $(COMPILED_STAMP)
 	$(RUN_COMPILED) $(BIN)/eoam-sumo batch scenarios/table2_safe_v2x.toml \
 		--out $(OUT)/table2_safe_v2x --jobs 2
 	cat $(OUT)/table2_safe_v2x/table2.md
+
+## Any command on the compiled build (its workers too), e.g. a study:
+##   make study ARGS="batch scenarios/vehicles.toml --out out/vehicles"
+study: $(COMPILED_STAMP)
+	$(RUN_COMPILED) $(BIN)/eoam-sumo $(ARGS)
 
 ## Every test on the Python sources, the SUMO co-simulations and the golden Table 2 within its
 ## tolerances included (what CI runs, with test-compiled). It changes nothing outside the
