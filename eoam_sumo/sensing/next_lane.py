@@ -114,6 +114,9 @@ class NextLaneSensing:
         self.ego_length_m, self.ego_width_m = ego_length_m, ego_width_m
         v2x = v2x or V2XSettings()
         self.corner = corner or CornerRadarSettings()
+        # the corner radars' half field of view and boresight (toward the lane's side) [rad]
+        self._corner_half_fov = math.radians(0.5 * self.corner.fov_deg)
+        self._corner_bore = math.radians(self.corner.boresight_deg) * self.side
         self.v2x = V2XReceiver(v2x) if v2x.enabled else None
         fastest = speed_limit_mps if fastest_mps is None else fastest_mps
         self._v2x_free_m = v2x.range_m - fastest * v2x.blind_time_s() if v2x.covers_all else 0.0
@@ -177,8 +180,8 @@ class NextLaneSensing:
             nearest_ahead_speed_mps=ahead[0][1] if ahead else None,
             nearest_behind_m=None if behind is None else behind[0],
             nearest_behind_speed_mps=None if behind is None else behind[1],
-            ahead=tuple((gap, v) for gap, v, _a in ahead),
-            accel_ahead_mps2=tuple(a for _gap, _v, a in ahead),
+            ahead=tuple([(gap, v) for gap, v, _a in ahead]),
+            accel_ahead_mps2=tuple([a for _gap, _v, a in ahead]),
             nearest_behind_accel_mps2=0.0 if behind is None else behind[2],
             coverage_behind_m=max(self.corner.range_m, self._v2x_free_m),
             side=self.side,
@@ -338,8 +341,7 @@ class NextLaneSensing:
         half_w = 0.5 * self.ego_width_m * self.side
         fx, fy = front_xy[0] - half_w * sy, front_xy[1] + half_w * cy  # front corner
         rx, ry = fx - self.ego_length_m * cy, fy - self.ego_length_m * sy  # rear corner
-        half = math.radians(0.5 * c.fov_deg)
-        bore = math.radians(c.boresight_deg) * self.side
+        half, bore = self._corner_half_fov, self._corner_bore
         return (
             (front_xy[0], front_xy[1], yaw_rad, self._radar_half_fov, self.radar_range_m),
             (fx, fy, yaw_rad + bore, half, c.range_m),

@@ -216,7 +216,7 @@ class Margins(StepObserver):
             rel = b.yaw_rad - road_yaw
             if math.cos(rel) < 0.0:  # opposite direction
                 v = self._rates(b, st, d, rel)
-                radius = math.hypot(0.5 * b.length_m, 0.5 * b.width_m)
+                radius = b.box.radius_m
                 if _apart(ego, st, d, radius, ego_v, v, self.min_ttc_oncoming_s):
                     continue  # never on a collision course within the smallest yet
                 box = OrientedBox(st, d, rel, b.length_m, b.width_m)
@@ -232,7 +232,7 @@ class Margins(StepObserver):
                 horizon = max(horizon, min(self.min_ttc_rear_s, TTC_HORIZON_S))
             v = self._rates(b, st, d, rel)
             # the box in the frame only when its bounding circle may meet the ego's
-            radius = math.hypot(0.5 * b.length_m, 0.5 * b.width_m)
+            radius = b.box.radius_m
             if _apart(ego, st, d, radius, ego_v, v, horizon):
                 ttc = math.inf
             else:

@@ -192,20 +192,23 @@ class RolloverWatch(StepObserver):
         static, per_ax, per_ay = self._static, self._per_ax, self._per_ay
         low = math.inf
         lifted = [False, False, False, False]
+        any_lifted = False
         for i in range(4):
             load = static[i] + per_ax[i] * ax + per_ay[i] * ay
             low = min(low, load)
-            lifted[i] = load <= 0.0 and per_ay[i] * ay < 0.0  # inner: the roll unloads it
+            if load <= 0.0 and per_ay[i] * ay < 0.0:  # inner: the roll unloads it
+                lifted[i] = any_lifted = True
         self.min_load_n = min(self.min_load_n, max(low, 0.0))
-        if self.lift_time_s is None and any(lifted):
-            self.lift_time_s, self.lift_ay_mps2 = sim.t, ay
-            self.lift_tyre = self._tyres[lifted.index(True)]
-        for front, rear in ((0, 2), (1, 3)):
-            if lifted[front] and lifted[rear]:
-                self.time_s = sim.t
-                side = self._tyres[front].split()[-1]
-                self.cause = f"both inner {side} wheels lifted"
-                return
+        if any_lifted:  # else nothing lifted: the usual step, no more to do
+            if self.lift_time_s is None:
+                self.lift_time_s, self.lift_ay_mps2 = sim.t, ay
+                self.lift_tyre = self._tyres[lifted.index(True)]
+            for front, rear in ((0, 2), (1, 3)):
+                if lifted[front] and lifted[rear]:
+                    self.time_s = sim.t
+                    side = self._tyres[front].split()[-1]
+                    self.cause = f"both inner {side} wheels lifted"
+                    return
         if abs(sim.ay) > self._ssf_ay_mps2:
             self.time_s = sim.t
             self.cause = (

@@ -48,6 +48,9 @@ class RoadFrame:
         self._breaks, self._break_yaw, self._break_slope = _smooth_heading(clean, self._s)
         self._break_hint = 0
         self._hint = 0
+        self._last_segment = len(self._len) - 1
+        self._last_break = len(self._breaks) - 1
+        self._length = self._s[-1]
 
     @property
     def length_m(self) -> float:
@@ -73,7 +76,7 @@ class RoadFrame:
         heading of ``_smooth_heading`` (continuous, not wrapped), not the segment's own: that
         jumps at every vertex (0.017 rad for 25 m chords of a 1500 m curve), which a look-ahead
         steering feedback 30 m ahead would turn into half-metre steps."""
-        last = len(self._len) - 1
+        last = self._last_segment
         i = self._hint
         hx, hy, xs, ys, seg = self._hx, self._hy, self._x, self._y, self._len
         rx, ry = x - xs[i], y - ys[i]
@@ -89,9 +92,22 @@ class RoadFrame:
                 along = rx * hx[i] + ry * hy[i]
         self._hint = i
         s_m = self._s[i] + along
-        j = self._break_interval(s_m)
-        h = min(max(0.0, s_m), self._s[-1])  # beyond its ends the road runs straight on
-        yaw = self._break_yaw[j] + (h - self._breaks[j]) * self._break_slope[j]
+        # the smooth heading's interval (``_break_interval``, inlined: the hot path)
+        breaks, j, j_last = self._breaks, self._break_hint, self._last_break
+        while j < j_last and s_m >= breaks[j + 1]:
+            j += 1
+        while j > 0 and s_m < breaks[j]:
+            j -= 1
+        self._break_hint = j
+        # beyond its ends the road runs straight on: s clamped to [0, length] (comparisons
+        # here cost less than min and max calls; NaN gives 0, as max(0.0, s) does)
+        if not s_m > 0.0:
+            h = 0.0
+        elif self._length < s_m:
+            h = self._length
+        else:
+            h = s_m
+        yaw = self._break_yaw[j] + (h - breaks[j]) * self._break_slope[j]
         return s_m, ry * hx[i] - rx * hy[i], yaw
 
     def _break_interval(self, s_m: float) -> int:

@@ -263,10 +263,32 @@ def _nearest_point(box: OrientedBox, x_m: float, y_m: float) -> tuple[float, flo
 
 def _nearest_corner(src: OrientedBox, dst: OrientedBox) -> tuple[float, float, float, float, float]:
     """(distance, x, y of the corner, x, y of its nearest point of dst) of the first corner of
-    ``src`` nearest to ``dst`` (distance inf, zeros if none is finite)."""
+    ``src`` nearest to ``dst`` (distance inf, zeros if none is finite). ``corners`` and
+    ``_nearest_point`` written out, the same arithmetic: the margins and the contact check
+    ask this at every step of an approach."""
+    c, s = src.cos_yaw, src.sin_yaw
+    fx, fy = c * src.half_length_m, s * src.half_length_m
+    lx, ly = -s * src.half_width_m, c * src.half_width_m
+    x, y = src.x_m, src.y_m
+    dc, ds, hl, hw = dst.cos_yaw, dst.sin_yaw, dst.half_length_m, dst.half_width_m
     best = (math.inf, 0.0, 0.0, 0.0, 0.0)
-    for cx, cy in src.corners():
-        px, py = _nearest_point(dst, cx, cy)
+    for cx, cy in (
+        (x + fx + lx, y + fy + ly),
+        (x - fx + lx, y - fy + ly),
+        (x - fx - lx, y - fy - ly),
+        (x + fx - lx, y + fy - ly),
+    ):
+        dx, dy = cx - dst.x_m, cy - dst.y_m
+        u, v = dc * dx + ds * dy, -ds * dx + dc * dy  # in dst's frame, clamped to it
+        if u > hl:
+            u = hl
+        elif u < -hl:
+            u = -hl
+        if v > hw:
+            v = hw
+        elif v < -hw:
+            v = -hw
+        px, py = dst.x_m + dc * u - ds * v, dst.y_m + ds * u + dc * v
         dist = math.hypot(cx - px, cy - py)
         if dist < best[0]:
             best = (dist, cx, cy, px, py)
@@ -446,15 +468,21 @@ def time_to_contact(
     the projections changes linearly with time; contact needs every axis closed at once."""
     dx, dy = b.x_m - a.x_m, b.y_m - a.y_m
     rvx, rvy = vb[0] - va[0], vb[1] - va[1]
+    ac, asn, ahl, ahw = a.cos_yaw, a.sin_yaw, a.half_length_m, a.half_width_m
+    bc, bsn, bhl, bhw = b.cos_yaw, b.sin_yaw, b.half_length_m, b.half_width_m
     # b's centre on each axis relative to a's, its rate, and the pair's reach on that axis
+    # (``_axes`` and ``_half_extent`` written out, the same arithmetic)
     return slab_entry(
         [
             (
                 dx * nx + dy * ny,
                 rvx * nx + rvy * ny,
-                _half_extent(a, nx, ny) + _half_extent(b, nx, ny) + CONTACT_TOLERANCE_M,
+                ahl * abs(ac * nx + asn * ny)
+                + ahw * abs(-asn * nx + ac * ny)
+                + (bhl * abs(bc * nx + bsn * ny) + bhw * abs(-bsn * nx + bc * ny))
+                + CONTACT_TOLERANCE_M,
             )
-            for nx, ny in _axes(a, b)
+            for nx, ny in ((ac, asn), (-asn, ac), (bc, bsn), (-bsn, bc))
         ],
         horizon_s,
     )

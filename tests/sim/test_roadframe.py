@@ -128,3 +128,22 @@ def test_locate_starts_the_walk_on_the_return_leg_of_a_hairpin():
     assert d_m == pytest.approx(0.0, abs=1e-9)
     assert s_m == pytest.approx(1000.0 + math.pi * radius + 500.0, abs=1.0)
     assert math.cos(yaw) == pytest.approx(-1.0, abs=1e-6)  # heading west
+
+
+@pytest.mark.parametrize("hint", [0, 50, 99])
+def test_beyond_its_ends_the_heading_is_held(hint):
+    """Before its start and past its end the road runs straight on: the heading of a point
+    there is the one at the end it is beyond, however far out and wherever the walk began
+    (the arc's first heading chord, 10 m, points 0.025 rad left; its last, 10-20 m long
+    to the end at 1 rad, between 0.95 and 0.975 rad)."""
+    length = ARC.length_m
+    yaws = []
+    for s_m in (-30.0, -0.5, length + 0.5, length + 30.0):
+        ARC._hint = hint
+        x, y, _ = ARC.point_at(s_m, 1.0)
+        s2, _d, yaw = ARC.project(x, y)
+        assert (s2 < 0.0) == (s_m < 0.0) and (s2 > length) == (s_m > length)
+        yaws.append(yaw)
+    assert yaws[0] == yaws[1] == pytest.approx(0.025, abs=0.01)
+    assert yaws[2] == yaws[3]
+    assert 0.95 - 1e-9 <= yaws[2] <= 0.975 + 1e-9
