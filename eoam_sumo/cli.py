@@ -556,12 +556,16 @@ def _run_matrix_batch(args) -> int:
             timeseries=args.timeseries,
             after_stop_s=args.after_stop_s,
             plan=plan,
+            meanwhile=_import_batch_plots,  # matplotlib: in this process only, on a free core
         )
-        # matplotlib is imported once the cases have run, in this process only
         from eoam_sumo.plotting.batch_plots import plot_batch_report
 
         plot_batch_report(results, out)
     return _batch_status(results, Path(args.out))
+
+
+def _import_batch_plots() -> None:
+    import eoam_sumo.plotting.batch_plots  # noqa: F401 - imported for the images to come
 
 
 def _cmd_xosc_batch(args) -> int:

@@ -11,6 +11,7 @@ import json
 import math
 import numbers
 import os
+import threading
 from dataclasses import asdict
 from pathlib import Path
 
@@ -150,21 +151,54 @@ def read_results(path: Path) -> pd.DataFrame:
 
 
 class RowLog:
-    """results.csv open for appending: one row per finished case, flushed and synced."""
+    """results.csv open for appending: one row per finished case, written and flushed at
+    once (a batch killed afterwards keeps it), and synced to disk by a thread of its own, so
+    the caller (who hands the next case out) does not wait for the disk (an ``os.fsync``
+    took 28 ms a row here). One sync covers every row written before it; ``close`` waits for
+    the last."""
 
     def __init__(self, path: Path, kept: pd.DataFrame):
         self.path = path
         kept_text = kept.to_csv(index=False) if len(kept) else csv_text([], header=True)
         write_atomic(path, kept_text, durable=True)
         self.fh = open(path, "a", encoding="utf-8", newline="")  # noqa: SIM115 - closed in close()
+        self._unsynced = threading.Event()
+        self._closing = False
+        self._error: OSError | None = None
+        self._syncer = threading.Thread(target=self._sync_rows, name="results-sync", daemon=True)
+        self._syncer.start()
 
     def add(self, row: dict) -> None:
         self.fh.write(row_text(row))
         self.fh.flush()
-        os.fsync(self.fh.fileno())
+        self._unsynced.set()
+
+    def _sync_rows(self) -> None:
+        """Sync the file whenever rows were written since the last sync, until closed."""
+        while True:
+            self._unsynced.wait()
+            self._unsynced.clear()
+            if self._closing:
+                return
+            try:
+                os.fsync(self.fh.fileno())
+            except OSError as exc:  # reported by close()
+                self._error = exc
+                return
 
     def close(self) -> None:
-        self.fh.close()
+        """Stop the syncing thread, sync what it has not and close the file."""
+        self._closing = True
+        self._unsynced.set()
+        self._syncer.join()
+        try:
+            self.fh.flush()
+            if self._error is None:
+                os.fsync(self.fh.fileno())
+        finally:
+            self.fh.close()
+        if self._error is not None:
+            raise InputError(f"{self.path} cannot be written: {self._error.strerror}")
 
 
 #: results.csv columns that, besides the case id, make a kept row the same case for --resume:

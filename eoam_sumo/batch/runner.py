@@ -19,7 +19,9 @@ matrix's (the report and the returned frame are the matrix's cases).
 from __future__ import annotations
 
 import contextlib
+import os
 import sys
+import threading
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -146,6 +148,7 @@ def run_batch(
     after_stop_s: float | None = None,
     plan: BatchPlan | None = None,
     sumo_step_s: float | None = None,
+    meanwhile: Callable[[], object] | None = None,
 ) -> pd.DataFrame:
     """Run every case of the matrix; return the final results (as :func:`read_results`).
 
@@ -164,7 +167,7 @@ def run_batch(
     :func:`~eoam_sumo.matrix.check_matrix`). A case that fails is a ``failed`` row.
     ``after_stop_s`` and ``sumo_step_s`` set every case's (over the matrix's ``[scenario]``).
     ``plan``: the matrix already checked by :func:`plan_batch` (the command line checks it
-    before it takes the output folder).
+    before it takes the output folder). ``meanwhile``: as :func:`run_cases`.
     """
     check_options(jobs, timeout_s, timeseries)
     plan = plan or plan_batch(matrix_path, tables_dir, after_stop_s, sumo_step_s)
@@ -182,6 +185,7 @@ def run_batch(
         tables_dir=tables_dir,
         timeseries=timeseries,
         paper=paper,
+        meanwhile=meanwhile,
     )
     if matrix.sample is None:
         write_report(out_dir, results)
@@ -240,9 +244,12 @@ def run_cases(
     tables_dir: Path | None = None,
     timeseries: str = "csv",
     paper: dict[str, str] | None = None,
+    meanwhile: Callable[[], object] | None = None,
 ) -> pd.DataFrame:
     """Run ``cases`` (each with its own scenario file) into ``out_dir``: the cases' folders
-    and ``results.csv`` in the cases' order; return the results (as ``read_results``)."""
+    and ``results.csv`` in the cases' order; return the results (as ``read_results``).
+    ``meanwhile`` (e.g. importing what draws the images) is called in a thread of its own
+    once a core is free of cases (:class:`_Meanwhile`) and joined before returning."""
     check_options(jobs, timeout_s, timeseries)
     paper = paper or {}
     out_dir = _cases_folder(Path(out_dir))
@@ -257,6 +264,7 @@ def run_cases(
     log = RowLog(results_path, kept)
     bar = _progress_bar(len(cases), len(done), progress)
     failed = 0
+    side = _Meanwhile(meanwhile, len(to_run), jobs if scheduler is None else 0)
     try:
         for case, result in _results(
             to_run, out_dir, jobs, scheduler, timeout_s, case_func, tables_dir, timeseries
@@ -264,10 +272,44 @@ def run_cases(
             failed += _record(out_dir, log, case, result, paper.get(case.case_id))
             bar.set_postfix(failed=failed, refresh=False)
             bar.update(1)
+            side.finished_one()
     finally:
         bar.close()
         log.close()
+        side.join()
     return finalise(results_path, cases, paper)
+
+
+class _Meanwhile:
+    """Runs a task in a thread of its own once this machine has a core the cases leave free,
+    after the first case finished (the workers have started): at once when the workers
+    (``jobs``; 0: none here) are fewer than the cores, else when fewer cases are left to
+    finish than workers. Its exceptions are left to whoever does the work again (an import
+    retried in the main thread raises there)."""
+
+    def __init__(self, task: Callable[[], object] | None, cases: int, jobs: int):
+        self._task, self._left, self._jobs = task, cases, jobs
+        self._thread: threading.Thread | None = None
+        self._spare_core = jobs < (os.cpu_count() or 1)
+
+    def finished_one(self) -> None:
+        self._left -= 1
+        if self._spare_core or self._left < self._jobs:
+            self._start()
+
+    def _start(self) -> None:
+        if self._task is not None and self._thread is None:
+            self._thread = threading.Thread(target=self._run, args=(self._task,), daemon=True)
+            self._thread.start()
+
+    @staticmethod
+    def _run(task: Callable[[], object]) -> None:
+        with contextlib.suppress(Exception):
+            task()
+
+    def join(self) -> None:
+        if self._thread is not None:
+            self._thread.join()
 
 
 #: The longest per-case time limit accepted [s]: a day (a larger one overflows the worker's

@@ -23,7 +23,7 @@ from eoam_sumo.colours import DARK_TEXT
 from eoam_sumo.colours import HEX as OUTCOME_COLOURS
 from eoam_sumo.params import PONR_FRACTION
 from eoam_sumo.plotting.envelope_plots import plot_envelopes
-from eoam_sumo.plotting.figures import save
+from eoam_sumo.plotting.figures import draw_all, save
 from eoam_sumo.plotting.runfacts import (
     fit,
     lane_width_m,
@@ -307,13 +307,14 @@ def plot_batch_report(results: pd.DataFrame, out_dir: Path) -> list[Path]:
     for a sampled batch ``envelope.png``."""
     if is_sampled(results):
         return plot_envelopes(results, out_dir)
-    paths = [
-        plot_table2(outcome_grid(results), Path(out_dir) / TABLE_PNG),
-        plot_margins(results, Path(out_dir) / MARGINS_PNG),
+    draws = [
+        lambda: plot_margins(results, Path(out_dir) / MARGINS_PNG),
+        lambda: plot_table2(outcome_grid(results), Path(out_dir) / TABLE_PNG),
     ]
     if sweeps_vehicles(results):  # vehicles, ABS/ESC or policies swept
-        paths.append(plot_vehicles(results, Path(out_dir) / VEHICLES_PNG))
-    return paths
+        draws.append(lambda: plot_vehicles(results, Path(out_dir) / VEHICLES_PNG))
+    margins, *rest = draw_all(draws)  # at once: the margins here, the rest in copies
+    return [rest[0], margins, *rest[1:]]
 
 
 def is_sampled(results: pd.DataFrame) -> bool:

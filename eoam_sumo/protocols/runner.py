@@ -143,7 +143,13 @@ def run_protocol(
         for p in runnable
     ]
     batch = run_cases(
-        cases, out / BATCH_DIR, jobs, scheduler, progress=progress, tables_dir=tables_dir
+        cases,
+        out / BATCH_DIR,
+        jobs,
+        scheduler,
+        progress=progress,
+        tables_dir=tables_dir,
+        meanwhile=_import_scorecard_plots,  # matplotlib, on a core the last points leave free
     )
     run = RunLabel(name, system, policy, vehicle, mu, low, params.width_m)
     frame = results_frame(points, batch, run, out)
@@ -153,6 +159,10 @@ def run_protocol(
     plot(frame, out / SCORECARD_PNG, run)
     failed = int((frame["status"] == "failed").sum())
     return ProtocolSummary(len(frame), len(runnable), failed, len(points) - len(runnable))
+
+
+def _import_scorecard_plots() -> None:
+    import eoam_sumo.plotting.protocol_plots  # noqa: F401 - imported for scorecard.png
 
 
 def _relative(path, out: Path):

@@ -223,3 +223,21 @@ def test_resume_reruns_cases_whose_scenario_settings_changed(tmp_path, matrix, c
     assert [
         len((p / "calls.txt").read_text().splitlines()) for p in sorted((out / "cases").iterdir())
     ] == [2] * 8  # now all kept
+
+
+def test_meanwhile_runs_once_before_the_batch_returns_and_its_error_is_not_the_batch_s(
+    tmp_path, matrix
+):
+    """``meanwhile`` runs exactly once, done by the time run_batch returns; an exception in
+    it leaves the results as they would be."""
+    calls = []
+
+    def task():
+        calls.append(1)
+        raise RuntimeError("nothing to import")
+
+    res = run_batch(
+        matrix, tmp_path / "m", jobs=1, progress=False, case_func=fake_case, meanwhile=task
+    )
+    assert calls == [1]
+    assert (res["status"] == "ok").all()

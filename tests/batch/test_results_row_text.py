@@ -35,3 +35,20 @@ def test_row_text_is_pandas_to_csv(cells):
 def test_a_row_with_missing_keys_leaves_them_empty():
     row = {"case_id": "onc-none_v55_mu0.1", "status": "ok", "ego_speed_kmh": 55}
     assert row_text(row) == csv_text([row], header=False)
+
+
+def test_row_log_rows_readable_at_once_and_after_close(tmp_path):
+    """RowLog: each row is in the file as soon as it is added (before any sync), and all
+    of them after close."""
+    import pandas as pd
+
+    from eoam_sumo.batch.results import COLUMNS, RowLog
+
+    path = tmp_path / "results.csv"
+    log = RowLog(path, pd.DataFrame(columns=list(COLUMNS), dtype=str))
+    for k in range(3):
+        log.add({"case_id": f"case{k}", "status": "ok"})
+        assert path.read_text(encoding="utf-8").count("\ncase") == k + 1
+    log.close()
+    assert log.fh.closed
+    assert path.read_text(encoding="utf-8").count("\ncase") == 3
