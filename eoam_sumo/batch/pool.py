@@ -289,6 +289,9 @@ def run_local(
                 if not w.alive:
                     workers.remove(w)
                     w.close()
+                elif pending and w.ready and not w.busy:  # its next task before the caller
+                    key, payload = pending.popleft()  # records this result
+                    w.dispatch(func, key, payload, timeout_s)
                 if result is not None:
                     yield result
             now = time.monotonic()

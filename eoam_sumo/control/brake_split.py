@@ -55,11 +55,10 @@ def wheel_lock_brake_n(
         (0.5 * phi, p.cg_to_rear_m, 1.0, d_front),
         (0.5 * (1.0 - phi), p.cg_to_front_m, -1.0, lateral_n - d_front),
     )
+    front, rear = axles
     return min(
-        _inner_wheel_limit_n(
-            p, mu, ellipse, share, lever, sign, d_lat, resistance_n, equivalent_mass_kg
-        )
-        for share, lever, sign, d_lat in axles
+        _inner_wheel_limit_n(p, mu, ellipse, *front, resistance_n, equivalent_mass_kg),
+        _inner_wheel_limit_n(p, mu, ellipse, *rear, resistance_n, equivalent_mass_kg),
     )
 
 

@@ -4,6 +4,8 @@ drawing several figures at once."""
 from __future__ import annotations
 
 import os
+import select
+import signal
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -19,6 +21,11 @@ def save(fig: Figure, path: Path, dpi: int = 120) -> Path:
     FigureCanvasAgg(fig)
     fig.savefig(path, dpi=dpi)
     return path
+
+
+#: The longest a forked copy may take to draw its figure before it is killed and the figure
+#: drawn in this process instead [s].
+FORK_TIMEOUT_S = 300.0
 
 
 def draw_all(draws: Sequence[Callable[[], Path]]) -> list[Path]:
@@ -62,8 +69,13 @@ def _forked(draw: Callable[[], Path]) -> tuple[int, int] | None:
 
 
 def _joined(pid: int, read_fd: int) -> Path | None:
-    """The path a forked copy drew, once it has exited; None if it failed."""
+    """The path a forked copy drew, once it has exited; None if it failed, or gave no path
+    within ``FORK_TIMEOUT_S`` (killed: a copy forked while another thread held a lock may
+    never get it)."""
+    ready, _, _ = select.select([read_fd], [], [], FORK_TIMEOUT_S)
+    if not ready:
+        os.kill(pid, signal.SIGKILL)
     with os.fdopen(read_fd, "rb") as fh:
-        data = fh.read()
+        data = fh.read() if ready else b""
     _, status = os.waitpid(pid, 0)
     return Path(os.fsdecode(data)) if status == 0 and data else None

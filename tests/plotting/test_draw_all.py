@@ -33,3 +33,25 @@ def test_a_failing_draw_raises_here_the_others_still_drawn(tmp_path):
     with pytest.raises(ValueError, match="no data to draw"):
         draw_all([_writer(first, "drawn"), broken])
     assert first.read_text() == "drawn"
+
+
+def test_a_copy_that_hangs_is_killed_and_its_figure_drawn_here(tmp_path, monkeypatch):
+    """A forked copy may hang (a lock another thread held when it forked): past the time
+    limit it is killed and the figure drawn in this process."""
+    import os
+    import time
+
+    from eoam_sumo.plotting import figures
+
+    monkeypatch.setattr(figures, "FORK_TIMEOUT_S", 1.0)
+    here, path = os.getpid(), tmp_path / "second.txt"
+
+    def hangs_in_a_copy() -> Path:
+        if os.getpid() != here:
+            time.sleep(600)
+        path.write_text(f"drawn by {os.getpid()}")
+        return path
+
+    got = draw_all([_writer(tmp_path / "first.txt", "drawn"), hangs_in_a_copy])
+    assert got == [tmp_path / "first.txt", path]
+    assert path.read_text() == f"drawn by {here}"
