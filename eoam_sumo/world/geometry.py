@@ -263,14 +263,12 @@ def _nearest_point(box: OrientedBox, x_m: float, y_m: float) -> tuple[float, flo
 
 def _nearest_corner(src: OrientedBox, dst: OrientedBox) -> tuple[float, float, float, float, float]:
     """(distance, x, y of the corner, x, y of its nearest point of dst) of the first corner of
-    ``src`` nearest to ``dst`` (distance inf, zeros if none is finite). ``corners`` and
-    ``_nearest_point`` written out, the same arithmetic: the margins and the contact check
-    ask this at every step of an approach."""
+    ``src`` nearest to ``dst`` (distance inf, zeros if none is finite); ``corners`` written
+    out, the same arithmetic: the margins and the contact check ask this every step."""
     c, s = src.cos_yaw, src.sin_yaw
     fx, fy = c * src.half_length_m, s * src.half_length_m
     lx, ly = -s * src.half_width_m, c * src.half_width_m
     x, y = src.x_m, src.y_m
-    dc, ds, hl, hw = dst.cos_yaw, dst.sin_yaw, dst.half_length_m, dst.half_width_m
     best = (math.inf, 0.0, 0.0, 0.0, 0.0)
     for cx, cy in (
         (x + fx + lx, y + fy + ly),
@@ -278,17 +276,7 @@ def _nearest_corner(src: OrientedBox, dst: OrientedBox) -> tuple[float, float, f
         (x - fx - lx, y - fy - ly),
         (x + fx - lx, y + fy - ly),
     ):
-        dx, dy = cx - dst.x_m, cy - dst.y_m
-        u, v = dc * dx + ds * dy, -ds * dx + dc * dy  # in dst's frame, clamped to it
-        if u > hl:
-            u = hl
-        elif u < -hl:
-            u = -hl
-        if v > hw:
-            v = hw
-        elif v < -hw:
-            v = -hw
-        px, py = dst.x_m + dc * u - ds * v, dst.y_m + ds * u + dc * v
+        px, py = _nearest_point(dst, cx, cy)
         dist = math.hypot(cx - px, cy - py)
         if dist < best[0]:
             best = (dist, cx, cy, px, py)
