@@ -28,6 +28,7 @@ from eoam_sumo.eoam import (
     ObjectState,
     Perception,
 )
+from eoam_sumo.eoam_messages import NextLaneView
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import VehicleParams
 from eoam_sumo.plant import Plant, initial_state
@@ -364,17 +365,12 @@ class CoSimulation:
         front = self._front
         front_xy = (X + front * self._cy, Y + front * self._sy)
         report = self.radar.scan(front_xy, yaw, vx, road, self.bodies, self.lane_width_m, self.t)
-        perception = _perception(report)
+        left = right = None
         if self.lane_sensing is not None:
-            perception = perception._replace(
-                next_lane=self.lane_sensing.update(self.t, front_xy, yaw, road, report, self.bodies)
-            )
+            left = self.lane_sensing.update(self.t, front_xy, yaw, road, report, self.bodies)
         if self.right_sensing is not None:
-            perception = perception._replace(
-                right_lane=self.right_sensing.update(
-                    self.t, front_xy, yaw, road, report, self.bodies
-                )
-            )
+            right = self.right_sensing.update(self.t, front_xy, yaw, road, report, self.bodies)
+        perception = _perception(report, left, right)
         meas = EgoMeasurement(
             self.t,
             vx,
@@ -711,30 +707,39 @@ def run_case(
 _NOTHING = Perception(None, None, False)  # immutable, so shared by all steps that see nothing
 
 
-def _perception(report: RadarReport) -> Perception:
+def _perception(
+    report: RadarReport,
+    next_lane: NextLaneView | None = None,
+    right_lane: NextLaneView | None = None,
+) -> Perception:
     """The EOAM's view of a radar report: the in-path obstacle as an object, the oncoming
     flag, the nearest oncoming road user as an object, the range of a coasted in-path
-    object."""
-    det = report.in_path
+    object; with what is known of the lanes beside (``next_lane`` left, ``right_lane``)."""
+    det, coasted = report.in_path, report.coasted
     oncoming = _nearest_oncoming(report) if report.oncoming_detected else None
-    if det is None:
-        perception = (
-            _NOTHING if oncoming is None else Perception(None, None, True, oncoming_object=oncoming)
-        )
-    else:
+    nothing_beside = next_lane is None and right_lane is None
+    if det is None and oncoming is None and coasted is None and nothing_beside:
+        return _NOTHING
+    obstacle: ObjectState | None = None
+    aro_range: float | None = None
+    aro_rate: float | None = None
+    next_range: float | None = None
+    seen = oncoming is not None
+    if det is not None:
         obstacle = ObjectState(det.s_m, det.d_m, det.road_speed_mps, det.length_m, det.width_m)
-        perception = Perception(
-            det.range_m,
-            det.range_rate_mps,
-            report.oncoming_detected,
-            obstacle,
-            report.next_lane_range_m,
-            oncoming_object=oncoming,
-        )
-    if report.coasted is None:
-        return perception
-    return perception._replace(
-        coasted_range_m=report.coasted.range_m, coasted_range_rate_mps=report.coasted.range_rate_mps
+        aro_range, aro_rate, seen = det.range_m, det.range_rate_mps, report.oncoming_detected
+        next_range = report.next_lane_range_m
+    return Perception(
+        aro_range,
+        aro_rate,
+        seen,
+        obstacle,
+        next_range,
+        next_lane,
+        None if coasted is None else coasted.range_m,
+        0.0 if coasted is None else coasted.range_rate_mps,
+        oncoming,
+        right_lane,
     )
 
 
