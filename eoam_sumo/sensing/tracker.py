@@ -28,7 +28,6 @@ import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
-import numpy as np
 from mypy_extensions import mypyc_attr
 
 from eoam_sumo.errors import InputError
@@ -93,22 +92,91 @@ class TrackState(NamedTuple):
 
 
 class _Track:
+    """A track's state ``x`` (x, y, vx, vy) and covariance ``P`` (4 x 4, row-major), in
+    plain floats: the filter's algebra written out (a 4-state filter through numpy costs
+    more in calls than in arithmetic)."""
+
     __slots__ = ("P", "age", "confirmed", "extent", "hits", "misses", "t", "tid", "x")
 
-    def __init__(self, tid: int, x: np.ndarray, P: np.ndarray, t: float, extent: tuple):
+    def __init__(self, tid: int, x: list[float], P: list[float], t: float, extent: tuple):
         self.tid, self.x, self.P, self.t = tid, x, P, t
         self.hits, self.age, self.misses, self.confirmed = 1, 1, 0, False  # age in cycles
         self.extent = extent
 
 
-def _converted(m: Measurement, ox: float, oy: float) -> tuple[np.ndarray, np.ndarray]:
-    """x-y position of a polar measurement and its covariance J diag(sr^2, sa^2) J^T."""
+def _converted(m: Measurement, ox: float, oy: float) -> tuple[float, float, float, float, float]:
+    """x-y position of a polar measurement and its covariance J diag(sr^2, sa^2) J^T, with
+    J = [[c, -r s], [s, r c]]: (zx, zy, R_xx, R_xy, R_yy)."""
     c, s = math.cos(m.azimuth_rad), math.sin(m.azimuth_rad)
-    z = np.array([ox + m.range_m * c, oy + m.range_m * s])
-    J = np.array([[c, -m.range_m * s], [s, m.range_m * c]])
+    r = m.range_m
     sr, sa = max(m.range_sd_m, SD_FLOOR[0]), max(m.azimuth_sd_rad, SD_FLOOR[1])
-    R = J @ np.diag([sr * sr, sa * sa]) @ J.T
-    return z, R
+    vr, va = sr * sr, sa * sa
+    rs, rc = r * s, r * c
+    return (
+        ox + r * c,
+        oy + r * s,
+        c * c * vr + rs * rs * va,
+        c * s * vr - rs * rc * va,
+        s * s * vr + rc * rc * va,
+    )
+
+
+def _predicted(P: list[float], dt: float, q2: float) -> list[float]:
+    """F P F^T + Q for F = [[I, dt I], [0, I]] and the white-acceleration Q (module doc)."""
+    fp = [P[k] + dt * P[k + 8] if k < 8 else P[k] for k in range(16)]  # F P: rows 0, 1
+    out = [0.0] * 16
+    for row in range(4):
+        i = 4 * row
+        out[i] = fp[i] + dt * fp[i + 2]  # (F P) F^T: columns 0, 1
+        out[i + 1] = fp[i + 1] + dt * fp[i + 3]
+        out[i + 2] = fp[i + 2]
+        out[i + 3] = fp[i + 3]
+    a, b, c = q2 * (dt**4 / 4.0), q2 * (dt**3 / 2.0), q2 * dt**2
+    for k, q in ((0, a), (5, a), (2, b), (7, b), (8, b), (13, b), (10, c), (15, c)):
+        out[k] += q
+    return out
+
+
+def _position_update(track: _Track, zx: float, zy: float, R: tuple[float, float, float]) -> None:
+    """The position update, H = [I 0]: S = P_pp + R, K = P H^T S^-1, x += K (z - H x),
+    P -= K H P."""
+    P, x = track.P, track.x
+    s00, s01, s10, s11 = P[0] + R[0], P[1] + R[1], P[4] + R[1], P[5] + R[2]
+    det = s00 * s11 - s01 * s10
+    i00, i01, i10, i11 = s11 / det, -s01 / det, -s10 / det, s00 / det
+    nu0, nu1 = zx - x[0], zy - x[1]
+    K = []
+    for row in range(4):
+        p0, p1 = P[4 * row], P[4 * row + 1]
+        K.append((p0 * i00 + p1 * i10, p0 * i01 + p1 * i11))
+    track.x = [x[r] + K[r][0] * nu0 + K[r][1] * nu1 for r in range(4)]
+    track.P = [
+        P[4 * r + c] - (K[r][0] * P[c] + K[r][1] * P[4 + c]) for r in range(4) for c in range(4)
+    ]
+
+
+def _range_rate_update(track: _Track, m: Measurement, ego_v: tuple[float, float]) -> None:
+    """The range-rate update, h = [0, 0, u_x, u_y] at the measured azimuth; then P made
+    symmetric."""
+    P, x = track.P, track.x
+    ux, uy = math.cos(m.azimuth_rad), math.sin(m.azimuth_rad)
+    ph = [ux * P[4 * r + 2] + uy * P[4 * r + 3] for r in range(4)]  # P h
+    hp = [ux * P[8 + c] + uy * P[12 + c] for c in range(4)]  # h P
+    s = ux * ph[2] + uy * ph[3] + max(m.range_rate_sd_mps, SD_FLOOR[2]) ** 2
+    k = [v / s for v in ph]
+    innovation = m.range_rate_mps + ux * ego_v[0] + uy * ego_v[1] - (ux * x[2] + uy * x[3])
+    track.x = [x[r] + k[r] * innovation for r in range(4)]
+    new = [P[4 * r + c] - k[r] * hp[c] for r in range(4) for c in range(4)]
+    track.P = [0.5 * (new[4 * r + c] + new[4 * c + r]) for r in range(4) for c in range(4)]
+
+
+def _gate_distance(track: _Track, z: tuple[float, float, float, float, float]) -> float:
+    """Squared Mahalanobis distance of the position innovation, nu^T (P_pp + R)^-1 nu."""
+    P, x = track.P, track.x
+    a, b, c, d = P[0] + z[2], P[1] + z[3], P[4] + z[3], P[5] + z[4]
+    nu0, nu1 = z[0] - x[0], z[1] - x[1]
+    det = a * d - b * c
+    return (nu0 * (d * nu0 - b * nu1) + nu1 * (a * nu1 - c * nu0)) / det
 
 
 class Tracker:
@@ -123,33 +191,20 @@ class Tracker:
         dt = t - track.t
         if dt <= 0.0:
             return
-        F = np.eye(4)
-        F[0, 2] = F[1, 3] = dt
-        q2 = self.settings.accel_noise_mps2**2
-        a, b, c = dt**4 / 4.0, dt**3 / 2.0, dt**2
-        Q = q2 * np.array([[a, 0, b, 0], [0, a, 0, b], [b, 0, c, 0], [0, b, 0, c]])
-        track.x = F @ track.x
-        track.P = F @ track.P @ F.T + Q
+        x = track.x
+        track.x = [x[0] + dt * x[2], x[1] + dt * x[3], x[2], x[3]]
+        track.P = _predicted(track.P, dt, self.settings.accel_noise_mps2**2)
         track.t = t
 
     @staticmethod
     def _update(
-        track: _Track, z: np.ndarray, R: np.ndarray, m: Measurement, ego_v: tuple[float, float]
+        track: _Track,
+        z: tuple[float, float, float, float, float],
+        m: Measurement,
+        ego_v: tuple[float, float],
     ) -> None:
-        H = np.zeros((2, 4))
-        H[0, 0] = H[1, 1] = 1.0
-        S = H @ track.P @ H.T + R
-        K = track.P @ H.T @ np.linalg.inv(S)
-        track.x = track.x + K @ (z - H @ track.x)
-        track.P = (np.eye(4) - K @ H) @ track.P
-        ux, uy = math.cos(m.azimuth_rad), math.sin(m.azimuth_rad)
-        h = np.array([0.0, 0.0, ux, uy])
-        s = float(h @ track.P @ h) + max(m.range_rate_sd_mps, SD_FLOOR[2]) ** 2
-        k = track.P @ h / s
-        innovation = m.range_rate_mps + ux * ego_v[0] + uy * ego_v[1] - float(h @ track.x)
-        track.x = track.x + k * innovation
-        track.P = track.P - np.outer(k, h @ track.P)
-        track.P = 0.5 * (track.P + track.P.T)
+        _position_update(track, z[0], z[1], (z[2], z[3], z[4]))
+        _range_rate_update(track, m, ego_v)
 
     def update(
         self,
@@ -166,10 +221,8 @@ class Tracker:
         converted = [_converted(m, *origin) for m in measurements]
         pairs = []
         for i, track in enumerate(self._tracks):
-            P = track.P[:2, :2]
-            for j, (z, R) in enumerate(converted):
-                nu = z - track.x[:2]
-                d2 = float(nu @ np.linalg.solve(P + R, nu))
+            for j, z in enumerate(converted):
+                d2 = _gate_distance(track, z)
                 if d2 <= st.gate_chi2:
                     pairs.append((d2, i, j))
         pairs.sort()
@@ -180,7 +233,7 @@ class Tracker:
             used_tracks.add(i)
             used_meas.add(j)
             track, m = self._tracks[i], measurements[j]
-            self._update(track, *converted[j], m, ego_velocity)
+            self._update(track, converted[j], m, ego_velocity)
             track.extent = (m.centre_dx_m, m.centre_dy_m, m.length_m, m.width_m)
             track.hits += 1
             track.misses = 0
@@ -201,18 +254,21 @@ class Tracker:
                 alive.append(self._new_track(t, m, converted[j], ego_velocity))
         self._tracks = alive
 
-    def _new_track(self, t: float, m: Measurement, zR: tuple, ego_v: tuple) -> _Track:
-        z, R = zR
+    def _new_track(
+        self, t: float, m: Measurement, z: tuple[float, float, float, float, float], ego_v: tuple
+    ) -> _Track:
+        """A tentative track at the detection: position and its covariance R as measured,
+        the radial velocity as measured (sd of the range rate), the tangential one unknown
+        (``initial_speed_sd_mps``): P_vv = sd_r^2 u u^T + sd_t^2 n n^T."""
         ux, uy = math.cos(m.azimuth_rad), math.sin(m.azimuth_rad)
         radial = m.range_rate_mps + ux * ego_v[0] + uy * ego_v[1]
-        P = np.zeros((4, 4))
-        P[:2, :2] = R
         sd_t2 = self.settings.initial_speed_sd_mps**2
         sd_r2 = max(m.range_rate_sd_mps, SD_FLOOR[2]) ** 2
-        u = np.array([ux, uy])
-        n = np.array([-uy, ux])
-        P[2:, 2:] = sd_r2 * np.outer(u, u) + sd_t2 * np.outer(n, n)
-        x = np.array([z[0], z[1], radial * ux, radial * uy])
+        vxx = sd_r2 * ux * ux + sd_t2 * uy * uy
+        vxy = sd_r2 * ux * uy - sd_t2 * uy * ux
+        vyy = sd_r2 * uy * uy + sd_t2 * ux * ux
+        P = [z[2], z[3], 0.0, 0.0, z[3], z[4], 0.0, 0.0, 0.0, 0.0, vxx, vxy, 0.0, 0.0, vxy, vyy]
+        x = [z[0], z[1], radial * ux, radial * uy]
         track = _Track(
             self._next_id, x, P, t, (m.centre_dx_m, m.centre_dy_m, m.length_m, m.width_m)
         )
@@ -224,9 +280,7 @@ class Tracker:
     def confirmed(self) -> list[TrackState]:
         """The confirmed tracks, as of the last update."""
         return [
-            TrackState(
-                tr.tid, float(tr.x[0]), float(tr.x[1]), float(tr.x[2]), float(tr.x[3]), *tr.extent
-            )
+            TrackState(tr.tid, tr.x[0], tr.x[1], tr.x[2], tr.x[3], *tr.extent)
             for tr in self._tracks
             if tr.confirmed
         ]
