@@ -76,14 +76,29 @@ def vehicle_path(name_or_file: str, directory: Path | None = None) -> Path:
     return path
 
 
+#: The parameters of each vehicle file this process checked, by its path and bytes: a batch's
+#: cases share one vehicle without parsing it again; an edited file is checked again.
+_LOADED: dict[tuple[str, bytes], VehicleParams] = {}
+
+
 def load_vehicle(name_or_file: str, directory: Path | None = None) -> VehicleParams:
     """The ``VehicleParams`` of a catalogue NAME or a vehicle FILE (checked, see module doc)."""
     path = vehicle_path(name_or_file, directory)
     try:
-        with path.open("rb") as fh:
-            data = tomllib.load(fh)
+        raw = path.read_bytes()
     except OSError as exc:
         raise InputError(f"{path}: cannot read: {exc}") from None
+    key = (str(path), raw)
+    params = _LOADED.get(key)
+    if params is None:
+        params = _LOADED[key] = _parsed(path, raw)
+    return params
+
+
+def _parsed(path: Path, raw: bytes) -> VehicleParams:
+    """A vehicle file's bytes parsed and checked."""
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
     except UnicodeDecodeError as exc:
         raise not_utf8(path, exc, "vehicle file") from None
     except tomllib.TOMLDecodeError as exc:

@@ -35,6 +35,22 @@ def test_a_changed_value_is_read_back(tmp_path):
     assert load_vehicle(str(_write(tmp_path, vehicle_toml(heavier)))) == heavier
 
 
+def test_a_file_edited_in_place_is_read_again(tmp_path):
+    """A process keeps what it read of a file, but not past an edit of the same length made
+    within the file system's time resolution."""
+    sedan = ego_e_class_sedan()
+    path = _write(tmp_path, vehicle_toml(sedan))
+    assert load_vehicle(str(path)) is load_vehicle(str(path))
+    edited = dataclasses.replace(sedan, mass_kg=sedan.mass_kg + 1.0)
+    text = vehicle_toml(edited)
+    assert len(text) == len(vehicle_toml(sedan))
+    path.write_text(text)
+    assert load_vehicle(str(path)) == edited
+    path.write_text("[mass_kg\n")
+    with pytest.raises(InputError, match="not valid TOML"):
+        load_vehicle(str(path))
+
+
 def _without_table(text: str, key: str) -> str:
     return re.sub(rf"\[{key}\]\n(.*\n){{3}}", "", text)
 
