@@ -179,10 +179,13 @@ def test_an_interrupted_protocol_rerun_leaves_the_finished_folder(tmp_path):
     out = tmp_path / "out"
     subprocess.run(_protocol(out), check=True, capture_output=True)
     before = snapshot(out)
-    # the rerun: all 19 points on one job, so that it runs for seconds after its results file
-    # is made, however loaded the machine (4 points on two jobs could end between two looks)
-    rerun_args = _protocol(out, "--mu", "0.3", "--points", "R152", "--jobs", "1")
-    rerun = subprocess.Popen(rerun_args, stderr=subprocess.PIPE, text=True)
+    # Ctrl-C as from a terminal: a suite started in the background ignores SIGINT, and the
+    # rerun would inherit that and run to its end; it gets Python's own handler
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        rerun = subprocess.Popen(_protocol(out, "--mu", "0.3"), stderr=subprocess.PIPE, text=True)
+    finally:
+        signal.signal(signal.SIGINT, previous)
     # Ctrl-C once the new run has started writing (its results file made, no case finished)
     while rerun.poll() is None and not list(tmp_path.glob("out.partial-*/batch/results.csv")):
         time.sleep(0.02)
