@@ -79,6 +79,7 @@ def vehicle_path(name_or_file: str, directory: Path | None = None) -> Path:
 #: The parameters of each vehicle file this process checked, by its path and bytes: a batch's
 #: cases share one vehicle without parsing it again; an edited file is checked again.
 _LOADED: dict[tuple[str, bytes], VehicleParams] = {}
+_LOADED_MAX = 64  # files kept; the oldest goes first
 
 
 def load_vehicle(name_or_file: str, directory: Path | None = None) -> VehicleParams:
@@ -91,7 +92,10 @@ def load_vehicle(name_or_file: str, directory: Path | None = None) -> VehiclePar
     key = (str(path), raw)
     params = _LOADED.get(key)
     if params is None:
-        params = _LOADED[key] = _parsed(path, raw)
+        params = _parsed(path, raw)
+        if len(_LOADED) >= _LOADED_MAX:
+            _LOADED.pop(next(iter(_LOADED)))
+        _LOADED[key] = params
     return params
 
 

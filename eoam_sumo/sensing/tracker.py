@@ -137,14 +137,14 @@ def _predicted(P: list[float], dt: float, q2: float) -> list[float]:
     return out
 
 
-def _position_update(track: _Track, zx: float, zy: float, R: tuple[float, float, float]) -> None:
-    """The position update, H = [I 0]: S = P_pp + R, K = P H^T S^-1, x += K (z - H x),
-    P -= K H P."""
+def _position_update(track: _Track, z: tuple[float, float, float, float, float]) -> None:
+    """The position update with the converted measurement ``z`` (``_converted``), H = [I 0]:
+    S = P_pp + R, K = P H^T S^-1, x += K (z - H x), P -= K H P."""
     P, x = track.P, track.x
-    s00, s01, s10, s11 = P[0] + R[0], P[1] + R[1], P[4] + R[1], P[5] + R[2]
+    s00, s01, s10, s11 = P[0] + z[2], P[1] + z[3], P[4] + z[3], P[5] + z[4]
     det = s00 * s11 - s01 * s10
     i00, i01, i10, i11 = s11 / det, -s01 / det, -s10 / det, s00 / det
-    nu0, nu1 = zx - x[0], zy - x[1]
+    nu0, nu1 = z[0] - x[0], z[1] - x[1]
     K = []
     for row in range(4):
         p0, p1 = P[4 * row], P[4 * row + 1]
@@ -196,16 +196,6 @@ class Tracker:
         track.P = _predicted(track.P, dt, self.settings.accel_noise_mps2**2)
         track.t = t
 
-    @staticmethod
-    def _update(
-        track: _Track,
-        z: tuple[float, float, float, float, float],
-        m: Measurement,
-        ego_v: tuple[float, float],
-    ) -> None:
-        _position_update(track, z[0], z[1], (z[2], z[3], z[4]))
-        _range_rate_update(track, m, ego_v)
-
     def update(
         self,
         t: float,
@@ -233,7 +223,8 @@ class Tracker:
             used_tracks.add(i)
             used_meas.add(j)
             track, m = self._tracks[i], measurements[j]
-            self._update(track, converted[j], m, ego_velocity)
+            _position_update(track, converted[j])
+            _range_rate_update(track, m, ego_velocity)
             track.extent = (m.centre_dx_m, m.centre_dy_m, m.length_m, m.width_m)
             track.hits += 1
             track.misses = 0
