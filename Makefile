@@ -1,5 +1,22 @@
 # eoam-sumo: every target creates the virtual environment when it is missing.
-PYTHON ?= python3
+#
+# The interpreter it is made from, unless PYTHON is given (README "Installs"): of
+# PYTHON_CANDIDATES, those that are CPython 3.11 or newer with venv's pip (ensurepip) and the
+# C headers (mypyc and the plant's extension compile against them); one whose core is linked
+# into its executable before one that loads a shared libpython (the step loop spends half its
+# time in the interpreter's core, which a shared libpython built without profile-guided
+# optimisation runs about a fifth slower: docs/performance.md); else python3. A virtual
+# environment already made is kept: `make clean` first to change it.
+PYTHON_CANDIDATES ?= python3 /usr/bin/python3
+PYTHON_PROBE := import os, sys, sysconfig, importlib.util as u; \
+	ok = sys.implementation.name == "cpython" and sys.version_info >= (3, 11) \
+	and u.find_spec("ensurepip") is not None \
+	and os.path.exists(os.path.join(sysconfig.get_paths()["include"], "Python.h")); \
+	maps = "/proc/self/maps"; \
+	shared = not os.path.exists(maps) or "libpython" in open(maps).read(); \
+	ok and print(int(shared), sys.executable)
+PYTHON ?= $(or $(shell for p in $(PYTHON_CANDIDATES); do $$p -c '$(PYTHON_PROBE)' 2>/dev/null; \
+	done | sort -s -n -k1,1 | head -n 1 | cut -d' ' -f2-),python3)
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed

@@ -40,6 +40,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import platform
 import statistics
 import subprocess
 import sys
@@ -328,12 +329,40 @@ def _quick_matrix(out_dir: Path) -> Path:
     return matrix
 
 
+def interpreter() -> dict:
+    """The Python the benchmark runs on: implementation, version, executable, and whether its
+    core is a shared libpython loaded at start (Linux: found in the process's memory map) or
+    linked into the executable. The step loop spends about half its time in that core, so a
+    study's time depends on how the interpreter was built (docs/performance.md)."""
+    maps = Path("/proc/self/maps")
+    shared = None
+    if maps.exists():
+        shared = any("libpython" in line for line in maps.read_text().splitlines())
+    return {
+        "implementation": sys.implementation.name,
+        "version": platform.python_version(),
+        "executable": sys.executable,
+        "shared_libpython": shared,
+    }
+
+
+def interpreter_text(record: dict) -> str:
+    """One line for the tables' heads, e.g. ``python: cpython 3.11.2, core in the
+    executable``."""
+    core = {True: "shared libpython", False: "core in the executable", None: "core unknown"}
+    return (
+        f"python: {record['implementation']} {record['version']} ({record['executable']}), "
+        f"{core[record['shared_libpython']]}"
+    )
+
+
 def run_bench(out_dir: Path, quick: bool = False) -> dict:
     """Measure every figure; ``quick`` uses tiny settings (one repeat, 2-case batch)."""
     repeats = 1 if quick else 15  # short runs on a shared machine: a median of many
     with tempfile.TemporaryDirectory(prefix="eoam-bench-") as tmp_dir:
         tmp = Path(tmp_dir)
         result: dict[str, Any] = {"quick": quick, "jobs": 2, "compiled": _compiled()}
+        result["python"] = interpreter()
         result["peak_rss_mb"] = _peak_rss_mb(tmp / "rss")
         result.update(_cosim_and_sumo_only(repeats))
         result["floor_over_sumo_cost"] = _floor_over_sumo(repeats)
@@ -358,6 +387,7 @@ def format_table(result: dict) -> str:
     width = max(len(k) for k, _ in rows)
     lines = [
         f"step loop: {'compiled' if result['compiled'] else 'Python sources'}",
+        interpreter_text(result["python"]),
         f"{'figure':<{width}}  value        target",
     ]
     for k, v in rows:
@@ -593,6 +623,7 @@ def run_studies(
         "quick": quick,
         "jobs": jobs,
         "compiled": _compiled(),
+        "python": interpreter(),
         "studies": steps,
         "study_rows": [row for _step, rows in done for row in rows],
     }
@@ -611,6 +642,7 @@ def format_study_table(result: dict) -> str:
     lines = [
         f"step loop: {'compiled' if result['compiled'] else 'Python sources'}"
         + (f"; --quick: {QUICK_RUNS} runs of each study" if result["quick"] else ""),
+        interpreter_text(result["python"]),
         "study | runs | sumo step s | jobs | wall s | goal s | CPU s | CPU s per run | "
         "load avg (1 min) | cost ratio wall (CPU)",
     ]

@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import shutil
 import subprocess
 import sys
 from importlib import machinery
@@ -67,6 +68,18 @@ def _documented_keys() -> set[str]:
     section = text.split("## What is measured", 1)[1].split("\n## ", 1)[0]
     rows = [line.split("|")[1] for line in section.splitlines() if line.startswith("| `")]
     return {key for cell in rows for key in re.findall(r"`([a-z_0-9]+)`", cell)}
+
+
+@pytest.mark.skipif(shutil.which("ldd") is None, reason="needs ldd to read the executable's links")
+def test_the_interpreter_record_says_whether_its_core_is_a_shared_libpython():
+    record = bench.interpreter()
+    ldd = ["ldd", sys.executable]  # a static executable: exit status 1, no libpython
+    linked = subprocess.run(ldd, check=False, capture_output=True, text=True).stdout
+    assert record["shared_libpython"] is ("libpython" in linked)
+    assert record["executable"] == sys.executable
+    assert record["version"] == "{}.{}.{}".format(*sys.version_info[:3])
+    core = "shared libpython" if record["shared_libpython"] else "core in the executable"
+    assert bench.interpreter_text(record).endswith(core)
 
 
 def test_summarise_takes_medians_per_tree_and_their_ratios():
@@ -273,6 +286,7 @@ def test_quick_studies_write_each_step_and_the_changes_against_the_first(tmp_pat
     assert (tmp_path / "table2_100ms" / "results.csv").is_file()
     assert (tmp_path / "protocol_10ms" / "scorecard.md").is_file()
     table = bench.format_study_table(result).splitlines()
-    assert table[1].split(" | ")[:6] == ["study", "runs", "sumo step s", "jobs", "wall s", "goal s"]
-    assert table[2].startswith("table2 | 2 of 64 | 0.01 | 1 | ") and len(table) == 6
+    assert table[1] == bench.interpreter_text(saved["python"])
+    assert table[2].split(" | ")[:6] == ["study", "runs", "sumo step s", "jobs", "wall s", "goal s"]
+    assert table[3].startswith("table2 | 2 of 64 | 0.01 | 1 | ") and len(table) == 7
     assert "0.1 |" in bench.format_studies(result)
