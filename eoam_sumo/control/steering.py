@@ -124,10 +124,26 @@ def single_track_matrices(params: VehicleParams, speed_mps: float):
 
 def place_poles(A: np.ndarray, B: np.ndarray, poles) -> np.ndarray:
     """State-feedback gains K (u = -K x) giving A - B K the ``poles`` (Ackermann's formula)."""
-    n = A.shape[0]
-    ctrb = np.column_stack([np.linalg.matrix_power(A, i) @ B for i in range(n)])
+    powers = matrix_powers(A)
+    return ackermann(powers, controllability(powers, B), poles)
+
+
+def matrix_powers(A: np.ndarray) -> list[np.ndarray]:
+    """A^0, A^1, ..., A^n of an n x n matrix."""
+    return [np.linalg.matrix_power(A, k) for k in range(A.shape[0] + 1)]
+
+
+def controllability(powers: list[np.ndarray], B: np.ndarray) -> np.ndarray:
+    """The controllability matrix [B, A B, ..., A^(n-1) B] (``powers``: A^0 ... A^n)."""
+    return np.column_stack([powers[k] @ B for k in range(len(powers) - 1)])
+
+
+def ackermann(powers: list[np.ndarray], ctrb: np.ndarray, poles) -> np.ndarray:
+    """Ackermann's formula: K = [0 ... 0 1] C^-1 phi(A), C the controllability matrix and phi
+    the monic polynomial with roots ``poles`` (``powers``: A^0 ... A^n)."""
+    n = len(powers) - 1
     coeffs = np.real(np.poly(poles))
-    phi = sum(c * np.linalg.matrix_power(A, n - i) for i, c in enumerate(coeffs))
+    phi = sum(c * powers[n - i] for i, c in enumerate(coeffs))
     last = np.zeros(n)
     last[-1] = 1.0
     return last @ np.linalg.solve(ctrb, phi)
@@ -138,6 +154,10 @@ _Gains = tuple[float, float, float, float]
 #: row (one speed) is placed when first needed: an estimated friction takes many values a run.
 _GAIN_TABLES: dict[tuple, list[_Gains | None]] = {}
 _MAX_GAIN_TABLES = 512  # beyond this many frictions the tables are dropped (memory)
+#: What a gain-table row needs that does not depend on the friction, by (vehicle parameters,
+#: gains) and speed index: A's powers, the controllability matrix and the body poles. A new
+#: friction (an estimate moves every update) then costs Ackermann's formula alone.
+_SPEED_ROWS: dict[tuple, list[tuple | None]] = {}
 
 
 class SteeringController:
@@ -152,6 +172,7 @@ class SteeringController:
         "_max",
         "_params",
         "_preview_s",
+        "_rows",
         "_slip_frac",
         "_slip_k",
         "_speeds",
@@ -187,6 +208,12 @@ class SteeringController:
         self._speeds = [self._vmin + i * gains.schedule_step_mps for i in range(n + 1)]
         self._table_mu = math.nan
         self._table: list[_Gains | None] = []
+        key = (params, gains)
+        if key not in _SPEED_ROWS:
+            if len(_SPEED_ROWS) >= _MAX_GAIN_TABLES:
+                _SPEED_ROWS.clear()
+            _SPEED_ROWS[key] = [None] * len(self._speeds)
+        self._rows = _SPEED_ROWS[key]
 
     def natural_freq(self, speed_mps: float, mu: float) -> float:
         """omega = omega_0 mu^p min(1, v / v_full) [rad/s], v floored."""
@@ -200,25 +227,30 @@ class SteeringController:
 
     def design_poles(self, speed_mps: float, mu: float) -> np.ndarray:
         """The closed-loop poles the gains place at this speed and friction."""
-        g = self._gains
         v = max(speed_mps, self._vmin)
-        w = self.natural_freq(v, mu)
-        z = g.damping_ratio
-        root = math.sqrt(abs(z * z - 1.0))
-        path = (
-            [complex(-z * w, w * root), complex(-z * w, -w * root)]
-            if z < 1.0
-            else [-w * (z - root), -w * (z + root)]
-        )
         A, _ = single_track_matrices(self._params, v)
+        return np.array(self._path_poles(v, mu) + self._body_poles(A))
+
+    def _path_poles(self, v: float, mu: float) -> list:
+        """The path-following pair at s^2 + 2 zeta omega s + omega^2 (``natural_freq``)."""
+        w = self.natural_freq(v, mu)
+        z = self._gains.damping_ratio
+        root = math.sqrt(abs(z * z - 1.0))
+        if z < 1.0:
+            return [complex(-z * w, w * root), complex(-z * w, -w * root)]
+        return [-w * (z - root), -w * (z + root)]
+
+    def _body_poles(self, A: np.ndarray) -> list:
+        """The car's own sideslip and yaw modes (of A's upper 2 x 2), their damping raised to
+        at least ``body_damping_ratio``."""
         body = []
-        for p in np.linalg.eigvals(A[:2, :2]):  # the car's own sideslip and yaw modes
+        for p in np.linalg.eigvals(A[:2, :2]):
             mag = abs(p)
-            re = min(p.real, -g.body_damping_ratio * mag)
+            re = min(p.real, -self._gains.body_damping_ratio * mag)
             body.append(
                 complex(re, math.copysign(math.sqrt(max(mag * mag - re * re, 0.0)), p.imag))
             )
-        return np.array(path + body)
+        return body
 
     def gains_at(self, speed_mps: float, mu: float) -> _Gains:
         """(k_vy [rad s/m], k_r [rad s/rad], k_psi [rad/rad], k_e [rad/m]) at this speed and
@@ -251,10 +283,17 @@ class SteeringController:
         )
 
     def _place(self, i: int) -> _Gains:
-        """Row ``i`` of the gain table at the table's friction (pole placement)."""
+        """Row ``i`` of the gain table at the table's friction (pole placement: the same
+        arithmetic as ``place_poles(A, B, design_poles(v, mu))``, its friction-free part kept
+        per speed in ``_SPEED_ROWS``)."""
         v = self._speeds[i]
-        A, B = single_track_matrices(self._params, v)
-        k = place_poles(A, B, self.design_poles(v, self._table_mu))
+        known = self._rows[i]
+        if known is None:
+            A, B = single_track_matrices(self._params, v)
+            powers = matrix_powers(A)
+            known = self._rows[i] = (powers, controllability(powers, B), self._body_poles(A))
+        powers, ctrb, body = known
+        k = ackermann(powers, ctrb, np.array(self._path_poles(v, self._table_mu) + body))
         row = (float(k[0]), float(k[1]), float(k[2]), float(k[3]))
         self._table[i] = row
         return row

@@ -245,3 +245,21 @@ def test_gain_rows_are_placed_when_first_needed_and_blend_the_placed_ones():
         ends.append(place_poles(A, B, ctrl.design_poles(vi, mu)))
     w = (v - v0) / (v1 - v0)
     assert k == pytest.approx(tuple(ends[0] + w * (ends[1] - ends[0])), rel=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(mu=st.floats(0.05, 1.2), v=st.floats(0.0, 90.0))
+def test_a_row_placed_from_the_kept_speed_part_is_the_pole_placement_bit_for_bit(mu, v):
+    """A gain-table row placed after another friction left its speed's friction-free part
+    (A's powers, the controllability matrix, the body poles) in the cache is exactly
+    ``place_poles(A, B, design_poles(v, mu))`` at its grid speed."""
+    ctrl = SteeringController(P)
+    ctrl.gains_at(v, 0.5123)  # the rows around v placed once, at another friction
+    ctrl.gains_at(v, mu)
+    rows = _GAIN_TABLES[(P, SteeringGains(), mu)]
+    placed = [i for i, row in enumerate(rows) if row is not None]
+    assert placed
+    for i in placed:
+        vi = ctrl._speeds[i]
+        A, B = single_track_matrices(P, vi)
+        assert rows[i] == tuple(float(k) for k in place_poles(A, B, ctrl.design_poles(vi, mu)))
