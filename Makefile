@@ -4,9 +4,9 @@
 # PYTHON_CANDIDATES, those that are CPython 3.11 or newer with venv's pip (ensurepip) and the
 # C headers (mypyc and the plant's extension compile against them); one whose core is linked
 # into its executable before one that loads a shared libpython (the step loop spends half its
-# time in the interpreter's core, which a shared libpython built without profile-guided
-# optimisation runs about a fifth slower: docs/performance.md); else python3. A virtual
-# environment already made is kept: `make clean` first to change it.
+# time in the interpreter's core: on pyenv's shared build without profile-guided optimisation
+# it took 16 % more time, the studies 3-14 % more; docs/performance.md); else python3. A
+# virtual environment already made is kept: `make clean` first to change it.
 PYTHON_CANDIDATES ?= python3 /usr/bin/python3
 PYTHON_PROBE := import os, sys, sysconfig, importlib.util as u; \
 	ok = sys.implementation.name == "cpython" and sys.version_info >= (3, 11) \

@@ -347,8 +347,8 @@ def interpreter() -> dict:
 
 
 def interpreter_text(record: dict) -> str:
-    """One line for the tables' heads, e.g. ``python: cpython 3.11.2, core in the
-    executable``."""
+    """One line for the tables' heads, e.g. ``python: cpython 3.11.2 (/usr/bin/python3),
+    core in the executable``."""
     core = {True: "shared libpython", False: "core in the executable", None: "core unknown"}
     return (
         f"python: {record['implementation']} {record['version']} ({record['executable']}), "
