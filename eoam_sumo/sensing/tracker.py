@@ -137,14 +137,22 @@ def _predicted(P: list[float], dt: float, q2: float) -> list[float]:
     return out
 
 
-def _position_update(track: _Track, z: tuple[float, float, float, float, float]) -> None:
-    """The position update with the converted measurement ``z`` (``_converted``), H = [I 0]:
-    S = P_pp + R, K = P H^T S^-1, x += K (z - H x), P -= K H P."""
+def _innovation(
+    track: _Track, z: tuple[float, float, float, float, float]
+) -> tuple[float, float, float, float, float, float]:
+    """The position innovation of the converted measurement ``z`` (``_converted``), H = [I 0]:
+    its covariance S = P_pp + R (s00, s01, s10, s11) and nu = z - H x (nu0, nu1)."""
     P, x = track.P, track.x
-    s00, s01, s10, s11 = P[0] + z[2], P[1] + z[3], P[4] + z[3], P[5] + z[4]
+    return P[0] + z[2], P[1] + z[3], P[4] + z[3], P[5] + z[4], z[0] - x[0], z[1] - x[1]
+
+
+def _position_update(track: _Track, z: tuple[float, float, float, float, float]) -> None:
+    """The position update with the converted measurement ``z`` (``_innovation``):
+    K = P H^T S^-1, x += K nu, P -= K H P."""
+    P, x = track.P, track.x
+    s00, s01, s10, s11, nu0, nu1 = _innovation(track, z)
     det = s00 * s11 - s01 * s10
     i00, i01, i10, i11 = s11 / det, -s01 / det, -s10 / det, s00 / det
-    nu0, nu1 = z[0] - x[0], z[1] - x[1]
     K = []
     for row in range(4):
         p0, p1 = P[4 * row], P[4 * row + 1]
@@ -171,10 +179,9 @@ def _range_rate_update(track: _Track, m: Measurement, ego_v: tuple[float, float]
 
 
 def _gate_distance(track: _Track, z: tuple[float, float, float, float, float]) -> float:
-    """Squared Mahalanobis distance of the position innovation, nu^T (P_pp + R)^-1 nu."""
-    P, x = track.P, track.x
-    a, b, c, d = P[0] + z[2], P[1] + z[3], P[4] + z[3], P[5] + z[4]
-    nu0, nu1 = z[0] - x[0], z[1] - x[1]
+    """Squared Mahalanobis distance of the position innovation, nu^T S^-1 nu
+    (``_innovation``)."""
+    a, b, c, d, nu0, nu1 = _innovation(track, z)
     det = a * d - b * c
     return (nu0 * (d * nu0 - b * nu1) + nu1 * (a * nu1 - c * nu0)) / det
 
