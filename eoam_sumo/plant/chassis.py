@@ -166,12 +166,24 @@ def slip_past(wheel_mps, v_long, mu, ch: Chassis, ops):
 
 def wheel_pressure_target(p_cmd_bar, esc_bar, wheel_mps, v_long, mu, p, ch: Chassis, ops):
     """A wheel's target pressure [bar]: the driver's line pressure plus the ESC's for this
-    wheel, up to ``max_brake_pressure_bar``. ESC keeps its own wheel below the peak slip (its
-    hydraulic unit is the ABS's): without ABS its share is cut as the slip passes the peak."""
-    if not p.abs_fitted:
-        excess, on = _slip_excess(wheel_mps, v_long, mu, ch, ops)
-        esc_bar = esc_bar * (1.0 - excess * on)
+    wheel, up to ``max_brake_pressure_bar``. ESC keeps its own wheel below the peak slip: its
+    share is cut as the slip passes the peak (a slip-controlled intervention, with or without
+    ABS; ``abs_weight``)."""
+    excess, on = _slip_excess(wheel_mps, v_long, mu, ch, ops)
+    esc_bar = esc_bar * (1.0 - excess * on)
     return ops.fmin(p_cmd_bar + esc_bar, p.max_brake_pressure_bar)
+
+
+def abs_weight(p_cmd_bar, esc_bar, ops):
+    """How much of the ABS's cut a wheel takes, in [0, 1]: all of it while the driver brakes
+    (line pressure ``p_cmd_bar`` from ``BRAKE_ON_BAR``) or the ESC asks nothing of the wheel;
+    none while only the ESC brakes it. The ESC's intervention limits its own slip
+    (``wheel_pressure_target``): the ABS's dump-hold-build cycle, judging the slip against a
+    reference speed that knows no lateral velocity, would throw away the corrective moment
+    in a slide."""
+    driver = ops.fmin(ops.fmax(p_cmd_bar / BRAKE_ON_BAR, 0.0), 1.0)
+    esc_only = ops.fmin(ops.fmax(esc_bar / BRAKE_ON_BAR, 0.0), 1.0)
+    return ops.fmax(driver, 1.0 - esc_only)
 
 
 def pressure_rate(p_target_bar, p_bar, cut_barps, p: VehicleParams, ops):
@@ -226,16 +238,16 @@ def estimated_wheel_speeds(v_est, r, steer, p: VehicleParams, ops):
 
 
 def speed_estimate_rate(v_est, ax_meas, wheel_mps, r, steer, pressure_bar, mu_est, p, ch, ops):
-    """Rate of the vehicle-speed estimate: the accelerometer's ``ax`` integrated, pulled to
-    the fastest wheel (each wheel's speed referred to the centre of gravity, the inverse of
-    ``estimated_wheel_speeds``) at once unbraked. Braked (``pressure_bar`` the mean wheel
-    pressure) every wheel runs at some slip, the fastest one (the ABS's recovered wheel)
-    within the ABS's threshold slip at the friction estimate ``mu_est``: the estimate is
-    pulled up while below the fastest wheel and down while even the fastest wheel is beyond
-    that slip, slowly and by at most ``SPEED_EST_BRAKED_SHARE`` of the measured deceleration
-    plus ``SPEED_EST_BRAKED_MIN_MPS2`` (the accelerometer's own error: gain, the body's pitch,
-    its offset; a wheel spinning up past the car for a moment does not carry the estimate
-    with it)."""
+    """Rate of the vehicle-speed estimate: the accelerometer's ``ax`` integrated; unbraked,
+    pulled at once to the free-rolling wheels (``_rolling_reference``; each wheel's speed
+    referred to the centre of gravity, the inverse of ``estimated_wheel_speeds``). Braked
+    (``pressure_bar`` the mean wheel pressure) every wheel runs at some slip, the fastest one
+    (the ABS's recovered wheel) within the ABS's threshold slip at the friction estimate
+    ``mu_est``: the estimate is pulled up while below the fastest wheel and down while even
+    the fastest wheel is beyond that slip, slowly and by at most ``SPEED_EST_BRAKED_SHARE`` of
+    the measured deceleration plus ``SPEED_EST_BRAKED_MIN_MPS2`` (the accelerometer's own
+    error: gain, the body's pitch, its offset; a wheel spinning up past the car for a moment
+    does not carry the estimate with it)."""
     half = 0.5 * p.track_m * r
     c, s = ops.cos(steer), ops.sin(steer)
     lat_f = p.cg_to_front_m * r * s
@@ -247,7 +259,22 @@ def speed_estimate_rate(v_est, ax_meas, wheel_mps, r, steer, pressure_bar, mu_es
     gap = ops.fmax(fastest - v_est, 0.0) + ops.fmin(fastest + slack - v_est, 0.0)
     cap = SPEED_EST_BRAKED_SHARE * ops.fabs(ax_meas) + SPEED_EST_BRAKED_MIN_MPS2
     slow = ops.fmin(ops.fmax(SPEED_EST_BRAKED_PER_S * gap, -cap), cap)
-    return ax_meas + braked * slow + (1.0 - braked) * SPEED_EST_PER_S * gap
+    rolling = _rolling_reference(refs, p, ops)
+    return ax_meas + braked * slow + (1.0 - braked) * SPEED_EST_PER_S * (rolling - v_est)
+
+
+def _rolling_reference(refs, p: VehicleParams, ops):
+    """The unbraked speed estimate's reference (``refs``: each wheel's speed referred to the
+    centre of gravity, FL, FR, RL, RR): the faster undriven wheel, which rolls free, on a
+    front- or rear-driven car (the undriven wheels stand for the car's speed in traction
+    control: Hori, Toyoda and Tsuruoka, IEEE Trans. Ind. Appl. 34(5), 1998); with all wheels
+    driven (AWD, eAWD) the slowest, the least spun up by the drive. A driven wheel spinning
+    on ice never carries it."""
+    if p.drivetrain == "fwd":
+        return ops.fmax(refs[2], refs[3])
+    if p.drivetrain == "rwd":
+        return ops.fmax(refs[0], refs[1])
+    return ops.fmin(ops.fmin(refs[0], refs[1]), ops.fmin(refs[2], refs[3]))
 
 
 def mu_estimate_rate(mu_est, accel_g, active, ops):

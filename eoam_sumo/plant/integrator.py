@@ -7,22 +7,39 @@ from __future__ import annotations
 
 from eoam_sumo.params import VehicleParams
 from eoam_sumo.plant.chassis import constants
-from eoam_sumo.plant.model import OMEGAS, PRESSURES, outputs, rhs, tyre_loads_n
+from eoam_sumo.plant.model import (
+    OMEGAS,
+    PRESSURES,
+    VX,
+    YAW_RATE,
+    outputs,
+    rhs,
+    tyre_loads_n,
+)
 
 
 def resist(x, params: VehicleParams, dt_s: float, ops) -> list:
     """The brake and rolling-resistance torques over ``dt_s`` as Coulomb friction on each
-    wheel: the spin falls by ``dt T / J`` and stops at zero (a wheel the brake can hold stays
-    at rest: no reversal, no chatter); pressures kept >= 0."""
+    wheel: the spin's magnitude falls by ``dt T / J`` and stops at zero (a wheel the brake can
+    hold stays at rest: no reversal, no chatter); a wheel turning backwards (a car sliding or
+    rolling backwards, or spun round) is slowed the same way. No drive turns a wheel
+    backwards, so it turns backwards no faster than the ground under it (its side's speed
+    along the body, ``vx -/+ r t / 2``): the tyre's spring cannot wind it back past it.
+    Pressures kept >= 0."""
     p = params
     ch = constants(p)
     loads = tyre_loads_n(x, p, ops)
     step = dt_s * p.wheel_radius_m / p.wheel_inertia_kgm2
     out = list(x)
-    for p_i, omega_i, gain, fz in zip(PRESSURES, OMEGAS, ch.wheel_brake_n_per_bar, loads):
+    half = 0.5 * p.track_m * x[YAW_RATE]
+    grounds = (x[VX] - half, x[VX] + half, x[VX] - half, x[VX] + half)
+    wheels = zip(PRESSURES, OMEGAS, ch.wheel_brake_n_per_bar, loads, grounds)
+    for p_i, omega_i, gain, fz, ground_mps in wheels:
         pressure = ops.fmax(x[p_i], 0.0)
         torque = gain * pressure + p.rolling_resistance_coeff * fz
-        out[omega_i] = ops.fmax(x[omega_i] - step * torque, 0.0)
+        spin = x[omega_i]
+        coulomb = ops.fmax(spin - step * torque, ops.fmin(spin + step * torque, 0.0))
+        out[omega_i] = ops.fmax(coulomb, ops.fmin(ground_mps / p.wheel_radius_m, 0.0))
         out[p_i] = pressure
     return out
 

@@ -135,20 +135,28 @@ class _Forces(NamedTuple):
 
 def tyre_loads_n(x, p: VehicleParams, ops):
     """``(FL, FR, RL, RR)`` normal loads [N]: static, plus the longitudinal transfer
-    ``m ax h / L`` and the lateral ``m ay h / track`` shared by the roll stiffness."""
+    ``m ax h / L`` and the lateral ``m ay h / track`` shared by the roll stiffness. The loads
+    always add up to the weight: an axle's load lies in [0, m g] (the other axle carries the
+    rest), an axle's lateral transfer at most lifts its inner wheel, the excess passing to the
+    other axle (``_lateral_transfer``)."""
     m, h, wb = p.mass_kg, p.cg_height_m, p.wheelbase_m
     ax, ay = x[AX_LOAD], x[AY_LOAD]
-    half_f = 0.5 * m * (G_MPS2 * p.cg_to_rear_m - h * ax) / wb
-    half_r = 0.5 * m * (G_MPS2 * p.cg_to_front_m + h * ax) / wb
-    lateral = m * ay * h / p.track_m
-    d_f = lateral * p.roll_stiffness_front_share
-    d_r = lateral - d_f
-    return (
-        ops.fmax(half_f - d_f, 0.0),  # a left turn (ay > 0) loads the right tyres
-        ops.fmax(half_f + d_f, 0.0),
-        ops.fmax(half_r - d_r, 0.0),
-        ops.fmax(half_r + d_r, 0.0),
-    )
+    weight = m * G_MPS2
+    half_f = 0.5 * ops.fmin(ops.fmax(m * (G_MPS2 * p.cg_to_rear_m - h * ax) / wb, 0.0), weight)
+    half_r = 0.5 * ops.fmin(ops.fmax(m * (G_MPS2 * p.cg_to_front_m + h * ax) / wb, 0.0), weight)
+    d_f, d_r = _lateral_transfer(m * ay * h / p.track_m, half_f, half_r, p, ops)
+    return (half_f - d_f, half_f + d_f, half_r - d_r, half_r + d_r)  # ay > 0 loads the right
+
+
+def _lateral_transfer(lateral_n, half_f, half_r, p: VehicleParams, ops):
+    """Each axle's lateral load transfer ``(d_f, d_r)`` [N] from the total ``lateral_n``:
+    shared by the roll stiffness (``roll_stiffness_front_share``), each at most its axle's
+    half load (the inner wheel lifted); what the front axle cannot take passes to the rear,
+    what neither can is lost (the car on its two outer wheels, rolling over)."""
+    wanted_f = lateral_n * p.roll_stiffness_front_share
+    d_f = ops.fmin(ops.fmax(wanted_f, -half_f), half_f)
+    d_r = ops.fmin(ops.fmax(lateral_n - wanted_f + (wanted_f - d_f), -half_r), half_r)
+    return d_f, d_r
 
 
 def _axle(kappas, alpha, loads, steer_cs, mu, lky, p: VehicleParams, ch: Chassis, ops) -> Axle:
@@ -182,11 +190,24 @@ def _forces(x, mu, p: VehicleParams, ops) -> _Forces:
     )
     vx = x[VX]
     esc_nm = x[ESC] if p.esc_fitted else 0.0
-    drive_n = ops.fmin(x[DRIVE], p.max_drive_power_w / ops.fmax(vx, 1.0))
+    drive_n = ops.fmin(x[DRIVE], p.max_drive_power_w / ops.fmax(driven_speed_mps(x, p, ops), 1.0))
     if p.esc_fitted:
         drive_n = drive_n * ops.fmax(1.0 - ops.fabs(esc_nm) / ch_.ESC_TORQUE_CUT_NM, 0.0)
     drag_n = 0.5 * AIR_DENSITY_KGPM3 * p.drag_area_m2 * vx * ops.fabs(vx)
     return _Forces(front, rear, drive_n, drag_n, esc_nm, steer, loads)
+
+
+def driven_speed_mps(x, p: VehicleParams, ops):
+    """The driven wheels' speed ``omega r_w`` [m/s], each axle's mean weighted by its share of
+    the drive torque: the drive force delivers ``F v`` of the engine's power at the wheels, so
+    a spinning wheel takes its share of the power and cannot spin up without bound."""
+    ch = constants(p)
+    front = 0.5 * (x[OMEGAS[0]] + x[OMEGAS[1]])
+    rear = 0.5 * (x[OMEGAS[2]] + x[OMEGAS[3]])
+    share = ch_.front_drive_share(
+        0.5 * (x[SLIPS[0]] + x[SLIPS[1]]), 0.5 * (x[SLIPS[2]] + x[SLIPS[3]]), p, ch, ops
+    )
+    return (share * front + (1.0 - share) * rear) * p.wheel_radius_m
 
 
 def compliant_steer(steer_rad, fy_front_n, ch: Chassis):
@@ -266,6 +287,8 @@ def _actuator_rates(x, u, f: _Forces, spins, p: VehicleParams, ch: Chassis, ops)
         resisting = ch.wheel_brake_n_per_bar[i] * x[p_i] + p.rolling_resistance_coeff * f.loads[i]
         accel = (spins[i] - resisting * p.wheel_radius_m / p.wheel_inertia_kgm2) * p.wheel_radius_m
         cut, past = ch_.abs_cut_target(wheel_mps, v_refs[i], mu_est, accel, ax, p, ch, ops)
+        if p.esc_fitted:
+            cut = cut * ch_.abs_weight(p_cmd, esc_bar, ops)
         cuts.append((cut - x[ABS_CUTS[i]]) / ch_.ABS_VALVE_LAG_S)
         active = ops.fmax(active, past)
     return [steer_rate, (drive_target - x[DRIVE]) / p.drive_lag_s, *pressures], cuts, active
