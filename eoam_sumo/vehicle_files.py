@@ -16,13 +16,14 @@ unknown keys are refused (a misspelt key would otherwise fall back to the sedan'
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
 
 from eoam_sumo.errors import InputError
-from eoam_sumo.params import VehicleParams, VehicleValueError
+from eoam_sumo.params import G_MPS2, VehicleParams, VehicleValueError
 from eoam_sumo.textfiles import not_utf8
 
 DEFAULT_VEHICLE = "sedan"
@@ -205,3 +206,51 @@ def _toml_scalar(value) -> str:
         return str(value)
     escaped = str(value).replace("\\", "\\\\").replace('"', '\\"')
     return f'"{escaped}"'
+
+
+#: The catalogue table's columns (docs/vehicles.md "The vehicles").
+CATALOGUE_HEADER = (
+    "| name | vehicle | drive | ABS / ESC | mass kg | Iz kg m^2 | a / b m | h m | track m | SSF "
+    "| k^2/(a b) | L x W m | brake front share | C_f / C_r kN/rad | linear understeer deg/g |"
+)
+
+
+def linear_understeer_deg_per_g(params: VehicleParams) -> float:
+    """The linear single-track understeer gradient ``m g / L (b / C_f - a / C_r)`` [deg/g],
+    C_f the front axle's effective cornering stiffness (its tyres' times the steering
+    compliance)."""
+    p = params
+    weight_n = p.mass_kg * G_MPS2
+    rad = (
+        weight_n
+        / p.wheelbase_m
+        * (
+            p.cg_to_rear_m / p.front_axle_stiffness_npr
+            - p.cg_to_front_m / p.cornering_stiffness_rear_npr
+        )
+    )
+    return math.degrees(rad)
+
+
+def catalogue_row(name: str, directory: Path | None = None) -> str:
+    """One vehicle's row of the catalogue table (``CATALOGUE_HEADER``), from its file."""
+    p = load_vehicle(name, directory)
+    fitted = f"{'yes' if p.abs_fitted else 'no'} / {'yes' if p.esc_fitted else 'no'}"
+    cells = (
+        f"`{name}`",
+        p.name,
+        p.drivetrain.upper().replace("EAWD", "eAWD"),
+        fitted,
+        f"{p.mass_kg:.0f}",
+        f"{p.yaw_inertia_kgm2:.0f}",
+        f"{p.cg_to_front_m:.3f} / {p.cg_to_rear_m:.3f}",
+        f"{p.cg_height_m:.3f}",
+        f"{p.track_m:.3f}",
+        f"{static_stability_factor(p):.2f}",
+        f"{dynamic_index(p):.2f}",
+        f"{p.length_m:.2f} x {p.width_m:.2f}",
+        f"{p.brake_front_share:.3f}",
+        f"{p.front_axle_stiffness_npr / 1e3:.0f} / {p.cornering_stiffness_rear_npr / 1e3:.0f}",
+        f"{linear_understeer_deg_per_g(p):.2f}",
+    )
+    return "| " + " | ".join(cells) + " |"

@@ -4,13 +4,16 @@ from __future__ import annotations
 
 import dataclasses
 import re
+from pathlib import Path
 
 import pytest
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.vehicle_files import (
+    CATALOGUE_HEADER,
     catalogue,
+    catalogue_row,
     load_vehicle,
     sources_of,
     vehicle_path,
@@ -136,3 +139,12 @@ def test_every_catalogue_file_is_the_canonical_writing_of_its_values():
 def test_sources_for_unknown_keys_are_refused():
     with pytest.raises(ValueError, match="mass_kgs"):
         vehicle_toml(ego_e_class_sedan(), {"mass_kgs": "typo"})
+
+
+def test_the_catalogue_table_in_the_docs_is_the_files():
+    """docs/vehicles.md's table of the vehicles holds each catalogue file's values, as
+    ``catalogue_row`` writes them from the file (a hand-typed row went stale before)."""
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "vehicles.md").read_text("utf-8")
+    assert CATALOGUE_HEADER in doc
+    for name in catalogue():
+        assert catalogue_row(name) in doc.splitlines(), name

@@ -78,9 +78,10 @@ def _brake_figures(run: Run, v0_mps: float, mu: float, with_abs: bool) -> dict:
     utilisation = None if mfdd is None else mfdd / (mu * G_MPS2)
     front = locked(run["wheel_speed_front_mps"], vx)
     rear = locked(run["wheel_speed_rear_mps"], vx)
-    rest = time_s >= (t_stop if t_stop is not None else np.inf)
+    stopped = t_stop is not None
+    rest = time_s >= (t_stop if stopped else np.inf)
     limit_m = stopping_distance_limit_m(v0_mps * 3.6)
-    criteria = [criterion("stopping_distance_m", stopping_m, limit_m, True, c.CITE["stop"])]
+    criteria = [_stopping_criterion(run, float(distance[-1]), stopping_m, limit_m)]
     if with_abs:
         criteria.append(
             criterion(
@@ -93,7 +94,9 @@ def _brake_figures(run: Run, v0_mps: float, mu: float, with_abs: bool) -> dict:
         )
     wheel_min = min(run["wheel_speed_front_mps"].min(), run["wheel_speed_rear_mps"].min())
     figures = {
+        "stopped": stopped,
         "stopping_distance_m": rounded(stopping_m, 3),
+        "stopping_distance_at_least_m": None if stopped else round(float(distance[-1]), 3),
         "stopping_distance_limit_m": round(limit_m, 3),
         "stop_time_s": rounded(t_stop, 3),
         "mfdd_mps2": rounded(mfdd),
@@ -107,6 +110,26 @@ def _brake_figures(run: Run, v0_mps: float, mu: float, with_abs: bool) -> dict:
         "max_speed_at_rest_mps": round(float(np.abs(vx[rest]).max()), 6) if rest.any() else None,
     }
     return {"figures": figures, "criteria": criteria, "passed": overall(criteria)}
+
+
+def _stopping_criterion(
+    run: Run, travelled_m: float, stopping_m: float | None, limit_m: float
+) -> dict:
+    """The stopping distance against its limit. A car still moving when the run ends fails:
+    its stopping distance is more than the ``travelled_m`` so far (the value given, a lower
+    bound), and it did not stop in four times the friction's shortest stopping time."""
+    if stopping_m is not None:
+        return criterion("stopping_distance_m", stopping_m, limit_m, True, c.CITE["stop"])
+    judged = criterion("stopping_distance_m", round(travelled_m, 3), limit_m, True, c.CITE["stop"])
+    beyond = "beyond" if travelled_m > limit_m else "within"
+    judged["value_is_lower_bound"] = True
+    judged["passed"] = False
+    judged["reason"] = (
+        f"not stopped when the run ended {run['time_s'][-1]:.1f} s after the brake was applied, "
+        f"still at {run['vx_mps'][-1]:.2f} m/s: the stopping distance is more than the "
+        f"{travelled_m:.1f} m travelled ({beyond} the {limit_m:.1f} m limit)"
+    )
+    return judged
 
 
 def brake_ramp(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle | None = None):

@@ -65,8 +65,10 @@ def add_arguments(subparsers) -> None:
 
 
 def run(args) -> int:
-    """Run the test, write its files and figure, print where and the verdict."""
+    """Run the test, write its files and figure, print the verdict (with its reasons) and
+    where they are."""
     from eoam_sumo.plotting.vehicle_tests import plot_vehicle_test
+    from eoam_sumo.vehicle_tests.common import verdict_text
     from eoam_sumo.vehicle_tests.equipment import equipped
     from eoam_sumo.vehicle_tests.output import write_result
     from eoam_sumo.vehicle_tests.procedures import TESTS, VehicleTestOptions
@@ -77,6 +79,5 @@ def run(args) -> int:
     summary = write_result(result, out)
     runs = [(r.label, r.columns) for r in result.runs]
     png = plot_vehicle_test(summary, runs, out / f"{args.test}.png")
-    verdict = {True: "PASS", False: "FAIL", None: "figures only"}[summary["passed"]]
-    print(f"{args.test}: {verdict}; {out / 'summary.json'}, {png}")
+    print(f"{args.test}: {verdict_text(summary)}; {out / 'summary.json'}, {png}")
     return 0

@@ -3,7 +3,7 @@ speed keeping."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -67,6 +67,26 @@ def overall(criteria: list[dict[str, Any]]) -> bool | None:
     """All criteria passed (None when none could be judged)."""
     judged = [c["passed"] for c in criteria if c["passed"] is not None]
     return all(judged) if judged else None
+
+
+def verdict(summary: Mapping[str, Any]) -> str:
+    """``PASS``, ``FAIL``, ``NOT MEASURED`` (what the test is for could not be measured: the
+    summary's ``not_measured`` says why) or ``figures only`` (the standard sets no pass mark)."""
+    passed = summary.get("passed")
+    if passed is not None:
+        return "PASS" if passed else "FAIL"
+    return "NOT MEASURED" if summary.get("not_measured") else "figures only"
+
+
+def verdict_text(summary: Mapping[str, Any]) -> str:
+    """The verdict with its reasons: why nothing was measured, or why a criterion failed."""
+    word = verdict(summary)
+    if word == "NOT MEASURED":
+        reasons = [summary["not_measured"]]
+    else:
+        criteria = summary.get("criteria", [])
+        reasons = [c["reason"] for c in criteria if c.get("passed") is False and c.get("reason")]
+    return f"{word}: {'; '.join(reasons)}" if reasons else word
 
 
 def header(test: str, params: VehicleParams, options: VehicleTestOptions, speed_mps: float) -> dict:

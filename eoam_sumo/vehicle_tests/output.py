@@ -11,7 +11,7 @@ import json
 from pathlib import Path
 
 from eoam_sumo.fileio import writable_dir, write_atomic
-from eoam_sumo.vehicle_tests.common import VehicleTestResult
+from eoam_sumo.vehicle_tests.common import VehicleTestResult, verdict
 from eoam_sumo.vehicle_tests.harness import COLUMNS, Run
 
 
@@ -34,8 +34,8 @@ def timeseries_csv(run: Run) -> str:
 
 
 def write_result(result: VehicleTestResult, out: Path) -> dict:
-    """Write every run's CSV and ``summary.json`` (with the runs' files) into ``out``; the
-    summary as written."""
+    """Write every run's CSV and ``summary.json`` (with the verdict and the runs' files) into
+    ``out``; the summary as written."""
     out = writable_dir(out)
     files = {}
     for run in result.runs:
@@ -43,6 +43,6 @@ def write_result(result: VehicleTestResult, out: Path) -> dict:
         path.parent.mkdir(parents=True, exist_ok=True)
         write_atomic(path, timeseries_csv(run))
         files[run.label] = str(path.relative_to(out))
-    summary = {**result.summary, "timeseries": files}
+    summary = {**result.summary, "verdict": verdict(result.summary), "timeseries": files}
     write_atomic(out / "summary.json", json.dumps(summary, indent=2) + "\n")
     return summary

@@ -10,8 +10,21 @@ import numpy as np
 from eoam_sumo.params import G_MPS2
 
 LINEAR_AY_RANGE_G = (0.1, 0.4)
-"""Lateral accelerations over which the understeer gradient is fitted (ours: the linear range
-of a passenger car's tyres, below the 0.5 g the slowly increasing steer reaches)."""
+"""Lateral accelerations over which the understeer gradient is fitted on a dry road (ours: the
+linear range of a passenger car's tyres, below the 0.5 g the slowly increasing steer reaches);
+``linear_range_g`` narrows it to the car's limit on the road of the test."""
+
+LINEAR_PEAK_FRACTION = 0.5
+"""The fit ends at most at this share of the peak lateral acceleration the run reached (ours:
+below about half its peak a tyre's force is close to proportional to its slip, and the
+gradients are figures of that linear range; above it the road's friction sets the steer)."""
+
+
+def linear_range_g(peak_g: float) -> tuple[float, float]:
+    """The fit range [g] of a run that peaked at ``peak_g``: ``LINEAR_AY_RANGE_G``, its upper
+    end at most ``LINEAR_PEAK_FRACTION`` of the peak (empty, low > high, below 0.2 g)."""
+    low_g, high_g = LINEAR_AY_RANGE_G
+    return low_g, min(high_g, LINEAR_PEAK_FRACTION * peak_g)
 
 
 def understeer_gradient_deg_per_g(
@@ -87,6 +100,15 @@ def step_response(
         peak_response_time_s=None if t_half is None else float(time_s[k_peak]) - t_half,
         overshoot=(peak - steady) / steady,
     )
+
+
+def drift_over_window(time_s: np.ndarray, response: np.ndarray, window_s: float = 1.0) -> float:
+    """How much ``response`` still changes over the last ``window_s`` of the series: its
+    least-squares slope there times ``window_s`` (0 for a steady state)."""
+    tail = time_s >= time_s[-1] - window_s
+    if np.count_nonzero(tail) < 2:
+        return 0.0
+    return float(np.polyfit(time_s[tail], response[tail], 1)[0]) * window_s
 
 
 def _first_crossing_time(time_s: np.ndarray, y: np.ndarray, level: float) -> float | None:

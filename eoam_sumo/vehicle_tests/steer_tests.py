@@ -22,6 +22,10 @@ from eoam_sumo.vehicle_tests.common import (
 from eoam_sumo.vehicle_tests.harness import Controls, Run, Sample, Vehicle, simulate
 from eoam_sumo.vehicle_tests.steer_figures import (
     LINEAR_AY_RANGE_G,
+    LINEAR_PEAK_FRACTION,
+    StepResponse,
+    drift_over_window,
+    linear_range_g,
     steer_angle_gradient_deg_per_g,
     step_response,
     understeer_gradient_deg_per_g,
@@ -54,50 +58,69 @@ STEP_HOLD_S = 4.0
 STEP_ITERATIONS = 3
 """Runs to scale the step to the standard's steady-state lateral acceleration."""
 
+STEP_AY_TOLERANCE = 0.05
+"""The step steer is measured only when its last second's lateral acceleration is within this
+share of the standard's 4 m/s^2 and changes by no more than it (ours): short of it, the road
+cannot give the lateral acceleration (the step was scaled towards the lock, the tyres are at
+their limit) and the response is the friction's, not the car's transient response."""
+
 
 def ramp_steer(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle | None = None):
     """ISO 4138 at constant speed: the hand wheel turned left at ``RAMP_STEER_RATE_DEGPS`` with
     the speed held, until the lateral acceleration stops growing or the turn stops being
-    quasi-steady. Figures over ``LINEAR_AY_RANGE_G``: the understeer gradient and the steering
-    angle gradient (deg of road-wheel angle per g; of hand-wheel angle: times the steering
-    ratio); the peak lateral acceleration."""
+    quasi-steady. Figures over the linear range (``linear_range_g``: 0.1-0.4 g, at most half
+    the peak): the understeer gradient and the steering angle gradient (deg of road-wheel angle
+    per g; of hand-wheel angle: times the steering ratio); the peak lateral acceleration."""
     speed_mps = options.speed_mps(c.RAMP_SPEED_KMH)
     run = slowly_increasing_steer(
         params, speed_mps, options.mu, vehicle, rate_degps=RAMP_STEER_RATE_DEGPS
     )
     peak_mps2 = float(np.max(np.abs(run["ay_mps2"])))
+    fit_range_g = linear_range_g(peak_mps2 / G_MPS2)
     summary = header("ramp-steer", params, options, speed_mps)
+    gradients = _gradients(run, params, fit_range_g)
     summary["figures"] = {
-        **_gradients(run, params),
+        **gradients,
         "steer_rate_degps": RAMP_STEER_RATE_DEGPS,
-        "fit_range_g": list(LINEAR_AY_RANGE_G),
+        "fit_range_g": None if "not_measured" in gradients else [round(g, 4) for g in fit_range_g],
+        "fit_range_rule": f"{LINEAR_AY_RANGE_G[0]:g} g to the lesser of "
+        f"{LINEAR_AY_RANGE_G[1]:g} g and {LINEAR_PEAK_FRACTION:g} of the peak",
         "peak_lateral_acceleration_mps2": round(peak_mps2, 4),
         "peak_lateral_acceleration_g": round(peak_mps2 / G_MPS2, 4),
         "clause": c.CITE["ramp"],
     }
     summary["criteria"] = []
     summary["passed"] = None
+    if "not_measured" in gradients:
+        summary["not_measured"] = gradients["not_measured"]
     return VehicleTestResult("ramp-steer", (run,), summary)
 
 
-def _gradients(run: Run, params: VehicleParams) -> dict:
-    """The ramp steer's gradients over ``LINEAR_AY_RANGE_G``; ``None`` with the reason under
-    ``not_measured`` when the run never reaches that range (a low mu or speed: the road or the
-    turn cannot give 0.1 g), as ISO 4138's figures are defined there only."""
+def _gradients(run: Run, params: VehicleParams, fit_range_g: tuple[float, float]) -> dict:
+    """The ramp steer's gradients over ``fit_range_g``; ``None`` with the reason under
+    ``not_measured`` when the run has no samples there (a low mu or speed: the road or the
+    turn cannot give 0.1 g, or not twice that), as ISO 4138's figures are defined there only."""
     road_rad = np.radians(run["steer_wheel_deg"]) / params.steering_ratio
     try:
-        steer_gradient = steer_angle_gradient_deg_per_g(run["ay_mps2"], road_rad)
+        steer_gradient = steer_angle_gradient_deg_per_g(run["ay_mps2"], road_rad, fit_range_g)
         gradient = understeer_gradient_deg_per_g(
-            run["ay_mps2"], road_rad, run["yaw_rate_radps"], run["vx_mps"], params.wheelbase_m
+            run["ay_mps2"],
+            road_rad,
+            run["yaw_rate_radps"],
+            run["vx_mps"],
+            params.wheelbase_m,
+            fit_range_g,
         )
     except ValueError:
         peak_g = float(np.max(np.abs(run["ay_mps2"]))) / G_MPS2
+        low_g, high_g = LINEAR_AY_RANGE_G
         return {
             "understeer_gradient_deg_per_g": None,
             "steer_angle_gradient_deg_per_g": None,
             "steering_wheel_angle_gradient_deg_per_g": None,
-            "not_measured": f"the lateral acceleration (peak {peak_g:.3f} g) never spans the "
-            f"fit range {LINEAR_AY_RANGE_G[0]:g}-{LINEAR_AY_RANGE_G[1]:g} g",
+            "not_measured": f"no linear range to fit: the lateral acceleration (peak "
+            f"{peak_g:.3f} g) never spans the fit range {low_g:g}-{high_g:g} g below "
+            f"{LINEAR_PEAK_FRACTION:g} of its peak ({fit_range_g[1]:.3f} g)",
         }
     return {
         "understeer_gradient_deg_per_g": round(gradient, 4),
@@ -144,7 +167,9 @@ def step_steer(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehi
     """ISO 7401 sec. 10: a step of the hand wheel (left, ``STEP_RISE_S``) held for
     ``STEP_HOLD_S``, throttle held from the step on; the step scaled (``STEP_ITERATIONS``
     runs) to a steady-state lateral acceleration of 4 m/s^2. Figures of the yaw rate and of
-    the lateral acceleration: steady-state gain, response time, peak response time, overshoot."""
+    the lateral acceleration: steady-state gain, response time, peak response time, overshoot;
+    not measured (``None``, the reason in ``not_measured``) when the steady state is not that
+    lateral acceleration (``STEP_AY_TOLERANCE``: beyond the road's friction)."""
     speed_mps = options.speed_mps(c.STEP_SPEED_KMH)
     steer_rad = _linear_steer_rad(params, speed_mps, c.STEP_AY_MPS2)
     for _ in range(STEP_ITERATIONS):
@@ -153,11 +178,52 @@ def step_steer(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehi
         steer_rad *= c.STEP_AY_MPS2 / max(steady_ay.steady_state, 0.1)
     yaw = step_response(run["time_s"], run["steer_wheel_deg"], run["yaw_rate_radps"])
     ay = step_response(run["time_s"], run["steer_wheel_deg"], run["ay_mps2"])
+    why = _step_not_measured(ay.steady_state, drift_over_window(run["time_s"], run["ay_mps2"]))
     summary = header("step-steer", params, options, speed_mps)
     summary["figures"] = {
         "steer_wheel_deg": round(float(run["steer_wheel_deg"][-1]), 3),
+        "target_lateral_acceleration_mps2": c.STEP_AY_MPS2,
         "steady_lateral_acceleration_mps2": round(ay.steady_state, 4),
-        "yaw_rate_gain_per_s": round(yaw.gain * 180.0 / math.pi * params.steering_ratio, 5),
+        **_step_figures(yaw, ay, params.steering_ratio, measured=why is None),
+        "clause": c.CITE["step"],
+    }
+    summary["criteria"] = []
+    summary["passed"] = None
+    if why is not None:
+        summary["figures"]["not_measured"] = summary["not_measured"] = (
+            f"{why}; mu g = {options.mu * G_MPS2:.2f} m/s^2; no ISO 7401 gain, response time "
+            "or overshoot"
+        )
+    return VehicleTestResult("step-steer", (run,), summary)
+
+
+def _step_not_measured(steady_mps2: float, drift_mps2: float) -> str | None:
+    """Why a step steer's steady state is not ISO 7401's 4 m/s^2 (``STEP_AY_TOLERANCE``), or
+    None when it is."""
+    target, allowed = c.STEP_AY_MPS2, STEP_AY_TOLERANCE * c.STEP_AY_MPS2
+    if abs(steady_mps2 - target) > allowed:
+        where = "short of" if steady_mps2 < target else "above"
+        return (
+            f"the steady-state lateral acceleration reached, {steady_mps2:.2f} m/s^2, is "
+            f"{abs(steady_mps2 - target) / target:.0%} {where} the standard's {target:g} m/s^2 "
+            f"(more than {STEP_AY_TOLERANCE:.0%})"
+            + (": the road cannot give it" if steady_mps2 < target else "")
+        )
+    if abs(drift_mps2) > allowed:
+        return (
+            f"no steady state: the lateral acceleration still changes by {drift_mps2:+.2f} "
+            f"m/s^2 over the last second (more than {STEP_AY_TOLERANCE:.0%} of {target:g} m/s^2)"
+        )
+    return None
+
+
+def _step_figures(
+    yaw: StepResponse, ay: StepResponse, steering_ratio: float, measured: bool
+) -> dict:
+    """ISO 7401's figures of the yaw rate and the lateral acceleration (``None`` unless
+    ``measured``)."""
+    figures = {
+        "yaw_rate_gain_per_s": round(yaw.gain * 180.0 / math.pi * steering_ratio, 5),
         "yaw_rate_gain_degps_per_deg": round(math.degrees(yaw.gain), 5),
         "yaw_rate_response_time_s": rounded(yaw.response_time_s),
         "yaw_rate_peak_response_time_s": rounded(yaw.peak_response_time_s),
@@ -165,11 +231,8 @@ def step_steer(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehi
         "lateral_acceleration_response_time_s": rounded(ay.response_time_s),
         "lateral_acceleration_peak_response_time_s": rounded(ay.peak_response_time_s),
         "lateral_acceleration_overshoot": round(ay.overshoot, 4),
-        "clause": c.CITE["step"],
     }
-    summary["criteria"] = []
-    summary["passed"] = None
-    return VehicleTestResult("step-steer", (run,), summary)
+    return figures if measured else dict.fromkeys(figures)
 
 
 def _linear_steer_rad(params: VehicleParams, speed_mps: float, ay_mps2: float) -> float:

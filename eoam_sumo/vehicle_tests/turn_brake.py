@@ -37,6 +37,10 @@ CIRCLE_GAIN_S = 0.5
 error [s] (ours)."""
 SPIN_SIDESLIP_DEG = 45.0
 """A run counts as a spin once the sideslip passes this (ours)."""
+CIRCLE_TOLERANCE = 0.05
+"""At the brake's onset the yaw rate must be within this share of the circle's ``v / R``
+(ours): otherwise the car is not on the initial circle (the turn asks more than the road
+gives) and the series is not measured."""
 
 
 def decelerations_mps2(mu: float) -> list[float]:
@@ -49,26 +53,69 @@ def brake_in_turn(
     params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle | None = None
 ) -> VehicleTestResult:
     """The series on the initial circle (``TURN_BRAKE_RADIUS_M``; the speed of
-    ``TURN_BRAKE_AY_MPS2`` on it unless given): one run per deceleration (``decel_<a>``)."""
+    ``TURN_BRAKE_AY_MPS2`` on it unless given): one run per deceleration (``decel_<a>``). Not
+    measured (no figures, the reason in ``not_measured``) when the road is too slippery for
+    the series' first step, or the car is not on the circle at the brake's onset."""
     radius_m = c.TURN_BRAKE_RADIUS_M
     ay0 = min(c.TURN_BRAKE_AY_MPS2, 0.6 * options.mu * G_MPS2)  # a steady turn on any road
     default_kmh = math.sqrt(ay0 * radius_m) * 3.6
     speed_mps = options.speed_mps(default_kmh)
+    series = decelerations_mps2(options.mu)
+    why = None if series else _no_series(options.mu, speed_mps * speed_mps / radius_m)
     runs, per_run = [], []
-    for decel in decelerations_mps2(options.mu):
+    for decel in series:
         run = _run(params, speed_mps, radius_m, decel, options.mu, vehicle)
         runs.append(run)
+        why = _off_circle(run, speed_mps, radius_m, options.mu)
+        if why is not None:  # every run drives the same circle first: none is measured
+            break
         per_run.append(_figures(run, decel, radius_m))
     summary = header("brake-in-turn", params, options, speed_mps)
     summary["figures"] = {
         "radius_m": radius_m,
         "initial_lateral_acceleration_mps2": round(speed_mps * speed_mps / radius_m, 4),
+        "brake_onset_s": CIRCLE_S,
+        "measured_after_onset_s": c.TURN_BRAKE_MEASURE_S,
         "runs": per_run,
         "clause": c.CITE["turn_brake"],
     }
     summary["criteria"] = []
     summary["passed"] = None
+    if why is not None:
+        summary["figures"]["not_measured"] = summary["not_measured"] = why
     return VehicleTestResult("brake-in-turn", tuple(runs), summary)
+
+
+def _no_series(mu: float, ay_mps2: float) -> str:
+    """Why no run brakes: the series' first step is beyond the road's friction."""
+    mu_g = mu * G_MPS2
+    left_mps2 = math.sqrt(max(mu_g * mu_g - ay_mps2 * ay_mps2, 0.0))
+    return (
+        f"no run: the series' first deceleration, {c.TURN_BRAKE_DECEL_STEP_MPS2:g} m/s^2, is "
+        f"beyond the road's friction (mu g = {mu_g:.2f} m/s^2; in the turn's {ay_mps2:.2f} "
+        f"m/s^2 of lateral acceleration the tyres have {left_mps2:.2f} m/s^2 left to brake)"
+    )
+
+
+def _off_circle(run: Run, speed_mps: float, radius_m: float, mu: float) -> str | None:
+    """Why the car is not on the initial circle at the brake's onset (``CIRCLE_TOLERANCE``),
+    or None when it is."""
+    r0_radps = float(run["yaw_rate_radps"][_onset_index(run)])
+    circle_radps = speed_mps / radius_m
+    if abs(r0_radps / circle_radps - 1.0) <= CIRCLE_TOLERANCE:
+        return None
+    return (
+        f"no run measured: the car was not on the {radius_m:g} m circle when the brake came on "
+        f"(yaw rate {math.degrees(r0_radps):.1f} deg/s, the circle's "
+        f"{math.degrees(circle_radps):.1f} deg/s): the turn's lateral acceleration, "
+        f"{speed_mps * circle_radps:.2f} m/s^2, is more than the car holds on this road "
+        f"(mu g = {mu * G_MPS2:.2f} m/s^2)"
+    )
+
+
+def _onset_index(run: Run) -> int:
+    """The sample of the brake's onset (``CIRCLE_S``)."""
+    return int(np.searchsorted(run["time_s"], CIRCLE_S - 1e-9))
 
 
 def _run(
@@ -108,7 +155,7 @@ def _run(
 def _figures(run: Run, decel_mps2: float, radius_m: float) -> dict:
     """One run's figures at the onset ``t0`` and ``c.TURN_BRAKE_MEASURE_S`` after it."""
     t = run["time_s"]
-    i0 = int(np.searchsorted(t, CIRCLE_S - 1e-9))
+    i0 = _onset_index(run)
     i1 = int(np.searchsorted(t, CIRCLE_S + c.TURN_BRAKE_MEASURE_S - 1e-9))
     i1 = min(i1, len(t) - 1)
     vx, r, ay = run["vx_mps"], run["yaw_rate_radps"], run["ay_mps2"]
