@@ -196,21 +196,21 @@ class TestScore:
 
 
 def test_score(test: str, cells: list[tuple[float, bool]]) -> TestScore:
-    """``cells``: (cell points, extended) of every point of a test. Each range scores its
-    weight times the mean of its cells' points (RATING_2026 ``compute_predicted_score``; a
-    point not run counts, with 0), the extended range then banded (``extended_band``)."""
+    """``cells``: (cell points, extended) of every point of a test, the points not run (or
+    not selected) included with 0. Each range scores its weight times the mean of its cells'
+    points (RATING_2026 ``compute_predicted_score``), the extended range then banded
+    (``extended_band``); the maxima are the test's whole weights (``TOTAL_SCORES``)."""
     weights = TOTAL_SCORES[test]
     parts = {}
     for name, extended in (("standard", False), ("extended", True)):
         own = [p for p, ext in cells if ext == extended]
         parts[name] = weights[name] * sum(own) / len(own) if own else 0.0
-    max_ext = weights["extended"] if any(ext for _, ext in cells) else 0.0
     return TestScore(
         test,
         parts["standard"],
-        extended_band(parts["extended"], max_ext),
+        extended_band(parts["extended"], weights["extended"]),
         weights["standard"],
-        max_ext,
+        weights["extended"],
         weights["robustness"],
     )
 
@@ -270,6 +270,24 @@ R152_LIMITS_KMH: dict[tuple[str, float], float | None] = {
 }
 PASS, FAIL, UNDETERMINED = "pass", "fail", "undetermined"
 
+#: The protocols' test surface: a dry road. R152's test conditions: a dry, solid-paved
+#: surface of "nominal peak braking coefficient (PBC) of 0.9" (the PBC reference that
+#: CLEPA/OICA's GRVA-09-17 proposes to amend; the clause's number is not verified here);
+#: Euro NCAP's test protocols: a dry surface (their PBC clause is not held here). We run the
+#: dry road at mu 1.0 (the default); a run below 0.9 is not a protocol condition: its
+#: figures are ours, with no regulation verdict and no rating (docs/protocols.md).
+DRY_ROAD_MU = 0.9
+#: What a scorecard says of a run on another surface
+OFF_PROTOCOL = (
+    "friction {mu:g}: not a protocol condition; figures only (the protocols test on a dry "
+    "road, a peak braking coefficient of 0.9; below it no regulation verdict and no rating)"
+)
+
+
+def on_protocol_surface(mu: float) -> bool:
+    """The friction is the protocols' dry road (``DRY_ROAD_MU`` or above)."""
+    return mu >= DRY_ROAD_MU
+
 
 def r152_verdict(limit_kmh: float | None, impact_speed_kmh: float) -> tuple[str, str]:
     """(verdict, reason) of one R152 row from its relative impact speed and its limit."""
@@ -297,6 +315,12 @@ R152_WARNING_SOURCE = (
 )
 
 
+#: A lead is the difference of two time stamps of the run's time series (multiples of the
+#: plant's 0.01 s step, written as decimals): it is settled at 1 us, a ten-thousandth of the
+#: step, before the comparison, so that 4.21 - 3.41 = 0.7999999999999998 s counts as 0.8 s.
+LEAD_DIGITS = 6
+
+
 def r152_warning(fcw_raised: bool, lead_s: float | None, braked: bool) -> tuple[str, str]:
     """(verdict, reason) of R152's warning (para. 5.2.1.1) from the FCW: raised at least
     ``R152_WARNING_LEAD_S`` before the emergency braking began (``lead_s``; None: unknown)."""
@@ -306,7 +330,7 @@ def r152_warning(fcw_raised: bool, lead_s: float | None, braked: bool) -> tuple[
         return FAIL, "no collision warning before the emergency braking"
     if lead_s is None:
         return UNDETERMINED, "warning raised; its lead over the braking not measured"
-    if lead_s >= R152_WARNING_LEAD_S:
+    if round_half_up(lead_s, LEAD_DIGITS) >= R152_WARNING_LEAD_S:
         return PASS, f"warning {lead_s:.2f} s before the braking (>= {R152_WARNING_LEAD_S:g} s)"
     return FAIL, f"warning {lead_s:.2f} s before the braking (< {R152_WARNING_LEAD_S:g} s)"
 

@@ -17,7 +17,7 @@ from eoam_sumo.offline.tables import MIN_ENTRY_SPEED_KMH
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.protocols import rules, scoring
 from eoam_sumo.protocols.impact import measure, steered
-from eoam_sumo.protocols.points import TestPoint
+from eoam_sumo.protocols.points import TestPoint, protocol_points
 from eoam_sumo.protocols.scenario import write_scenarios
 from eoam_sumo.protocols.scorecard import RunLabel, plot, scorecard_markdown
 from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
@@ -32,6 +32,7 @@ PROTOCOL_COLUMNS = (
     "protocol",
     "system",
     "policy",
+    "vehicle",
     "sumo_step_s",
     "test",
     "ego_speed_kmh",
@@ -65,12 +66,22 @@ class ProtocolSummary:
     run: int
     failed: int
     outside: int
+    matrix: int = 0  # the protocol's points (0: as many as ``points``)
+    off_protocol: str = ""  # why the run is no protocol condition ("": it is)
 
     def line(self, out: Path) -> str:
-        """The summary line, naming the files in the output folder ``out``."""
+        """The summary line, naming the files in the output folder ``out``; a ``--points``
+        subset is named a partial run (scored against the whole protocol)."""
+        partial = ""
+        if self.matrix > self.points:
+            partial = (
+                f"partial run: {self.points} of the protocol's {self.matrix} points "
+                "selected (--points), the others counted as not run: not the protocol's score; "
+            )
+        off = f"{self.off_protocol}; " if self.off_protocol else ""
         return (
-            f"{self.points} points, {self.run} run, {self.failed} failed, {self.outside} "
-            f"not run (below the design range); {out / RESULTS_FILE}, "
+            f"{partial}{off}{self.points} points, {self.run} run, {self.failed} failed, "
+            f"{self.outside} not run (below the design range); {out / RESULTS_FILE}, "
             f"{out / SCORECARD_MD}"
         )
 
@@ -151,14 +162,17 @@ def run_protocol(
         tables_dir=tables_dir,
         meanwhile=_import_scorecard_plots,  # matplotlib, on a core the last points leave free
     )
-    run = RunLabel(name, system, policy, vehicle, mu, low, params.width_m)
+    run = RunLabel(name, system, policy, vehicle, mu, low, params.width_m, vehicle_id)
     frame = results_frame(points, batch, run, out)
     frame["net_file"] = [_relative(v, out) for v in frame["net_file"]]
     write_atomic(out / RESULTS_FILE, frame.to_csv(index=False), durable=True)
     write_atomic(out / SCORECARD_MD, scorecard_markdown(frame, run))
     plot(frame, out / SCORECARD_PNG, run)
     failed = int((frame["status"] == "failed").sum())
-    return ProtocolSummary(len(frame), len(runnable), failed, len(points) - len(runnable))
+    off = "" if rules.on_protocol_surface(mu) else rules.OFF_PROTOCOL.format(mu=mu)
+    matrix = len(protocol_points(name, params.width_m))
+    outside = len(points) - len(runnable)
+    return ProtocolSummary(len(frame), len(runnable), failed, outside, matrix, off)
 
 
 def _import_scorecard_plots() -> None:
@@ -205,7 +219,12 @@ def _facts(run: dict, width_m: float) -> scoring.RunFacts:
 
 
 def _row(point: TestPoint, run: dict | None, label: RunLabel, out: Path) -> dict:
-    head = {"point_id": point.point_id, "system": label.system, "policy": label.policy}
+    head = {
+        "point_id": point.point_id,
+        "system": label.system,
+        "policy": label.policy,
+        "vehicle": label.vehicle_id,
+    }
     if run is None:
         note = scoring.OUTSIDE_DESIGN.format(v=point.ego_speed_kmh, low=label.low_kmh)
         row = scoring.point_row(point, None, note)
@@ -213,7 +232,8 @@ def _row(point: TestPoint, run: dict | None, label: RunLabel, out: Path) -> dict
     summary = {c: run.get(c) for c in SUMMARY_COLUMNS}
     case_dir = f"{BATCH_DIR}/{run['case_dir']}"
     if run["status"] != "ok":
-        row = scoring.point_row(point, None, "the run failed: " + str(run["error"]))
+        note = "the run failed: " + str(run["error"])
+        row = scoring.point_row(point, None, note, failed=True)
     else:
         contact = run.get("contact_time_s")
         measured = measure(out / case_dir, None if contact is None else float(contact))

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import pandas as pd
 
 from eoam_sumo.protocols import rules, scoring
-from eoam_sumo.protocols.points import PROTOCOLS
+from eoam_sumo.protocols.points import PROTOCOLS, protocol_points
 
 
 @dataclass(frozen=True)
@@ -25,11 +25,17 @@ class RunLabel:
     mu: float
     low_kmh: float
     width_m: float
+    vehicle_id: str = "sedan"
 
     @property
     def title(self) -> str:
         ours = " (our extension, not the protocol's score)" if self.system == "eoam" else ""
-        return f"{self.name}, system {self.system}{ours}, policy {self.policy}"
+        off = "" if rules.on_protocol_surface(self.mu) else f", off-protocol (mu {self.mu:g})"
+        return f"{self.name}, system {self.system}{ours}, policy {self.policy}{off}"
+
+    def matrix(self) -> list:
+        """Every test point of the protocol (for this VUT's width)."""
+        return protocol_points(self.name, self.width_m)
 
 
 #: What the head-on sources say and what we did (the scorecard prints it)
@@ -53,8 +59,9 @@ def scorecard_markdown(frame: pd.DataFrame, run: RunLabel) -> str:
     lines = [
         f"# Scorecard: {run.title}",
         "",
-        f"Edition: {scoring.EDITION[run.name]}.",
+        f"Edition: {scoring.edition(run.name, run.mu)}.",
         "",
+        *partial_lines(rows, run),
         f"System {scoring.SYSTEM_TEXT[run.system]}.",
         "",
         f"Vehicle {run.vehicle}, friction {run.mu:g}, decision policy {run.policy}. Colours, "
@@ -64,13 +71,39 @@ def scorecard_markdown(frame: pd.DataFrame, run: RunLabel) -> str:
         "",
     ]
     if run.name == PROTOCOLS[1]:
-        lines += fc_lines(rows, run) + not_built_lines() + [CCFHOS_TEXT, ""]
+        scored = scoring.with_unselected(rows, run.matrix())
+        lines += fc_lines(scored, run) + not_built_lines() + [CCFHOS_TEXT, ""]
+        lines += our_reading_lines(scored)
     elif run.name == PROTOCOLS[2]:
-        lines += r152_lines(rows)
+        lines += r152_lines(rows, run)
     else:
         lines += unscored_lines(rows)
-    lines += not_run_lines(rows, run) + short_lines(rows)
+    lines += not_run_lines(rows, run)
+    lines += contact_lines(rows) if run.name == PROTOCOLS[0] else short_lines(rows)
     return "\n".join(lines) + "\n"
+
+
+def partial_lines(rows: list[dict], run: RunLabel) -> list[str]:
+    """A ``--points`` subset: how many of the protocol's points ran, and how it is scored."""
+    total = len(run.matrix())
+    if len(rows) >= total:
+        return []
+    effect = {
+        PROTOCOLS[1]: "the totals below count the points not selected as not run (0 points, "
+        "in the maximum) and the FC gate fails without its cells: not the protocol's score",
+        PROTOCOLS[2]: "the verdicts below are those of the rows run, not the regulation's",
+    }.get(run.name, "the runs below are those selected")
+    return [
+        f"**Partial run: {len(rows)} of the protocol's {total} points selected (--points)**; "
+        f"{effect}.",
+        "",
+    ]
+
+
+def _pts(value: float) -> str:
+    """A score as the rating code reports it: rounded half-up to 3 decimals (RATING_2026
+    compute_score.py ``get_updated_dfs``: scenario, category and test scores)."""
+    return f"{rules.round_half_up(value, 3):.3f}"
 
 
 def manoeuvre_line(rows: list[dict]) -> str:
@@ -92,10 +125,10 @@ def fc_lines(rows: list[dict], run: RunLabel) -> list[str]:
         "|---|---|---|---|---|---|---|",
     ]
     lines += [
-        f"| {x['test']} | {x['run']} / {x['rows']} | {x['standard']:.3f} of "
-        f"{x['max_standard']:.3f} | {x['extended']:.3f} of {x['max_extended']:.3f} | "
-        f"not assessed, 0 of {x['max_robustness']:.3f} | {x['points']:.3f} | "
-        f"{x['max_points']:.3f} |"
+        f"| {x['test']} | {x['run']} / {x['rows']} | {_pts(x['standard'])} of "
+        f"{_pts(x['max_standard'])} | {_pts(x['extended'])} of {_pts(x['max_extended'])} | "
+        f"not assessed, 0 of {_pts(x['max_robustness'])} | {_pts(x['points'])} | "
+        f"{_pts(x['max_points'])} |"
         for x in t["tests"]
     ]
     gate = "passed" if t["gate_passed"] else "FAILED"
@@ -106,10 +139,10 @@ def fc_lines(rows: list[dict], run: RunLabel) -> list[str]:
         "green; its general-requirement and pedestrian (CPNA) conditions are not assessed "
         "here)." + ("" if t["gate_passed"] else f" Failing: {', '.join(t['gate_failing'])}."),
         "",
-        f"**Overall, system {run.system}, policy {run.policy}: {t['points']:.3f} of "
-        f"{t['max_run']:.3f}** for the tests run ({t['points_before_gate']:.3f} before the "
-        f"gate); the protocol's car-target Frontal Collision maximum is "
-        f"{t['max_protocol']:.3f} (the tests not built below hold the rest).",
+        f"**Overall, system {run.system}, policy {run.policy}: {_pts(t['points'])} of "
+        f"{_pts(t['max_run'])}** for the tests run ({_pts(t['points_before_gate'])} before "
+        f"the gate); the protocol's car-target Frontal Collision maximum is "
+        f"{_pts(t['max_protocol'])} (the tests not built below hold the rest).",
         "",
     ]
     return lines
@@ -156,11 +189,14 @@ def _ptw_line(test: str, why: str) -> str:
     )
 
 
-def r152_lines(rows: list[dict]) -> list[str]:
-    """R152 verdicts per target: pass / fail, and the warning's."""
+def r152_lines(rows: list[dict], run: RunLabel) -> list[str]:
+    """R152 verdicts per target: pass / fail, and the warning's; off the dry road (para.
+    5.2.1.4's test conditions) the rows against the table, no regulation verdict."""
+    head = "Verdicts"
+    if not rules.on_protocol_surface(run.mu):
+        head = f"Rows against the table at mu {run.mu:g} (off-protocol: not R152 verdicts)"
     lines = [
-        "## Verdicts (pass: speed within the table, lane kept, warning >= 0.8 s before the "
-        "braking)",
+        f"## {head} (pass: speed within the table, lane kept, warning >= 0.8 s before the braking)",
         "",
         "| test | rows | pass | fail | undetermined | not run | warning pass | warning fail |",
         "|---|---|---|---|---|---|---|---|",
@@ -211,14 +247,19 @@ def not_run_lines(rows: list[dict], run: RunLabel) -> list[str]:
     ]
 
 
+def _short(row: dict) -> bool:
+    """The point is short of full marks: its run failed, its points are below its maximum
+    (an extended cell scores 1 unless red, whatever its colour), or (R152) it does not pass."""
+    if row["status"] == "failed" or row["verdict"] in (rules.FAIL, rules.UNDETERMINED):
+        return True
+    points, most = row["points"], row["max_points"]
+    scored = row["status"] == "ok" and row["colour"] in rules.COLOURS
+    return scored and not math.isnan(points) and points < most
+
+
 def short_lines(rows: list[dict]) -> list[str]:
-    bad = [
-        r
-        for r in rows
-        if r["status"] == "failed"
-        or r["colour"] in ("red", "brown", "orange", "yellow")
-        or r["verdict"] in ("fail", "undetermined")
-    ]
+    """Every point short of full marks (R152: every row that does not pass), with its cause."""
+    bad = [r for r in rows if _short(r)]
     if not bad:
         return ["No point short of full marks among those run.", ""]
     r152 = str(bad[0]["test"]).startswith("R152")
@@ -237,6 +278,59 @@ def short_lines(rows: list[dict]) -> list[str]:
     return [*lines, ""]
 
 
+def contact_lines(rows: list[dict]) -> list[str]:
+    """2023 (unscored): every run with a contact, or that failed; no claim of full marks."""
+    hit = [
+        r
+        for r in rows
+        if r["status"] == "failed"
+        or (r["status"] == "ok" and _num(r["impact_speed_kmh"]) != "0.00")
+    ]
+    if not hit:
+        return ["No contact among the runs (unscored: no points are given).", ""]
+    lines = [
+        f"## Runs with a contact or that failed (unscored; {len(hit)})",
+        "",
+        "| point | impact km/h | reduction km/h | B/S | cause |",
+        "|---|---|---|---|---|",
+    ]
+    lines += [
+        f"| {r['point_id']} | {_num(r['impact_speed_kmh'])} | {_num(r['speed_reduction_kmh'])} "
+        f"| {r['manoeuvre']} | {scoring.failure_cause(r)} |"
+        for r in hit
+    ]
+    return [*lines, ""]
+
+
+def our_reading_lines(rows: list[dict]) -> list[str]:
+    """The head-on cells green only by our reading above 30 km/h of speed reduction, and the
+    total the rating code's bands (red there) would give."""
+    ours = [r for r in rows if _above_top_band(r)]
+    if not ours:
+        return []
+    as_rated = [
+        {**r, "colour": rules.RED, "points": rules.cell_points(rules.RED, r["range"] == "extended")}
+        if _above_top_band(r)
+        else r
+        for r in rows
+    ]
+    t = scoring.fc_totals(as_rated)
+    return [
+        f"Head-on cells green only by our reading (a speed reduction above 30 km/h; the rating "
+        f"code: red): {len(ours)}. With the rating code's bands there the overall is "
+        f"{_pts(t['points'])} ({_pts(t['points_before_gate'])} before the gate).",
+        "",
+    ]
+
+
+def _above_top_band(row: dict) -> bool:
+    """A head-on cell with a contact and a speed reduction above the top published band."""
+    value = row.get("speed_reduction_kmh")
+    if row["test"] not in ("CCFhos", "CCFhol") or value is None or _num(value) == "-":
+        return False
+    return float(value) > rules.MITIGATION_BANDS[-2][1]
+
+
 def _num(value) -> str:
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "-"
@@ -246,6 +340,11 @@ def _num(value) -> str:
 def picture_headline(run: RunLabel, totals: dict, rows: list[dict]) -> str:
     """The picture's title: the run, and (2026) the overall points and the gate."""
     head = f"{run.title}; {run.vehicle}, mu {run.mu:g}\n{manoeuvre_line(rows)}"
+    total = len(run.matrix())
+    if len(rows) < total:
+        head += f"\npartial run: {len(rows)} of {total} points (--points)"
+    if not rules.on_protocol_surface(run.mu):
+        head += "\nnot a protocol condition (not the dry road): figures only"
     if run.name == PROTOCOLS[0]:
         return head + "\nunscored: the 2023 bands are not held"
     if run.name != PROTOCOLS[1]:
@@ -254,8 +353,8 @@ def picture_headline(run: RunLabel, totals: dict, rows: list[dict]) -> str:
         )
     gate = "passed" if totals["gate_passed"] else "FAILED: every FC point 0"
     return (
-        f"{head}\noverall {totals['points']:.2f} of {totals['max_run']:.2f} for the tests run "
-        f"({totals['points_before_gate']:.2f} before the gate); FC gate {gate}; "
+        f"{head}\noverall {_pts(totals['points'])} of {_pts(totals['max_run'])} for the tests "
+        f"run ({_pts(totals['points_before_gate'])} before the gate); FC gate {gate}; "
         f"protocol maximum {totals['max_protocol']:.0f}"
     )
 
@@ -265,9 +364,10 @@ def plot(frame: pd.DataFrame, path, run: RunLabel) -> None:
     from eoam_sumo.plotting.protocol_plots import plot_scorecard
 
     scored = run.name == PROTOCOLS[1]
-    totals = scoring.fc_totals(frame.to_dict("records")) if scored else {}
+    rows = frame.to_dict("records")
+    totals = scoring.fc_totals(scoring.with_unselected(rows, run.matrix())) if scored else {}
     kind = {PROTOCOLS[0]: "unscored", PROTOCOLS[1]: "bands", PROTOCOLS[2]: "verdicts"}[run.name]
-    headline = picture_headline(run, totals, frame.to_dict("records"))
+    headline = picture_headline(run, totals, rows)
     plot_scorecard(frame, path, headline, kind, totals, not_built_note(run))
 
 

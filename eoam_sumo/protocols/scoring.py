@@ -25,9 +25,47 @@ EDITION = {
     "(fcw_raised) but not assessed",
     PROTOCOLS[1]: "Crash Avoidance FC 2026 (v1.2), scored as the rating code "
     + rules.RATING_2026
-    + " computes it",
+    + " computes it, but for CCFhos and CCFhol: a speed reduction above 30 km/h scores green "
+    "here (our reading), red in the rating code (mitigation_scenarios_thresholds; below)",
     PROTOCOLS[2]: rules.R152 + " and 5.2.1.1 (M1, dry road; the mass-in-running-order column)",
 }
+
+
+def edition(name: str, mu: float) -> str:
+    """The scorecard's edition line for a run at friction ``mu``: the protocol's own on its
+    dry road (``rules.DRY_ROAD_MU`` or above), else its rules applied off-protocol (figures
+    only: no rating, no regulation verdict)."""
+    if rules.on_protocol_surface(mu):
+        return EDITION[name]
+    off = rules.OFF_PROTOCOL.format(mu=mu)
+    if name == PROTOCOLS[1]:
+        return (
+            f"Crash Avoidance FC 2026 (v1.2): the bands and weights of the rating code "
+            f"{rules.RATING_2026} (CCFhos and CCFhol above 30 km/h of speed reduction: our "
+            f"reading, below) applied to runs at {off}"
+        )
+    if name == PROTOCOLS[2]:
+        return f"{rules.R152}: its M1 table (mass in running order) applied to runs at {off}"
+    return f"{EDITION[name]}; at {off}"
+
+
+#: Note of a protocol point that ``--points`` left out (scored 0, as a point not run)
+NOT_SELECTED = "not selected by --points: scores 0 and counts in the maximum, as not run"
+
+
+def with_unselected(rows: list[dict], matrix: list[TestPoint]) -> list[dict]:
+    """``rows`` and a not-run row for every point of the protocol's ``matrix`` they lack:
+    the scoring of a ``--points`` subset against the whole protocol, by the rule for a point
+    not run (0 points, in the maximum; a gate cell not run is not green: the gate fails)."""
+    have = {r["point_id"] for r in rows}
+    missing = [
+        {**point_row(p, None, NOT_SELECTED), "point_id": p.point_id, "status": "not_selected"}
+        for p in matrix
+        if p.point_id not in have
+    ]
+    return [*rows, *missing]
+
+
 SYSTEM_TEXT = {
     "aeb": "aeb: the EOAM with its lane change inhibited (it brakes in lane; the FCW is its "
     "warning): what the protocol scores",
@@ -68,25 +106,19 @@ def manoeuvre_mark(measured: Measured, facts: RunFacts) -> str:
 
 
 def point_row(
-    point: TestPoint, measured: Measured | None, note: str = "", facts: RunFacts | None = None
+    point: TestPoint,
+    measured: Measured | None,
+    note: str = "",
+    facts: RunFacts | None = None,
+    failed: bool = False,
 ) -> dict:
     """One results row of a point: its parameters, the scored quantities, colour and cell
-    points (R152: verdict). ``measured`` None: the point did not run, ``note`` says why."""
-    row = _base(point)
+    points (R152: verdict). ``measured`` None: the point did not run, ``note`` says why;
+    ``failed``: its run failed (R152: a row whose test did not complete is not a pass, so
+    its verdict is fail; Euro NCAP: it scores 0 as a point not run)."""
     if measured is None:
-        return {
-            **row,
-            "impact_speed_kmh": None,
-            "speed_reduction_kmh": None,
-            "manoeuvre": "",
-            "colour": rules.NOT_RUN,
-            "points": 0.0,
-            "max_points": 1.0,
-            "verdict": rules.NOT_RUN if point.protocol == PROTOCOLS[2] else "",
-            "warning": "",
-            "warning_lead_s": None,
-            "note": note,
-        }
+        return _not_run_row(point, note, failed)
+    row = _base(point)
     facts = facts or RunFacts()
     impact = rules.round_half_up(measured.impact_long_kmh, 2)
     reduction = None
@@ -125,6 +157,25 @@ def point_row(
         "max_points": 1.0,
         "verdict": "",
         "warning": "",
+        "note": note,
+    }
+
+
+def _not_run_row(point: TestPoint, note: str, failed: bool) -> dict:
+    """The row of a point without a measurement: 0 points (in the maximum); R152 verdict
+    not_run, or fail when its run failed."""
+    r152 = point.protocol == PROTOCOLS[2]
+    return {
+        **_base(point),
+        "impact_speed_kmh": None,
+        "speed_reduction_kmh": None,
+        "manoeuvre": "",
+        "colour": rules.NOT_RUN,
+        "points": 0.0,
+        "max_points": 1.0,
+        "verdict": (rules.FAIL if failed else rules.NOT_RUN) if r152 else "",
+        "warning": "",
+        "warning_lead_s": None,
         "note": note,
     }
 

@@ -41,11 +41,36 @@ def _parse(args) -> tuple[list[float], list[str]]:
         raise InputError(f"--speeds-kmh {args.speeds_kmh!r}: not comma-separated numbers") from None
     if not speeds or not all(20.0 <= v <= 175.0 for v in speeds):
         raise InputError(f"--speeds-kmh {args.speeds_kmh!r}: each must be in [20, 175]")
+    if len(set(speeds)) < len(speeds):
+        raise InputError(f"--speeds-kmh {args.speeds_kmh!r}: a speed given twice")
     drivers = [d.strip() for d in args.drivers.split(",") if d.strip()]
     bad = [d for d in drivers if d not in DRIVERS]
     if bad or not drivers:
         raise InputError(f"--drivers: {', '.join(bad) or 'none'} (choose from {DRIVERS})")
+    if len(set(drivers)) < len(drivers):
+        raise InputError(f"--drivers {args.drivers!r}: a driver given twice")
     return speeds, drivers
+
+
+#: R157's test compares these two (Annex 4 App. 3: the system avoids what the careful driver does)
+COMPARED = ("eoam", "r157-cc")
+
+
+def verdict_lines(
+    kind: str, speeds: list[float], drivers: list[str], failed: list[dict]
+) -> list[str]:
+    """Per speed, the points where the EOAM hits and the careful driver avoids (R157 Annex 4
+    App. 3); without both drivers run, one line saying the study is not compared."""
+    if not all(d in drivers for d in COMPARED):
+        return [
+            f"{kind}: not compared (R157's test needs both drivers eoam and r157-cc; ran "
+            f"{', '.join(drivers)}): no verdict"
+        ]
+    return [
+        f"{kind} {v:g} km/h: the EOAM hits where the careful driver avoids at "
+        f"{sum(1 for r in failed if r['ego_kmh'] == v)} points"
+        for v in speeds
+    ]
 
 
 def run(args) -> int:
@@ -57,9 +82,6 @@ def run(args) -> int:
         rows = run_study(points, drivers, out, progress=lambda s: print(s, file=sys.stderr))
         failed = eoam_fails_where_careful_avoids(rows)
         r157_figure(rows, args.kind, failed, out / f"r157_{args.kind.replace('-', '_')}.png")
-    for v in speeds:
-        n = sum(1 for r in failed if r["ego_kmh"] == v)
-        print(
-            f"{args.kind} {v:g} km/h: the EOAM hits where the careful driver avoids at {n} points"
-        )
+    for line in verdict_lines(args.kind, speeds, drivers, failed):
+        print(line)
     return 0

@@ -65,7 +65,13 @@ def test_the_r157_verdict_and_its_chart(tmp_path):
 
 
 @pytest.mark.parametrize(
-    "option", [["--speeds-kmh", "fast"], ["--speeds-kmh", "300"], ["--drivers", "eoam,human"]]
+    "option",
+    [
+        ["--speeds-kmh", "fast"],
+        ["--speeds-kmh", "300"],
+        ["--speeds-kmh", "60,60"],
+        ["--drivers", "eoam,human"],
+    ],
 )
 def test_bad_study_options_exit_2(tmp_path, capsys, option):
     code = main(["r157-study", "--type", "cut-in", "--out", str(tmp_path / "o"), *option])
