@@ -50,6 +50,7 @@ SPEED_EST_PER_S = 20.0  # unbraked, the speed estimate is pulled to the fastest 
 SPEED_EST_BRAKED_PER_S = 0.1  # braked, the accelerometer carries it (every wheel slips) ...
 SPEED_EST_BRAKED_SHARE = 0.03  # ... pulled by at most this share of the measured deceleration
 SPEED_EST_BRAKED_MIN_MPS2 = 0.02  # ... plus this (the accelerometer's offset), so never stuck
+SPEED_EST_DRIVE_SHARE = 0.05  # AWD: from this drive force (share of the weight) the slowest wheel
 BRAKE_ON_BAR = 2.0  # mean wheel pressure from which the car counts as braked
 MU_EST_HIGH = 1.0  # the friction estimate starts at, and returns to, a dry road's
 MU_EST_MIN = 0.05  # the ABS and ESC thresholds use at least this friction estimate
@@ -237,9 +238,11 @@ def estimated_wheel_speeds(v_est, r, steer, p: VehicleParams, ops):
     return ((v_est - half) * c + lat_f, (v_est + half) * c + lat_f, v_est - half, v_est + half)
 
 
-def speed_estimate_rate(v_est, ax_meas, wheel_mps, r, steer, pressure_bar, mu_est, p, ch, ops):
+def speed_estimate_rate(
+    v_est, ax_meas, wheel_mps, r, steer, pressure_bar, drive_n, mu_est, p, ch, ops
+):
     """Rate of the vehicle-speed estimate: the accelerometer's ``ax`` integrated; unbraked,
-    pulled at once to the free-rolling wheels (``_rolling_reference``; each wheel's speed
+    pulled to the free-rolling wheels (``_unbraked_pull``; each wheel's speed
     referred to the centre of gravity, the inverse of ``estimated_wheel_speeds``). Braked
     (``pressure_bar`` the mean wheel pressure) every wheel runs at some slip, the fastest one
     (the ABS's recovered wheel) within the ABS's threshold slip at the friction estimate
@@ -259,22 +262,30 @@ def speed_estimate_rate(v_est, ax_meas, wheel_mps, r, steer, pressure_bar, mu_es
     gap = ops.fmax(fastest - v_est, 0.0) + ops.fmin(fastest + slack - v_est, 0.0)
     cap = SPEED_EST_BRAKED_SHARE * ops.fabs(ax_meas) + SPEED_EST_BRAKED_MIN_MPS2
     slow = ops.fmin(ops.fmax(SPEED_EST_BRAKED_PER_S * gap, -cap), cap)
-    rolling = _rolling_reference(refs, p, ops)
-    return ax_meas + braked * slow + (1.0 - braked) * SPEED_EST_PER_S * (rolling - v_est)
+    unbraked = _unbraked_pull(refs, v_est, cap, drive_n, p, ops)
+    return ax_meas + braked * slow + (1.0 - braked) * unbraked
 
 
-def _rolling_reference(refs, p: VehicleParams, ops):
-    """The unbraked speed estimate's reference (``refs``: each wheel's speed referred to the
-    centre of gravity, FL, FR, RL, RR): the faster undriven wheel, which rolls free, on a
-    front- or rear-driven car (the undriven wheels stand for the car's speed in traction
-    control: Hori, Toyoda and Tsuruoka, IEEE Trans. Ind. Appl. 34(5), 1998); with all wheels
-    driven (AWD, eAWD) the slowest, the least spun up by the drive. A driven wheel spinning
-    on ice never carries it."""
-    if p.drivetrain == "fwd":
-        return ops.fmax(refs[2], refs[3])
-    if p.drivetrain == "rwd":
-        return ops.fmax(refs[0], refs[1])
-    return ops.fmin(ops.fmin(refs[0], refs[1]), ops.fmin(refs[2], refs[3]))
+def _unbraked_pull(refs, v_est, cap, drive_n, p: VehicleParams, ops):
+    """The unbraked speed estimate's pull [m/s^2] to the wheels that roll free (``refs``:
+    each wheel's speed referred to the centre of gravity, FL, FR, RL, RR): at once
+    (``SPEED_EST_PER_S``) to the faster undriven wheel of a front- or rear-driven car (the
+    undriven wheels stand for the car's speed in traction control: Hori, Toyoda and
+    Tsuruoka, IEEE Trans. Ind. Appl. 34(5), 1998). With every wheel driven (AWD, eAWD) to the
+    fastest while coasting (a wheel the ESC brakes does not pull it down) and, under drive
+    (blended by the drive force ``drive_n`` up to ``SPEED_EST_DRIVE_SHARE`` of the weight:
+    the control unit knows the engine's torque), to the slowest, up by no more than the
+    accelerometer's error ``cap`` over its reading, as while braked: four wheels spinning on
+    ice do not carry it."""
+    if p.drivetrain in ("fwd", "rwd"):
+        undriven = (refs[2], refs[3]) if p.drivetrain == "fwd" else (refs[0], refs[1])
+        return SPEED_EST_PER_S * (ops.fmax(undriven[0], undriven[1]) - v_est)
+    fastest = ops.fmax(ops.fmax(refs[0], refs[1]), ops.fmax(refs[2], refs[3]))
+    slowest = ops.fmin(ops.fmin(refs[0], refs[1]), ops.fmin(refs[2], refs[3]))
+    driving = ops.fmin(ops.fmax(drive_n / (SPEED_EST_DRIVE_SHARE * p.mass_kg * G_MPS2), 0.0), 1.0)
+    coasting_pull = SPEED_EST_PER_S * (fastest - v_est)
+    driving_pull = ops.fmin(SPEED_EST_PER_S * (slowest - v_est), cap)
+    return coasting_pull + driving * (driving_pull - coasting_pull)
 
 
 def mu_estimate_rate(mu_est, accel_g, active, ops):

@@ -306,7 +306,10 @@ def _estimate_rates(x, u, accel, steer, abs_active, p: VehicleParams, ops) -> li
     r, v_est, mu_est = x[YAW_RATE], x[V_EST], x[MU_EST]
     wheel_mps = [x[i] * p.wheel_radius_m for i in OMEGAS]
     pressure = ops.fmin(ops.fmax(u[BRAKE_CMD], 0.0), p.max_brake_force_n) / ch.brake_n_per_bar
-    v_rate = ch_.speed_estimate_rate(v_est, ax, wheel_mps, r, steer, pressure, mu_est, p, ch, ops)
+    drive_n = x[DRIVE]
+    v_rate = ch_.speed_estimate_rate(
+        v_est, ax, wheel_mps, r, steer, pressure, drive_n, mu_est, p, ch, ops
+    )
     active = abs_active
     if p.esc_fitted:
         active = ops.fmax(active, ch_.esc_understeer(v_est, r, x[ESC_REF], p, ops))

@@ -14,6 +14,7 @@ from eoam_sumo.params import G_MPS2
 from eoam_sumo.plant import STATE_NAMES, Plant, initial_state
 from eoam_sumo.plant.model import tyre_loads_n
 from eoam_sumo.plant.ops import FLOAT_OPS
+from eoam_sumo.vehicle_files import load_vehicle
 
 S = {name: i for i, name in enumerate(STATE_NAMES)}
 SPINS = [S[f"wheel_spin_{w}_radps"] for w in ("fl", "fr", "rl", "rr")]
@@ -44,17 +45,20 @@ def _distance_m(xs) -> float:
     )
 
 
-@pytest.mark.parametrize("drive_g", [0.06, 0.15])
-def test_after_wheelspin_on_ice_the_abs_still_stops_the_car(
-    equipped_plant, equipped_params, drive_g
-):
-    """Throttle that spins the driven wheels, then full brake: the speed estimate must not
-    follow the spinning wheels, or the ABS reads every wheel as locked and dumps the brakes."""
-    p, mu = equipped_params, 0.1
+@pytest.mark.parametrize(
+    "vehicle, drive_g",
+    [("sedan-r13h", 0.06), ("sedan-r13h", 0.15), ("compact", 0.15), ("suv", 0.15)],
+)
+def test_after_wheelspin_on_ice_the_abs_still_stops_the_car(vehicle, drive_g, plant_cache_dir):
+    """Throttle that spins the driven wheels (rear, front, all four), then full brake: the
+    speed estimate must not follow the spinning wheels, or the ABS reads every wheel as
+    locked and dumps the brakes."""
+    p = dataclasses.replace(load_vehicle(vehicle), abs_fitted=True, esc_fitted=True)
+    plant, mu = Plant(p, dt_s=1e-3, substeps=10, cache_dir=plant_cache_dir), 0.1
     x = [float(v) for v in initial_state(0.0, 0.0, 0.0, 15.0, params=p)]
-    x, _ = _drive(equipped_plant, x, (0.0, drive_g * p.mass_kg * G_MPS2, 0.0), mu, 2.0)
+    x, _ = _drive(plant, x, (0.0, drive_g * p.mass_kg * G_MPS2, 0.0), mu, 2.0)
     v0 = x[S["vx_mps"]]
-    x, xs = _drive(equipped_plant, x, (0.0, 0.0, p.max_brake_force_n), mu, 25.0)
+    x, xs = _drive(plant, x, (0.0, 0.0, p.max_brake_force_n), mu, 25.0)
     assert x[S["vx_mps"]] < 0.1
     assert _distance_m(xs) <= 1.15 * v0 * v0 / (2.0 * mu * G_MPS2)
 
@@ -105,14 +109,15 @@ def test_the_loads_carry_the_weight_whatever_lifts(r13h_params, ax_mps2, ay_mps2
     assert sum(loads) == pytest.approx(p.mass_kg * G_MPS2, rel=1e-12)
 
 
-def test_the_esc_keeps_its_corrective_moment_through_the_abs(equipped_params):
-    """FMVSS 126 S5.2's yaw-rate ratios (<= 0.35 at 1 s, <= 0.20 at 1.75 s after the dwell)
-    on a wet road (mu 0.7): the ABS must not dump the pressure the ESC applies in a slide."""
+@pytest.mark.parametrize("vehicle, mu", [("sedan-r13h", 0.7), ("suv", 1.0), ("suv", 0.7)])
+def test_the_esc_keeps_its_corrective_moment_through_the_abs(vehicle, mu):
+    """FMVSS 126 S5.2's yaw-rate ratios (<= 0.35 at 1 s, <= 0.20 at 1.75 s after the dwell),
+    dry and wet: the ABS must not dump the pressure the ESC applies in a slide, nor a wheel
+    the ESC brakes pull the speed estimate down (the eAWD suv)."""
     from eoam_sumo.vehicle_tests.common import VehicleTestOptions
     from eoam_sumo.vehicle_tests.procedures import TESTS
 
-    runs = TESTS["sine-with-dwell"](equipped_params, VehicleTestOptions(mu=0.7)).summary["figures"][
-        "runs"
-    ]
+    p = dataclasses.replace(load_vehicle(vehicle), abs_fitted=True, esc_fitted=True)
+    runs = TESTS["sine-with-dwell"](p, VehicleTestOptions(mu=mu)).summary["figures"]["runs"]
     assert max(run["yaw_ratio_1s"] for run in runs) <= 0.35
     assert max(run["yaw_ratio_1.75s"] for run in runs) <= 0.20
