@@ -24,6 +24,8 @@ class EgoMeasurement(NamedTuple):
     mu: float
     lane_width_m: float
     left_lane_available: bool = True  # map: a lane (either direction) left of the ego's lane
+    # the friction believed for a lane change to the right (``mu``: to the left); 0: ``mu``
+    mu_right: float = 0.0
 
 
 class ObjectState(NamedTuple):

@@ -57,7 +57,8 @@ def open_side(
     if meas.left_lane_available:
         options.insert(0, (LEFT, perception.next_lane))
     for side, view in options:
-        _, reason = judge.lane_reason(meas, perception, view, decel, traffic_only)
+        seen = meas if side == LEFT else right_friction(meas)
+        _, reason = judge.lane_reason(seen, perception, view, decel, traffic_only)
         if not reason:
             return side
     return options[0][0]
@@ -71,10 +72,18 @@ def lane_offset_m(lane_width_m: float, view: NextLaneView | None) -> float:
     return 0.5 * (lane_width_m + view.lane_width_m)
 
 
+def right_friction(meas: EgoMeasurement) -> EgoMeasurement:
+    """``meas`` with the friction believed for a lane change to the right as ``mu`` (that to
+    the left as ``mu_right``: swapped, so that doing it twice gives ``meas`` back)."""
+    if not meas.mu_right > 0.0:  # none given: the same
+        return meas
+    return meas._replace(mu=meas.mu_right, mu_right=meas.mu)
+
+
 def mirrored_measurement(meas: EgoMeasurement) -> EgoMeasurement:
     """The ego's state in the road frame mirrored about its lane centre (the right lane to
-    its left)."""
-    return meas._replace(
+    its left, its friction the believed one: ``right_friction``)."""
+    return right_friction(meas)._replace(
         vy_mps=-meas.vy_mps,
         yaw_rate_radps=-meas.yaw_rate_radps,
         ay_mps2=-meas.ay_mps2,

@@ -27,8 +27,11 @@ ARO stays the in-path object the DMM tracks until it leaves the field of view (p
 Classification (lane band half-width = lane_width_m / 2 + lane_margin_m, on the centre's d;
 road speed = target speed times the cosine of its heading relative to the road):
 
-* ``oncoming``: road speed below -oncoming_speed_mps and the centre not right of the lane
-  band (in the ego lane or any lane to its left; a wrong-way driver in the ego lane counts);
+* ``oncoming``: road speed below -oncoming_speed_mps and the centre in the lane band or in
+  the next lane's to its left (up to one lane width beyond the band, as ``in_next_lane``):
+  in the ego lane (a wrong-way driver counts) or in the lane a lane change would take. A road
+  user moving against the road further left (the other carriageway of a divided road, a
+  jogger on the far pavement) is ``other``: it is not in the way of the lane change;
 * ``in_path``: centre ahead of the ego's front bumper along the road, inside the lane band,
   and not oncoming (road speed above -oncoming_speed_mps): stopped, moving with the road, or
   slowly towards the ego (a person walking towards it in its lane, a car backing up); also a
@@ -441,7 +444,7 @@ class Radar:
         ego's lane beyond ``CUT_IN_WANDER_M`` of its lane centre for ``CUT_IN_PERCEPTION_S``
         is in the path (a cut-in, :func:`cutting_in`)."""
         st = self.settings
-        if road_speed_mps < -st.oncoming_speed_mps and d_m > -band_m:
+        if road_speed_mps < -st.oncoming_speed_mps and -band_m < d_m < band_m + lane_width_m:
             return "oncoming"
         if abs(d_m) < band_m:
             if ahead:  # not oncoming (tested above)

@@ -78,7 +78,13 @@ from eoam_sumo.world.geometry import (
 __all__ = ["CoSimulation", "policy_settings", "run_case"]
 
 
-GAP_WATCH_M = 20.0  # centre distance under which box gaps are measured and contact checked [m]
+#: Box gaps are measured and contact checked for a road user whose box may lie within a watch
+#: of the ego's box: the centres' distance minus both bounding radii (a lower bound of the box
+#: gap) at most ``GAP_WATCH_M - ego radius - WATCH_RADIUS_M``. A road user smaller than
+#: ``WATCH_RADIUS_M`` (a car, a van, a person) counts as that large: watched while the centres
+#: are within ``GAP_WATCH_M``; a longer one (a trailer) as far as its box may come.
+GAP_WATCH_M = 20.0  # centre distance watched for road users up to WATCH_RADIUS_M [m]
+WATCH_RADIUS_M = 4.0  # a 7.5 m x 2.5 m box's bounding radius [m]
 ROAD_END_MARGIN_M = 50.0  # a run ends when the ego is this close to the end of its road [m]
 
 
@@ -210,11 +216,7 @@ class CoSimulation:
             opposing, limit = session.next_lane_traffic()
             self._left_fallback = SideLane("", self.lane_width_m, limit, opposing)
         self.left_usable = self.side_lanes[0] is not None
-        # the lowest friction of the lanes a lane change may use (the net's, or --mu)
-        self.mu_side = min(
-            (session.lane_friction(lane.lane_id) for lane in self.side_lanes if lane),
-            default=math.inf,
-        )
+        self.mu_sides = _side_frictions(session, self.side_lanes)
         self.right_width_m = self.side_lanes[1].width_m if self.side_lanes[1] else 0.0
         self.x = initial_state(
             ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps, params=self.params
@@ -358,10 +360,7 @@ class CoSimulation:
         X, Y, yaw, vx, vy, r = x[:6]
         s, d, road_yaw = road.project(X, Y)
         self.mu_true = mu_true = self.session.friction_at_ego()
-        # what the EOAM believes; known friction: the lowest of the lanes its manoeuvre uses
-        known = self.belief.belief == "known"
-        mu_road = min(mu_true, self.mu_side) if known else mu_true
-        mu = self.belief.mu(mu_road, self.t, self.ax, self.ay)
+        mu, mu_right = self._believed_mu(mu_true)
         front = self._front
         front_xy = (X + front * self._cy, Y + front * self._sy)
         report = self.radar.scan(front_xy, yaw, vx, road, self.bodies, self.lane_width_m, self.t)
@@ -385,12 +384,30 @@ class CoSimulation:
             mu,
             self.lane_width_m,
             self.left_usable,  # yaw is continuous
+            mu_right,
         )
         return meas, perception
 
+    def _believed_mu(self, mu_true: float) -> tuple[float, float]:
+        """The friction the EOAM believes for a lane change to the left (or to its only usable
+        side) and to the right. Known friction: the lower of the ego's lane's and the lane
+        that lane change takes (the net's, or --mu), so that a lane the EOAM does not evade
+        into does not lower it; that belief is recorded at ``decide``."""
+        if self.belief.belief != "known":
+            mu = self.belief.mu(mu_true, self.t, self.ax, self.ay)
+            return mu, mu
+        left_mu, right_mu = self.mu_sides
+        mu = min(mu_true, left_mu)
+        return mu, (mu if math.isnan(right_mu) else min(mu_true, right_mu))
+
     def decide(self, meas: EgoMeasurement, perception: Perception) -> Command:
-        """The EOAM's decision and control for this step."""
-        return self.ctrl.step(meas, perception, self.settings.step_s)
+        """The EOAM's decision and control for this step; known friction: the belief it
+        used, on the side it chose (``_believed_mu``), recorded."""
+        cmd = self.ctrl.step(meas, perception, self.settings.step_s)
+        if self.belief.belief == "known":
+            used = meas.mu_right if self.ctrl.state.side < 0 else meas.mu
+            self.belief.mu(used, self.t, self.ax, self.ay)
+        return cmd
 
     def actuate(self, cmd: Command) -> None:
         """The plant over the step, on the road's true friction: all sub-steps in one call."""
@@ -461,7 +478,9 @@ class CoSimulation:
         min_gap_aro = self.min_gap_aro_m
         for b in self.bodies:
             centres_m = math.hypot(b.x_m - ego_cx, b.y_m - ego_cy)
-            if centres_m > GAP_WATCH_M:
+            # the box gap's bound beyond the watch (the same as centres - ego radius -
+            # max(radius, WATCH_RADIUS_M) > GAP_WATCH_M - ego radius - WATCH_RADIUS_M)
+            if centres_m - max(b.box.radius_m - WATCH_RADIUS_M, 0.0) > GAP_WATCH_M:
                 continue
             reach_m = ego_move + b.speed_mps * step_s + self._reach_pad_m
             # the bounding circles' gap is a lower bound of the boxes' gap
@@ -702,6 +721,16 @@ def run_case(
             sim.session.ego_lane_centreline(),
         )
     return summary
+
+
+def _side_frictions(session: SumoSession, side_lanes: tuple) -> tuple[float, float]:
+    """The friction of the lane a lane change takes, (left, right): the left lane's, or the
+    right lane's when only that one is usable (inf: neither); the right lane's (nan: not
+    usable, the EOAM does not evade right)."""
+    left, right = (session.lane_friction(lane.lane_id) if lane else math.nan for lane in side_lanes)
+    if math.isnan(left):
+        left = math.inf if math.isnan(right) else right
+    return left, right
 
 
 _NOTHING = Perception(None, None, False)  # immutable, so shared by all steps that see nothing

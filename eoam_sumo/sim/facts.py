@@ -186,8 +186,8 @@ def collect_facts(sim: EndedRun) -> RunFacts:
         min_gap_oncoming_m=margins.min_gap_oncoming_m,
         min_ttc_oncoming_s=margins.min_ttc_oncoming_s,
         # the margins count the steps left of the lane, whatever the next lane's direction
-        time_in_opposite_lane_s=margins.time_in_opposite_lane_s if sim.next_lane_opposing else 0.0,
-        time_in_next_lane_s=margins.time_in_opposite_lane_s,
+        time_in_opposite_lane_s=margins.time_in_left_lane_s if sim.next_lane_opposing else 0.0,
+        time_in_next_lane_s=margins.time_in_next_lane_s,
         near_miss_margins=margins.near_miss(),
         min_ttc_s=margins.min_ttc_s,
         min_ttc_rear_s=margins.min_ttc_rear_s,

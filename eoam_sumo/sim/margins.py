@@ -23,8 +23,10 @@ left of its lane, and whether a run without contact was a near miss.
   within ``LEADER_HEADWAY_S`` of the ego, ``max_follower_decel_mps2`` (``follower_decel_id``
   who; a vehicle whose stop is scripted and that is not closing in brakes for its script,
   not for the ego);
-* ``time_in_opposite_lane_s``: steps with the ego's centre left of its lane (in the next lane
-  to the left, the opposite lane on a two-way road) times the step;
+* ``time_in_left_lane_s``: steps with the ego's centre left of its lane (in the next lane
+  to the left, the opposite lane on a two-way road) times the step; ``time_in_next_lane_s``
+  the same, right of its lane counted too where the ego's class may use a lane there (the
+  lane it evaded into, either side);
 * ``closest_gap_m`` and ``closest_id``: the smallest gap to any road user once within
   ``NEAR_MISS_GAP_M`` (gaps farther out are not measured);
 * a run without contact is a **near miss** when it came within ``NEAR_MISS_GAP_M`` of any
@@ -103,11 +105,12 @@ class Margins(StepObserver):
         self.min_ttc_oncoming_s = math.inf
         self.closest_gap_m = math.inf
         self.closest_id: str | None = None
-        self._opposite_steps = 0
+        self._left_steps = self._right_steps = 0
         self._step_s = sim.step_s
         self._half_lane_m = 0.5 * sim.lane_width_m
         self._band_m = lane_band_m(sim.lane_width_m)
         self._left_lane = sim.left_lane
+        self._right_lane = sim.right_width_m > 0.0  # a lane on the right the ego may use
         # along the lanes: the road frame of the ego's original lane (its own walk)
         self._frame = RoadFrame(sim.session.ego_lane_centreline())
         self._frame.locate(sim.x[0], sim.x[1])
@@ -120,8 +123,14 @@ class Margins(StepObserver):
         self._scripted: frozenset[str] = getattr(sim.session, "scripted_ids", frozenset())
 
     @property
-    def time_in_opposite_lane_s(self) -> float:
-        return self._opposite_steps * self._step_s
+    def time_in_left_lane_s(self) -> float:
+        """Time with the ego's centre left of its lane, in the lane there."""
+        return self._left_steps * self._step_s
+
+    @property
+    def time_in_next_lane_s(self) -> float:
+        """Time with the ego's centre out of its lane, in the lane beside on either side."""
+        return (self._left_steps + self._right_steps) * self._step_s
 
     def end(self, sim: RunView) -> None:
         self.min_gap_oncoming_m = min(self.min_gap_oncoming_m, self._opposite_gap(sim, sim.x))
@@ -156,9 +165,11 @@ class Margins(StepObserver):
         )
 
     def after_step(self, sim: RunView) -> None:
-        meas = sim.meas
-        if self._left_lane and meas.d_m > self._half_lane_m:
-            self._opposite_steps += 1
+        d_m = sim.meas.d_m
+        if self._left_lane and d_m > self._half_lane_m:
+            self._left_steps += 1
+        elif self._right_lane and d_m < -self._half_lane_m:
+            self._right_steps += 1
         self._gaps(sim)
         self._along_lanes(sim)
 

@@ -75,6 +75,8 @@ class RunView(Protocol):
     @property
     def left_lane(self) -> bool: ...  # a lane (either direction) lies left of the ego's
     @property
+    def right_width_m(self) -> float: ...  # the lane right of the ego's it may use (0: none)
+    @property
     def ay(self) -> float: ...  # the ego's lateral acceleration now (the plant's output)
 
 

@@ -476,7 +476,11 @@ def _no_contact(
             else "lane change completed, no contact, not back in lane when the run ended"
         )
     elif stopped:
-        reason = "stopped behind the obstacle, no contact"
+        reason = (
+            "stopped past the obstacle it was avoiding (the obstacle ended behind it), no contact"
+            if passed_obstacle
+            else "stopped behind the obstacle, no contact"
+        )
     else:
         reason = "braked without contact, still moving when the run ended"
     return Outcome("green", "none", 0.0, reason)

@@ -123,7 +123,8 @@ class RunSummary:
         metadata={"doc": "SUMO options the run set over the sumocfg, option -> value"}
     )
     time_in_next_lane_s: float = _doc(
-        "time with the ego's centre left of its lane (in the next lane, whatever its direction)"
+        "time with the ego's centre out of its lane in the next lane, whatever its direction "
+        "(left, or right where its class may use a lane there)"
     )
     min_ttc_s: float | None = _doc(
         "smallest time to collision along the lanes with any moving road user but the "

@@ -17,7 +17,8 @@ the radar's classes are, with the radar's thresholds):
 * ``ego``;
 * ``parked``: SUMO reports the road user parked;
 * ``oncoming``: moving against the road direction faster than 2 m/s, not right of the
-  ego's lane;
+  ego's lane (any lane to its left, the other carriageway too: the traffic as it is; the
+  radar's ``oncoming`` class, which the EOAM decides on, stops at the next lane's band);
 * ``aro``: its centre in the ego lane's band (half the lane width + 0.5 m), ahead of the
   ego (station beyond the ego's centre) or first met in the band ahead of it: the obstacle
   in the ego's lane, whatever it is (a stopped car, a person walking on the road), which

@@ -24,6 +24,10 @@ def test_mirroring_twice_is_the_identity_on_the_geometry():
     assert twice == meas._replace(left_lane_available=True)
     once = mirrored_measurement(meas)
     assert (once.d_m, once.e_yaw_rad, once.yaw_rate_radps) == (0.4, -0.01, -0.05)
+    assert mirrored_measurement(meas).mu == 0.8  # no friction of its own for the right
+    icy = meas._replace(mu_right=0.1)
+    assert (mirrored_measurement(icy).mu, mirrored_measurement(icy).mu_right) == (0.1, 0.8)
+    assert mirrored_measurement(mirrored_measurement(icy)) == icy._replace(left_lane_available=True)
     cmd = Command(0.02, 0.0, 100.0, 2, True, "D", -3.0, 1.2, 4.0, 0.1, 0.2, 0.01, 0.005, -0.003, 30)
     assert mirrored_command(mirrored_command(cmd)) == cmd
     assert mirrored_command(cmd).steer_cmd_rad == -0.02

@@ -147,11 +147,23 @@ def test_oncoming_at_80_m_in_the_left_lane():
         (_ahead(40.0, 2.2 * LANE_M, CAR, 0.0), "stationary_side"),  # beyond the next lane
         (_ahead(40.0, -LANE_M, CAR, 0.0), "stationary_side"),  # parked on the right
         (_ahead(40.0, 0.5 * LANE_M + 0.4, CAR, 0.0), "in_path"),  # half on the marker
+        (_ahead(40.0, 1.4 * LANE_M, CAR, 20.0, reverse=True), "oncoming"),  # the next lane
+        (_ahead(40.0, 2.0 * LANE_M, CAR, 20.0, reverse=True), "other"),  # two lanes left
+        (_ahead(80.0, 3.0 * LANE_M, (0.5, 0.6), 3.0, reverse=True), "other"),  # far pavement
     ],
 )
 def test_classification(target, category):
     (det,) = _scan([target]).detections
     assert det.category == category
+
+
+def test_traffic_beyond_the_next_lane_is_not_oncoming():
+    """A car against the road two lanes left (the other carriageway of a 2+2 road) is not in
+    the way of a lane change: no oncoming flag, no oncoming object; one in the next lane is."""
+    far = _scan([_ahead(60.0, 2.0 * LANE_M, CAR, 25.0, reverse=True)])
+    assert far.detections and not far.oncoming_detected
+    near = _scan([_ahead(60.0, LANE_M, CAR, 25.0, reverse=True)])
+    assert near.oncoming_detected
 
 
 # --- head-on: a wrong-way car in the ego's lane (Euro NCAP CCFhos) ----------------------------

@@ -23,6 +23,7 @@ class FakeRun:
         self.step_s = STEP_S
         self.lane_width_m = lane_width_m
         self.left_lane = True
+        self.right_width_m = 0.0  # no lane on the right the ego may use
         self.road = RoadFrame(centreline)
         self.session = SimpleNamespace(
             ego_lane_centreline=lambda: centreline, road_users=lambda: self.bodies

@@ -50,3 +50,20 @@ def test_time_in_the_opposite_lane_counts_only_an_opposite_lane(tmp_path, edges,
     assert s["time_in_opposite_lane_s"] == (s["time_in_next_lane_s"] if opposing else 0.0)
     # added after the older fields (they keep their place), before the margins along the lanes
     assert list(s)[list(s).index("time_in_next_lane_s") + 1 :][0] == "min_ttc_s"
+
+
+def test_time_in_the_next_lane_counts_an_evasion_to_the_right(tmp_path):
+    """The ego and the halted car in the left lane of a one-way road (no lane on its left): it
+    evades right, and that time in the next lane counts (it counted only the left before)."""
+    cfg = halted_car_scenario(tmp_path, NODES, ONE_WAY, 220.0)
+    routes = tmp_path / "r.rou.xml"
+    text = routes.read_text().replace('lane="fwd_0"', 'lane="fwd_1"')
+    routes.write_text(text.replace("departSpeed=", 'departLane="1" departSpeed='))
+    out = tmp_path / "run"
+    overrides = ScenarioOverrides(ego_speed_mps=165 / 3.6, mu=1.0)
+    s = run_case(cfg, overrides, out, RunSettings(max_time_s=25.0))
+    ts = pd.read_csv(out / "timeseries.csv")
+    right_s = float((ts.iloc[:-1]["lateral_offset_m"] < -0.5 * s["lane_width_m"]).sum() * 0.01)
+    assert right_s > 1.0, s["reason"]
+    assert s["time_in_next_lane_s"] == pytest.approx(right_s, abs=0.015)
+    assert s["time_in_opposite_lane_s"] == 0.0

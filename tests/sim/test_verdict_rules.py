@@ -77,6 +77,19 @@ def test_returning_behind_the_obstacle_is_not_a_completed_lane_change():
     assert ahead.reason == "lane change completed, returned to lane, no contact"
 
 
+@pytest.mark.parametrize("passed", [True, False, None])
+def test_a_stop_says_behind_the_obstacle_only_when_it_is(passed):
+    """An aborted lane change ending stopped, in lane: "stopped behind the obstacle" unless
+    the ego ended ahead of the obstacle it was avoiding (``passed_obstacle``: a person
+    walking towards it who walked past, the ego past it)."""
+    out = classify_outcome(
+        [0, 1, 2, 3], 0.1, LANE_M, final_offset_m=0.0, final_speed_mps=0.0, passed_obstacle=passed
+    )
+    assert out.colour == "green"
+    assert ("stopped behind the obstacle" in out.reason) == (passed is not True)
+    assert ("past the obstacle" in out.reason) == (passed is True)
+
+
 def _box(x, y, yaw=0.0, length=4.9, width=1.85):
     return OrientedBox(x, y, yaw, length, width)
 

@@ -96,3 +96,21 @@ def test_the_aro_holds_its_speed_and_lane_then_stops(tmp_path, aro_type, others,
     after = [(t, v) for t, v, _ in log if t > DEPART_S + HOLD_S + 0.5]
     t_end, v_end = after[-1]
     assert v_end == pytest.approx(SPEED_MPS - 8.0 * (t_end - DEPART_S - HOLD_S), abs=0.1)
+
+
+def test_the_stopped_aro_stays_in_its_lane(tmp_path):
+    """Once standing, the ARO keeps its lane (its lane changes are off again): given back its
+    own lane-change mode, SUMO's keep-right moved the standing car a whole lane to the right."""
+    cfg = motorway(tmp_path, 'sigma="0" speedDev="0"')
+    session = SumoSession.start(cfg, ScenarioOverrides())
+    try:
+        standing = []
+        while session.time_s < DEPART_S + HOLD_S + SPEED_MPS / 8.0 + 6.0:
+            body = session.body("aro")
+            if body.speed_mps == 0.0:
+                standing.append((session.vehicle_lane("aro"), round(body.y_m, 6)))
+            session.step()
+    finally:
+        session.close()
+    assert len(standing) > 500
+    assert set(standing) == {standing[0]} and standing[0][0] == "mw_1"
