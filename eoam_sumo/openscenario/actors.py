@@ -31,11 +31,14 @@ class Actor:
     still_s: float = 0.0  # how long it has stood still
     speed_busy: object = None  # the running action that sets its speed
     lateral_busy: object = None  # the running action that moves it across
+    direction: int = 0  # +1 along s, -1 against (0: its lane's, set at the start)
 
-    @property
-    def direction(self) -> int:
-        """+1 along s (lanes right of the reference line, negative ids), -1 against."""
-        return 1 if self.lane < 0 else -1
+    def __post_init__(self) -> None:
+        """The direction of travel is its starting lane's (negative ids run along s) and
+        stays so: a lane change across the centre line (an overtake in the oncoming lane, as
+        esmini drives it) does not turn the entity round."""
+        if self.direction == 0:
+            self.direction = 1 if self.lane < 0 else -1
 
     def front_s_m(self) -> float:
         return self.s_m + self.direction * self.body.front_ahead_m

@@ -15,7 +15,9 @@ from pathlib import Path
 from eoam_sumo.batch.pool import run_local
 from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import write_atomic
+from eoam_sumo.openscenario.checks import check_places
 from eoam_sumo.openscenario.compile import compile_plan
+from eoam_sumo.openscenario.geometry import LaneMap
 from eoam_sumo.openscenario.reader import read_scenario
 from eoam_sumo.openscenario.variations import XoscBatch
 
@@ -29,10 +31,18 @@ def case_id(index: int) -> str:
 
 
 def check_cases(batch: XoscBatch) -> None:
-    """Read and compile every case: InputError naming the first case outside the subset."""
+    """Read and compile every case and check its places on its road (each road converted
+    once): InputError naming the first case outside the subset."""
+    from eoam_sumo.openscenario.runner import road_map
+
+    roads: dict[Path, LaneMap] = {}
     for k, params in enumerate(batch.cases):
         try:
-            compile_plan(read_scenario(batch.scenario, params))
+            scenario = read_scenario(batch.scenario, params)
+            plan = compile_plan(scenario)
+            if scenario.road not in roads:
+                roads[scenario.road] = road_map(scenario.road)[1]
+            check_places(scenario.root, plan.places, roads[scenario.road])
         except InputError as exc:
             raise InputError(f"{case_id(k)} ({_params_text(params)}): {exc}") from None
 

@@ -14,8 +14,10 @@ from dataclasses import dataclass
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.openscenario.actors import lane_plus
+from eoam_sumo.openscenario.checks import check_references
 from eoam_sumo.openscenario.model import Body, Place, Plan
 from eoam_sumo.openscenario.reader import Scenario
+from eoam_sumo.openscenario.story import Element, build_all, resolve
 from eoam_sumo.openscenario.subset import refuse
 from eoam_sumo.openscenario.timing import DYNAMIC, NEVER, Clock, NotYet
 from eoam_sumo.openscenario.xmltree import Node
@@ -23,11 +25,35 @@ from eoam_sumo.openscenario.xmltree import Node
 
 @dataclass(frozen=True)
 class _Event:
-    act: Node
-    actors: tuple[str, ...]
-    group: Node
-    maneuver: Node
-    event: Node
+    """An event of the storyboard's element tree (:func:`.story.build_all`): its node, its
+    owners' nodes and their qualified names (names repeat across a storyboard, paths not)."""
+
+    element: Element
+
+    def owner(self, key: str) -> Element:
+        """The story, act, group or maneuver the event is in (``event``: itself)."""
+        kinds = {"story": "Story", "act": "Act", "group": "ManeuverGroup", "maneuver": "Maneuver"}
+        kind = kinds.get(key, "Event")
+        at = self.element
+        while at.kind != kind:
+            assert at.parent is not None
+            at = at.parent
+        return at
+
+    def path(self, key: str) -> str:
+        return self.owner(key).path
+
+    @property
+    def actors(self) -> tuple[str, ...]:
+        return self.element.actors
+
+    @property
+    def act(self) -> Node:
+        return self.owner("act").node
+
+    @property
+    def event(self) -> Node:
+        return self.element.node
 
 
 def compile_plan(scenario: Scenario, ego: str | None = None) -> Plan:
@@ -36,15 +62,21 @@ def compile_plan(scenario: Scenario, ego: str | None = None) -> Plan:
     board = scenario.root.find("Storyboard")
     assert board is not None  # the reader checked
     bodies = _bodies(scenario.root)
+    check_references(scenario.root, set(bodies), scenario.parameters)
     plan = Plan(bodies, "", {}, {})
     init = board.find("Init")
     for private in [] if init is None else _privates(init):
         _init_private(plan, private)
-    clock = Clock(scenario.parameters)
-    events = _events(board)
+    elements = build_all(board)
+    clock = Clock(scenario.parameters, lambda cond: resolve(elements, cond).path)
+    events = [_Event(e) for e in elements.values() if e.kind == "Event"]
     controlled = _time_events(plan, clock, events)
     plan.ego = _choose_ego(plan, controlled, ego, scenario.root)
     _check_ego_actions(plan.ego, events)
+    for name, action in plan.init_actions:
+        if name == plan.ego:
+            raise refuse(action, f"the ego {name}'s Init must place it and set its speed at "
+                         "once (a step): the EOAM drives it from there")  # fmt: skip
     plan.notes += _not_applied(board)
     missing = sorted(set(bodies) - set(plan.places))
     if missing:
@@ -86,7 +118,31 @@ def _init_private(plan: Plan, private: Node) -> None:
     if name not in plan.bodies:
         raise refuse(private, f"entity {name} is not declared")
     for pa in private.findall("PrivateAction"):
-        _private_action(plan, name, pa.children[0], 0.0)
+        action = pa.children[0]
+        if _runs_from_start(action):
+            plan.init_actions.append((name, action))
+        else:
+            _private_action(plan, name, action, 0.0)
+
+
+def _runs_from_start(action: Node) -> bool:
+    """An Init action with a duration: a shaped speed change, a lane change or offset.
+    Init actions execute at time 0 (OpenSCENARIO 1.2 sec. 7.3.1); one with a duration runs
+    on from there, so the storyboard engine runs it from the first step."""
+    what = action.children[0] if action.children else action
+    if what.tag in ("LaneChangeAction", "LaneOffsetAction"):
+        return True
+    return what.tag == "SpeedAction" and not _is_step(what)
+
+
+def _is_step(speed: Node) -> bool:
+    """A SpeedAction that sets its speed at once: a step, or any shape over no time."""
+    dyn = speed.find("SpeedActionDynamics")
+    if dyn is None:
+        raise refuse(speed, "a SpeedAction needs its dynamics and a target")
+    if dyn.need("dynamicsShape") == "step":
+        return True
+    return dyn.get("dynamicsDimension") == "time" and dyn.num("value", 0.0) == 0.0
 
 
 def _private_action(plan: Plan, name: str, action: Node, t_s: float) -> float:
@@ -145,7 +201,7 @@ def _speed(plan: Plan, name: str, node: Node, t_s: float) -> float:
     dyn, target = node.find("SpeedActionDynamics"), node.find("SpeedActionTarget")
     if dyn is None or target is None or not target.children:
         raise refuse(node, "a SpeedAction needs its dynamics and a target")
-    if dyn.need("dynamicsShape") != "step":
+    if not _is_step(node):
         return t_s
     goal = target.children[0]
     if goal.tag == "AbsoluteTargetSpeed":
@@ -155,19 +211,6 @@ def _speed(plan: Plan, name: str, node: Node, t_s: float) -> float:
     factor = goal.get("speedTargetValueType", "delta") == "factor"
     plan.speeds_mps[name] = ref * goal.num("value") if factor else ref + goal.num("value")
     return t_s
-
-
-def _events(board: Node) -> list[_Event]:
-    out = []
-    for story in board.findall("Story"):
-        for act in story.findall("Act"):
-            for group in act.findall("ManeuverGroup"):
-                actors_node = group.find("Actors")
-                refs = [] if actors_node is None else actors_node.findall("EntityRef")
-                actors = tuple(r.need("entityRef") for r in refs)
-                for man in group.findall("Maneuver"):
-                    out += [_Event(act, actors, group, man, ev) for ev in man.findall("Event")]
-    return out
 
 
 def _time_events(plan: Plan, clock: Clock, events: list[_Event]) -> set[str]:
@@ -198,25 +241,25 @@ def _start(clock: Clock, node: Node, default: float) -> float:
 
 
 def _time_event(plan: Plan, clock: Clock, ev: _Event) -> set[str]:
-    act_name = ev.act.need("name")
-    if act_name not in clock.starts:
-        clock.starts[act_name] = _start(clock, ev.act, 0.0)
-    t_act = clock.starts[act_name]
-    for node in (ev.group, ev.maneuver):
-        clock.starts.setdefault(node.need("name"), t_act)
-    actions = ev.event.findall("Action")
+    clock.starts.setdefault(ev.path("story"), 0.0)  # a Story starts with the storyboard
+    act_path = ev.path("act")
+    if act_path not in clock.starts:
+        clock.starts[act_path] = _start(clock, ev.act, 0.0)
+    t_act = clock.starts[act_path]
+    for key in ("group", "maneuver"):
+        clock.starts.setdefault(ev.path(key), t_act)
     t_ev = _start(clock, ev.event, t_act) if t_act < NEVER else NEVER
-    clock.starts[ev.event.need("name")] = t_ev
-    return _run_actions(plan, clock, ev, actions, t_ev)
+    clock.starts[ev.path("event")] = t_ev
+    return _run_actions(plan, clock, ev, ev.element.children, t_ev)
 
 
 def _run_actions(
-    plan: Plan, clock: Clock, ev: _Event, actions: list[Node], t_ev: float
+    plan: Plan, clock: Clock, ev: _Event, actions: list[Element], t_ev: float
 ) -> set[str]:
     controlled: set[str] = set()
     end = t_ev
-    for action in actions:
-        name = action.need("name")
+    for element in actions:
+        action, name = element.node, element.path
         clock.starts[name] = t_ev
         t_end = t_ev
         if t_ev < NEVER and action.find("PrivateAction") is not None:
@@ -227,16 +270,16 @@ def _run_actions(
                 controlled |= set(ev.actors)
         clock.ends[name] = t_end
         end = max(end, t_end)
-    clock.ends[ev.event.need("name")] = end
+    clock.ends[ev.path("event")] = end
     return controlled
 
 
 def _close(clock: Clock, events: list[_Event]) -> None:
     """The end of every maneuver, group and act whose events are all timed."""
-    for key in ("maneuver", "group", "act"):
+    for key in ("maneuver", "group", "act", "story"):
         owners: dict[str, list[str]] = {}
         for ev in events:
-            owners.setdefault(getattr(ev, key).need("name"), []).append(ev.event.need("name"))
+            owners.setdefault(ev.path(key), []).append(ev.path("event"))
         for owner, names in owners.items():
             if all(n in clock.ends for n in names):
                 ends = [clock.ends[n] for n in names if clock.ends[n] < NEVER]

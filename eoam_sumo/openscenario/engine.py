@@ -23,7 +23,8 @@ from eoam_sumo.openscenario.story import (
     STANDBY,
     Element,
     Trigger,
-    build,
+    build_all,
+    resolve,
     state_holds,
     walk,
 )
@@ -43,7 +44,8 @@ class World:
                      plan.places[n].offset_m, plan.speeds_mps.get(n, 0.0), n != plan.ego)
             for n, b in plan.bodies.items()
         }  # fmt: skip
-        self.elements: dict[str, Element] = {}
+        self.elements: dict[str, Element] = {}  # by qualified name (story::act::...)
+        self._refs: dict[int, Element] = {}
         self.collided: set[str] = set()
         self.ego_xy = (0.0, 0.0)
         self.ego = plan.ego
@@ -53,8 +55,11 @@ class World:
         }
 
     def element_state(self, node: Node) -> bool:
-        element = self.elements.get(node.need("storyboardElementRef"))
-        return element is not None and state_holds(element, node.need("state"), self.step)
+        """A ``StoryboardElementStateCondition`` now (its element resolved once)."""
+        element = self._refs.get(id(node))
+        if element is None:
+            element = self._refs[id(node)] = resolve(self.elements, node)
+        return state_holds(element, node.need("state"), self.step)
 
     def xy(self, actor: Actor) -> tuple[float, float]:
         if not actor.puppet:
@@ -82,11 +87,12 @@ class Storyboard(StepObserver):
             d.need("name"): d.need("value") for d in ([] if decls is None else decls.children)
         }
         self.world = World(plan, lanes, parameters, variables)
-        self.stories = [build(s) for s in board.findall("Story")]
+        self.world.elements = build_all(board)
+        self.stories = [e for e in self.world.elements.values() if e.parent is None]
+        self.plan, self.init_node = plan, board.find("Init") or board
+        self.ids = plan.sumo_ids()  # entity name -> SUMO vehicle id
         stop = board.find("StopTrigger")
         self.stop = None if stop is None or not stop.children else Trigger(stop)
-        for story in self.stories:
-            self.world.elements |= {e.name: e for e in walk(story)}
         self.ended_by_storyboard = False
 
     def start(self, sim) -> None:
@@ -94,8 +100,19 @@ class Storyboard(StepObserver):
         self.world.friction = sim.session.lane_friction
         for actor in self.world.actors.values():
             if actor.puppet:
-                self.puppets.take(actor.name)
+                self.puppets.take(self.ids[actor.name])
+        self._start_init()
         self.after_step(sim)
+
+    def _start_init(self) -> None:
+        """The Init actions with a duration start at time 0 (a shaped speed change, a lane
+        change or offset), stepped as one running action of the storyboard."""
+        started = (start_private(self.world, n, a) for n, a in self.plan.init_actions)
+        motions = [m for m in started if m is not None]
+        if motions:
+            init = Element("Action", "", self.init_node, [], None, None, path="Init")
+            init.state, init.started_step, init.motions = RUNNING, 0, motions
+            self.world.elements["Init"] = init
 
     def after_step(self, sim) -> None:
         world = self.world
@@ -103,7 +120,8 @@ class Storyboard(StepObserver):
         world.time_s, world.step = sim.t - DEPART_S, world.step + 1
         self._read_ego(sim, dt)
         if sim.first_contact is not None:
-            world.collided |= {world.ego, sim.first_contact.body.vid}
+            hit = sim.first_contact.body.vid
+            world.collided |= {world.ego, next((n for n, v in self.ids.items() if v == hit), hit)}
         if self.stop is not None and self.stop.fired(world):
             self.ended_by_storyboard = True
         if self.ended_by_storyboard and (sim.ctrl.mode == 0 or sim.eoam_done()):
@@ -143,7 +161,7 @@ class Storyboard(StepObserver):
         front_x = x + body.front_ahead_m * math.cos(yaw)
         front_y = y + body.front_ahead_m * math.sin(yaw)
         nav = (90.0 - math.degrees(yaw)) % 360.0
-        self.puppets.place(actor.name, front_x, front_y, nav, actor.speed_mps)
+        self.puppets.place(self.ids[actor.name], front_x, front_y, nav, actor.speed_mps)
 
     # ------------------------------------------------------------------ the state machines
     def _step_element(self, el: Element) -> None:
@@ -167,7 +185,8 @@ class Storyboard(StepObserver):
 
     def _start_event(self, ev: Element) -> None:
         world = self.world
-        owner = next(m for m in world.elements.values() if ev in m.children)
+        owner = ev.parent
+        assert owner is not None  # an Event is in a Maneuver
         if ev.node.get("priority") == "skip" and any(e.state == RUNNING for e in owner.children):
             return
         if ev.node.get("priority") in ("override", "overwrite"):
@@ -226,8 +245,6 @@ def _release(actor: Actor, motion) -> None:
 
 def start_action(world: World, action: Element, actors: tuple[str, ...]) -> list:
     """The motions of an action just started (placements and global actions take effect now)."""
-    from eoam_sumo.openscenario.placing import place_now
-
     node = action.node.children[0]
     if node.tag == "GlobalAction":
         inner = node.children[0]
@@ -235,22 +252,28 @@ def start_action(world: World, action: Element, actors: tuple[str, ...]) -> list
             _variable(world, inner)
         return []
     inner = node.children[0]
+    started = (start_private(world, name, inner) for name in actors)
+    return [m for m in started if m is not None]
+
+
+def start_private(world: World, name: str, inner: Node) -> tuple[str, object] | None:
+    """Start a private action of ``name`` (``inner``: the PrivateAction's child): its
+    motion, or None for a placement (done now) or a controller action."""
+    from eoam_sumo.openscenario.placing import place_now
+
+    actor = world.actors[name]
     what = inner.children[0] if inner.children else inner
-    motions = []
-    for name in actors:
-        actor = world.actors[name]
-        if what.tag == "SpeedAction":
-            motion: object = SpeedMotion(what)
-            _take(actor, "speed_busy", motion)
-        elif what.tag in ("LaneChangeAction", "LaneOffsetAction"):
-            motion = LateralMotion(what)
-            _take(actor, "lateral_busy", motion)
-        else:
-            place_now(world, actor, inner)
-            continue
-        motion.start(world, actor)  # type: ignore[attr-defined]
-        motions.append((name, motion))
-    return motions
+    if what.tag == "SpeedAction":
+        motion: object = SpeedMotion(what)
+        _take(actor, "speed_busy", motion)
+    elif what.tag in ("LaneChangeAction", "LaneOffsetAction"):
+        motion = LateralMotion(what)
+        _take(actor, "lateral_busy", motion)
+    else:
+        place_now(world, actor, inner)
+        return None
+    motion.start(world, actor)  # type: ignore[attr-defined]
+    return name, motion
 
 
 def _take(actor: Actor, slot: str, motion) -> None:

@@ -52,9 +52,12 @@ def number(text: str) -> float | bool:
     if low in ("true", "false"):
         return low == "true"
     try:
-        return float(text)
+        value = float(text)
     except ValueError as exc:
         raise ExpressionError(f"{text!r} is not a number") from exc
+    if not math.isfinite(value):
+        raise ExpressionError(f"{text!r} is not a finite number")
+    return value
 
 
 def evaluate(expr: str, values: dict[str, str]) -> float | bool:
@@ -67,7 +70,10 @@ def evaluate(expr: str, values: dict[str, str]) -> float | bool:
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError as exc:
         raise ExpressionError(f"${{{expr}}} is not an expression") from exc
-    return _walk(tree.body, values, expr)
+    value = _walk(tree.body, values, expr)
+    if not math.isfinite(value):
+        raise ExpressionError(f"${{{expr}}} is {value}, not a finite number")
+    return value
 
 
 def _walk(node: ast.AST, values: dict[str, str], expr: str) -> float | bool:
@@ -85,7 +91,9 @@ def _walk(node: ast.AST, values: dict[str, str], expr: str) -> float | bool:
         left, right = _walk(node.left, values, expr), _walk(node.right, values, expr)
         try:
             return float(_BINARY[type(node.op)](left, right))
-        except (ZeroDivisionError, OverflowError, ValueError) as exc:
+        except OverflowError:
+            raise ExpressionError(f"${{{expr}}}: the result is too large") from None
+        except (ZeroDivisionError, ValueError) as exc:
             raise ExpressionError(f"${{{expr}}}: {exc}") from exc
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub):
         return -_walk(node.operand, values, expr)
@@ -103,6 +111,8 @@ def _walk(node: ast.AST, values: dict[str, str], expr: str) -> float | bool:
         args = [float(_walk(a, values, expr)) for a in node.args]
         try:
             return float(_FUNCTIONS[node.func.id](*args))
+        except OverflowError:
+            raise ExpressionError(f"${{{expr}}}: the result is too large") from None
         except (TypeError, ValueError) as exc:
             raise ExpressionError(f"${{{expr}}}: {exc}") from exc
     raise ExpressionError(f"${{{expr}}}: {ast.unparse(node)!r} is not allowed in an expression")

@@ -10,26 +10,31 @@ from __future__ import annotations
 
 import math
 from bisect import bisect_right
-from itertools import accumulate
+from itertools import accumulate, pairwise
 from pathlib import Path
 
-from eoam_sumo.openscenario.road import SumoLane, lane_table, locate
+from eoam_sumo.openscenario.lanetable import lane_table
+from eoam_sumo.openscenario.road import SumoLane, locate
 
 
 class _Shape:
     """A SUMO lane's centre line: points, cumulated lengths, per metre of the lane's length."""
 
     def __init__(self, points: list, lane_length_m: float, width_m: float) -> None:
-        self.xy = [(float(x), float(y)) for x, y in points]
+        xy = [(float(x), float(y)) for x, y in points]
+        self.xy = xy[:1] + [b for a, b in pairwise(xy) if math.dist(a, b) > 1e-6]
+        if len(self.xy) < 2:
+            self.xy = xy[:1] * 2
         seg = [math.dist(a, b) for a, b in zip(self.xy, self.xy[1:], strict=False)]
         self.cum = [0.0, *accumulate(seg)]
         self.factor = self.cum[-1] / lane_length_m if lane_length_m > 0 else 1.0
         self.width_m = width_m
 
     def at(self, pos_m: float, offset_m: float) -> tuple[float, float, float]:
-        """(x, y, heading) ``pos_m`` along the lane, ``offset_m`` to its left."""
-        d = min(max(pos_m * self.factor, 0.0), self.cum[-1])
-        i = min(bisect_right(self.cum, d) - 1, len(self.cum) - 2)
+        """(x, y, heading) ``pos_m`` along the lane, ``offset_m`` to its left (before its
+        start or past its end: straight on along its first or last segment)."""
+        d = pos_m * self.factor
+        i = max(min(bisect_right(self.cum, d) - 1, len(self.cum) - 2), 0)
         (x0, y0), (x1, y1) = self.xy[i], self.xy[i + 1]
         heading = math.atan2(y1 - y0, x1 - x0)
         f = (d - self.cum[i]) / max(self.cum[i + 1] - self.cum[i], 1e-12)
@@ -61,10 +66,7 @@ class LaneMap:
         """(SUMO lane id, position along it) of the lane's centre at ``s_m`` (clamped to the
         lane's ends: an entity driven past the end of the road stays at it)."""
         lanes = self.table[(road, lane)]
-        ends = [sl.start_s_m for sl in lanes] + [
-            sl.start_s_m + sl.length_m / sl.scale for sl in lanes
-        ]
-        s_m = min(max(s_m, min(ends)), max(ends))
+        s_m = min(max(s_m, lanes[0].start_s_m), lanes[-1].end_s_m)
         sl, pos = locate(self.table, road, lane, s_m, f"road {road} lane {lane}")
         return f"{sl.edge}_{sl.index}", pos
 
@@ -91,5 +93,4 @@ class LaneMap:
         if found is None:
             return None
         road, lane, sl = found
-        along = pos_m if sl.along_s else sl.length_m - pos_m
-        return road, lane, sl.start_s_m + along / sl.scale
+        return road, lane, sl.s_m(pos_m)

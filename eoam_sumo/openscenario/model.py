@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 from eoam_sumo.openscenario.xmltree import Node
@@ -49,3 +50,23 @@ class Plan:
     places: dict[str, Place]
     speeds_mps: dict[str, float]
     notes: list[str] = field(default_factory=list)
+    # Init actions the storyboard engine runs from time 0 (entity, the PrivateAction's child)
+    init_actions: list[tuple[str, Node]] = field(default_factory=list)
+
+    def sumo_ids(self) -> dict[str, str]:
+        """Entity name -> its SUMO vehicle id: ``ego`` for the ego; for a target its name
+        with anything but letters, digits, ``_ . -`` as ``_`` (a space, ``&`` or ``"``
+        broke the SUMO files), made unique (a target named ``ego`` becomes ``ego_2``)."""
+        ids = {self.ego: "ego"}
+        taken = {"ego"}
+        for name in self.bodies:
+            if name == self.ego:
+                continue
+            base = re.sub(r"[^A-Za-z0-9_.\-]", "_", name) or "_"
+            vid, k = base, 1
+            while vid.lower() in taken:
+                k += 1
+                vid = f"{base}_{k}"
+            ids[name] = vid
+            taken.add(vid.lower())
+        return ids

@@ -10,6 +10,7 @@ step ``1``.
 from __future__ import annotations
 
 import math
+import sys
 
 from eoam_sumo.openscenario.actors import Actor, lane_plus
 from eoam_sumo.openscenario.subset import refuse
@@ -110,9 +111,12 @@ class LateralMotion:
             actor.odometer_m,
         )
         self.lane1, offset1 = self._goal(world, actor)
-        if not lanes.has(actor.road, self.lane1):  # no such lane: the actor keeps its own
+        if not lanes.has(actor.road, self.lane1):  # no such lane: said, the actor keeps its own
+            where = f"{node.where()} at {world.time_s:.2f} s"
+            print(f"eoam-sumo: {where}: {actor.name} has no lane {self.lane1} to change to; "
+                  "it keeps its lane", file=sys.stderr)  # fmt: skip
             self.lane1 = self.lane0
-        shift = lanes.shift_m(actor.road, self.lane0, self.lane1, actor.s_m) * actor.direction
+        shift = lanes.shift_m(actor.road, self.lane0, self.lane1, actor.s_m)  # left of s
         self.delta = shift + offset1 - self.o0
         self.offset1 = offset1
         dyn = node.children[0]

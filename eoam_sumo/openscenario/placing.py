@@ -21,10 +21,12 @@ def place_now(world, actor: Actor, action: Node) -> None:
                 int(where.num("laneId")),
                 where.num("s"),
             )
+            actor.direction = 1 if actor.lane < 0 else -1  # along its new lane
         else:
             ref = world.actors[where.need("entityRef")]
             actor.road, actor.lane = ref.road, lane_plus(ref.lane, int(where.num("dLane", 0.0)))
             actor.s_m = ref.s_m + ref.direction * where.num("ds")
+            actor.direction = ref.direction
         actor.offset_m = offset
         return
     inner = action.children[0] if action.children else action

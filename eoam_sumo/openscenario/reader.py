@@ -9,6 +9,7 @@ the reference's ``ParameterAssignments``. Nothing here runs the scenario.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,6 +19,9 @@ from eoam_sumo.openscenario.subset import check_subset
 from eoam_sumo.openscenario.xmltree import Node, parse
 
 UNRESOLVED = ("ParameterDeclarations", "ParameterValueDistribution")
+# attributes nothing refers to, kept as written (esmini's files build a condition's name
+# with a string concatenation, ``${Name + _ + $Value}``, outside the standard's expressions)
+UNUSED = {("Condition", "name")}
 
 
 @dataclass(frozen=True)
@@ -41,26 +45,52 @@ def read_scenario(path: Path, overrides: dict[str, str] | None = None) -> Scenar
         path, chosen = _distribution(path, dist, set(given))
         given = {**chosen, **given}
         root = parse(path)
+        _distributed_declared(root, chosen, dist, path)
     if root.find("Storyboard") is None:
         raise InputError(f"{path}: not an OpenSCENARIO scenario (no <Storyboard>)")
     values = declared_values(root.find("ParameterDeclarations"), given, path)
     catalogs = _catalog_dirs(root, values, path.parent)
-    tree = _resolve(root, values, catalogs)
+    tree = _resolve(root, values, catalogs, scoped=True)
     check_subset(tree)
     return Scenario(path, values, tree, _road(tree, path))
 
 
-def declared_values(decls: Node | None, given: dict[str, str], path: Path) -> dict[str, str]:
-    """Parameter name -> value: declarations in order, ``given`` replacing declared values."""
+def _distributed_declared(root: Node, chosen: dict[str, str], dist: Node, path: Path) -> None:
+    """Every parameter a distribution sets is declared by its scenario."""
+    decls = root.find("ParameterDeclarations")
+    names = {d.get("name") for d in ([] if decls is None else decls.children)}
+    for name in chosen:
+        if name not in names:
+            raise InputError(
+                f"{dist.where()}: sets parameter {name}, which {path} does not declare"
+            )
+
+
+def declared_values(
+    decls: Node | None, given: dict[str, str], path: Path, outer: dict[str, str] | None = None
+) -> dict[str, str]:
+    """Parameter name -> value: declarations in order, ``given`` replacing declared values
+    (``outer``: the values of the enclosing scope, which a declaration's value may use)."""
     values: dict[str, str] = {}
     for decl in [] if decls is None else decls.findall("ParameterDeclaration"):
         name = decl.need("name")
         text = given[name] if name in given else decl.need("value")
-        values[name] = _sub(text, values, decl)
+        values[name] = _finite(_sub(text, {**(outer or {}), **values}, decl), name, decl)
     unknown = sorted(set(given) - set(values))
     if unknown:
         raise InputError(f"--param {unknown[0]}: no such parameter declared in {path}")
     return values
+
+
+def _finite(text: str, name: str, decl: Node) -> str:
+    """``text`` unless it is a number that is not finite (float() reads "nan", "inf")."""
+    try:
+        bad = not math.isfinite(float(text))
+    except ValueError:
+        bad = False
+    if bad:
+        raise InputError(f"{decl.where()}: parameter {name} = {text!r} is not a finite number")
+    return text
 
 
 def _sub(text: str, values: dict[str, str], node: Node) -> str:
@@ -76,10 +106,7 @@ def _distribution(path: Path, dist: Node, given: set[str]) -> tuple[Path, dict[s
     scen = dist.find("ScenarioFile")
     if scen is None:
         raise InputError(f"{dist.where()}: no <ScenarioFile>")
-    det = dist.find("Deterministic")
-    if det is None or len(dist.children) != 2:
-        other = next(c for c in dist.children if c.tag != "ScenarioFile")
-        raise InputError(f"{other.where()}: only a Deterministic distribution is supported")
+    det = deterministic(dist)
     chosen: dict[str, str] = {}
     for node in det.children:
         names = {node.get("parameterName")} | {
@@ -89,6 +116,19 @@ def _distribution(path: Path, dist: Node, given: set[str]) -> tuple[Path, dict[s
             continue
         chosen |= _one_set(node)
     return (path.parent / scen.need("filepath")).resolve(), chosen
+
+
+def deterministic(dist: Node) -> Node:
+    """The ``Deterministic`` distribution of a ``ParameterValueDistribution`` (the only
+    kind supported; the standard requires one, deterministic or stochastic)."""
+    others = [c for c in dist.children if c.tag != "ScenarioFile"]
+    if not others:
+        raise InputError(f"{dist.where()}: no distribution (Deterministic) beside <ScenarioFile>")
+    det = dist.find("Deterministic")
+    if det is None or len(others) != 1:
+        other = next((c for c in others if c.tag != "Deterministic"), others[-1])
+        raise InputError(f"{other.where()}: only a Deterministic distribution is supported")
+    return det
 
 
 def _one_set(node: Node) -> dict[str, str]:
@@ -117,11 +157,21 @@ def _catalog_dirs(root: Node, values: dict[str, str], base: Path) -> list[Path]:
     ]
 
 
-def _resolve(node: Node, values: dict[str, str], catalogs: list[Path], via: str = "") -> Node:
-    """A copy of ``node`` with attributes resolved and catalog references expanded."""
+def _resolve(
+    node: Node, values: dict[str, str], catalogs: list[Path], via: str = "", scoped: bool = False
+) -> Node:
+    """A copy of ``node`` with attributes resolved and catalog references expanded. A node's
+    own ``ParameterDeclarations`` (a Story's, a Maneuver's...) add to the values in scope
+    for it and its descendants (OpenSCENARIO 1.2 sec. 8.4.1); ``scoped``: already added (the
+    scenario's and a catalog entry's)."""
     if node.tag == "CatalogReference":
         return _expand(node, values, catalogs)
-    attrib = {k: _sub(v, values, node) for k, v in node.attrib.items()}
+    decls = node.find("ParameterDeclarations")
+    if decls is not None and not scoped:
+        values = {**values, **declared_values(decls, {}, node.file, values)}
+    attrib = {
+        k: v if (node.tag, k) in UNUSED else _sub(v, values, node) for k, v in node.attrib.items()
+    }
     kids = [c if c.tag in UNRESOLVED else _resolve(c, values, catalogs, via) for c in node.children]
     return Node(node.tag, attrib, node.file, node.line, kids, via)
 
@@ -132,12 +182,17 @@ def _expand(ref: Node, values: dict[str, str], catalogs: list[Path]) -> Node:
     found = find_entry(cat, entry, catalogs)
     if found is None:
         raise InputError(f"{ref.where()}: catalog entry {cat}/{entry} not found")
-    assigned = {
-        a.need("parameterRef"): _sub(a.need("value"), values, a)
-        for a in (ref.find("ParameterAssignments") or _EMPTY).children
-    }
-    own = declared_values(found.find("ParameterDeclarations"), assigned, found.file)
-    return _resolve(found, own, catalogs, f" (from {ref.where()})")
+    decls = found.find("ParameterDeclarations")
+    names = {d.need("name") for d in ([] if decls is None else decls.children)}
+    assigned = {}
+    for a in (ref.find("ParameterAssignments") or _EMPTY).children:
+        name = a.need("parameterRef").removeprefix("$")  # esmini's files write "$Name"
+        if name not in names:
+            raise InputError(f"{a.where()}: catalog entry {cat}/{entry} declares no parameter "
+                             f"{name} ({found.file})")  # fmt: skip
+        assigned[name] = _sub(a.need("value"), values, a)
+    own = declared_values(decls, assigned, found.file)
+    return _resolve(found, own, catalogs, f" (from {ref.where()})", scoped=True)
 
 
 _EMPTY = Node("ParameterAssignments", {}, Path("-"), 0)

@@ -9,6 +9,7 @@ drivable. The network is cached under ``cache_dir`` keyed by the road file's SHA
 
 from __future__ import annotations
 
+import bisect
 import hashlib
 import shutil
 import subprocess
@@ -25,20 +26,49 @@ NETCONVERT_OPTIONS = ("--output.original-names", "true", "--no-turnarounds", "tr
 
 @dataclass(frozen=True)
 class SumoLane:
-    """A SUMO lane: ``pos_m`` along it of a reference-line ``s`` (``scale``: lane length per
-    metre of road, 1 on a straight road)."""
+    """A SUMO lane carrying an OpenDRIVE lane from ``start_s_m`` to ``end_s_m`` of its road's
+    reference line (its edge's part of the road); ``s_pts``/``pos_pts`` pair each vertex of
+    its shape with the ``s`` it lies at (increasing) and its position along the lane, so that
+    a lane of a curve beside straights, or one that starts in a later lane section, maps
+    ``s`` to its own positions (:mod:`.lanetable`)."""
 
     edge: str
     index: int
     start_s_m: float
+    end_s_m: float
     length_m: float
-    scale: float
     along_s: bool
+    s_pts: tuple[float, ...]
+    pos_pts: tuple[float, ...]
 
     def pos_m(self, s_m: float) -> float:
-        """Position along the SUMO lane of the reference-line coordinate ``s_m``."""
-        d = (s_m - self.start_s_m) * self.scale
-        return d if self.along_s else self.length_m - d
+        """Position along the SUMO lane of the reference-line coordinate ``s_m`` (beyond the
+        lane's shape, where netconvert cut it short of a junction, straight on from its end:
+        an entity driving through moves on, it does not stop at the lane's end and jump)."""
+        s, pos = self.s_pts, self.pos_pts
+        if len(s) < 2 or s[0] <= s_m <= s[-1]:
+            return _interp(s_m, s, pos)
+        slope = (pos[-1] - pos[0]) / (s[-1] - s[0]) if s[-1] > s[0] else 0.0
+        end = 0 if s_m < s[0] else -1
+        return pos[end] + (s_m - s[end]) * slope
+
+    def s_m(self, pos_m: float) -> float:
+        """The reference-line coordinate of a position along the SUMO lane."""
+        pos, s = (self.pos_pts, self.s_pts) if self.along_s else (
+            self.pos_pts[::-1], self.s_pts[::-1])  # fmt: skip
+        return _interp(pos_m, pos, s)
+
+
+def _interp(x: float, xp: tuple[float, ...], fp: tuple[float, ...]) -> float:
+    """``numpy.interp`` for one value: piecewise linear over increasing ``xp``, held at the
+    end values outside."""
+    if x <= xp[0]:
+        return float(fp[0])
+    if x >= xp[-1]:
+        return float(fp[-1])
+    k = bisect.bisect_right(xp, x)
+    x0, x1, f0, f1 = xp[k - 1], xp[k], fp[k - 1], fp[k]
+    return float(f0 + (f1 - f0) * (x - x0) / (x1 - x0)) if x1 > x0 else float(f1)
 
 
 def convert(xodr: Path, cache_dir: Path) -> Path:
@@ -68,50 +98,44 @@ def convert(xodr: Path, cache_dir: Path) -> Path:
     return net
 
 
+def check_road(xodr: Path) -> None:
+    """InputError for a road under left-hand traffic (OpenDRIVE 1.5+ ``rule="LHT"``): its
+    lanes with positive ids run along s, the mapping here (negative ids along s) is the
+    right-hand one."""
+    try:
+        root = ET.parse(xodr).getroot()
+    except ET.ParseError as exc:
+        raise InputError(f"{xodr}: not well-formed XML: {exc}") from None
+    for road in root.iter("road"):
+        if road.get("rule", "RHT").upper() == "LHT":
+            raise InputError(
+                f'{xodr}: road {road.get("id")} has rule="LHT": left-hand traffic is not '
+                "supported (docs/openscenario.md)"
+            )
+
+
+WIDE_M = 6.0  # a driving lane wider than this: the EOAM may swerve inside it
+
+
+def wide_lanes(xodr: Path) -> list[str]:
+    """A note (one line) naming the driving lanes wider than ``WIDE_M`` (Vector's NCAP road is
+    one 28 m lane each way: the EOAM swerves within it), or none."""
+    wide = {}
+    for road in ET.parse(xodr).getroot().iter("road"):
+        for lane in road.iter("lane"):
+            widths = [float(w.get("a", "0")) for w in lane.iter("width")]
+            if lane.get("type") == "driving" and widths and max(widths) > WIDE_M:
+                wide[f"road {road.get('id')} lane {lane.get('id')}"] = max(widths)
+    if not wide:
+        return []
+    listed = ", ".join(f"{k}: {w:g} m" for k, w in wide.items())
+    return [f"driving lanes wider than {WIDE_M:g} m ({listed}): the EOAM may swerve within one"]
+
+
 def road_lengths(xodr: Path) -> dict[str, float]:
     """OpenDRIVE road id -> its reference line length."""
     root = ET.parse(xodr).getroot()
     return {r.get("id", ""): float(r.get("length", "0")) for r in root.iter("road")}
-
-
-def lane_table(net: Path, xodr: Path) -> dict[tuple[str, int], list[SumoLane]]:
-    """(road, lane id) -> the SUMO lanes carrying it, in the order of s."""
-    lengths = road_lengths(xodr)
-    found: dict[tuple[str, int], list[tuple[str, int, float]]] = {}
-    for edge in ET.parse(net).getroot().iter("edge"):
-        if edge.get("function") == "internal":
-            continue
-        for lane in edge.iter("lane"):
-            orig = next(
-                (p.get("value") for p in lane.iter("param") if p.get("key") == "origId"), None
-            )
-            if orig is None or "_" not in orig:
-                continue
-            road, _, lane_id = orig.rpartition("_")
-            key = (road, int(lane_id))
-            item = (edge.get("id", ""), int(lane.get("index", "0")), float(lane.get("length", "0")))
-            found.setdefault(key, []).append(item)
-    return {key: _ordered(key, items, lengths) for key, items in found.items()}
-
-
-def _ordered(
-    key: tuple[str, int], items: list[tuple[str, int, float]], lengths: dict[str, float]
-) -> list[SumoLane]:
-    along = key[1] < 0
-    items = sorted(items, key=lambda it: _section(it[0]), reverse=not along)
-    total = sum(it[2] for it in items)
-    road_m = lengths.get(key[0], total) or total
-    scale = total / road_m
-    out, start = [], 0.0
-    for edge, index, length in items if along else reversed(items):
-        out.append(SumoLane(edge, index, start, length, scale, along))
-        start += length / scale
-    return out if along else list(reversed(out))
-
-
-def _section(edge: str) -> int:
-    _, sep, k = edge.rpartition("#")
-    return int(k) if sep and k.isdigit() else 0
 
 
 def locate(table: dict, road: str, lane: int, s_m: float, where: str) -> tuple[SumoLane, float]:
@@ -120,6 +144,6 @@ def locate(table: dict, road: str, lane: int, s_m: float, where: str) -> tuple[S
     if not lanes:
         raise InputError(f"{where}: road {road} lane {lane} is not a drivable SUMO lane")
     for sl in lanes:
-        if sl.start_s_m - 1e-6 <= s_m <= sl.start_s_m + sl.length_m / sl.scale + 1e-6:
+        if sl.start_s_m - 1e-6 <= s_m <= sl.end_s_m + 1e-6:
             return sl, sl.pos_m(s_m)
     raise InputError(f"{where}: s={s_m:g} m is off road {road} lane {lane}")

@@ -6,13 +6,13 @@ import os
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from eoam_sumo.errors import InputError
+from eoam_sumo.openscenario.checks import check_places
 from eoam_sumo.openscenario.compile import compile_plan
 from eoam_sumo.openscenario.engine import Storyboard
 from eoam_sumo.openscenario.geometry import LaneMap
 from eoam_sumo.openscenario.model import Plan
 from eoam_sumo.openscenario.reader import Scenario, read_scenario
-from eoam_sumo.openscenario.road import convert
+from eoam_sumo.openscenario.road import check_road, convert, wide_lanes
 from eoam_sumo.openscenario.sumofiles import write_sumo
 
 CACHE_ENV = "EOAM_SUMO_CACHE_DIR"
@@ -40,13 +40,17 @@ def load(xosc: Path, params: dict[str, str], ego: str | None = None) -> Loaded:
     """Everything outside the subset is refused here, before any run or output."""
     scenario = read_scenario(xosc, params)
     plan = compile_plan(scenario, ego)
-    net = convert(scenario.road, road_cache())
-    lanes = LaneMap(net, scenario.road)
-    for name, place in plan.places.items():
-        if not lanes.has(place.road, place.lane):
-            where = f"{place.node.where()}: {name}'s road {place.road} lane {place.lane}"
-            raise InputError(f"{where} is not a drivable SUMO lane")
+    plan.notes += wide_lanes(scenario.road)
+    net, lanes = road_map(scenario.road)
+    check_places(scenario.root, plan.places, lanes)
     return Loaded(scenario, plan, net, lanes)
+
+
+def road_map(road: Path) -> tuple[Path, LaneMap]:
+    """The road checked (left-hand traffic refused), converted (cached) and mapped."""
+    check_road(road)
+    net = convert(road, road_cache())
+    return net, LaneMap(net, road)
 
 
 def write_scenario(loaded: Loaded, folder: Path) -> Path:

@@ -9,15 +9,21 @@ evaluates the triggers, then starts what they fire, then steps the running actio
 
 from __future__ import annotations
 
-from collections import deque
+from collections import Counter, deque
 from dataclasses import dataclass, field
 
+from eoam_sumo.errors import InputError
 from eoam_sumo.openscenario.conditions import by_entity, by_value
+from eoam_sumo.openscenario.subset import refuse
 from eoam_sumo.openscenario.xmltree import Node
 
 STANDBY, RUNNING, COMPLETE = "standby", "running", "complete"
 KINDS = {"Story": "Act", "Act": "ManeuverGroup", "ManeuverGroup": "Maneuver",
          "Maneuver": "Event", "Event": "Action"}  # fmt: skip
+# StoryboardElementStateCondition's storyboardElementType -> the element's tag
+TYPES = {"story": "Story", "act": "Act", "maneuverGroup": "ManeuverGroup",
+         "maneuver": "Maneuver", "event": "Event", "action": "Action"}  # fmt: skip
+SEP = "::"  # a qualified name: the names of the element's parents and its own
 
 
 class Condition:
@@ -74,7 +80,8 @@ class Trigger:
 @dataclass(eq=False)
 class Element:
     """A storyboard element and its state; an Action's ``motions`` (actor, motion) once
-    started."""
+    started. ``path`` is its qualified name (``Story::Act::...::Action``): names repeat
+    across a storyboard (only the path is unique), so elements are kept by path."""
 
     kind: str
     name: str
@@ -83,23 +90,32 @@ class Element:
     start: Trigger | None
     stop: Trigger | None
     actors: tuple[str, ...] = ()
+    path: str = ""
+    parent: Element | None = None
     state: str = STANDBY
     started_step: int = -10
     ended_step: int = -10
     motions: list = field(default_factory=list)
 
 
-def build(node: Node, actors: tuple[str, ...] = ()) -> Element:
-    """The element tree under ``node`` (a Story)."""
+def build(node: Node, actors: tuple[str, ...] = (), prefix: str = "", suffix: str = "") -> Element:
+    """The element tree under ``node`` (a Story), each element's path its qualified name
+    (a second sibling of one name: ``#2`` after its name, a third ``#3``)."""
     if node.tag == "ManeuverGroup":
         refs = node.find("Actors")
         actors = tuple(
             r.need("entityRef") for r in ([] if refs is None else refs.findall("EntityRef"))
         )
+    path = prefix + node.need("name") + suffix
     child_tag = KINDS.get(node.tag)
-    kids = [build(c, actors) for c in node.findall(child_tag)] if child_tag else []
+    kids, seen = [], Counter[str]()
+    for child in node.findall(child_tag) if child_tag else []:
+        name = child.need("name")
+        seen[name] += 1  # siblings of one name (esmini's acc-test): the path gets #2, #3
+        suffix = "" if seen[name] == 1 else f"#{seen[name]}"
+        kids.append(build(child, actors, path + SEP, suffix))
     start, stop = node.find("StartTrigger"), node.find("StopTrigger")
-    return Element(
+    element = Element(
         node.tag,
         node.need("name"),
         node,
@@ -107,7 +123,58 @@ def build(node: Node, actors: tuple[str, ...] = ()) -> Element:
         None if start is None or not start.children else Trigger(start),
         None if stop is None or not stop.children else Trigger(stop),
         actors,
+        path,
     )
+    for kid in kids:
+        kid.parent = element
+    return element
+
+
+def build_all(board: Node) -> dict[str, Element]:
+    """Every element of the storyboard's stories by its qualified name, parents first."""
+    elements: dict[str, Element] = {}
+    seen = Counter[str]()
+    for story in board.findall("Story"):
+        seen[story.need("name")] += 1
+        count = seen[story.need("name")]
+        top = build(story, suffix="" if count == 1 else f"#{count}")
+        elements |= {e.path: e for e in walk(top)}
+    return elements
+
+
+def _names(element: Element) -> list[str]:
+    """The names of the element's parents and its own, outermost first."""
+    out = []
+    at: Element | None = element
+    while at is not None:
+        out.append(at.name)
+        at = at.parent
+    return out[::-1]
+
+
+def resolve(elements: dict[str, Element], cond: Node) -> Element:
+    """The element a ``StoryboardElementStateCondition`` names: its ``storyboardElementRef``
+    is a name or a qualified name (parents' names first, ``::`` between) matching the end of
+    exactly one element's path of its ``storyboardElementType`` (OpenSCENARIO 1.2 sec. 7.4.2,
+    references by name); none or several: refused."""
+    ref, kind = cond.need("storyboardElementRef"), cond.get("storyboardElementType")
+    tag = TYPES.get(kind or "")
+    if kind is not None and tag is None:
+        raise refuse(cond, f"storyboardElementType={kind} is not an element type")
+    parts = ref.split(SEP)
+    hits = [
+        e
+        for e in elements.values()
+        if (tag is None or e.kind == tag) and _names(e)[-len(parts) :] == parts
+    ]
+    if not hits:
+        raise InputError(f"{cond.where()}: no {kind or 'storyboard element'} named {ref!r}")
+    if len(hits) > 1:
+        paths = ", ".join(e.path for e in hits)
+        raise InputError(
+            f"{cond.where()}: {ref!r} names {len(hits)} elements ({paths}): qualify it"
+        )
+    return hits[0]
 
 
 def walk(element: Element):

@@ -147,6 +147,12 @@ def refuse(node: Node, why: str) -> InputError:
     return InputError(f"{node.where()}: {why} (docs/openscenario.md lists the subset)")
 
 
+def invalid(node: Node, why: str) -> InputError:
+    """The one-line refusal of ``node`` for a value or structure the standard does not allow
+    (not a matter of the subset)."""
+    return InputError(f"{node.where()}: {why}")
+
+
 SHAPES = ("step", "linear", "cubic", "sinusoidal")
 
 
@@ -175,6 +181,7 @@ def _orientation(node: Node) -> None:
 def _relative_lane(node: Node) -> None:
     if node.get("ds") is None:
         raise refuse(node, "only ds (not dsLane) is supported")
+    _integer(node, "dLane")
 
 
 def _lateral_target(node: Node) -> None:
@@ -192,6 +199,55 @@ def _distance(node: Node) -> None:
         raise refuse(constraints, "dynamic constraints are not supported")
 
 
+# elements that are a choice of exactly one child (OpenSCENARIO 1.2 XSD xsd:choice)
+ONE_CHILD = ("Condition", "ByValueCondition", "EntityCondition", "PrivateAction",
+             "GlobalAction", "Position", "LongitudinalAction", "LateralAction",
+             "SpeedActionTarget", "LaneChangeTarget", "LaneOffsetTarget", "Action")  # fmt: skip
+# vehicleCategory values with a SUMO vehicle class (train, tram, trailers: none)
+CATEGORIES = ("car", "van", "truck", "bus", "motorbike", "bicycle")
+
+
+def _one_child(node: Node) -> None:
+    kids = [c for c in node.children if c.tag != "ParameterDeclarations"]
+    if len(kids) != 1:
+        got = "is empty" if not kids else f"has {len(kids)} children"
+        raise invalid(node, f"a <{node.tag}> holds exactly one element; this one {got}")
+
+
+def _by_entity(node: Node) -> None:
+    if node.find("TriggeringEntities") is None or node.find("EntityCondition") is None:
+        raise invalid(node, "a ByEntityCondition needs TriggeringEntities and EntityCondition")
+
+
+def _integer(node: Node, key: str) -> None:
+    value = node.num(key, 0.0)
+    if value != int(value):
+        raise invalid(node, f"{key}={node.get(key)} is not an integer (a lane id or count)")
+
+
+def _not_negative(node: Node, key: str, what: str) -> None:
+    if node.num(key, 0.0) < 0:
+        raise invalid(node, f"{key}={node.get(key)}: {what} cannot be negative")
+
+
+def _dimensions(node: Node) -> None:
+    for key in ("length", "width"):
+        if node.num(key) <= 0:
+            raise invalid(node, f"{key}={node.get(key)}: a bounding box's {key} must be > 0")
+
+
+def _vehicle(node: Node) -> None:
+    category = node.get("vehicleCategory", "car")
+    if category not in CATEGORIES:
+        raise refuse(node, f"vehicleCategory={category} is not supported ({', '.join(CATEGORIES)})")
+
+
+def _reach(node: Node) -> None:
+    pos = node.find("Position")
+    if pos is None or pos.find("LanePosition") is None:
+        raise refuse(node, "only a LanePosition is supported to reach")
+
+
 CHECKS: dict[str, Callable[[Node], None]] = {
     "SpeedActionDynamics": _speed_dynamics,
     "LaneChangeActionDynamics": _lane_change_dynamics,
@@ -199,6 +255,15 @@ CHECKS: dict[str, Callable[[Node], None]] = {
     "RelativeLanePosition": _relative_lane,
     "LaneOffsetAction": _lateral_target,
     "LongitudinalDistanceAction": _distance,
+    "ByEntityCondition": _by_entity,
+    "Dimensions": _dimensions,
+    "Vehicle": _vehicle,
+    "ReachPositionCondition": _reach,
+    "AbsoluteTargetSpeed": lambda n: _not_negative(n, "value", "a target speed"),
+    "LanePosition": lambda n: _integer(n, "laneId"),
+    "AbsoluteTargetLane": lambda n: _integer(n, "value"),
+    "RelativeTargetLane": lambda n: _integer(n, "value"),
+    **dict.fromkeys(ONE_CHILD, _one_child),
 }
 
 

@@ -32,10 +32,10 @@ EGO_VTYPE = (
 )
 
 
-def _vtype(body: Body) -> str:
+def _vtype(body: Body, vid: str) -> str:
     vclass = VCLASS.get(body.category, "passenger")
     return (
-        f'<vType id="t_{body.name}" vClass="{vclass}" length="{body.length_m:g}" '
+        f'<vType id="t_{vid}" vClass="{vclass}" length="{body.length_m:g}" '
         f'width="{body.width_m:g}" minGap="1.00" maxSpeed="70.00" accel="2.50" decel="10.00" '
         f'emergencyDecel="12.00" sigma="0" speedDev="0" speedFactor="4" {NO_OWN_LANE_CHANGES}/>'
     )
@@ -71,10 +71,11 @@ def _vehicle(plan: Plan, name: str, lanes: LaneMap, net) -> str:
     place, body = plan.places[name], plan.bodies[name]
     lane_id = _nearest_lane(lanes, place)
     lane, pos = locate(lanes.table, place.road, lane_id, place.s_m, place.node.where())
+    pos = min(max(pos, 0.0), lane.length_m)  # a place in a junction's gap: the lane's end
     front = pos + body.front_ahead_m
     speed = plan.speeds_mps.get(name, 0.0)
-    vid = "ego" if name == plan.ego else name
-    vtype = "ego" if name == plan.ego else f"t_{name}"
+    vid = plan.sumo_ids()[name]
+    vtype = "ego" if name == plan.ego else f"t_{vid}"
     return (
         f'    <route id="r_{vid}" edges="{" ".join(_route(net, lane))}"/>\n'
         f'    <vehicle id={quoteattr(vid)} type={quoteattr(vtype)} route="r_{vid}" '
@@ -92,7 +93,8 @@ def write_sumo(plan: Plan, net_file: Path, lanes: LaneMap, folder: Path, source:
     folder.mkdir(parents=True, exist_ok=True)
     net = sumolib.net.readNet(str(net_file))
     others = [n for n in plan.bodies if n != plan.ego]
-    vtypes = [EGO_VTYPE] + [_vtype(plan.bodies[n]) for n in others]
+    ids = plan.sumo_ids()
+    vtypes = [EGO_VTYPE] + [_vtype(plan.bodies[n], ids[n]) for n in others]
     head = f'<?xml version="1.0" encoding="UTF-8"?>\n<!-- from {source.name} -->\n'
     write_atomic(
         folder / "scenario_vtypes.add.xml",

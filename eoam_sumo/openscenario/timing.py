@@ -11,6 +11,7 @@ it unless the event only sets variables.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 from eoam_sumo.openscenario.subset import refuse
 from eoam_sumo.openscenario.xmltree import Node
@@ -31,10 +32,11 @@ class NotYet(Exception):
 
 
 class Clock:
-    """Start and end times of the named elements (``ends`` filled as actions are timed)."""
+    """Start and end times of the elements by qualified name (``ends`` filled as actions
+    are timed); ``resolve`` gives the qualified name a state condition refers to."""
 
-    def __init__(self, parameters: dict[str, str]) -> None:
-        self.parameters = parameters
+    def __init__(self, parameters: dict[str, str], resolve: Callable[[Node], str]) -> None:
+        self.parameters, self.resolve = parameters, resolve
         self.starts: dict[str, float] = {}
         self.ends: dict[str, float] = {}
 
@@ -96,7 +98,7 @@ class Clock:
         return ops[rule]
 
     def _state_time(self, node: Node) -> float:
-        ref, state = node.need("storyboardElementRef"), node.need("state")
+        ref, state = self.resolve(node), node.need("state")
         if node.get("storyboardElementType") not in STATE_TYPES:
             raise refuse(node, f"element type {node.get('storyboardElementType')} unsupported")
         table = self.starts if state in START_STATES else self.ends

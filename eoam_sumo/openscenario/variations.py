@@ -19,7 +19,7 @@ from pathlib import Path
 from eoam_sumo.errors import InputError
 from eoam_sumo.openscenario.conditions import RULES
 from eoam_sumo.openscenario.expressions import ExpressionError, format_value, substitute
-from eoam_sumo.openscenario.reader import declared_values
+from eoam_sumo.openscenario.reader import declared_values, deterministic
 from eoam_sumo.openscenario.xmltree import Node, parse
 from eoam_sumo.params import MU_MAX
 from eoam_sumo.sim.settings import MAX_TIME_LIMIT_S
@@ -112,10 +112,7 @@ def _distribution_cases(
         return path.resolve(), [{}]
     if scen is None:
         raise InputError(f"{dist.where()}: no <ScenarioFile>")
-    det = dist.find("Deterministic")
-    if det is None:
-        other = next(c for c in dist.children if c.tag != "ScenarioFile")
-        raise InputError(f"{other.where()}: only a Deterministic distribution is supported")
+    det = deterministic(dist)
     axes = [_axis(node) for node in det.children if not _names(node) <= swept]
     combos = [
         dict(kv for part in parts for kv in part.items()) for parts in itertools.product(*axes)

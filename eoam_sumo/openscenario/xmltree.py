@@ -6,6 +6,7 @@ built from expat's events.
 
 from __future__ import annotations
 
+import math
 import xml.parsers.expat
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -61,10 +62,14 @@ class Node:
 
 
 def _number(node: Node, key: str, text: str) -> float:
+    """A finite number (Python's float() also reads "nan" and "inf": refused here)."""
     try:
-        return float(text)
+        value = float(text)
     except ValueError:
         raise InputError(f"{node.where()}: {key}={text!r} is not a number") from None
+    if not math.isfinite(value):
+        raise InputError(f"{node.where()}: {key}={text!r} is not a finite number")
+    return value
 
 
 def parse(path: Path) -> Node:

@@ -113,8 +113,8 @@ def test_a_continuous_lane_offset_is_refused(tmp_path: Path) -> None:
         "<LongitudinalAction>",
         '<LateralAction><LaneOffsetAction continuous="true"><LaneOffsetActionDynamics '
         'maxLateralAcc="1" dynamicsShape="cubic"/><LaneOffsetTarget><AbsoluteTargetLaneOffset '
-        'value="1"/></LaneOffsetTarget></LaneOffsetAction></LateralAction>'
-        "<LongitudinalAction>",
+        'value="1"/></LaneOffsetTarget></LaneOffsetAction></LateralAction></PrivateAction>'
+        "<PrivateAction><LongitudinalAction>",
         1,
     )
     assert "LaneOffsetAction" in text
