@@ -55,17 +55,18 @@ def build_parts(params: VehicleParams, tables: Any, settings: EoamSettings) -> P
         escapes = ArrestFirst(st)
     else:
         escapes = MinTimeEscapes(st)
+    steering = SteeringController(params, st.steering, st.preview_time_s)
     return Parts(
         params,
         tables,
         st,
-        SteeringController(params, st.steering, st.preview_time_s),
+        steering,
         SteeringController(params, st.planned_steering),
         LongitudinalController(params, st.longitudinal),
         BrakingObstaclePlacement() if st.obstacle_decel_in_dmm else PaperPlacement(),
         CompareOutcomes(params, st, ponr) if st.compare_outcomes else PonrCommit(params, st, ponr),
         escapes,
-        StableReturn(st) if st.return_when_stable else TimerReturn(st),
+        StableReturn(st, steering) if st.return_when_stable else TimerReturn(st),
         SafeGate(SafePolicy(params, tables, st, st.policy))
         if st.policy.name == "safe"
         else NextLaneGate(

@@ -16,9 +16,8 @@ from eoam_sumo.decision.modes import (
 from eoam_sumo.eoam.parts import Parts
 from eoam_sumo.eoam.shifts import lane_change_height_m, passing_offset_m, quintic_shift
 from eoam_sumo.eoam.state import ControllerState, Decision
-from eoam_sumo.eoam.strategies import beside_obstacle
+from eoam_sumo.eoam.strategies import beside_obstacle, heading_settled
 from eoam_sumo.eoam_messages import EgoMeasurement, Perception
-from eoam_sumo.manoeuvre.angles import wrap_angle
 from eoam_sumo.manoeuvre.min_time_shift import MinTimeShift
 from eoam_sumo.manoeuvre.path_reference import PathReference
 
@@ -76,7 +75,7 @@ def released(parts: Parts, meas: EgoMeasurement, decision: Decision) -> bool:
     return (
         decision.sector is not None
         and abs(meas.d_m) <= st.settle_offset_m
-        and abs(wrap_angle(meas.e_yaw_rad)) <= st.settle_heading_rad
+        and heading_settled(st, parts.steering, meas)
     )
 
 
@@ -87,12 +86,13 @@ def settled_in_lane(
     path: PathReference | None,
     dx_m: float,
 ) -> bool:
-    """Mode 5 after its path: within ``settle_offset_m`` of the lane centre and
-    ``settle_heading_rad`` of the road's heading for ``settle_dwell_s``."""
+    """Mode 5 after its path: within ``settle_offset_m`` of the lane centre and its heading
+    settled (``heading_settled``: within ``settle_heading_rad`` of the road's, less the
+    steady sideslip on a curve) for ``settle_dwell_s``."""
     if not (state.mode is RETURN and path is not None and dx_m >= path.length_m):
         return False
     st = parts.settings
-    heading_ok = abs(wrap_angle(meas.e_yaw_rad)) <= st.settle_heading_rad
+    heading_ok = heading_settled(st, parts.steering, meas)
     if not (abs(meas.d_m) <= st.settle_offset_m and heading_ok):
         state.settle_since_s = None
         return False
