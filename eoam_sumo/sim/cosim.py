@@ -218,8 +218,9 @@ class CoSimulation:
         self.left_usable = self.side_lanes[0] is not None
         self.mu_sides = _side_frictions(session, self.side_lanes)
         self.right_width_m = self.side_lanes[1].width_m if self.side_lanes[1] else 0.0
+        cg_x_m, cg_y_m = _centre_of_gravity(ego, self.params)
         self.x = initial_state(
-            ego.x_m, ego.y_m, ego.yaw_rad, ego.speed_mps, params=self.params
+            cg_x_m, cg_y_m, ego.yaw_rad, ego.speed_mps, params=self.params
         ).tolist()
         self.x_prev = self.x
         self.ax = self.ay = 0.0
@@ -721,6 +722,17 @@ def run_case(
             sim.session.ego_lane_centreline(),
         )
     return summary
+
+
+def _centre_of_gravity(ego: Body, params: VehicleParams) -> tuple[float, float]:
+    """Where the plant's centre of gravity starts: ``cg_to_front_bumper_m`` behind the front
+    bumper SUMO departed (half the box ``ego`` ahead of its centre), as every write-back
+    places the front bumper from it."""
+    back_m = 0.5 * ego.length_m - params.cg_to_front_bumper_m
+    return (
+        ego.x_m + back_m * math.cos(ego.yaw_rad),
+        ego.y_m + back_m * math.sin(ego.yaw_rad),
+    )
 
 
 def _side_frictions(session: SumoSession, side_lanes: tuple) -> tuple[float, float]:

@@ -541,3 +541,21 @@ def test_at_10_kmh_the_eoam_brakes_to_a_stop_without_steering(tmp_path):
     assert not {2, 3, 4, 5} & set(summary["modes_visited"]), summary["modes_visited"]
     assert summary["max_lateral_offset_m"] < 0.2
     assert 0.0 < summary["min_gap_aro_m"] < 5.0  # stopped short, within about the 2 m buffer
+
+
+@pytest.mark.sumo
+@pytest.mark.parametrize("length_m", [None, 20.0])
+def test_the_ego_starts_with_its_front_bumper_at_its_depart_pos(tmp_path, length_m):
+    """SUMO departs a vehicle with its front at ``departPos`` (100 m on the baseline's
+    straight east-bound edge from x = 0); the plant's centre of gravity starts
+    ``cg_to_front_bumper_m`` behind it, whatever the length of the route file's vType (the
+    box is resized to the plant's), so the gap to the obstacle is the scenario's."""
+    from eoam_sumo.params import ego_e_class_sedan
+
+    old, new = '<vehicle id="ego" type="ego"', '<vehicle id="ego" type="ego"'
+    if length_m is not None:
+        new = f'<vType id="ego_long" length="{length_m}"/>\n    <vehicle id="ego" type="ego_long"'
+    cfg = baseline_variant(tmp_path, old, new)
+    _summary, out = _run(cfg, tmp_path, ego_speed_mps=90 / 3.6, mu=1.0, max_time_s=0.05)
+    first = pd.read_csv(out / "timeseries.csv").iloc[0]
+    assert first["x_m"] + ego_e_class_sedan().cg_to_front_bumper_m == pytest.approx(100.0, abs=1e-6)

@@ -609,11 +609,12 @@ class SumoSession:
         return res
 
     def ego_body(self) -> Body:
-        """The ego as SUMO sees it."""
+        """The ego as SUMO sees it: its type now, a type of its own once ``size_ego`` gave it
+        the plant's size (not its route's)."""
         self._ego_results()  # fails when the ego has left
-        veh, ego, start = self._veh, self.ego_id, self._ego
+        veh, ego = self._veh, self.ego_id
         return self._users.vehicle_body(
-            ego, veh.getPosition(ego), veh.getAngle(ego), veh.getSpeed(ego), start.type_id, 0
+            ego, veh.getPosition(ego), veh.getAngle(ego), veh.getSpeed(ego), veh.getTypeID(ego), 0
         )
 
     def body(self, vid: str) -> Body:
