@@ -17,7 +17,7 @@ def check_references(root: Node, entities: set[str], parameters: dict[str, str])
     """InputError for the first reference to an undeclared entity, variable or parameter."""
     board = root.find("Storyboard")
     decls = root.find("VariableDeclarations")
-    variables = {d.need("name") for d in ([] if decls is None else decls.children)}
+    variables = {d.need("name"): d for d in ([] if decls is None else decls.children)}
     for node in [] if board is None else board.iter():
         name = node.get("entityRef")
         if name is not None and name not in entities:
@@ -26,10 +26,35 @@ def check_references(root: Node, entities: set[str], parameters: dict[str, str])
             ref = node.need("variableRef")
             if ref not in variables:
                 raise invalid(node, f"variable {ref!r} is not declared (VariableDeclarations)")
-        if node.tag == "ParameterCondition" and node.need("parameterRef") not in parameters:
-            ref = node.need("parameterRef")
-            raise invalid(node, f"parameter {ref!r} is not declared in the scenario's "
-                          "ParameterDeclarations")  # fmt: skip
+            if node.tag == "VariableAction":
+                _variable_action(node, variables[ref])
+        ref = node.need("parameterRef") if node.tag == "ParameterCondition" else ""
+        if ref and ref not in node.parameters(parameters):
+            why = "the scenario's or an enclosing element's ParameterDeclarations"
+            raise invalid(node, f"parameter {ref!r} is not declared in its scope ({why})")
+
+
+# VariableDeclaration variableType values that are numbers (OpenSCENARIO 1.2 ParameterType)
+NUMERIC = ("int", "double", "unsignedInt", "unsignedShort")
+
+
+def _variable_action(node: Node, decl: Node) -> None:
+    """A ``ModifyAction`` (``Rule`` > ``AddValue``/``MultiplyByValue``, OpenSCENARIO 1.2
+    VariableModifyAction) adds to or multiplies a number: its variable is numeric; a
+    ``SetAction`` gives a numeric variable a number (else a ValueError at run time)."""
+    kind, ref = decl.get("variableType", "string"), node.need("variableRef")
+    modify = node.find("ModifyAction")
+    rule = None if modify is None else modify.find("Rule")
+    what = None if rule is None or not rule.children else rule.children[0].tag
+    if modify is not None and what not in ("AddValue", "MultiplyByValue"):
+        raise invalid(modify, "a ModifyAction holds a Rule of AddValue or MultiplyByValue")
+    if modify is not None and kind not in NUMERIC:
+        raise invalid(node, f"variable {ref!r} is a {kind}: AddValue and MultiplyByValue "
+                      "apply to a number (int, double, unsignedInt, unsignedShort)")  # fmt: skip
+    given = ("SetAction", "AddValue", "MultiplyByValue")
+    values = [decl] + [n for n in node.iter() if n.tag in given]
+    for value in values if kind in NUMERIC else []:
+        value.num("value")  # InputError naming the element when not a number
 
 
 def check_places(root: Node, places: dict, lanes) -> None:

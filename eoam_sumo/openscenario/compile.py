@@ -160,6 +160,10 @@ def _private_action(plan: Plan, name: str, action: Node, t_s: float) -> float:
 
 
 def _place(plan: Plan, name: str, node: Node) -> Place:
+    """A ``LanePosition``, or a ``RelativeLanePosition``: ``dLane`` lanes on from the
+    reference's lane (ids counted along the road's t, as esmini), ``ds`` along the road's s
+    whatever the reference's direction (OpenSCENARIO 1.2: "relative offset in the road's
+    s coordinate"; esmini moves it in ROAD_DIRECTION)."""
     if node.tag == "LongitudinalDistanceAction":
         return _distance_place(plan, name, node)
     pos = node.find("Position")
@@ -170,9 +174,8 @@ def _place(plan: Plan, name: str, node: Node) -> Place:
     if where.tag == "LanePosition":
         return Place(where.need("roadId"), int(where.num("laneId")), where.num("s"), where, offset)
     ref = _placed(plan, where.need("entityRef"), where)
-    direction = 1 if ref.lane < 0 else -1
     lane = lane_plus(ref.lane, int(where.num("dLane", 0.0)))
-    return Place(ref.road, lane, ref.s_m + direction * where.num("ds"), where, offset)
+    return Place(ref.road, lane, ref.s_m + where.num("ds"), where, offset)  # ds: along s
 
 
 def _placed(plan: Plan, name: str, node: Node) -> Place:

@@ -45,9 +45,8 @@ def by_value(node: Node, world) -> bool:
     if tag == "SimulationTimeCondition":
         return compare(node, world.time_s)
     if tag == "ParameterCondition":
-        return _text_or_number(
-            node, world.parameters[node.need("parameterRef")], node.need("value")
-        )
+        have = node.parameters(world.parameters)[node.need("parameterRef")]
+        return _text_or_number(node, have, node.need("value"))
     if tag == "VariableCondition":
         return _text_or_number(node, world.variables[node.need("variableRef")], node.need("value"))
     if tag == "StoryboardElementStateCondition":

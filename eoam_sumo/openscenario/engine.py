@@ -28,6 +28,7 @@ from eoam_sumo.openscenario.story import (
     state_holds,
     walk,
 )
+from eoam_sumo.openscenario.subset import refuse
 from eoam_sumo.openscenario.sumofiles import DEPART_S
 from eoam_sumo.openscenario.xmltree import Node
 from eoam_sumo.sim.observers import StepObserver
@@ -282,14 +283,19 @@ def _take(actor: Actor, slot: str, motion) -> None:
 
 
 def _variable(world: World, node: Node) -> None:
+    """A ``VariableAction`` now: ``SetAction`` value=, or ``ModifyAction`` > ``Rule`` >
+    ``AddValue``/``MultiplyByValue`` value= (OpenSCENARIO 1.2 VariableModifyRule; the
+    variable is numeric, :mod:`.checks`)."""
     name = node.need("variableRef")
     set_ = node.find("SetAction") or node.find("VariableSetAction")
     if set_ is not None:
         world.variables[name] = set_.need("value")
         return
     modify = node.find("ModifyAction")
-    rule = None if modify is None else modify.children[0]
-    if rule is not None and rule.tag == "AddValue":
-        world.variables[name] = str(float(world.variables[name]) + rule.num("value"))
-    elif rule is not None and rule.tag == "MultiplyByValue":
-        world.variables[name] = str(float(world.variables[name]) * rule.num("value"))
+    rule = None if modify is None else modify.find("Rule")
+    what = None if rule is None or not rule.children else rule.children[0]
+    if what is None or what.tag not in ("AddValue", "MultiplyByValue"):
+        raise refuse(node, "a VariableAction sets (SetAction) or modifies (ModifyAction > Rule)")
+    have = float(world.variables[name])
+    new = have + what.num("value") if what.tag == "AddValue" else have * what.num("value")
+    world.variables[name] = repr(new)

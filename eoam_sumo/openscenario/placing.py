@@ -25,7 +25,7 @@ def place_now(world, actor: Actor, action: Node) -> None:
         else:
             ref = world.actors[where.need("entityRef")]
             actor.road, actor.lane = ref.road, lane_plus(ref.lane, int(where.num("dLane", 0.0)))
-            actor.s_m = ref.s_m + ref.direction * where.num("ds")
+            actor.s_m = ref.s_m + where.num("ds")  # along the road's s (as compile._place)
             actor.direction = ref.direction
         actor.offset_m = offset
         return

@@ -173,7 +173,8 @@ def _resolve(
         k: v if (node.tag, k) in UNUSED else _sub(v, values, node) for k, v in node.attrib.items()
     }
     kids = [c if c.tag in UNRESOLVED else _resolve(c, values, catalogs, via) for c in node.children]
-    return Node(node.tag, attrib, node.file, node.line, kids, via)
+    scope = values if node.tag == "ParameterCondition" else None  # sec. 8.4.1: its scope
+    return Node(node.tag, attrib, node.file, node.line, kids, via, scope)
 
 
 def _expand(ref: Node, values: dict[str, str], catalogs: list[Path]) -> Node:

@@ -50,6 +50,10 @@ STRUCTURE = frozenset(
         "FrontAxle",
         "RearAxle",
         "AdditionalAxle",
+        "TrailerHitch",
+        "TrailerCoupler",
+        "Trailer",
+        "TrailerRef",
         "ObjectController",
         "Controller",
         "Storyboard",
@@ -95,6 +99,10 @@ ACTIONS = frozenset(
         "VariableAction",
         "VariableSetAction",
         "SetAction",
+        "ModifyAction",
+        "Rule",
+        "AddValue",
+        "MultiplyByValue",
         "RelativeTargetSpeed",
         "LateralAction",
         "LaneChangeAction",
@@ -154,6 +162,8 @@ def invalid(node: Node, why: str) -> InputError:
 
 
 SHAPES = ("step", "linear", "cubic", "sinusoidal")
+# OpenSCENARIO 1.2 Rule: every condition's rule is one of these (sec. 7.4.3)
+RULES = ("greaterThan", "lessThan", "equalTo", "greaterOrEqual", "lessOrEqual", "notEqualTo")
 
 
 def _speed_dynamics(node: Node) -> None:
@@ -202,7 +212,8 @@ def _distance(node: Node) -> None:
 # elements that are a choice of exactly one child (OpenSCENARIO 1.2 XSD xsd:choice)
 ONE_CHILD = ("Condition", "ByValueCondition", "EntityCondition", "PrivateAction",
              "GlobalAction", "Position", "LongitudinalAction", "LateralAction",
-             "SpeedActionTarget", "LaneChangeTarget", "LaneOffsetTarget", "Action")  # fmt: skip
+             "SpeedActionTarget", "LaneChangeTarget", "LaneOffsetTarget", "Action",
+             "VariableAction", "Rule")  # fmt: skip
 # vehicleCategory values with a SUMO vehicle class (train, tram, trailers: none)
 CATEGORIES = ("car", "van", "truck", "bus", "motorbike", "bicycle")
 
@@ -242,6 +253,17 @@ def _vehicle(node: Node) -> None:
         raise refuse(node, f"vehicleCategory={category} is not supported ({', '.join(CATEGORIES)})")
 
 
+def _trailer(node: Node) -> None:
+    """A vehicle's ``Trailer`` (OpenSCENARIO 1.3: a ``Trailer`` entity or a ``TrailerRef``)
+    that names no trailer (esmini's catalog cars: ``TrailerRef entityRef=""``) tows none;
+    one that does is refused (a hitch point alone, ``TrailerHitch``, changes nothing)."""
+    kids = node.children
+    if all(k.tag == "TrailerRef" and not k.get("entityRef") for k in kids):
+        return
+    named = next((k.get("entityRef") or k.get("name") or k.tag for k in kids), "")
+    raise refuse(node, f"a vehicle towing a trailer ({named}) is not supported")
+
+
 def _reach(node: Node) -> None:
     pos = node.find("Position")
     if pos is None or pos.find("LanePosition") is None:
@@ -258,6 +280,7 @@ CHECKS: dict[str, Callable[[Node], None]] = {
     "ByEntityCondition": _by_entity,
     "Dimensions": _dimensions,
     "Vehicle": _vehicle,
+    "Trailer": _trailer,
     "ReachPositionCondition": _reach,
     "AbsoluteTargetSpeed": lambda n: _not_negative(n, "value", "a target speed"),
     "LanePosition": lambda n: _integer(n, "laneId"),
@@ -277,3 +300,5 @@ def check_subset(root: Node) -> None:
         check = CHECKS.get(node.tag)
         if check is not None:
             check(node)
+        if node.get("rule", RULES[0]) not in RULES:
+            raise invalid(node, f"rule={node.get('rule')} is not a rule ({', '.join(RULES)})")

@@ -23,6 +23,28 @@ START_STATES = ("startTransition", "runningState")
 END_STATES = ("completeState", "endTransition", "stopTransition")
 
 
+# SimulationTimeCondition rules that hold from time 0 (for a value above 0)
+FROM_START = ("lessThan", "lessOrEqual", "notEqualTo")
+
+
+def _first_time(node: Node) -> float:
+    """The first time >= 0 a ``SimulationTimeCondition`` holds, NEVER if none: every Rule
+    of OpenSCENARIO 1.2 (greaterThan, lessThan, equalTo, greaterOrEqual, lessOrEqual,
+    notEqualTo), as :func:`.conditions.compare` evaluates them during the run."""
+    rule, value = node.need("rule"), node.num("value")
+    if rule in ("greaterThan", "greaterOrEqual"):
+        return max(value, 0.0)
+    if rule == "equalTo":
+        return value if value >= 0.0 else NEVER
+    if rule == "lessThan":
+        return 0.0 if value > 0.0 else NEVER
+    if rule == "lessOrEqual":
+        return 0.0 if value >= 0.0 else NEVER
+    if rule == "notEqualTo":
+        return 0.0
+    raise refuse(node, f"rule={rule} is not a rule (OpenSCENARIO 1.2 Rule)")
+
+
 class NotYet(Exception):
     """A state condition on an element not timed yet (the caller retries after others)."""
 
@@ -58,15 +80,15 @@ class Clock:
     def _condition(self, cond: Node) -> float | str:
         delay = cond.num("delay", 0.0)
         inner = cond.children[0].children[0] if cond.children[0].children else cond
+        rule = inner.get("rule") if inner.tag == "SimulationTimeCondition" else None
+        if rule in FROM_START and cond.get("conditionEdge", "none") != "none":
+            return DYNAMIC  # true from the start: its edges are the run's (the engine's)
         t = self._value_time(inner)
         return t if t == DYNAMIC else float(t) + delay
 
     def _value_time(self, node: Node) -> float | str:
         if node.tag == "SimulationTimeCondition":
-            rule = node.need("rule")
-            if rule not in ("greaterThan", "greaterOrEqual", "equalTo"):
-                raise refuse(node, f"rule={rule} is not supported for a simulation time")
-            return node.num("value")
+            return _first_time(node)
         if node.tag == "ParameterCondition":
             return 0.0 if self._parameter_true(node) else NEVER
         if node.tag == "StoryboardElementStateCondition":
@@ -75,9 +97,10 @@ class Clock:
 
     def _parameter_true(self, node: Node) -> bool:
         ref, rule, want = node.need("parameterRef"), node.need("rule"), node.need("value")
-        if ref not in self.parameters:
+        scope = node.parameters(self.parameters)  # the Story's, if declared there
+        if ref not in scope:
             raise refuse(node, f"parameter {ref} is not declared")
-        have = self.parameters[ref]
+        have = scope[ref]
         try:
             a, b = float(have), float(want)
         except ValueError:  # text: equal or not

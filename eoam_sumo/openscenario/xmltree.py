@@ -24,6 +24,11 @@ class Node:
     line: int
     children: list[Node] = field(default_factory=list)
     via: str = ""  # the catalog reference this node was expanded from, if any
+    scope: dict[str, str] | None = None  # a ParameterCondition's parameters in scope
+
+    def parameters(self, top: dict[str, str]) -> dict[str, str]:
+        """The parameters in scope at this node (``top``: the scenario's, when not kept)."""
+        return top if self.scope is None else self.scope
 
     def where(self) -> str:
         """``<Tag> at FILE:LINE`` for messages (and the reference that brought it in)."""
