@@ -524,8 +524,11 @@ def _cmd_batch(args) -> int:
         return _run_matrix_batch(args)
     from eoam_sumo.batch.case import PRELOAD
     from eoam_sumo.batch.pool import warm_workers
+    from eoam_sumo.matrix import load_matrix
 
-    with warm_workers(args.jobs, PRELOAD):  # they import while this process plans the batch
+    # no more than its cases (a resumed batch: those left, known once planned; none warmed)
+    cases = 0 if args.resume else len(load_matrix(Path(args.matrix)).cases())
+    with warm_workers(args.jobs, PRELOAD, cases):  # they import while the batch is planned
         return _run_matrix_batch(args)
 
 

@@ -31,16 +31,18 @@ from eoam_sumo.sampling import Sample, parse_sample
 from eoam_sumo.seeds import check_seed
 from eoam_sumo.sensing.automotive import parse_radar_model
 from eoam_sumo.sensing.friction import parse_mu_belief
-from eoam_sumo.sim.scenario import ScenarioOverrides, check_scenario, scripted_stops
+from eoam_sumo.sim.scenario import ScenarioFiles, ScenarioOverrides, check_scenario, scripted_stops
+from eoam_sumo.sim.scenario.routes import check_oncoming_road
 from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S, MAX_TIME_LIMIT_S, check_sumo_step_s
 from eoam_sumo.sim.vehicle import vehicle_name, vehicle_tables, vehicle_tables_dir
 from eoam_sumo.textfiles import not_utf8
 from eoam_sumo.traffic_levels.hcm import LEVELS
 from eoam_sumo.traffic_levels.spec import (
     MIN_CURVE_RADIUS_M,
+    MIN_SPEED_LIMIT_KMH,
     ROADS,
-    SPEED_LIMIT_RANGE_KMH,
     TrafficSpec,
+    max_speed_limit_kmh,
 )
 from eoam_sumo.vehicle_files import DEFAULT_VEHICLE, load_vehicle
 
@@ -495,12 +497,17 @@ def _curve_radius(value) -> float | None:
     return _checked(MIN_CURVE_RADIUS_M, True)(value)
 
 
+def _speed_limit(value):
+    """A generated road's speed limit: up to the top speed the default tables cover."""
+    return _checked(MIN_SPEED_LIMIT_KMH, True, max_speed_limit_kmh())(value)
+
+
 #: The generated scenario's keys, with the check of one value of each.
 TRAFFIC_CHECKS = {
     "road": _road,
     "los": _los,
     "lanes": _lanes,
-    "speed_limit_kmh": _checked(SPEED_LIMIT_RANGE_KMH[0], True, SPEED_LIMIT_RANGE_KMH[1]),
+    "speed_limit_kmh": _speed_limit,
     "curve_radius_m": _curve_radius,
 }
 
@@ -943,7 +950,21 @@ def check_matrix(matrix: Matrix, tables_dir: Path | None = None, ego_id: str = "
                 scripted_stops(files, over, ego_id)
     except InputError as exc:
         raise InputError(f"{matrix.path}: [scenario] sumocfg: {exc}") from exc
+    _check_oncoming_road(matrix, files, ego_id)
     _check_vehicles_tables(matrix, tables_dir)
+
+
+def _check_oncoming_road(matrix: Matrix, files: ScenarioFiles, ego_id: str) -> None:
+    """An oncoming start (swept or sampled) only on a road with a lane of the other
+    direction beside the ego's route (``check_oncoming_road``), once per scenario file."""
+    starts = (*matrix.oncoming_starts_m, *_extremes(matrix, "oncoming_start_m"))
+    asked = [d for d in starts if d is not None]
+    if not asked:
+        return
+    try:
+        check_oncoming_road(files, ego_id)
+    except InputError as exc:
+        raise InputError(f"{matrix.path}: oncoming_start_m = {asked[0]:g}: {exc}") from exc
 
 
 def _check_vehicles_tables(matrix: Matrix, tables_dir: Path | None) -> None:

@@ -118,7 +118,7 @@ RULES: dict[str, tuple[set[str], set[str]]] = {
     "traffic_scenario": (set(), {"sumolib"}),
     "netbuild": ({"errors"}, {"sumolib", "sumo"}),
     "openscenario": ({"params", "errors", "fileio", "netbuild", "sim", "batch"}, {"sumolib"}),
-    "traffic_levels": ({"errors", "seeds", "netbuild", "outputs"}, {"numpy", "libsumo"}),
+    "traffic_levels": ({"errors", "seeds", "offline", "netbuild", "outputs"}, {"numpy", "libsumo"}),
     "bench": (
         {
             "params",

@@ -369,3 +369,37 @@ def test_sumo_step_is_a_scenario_key_checked_and_carried_by_every_case(tmp_path)
         path = _write(tmp_path, GOOD_SCENARIO + f"sumo_step_s = {bad}\n" + GOOD_SWEEP)
         with pytest.raises(InputError, match=r"m\.toml: \[scenario\] sumo_step_s"):
             load_matrix(path)
+
+
+ONE_WAY_NET = (
+    '<net version="1.20"><edge id="E0" from="w" to="e">'
+    '<lane id="E0_0" index="0" speed="50" length="3000" shape="0,-5.25 3000,-5.25"/>'
+    '<lane id="E0_1" index="1" speed="50" length="3000" shape="0,-1.75 3000,-1.75"/>'
+    "</edge></net>"
+)
+EGO_ROUTES = {
+    "named": '<routes><route id="r" edges="E0"/><vehicle id="ego" route="r" depart="1"/></routes>',
+    "embedded": '<routes><vehicle id="ego" depart="1"><route edges="E0"/></vehicle></routes>',
+}
+
+
+@pytest.mark.parametrize("route", sorted(EGO_ROUTES))
+def test_an_oncoming_start_on_a_one_way_road_is_refused_before_any_case(tmp_path, route):
+    """``batch`` checks the scenario's road for what the matrix asks before any case runs:
+    an oncoming car on a road without a lane of the other direction is bad input."""
+    from eoam_sumo.batch.runner import plan_batch
+
+    (tmp_path / "n.net.xml").write_text(ONE_WAY_NET)
+    (tmp_path / "r.rou.xml").write_text(EGO_ROUTES[route])
+    cfg = tmp_path / "s.sumocfg"
+    cfg.write_text(
+        '<configuration><input><net-file value="n.net.xml"/>'
+        '<route-files value="r.rou.xml"/></input></configuration>'
+    )
+    sweep = 'ego_speed_kmh = [120]\nmu = [1.0]\noncoming_start_m = ["none", 300]\n'
+    path = tmp_path / "m.toml"
+    path.write_text(f'[scenario]\nsumocfg = "s.sumocfg"\n[sweep]\n{sweep}')
+    with pytest.raises(InputError, match=r"m\.toml: oncoming_start_m = 300: .*n\.net\.xml: "):
+        plan_batch(path)
+    path.write_text(f'[scenario]\nsumocfg = "s.sumocfg"\n[sweep]\n{sweep.replace(", 300", "")}')
+    assert len(plan_batch(path).cases) == 1  # no oncoming car asked: the road is fine

@@ -309,14 +309,18 @@ _warm: list[_Worker] = []
 
 
 @contextlib.contextmanager
-def warm_workers(jobs: int, preload: Sequence[str] = ()) -> Generator[None, None, None]:
-    """Start ``jobs`` workers now, for the :func:`run_local` calls inside the block (with the
-    same ``preload``) to take before starting their own: a worker imports its modules while
-    the caller still prepares its tasks. Those not taken (no task left, or bad input found
-    meanwhile) are killed when the block ends: they hold no task, and waiting for one still
-    importing would keep a refusal waiting."""
+def warm_workers(
+    jobs: int, preload: Sequence[str] = (), tasks: int | None = None
+) -> Generator[None, None, None]:
+    """Start ``jobs`` workers now (no more than ``tasks``, the tasks known to come), for the
+    :func:`run_local` calls inside the block (with the same ``preload``) to take before
+    starting their own: a worker imports its modules while the caller still prepares its
+    tasks. Those not taken (no task left, or bad input found meanwhile) are killed when the
+    block ends: they hold no task, and waiting for one still importing would keep a refusal
+    waiting."""
     _check(jobs, 1.0)
-    started = [_Worker(preload) for _ in range(jobs)]
+    count = jobs if tasks is None else max(min(jobs, tasks), 0)
+    started = [_Worker(preload) for _ in range(count)]
     _warm.extend(started)
     try:
         yield

@@ -61,6 +61,12 @@ BOUNDARY_COLUMNS = (
 )
 
 
+def entry_speed_range_mps(speed_grid_mps) -> tuple[float, float]:
+    """The entry speeds a run may have on tables of this speed grid [m/s]: from
+    ``MIN_ENTRY_SPEED_KMH`` (or the grid's lowest, if lower) to the grid's highest."""
+    return min(MIN_ENTRY_SPEED_KMH / 3.6, speed_grid_mps[0]), speed_grid_mps[-1]
+
+
 def default_tables_dir() -> Path:
     """``$EOAM_TABLES_DIR`` if set, else the repository's ``tables/``."""
     env = os.environ.get("EOAM_TABLES_DIR")
@@ -304,13 +310,16 @@ class LookupTables:
             _LOADED[key] = tables
         return tables
 
+    def entry_speed_range_mps(self) -> tuple[float, float]:
+        """The entry speeds a run may have [m/s] (what ``check_run`` accepts)."""
+        return entry_speed_range_mps(self.speed_grid_mps)
+
     def check_run(self, mu: float, speed_mps: float) -> None:
         """Refuse (``InputError``) a run the tables do not cover: entry speed below
         ``MIN_ENTRY_SPEED_KMH`` or above the grid, or friction below the grid (above it the
         highest friction's tables are used: they ask for less than the road gives). Below the
         grid's lowest speed the DMM only brakes (``PhaseBoundaries._below_grid``)."""
-        low = min(MIN_ENTRY_SPEED_KMH / 3.6, self.speed_grid_mps[0])
-        top = self.speed_grid_mps[-1]
+        low, top = entry_speed_range_mps(self.speed_grid_mps)
         if not low - 1e-9 <= speed_mps <= top + 1e-9:
             raise InputError(
                 f"ego speed {speed_mps * 3.6:.1f} km/h is outside the design range "

@@ -2,7 +2,9 @@
 
 :func:`output_folder` locks ``PATH`` (:mod:`.lock`) and gives the command the folder to write:
 
-- ``PATH`` new, or empty but for its lock file: ``PATH`` itself;
+- ``PATH`` new, or empty but for its lock file: ``PATH`` itself; unless ``keep_partial``
+  (``protocol``: no ``--resume`` to finish it), what the command wrote is removed when it
+  raises: a new ``PATH`` (and the parents made for it) whole, an empty one back to empty;
 - ``PATH`` holding this kind of output (one of ``OutputKind.markers``, finished or not): a
   staging folder beside it, ``PATH.partial-<pid>``. When the command ends normally, the
   staging folder's paths recorded in its ``results.csv`` and ``summary.json`` files are made
@@ -43,10 +45,13 @@ class OutputKind:
 
 
 @contextlib.contextmanager
-def output_folder(path: Path, kind: OutputKind, *, in_place: bool = False) -> Iterator[Path]:
+def output_folder(
+    path: Path, kind: OutputKind, *, in_place: bool = False, keep_partial: bool = True
+) -> Iterator[Path]:
     """Lock ``path`` and yield the folder to write (module docstring); InputError in one line
     when another process writes it, it cannot be written, or it holds other files."""
     path = Path(path)
+    made = _first_missing(path)
     with locked(path):
         names = _entries(path)
         if names and not names & set(kind.markers):
@@ -54,12 +59,46 @@ def output_folder(path: Path, kind: OutputKind, *, in_place: bool = False) -> It
                 f"output folder {path} is not empty and holds no {kind.name} output (none of "
                 f"{', '.join(kind.markers)}); give a new or empty folder"
             )
+        if not names and not keep_partial:
+            with _undone_on_error(path, made):
+                yield path
+            return
         if not names or in_place:
             yield path
             return
         plain = path.name not in ("", ".", "..") and not path.is_symlink()
         with _staged(path if plain else path.resolve()) as stage:
             yield stage
+
+
+def _first_missing(path: Path) -> Path | None:
+    """The outermost of ``path`` and its parents that does not exist yet (None: it exists)."""
+    missing = None
+    for folder in (path, *path.parents):
+        if folder.exists() or folder.is_symlink():
+            break
+        missing = folder
+    return missing
+
+
+@contextlib.contextmanager
+def _undone_on_error(path: Path, made: Path | None) -> Iterator[None]:
+    """When the block raises, what it wrote into the new or empty ``path`` is removed: the
+    folders made for it (``made``) whole, else every entry but the lock file."""
+    try:
+        yield
+    except BaseException:
+        if made is not None:
+            shutil.rmtree(made, ignore_errors=True)
+        else:
+            for entry in _entries(path):
+                target = path / entry
+                if target.is_dir() and not target.is_symlink():
+                    shutil.rmtree(target, ignore_errors=True)
+                else:
+                    with contextlib.suppress(OSError):
+                        target.unlink()
+        raise
 
 
 def _entries(path: Path) -> set[str]:

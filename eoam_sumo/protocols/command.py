@@ -130,8 +130,8 @@ def run(args) -> int:
     points = selected_points(args)
     local = args.scheduler is None  # its workers import while the scenarios are written
     with (
-        warm_workers(args.jobs, PRELOAD) if local else contextlib.nullcontext(),
-        output_folder(Path(args.out), PROTOCOL_OUTPUT) as out,
+        warm_workers(args.jobs, PRELOAD, len(points)) if local else contextlib.nullcontext(),
+        output_folder(Path(args.out), PROTOCOL_OUTPUT, keep_partial=False) as out,
     ):
         summary = run_points(args, points, out)
     print(summary.line(Path(args.out)))

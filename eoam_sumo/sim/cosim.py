@@ -274,6 +274,7 @@ class CoSimulation:
         # vid -> True: first met in the ego's lane band ahead of the ego (the obstacle, which
         # keeps that identity once passed); False: first met behind it (a follower)
         self._met_ahead: dict[str, bool] = {}
+        self._obstacles: set[str] = set()  # road users once in the obstacle's role (``_role``)
         self.end_cause: str | None = None
         self.n_steps = 0
         self._stop_at: float | None = None
@@ -472,7 +473,7 @@ class CoSimulation:
         ego_move = math.hypot(Xn - x_prev[0], Yn - x_prev[1]) + self._ego_radius * abs(
             yawn - x_prev[2]
         )
-        road, lane_width, step_s = self.road, self.lane_width_m, self.settings.step_s
+        step_s = self.settings.step_s
         ego_box_radius, p = self._ego_box_radius, self.params
         gaps = self._gaps if (Xn, Yn, yawn) == self._gaps_pose else {}
         self._gaps, self._gaps_pose = {}, (Xn, Yn, yawn)
@@ -489,7 +490,7 @@ class CoSimulation:
             if circles_m > reach_m and circles_m >= min_gap_aro:
                 continue  # the box gap can be neither the ARO's least nor a contact
             # a parked car cannot be the ARO: its role is worked out only if it is hit
-            role = None if b.parked else role_of(b, road, lane_width)
+            role = None if b.parked else self._role(b)
             if circles_m > reach_m and role != "aro":
                 continue
             if ego_box is None:
@@ -523,9 +524,17 @@ class CoSimulation:
     def _role_hit(self, b, role: str | None, ego_x_m: float, ego_y_m: float) -> str:
         """The role of a road user hit (``role_of``; ``role`` when known): one in the ego's
         lane band first met behind the ego is a follower (``other``), never the obstacle."""
-        role = role or role_of(b, self.road, self.lane_width_m)
+        role = role or self._role(b)
         if role == "aro" and not self._met_ahead_of(b, ego_x_m, ego_y_m):
             return "other"
+        return role
+
+    def _role(self, b) -> str:
+        """``role_of`` a road user, remembering those once in the obstacle's role: one that
+        then crosses the ego's lane keeps it, cross traffic never in it does not."""
+        role = role_of(b, self.road, self.lane_width_m, was_obstacle=b.vid in self._obstacles)
+        if role == "aro":
+            self._obstacles.add(b.vid)
         return role
 
     def _met_ahead_of(self, b, ego_x_m: float, ego_y_m: float) -> bool:

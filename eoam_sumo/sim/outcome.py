@@ -78,6 +78,7 @@ from eoam_sumo.world.lanes import (
     LANE_MARGIN_M,
     STATIONARY_SPEED_MPS,
     RoadProjection,
+    crosses_lane,
     lane_band_m,
 )
 
@@ -126,6 +127,7 @@ def role_of(
     lane_width_m: float,
     *,
     in_lane_at_start: bool = False,
+    was_obstacle: bool = False,
     stationary_speed_mps: float = STATIONARY_SPEED_MPS,
     lane_margin_m: float = LANE_MARGIN_M,
 ) -> str:
@@ -134,8 +136,10 @@ def role_of(
     ``oncoming``: heading against the road direction there (more than 90 deg off it) and not
     parked, whatever its speed; ``aro``: otherwise, when its centre is inside the ego lane
     band (half-width lane_width/2 + lane_margin_m) or it was the vehicle ahead in the ego lane
-    at the start (``in_lane_at_start``); ``parked``: slower than ``stationary_speed_mps``
-    outside the band; ``other``: the rest.
+    at the start (``in_lane_at_start``), unless it crosses the lane (``crosses_lane``: cross
+    traffic at a junction) without having been the obstacle in it before (``was_obstacle``):
+    then ``other``; ``parked``: slower than ``stationary_speed_mps`` outside the band;
+    ``other``: the rest.
     """
     if not lane_width_m > 0.0:
         raise ValueError(f"lane_width_m={lane_width_m} must be > 0")
@@ -143,6 +147,9 @@ def role_of(
     if not body.parked and math.cos(body.yaw_rad - road_yaw) < 0.0:
         return "oncoming"
     if in_lane_at_start or abs(d) < lane_band_m(lane_width_m, lane_margin_m):
+        obstacle = in_lane_at_start or was_obstacle
+        if not obstacle and crosses_lane(body.speed_mps, body.yaw_rad, road_yaw):
+            return "other"
         return "aro"
     if abs(body.speed_mps) < stationary_speed_mps:
         return "parked"

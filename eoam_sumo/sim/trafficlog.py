@@ -23,7 +23,9 @@ the radar's classes are, with the radar's thresholds):
   ego (station beyond the ego's centre) or first met in the band ahead of it: the obstacle
   in the ego's lane, whatever it is (a stopped car, a person walking on the road), which
   keeps that role once passed (as ``min_gap_aro_m`` counts it); one first met in the band
-  behind the ego is a follower (``other``);
+  behind the ego is a follower (``other``), and so is one crossing the lane (``crosses_lane``:
+  more than 45 deg off the road's direction, faster than 2 m/s: cross traffic at a junction)
+  that was not the obstacle before it crossed;
 * ``other``: the rest (traffic in other lanes, behind the ego, people on the pavement).
 
 Cost in the step loop: one tuple kept per step (the ``Body`` tuples the loop already has are
@@ -42,7 +44,7 @@ import numpy as np
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.sim.observers import RunView, StepObserver
 from eoam_sumo.sim.roadframe import RoadFrame
-from eoam_sumo.world.lanes import ONCOMING_SPEED_MPS, lane_band_m
+from eoam_sumo.world.lanes import ONCOMING_SPEED_MPS, crosses_lane, lane_band_m
 
 TRAFFIC_FILE = "traffic.csv"
 #: traffic.csv columns, SI units in the names.
@@ -241,20 +243,21 @@ class TrafficLog(StepObserver):
             roles[k] = "parked"
         by_id = sorted(others.tolist(), key=lambda k: (ids[k], k))
         step_at = step_of.tolist()
-        previous, met_ahead = None, None
+        previous, met_ahead, was_aro = None, None, False
         for k in by_id:
             x, y = xs[k], ys[k]
             if ids[k] != previous:
                 road.locate(x, y)
-                previous, met_ahead = ids[k], None
+                previous, met_ahead, was_aro = ids[k], None, False
             s, d, road_yaw = road.project(x, y)
             if speeds[k] * math.cos(yaws[k] - road_yaw) < -ONCOMING_SPEED_MPS and d > -band:
                 roles[k] = "oncoming"
             elif abs(d) < band:
                 ahead = s > ego_s[step_at[k]]
                 met_ahead = ahead if met_ahead is None else met_ahead
-                if ahead or met_ahead:
-                    roles[k] = "aro"
+                crossing = crosses_lane(speeds[k], yaws[k], road_yaw)
+                if (ahead or met_ahead) and (was_aro or not crossing):
+                    roles[k], was_aro = "aro", True
         return roles
 
     def write(self, path: Path) -> None:

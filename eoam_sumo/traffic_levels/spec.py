@@ -7,6 +7,7 @@ import math
 from dataclasses import dataclass
 
 from eoam_sumo.errors import InputError
+from eoam_sumo.offline.tables import LookupTables
 from eoam_sumo.seeds import check_seed
 from eoam_sumo.traffic_levels.hcm import LEVELS
 
@@ -18,7 +19,15 @@ MAX_LANES = 6
 #: The tightest curve accepted [m]: the EOAM's tables are built on a straight road; 150 m is
 #: a design radius for about 70 km/h (any tighter is a bend for walking speeds here).
 MIN_CURVE_RADIUS_M = 150.0
-SPEED_LIMIT_RANGE_KMH = (30.0, 200.0)
+#: The lowest speed limit accepted [km/h]; the highest is the top of the default tables'
+#: speed grid (``max_speed_limit_kmh``): the ego departs at the speed limit.
+MIN_SPEED_LIMIT_KMH = 30.0
+
+
+def max_speed_limit_kmh() -> float:
+    """The highest speed limit a generated scenario may have [km/h]: the top entry speed
+    ``run`` accepts on the default tables (``LookupTables.check_run``)."""
+    return LookupTables.cached().entry_speed_range_mps()[1] * 3.6
 
 
 @dataclass(frozen=True)
@@ -45,8 +54,8 @@ class TrafficSpec:
             raise InputError(f"lanes {lanes}: a motorway has 2 to {MAX_LANES} lanes")
         limit = self.speed_limit_kmh
         limit = DEFAULT_SPEED_LIMIT_KMH[self.road] if limit is None else float(limit)
-        low, high = SPEED_LIMIT_RANGE_KMH
-        if not (math.isfinite(limit) and low <= limit <= high):
+        low, high = MIN_SPEED_LIMIT_KMH, max_speed_limit_kmh()
+        if not (math.isfinite(limit) and low <= limit <= high + 1e-9):
             raise InputError(f"speed limit {limit:g} km/h is outside [{low:g}, {high:g}]")
         radius = self.curve_radius_m
         if radius is not None:

@@ -10,6 +10,7 @@ under ``STATIONARY_SPEED_MPS`` (in absolute value) it is standing.
 
 from __future__ import annotations
 
+import math
 from typing import Protocol
 
 #: Below this speed a road user counts as standing [m/s]: SUMO reports exactly 0 for parked
@@ -23,6 +24,9 @@ ONCOMING_SPEED_MPS = 2.0
 #: beyond the marker (centre ~2.4 m beyond) and an oncoming car centred in the next lane
 #: (1.75 m beyond) are outside.
 LANE_MARGIN_M = 0.5
+#: A road user heading more than this off the road's direction, moving faster than
+#: ``ONCOMING_SPEED_MPS``, crosses the ego's lane (cross traffic at a junction) [rad].
+CROSSING_ANGLE_RAD = math.radians(45.0)
 
 
 class RoadProjection(Protocol):
@@ -36,3 +40,11 @@ class RoadProjection(Protocol):
 def lane_band_m(lane_width_m: float, margin_m: float = LANE_MARGIN_M) -> float:
     """Half-width [m] of the band around a lane's centre line that counts as in the lane."""
     return 0.5 * lane_width_m + margin_m
+
+
+def crosses_lane(speed_mps: float, yaw_rad: float, road_yaw_rad: float) -> bool:
+    """Whether a road user crosses the road rather than follows it: heading more than
+    ``CROSSING_ANGLE_RAD`` off the road's direction (either way), faster than
+    ``ONCOMING_SPEED_MPS`` (a person walking across at 1.5 m/s does not count)."""
+    along = abs(math.cos(yaw_rad - road_yaw_rad))
+    return abs(speed_mps) > ONCOMING_SPEED_MPS and along < math.cos(CROSSING_ANGLE_RAD)

@@ -139,3 +139,40 @@ def test_workers_run_native_thread_pools_single_threaded_unless_told(monkeypatch
     results = _by_key(run_local(os.getenv, tasks, jobs=1, timeout_s=120))
     assert results["blas"].value == "1"
     assert results["omp"].value == "3"
+
+
+def test_no_more_workers_are_warmed_than_there_are_tasks(monkeypatch, tmp_path):
+    """``protocol --jobs 3`` on one point starts one worker (and ``batch`` no more than its
+    cases); ``--jobs`` itself is checked as before."""
+    from eoam_sumo.cli import build_parser
+    from eoam_sumo.protocols import command
+
+    started = []
+
+    class Counted:
+        def __init__(self, preload):
+            started.append(preload)
+
+        def kill(self):
+            pass
+
+        def close(self):
+            pass
+
+    class Summary:
+        failed = 0
+
+        def line(self, out):
+            return "ok"
+
+    monkeypatch.setattr(pool, "_Worker", Counted)
+    monkeypatch.setattr(command, "run_points", lambda args, points, out: Summary())
+    args = build_parser().parse_args(
+        ["protocol", "unr152", "--out", str(tmp_path / "p"), "--jobs", "3", "--points", "^"]
+    )
+    points = command.selected_points(args)
+    args.points = f"^{points[0].point_id}$"
+    assert command.run(args) == 0
+    assert len(started) == 1
+    with pytest.raises(ValueError, match="jobs=0"), warm_workers(0, (), tasks=5):
+        pass

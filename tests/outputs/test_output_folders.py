@@ -161,3 +161,25 @@ def test_the_current_folder_is_replaced_by_its_real_path(tmp_path, monkeypatch):
         assert stage == out.resolve().with_name(f"out.partial-{os.getpid()}")
         (stage / "results.csv").write_text("new\n")
     assert snapshot(out) == {"results.csv": b"new\n"}
+
+
+def test_a_failed_first_protocol_run_leaves_no_folder(tmp_path, monkeypatch):
+    """``protocol`` into a new folder that fails (a scheduler it cannot reach) leaves no
+    folder, nor the parents made for it; into an empty one, the folder as it was."""
+    from eoam_sumo.cli import build_parser
+    from eoam_sumo.protocols import command
+
+    def fails(args, points, out):
+        (out / "scenarios").mkdir()
+        (out / "batch").mkdir()
+        raise InputError("cannot connect to the Dask scheduler 'tcp://127.0.0.1:1'")
+
+    monkeypatch.setattr(command, "run_points", fails)
+    for out in (tmp_path / "new" / "p", tmp_path / "empty"):
+        if out.name == "empty":
+            out.mkdir()
+        argv = ["protocol", "unr152", "--out", str(out), "--scheduler", "tcp://127.0.0.1:1"]
+        with pytest.raises(InputError, match="Dask scheduler"):
+            command.run(build_parser().parse_args(argv))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["empty"]
+    assert [p.name for p in (tmp_path / "empty").iterdir()] == [LOCK_NAME]

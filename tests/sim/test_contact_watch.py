@@ -13,10 +13,12 @@ from eoam_sumo.sim.settings import RunSettings
 from eoam_sumo.world.bodies import Body
 
 
-def _checked(front_gap_m: float, length_m: float) -> CoSimulation:
-    """A standing ego at the origin heading +x and a standing road user ``length_m`` long
-    whose rear is ``front_gap_m`` ahead of the ego's front bumper, in its lane; the contact
-    check run once."""
+def _checked(
+    front_gap_m: float, length_m: float, yaw_rad: float = 0.0, speed_mps: float = 0.0
+) -> CoSimulation:
+    """A standing ego at the origin heading +x and a road user ``length_m`` long (standing,
+    or moving at ``speed_mps`` heading ``yaw_rad``) whose rear is ``front_gap_m`` ahead of
+    the ego's front bumper, in its lane; the contact check run once."""
     sim = object.__new__(CoSimulation)
     sim.settings = settings = RunSettings()
     sim.params = p = settings.vehicle
@@ -27,10 +29,12 @@ def _checked(front_gap_m: float, length_m: float) -> CoSimulation:
     sim._cy, sim._sy = 1.0, 0.0
     sim._reach_pad_m, sim.t = 0.05, 10.0
     centre_x_m = p.cg_to_front_bumper_m + front_gap_m + 0.5 * length_m
-    other = Body("obstacle", "trailer", centre_x_m, 0.0, 0.0, 0.0, length_m, 2.5)
+    if yaw_rad:  # across the lane: its side faces the ego, ``front_gap_m`` ahead
+        centre_x_m = p.cg_to_front_bumper_m + front_gap_m + 1.25
+    other = Body("obstacle", "trailer", centre_x_m, 0.0, yaw_rad, speed_mps, length_m, 2.5)
     sim.bodies = sim.bodies_before = [other]
     sim.first_contact, sim.min_gap_aro_m = None, math.inf
-    sim._gaps, sim._gaps_pose, sim._met_ahead = {}, None, {}
+    sim._gaps, sim._gaps_pose, sim._met_ahead, sim._obstacles = {}, None, {}, set()
     sim.check_contact()
     return sim
 
@@ -55,3 +59,12 @@ def test_contact_with_a_long_obstacle_is_found(length_m):
 def test_a_car_beyond_the_watch_is_not_measured():
     """For a car the watch is as before: centres more than 20 m apart, no gap measured."""
     assert math.isinf(_checked(16.0, 4.5).min_gap_aro_m)
+
+
+def test_a_car_crossing_the_lane_at_a_junction_is_not_the_obstacle():
+    """A car crossing the ego's lane from the side (heading north at 15 m/s), hit with the
+    ego's front, is another road user, not the ARO (docs/outcomes.md, Roles)."""
+    sim = _checked(-0.3, 4.5, math.pi / 2, 15.0)
+    assert sim.first_contact is not None
+    assert sim.first_contact.role == "other"
+    assert math.isinf(sim.min_gap_aro_m)

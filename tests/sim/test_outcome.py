@@ -97,6 +97,18 @@ def test_role_of_uses_the_start_lane_flag_and_the_road_heading():
         role_of(aro, north, 0.0)
 
 
+def test_cross_traffic_in_the_ego_lane_is_not_the_obstacle_unless_it_was():
+    """A car crossing the ego's lane from the side at a junction (heading 80 deg off the
+    road, 15 m/s) is another road user, not the ARO; the ARO that swerves across its lane
+    stays the ARO, and a person walking across at 1.4 m/s is still the obstacle."""
+    crossing = _body(80.0, 0.0, math.radians(80.0), 15.0)
+    assert role_of(crossing, ROAD, LANE_M) == "other"
+    assert role_of(crossing, ROAD, LANE_M, was_obstacle=True) == "aro"
+    assert role_of(crossing, ROAD, LANE_M, in_lane_at_start=True) == "aro"
+    assert role_of(_body(80.0, 0.0, math.pi / 2, 1.4, (0.215, 0.478)), ROAD, LANE_M) == "aro"
+    assert role_of(_body(80.0, 0.0, math.radians(30.0), 15.0), ROAD, LANE_M) == "aro"
+
+
 # --- colours: one test per rule -----------------------------------------------------------
 
 

@@ -20,7 +20,7 @@ from eoam_sumo.params import (
     oncoming_sedan,
     parked_car,
 )
-from eoam_sumo.sim.scenario import ScenarioOverrides
+from eoam_sumo.sim.scenario import ScenarioOverrides, check_scenario
 from eoam_sumo.sim.session import SumoSession
 from eoam_sumo.world.bodies import nav_angle_deg, yaw_rad
 from tests.builders import (
@@ -424,6 +424,24 @@ def test_bad_scenarios_are_input_errors_naming_the_file(tmp_path):
         SumoSession.start(PARKED_ONLY, ScenarioOverrides(aro_hold_s=1.0))
     with pytest.raises(InputError, match="step_length_s"):
         SumoSession.start(BASELINE, step_length_s=0.0105)
+
+
+@pytest.mark.parametrize("end_s, refused", [(0.5, True), (3.0, False), (-1.0, False)])
+def test_an_end_before_the_ego_departs_is_refused_like_a_begin_after_it(tmp_path, end_s, refused):
+    """A sumocfg whose ``end`` comes before the ego's departure is refused before SUMO
+    starts, in one line naming the file and both times (SUMO's -1: no end)."""
+    routes = tmp_path / "r.rou.xml"
+    routes.write_text('<routes><vehicle id="ego" depart="1"><route edges="E0"/></vehicle></routes>')
+    cfg = write_sumocfg(tmp_path / "s.sumocfg", HIGHWAY_NET, routes)
+    text = cfg.read_text().replace("</input>", f'</input><time><end value="{end_s:g}"/></time>')
+    cfg.write_text(text)
+    if not refused:
+        assert check_scenario(cfg).options["end"] == f"{end_s:g}"
+        return
+    with pytest.raises(
+        InputError, match=r"s\.sumocfg: the simulation ends at 0\.5 s .* 'ego' departs \(1 s"
+    ):
+        check_scenario(cfg)
 
 
 @pytest.mark.sumo

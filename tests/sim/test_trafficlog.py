@@ -94,6 +94,23 @@ def test_the_obstacle_keeps_its_role_once_passed_and_a_follower_never_takes_it()
     assert {r for i, r in zip(c["id"], c["role"]) if i == "follower"} == {"other"}
 
 
+def test_cross_traffic_is_other_and_an_obstacle_that_turns_across_stays_the_obstacle():
+    """A car crossing the ego's lane ahead at a junction (heading north at 15 m/s) is
+    'other' while in the band; the ARO, in the lane along the road first, stays 'aro' when
+    it then turns across."""
+    log = _log()
+    for k in range(3):
+        cross = User(
+            "cross", "passenger", 150.0, -5.0 + 3.0 * k, math.pi / 2, 15.0, 4.7, 1.8, False
+        )
+        yaw = 0.0 if k == 0 else math.pi / 2
+        aro = User("aro", "passenger", 170.0, -1.75 + k, yaw, 10.0, 4.7, 1.8, False)
+        log.add(k * 0.1, _ego(100.0 + k), [cross, aro])
+    c = log.columns()
+    assert {r for i, r in zip(c["id"], c["role"]) if i == "cross"} == {"other"}
+    assert [r for i, r in zip(c["id"], c["role"]) if i == "aro"] == ["aro", "aro", "aro"]
+
+
 def test_written_file_has_the_columns_and_reads_back(tmp_path):
     log = _log()
     users = [User("p", "pedestrian", 120.0, -1.0, 1.0, 1.3, 0.2, 0.5, False)]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from eoam_sumo.errors import InputError
+from eoam_sumo.offline.tables import LookupTables
 from eoam_sumo.traffic_levels import hcm
 from eoam_sumo.traffic_levels.network import centre_line
 from eoam_sumo.traffic_levels.spec import TrafficSpec
@@ -54,9 +55,18 @@ def test_the_curve_has_its_radius():
         (TrafficSpec("motorway", "A", lanes=1), "2 to 6 lanes"),
         (TrafficSpec("motorway", "A", curve_radius_m=400.0), "rural road only"),
         (TrafficSpec("rural", "A", curve_radius_m=50.0), "must be >= 150"),
-        (TrafficSpec("rural", "A", speed_limit_kmh=500.0), "outside [30, 200]"),
+        (TrafficSpec("rural", "A", speed_limit_kmh=500.0), "outside [30, 175]"),
     ],
 )
 def test_bad_specs_are_named(spec, message):
     with pytest.raises(InputError, match=message.replace("[", r"\[")):
         spec.checked()
+
+
+def test_speed_limit_stops_where_the_tables_do():
+    """A generated road's speed limit is the ego's entry speed: the generator accepts up to
+    the default tables' top speed, what ``run`` accepts, and refuses one above it."""
+    top_kmh = LookupTables.cached().speed_grid_mps[-1] * 3.6
+    assert TrafficSpec("rural", "A", speed_limit_kmh=top_kmh).checked().speed_limit_kmh == top_kmh
+    with pytest.raises(InputError, match=rf"speed limit 200 km/h is outside \[30, {top_kmh:g}\]"):
+        TrafficSpec("rural", "A", speed_limit_kmh=200.0).checked()

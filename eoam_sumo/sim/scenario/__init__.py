@@ -1,7 +1,8 @@
 """A SUMO scenario as files: the ``.sumocfg`` and what it names (network, routes, additional
 files), checked before SUMO starts; the run's overrides; the vehicles whose stop is scripted.
 
-Modules: ``files`` (sumocfg, vehicles), ``network`` (opposite lanes, lane checks),
+Modules: ``files`` (sumocfg, vehicles, its end), ``network`` (opposite lanes, lane checks),
+``routes`` (the ego's route as written: an oncoming car needs a lane beside it),
 ``overrides`` (:class:`ScenarioOverrides`), ``stops`` (scripted emergency stops),
 ``xmlread`` and ``values`` (reading and checking helpers).
 """

@@ -76,7 +76,30 @@ def check_scenario(cfg: Path, ego_id: str = "ego") -> ScenarioFiles:
         raise InputError(
             f"{cfg}: no vehicle '{ego_id}' in its route or additional files ({searched})"
         )
-    return ScenarioFiles(cfg, nets[0], routes, additionals, vehicles, opposite, _options(root))
+    options = _options(root)
+    _check_end_after_departure(cfg, options, vehicles[ego_id])
+    return ScenarioFiles(cfg, nets[0], routes, additionals, vehicles, opposite, options)
+
+
+def _seconds(text: str | None) -> float | None:
+    """A time option or ``depart`` in seconds; None if absent or not a plain number."""
+    try:
+        value = float(text) if text is not None else math.nan
+    except ValueError:
+        return None
+    return value if math.isfinite(value) else None
+
+
+def _check_end_after_departure(cfg: Path, options: dict, ego: VehicleSpec) -> None:
+    """Refuse a sumocfg whose ``end`` (>= 0; SUMO's -1 is none) comes before the ego
+    departs, as the session refuses a ``begin`` after it: InputError naming both times."""
+    end_s, depart_s = _seconds(options.get("end")), _seconds(ego.attrs.get("depart", "0"))
+    if end_s is None or depart_s is None or end_s < 0.0 or end_s >= depart_s:
+        return
+    raise InputError(
+        f"{cfg}: the simulation ends at {end_s:g} s (<end>), before vehicle '{ego.vid}' "
+        f"departs ({depart_s:g} s, {ego.source.name})"
+    )
 
 
 def _vehicles(
