@@ -30,7 +30,7 @@ def plot_vehicle_test(
         or {True: "PASS", False: "FAIL", None: "figures only"}[summary.get("passed")]
     )
     fig.suptitle(
-        f"{summary['test']}: {summary['vehicle']}, {summary['speed_kmh']:g} km/h, "
+        f"{summary['test']}: {summary['vehicle']}, {summary['speed_kmh']:.1f} km/h, "
         f"mu {summary['mu']:g}, ABS {'on' if summary['abs'] else 'off'}, "
         f"ESC {'on' if summary['esc'] else 'off'} - {verdict}",
         fontsize=12,
