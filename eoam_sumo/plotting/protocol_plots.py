@@ -121,19 +121,25 @@ CELL_TEXT = {
 }
 
 
-def _legend(fig: Figure, kind: str) -> None:
-    """The colours (and the extended range's border) in one row, what a cell says under it."""
+def _legend(fig: Figure, kind: str) -> float:
+    """The colours (and the extended range's border) in one row, what a cell says under it,
+    wrapped to the figure's width; returns the height the text takes beyond one line (a
+    fraction of the figure's)."""
     handles: list = [Patch(facecolor=FILL[k], edgecolor="black", label=k) for k in LEGEND[kind]]
     if kind == "bands":
         handles.append(Line2D([], [], color="black", ls="--", lw=1.4, label="extended range"))
+    lines = textwrap.wrap(CELL_TEXT[kind], int(FOOTNOTE_CHARS_PER_INCH * fig.get_figwidth()))
+    line_height = 7 * 1.3 / 72 / fig.get_figheight()  # 7 pt type
+    extra = (len(lines) - 1) * line_height
     fig.legend(
         handles=handles,
         loc="lower center",
-        bbox_to_anchor=(0.5, 0.03),
+        bbox_to_anchor=(0.5, 0.03 + extra),
         ncol=len(handles),
         fontsize=7,
     )
-    fig.text(0.5, 0.01, CELL_TEXT[kind], ha="center", va="bottom", fontsize=7)
+    fig.text(0.5, 0.01, "\n".join(lines), ha="center", va="bottom", fontsize=7)
+    return extra
 
 
 def plot_scorecard(
@@ -162,8 +168,8 @@ def plot_scorecard(
     for ax in spare:
         ax.axis("off")
     fig.suptitle(headline, fontsize=9)
-    _legend(fig, kind)
-    fig.tight_layout(rect=(0, 0.08 if spare or not footnote else 0.14, 1, 0.95))
+    extra = _legend(fig, kind)
+    fig.tight_layout(rect=(0, (0.08 if spare or not footnote else 0.14) + extra, 1, 0.95))
     if footnote:  # placed after the layout, which it must not squeeze
         x, y = (spare[0].get_position().x0, spare[0].get_position().y1) if spare else (0.01, 0.13)
         width = FOOTNOTE_CHARS_PER_INCH * width * (1.0 - x) if spare else 200
