@@ -139,6 +139,19 @@ class VehicleParams:
         return self.front_steer_compliance * self.cornering_stiffness_front_npr
 
     @property
+    def understeer_gradient_rad_per_mps2(self) -> float:
+        """The linear single-track understeer gradient K_us = m (b / C_f - a / C_r) / L, C_f
+        the front axle's effective stiffness (``front_axle_stiffness_npr``; Gillespie ch. 6)."""
+        return (
+            self.mass_kg
+            * (
+                self.cg_to_rear_m / self.front_axle_stiffness_npr
+                - self.cg_to_front_m / self.cornering_stiffness_rear_npr
+            )
+            / self.wheelbase_m
+        )
+
+    @property
     def cg_to_front_bumper_m(self) -> float:
         """Distance from the CG forward to the front bumper (SUMO places the front bumper)."""
         return self.cg_to_front_m + self.front_overhang_m

@@ -215,23 +215,6 @@ CATALOGUE_HEADER = (
 )
 
 
-def linear_understeer_deg_per_g(params: VehicleParams) -> float:
-    """The linear single-track understeer gradient ``m g / L (b / C_f - a / C_r)`` [deg/g],
-    C_f the front axle's effective cornering stiffness (its tyres' times the steering
-    compliance)."""
-    p = params
-    weight_n = p.mass_kg * G_MPS2
-    rad = (
-        weight_n
-        / p.wheelbase_m
-        * (
-            p.cg_to_rear_m / p.front_axle_stiffness_npr
-            - p.cg_to_front_m / p.cornering_stiffness_rear_npr
-        )
-    )
-    return math.degrees(rad)
-
-
 def catalogue_row(name: str, directory: Path | None = None) -> str:
     """One vehicle's row of the catalogue table (``CATALOGUE_HEADER``), from its file."""
     p = load_vehicle(name, directory)
@@ -251,6 +234,6 @@ def catalogue_row(name: str, directory: Path | None = None) -> str:
         f"{p.length_m:.2f} x {p.width_m:.2f}",
         f"{p.brake_front_share:.3f}",
         f"{p.front_axle_stiffness_npr / 1e3:.0f} / {p.cornering_stiffness_rear_npr / 1e3:.0f}",
-        f"{linear_understeer_deg_per_g(p):.2f}",
+        f"{math.degrees(p.understeer_gradient_rad_per_mps2 * G_MPS2):.2f}",
     )
     return "| " + " | ".join(cells) + " |"

@@ -95,13 +95,9 @@ def axle_cornering_stiffness_npr(params: VehicleParams) -> tuple[float, float]:
 
 
 def understeer_gradient(params: VehicleParams) -> float:
-    """K_us = m (b / C_f - a / C_r) / L [rad per m/s^2] (``axle_cornering_stiffness_npr``)."""
-    c_f, c_r = axle_cornering_stiffness_npr(params)
-    return (
-        params.mass_kg
-        * (params.cg_to_rear_m / c_f - params.cg_to_front_m / c_r)
-        / (params.wheelbase_m)
-    )
+    """K_us = m (b / C_f - a / C_r) / L [rad per m/s^2] (``axle_cornering_stiffness_npr``:
+    ``VehicleParams.understeer_gradient_rad_per_mps2``)."""
+    return params.understeer_gradient_rad_per_mps2
 
 
 def single_track_matrices(params: VehicleParams, speed_mps: float):

@@ -99,9 +99,6 @@ def constants(p: VehicleParams) -> Chassis:
     c_front = p.front_axle_stiffness_npr
     k_lat = c_front + p.cornering_stiffness_rear_npr
     zeta2 = 2.0 * LOW_SPEED_DAMPING_RATIO
-    understeer = p.mass_kg * (
-        p.cg_to_rear_m / c_front - p.cg_to_front_m / p.cornering_stiffness_rear_npr
-    )
     share = {"fwd": 1.0, "rwd": 0.0}.get(p.drivetrain, p.awd_front_share)
     per_bar = p.max_brake_force_n / p.max_brake_pressure_bar
     front = 0.5 * per_bar * p.brake_front_share
@@ -116,7 +113,7 @@ def constants(p: VehicleParams) -> Chassis:
         damping_speed_long_mps=zeta2 * math.sqrt(k_long * p.relaxation_length_long_m / p.mass_kg),
         damping_speed_lat_mps=zeta2 * math.sqrt(k_lat * p.relaxation_length_lat_m / p.mass_kg),
         peak_slip_per_mu=peak_slip(PAC2002_235_60R16) / tyre.pdx1,
-        understeer_spmpm=understeer / p.wheelbase_m,
+        understeer_spmpm=p.understeer_gradient_rad_per_mps2,
         yaw_damping_nmspr=p.cg_to_front_m**2 * c_front
         + p.cg_to_rear_m**2 * p.cornering_stiffness_rear_npr,
         front_share=share,

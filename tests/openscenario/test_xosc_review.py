@@ -181,6 +181,19 @@ def test_bad_input_is_refused_in_one_line_before_the_run(
     assert re.search(says, _refusal(write_case(tmp_path, edit)))
 
 
+def _distribution(folder: Path, body: str) -> Path:
+    """``folder/dist.xosc``: a parameter value distribution over ``case.xosc`` holding
+    ``body`` beside its ScenarioFile."""
+    dist = folder / "dist.xosc"
+    dist.write_text(
+        '<OpenSCENARIO><FileHeader revMajor="1" revMinor="2" date="" description="" author=""/>'
+        f'<ParameterValueDistribution><ScenarioFile filepath="case.xosc"/>{body}'
+        "</ParameterValueDistribution></OpenSCENARIO>",
+        encoding="utf-8",
+    )
+    return dist
+
+
 def test_nan_given_to_a_parameter_is_refused_naming_it(tmp_path: Path) -> None:
     text = _refusal(write_case(tmp_path), TargetSpeed="nan")
     assert "parameter TargetSpeed = 'nan' is not a finite number" in text
@@ -190,13 +203,7 @@ def test_a_distribution_with_only_its_scenario_file_is_refused(tmp_path: Path) -
     from eoam_sumo.openscenario.variations import load_batch
 
     write_case(tmp_path)
-    dist = tmp_path / "dist.xosc"
-    dist.write_text(
-        '<OpenSCENARIO><FileHeader revMajor="1" revMinor="2" date="" description="" author=""/>'
-        '<ParameterValueDistribution><ScenarioFile filepath="case.xosc"/>'
-        "</ParameterValueDistribution></OpenSCENARIO>",
-        encoding="utf-8",
-    )
+    dist = _distribution(tmp_path, "")
     for read in (read_scenario, load_batch):
         with pytest.raises(InputError, match=r"no distribution .Deterministic. beside"):
             read(dist)
@@ -443,14 +450,11 @@ def test_a_catalog_assignment_names_what_is_wrong(tmp_path: Path) -> None:
 
 def test_a_distribution_setting_an_undeclared_parameter_says_so(tmp_path: Path) -> None:
     write_case(tmp_path)
-    dist = tmp_path / "dist.xosc"
-    dist.write_text(
-        '<OpenSCENARIO><ParameterValueDistribution><ScenarioFile filepath="case.xosc"/>'
+    dist = _distribution(
+        tmp_path,
         '<Deterministic><DeterministicSingleParameterDistribution parameterName="Speeed">'
         '<DistributionSet><Element value="3"/></DistributionSet>'
-        "</DeterministicSingleParameterDistribution></Deterministic>"
-        "</ParameterValueDistribution></OpenSCENARIO>",
-        encoding="utf-8",
+        "</DeterministicSingleParameterDistribution></Deterministic>",
     )
     with pytest.raises(InputError, match=r"dist.xosc:1: sets parameter Speeed, which .*case"):
         read_scenario(dist)
