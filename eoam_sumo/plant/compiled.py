@@ -33,7 +33,7 @@ from eoam_sumo.plant.codegen import (
     step_function,
 )
 from eoam_sumo.plant.model import INPUT_NAMES, OUTPUT_NAMES, STATE_NAMES
-from eoam_sumo.plant.stepping import check_mu, validate_step
+from eoam_sumo.plant.stepping import check_mu, stable_substeps, validate_step
 
 BACKEND_C = "compiled-c"
 BACKEND_VM = "casadi-vm"
@@ -118,7 +118,9 @@ class Plant:
     (``OUTPUT_NAMES``, evaluated at ``x_next``) are 1-D float arrays (``advance``: lists of
     floats, for loops that keep the state in plain floats); ``mu`` is the peak surface
     friction under the vehicle for this step. The model is ``model.rhs`` integrated by the
-    midpoint rule (``integrator.py``). The C library is built on first construction (a few
+    midpoint rule (``integrator.py``), ``dt_s`` split further where a vehicle's wheel-and-tyre
+    mode needs it (``stepping.stable_substeps``; ``dt_s`` and ``substeps`` then say what runs).
+    The C library is built on first construction (a few
     seconds) and cached in ``cache_dir`` (default ``codegen.default_cache_dir()``). Instances
     hold their own buffers: one instance must not be stepped from two threads at once.
     """
@@ -133,8 +135,9 @@ class Plant:
         cache_dir: str | Path | None = None,
     ):
         validate_step(params, dt_s, substeps)
+        dt_s, substeps = stable_substeps(params, float(dt_s), substeps)
         self.params = params
-        self.dt_s = float(dt_s)
+        self.dt_s = dt_s
         self.substeps = substeps
         self._use_compiler = bool(use_compiler)
         self._cache_dir = Path(cache_dir) if cache_dir is not None else default_cache_dir()

@@ -12,7 +12,7 @@ from eoam_sumo.params import VehicleParams
 from eoam_sumo.plant.integrator import advance
 from eoam_sumo.plant.model import INPUT_NAMES, STATE_NAMES
 from eoam_sumo.plant.ops import FLOAT_OPS
-from eoam_sumo.plant.stepping import check_mu, validate_step
+from eoam_sumo.plant.stepping import check_mu, stable_substeps, validate_step
 
 
 class ReferencePlant:
@@ -21,8 +21,7 @@ class ReferencePlant:
     def __init__(self, params: VehicleParams, dt_s: float = 1e-3, substeps: int = 10):
         validate_step(params, dt_s, substeps)
         self.params = params
-        self.dt_s = float(dt_s)
-        self.substeps = substeps
+        self.dt_s, self.substeps = stable_substeps(params, float(dt_s), substeps)
 
     @property
     def step_s(self) -> float:

@@ -6,7 +6,13 @@ import math
 
 import numpy as np
 
-from eoam_sumo.params import AIR_DENSITY_KGPM3, G_MPS2, VehicleParams, ego_e_class_sedan
+from eoam_sumo.params import (
+    AIR_DENSITY_KGPM3,
+    G_MPS2,
+    TYRE_LOAD_RANGE,
+    VehicleParams,
+    ego_e_class_sedan,
+)
 from eoam_sumo.plant.chassis import MU_EST_HIGH, constants
 from eoam_sumo.plant.model import (
     DRIVE,
@@ -23,9 +29,10 @@ from eoam_sumo.plant.model import (
 )
 
 MAX_DT_S = 0.002
-"""Largest sub-step accepted: keeps the wheel-and-tyre mode (about 160 rad/s) and the slip
-relaxation at speed (``|v| / sigma``, under 200 1/s) well inside the midpoint rule's stability
-region (|lambda dt| < 0.35)."""
+"""Largest sub-step accepted: keeps the sedan's wheel-and-tyre mode (about 160 rad/s; a faster
+one splits the sub-step: ``stable_substeps``) and the slip relaxation at speed
+(``|v| / sigma``, under 200 1/s) well inside the midpoint rule's stability region
+(|lambda dt| < 0.35)."""
 
 
 def validate_step(params: VehicleParams, dt_s: float, substeps: int) -> None:
@@ -40,6 +47,38 @@ def validate_step(params: VehicleParams, dt_s: float, substeps: int) -> None:
             raise ValueError(
                 f"vehicle parameter {name}={getattr(params, name)} must be >= dt_s={dt_s}"
             )
+
+
+WHEEL_MODE_STEP_BOUND = 0.35
+"""Largest ``omega_n dt`` of the wheel-and-tyre mode a sub-step may have (``MAX_DT_S``'s bound
+on |lambda dt|: the midpoint rule's stability region barely reaches along the imaginary axis,
+so a lightly damped mode must stay well inside it)."""
+
+
+def wheel_mode_radps(params: VehicleParams) -> float:
+    """Natural frequency [rad/s] of the stiffest wheel on its tyre's longitudinal relaxation
+    spring: ``I omega' = -r K kappa`` and ``sigma kappa' = omega r - ...`` (Pacejka 2012
+    sec. 7.2.1) give ``omega_n^2 = r^2 K / (I sigma)``, K the slip stiffness ``PKX1 Fz`` at
+    the most load a tyre is meant to carry (``TYRE_LOAD_RANGE``'s top multiple of the heavier
+    axle's static tyre load)."""
+    p = params
+    ch = constants(p)
+    axle_n = p.mass_kg * G_MPS2 * max(p.cg_to_front_m, p.cg_to_rear_m) / p.wheelbase_m
+    k_n = ch.tyre.pkx1 * TYRE_LOAD_RANGE[1] * 0.5 * axle_n
+    return math.sqrt(
+        p.wheel_radius_m**2 * k_n / (p.wheel_inertia_kgm2 * p.relaxation_length_long_m)
+    )
+
+
+def stable_substeps(params: VehicleParams, dt_s: float, substeps: int) -> tuple[float, int]:
+    """The sub-step and count the plant integrates ``dt_s * substeps`` with: ``dt_s`` split
+    into the fewest equal parts that keep the wheel-and-tyre mode within
+    ``WHEEL_MODE_STEP_BOUND`` (a light wheel on a stiff, short-relaxation tyre), so the step's
+    length is unchanged; ``(dt_s, substeps)`` itself for every catalogue vehicle."""
+    parts = math.ceil(dt_s * wheel_mode_radps(params) / WHEEL_MODE_STEP_BOUND - 1e-9)
+    if parts <= 1:
+        return dt_s, substeps
+    return dt_s / parts, substeps * parts
 
 
 def check_mu(mu: float) -> float:
