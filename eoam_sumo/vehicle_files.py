@@ -144,7 +144,10 @@ def _typed(value, f: dataclasses.Field, path: Path):
     """The value in the field's type (the default's); its range is the dataclass's check."""
     kind = type(f.default)
     if kind is float and isinstance(value, (int, float)) and not isinstance(value, bool):
-        return float(value)
+        try:
+            return float(value)
+        except OverflowError:
+            raise InputError(f"{path}: key {f.name!r} = {value} is too large for a float") from None
     if isinstance(value, kind) and not (kind is int and isinstance(value, bool)):
         return value
     raise InputError(f"{path}: key {f.name!r} = {value!r} must be a {kind.__name__}")

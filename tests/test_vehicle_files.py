@@ -95,6 +95,12 @@ def test_a_value_of_the_wrong_type_is_named(tmp_path):
         load_vehicle(str(_write(tmp_path, text)))
 
 
+def test_an_integer_too_large_for_a_float_is_named(tmp_path):
+    text = vehicle_toml(ego_e_class_sedan()).replace("value = 1723.0", "value = 1" + "0" * 400)
+    with pytest.raises(InputError, match=r"key 'mass_kg' = 10+ is too large for a float"):
+        load_vehicle(str(_write(tmp_path, text)))
+
+
 def test_broken_toml_and_unknown_names_are_one_line_errors(tmp_path):
     with pytest.raises(InputError, match=r"car\.toml: not valid TOML"):
         load_vehicle(str(_write(tmp_path, "[mass_kg\n")))

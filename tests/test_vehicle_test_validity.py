@@ -15,6 +15,7 @@ from eoam_sumo.vehicle_files import load_vehicle
 from eoam_sumo.vehicle_tests.command import TEST_NAMES
 from eoam_sumo.vehicle_tests.common import VehicleTestOptions, verdict, verdict_text
 from eoam_sumo.vehicle_tests.procedures import TESTS
+from eoam_sumo.vehicle_tests.sine_with_dwell import outside_scope
 from eoam_sumo.vehicle_tests.steer_figures import drift_over_window, linear_range_g
 
 R13H = load_vehicle("sedan-r13h")
@@ -142,3 +143,54 @@ def test_the_drift_over_the_last_second_is_the_change_of_a_ramp():
 )
 def test_the_verdict_never_makes_a_missing_measurement_a_pass(summary, word):
     assert verdict(summary) == word
+
+
+def test_a_brake_ramp_without_a_locked_axle_is_not_measured():
+    """R13-H Annex 5 judges the order in which the axles lock: with ABS no wheel locks on any
+    ramp, so there is no order to judge (it was a PASS)."""
+    abs_on = dataclasses.replace(R13H, abs_fitted=True)
+    summary = TESTS["brake-ramp"](abs_on, VehicleTestOptions()).summary
+    assert summary["figures"]["first_locked_axle"] == "none"
+    assert summary["passed"] is None
+    assert summary["criteria"] == []
+    assert "ABS kept every wheel from locking" in summary["not_measured"]
+    assert verdict(summary) == "NOT MEASURED"
+
+
+@pytest.mark.parametrize("speed_kmh", [1.0, 3.5, 4.0])
+def test_brake_in_turn_at_walking_pace_is_not_measured(speed_kmh):
+    """At a few km/h every brake of the series stops the car within the 1 s after its onset at
+    which ISO 7975 takes the figures (1-3.5 km/h crashed, 4 km/h reported the last sample)."""
+    result = TESTS["brake-in-turn"](R13H, VehicleTestOptions(speed_kmh=speed_kmh))
+    assert result.summary["figures"]["runs"] == []
+    assert "stopped" in result.summary["not_measured"]
+    assert verdict(result.summary) == "NOT MEASURED"
+
+
+def test_brake_in_turn_keeps_the_runs_measured_before_the_car_stops_within_the_second():
+    """At 15 km/h (4.2 m/s) a brake of 4 m/s^2 or more stops the car within 1 s: the series
+    ends there, its measured runs kept and the cut said."""
+    summary = TESTS["brake-in-turn"](R13H, VehicleTestOptions(speed_kmh=15.0)).summary
+    runs = summary["figures"]["runs"]
+    assert [r["target_deceleration_mps2"] for r in runs] == [1.0, 2.0, 3.0]
+    assert "from 4 m/s^2 on" in summary["figures"]["series_cut"]
+    assert verdict(summary) == "figures only"
+
+
+def test_a_sine_with_dwell_without_a_is_not_measured():
+    """On mu 0.25 the slowly increasing steer never reaches 0.3 g: no A, no series, and the
+    standard's pass mark not met by anything measured (it said "figures only")."""
+    compact = load_vehicle("compact")
+    summary = TESTS["sine-with-dwell"](compact, VehicleTestOptions(mu=0.25)).summary
+    assert summary["figures"]["A_deg"] is None
+    assert "never reached 0.3 g" in summary["not_measured"]
+    assert verdict(summary) == "NOT MEASURED"
+
+
+def test_a_vehicle_heavier_than_the_esc_standard_covers_gets_figures_only():
+    """FMVSS 126 applies up to 4 536 kg gross (S3): heavier, every criterion unjudged."""
+    summary = {"criteria": [{"name": "amp_5A.yaw_ratio_1s", "passed": False}], "passed": False}
+    outside_scope(summary, 12000.0)
+    assert summary["passed"] is None
+    assert summary["criteria"][0]["passed"] is None
+    assert verdict_text(summary).startswith("figures only: 12000 kg is above the 4536 kg")

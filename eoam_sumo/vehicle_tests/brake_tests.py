@@ -196,6 +196,12 @@ def _ramp_result(
         "ramp_runs": tries,
         "lock_sequence_clause": c.CITE["lock_sequence"],
     }
+    if order.first == "none":
+        summary["criteria"], summary["passed"] = [], None
+        summary["figures"]["not_measured"] = summary["not_measured"] = _no_lock_reason(
+            params, run, rate_n_per_s
+        )
+        return VehicleTestResult("brake-ramp", (run,), summary)
     summary["criteria"] = [
         {
             "name": "front_locks_first_between_braking_rates",
@@ -208,6 +214,22 @@ def _ramp_result(
     ]
     summary["passed"] = passed
     return VehicleTestResult("brake-ramp", (run,), summary)
+
+
+def _no_lock_reason(params: VehicleParams, run: Run, rate_n_per_s: float) -> str:
+    """Why a ramp without a locked axle measured no lock sequence (R13-H Annex 5 judges the
+    order in which the axles lock: none locked, nothing to judge)."""
+    why = (
+        "the ABS kept every wheel from locking"
+        if params.abs_fitted
+        else "the brakes could not lock a wheel on this road"
+    )
+    return (
+        f"no axle locked on the ramps ({why}; last ramp "
+        f"{rate_n_per_s / (params.mass_kg * G_MPS2):.2f} g/s up to "
+        f"{params.max_brake_force_n:.0f} N, peak braking rate "
+        f"{float(np.max(-run['ax_mps2'])) / G_MPS2:.2f} g): no lock sequence to judge"
+    )
 
 
 def _ramp_run(

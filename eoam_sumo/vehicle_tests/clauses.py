@@ -6,10 +6,14 @@ Sources (found in the regulations' public texts and NHTSA's papers on them):
   Regulation No. 140 (ESC) takes over the same test (Annex 3). S7.6: slowly increasing steer at
   80 km/h, 13.5 deg/s, to find A (the hand-wheel angle of 0.3 g). S7.9: sine with dwell, one
   0.7 Hz sine cycle with a 500 ms pause between its third and fourth quarter; amplitudes from
-  1.5 A in steps of 0.5 A up to 6.5 A or 270 deg. S5.2.1 / S5.2.2: the yaw rate 1.0 s and
-  1.75 s after the completion of steer at most 35 % and 20 % of the first yaw-rate peak after
-  the second steering reversal. S5.2.3: from 5 A, a lateral displacement of the centre of
-  gravity of at least 1.83 m (vehicles up to 3 500 kg gross) 1.07 s after the beginning of steer.
+  1.5 A in steps of 0.5 A up to 6.5 A or 270 deg, at most 300 deg (S7.9.4). S5.2.1 / S5.2.2:
+  the yaw rate 1.0 s and 1.75 s after the completion of steer at most 35 % and 20 % of the
+  first yaw-rate peak after the second steering reversal. S5.2.3: from 5 A, a lateral
+  displacement of the centre of gravity of at least 1.83 m (vehicles up to 3 500 kg gross;
+  1.52 m above) 1.07 s after the beginning of steer. S3: light vehicles up to 4 536 kg
+  (10 000 lb) gross. (The 300 deg cap and the heavier vehicles' 1.52 m as worded in GTR 8's
+  Chinese adoption, GB/T 30677-2014 7.7.6 and 5.1.4, ACEA's translation: the FMVSS text was
+  not in the search corpora.)
 - UN Regulation No. 13-H (braking of passenger cars), harmonised with FMVSS No. 135. Annex 3
   (R13 Annex 4) para. 1.1.2: the stopping distance runs from the first actuation of the control
   to the stop; the mean fully developed deceleration is ``(vb^2 - ve^2) / (25.92 (se - sb))``
@@ -51,10 +55,17 @@ SWD_FIRST_AMPLITUDE_A = 1.5  # FMVSS 126 S7.9
 SWD_AMPLITUDE_STEP_A = 0.5  # FMVSS 126 S7.9
 SWD_LAST_AMPLITUDE_A = 6.5  # FMVSS 126 S7.9
 SWD_LAST_AMPLITUDE_DEG = 270.0  # FMVSS 126 S7.9 (the greater of 6.5 A and 270 deg)
+SWD_MAX_AMPLITUDE_DEG = 300.0  # FMVSS 126 S7.9.4 (no run above; then the last run 300 deg)
+#: Ours: an amplitude of the series within this of the last run's is that run [deg] (7 A of
+#: A = 38.563 deg is 269.94 deg: one run at 270 deg, not two).
+SWD_SAME_AMPLITUDE_DEG = 1.0
 YAW_RATIO_1S_MAX = 0.35  # FMVSS 126 S5.2.1, 1.0 s after completion of steer
 YAW_RATIO_175S_MAX = 0.20  # FMVSS 126 S5.2.2, 1.75 s after completion of steer
 DISPLACEMENT_TIME_S = 1.07  # FMVSS 126 S5.2.3, after the beginning of steer
 DISPLACEMENT_MIN_M = 1.83  # FMVSS 126 S5.2.3, gross vehicle mass up to 3 500 kg
+DISPLACEMENT_MIN_HEAVY_M = 1.52  # FMVSS 126 S5.2.3, gross vehicle mass above 3 500 kg
+DISPLACEMENT_HEAVY_ABOVE_KG = 3500.0  # FMVSS 126 S5.2.3
+SWD_MAX_MASS_KG = 4536.0  # FMVSS 126 S3: vehicles of 10 000 lb gross or less
 DISPLACEMENT_FROM_A = 5.0  # FMVSS 126 S5.2.3, amplitudes of 5 A and more
 
 BRAKE_SPEED_KMH = 100.0  # R13-H Annex 3 para. 2.1.1 (Type-0)

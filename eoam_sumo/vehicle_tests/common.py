@@ -79,10 +79,13 @@ def verdict(summary: Mapping[str, Any]) -> str:
 
 
 def verdict_text(summary: Mapping[str, Any]) -> str:
-    """The verdict with its reasons: why nothing was measured, or why a criterion failed."""
+    """The verdict with its reasons: why nothing was measured, why a criterion failed, or why
+    figures carry no verdict (the summary's ``note``)."""
     word = verdict(summary)
     if word == "NOT MEASURED":
         reasons = [summary["not_measured"]]
+    elif word == "figures only" and summary.get("note"):
+        reasons = [summary["note"]]
     else:
         criteria = summary.get("criteria", [])
         reasons = [c["reason"] for c in criteria if c.get("passed") is False and c.get("reason")]

@@ -64,13 +64,26 @@ def sine_with_dwell_steer(t_s: float, amplitude: float) -> float:
 
 def amplitudes_deg(a_deg: float) -> list[float]:
     """The series' hand-wheel amplitudes: 1.5 A, 2 A, ... up to the greater of 6.5 A and
-    270 deg (the last one exactly that)."""
-    last_deg = max(c.SWD_LAST_AMPLITUDE_A * a_deg, c.SWD_LAST_AMPLITUDE_DEG)
+    270 deg (the last one exactly that), or 300 deg where 6.5 A is more (S7.9.4); an amplitude
+    within ``SWD_SAME_AMPLITUDE_DEG`` of the last is the last."""
+    last_deg = min(
+        max(c.SWD_LAST_AMPLITUDE_A * a_deg, c.SWD_LAST_AMPLITUDE_DEG), c.SWD_MAX_AMPLITUDE_DEG
+    )
     series, k = [], 0
-    while (amp := (c.SWD_FIRST_AMPLITUDE_A + k * c.SWD_AMPLITUDE_STEP_A) * a_deg) < last_deg:
+    while (
+        amp := (c.SWD_FIRST_AMPLITUDE_A + k * c.SWD_AMPLITUDE_STEP_A) * a_deg
+    ) < last_deg - c.SWD_SAME_AMPLITUDE_DEG:
         series.append(amp)
         k += 1
     return [*series, last_deg]
+
+
+def displacement_min_m(mass_kg: float) -> float:
+    """FMVSS 126 S5.2.3's least lateral displacement for a vehicle of ``mass_kg`` (the vehicle
+    file's mass taken as the gross mass): 1.83 m up to 3 500 kg, 1.52 m above."""
+    if mass_kg > c.DISPLACEMENT_HEAVY_ABOVE_KG:
+        return c.DISPLACEMENT_MIN_HEAVY_M
+    return c.DISPLACEMENT_MIN_M
 
 
 def run_label(amplitude_a: float) -> str:
@@ -92,20 +105,37 @@ def sine_with_dwell(
     summary = header("sine-with-dwell", params, options, speed_mps)
     if a_deg is None:
         summary.update(figures={"A_deg": None}, criteria=[], passed=None)
-        summary["note"] = f"the slowly increasing steer never reached {c.SIS_TARGET_AY_G} g"
+        summary["figures"]["not_measured"] = summary["not_measured"] = (
+            f"no A: the slowly increasing steer never reached {c.SIS_TARGET_AY_G} g "
+            f"(mu g = {options.mu * G_MPS2:.2f} m/s^2), so no sine with dwell was run"
+        )
         return VehicleTestResult("sine-with-dwell", (sis,), summary)
     runs, per_run, criteria = [sis], [], []
     for amp_deg in amplitudes_deg(a_deg):
         label = run_label(amp_deg / a_deg)
         run = _swd_run(params, speed_mps, amp_deg, options.mu, vehicle, label)
-        figures, judged = _judge(run, amp_deg, a_deg)
+        figures, judged = _judge(run, amp_deg, a_deg, params.mass_kg)
         runs.append(run)
         per_run.append(figures)
         criteria.extend(judged)
     summary["figures"] = {"A_deg": round(a_deg, 3), "runs": per_run, "clause": c.CITE["swd"]}
     summary["criteria"] = criteria
     summary["passed"] = overall(criteria)
+    if params.mass_kg > c.SWD_MAX_MASS_KG:
+        outside_scope(summary, params.mass_kg)
     return VehicleTestResult("sine-with-dwell", tuple(runs), summary)
+
+
+def outside_scope(summary: dict, mass_kg: float) -> None:
+    """No verdict for a vehicle heavier than FMVSS 126 covers (S3): its criteria kept as
+    figures, unjudged."""
+    for criterion_ in summary["criteria"]:
+        criterion_["passed"] = None
+    summary["passed"] = None
+    summary["note"] = (
+        f"{mass_kg:.0f} kg is above the {c.SWD_MAX_MASS_KG:.0f} kg the standard "
+        "applies to (FMVSS 126 S3; the vehicle file's mass taken as the gross mass)"
+    )
 
 
 def _swd_run(
@@ -132,8 +162,9 @@ def _swd_run(
     return simulate(vehicle_for(params, vehicle), speed_mps, driver, duration_s, mu, label=label)
 
 
-def _judge(run: Run, amp_deg: float, a_deg: float) -> tuple[dict, list[dict]]:
-    """One run's figures and its criteria (the displacement from 5 A only)."""
+def _judge(run: Run, amp_deg: float, a_deg: float, mass_kg: float) -> tuple[dict, list[dict]]:
+    """One run's figures and its criteria (the displacement from 5 A only, its limit by the
+    vehicle's mass: ``displacement_min_m``)."""
     time_s = run["time_s"]
     ratios = yaw_rate_ratios(
         time_s, run["yaw_rate_radps"], SETTLE_S + SECOND_REVERSAL_S, SETTLE_S + COMPLETION_S, -1.0
@@ -160,7 +191,7 @@ def _judge(run: Run, amp_deg: float, a_deg: float) -> tuple[dict, list[dict]]:
             criterion(
                 f"{label}.lateral_displacement_m",
                 displacement,
-                c.DISPLACEMENT_MIN_M,
+                displacement_min_m(mass_kg),
                 False,
                 c.CITE["displacement"],
             )

@@ -69,7 +69,13 @@ def brake_in_turn(
         why = _off_circle(run, speed_mps, radius_m, options.mu)
         if why is not None:  # every run drives the same circle first: none is measured
             break
+        why = _stopped_early(run, decel)
+        if why is not None:  # a harder brake stops sooner: the series ends here
+            runs.pop()
+            break
         per_run.append(_figures(run, decel, radius_m))
+    if per_run and why is not None:
+        cut, why = why, None
     summary = header("brake-in-turn", params, options, speed_mps)
     summary["figures"] = {
         "radius_m": radius_m,
@@ -79,6 +85,8 @@ def brake_in_turn(
         "runs": per_run,
         "clause": c.CITE["turn_brake"],
     }
+    if per_run and len(per_run) < len(series):
+        summary["figures"]["series_cut"] = cut
     summary["criteria"] = []
     summary["passed"] = None
     if why is not None:
@@ -110,6 +118,19 @@ def _off_circle(run: Run, speed_mps: float, radius_m: float, mu: float) -> str |
         f"{math.degrees(circle_radps):.1f} deg/s): the turn's lateral acceleration, "
         f"{speed_mps * circle_radps:.2f} m/s^2, is more than the car holds on this road "
         f"(mu g = {mu * G_MPS2:.2f} m/s^2)"
+    )
+
+
+def _stopped_early(run: Run, decel_mps2: float) -> str | None:
+    """Why a run has no figures at ``c.TURN_BRAKE_MEASURE_S`` after the onset (the car
+    stopped before it), or None when it has."""
+    end_s = float(run["time_s"][-1])
+    if end_s >= CIRCLE_S + c.TURN_BRAKE_MEASURE_S - 1e-9:
+        return None
+    return (
+        f"from {decel_mps2:g} m/s^2 on no run measured: the car stopped "
+        f"{max(end_s - CIRCLE_S, 0.0):.2f} s after the brake's onset, before the figures at "
+        f"{c.TURN_BRAKE_MEASURE_S:g} s (ISO 7975)"
     )
 
 
@@ -148,7 +169,7 @@ def _run(
         CIRCLE_S + AFTER_S,
         mu,
         label=f"decel_{decel_mps2:g}",
-        stop=lambda t, s: s.vx_mps < 1.0,
+        stop=lambda t, s: t > CIRCLE_S and s.vx_mps < 1.0,
     )
 
 

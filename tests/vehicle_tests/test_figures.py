@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from eoam_sumo.params import G_MPS2
 from eoam_sumo.vehicle_tests.figures import (
@@ -22,6 +25,7 @@ from eoam_sumo.vehicle_tests.sine_with_dwell import (
     COMPLETION_S,
     SECOND_REVERSAL_S,
     amplitudes_deg,
+    displacement_min_m,
     run_label,
     sine_with_dwell_steer,
 )
@@ -179,11 +183,33 @@ def test_the_sine_with_dwell_input():
 
 def test_the_amplitude_series_goes_to_the_greater_of_6_5_a_and_270_deg():
     assert amplitudes_deg(20.0) == [30.0 + 10.0 * k for k in range(24)] + [270.0]
-    big = amplitudes_deg(50.0)
-    assert big[0] == 75.0
-    assert big[-1] == 325.0
+    assert amplitudes_deg(44.0)[-2:] == [264.0, 286.0]  # 6.5 A = 286 deg
     assert run_label(1.5) == "amp_1.5A"
     assert run_label(2.0) == "amp_2A"
+
+
+def test_no_amplitude_of_the_series_is_above_300_deg():
+    """FMVSS 126 S7.9.4: where 6.5 A is above 300 deg the last run is 300 deg."""
+    big = amplitudes_deg(50.0)
+    assert big == [75.0 + 25.0 * k for k in range(9)] + [300.0]
+    assert max(amplitudes_deg(62.6)) == 300.0
+
+
+@given(st.floats(min_value=5.0, max_value=120.0))
+def test_the_series_has_one_run_per_amplitude_and_label(a_deg):
+    """An amplitude a hair below the last (7 A of 38.563 deg = 269.94 deg) is that run: every
+    run has its own amplitude and its own label."""
+    series = amplitudes_deg(a_deg)
+    assert all(b - a >= 1.0 - 1e-9 for a, b in itertools.pairwise(series))
+    assert len({run_label(amp / a_deg) for amp in series}) == len(series)
+    assert series[-1] in (270.0, 300.0) or series[-1] == pytest.approx(6.5 * a_deg)
+
+
+def test_the_displacement_limit_follows_the_vehicles_mass():
+    """FMVSS 126 S5.2.3: 1.83 m up to 3 500 kg gross, 1.52 m above."""
+    assert displacement_min_m(1800.0) == 1.83
+    assert displacement_min_m(3500.0) == 1.83
+    assert displacement_min_m(3600.0) == 1.52
 
 
 def test_the_yaw_rate_ratios_of_a_decaying_yaw_rate():
