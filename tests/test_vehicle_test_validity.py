@@ -14,9 +14,11 @@ from eoam_sumo.cli import main
 from eoam_sumo.vehicle_files import load_vehicle
 from eoam_sumo.vehicle_tests.command import TEST_NAMES
 from eoam_sumo.vehicle_tests.common import VehicleTestOptions, verdict, verdict_text
+from eoam_sumo.vehicle_tests.harness import Run
 from eoam_sumo.vehicle_tests.procedures import TESTS
 from eoam_sumo.vehicle_tests.sine_with_dwell import outside_scope
 from eoam_sumo.vehicle_tests.steer_figures import drift_over_window, linear_range_g
+from eoam_sumo.vehicle_tests.steer_tests import step_sliding
 
 R13H = load_vehicle("sedan-r13h")
 
@@ -194,3 +196,26 @@ def test_a_vehicle_heavier_than_the_esc_standard_covers_gets_figures_only():
     assert summary["passed"] is None
     assert summary["criteria"][0]["passed"] is None
     assert verdict_text(summary).startswith("figures only: 12000 kg is above the 4536 kg")
+
+
+def test_a_step_steer_that_ends_in_a_slide_says_so():
+    """``ay = vx (r + beta')``: an end where ``vx r`` is far from ``ay`` is a slide or a spin,
+    not a steady state above the standard's level (a spinning truck read "44 % above")."""
+    sliding = Run(
+        "run",
+        {
+            "vx_mps": np.array([22.2, 16.2]),
+            "yaw_rate_radps": np.array([0.0, 0.914]),
+            "ay_mps2": np.array([0.0, 6.0]),
+        },
+    )
+    assert "slides or spins (vx r = 14.81" in step_sliding(sliding)
+    steady = Run(
+        "run",
+        {
+            "vx_mps": np.array([22.2, 22.1]),
+            "yaw_rate_radps": np.array([0.0, 0.181]),
+            "ay_mps2": np.array([0.0, 4.0]),
+        },
+    )
+    assert step_sliding(steady) is None

@@ -179,6 +179,8 @@ def step_steer(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehi
     yaw = step_response(run["time_s"], run["steer_wheel_deg"], run["yaw_rate_radps"])
     ay = step_response(run["time_s"], run["steer_wheel_deg"], run["ay_mps2"])
     why = _step_not_measured(ay.steady_state, drift_over_window(run["time_s"], run["ay_mps2"]))
+    if ay.steady_state >= c.STEP_AY_MPS2 * (1.0 - STEP_AY_TOLERANCE):
+        why = step_sliding(run) or why  # above or near the level: a slide says more
     summary = header("step-steer", params, options, speed_mps)
     summary["figures"] = {
         "steer_wheel_deg": round(float(run["steer_wheel_deg"][-1]), 3),
@@ -195,6 +197,20 @@ def step_steer(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehi
             "or overshoot"
         )
     return VehicleTestResult("step-steer", (run,), summary)
+
+
+def step_sliding(run: Run) -> str | None:
+    """Why the step's end is no steady turn: the lateral acceleration departs from ``vx r`` by
+    more than ``QUASI_STEADY_TOLERANCE`` (the car slides or spins), or None."""
+    vx, r, ay = run["vx_mps"][-1], run["yaw_rate_radps"][-1], run["ay_mps2"][-1]
+    turn_mps2 = float(vx * r)
+    if abs(turn_mps2 - ay) <= QUASI_STEADY_TOLERANCE * max(abs(turn_mps2), c.STEP_AY_MPS2):
+        return None
+    return (
+        f"no steady turn: at the end the car slides or spins (vx r = {turn_mps2:.2f} m/s^2 "
+        f"against a lateral acceleration of {ay:.2f} m/s^2; speed {run['vx_mps'][0]:.1f} -> "
+        f"{vx:.1f} m/s)"
+    )
 
 
 def _step_not_measured(steady_mps2: float, drift_mps2: float) -> str | None:
