@@ -70,7 +70,7 @@ def _swd_cell(params: VehicleParams, esc: bool) -> str:
 
 def _percent(ratio: float) -> int:
     """A ratio in whole per cent (a ratio a hair below 0 is 0, not -0)."""
-    return int(round(100.0 * ratio))
+    return round(100.0 * ratio)
 
 
 def catalogue_row(name: str) -> str:
