@@ -126,7 +126,7 @@ class Storyboard(StepObserver):
         if self.stop is not None and self.stop.fired(world):
             self.ended_by_storyboard = True
         if self.ended_by_storyboard and (sim.ctrl.mode == 0 or sim.eoam_done()):
-            sim.max_steps = sim.n_steps  # the run ends now (a manoeuvre under way ends first)
+            sim.request_end("storyboard")  # ends now (a manoeuvre under way ends first)
         for story in self.stories:
             self._step_element(story)
         moved = self._step_actions(dt)

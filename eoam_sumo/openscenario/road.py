@@ -102,16 +102,23 @@ def check_road(xodr: Path) -> None:
     """InputError for a road under left-hand traffic (OpenDRIVE 1.5+ ``rule="LHT"``): its
     lanes with positive ids run along s, the mapping here (negative ids along s) is the
     right-hand one."""
-    try:
-        root = ET.parse(xodr).getroot()
-    except ET.ParseError as exc:
-        raise InputError(f"{xodr}: not well-formed XML: {exc}") from None
-    for road in root.iter("road"):
+    for road in parse_xodr(xodr).iter("road"):
         if road.get("rule", "RHT").upper() == "LHT":
             raise InputError(
                 f'{xodr}: road {road.get("id")} has rule="LHT": left-hand traffic is not '
                 "supported (docs/openscenario.md)"
             )
+
+
+def parse_xodr(xodr: Path) -> ET.Element:
+    """The OpenDRIVE file's root element; ``InputError`` naming the file when it is not
+    well-formed XML (a broken tag, bytes that are no text)."""
+    try:
+        return ET.parse(xodr).getroot()
+    except ET.ParseError as exc:
+        raise InputError(f"{xodr}: not well-formed XML: {exc}") from None
+    except OSError as exc:
+        raise InputError(f"{xodr}: cannot be read: {exc.strerror or exc}") from None
 
 
 WIDE_M = 6.0  # a driving lane wider than this: the EOAM may swerve inside it
@@ -121,20 +128,49 @@ def wide_lanes(xodr: Path) -> list[str]:
     """A note (one line) naming the driving lanes wider than ``WIDE_M`` (Vector's NCAP road is
     one 28 m lane each way: the EOAM swerves within it), or none."""
     wide = {}
-    for road in ET.parse(xodr).getroot().iter("road"):
-        for lane in road.iter("lane"):
-            widths = [float(w.get("a", "0")) for w in lane.iter("width")]
-            if lane.get("type") == "driving" and widths and max(widths) > WIDE_M:
-                wide[f"road {road.get('id')} lane {lane.get('id')}"] = max(widths)
+    for road in parse_xodr(xodr).iter("road"):
+        for lane, length_m in _section_lanes(road):
+            widest = _widest_m(lane, length_m)
+            if lane.get("type") == "driving" and widest > WIDE_M:
+                key = f"road {road.get('id')} lane {lane.get('id')}"
+                wide[key] = max(widest, wide.get(key, 0.0))
     if not wide:
         return []
     listed = ", ".join(f"{k}: {w:g} m" for k, w in wide.items())
     return [f"driving lanes wider than {WIDE_M:g} m ({listed}): the EOAM may swerve within one"]
 
 
+def _section_lanes(road: ET.Element) -> list[tuple[ET.Element, float]]:
+    """Each lane of each lane section of ``road``, with the section's length [m]."""
+    sections = list(road.iter("laneSection"))
+    starts = [float(sec.get("s", "0")) for sec in sections]
+    ends = [*starts[1:], float(road.get("length", "0"))]
+    return [
+        (lane, max(end - start, 0.0))
+        for sec, start, end in zip(sections, starts, ends, strict=True)
+        for lane in sec.iter("lane")
+    ]
+
+
+def _widest_m(lane: ET.Element, section_m: float) -> float:
+    """A lane's largest width over its section: each ``<width>`` polynomial
+    ``a + b ds + c ds^2 + d ds^3`` (OpenDRIVE 1.6 sec. 9.5.1) sampled from its ``sOffset`` to
+    the next one's (or the section's end)."""
+    entries = list(lane.iter("width"))
+    offsets = [float(w.get("sOffset", "0")) for w in entries]
+    ends = [*offsets[1:], section_m][: len(entries)]
+    widest = 0.0
+    for w, start, end in zip(entries, offsets, ends, strict=True):
+        a, b, c, d = (float(w.get(k, "0")) for k in "abcd")
+        for i in range(11):
+            ds = max(end - start, 0.0) * i / 10.0
+            widest = max(widest, a + ds * (b + ds * (c + ds * d)))
+    return widest
+
+
 def road_lengths(xodr: Path) -> dict[str, float]:
     """OpenDRIVE road id -> its reference line length."""
-    root = ET.parse(xodr).getroot()
+    root = parse_xodr(xodr)
     return {r.get("id", ""): float(r.get("length", "0")) for r in root.iter("road")}
 
 

@@ -149,7 +149,8 @@ def _axis(node: Node) -> list[dict[str, str]]:
         count = int((hi - lo) / step + 1e-9) + 1
         if count > MAX_CASES:
             raise InputError(f"{kind.where()}: {count} values is too many")
-        return [{name: format_value(lo + k * step)} for k in range(count)]
+        # lo + k step carries the binary fractions' error (0.1 + 2 x 0.1 = 0.30000000000000004)
+        return [{name: format_value(round(lo + k * step, 12))} for k in range(count)]
     raise InputError(f"{kind.where()}: {kind.tag} is not a supported deterministic distribution")
 
 

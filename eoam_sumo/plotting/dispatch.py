@@ -8,10 +8,15 @@ from eoam_sumo.errors import InputError
 
 
 def plot_folder(folder: Path, out_dir: Path) -> list[Path]:
-    """Plot a run folder (summary.json), a batch folder (results.csv) or a tables folder
-    (phase_boundaries.csv) into ``out_dir``; return the PNGs written."""
+    """Plot a run folder (summary.json), a batch folder (results.csv: a matrix's or an
+    .xosc's variations) or a tables folder (phase_boundaries.csv) into ``out_dir``; return the
+    PNGs written."""
     folder, out_dir = Path(folder), Path(out_dir)
     if (folder / "results.csv").is_file():
+        from eoam_sumo.plotting.xosc_batch_plots import is_xosc_results, plot_xosc_batch
+
+        if is_xosc_results(folder / "results.csv"):
+            return plot_xosc_batch(folder, out_dir)
         from eoam_sumo.plotting.batch_plots import plot_batch
 
         return plot_batch(folder, out_dir)

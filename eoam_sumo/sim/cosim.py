@@ -276,6 +276,7 @@ class CoSimulation:
         self._met_ahead: dict[str, bool] = {}
         self._obstacles: set[str] = set()  # road users once in the obstacle's role (``_role``)
         self.end_cause: str | None = None
+        self._end_request: str | None = None  # an observer's end of the run (``request_end``)
         self.n_steps = 0
         self._stop_at: float | None = None
         self.t = self.t_start = session.time_s
@@ -572,10 +573,17 @@ class CoSimulation:
         elif self.meas.s_m > self._end_s_m:
             self.end_cause = "road_end"
         elif self.n_steps >= self.max_steps:
-            self.end_cause = "time_limit"
+            self.end_cause = self._end_request or "time_limit"
         else:
             return False
         return True
+
+    def request_end(self, cause: str) -> None:
+        """End the run after this step, its ``end_cause`` ``cause`` (an OpenSCENARIO
+        StopTrigger: ``storyboard``), unless a contact, a rollover or the settling ends it
+        first."""
+        self.max_steps = self.n_steps
+        self._end_request = cause
 
     def _run_on_s(self) -> float:
         """How long the run goes on once the EOAM is done: ``after_stop_s`` after a stop

@@ -84,7 +84,10 @@ class RunSummary:
     passed_obstacle: bool | None = _doc(
         "a lane change ended ahead of the obstacle it avoided (empty: no lane change)"
     )
-    end_cause: str = _doc("contact, rollover, settled, road_end or time_limit")
+    end_cause: str = _doc(
+        "contact, rollover, settled, road_end, time_limit or storyboard (an OpenSCENARIO "
+        "StopTrigger)"
+    )
     rollover_time_s: float | None = _doc(
         "SUMO time both inner wheels had lifted or |ay| passed the static stability limit "
         "g track / (2 h) (empty: never)"

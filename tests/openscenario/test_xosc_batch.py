@@ -94,6 +94,21 @@ def test_batch_runs_each_case_into_its_folder(
     ]
     assert {r["collision_with"] for r in rows} == {"none"}
     assert all((out / "cases" / r["case_id"] / "summary.json").is_file() for r in rows)
+    # plot took results.csv for a matrix's and refused it ("its columns are not those ...")
+    assert main(["plot", str(out)]) == 0
+    assert (out / "xosc_outcomes.png").stat().st_size > 10_000
+
+
+def test_a_range_of_decimal_steps_gives_the_decimals(tmp_path: Path) -> None:
+    """40.1 to 40.3 km/h by 0.1: 40.1 + 2 x 0.1 is 40.300000000000004 in binary floats."""
+    text = VARIATION.format(scenario=CUT_IN).replace('stepWidth="20.0"', 'stepWidth="0.1"')
+    text = text.replace(
+        'lowerLimit="20.0" upperLimit="60.0"', 'lowerLimit="40.1" upperLimit="40.3"'
+    )
+    path = tmp_path / "v.xosc"
+    path.write_text(text, encoding="utf-8")
+    speeds = {c["Ego_InitSpeed_Ve0_kph"] for c in load_batch(path).cases}
+    assert sorted(speeds) == ["40.1", "40.2", "40.3"]
 
 
 def test_a_scenario_file_is_one_case_and_foreign_options_are_refused(

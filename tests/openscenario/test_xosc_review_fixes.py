@@ -179,3 +179,34 @@ def test_a_rule_outside_the_standards_six_is_refused_before_the_run(tmp_path: Pa
             "</EntityCondition></ByEntityCondition></Condition>")  # fmt: skip
     text = _refusal(write_case(tmp_path, edit))
     assert "<SpeedCondition> at" in text and "rule=bigger is not a rule" in text
+
+
+def test_a_broken_or_binary_road_file_is_one_line(tmp_path: Path) -> None:
+    """A malformed .xodr (a tag missing) or one of bytes that are no text crashed the run with
+    a ParseError traceback after netconvert had accepted it."""
+    from eoam_sumo.errors import InputError
+    from eoam_sumo.openscenario import road as od
+    from tests.openscenario.xosc_cases import road
+
+    broken = tmp_path / "broken.xodr"
+    broken.write_text(road().replace("</lanes>", ""), encoding="utf-8")
+    binary = tmp_path / "binary.xodr"
+    binary.write_bytes(b"\xff\xfe" + road().encode("utf-8"))
+    for bad in (broken, binary):
+        for read in (od.check_road, od.wide_lanes, od.road_lengths):
+            with pytest.raises(InputError, match=rf"{bad.name}: not well-formed XML"):
+                read(bad)
+
+
+def test_a_lane_that_widens_along_the_road_is_noted_wide(tmp_path: Path) -> None:
+    """Only the width polynomial's constant term was read: a lane of 3 m + 0.01 m per m over
+    500 m (8 m at its end, OpenDRIVE 1.6 sec. 9.5.1) was not noted."""
+    from eoam_sumo.openscenario import road as od
+    from tests.openscenario.xosc_cases import lane, road
+
+    widening = lane(-1, 3.0).replace('b="0"', 'b="0.01"')
+    xodr = tmp_path / "widening.xodr"
+    xodr.write_text(road(right=widening), encoding="utf-8")
+    assert od.wide_lanes(xodr) == [
+        "driving lanes wider than 6 m (road 1 lane -1: 8 m): the EOAM may swerve within one"
+    ]

@@ -144,3 +144,16 @@ def test_alks_free_driving_on_the_curved_road_starts_where_the_file_says(tmp_pat
     assert 'departPos="8.900"' in route and 'departSpeed="16.666667"' in route
     rows = list(csv.DictReader((out / "timeseries.csv").open()))
     assert float(rows[-1]["vx_mps"]) == pytest.approx(60 / 3.6, abs=0.3)
+
+
+def test_a_stop_trigger_ends_the_run_and_says_so(tmp_path: Path) -> None:
+    """The storyboard's StopTrigger (simulation time > 2 s, before the EOAM acts) ends the
+    run: ``end_cause`` said ``time_limit`` though no time limit was reached."""
+    from tests.openscenario.xosc_cases import STOP, write_case
+
+    path = write_case(tmp_path, (STOP, STOP.replace('value="12"', 'value="2"')))
+    assert main(["run", str(path), "--out", str(tmp_path / "o")]) == 0
+    summary = _summary(tmp_path / "o")
+    assert summary["storyboard_ended"] is True
+    assert summary["end_cause"] == "storyboard"
+    assert summary["sim_time_s"] == pytest.approx(2.0, abs=0.02)

@@ -1,0 +1,83 @@
+"""``eoam-sumo plot`` on a batch folder of an .xosc's variations: each case's outcome over its
+parameters (results.csv's ``param:NAME`` columns)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import pandas as pd
+
+from eoam_sumo.colours import FAILED, HEX, OUTCOMES
+from eoam_sumo.errors import InputError
+from eoam_sumo.textfiles import read_utf8
+
+PARAM = "param:"
+OUT_NAME = "xosc_outcomes.png"
+MAX_PANELS = 4
+
+
+def is_xosc_results(path: Path) -> bool:
+    """Whether results.csv is an .xosc batch's (its header has ``param:NAME`` columns or
+    starts with the .xosc batch's first columns)."""
+    header = read_utf8(path, "results file").split("\n", 1)[0]
+    names = header.split(",")
+    return any(n.startswith(PARAM) for n in names) or names[:4] == [
+        "case_id",
+        "status",
+        "error",
+        "outcome",
+    ]
+
+
+def _outcomes(frame: pd.DataFrame) -> pd.Series:
+    """Each case's outcome colour name; a case that did not finish ``failed``."""
+    return frame["outcome"].where(frame["status"] == "ok", FAILED).fillna(FAILED)
+
+
+def _axis(values: pd.Series) -> tuple[pd.Series, list[str] | None]:
+    """Numbers as they are; text as category positions with their labels."""
+    numbers = pd.to_numeric(values, errors="coerce")
+    if numbers.notna().all():
+        return numbers, None
+    labels = sorted(values.astype(str).unique())
+    return values.astype(str).map({v: i for i, v in enumerate(labels)}), labels
+
+
+def plot_xosc_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
+    """One panel per varied parameter (the first ``MAX_PANELS``): the impact speed of each
+    case (0 without contact) over the parameter, coloured by its outcome."""
+    path = Path(batch_dir) / "results.csv"
+    frame = pd.read_csv(path, dtype=str, keep_default_na=False)
+    params = [c for c in frame.columns if c.startswith(PARAM)]
+    if frame.empty:
+        raise InputError(f"{path}: no cases to plot")
+    params = [c for c in params if frame[c].nunique() > 1][:MAX_PANELS] or params[:1]
+    outcome = _outcomes(frame)
+    speed = pd.to_numeric(frame.get("impact_speed_mps"), errors="coerce").fillna(0.0)
+    panels = max(len(params), 1)
+    fig, axes = plt.subplots(1, panels, figsize=(4.2 * panels + 1.0, 3.8), squeeze=False)
+    for ax, column in zip(axes[0], params or [None], strict=True):
+        x, labels = _axis(frame[column]) if column else (pd.Series(range(len(frame))), None)
+        for name in (*OUTCOMES, FAILED):
+            mine = outcome == name
+            if mine.any():
+                ax.scatter(x[mine], speed[mine], c=HEX[name], edgecolors="k", label=name, s=40)
+        if labels is not None:
+            ax.set_xticks(range(len(labels)), labels, rotation=30, ha="right")
+        ax.set_xlabel(column.removeprefix(PARAM) if column else "case")
+        ax.set_ylabel("impact speed [m/s] (0: no contact)")
+        ax.set_ylim(0.0, max(float(speed.max()) * 1.1, 1.0))
+        ax.grid(alpha=0.3)
+    axes[0][-1].legend(title="outcome", fontsize=8, loc="best")
+    fig.suptitle(f"{Path(batch_dir).name}: {len(frame)} cases of the .xosc's variations")
+    fig.tight_layout()
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    target = out_dir / OUT_NAME
+    fig.savefig(target, dpi=110)
+    plt.close(fig)
+    return [target]
