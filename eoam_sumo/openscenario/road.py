@@ -127,7 +127,7 @@ WIDE_M = 6.0  # a driving lane wider than this: the EOAM may swerve inside it
 def wide_lanes(xodr: Path) -> list[str]:
     """A note (one line) naming the driving lanes wider than ``WIDE_M`` (Vector's NCAP road is
     one 28 m lane each way: the EOAM swerves within it), or none."""
-    wide = {}
+    wide: dict[str, float] = {}
     for road in parse_xodr(xodr).iter("road"):
         for lane, length_m in _section_lanes(road):
             widest = _widest_m(lane, length_m)
