@@ -385,6 +385,10 @@ def _cmd_run(args) -> int:
     _check_run_args(args)
     if is_xosc(args):
         xosc = prepare_command(args)  # refuses what the subset lacks before writing anything
+    else:
+        from eoam_sumo.sim.scenario.files import check_scenario
+
+        check_scenario(args.cfg, args.ego or "ego")  # a file that is no sumocfg: nothing written
     out = writable_dir(args.out)
     settings = _run_settings(args, out)
     if is_xosc(args):
@@ -413,6 +417,8 @@ def _cmd_run(args) -> int:
 
 def _check_run_args(args) -> None:
     """InputError for a ``run`` option out of its range, before anything is written."""
+    if args.cfg.is_dir():
+        raise InputError(f"{args.cfg}: a folder, not a scenario file (.sumocfg or .xosc)")
     if not args.cfg.is_file():
         raise InputError(f"{args.cfg}: no such scenario file")
     if not 0 < args.max_time_s <= MAX_TIME_LIMIT_S:

@@ -217,3 +217,18 @@ def test_a_scenario_rerun_replaces_the_folder_whole_or_not_at_all(tmp_path, caps
     assert json.loads((out / "scenario.json").read_text())["spec"]["curve_radius_m"] == 500
     assert snapshot(out) != before and _leftovers(out) == []
     capsys.readouterr()
+
+
+def test_a_run_of_a_file_that_is_no_scenario_writes_nothing(tmp_path, capsys):
+    """A text file given as the sumocfg was refused only after ``--out`` had been made; a
+    folder was "no such scenario file"."""
+    text = tmp_path / "notes.txt"
+    text.write_text("hello\n", encoding="utf-8")
+    folder = tmp_path / "case.xosc"
+    folder.mkdir()
+    for scenario, needle in ((text, "notes.txt: malformed XML"), (folder, "a folder, not")):
+        out = tmp_path / "out"
+        assert main(["run", str(scenario), "--out", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert needle in err and len(err.strip().splitlines()) == 1
+        assert not out.exists()

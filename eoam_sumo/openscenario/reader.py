@@ -200,11 +200,15 @@ _EMPTY = Node("ParameterAssignments", {}, Path("-"), 0)
 
 
 def find_entry(catalog: str, entry: str, dirs: list[Path]) -> Node | None:
-    """Entry ``entry`` of the catalog named ``catalog`` in any of ``dirs``."""
-    for d in dirs:
-        for f in sorted(d.glob("*.xosc")) if d.is_dir() else []:
+    """Entry ``entry`` of the catalog named ``catalog`` in any of ``dirs``: a ``<Catalog>``
+    of that name, else one in a file of that name (as esmini finds its own catalogs, whose
+    ``EnvironmentCatalog.xosc`` declares ``<Catalog name="VehicleCatalog">``)."""
+    files = [f for d in dirs if d.is_dir() for f in sorted(d.glob("*.xosc"))]
+    for by_file in (False, True):
+        for f in files:
             cat = parse(f).find("Catalog")
-            if cat is None or cat.get("name") != catalog:
+            name = f.stem if by_file else (None if cat is None else cat.get("name"))
+            if cat is None or name != catalog:
                 continue
             for e in cat.children:
                 if e.get("name") == entry:

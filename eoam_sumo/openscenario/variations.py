@@ -82,6 +82,7 @@ def load_batch(path: Path) -> XoscBatch:
     if parse(xosc).find("ParameterValueDistribution") is not None:  # the sweep replaces its axes
         xosc, base = _distribution_cases(xosc, set(names))
         combos = [{**b, **c} for b in base for c in combos]
+    _check_declared(path, names, xosc)
     system = str(scen.get("system", "eoam"))
     if system not in ("eoam", "aeb"):
         raise InputError(f"{path}: [scenario] system {system!r} must be eoam or aeb")
@@ -91,6 +92,16 @@ def load_batch(path: Path) -> XoscBatch:
         if value is not None and not ok:
             raise InputError(f"{path}: [scenario] {key} = {value!r} must be in (0, {top:g}]")
     return _kept(XoscBatch(xosc, combos, 0, system, mu, max_time))
+
+
+def _check_declared(path: Path, names: list[str], xosc: Path) -> None:
+    """InputError naming the matrix file and the first ``[sweep]`` name the scenario does not
+    declare (it was reported as a ``--param``)."""
+    decls = parse(xosc).find("ParameterDeclarations")
+    declared = {d.get("name") for d in ([] if decls is None else decls.children)}
+    missing = [n for n in names if n not in declared]
+    if missing:
+        raise InputError(f"{path}: [sweep] {missing[0]}: no such parameter declared in {xosc}")
 
 
 def _text(value) -> str:

@@ -132,3 +132,11 @@ def test_a_matrix_value_out_of_range_is_refused(tmp_path: Path, extra: str, need
     with pytest.raises(InputError) as err:
         load_batch(matrix)
     assert needle in str(err.value)
+
+
+def test_a_sweep_of_an_undeclared_parameter_names_the_matrix(tmp_path: Path) -> None:
+    """It said ``--param Nope: ...``, an option the user never gave."""
+    matrix = tmp_path / "m.toml"
+    matrix.write_text(f'[scenario]\nxosc = "{CUT_IN}"\n[sweep]\nNope = [1]\n', encoding="utf-8")
+    with pytest.raises(InputError, match=r"m.toml: \[sweep\] Nope: no such parameter declared"):
+        load_batch(matrix)

@@ -210,3 +210,19 @@ def test_a_lane_that_widens_along_the_road_is_noted_wide(tmp_path: Path) -> None
     assert od.wide_lanes(xodr) == [
         "driving lanes wider than 6 m (road 1 lane -1: 8 m): the EOAM may swerve within one"
     ]
+
+
+def test_a_catalog_entry_is_found_by_its_files_name_as_esmini_finds_it(tmp_path: Path) -> None:
+    """esmini's EnvironmentCatalog.xosc declares ``<Catalog name="VehicleCatalog">``: its
+    entries were "not found" though listed under the reference's catalog directory."""
+    from eoam_sumo.openscenario.reader import find_entry
+
+    (tmp_path / "EnvironmentCatalog.xosc").write_text(
+        '<OpenSCENARIO><Catalog name="VehicleCatalog"><Environment name="winter"/>'
+        "</Catalog></OpenSCENARIO>",
+        encoding="utf-8",
+    )
+    found = find_entry("EnvironmentCatalog", "winter", [tmp_path])
+    assert found is not None and found.tag == "Environment"
+    assert find_entry("VehicleCatalog", "winter", [tmp_path]) is not None  # its declared name
+    assert find_entry("EnvironmentCatalog", "summer", [tmp_path]) is None
