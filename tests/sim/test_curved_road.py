@@ -213,3 +213,23 @@ def test_a_queue_on_a_600_m_curve_at_130_kmh_is_stopped_for(tmp_path):
     assert summary["min_gap_aro_m"] > 0.3
     assert summary["modes_visited"][:2] == [0, 1]
     assert summary["trigger_range_m"] > 99.0  # braked as soon as it was seen
+
+
+def test_a_lane_added_on_the_right_does_not_pull_the_ego_over(tmp_path):
+    """SUMO numbers lanes from the right: where a lane is added on the right the ego's lane
+    straight on has the next index. The centre line followed the same index, so the ego
+    swerved a lane to the right and back ("left the road")."""
+    _straight_edges(tmp_path, "added", [3.5, 3.5, 3.5], [1, 2, 1])
+    out = tmp_path / "run"
+    summary = run_case(
+        tmp_path / "added.sumocfg",
+        ScenarioOverrides(ego_speed_mps=100 / 3.6, mu=1.0),
+        out,
+        RunSettings(max_time_s=40.0),
+    )
+    assert summary["outcome"] == "none"
+    road = pd.read_csv(out / "road.csv")
+    assert road["y_m"].abs().max() == pytest.approx(1.75, abs=0.05)  # one lane's centre
+    ts = pd.read_csv(out / "timeseries.csv")
+    assert ts["s_m"].iloc[-1] > 1000.0
+    assert ts["lateral_offset_m"].abs().max() < 0.1

@@ -182,7 +182,9 @@ def route_centreline(
 ) -> np.ndarray:
     """Centre line of the ego's start lane followed along its route: from each lane over its
     connection (and the junction's internal lanes) to the lane it leads to on the next
-    route edge, the one with the same index when there are several."""
+    route edge; of several, the one that starts nearest where the lane ends (the lane
+    straight on where a lane is added or dropped beside it, which shifts SUMO's indices),
+    then the one with the same index."""
     lane = start_lane_id
     points = [tuple(p) for p in lanes.getShape(lane)]
     for edge in route_edges[1:]:
@@ -193,7 +195,14 @@ def route_centreline(
                 f"edge '{edge}' of its route (no connection: the lane ends); start the ego "
                 "in a lane that continues"
             )
-        link = min(links, key=lambda k: abs(int(k[0].rsplit("_", 1)[1]) - lane_index))
+        end = points[-1]
+        link = min(
+            links,
+            key=lambda k: (
+                round(_gap_m(end, lanes.getShape(k[0])[0]), 1),
+                abs(int(k[0].rsplit("_", 1)[1]) - lane_index),
+            ),
+        )
         via = link[4]
         for _ in range(8):  # a junction's internal lanes, until the next normal lane
             if not via or not via.startswith(":"):
@@ -208,6 +217,10 @@ def route_centreline(
         if math.hypot(p[0] - line[-1][0], p[1] - line[-1][1]) > 1e-6:
             line.append(p)
     return np.array(line, dtype=float)
+
+
+def _gap_m(a, b) -> float:
+    return math.hypot(b[0] - a[0], b[1] - a[1])
 
 
 def let_fast_vehicles_depart(api, errors: tuple, files: ScenarioFiles, ego_id: str) -> None:
