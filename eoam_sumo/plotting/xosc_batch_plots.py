@@ -13,7 +13,6 @@ import pandas as pd
 
 from eoam_sumo.colours import FAILED, HEX, OUTCOMES
 from eoam_sumo.errors import InputError
-from eoam_sumo.textfiles import read_utf8
 
 PARAM = "param:"
 OUT_NAME = "xosc_outcomes.png"
@@ -23,8 +22,11 @@ MAX_PANELS = 4
 def is_xosc_results(path: Path) -> bool:
     """Whether results.csv is an .xosc batch's (its header has ``param:NAME`` columns or
     starts with the .xosc batch's first columns)."""
-    header = read_utf8(path, "results file").split("\n", 1)[0]
-    names = header.split(",")
+    try:
+        with open(path, encoding="utf-8") as f:
+            names = f.readline().rstrip("\n").split(",")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot be read as a results file: {exc}") from None
     return any(n.startswith(PARAM) for n in names) or names[:4] == [
         "case_id",
         "status",
