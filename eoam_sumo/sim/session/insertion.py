@@ -108,7 +108,7 @@ def place_ego(
         float(lanes.getWidth(lane_id)),
         left_lane,
         lane_point(lanes, lane_id, pos)[:2],
-        route_centreline(lanes, files, lane_id, edges, lane_index),
+        route_centreline(api, files, lane_id, edges, lane_index),
     )
 
 
@@ -178,45 +178,81 @@ def _ego_speed(
 
 
 def route_centreline(
-    lanes, files: ScenarioFiles, start_lane_id: str, route_edges: list, lane_index: int
+    api, files: ScenarioFiles, start_lane_id: str, route_edges: list, lane_index: int
 ) -> np.ndarray:
-    """Centre line of the ego's start lane followed along its route: from each lane over its
-    connection (and the junction's internal lanes) to the lane it leads to on the next
-    route edge; of several, the one that starts nearest where the lane ends (the lane
-    straight on where a lane is added or dropped beside it, which shifts SUMO's indices),
-    then the one with the same index."""
+    """Centre line of the ego's start lane followed along its route, lane by lane
+    (``_next_lane``): where the next route edge goes on straight, the lane that goes on
+    straight ahead of the ego's (a lane added or dropped beside it shifts SUMO's indices, which
+    count from the right, and netconvert may connect the lane elsewhere); at a turn, over
+    the connection (and the junction's internal lanes) to the lane it leads to."""
+    lanes = api.lane
     lane = start_lane_id
     points = [tuple(p) for p in lanes.getShape(lane)]
     for edge in route_edges[1:]:
-        links = [link for link in lanes.getLinks(lane) if lanes.getEdgeID(link[0]) == edge]
-        if not links:
-            raise InputError(
-                f"{files.net_file}: the ego's lane {lane} does not continue onto "
-                f"edge '{edge}' of its route (no connection: the lane ends); start the ego "
-                "in a lane that continues"
-            )
-        end = points[-1]
-        link = min(
-            links,
-            key=lambda k: (
-                round(_gap_m(end, lanes.getShape(k[0])[0]), 1),
-                abs(int(k[0].rsplit("_", 1)[1]) - lane_index),
-            ),
-        )
-        via = link[4]
+        nxt, via = _next_lane(api, files, lane, edge, lane_index)
         for _ in range(8):  # a junction's internal lanes, until the next normal lane
             if not via or not via.startswith(":"):
                 break
             points += [tuple(p) for p in lanes.getShape(via)]
             onward = lanes.getLinks(via)
             via = onward[0][0] if onward else None
-        lane = link[0]
+        lane = nxt
         points += [tuple(p) for p in lanes.getShape(lane)]
     line = [points[0]]
     for p in points[1:]:
         if math.hypot(p[0] - line[-1][0], p[1] - line[-1][1]) > 1e-6:
             line.append(p)
     return np.array(line, dtype=float)
+
+
+#: A next edge whose lanes start within this of the ego's lane's heading goes on straight
+#: (ours): its lane straight ahead is the ego's, connected or not.
+STRAIGHT_ON_RAD = math.radians(20.0)
+
+
+def _next_lane(api, files: ScenarioFiles, lane: str, edge: str, lane_index: int):
+    """The lane of route edge ``edge`` the ego's ``lane`` leads to, and the internal lane to
+    it (None: straight on without one): straight on, the lane whose centre starts within
+    half its width of the ego's lane's line, linked or not; else the linked lane that starts
+    nearest, then the one of the same index. InputError when the lane ends there."""
+    lanes = api.lane
+    shape = lanes.getShape(lane)
+    (x0, y0), (x1, y1) = shape[-2][:2], shape[-1][:2]
+    heading = math.atan2(y1 - y0, x1 - x0)
+    links = {link[0]: link[4] for link in lanes.getLinks(lane) if lanes.getEdgeID(link[0]) == edge}
+    ahead = _lane_straight_ahead(api, edge, (x1, y1), heading)
+    if ahead is not None:
+        return ahead, links.get(ahead) or None
+    if not links:
+        raise InputError(
+            f"{files.net_file}: the ego's lane {lane} does not continue onto "
+            f"edge '{edge}' of its route (no connection: the lane ends); start the ego "
+            "in a lane that continues"
+        )
+    best = min(
+        links,
+        key=lambda k: (
+            round(_gap_m((x1, y1), lanes.getShape(k)[0]), 1),
+            abs(int(k.rsplit("_", 1)[1]) - lane_index),
+        ),
+    )
+    return best, links[best]
+
+
+def _lane_straight_ahead(api, edge: str, end: tuple, heading: float) -> str | None:
+    """The lane of ``edge`` whose start lies on the line ahead of ``end`` (within half its
+    width across it) when the edge goes on straight (``STRAIGHT_ON_RAD``), else None."""
+    c, s = math.cos(heading), math.sin(heading)
+    best, best_d = None, math.inf
+    for k in range(api.edge.getLaneNumber(edge)):
+        lane = f"{edge}_{k}"
+        shape = api.lane.getShape(lane)
+        (xa, ya), (xb, yb) = shape[0][:2], shape[1][:2]
+        turn = abs(math.remainder(math.atan2(yb - ya, xb - xa) - heading, math.tau))
+        across = abs(-(xa - end[0]) * s + (ya - end[1]) * c)
+        if turn <= STRAIGHT_ON_RAD and across <= 0.5 * api.lane.getWidth(lane) and across < best_d:
+            best, best_d = lane, across
+    return best
 
 
 def _gap_m(a, b) -> float:
