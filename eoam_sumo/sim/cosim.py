@@ -86,6 +86,8 @@ __all__ = ["CoSimulation", "policy_settings", "run_case"]
 GAP_WATCH_M = 20.0  # centre distance watched for road users up to WATCH_RADIUS_M [m]
 WATCH_RADIUS_M = 4.0  # a 7.5 m x 2.5 m box's bounding radius [m]
 ROAD_END_MARGIN_M = 50.0  # a run ends when the ego is this close to the end of its road [m]
+ROAD_END_LAST_M = 1.0  # ... or, a road user ahead, when its front is this close to it [m]
+ROAD_END_SIDE_M = 1.0  # a road user ahead this far beside the ego's path at most counts [m]
 
 
 class CoSimulation:
@@ -570,13 +572,32 @@ class CoSimulation:
             and not self._waiting_for_follower()
         ):
             self.end_cause = "settled"
-        elif self.meas.s_m > self._end_s_m:
+        elif self.meas.s_m > self._end_s_m and not self._road_user_before_the_end():
             self.end_cause = "road_end"
         elif self.n_steps >= self.max_steps:
             self.end_cause = self._end_request or "time_limit"
         else:
             return False
         return True
+
+    def _road_user_before_the_end(self) -> bool:
+        """Whether the ego, in the road end's margin (``ROAD_END_MARGIN_M``), may still meet a
+        road user ahead of it before its front bumper is at the very end of the road
+        (``ROAD_END_LAST_M``): one whose box lies across the ego's path (their half widths
+        and ``ROAD_END_SIDE_M`` apart at most), its back short of that end. The run goes on
+        to meet it (it ended 50 m short and hid the contact)."""
+        front_s = self.meas.s_m + self._front
+        last_s = self.road.length_m - ROAD_END_LAST_M
+        if front_s > last_s:
+            return False
+        d_ego, half_width = self.meas.d_m, 0.5 * self.params.width_m
+        for b in self.bodies:
+            s, d, _ = self.road.project(b.x_m, b.y_m)
+            back_s = s - 0.5 * b.length_m
+            side = abs(d - d_ego) - half_width - 0.5 * b.width_m
+            if front_s < s and back_s <= last_s and side <= ROAD_END_SIDE_M:
+                return True
+        return False
 
     def request_end(self, cause: str) -> None:
         """End the run after this step, its ``end_cause`` ``cause`` (an OpenSCENARIO

@@ -237,3 +237,27 @@ def test_a_lane_added_on_the_right_does_not_pull_the_ego_over(tmp_path, lanes, c
     assert ts["s_m"].iloc[-1] > 600.0
     assert ts["lateral_offset_m"].abs().max() < 0.1
     assert ts["ay_mps2"].abs().max() < 0.5
+
+
+def test_an_obstacle_in_the_roads_last_50_m_is_met_not_cut_off(tmp_path):
+    """The run ended 50 m before the road's end whatever stood there: an obstacle whose back is
+    14.5 m from the end was never reached ("unfinished", no gap). Braking from 100 km/h on
+    mu 1.0 on a one-lane road, the ego now stops behind it (or hits it)."""
+    _straight_edges(tmp_path, "short", [3.5], [1])
+    (tmp_path / "short.rou.xml").write_text(
+        '<routes><vType id="car" length="4.9" width="1.85" sigma="0"/>'
+        '<vehicle id="obs" type="car" depart="0" departPos="490" departLane="0" '
+        'departSpeed="0"><route edges="e0"/><stop lane="e0_0" endPos="490" duration="1000"/>'
+        "</vehicle>"
+        '<vehicle id="ego" type="car" depart="0" departPos="50" departLane="0" '
+        'departSpeed="30"><route edges="e0"/></vehicle></routes>'
+    )
+    summary = run_case(
+        tmp_path / "short.sumocfg",
+        ScenarioOverrides(ego_speed_mps=100 / 3.6, mu=1.0),
+        tmp_path / "run",
+        RunSettings(max_time_s=40.0),
+    )
+    assert summary["end_cause"] != "road_end"
+    assert summary["outcome"] in ("green", "yellow")
+    assert summary["min_gap_aro_m"] is not None and summary["min_gap_aro_m"] < 10.0
