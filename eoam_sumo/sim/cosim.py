@@ -88,6 +88,9 @@ WATCH_RADIUS_M = 4.0  # a 7.5 m x 2.5 m box's bounding radius [m]
 ROAD_END_MARGIN_M = 50.0  # a run ends when the ego is this close to the end of its road [m]
 ROAD_END_LAST_M = 1.0  # ... or, a road user ahead, when its front is this close to it [m]
 ROAD_END_SIDE_M = 1.0  # a road user ahead this far beside the ego's path at most counts [m]
+#: A run ends when the ego's centre is this far beyond the road's edge with no road user near
+#: (ours: its box some 2 m clear of the road; ``left_road`` judges from 0.5 m) [m].
+OFF_ROAD_END_M = 3.0
 
 
 class CoSimulation:
@@ -548,7 +551,8 @@ class CoSimulation:
 
     def finished(self) -> bool:
         """Whether the run is over: a contact, a rollover (``sim/vehicle.py``: past it the
-        plant, which has no roll, no longer describes the car), ``settle_s`` after the EOAM
+        plant, which has no roll, no longer describes the car), the ego far off the road
+        (``_off_the_road``), ``settle_s`` after the EOAM
         handed back to NORMAL after a manoeuvre or stopped (a manoeuvre begun in that time
         runs to its end; not while the ego moves towards a road user close ahead in its lane:
         :func:`~eoam_sumo.sim.margins.road_user_close_ahead`), the end of the road, or the
@@ -558,6 +562,9 @@ class CoSimulation:
             return True
         if self.rollover.time_s is not None:
             self.end_cause = "rollover"
+            return True
+        if self._off_the_road():
+            self.end_cause = "left_road"
             return True
         if not self.eoam_done():
             self._stop_at = None  # (again) a manoeuvre under way: run on to its end
@@ -579,6 +586,19 @@ class CoSimulation:
         else:
             return False
         return True
+
+    def _off_the_road(self) -> bool:
+        """Whether the ego's centre is more than ``OFF_ROAD_END_M`` beyond the road's edge
+        (its lane, the lane left of it if any, the usable one right of it: ``left_road``'s
+        road) and no road user is within ``GAP_WATCH_M`` of it: nothing on the road is left
+        to meet, and the run would wander to its time limit."""
+        d, w = self.meas.d_m, self.lane_width_m
+        left = 0.5 * w + (w if self.left_lane else 0.0)
+        beyond = max(d - left, -0.5 * w - self.right_width_m - d)
+        if beyond <= OFF_ROAD_END_M:
+            return False
+        X, Y = self.x[0], self.x[1]
+        return all(math.hypot(b.x_m - X, b.y_m - Y) > GAP_WATCH_M for b in self.bodies)
 
     def _road_user_before_the_end(self) -> bool:
         """Whether the ego, in the road end's margin (``ROAD_END_MARGIN_M``), may still meet a

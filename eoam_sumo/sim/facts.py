@@ -82,8 +82,8 @@ class RunFacts:
     # no lane change, or the obstacle gone), whether oncoming traffic came within the log
     passed_obstacle: bool | None = None
     oncoming_traffic: bool = False
-    # the end: contact, rollover, settled, road_end, time_limit or storyboard; simulated time since
-    # the departure
+    # the end: contact, rollover, left_road, settled, road_end, time_limit or storyboard;
+    # simulated time since the departure
     end_cause: str = "settled"
     sim_time_s: float = 0.0
     # the road's width right of the original lane: a lane there the ego may evade into

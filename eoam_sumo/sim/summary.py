@@ -85,8 +85,8 @@ class RunSummary:
         "a lane change ended ahead of the obstacle it avoided (empty: no lane change)"
     )
     end_cause: str = _doc(
-        "contact, rollover, settled, road_end, time_limit or storyboard (an OpenSCENARIO "
-        "StopTrigger)"
+        "contact, rollover, left_road, settled, road_end, time_limit or storyboard (an "
+        "OpenSCENARIO StopTrigger)"
     )
     rollover_time_s: float | None = _doc(
         "SUMO time both inner wheels had lifted or |ay| passed the static stability limit "

@@ -261,3 +261,19 @@ def test_an_obstacle_in_the_roads_last_50_m_is_met_not_cut_off(tmp_path):
     assert summary["end_cause"] != "road_end"
     assert summary["outcome"] in ("green", "yellow")
     assert summary["min_gap_aro_m"] is not None and summary["min_gap_aro_m"] < 10.0
+
+
+def test_an_ego_far_off_the_road_ends_the_run(curve_scenario, tmp_path):
+    """165 km/h on the 1500 m arc asks 1.4 m/s^2 of a mu 0.1 road (0.98 m/s^2): the ego slides
+    off the outside of the curve. With nothing near it there, the run ends (it wandered on to
+    the 40 s limit) and the outcome is the road departure's."""
+    summary = run_case(
+        curve_scenario,
+        ScenarioOverrides(ego_speed_mps=165 / 3.6, mu=0.1),
+        tmp_path / "run",
+        RunSettings(max_time_s=40.0),
+    )
+    assert summary["end_cause"] == "left_road"
+    assert summary["sim_time_s"] < 30.0
+    assert summary["outcome"] == "orange" and summary["left_road"] is True
+    assert "left the road" in summary["reason"]
