@@ -232,3 +232,23 @@ def test_a_run_of_a_file_that_is_no_scenario_writes_nothing(tmp_path, capsys):
         err = capsys.readouterr().err
         assert needle in err and len(err.strip().splitlines()) == 1
         assert not out.exists()
+
+
+def test_a_protocol_and_an_r157_study_never_replace_each_others_folder(tmp_path, capsys):
+    """Both write results.csv and scenarios/: each took the other's folder for its own and
+    replaced it (a protocol's scorecard and batch/ gone after an r157-study into it)."""
+    protocol = tmp_path / "protocol"
+    (protocol / "batch").mkdir(parents=True)
+    for name in ("results.csv", "scorecard.md", "scorecard.png"):
+        (protocol / name).write_text("kept\n", encoding="utf-8")
+    study = tmp_path / "study"
+    (study / "runs").mkdir(parents=True)
+    for name in ("results.csv", "r157_cut_in.png"):
+        (study / name).write_text("kept\n", encoding="utf-8")
+    before = {p: snapshot(p) for p in (protocol, study)}
+    argv_study = ["r157-study", "--type", "deceleration", "--speeds-kmh", "60", "--out"]
+    assert main([*argv_study, str(protocol)]) == 2
+    assert "holds another command's output (batch, scorecard.md" in capsys.readouterr().err
+    assert main(["protocol", "unr152", "--points", "v10_", "--out", str(study)]) == 2
+    assert "holds another command's output (runs)" in capsys.readouterr().err
+    assert {p: snapshot(p) for p in (protocol, study)} == before

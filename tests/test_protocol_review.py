@@ -194,3 +194,27 @@ def test_the_r157_verdict_needs_the_eoam_and_the_careful_driver(drivers):
 def test_a_speed_or_driver_given_twice_is_refused(speeds, drivers):
     with pytest.raises(InputError, match="given twice"):
         r157_command._parse(argparse.Namespace(speeds_kmh=speeds, drivers=drivers))
+
+
+def test_a_collision_without_warning_or_braking_fails_the_warning():
+    """Para. 5.2.1.1 asks a warning before a collision: a run that neither warned nor braked
+    and hit passed the warning ("no emergency braking, no warning required")."""
+    assert rules.r152_warning(False, None, False, collided=True)[0] == rules.FAIL
+    assert rules.r152_warning(True, None, False, collided=True)[0] == rules.PASS
+    assert rules.r152_warning(False, None, False, collided=False)[0] == rules.PASS
+    (point,) = [p for p in protocol_points(R152, WIDTH_M) if "stationary_v30_" in p.point_id]
+    measured = Measured(True, 30.0, 30.0, None, False)
+    row = scoring.point_row(point, measured, "", scoring.RunFacts(fcw_raised=False))
+    assert (row["verdict"], row["warning"]) == (rules.FAIL, rules.FAIL)
+
+
+def test_points_are_selected_by_the_tests_own_name_and_r152_partial_runs_say_verdicts():
+    """The ids write "R152-stationary" as "R152mstationary": --points 'R152-stationary_v10'
+    matched nothing; a partial R152 run said 'not the protocol's score' (2026's rule)."""
+    from eoam_sumo.protocols.command import named
+
+    r152 = protocol_points(R152, WIDTH_M)
+    chosen = [p for p in r152 if named(p).startswith("R152-stationary_v10_")]
+    assert len(chosen) == 1 and chosen[0].point_id.startswith("R152mstationary_v10_")
+    line = runner.ProtocolSummary(1, 1, 0, 0, 19, scored=False).line(Path("out"))
+    assert "the verdicts are of the points run" in line and "protocol's score" not in line

@@ -8,4 +8,8 @@ from eoam_sumo.batch.report import TABLE_MD
 from eoam_sumo.batch.results import CASES_DIR, RESULTS_FILE
 from eoam_sumo.outputs.staging import OutputKind
 
-BATCH_OUTPUT = OutputKind("batch", (RESULTS_FILE, CASES_DIR, TABLE_MD, PROBABILITIES_FILE))
+BATCH_OUTPUT = OutputKind(
+    "batch",
+    (RESULTS_FILE, CASES_DIR, TABLE_MD, PROBABILITIES_FILE),
+    foreign=("batch", "scorecard.md", "scorecard.png", "runs"),
+)

@@ -42,6 +42,9 @@ class OutputKind:
 
     name: str
     markers: tuple[str, ...]
+    #: entries that show a folder holds another command's output (results.csv and scenarios/
+    #: are written by several commands): such a folder is refused, not replaced
+    foreign: tuple[str, ...] = ()
 
 
 @contextlib.contextmanager
@@ -54,6 +57,12 @@ def output_folder(
     made = _first_missing(path)
     with locked(path):
         names = _entries(path)
+        other = sorted(names & set(kind.foreign))
+        if other:
+            raise InputError(
+                f"output folder {path} holds another command's output ({', '.join(other)}), "
+                f"not {kind.name} output; give a new or empty folder"
+            )
         if names and not names & set(kind.markers):
             raise InputError(
                 f"output folder {path} is not empty and holds no {kind.name} output (none of "

@@ -26,7 +26,9 @@ SYSTEMS = ("aeb", "eoam")
 
 #: What shows a folder holds a protocol's output (``protocols.runner``'s files and folders).
 PROTOCOL_OUTPUT = OutputKind(
-    "protocol", ("results.csv", "scorecard.md", "scorecard.png", "scenarios", "batch")
+    "protocol",
+    ("results.csv", "scorecard.md", "scorecard.png", "scenarios", "batch"),
+    foreign=("runs", "cases", "table2.md", "outcome_probabilities.csv"),
 )
 
 #: the equipment switches, --abs and --esc
@@ -103,10 +105,17 @@ def selected_points(args) -> list[TestPoint]:
             raise InputError(
                 f"--points {args.points!r} is not a regular expression: {exc}"
             ) from None
-        points = [p for p in points if pattern.search(p.point_id)]
+        points = [p for p in points if pattern.search(p.point_id) or pattern.search(named(p))]
         if not points:
             raise InputError(f"--points {args.points!r} matches no test point of {args.name}")
     return points
+
+
+def named(point) -> str:
+    """A point's id with its test's own name (``R152-stationary_v10...``: the id writes the
+    name's "-" as "m"), for ``--points``."""
+    coded = point.test.replace("-", "m").replace(".", "p")
+    return point.test + point.point_id.removeprefix(coded)
 
 
 def _check_mu_in_tables(args, params: VehicleParams) -> None:

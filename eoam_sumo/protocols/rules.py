@@ -321,10 +321,15 @@ R152_WARNING_SOURCE = (
 LEAD_DIGITS = 6
 
 
-def r152_warning(fcw_raised: bool, lead_s: float | None, braked: bool) -> tuple[str, str]:
+def r152_warning(
+    fcw_raised: bool, lead_s: float | None, braked: bool, collided: bool = False
+) -> tuple[str, str]:
     """(verdict, reason) of R152's warning (para. 5.2.1.1) from the FCW: raised at least
-    ``R152_WARNING_LEAD_S`` before the emergency braking began (``lead_s``; None: unknown)."""
+    ``R152_WARNING_LEAD_S`` before the emergency braking began (``lead_s``; None: unknown);
+    without emergency braking, required before a collision (``collided``)."""
     if not braked:
+        if collided and not fcw_raised:
+            return FAIL, "a collision with neither a warning nor emergency braking"
         return PASS, "no emergency braking, no warning required"
     if not fcw_raised:
         return FAIL, "no collision warning before the emergency braking"

@@ -17,7 +17,7 @@ from eoam_sumo.offline.tables import MIN_ENTRY_SPEED_KMH
 from eoam_sumo.params import VehicleParams, ego_e_class_sedan
 from eoam_sumo.protocols import rules, scoring
 from eoam_sumo.protocols.impact import measure, steered
-from eoam_sumo.protocols.points import TestPoint, protocol_points
+from eoam_sumo.protocols.points import PROTOCOLS, TestPoint, protocol_points
 from eoam_sumo.protocols.scenario import write_scenarios
 from eoam_sumo.protocols.scorecard import RunLabel, plot, scorecard_markdown
 from eoam_sumo.vehicle_files import DEFAULT_VEHICLE
@@ -68,15 +68,21 @@ class ProtocolSummary:
     outside: int
     matrix: int = 0  # the protocol's points (0: as many as ``points``)
     off_protocol: str = ""  # why the run is no protocol condition ("": it is)
+    scored: bool = True  # the protocol gives a score (Euro NCAP 2026), not verdicts per point
 
     def line(self, out: Path) -> str:
         """The summary line, naming the files in the output folder ``out``; a ``--points``
         subset is named a partial run (scored against the whole protocol)."""
         partial = ""
         if self.matrix > self.points:
+            rest = (
+                "the others counted as not run: not the protocol's score"
+                if self.scored
+                else "the verdicts are of the points run"
+            )
             partial = (
                 f"partial run: {self.points} of the protocol's {self.matrix} points "
-                "selected (--points), the others counted as not run: not the protocol's score; "
+                f"selected (--points), {rest}; "
             )
         off = f"{self.off_protocol}; " if self.off_protocol else ""
         return (
@@ -172,7 +178,8 @@ def run_protocol(
     off = "" if rules.on_protocol_surface(mu) else rules.OFF_PROTOCOL.format(mu=mu)
     matrix = len(protocol_points(name, params.width_m))
     outside = len(points) - len(runnable)
-    return ProtocolSummary(len(frame), len(runnable), failed, outside, matrix, off)
+    scored = name == PROTOCOLS[1]
+    return ProtocolSummary(len(frame), len(runnable), failed, outside, matrix, off, scored)
 
 
 def _import_scorecard_plots() -> None:

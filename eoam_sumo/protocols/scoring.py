@@ -201,7 +201,9 @@ def _r152(point: TestPoint, measured: Measured, facts: RunFacts) -> dict:
     table = rules.R152_M1_TABLE_KMH.get(rel)
     if table is not None:
         reason += f" (relative speed {rel:g} km/h; maximum mass: {table[0]:g} km/h allowed)"
-    warning, why = rules.r152_warning(facts.fcw_raised, measured.warning_lead_s, measured.braked)
+    warning, why = rules.r152_warning(
+        facts.fcw_raised, measured.warning_lead_s, measured.braked, measured.contact
+    )
     verdicts = [speed, warning]
     if facts.left_lane:
         verdicts.append(rules.FAIL)

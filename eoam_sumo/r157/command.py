@@ -12,7 +12,11 @@ from eoam_sumo.outputs.staging import OutputKind, output_folder
 from eoam_sumo.r157.scenario import TYPES
 from eoam_sumo.r157.study import SPEEDS_KMH, eoam_fails_where_careful_avoids, grid, run_study
 
-R157_OUTPUT = OutputKind("r157-study", ("results.csv", "runs", "scenarios"))
+R157_OUTPUT = OutputKind(
+    "r157-study",
+    ("results.csv", "runs", "scenarios"),
+    foreign=("batch", "scorecard.md", "scorecard.png", "cases", "table2.md"),
+)
 
 
 def add_arguments(subparsers) -> None:
