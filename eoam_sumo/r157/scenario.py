@@ -71,9 +71,16 @@ def _network(folder: Path, shapes: dict[str, list[tuple[float, float]]]) -> Path
 
 
 def _shift(x_start: float, y_from: float, y_to: float, speed: float, lateral: float):
-    """A lane centre left for another along a diagonal starting at ``x_start``."""
+    """A lane centre left for another along a diagonal for a car whose front is at
+    ``x_start`` when its lateral move begins. SUMO moves a car's front along its lane and
+    turns it after its front: its centre leaves the lane at half the lateral speed until its
+    back reaches the bend, a car length later. The bend lies half a car length before
+    ``x_start``, so that the centre moves as a car translated at ``lateral`` from then on
+    (R157's lateral speed; the 0.375 m wandering threshold crossed ``0.375 / lateral`` after
+    the move began, 0.22 s later with the bend at ``x_start``)."""
     length = speed * abs(y_to - y_from) / lateral
-    return [(0.0, y_from), (x_start, y_from), (x_start + length, y_to), (ROAD_M, y_to)]
+    bend = x_start - 0.5 * CAR_LENGTH_M
+    return [(0.0, y_from), (bend, y_from), (bend + length, y_to), (ROAD_M, y_to)]
 
 
 def _car(vid: str, edge: str, pos: float, speed: float, hold: float, decel: float) -> str:
