@@ -121,25 +121,42 @@ CELL_TEXT = {
 }
 
 
-def _legend(fig: Figure, kind: str) -> float:
-    """The colours (and the extended range's border) in one row, what a cell says under it,
-    wrapped to the figure's width; returns the height the text takes beyond one line (a
+LINE_IN = 7 * 1.3 / 72  # a 7 pt line [in]
+LEGEND_IN = 0.32  # the colour legend's row [in]
+
+
+def _wrapped(text: str, chars: int) -> list[str]:
+    """``text``'s lines wrapped to ``chars``, continued lines indented."""
+    return [
+        wrapped
+        for line in text.split("\n")
+        for wrapped in textwrap.wrap(line, chars, subsequent_indent="  ") or [""]
+    ]
+
+
+def _legend(fig: Figure, kind: str, footnote: list[str]) -> float:
+    """Under the grids, bottom up: what a cell says (wrapped to the figure's width), the
+    colours (and the extended range's border) in one row, then ``footnote``'s lines (the
+    tests not built, when no spare panel holds them); returns the height they take (a
     fraction of the figure's)."""
     handles: list = [Patch(facecolor=FILL[k], edgecolor="black", label=k) for k in LEGEND[kind]]
     if kind == "bands":
         handles.append(Line2D([], [], color="black", ls="--", lw=1.4, label="extended range"))
     lines = textwrap.wrap(CELL_TEXT[kind], int(FOOTNOTE_CHARS_PER_INCH * fig.get_figwidth()))
-    line_height = 7 * 1.3 / 72 / fig.get_figheight()  # 7 pt type
-    extra = (len(lines) - 1) * line_height
+    height_in = fig.get_figheight()
+    fig.text(0.5, 0.01, "\n".join(lines), ha="center", va="bottom", fontsize=7)
+    legend_y = 0.01 + (len(lines) * LINE_IN + 0.04) / height_in
     fig.legend(
         handles=handles,
         loc="lower center",
-        bbox_to_anchor=(0.5, 0.03 + extra),
+        bbox_to_anchor=(0.5, legend_y),
         ncol=len(handles),
         fontsize=7,
     )
-    fig.text(0.5, 0.01, "\n".join(lines), ha="center", va="bottom", fontsize=7)
-    return extra
+    top = legend_y + (LEGEND_IN + len(footnote) * LINE_IN) / height_in
+    if footnote:
+        fig.text(0.01, top, "\n".join(footnote), va="top", ha="left", fontsize=7)
+    return top + 0.01
 
 
 def plot_scorecard(
@@ -160,7 +177,14 @@ def plot_scorecard(
     nrows = -(-len(panels) // ncols)
     most_rows = max(len(own.groupby(ROW_KEYS)) for _, own in panels)
     width = max(4.4 * ncols, 8.0)
-    fig = Figure(figsize=(width, (most_rows * 0.3 + 1.3) * nrows + 1.6))
+    spare_panels = nrows * ncols - len(panels)
+    under = (
+        []
+        if spare_panels or not footnote
+        else _wrapped(footnote, int(FOOTNOTE_CHARS_PER_INCH * width))
+    )
+    height = (most_rows * 0.3 + 1.3) * nrows + 1.6 + len(under) * LINE_IN
+    fig = Figure(figsize=(width, height))
     axes = fig.subplots(nrows, ncols, squeeze=False)
     for ax, (test, own) in zip(axes.flat, panels):
         _draw_panel(ax, str(test), own, totals)
@@ -168,14 +192,11 @@ def plot_scorecard(
     for ax in spare:
         ax.axis("off")
     fig.suptitle(headline, fontsize=9)
-    extra = _legend(fig, kind)
-    fig.tight_layout(rect=(0, (0.08 if spare or not footnote else 0.14) + extra, 1, 0.95))
-    if footnote:  # placed after the layout, which it must not squeeze
-        x, y = (spare[0].get_position().x0, spare[0].get_position().y1) if spare else (0.01, 0.13)
-        width = FOOTNOTE_CHARS_PER_INCH * width * (1.0 - x) if spare else 200
-        lines = [
-            textwrap.fill(line, int(width), subsequent_indent="  ") for line in footnote.split("\n")
-        ]
-        fig.text(x, y, "\n".join(lines), va="top", ha="left", fontsize=7)
+    bottom = _legend(fig, kind, under)
+    fig.tight_layout(rect=(0, bottom, 1, 0.95))
+    if footnote and spare:  # placed after the layout, which it must not squeeze
+        x, y = spare[0].get_position().x0, spare[0].get_position().y1
+        chars = int(FOOTNOTE_CHARS_PER_INCH * width * (1.0 - x))
+        fig.text(x, y, "\n".join(_wrapped(footnote, chars)), va="top", ha="left", fontsize=7)
     fig.savefig(path, dpi=130)
     return Path(path)
