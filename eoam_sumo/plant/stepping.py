@@ -15,15 +15,22 @@ from eoam_sumo.params import (
 )
 from eoam_sumo.plant.chassis import MU_EST_HIGH, constants
 from eoam_sumo.plant.model import (
+    AY_LOAD,
+    BETA_EST,
     DRIVE,
+    ESC_REF,
     MU_EST,
     OMEGAS,
     PRESSURES,
     STATE_NAMES,
     STEER,
+    TAN_F,
+    TAN_R,
     V_EST,
     VX,
+    VY,
     YAW,
+    YAW_RATE,
     X,
     Y,
 )
@@ -99,11 +106,13 @@ def initial_state(
     drive_force_n: float = 0.0,
     brake_force_n: float = 0.0,
     params: VehicleParams | None = None,
+    curvature_per_m: float = 0.0,
 ) -> np.ndarray:
     """State vector (``STATE_NAMES`` order) of a vehicle at ``(x_m, y_m)`` heading ``yaw_rad``
     moving straight at ``speed_mps >= 0``, its wheels rolling (``params``: default the
     paper's sedan); actuator states zero unless given (``brake_force_n`` as line pressure);
-    the speed estimate the speed, the friction estimate a dry road's."""
+    the speed estimate the speed, the friction estimate a dry road's. ``curvature_per_m``
+    not 0 (left positive): turning steadily on that curve instead (``_steady_turn``)."""
     if not speed_mps >= 0.0:
         raise ValueError(f"speed_mps={speed_mps!r} must be >= 0")
     p = params or ego_e_class_sedan()
@@ -115,7 +124,32 @@ def initial_state(
     for i in OMEGAS:
         x[i] = speed_mps / p.wheel_radius_m
     x[V_EST], x[MU_EST] = speed_mps, MU_EST_HIGH  # the control unit's estimates: a dry road
+    if curvature_per_m:
+        _steady_turn(x, speed_mps, curvature_per_m, p)
     return x
+
+
+def _steady_turn(x: np.ndarray, v: float, kappa: float, p: VehicleParams) -> None:
+    """``x`` turning steadily at ``v`` on a curve of curvature ``kappa`` by the linear
+    single-track model (Gillespie 1992 ch. 6): the steer ``L kappa + K_us v^2 kappa``, the
+    yaw rate ``v kappa``, the sideslip ``kappa (b - m a v^2 / (L C_r))``, the axles' slips
+    and the lagged lateral acceleration, the ESC's reference and sideslip estimate, at their
+    steady values (a car entering the run on a curve was started straight: it had to build
+    its turn up and drifted off near the friction's limit)."""
+    ay = v * v * kappa
+    steer = p.wheelbase_m * kappa + p.understeer_gradient_rad_per_mps2 * ay
+    beta = kappa * (
+        p.cg_to_rear_m
+        - p.mass_kg * p.cg_to_front_m * v * v / (p.wheelbase_m * p.cornering_stiffness_rear_npr)
+    )
+    r, vy = v * kappa, v * beta
+    x[STEER], x[YAW_RATE], x[VY] = steer, r, vy
+    vy_f, vy_r = vy + p.cg_to_front_m * r, vy - p.cg_to_rear_m * r
+    lat_f = -v * math.sin(steer) + vy_f * math.cos(steer)
+    long_f = v * math.cos(steer) + vy_f * math.sin(steer)
+    if v > 0.0:
+        x[TAN_F], x[TAN_R] = lat_f / long_f, vy_r / v
+    x[AY_LOAD], x[ESC_REF], x[BETA_EST] = ay, r, beta
 
 
 def brake_gains_n_per_bar(params: VehicleParams) -> tuple[float, float, float, float]:

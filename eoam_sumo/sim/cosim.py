@@ -224,8 +224,14 @@ class CoSimulation:
         self.mu_sides = _side_frictions(session, self.side_lanes)
         self.right_width_m = self.side_lanes[1].width_m if self.side_lanes[1] else 0.0
         cg_x_m, cg_y_m = _centre_of_gravity(ego, self.params)
+        kappa, road_yaw = _start_curve(road, cg_x_m, cg_y_m)
         self.x = initial_state(
-            cg_x_m, cg_y_m, ego.yaw_rad, ego.speed_mps, params=self.params
+            cg_x_m,
+            cg_y_m,
+            road_yaw if kappa else ego.yaw_rad,
+            ego.speed_mps,
+            params=self.params,
+            curvature_per_m=kappa,
         ).tolist()
         self.x_prev = self.x
         self.ax = self.ay = 0.0
@@ -791,6 +797,21 @@ def _centre_of_gravity(ego: Body, params: VehicleParams) -> tuple[float, float]:
         ego.x_m + back_m * math.cos(ego.yaw_rad),
         ego.y_m + back_m * math.sin(ego.yaw_rad),
     )
+
+
+#: A road straighter than this at the ego's start is straight (a radius above 100 km).
+STRAIGHT_PER_M = 1.0e-5
+
+
+def _start_curve(road: RoadFrame, x_m: float, y_m: float) -> tuple[float, float]:
+    """The road's curvature where the ego starts (0 on a straight, ``STRAIGHT_PER_M``) and
+    its heading there: on a curve the plant starts turning on it
+    (``plant.stepping.initial_state``) along the road's smooth heading (SUMO's angle is its
+    lane segment's: 0.025 rad off on a 400 m curve of 25 m chords, 0.8 m/s of drift at
+    120 km/h)."""
+    s_m, _, road_yaw = road.project(x_m, y_m)
+    kappa = road.curvature_at(s_m)
+    return (kappa, road_yaw) if abs(kappa) > STRAIGHT_PER_M else (0.0, road_yaw)
 
 
 def _side_frictions(session: SumoSession, side_lanes: tuple) -> tuple[float, float]:

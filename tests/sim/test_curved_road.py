@@ -277,3 +277,35 @@ def test_an_ego_far_off_the_road_ends_the_run(curve_scenario, tmp_path):
     assert summary["sim_time_s"] < 30.0
     assert summary["outcome"] == "orange" and summary["left_road"] is True
     assert "left the road" in summary["reason"]
+
+
+def test_an_ego_starting_on_a_curve_starts_turning_along_it(tmp_path):
+    """A 400 m left arc at 120 km/h on mu 0.4 (2.78 of 3.92 m/s^2): the plant started straight
+    with SUMO's angle (its 20 m chord's, 0.025 rad off the curve) and drifted 1.3 m in mode
+    0. It now starts on the curve: the yaw rate v / R, along the road's heading."""
+    radius, length = 400.0, 1200.0
+    end = (radius * math.sin(length / radius), radius * (1 - math.cos(length / radius)))
+    network(
+        tmp_path,
+        "arc",
+        f'<nodes><node id="a" x="0" y="0"/><node id="b" x="{end[0]:.3f}" y="{end[1]:.3f}"/>'
+        "</nodes>",
+        f'<edges><edge id="fwd" from="a" to="b" numLanes="1" speed="50" width="3.5" '
+        f'shape="{_arc(radius, length)}"/></edges>',
+    )
+    (tmp_path / "arc.rou.xml").write_text(
+        '<routes><vType id="car" length="4.6" width="1.8" sigma="0"/>'
+        '<vehicle id="ego" type="car" depart="0" departPos="100" departSpeed="30">'
+        '<route edges="fwd"/></vehicle></routes>'
+    )
+    cfg = write_sumocfg(tmp_path / "arc.sumocfg", "arc.net.xml", "arc.rou.xml")
+    out = tmp_path / "run"
+    speed = 120 / 3.6
+    summary = run_case(
+        cfg, ScenarioOverrides(ego_speed_mps=speed, mu=0.4), out, RunSettings(max_time_s=15.0)
+    )
+    assert summary["outcome"] == "none"
+    ts = pd.read_csv(out / "timeseries.csv")
+    assert ts["yaw_rate_radps"].iloc[0] == pytest.approx(speed / radius, rel=0.02)
+    assert abs(ts["heading_error_rad"].iloc[0]) < 0.002
+    assert ts["lateral_offset_m"].abs().max() < 0.5
