@@ -218,3 +218,15 @@ def test_points_are_selected_by_the_tests_own_name_and_r152_partial_runs_say_ver
     assert len(chosen) == 1 and chosen[0].point_id.startswith("R152mstationary_v10_")
     line = runner.ProtocolSummary(1, 1, 0, 0, 19, scored=False).line(Path("out"))
     assert "the verdicts are of the points run" in line and "protocol's score" not in line
+
+
+def test_every_row_says_whether_its_run_was_on_the_protocols_road():
+    """Rows of a run off the dry road carried verdicts and colours with nothing in results.csv
+    saying they are figures only."""
+    (point,) = [p for p in protocol_points(R152, WIDTH_M) if "stationary_v30_" in p.point_id]
+    for mu, on in ((1.0, True), (0.2, False)):
+        row = runner._row(point, None, _label(R152, mu), Path("out"))
+        assert row["on_protocol"] is on
+        assert list(runner.results_frame([point], pd.DataFrame(), _label(R152, mu), Path("o")))[
+            :6
+        ] == ["point_id", "protocol", "system", "policy", "vehicle", "on_protocol"]

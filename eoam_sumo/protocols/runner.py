@@ -33,6 +33,7 @@ PROTOCOL_COLUMNS = (
     "system",
     "policy",
     "vehicle",
+    "on_protocol",
     "sumo_step_s",
     "test",
     "ego_speed_kmh",
@@ -231,6 +232,7 @@ def _row(point: TestPoint, run: dict | None, label: RunLabel, out: Path) -> dict
         "system": label.system,
         "policy": label.policy,
         "vehicle": label.vehicle_id,
+        "on_protocol": rules.on_protocol_surface(label.mu),
     }
     if run is None:
         note = scoring.OUTSIDE_DESIGN.format(v=point.ego_speed_kmh, low=label.low_kmh)

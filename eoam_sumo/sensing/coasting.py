@@ -33,6 +33,7 @@ from typing import Protocol
 
 from eoam_sumo.world.bodies import Body
 from eoam_sumo.world.geometry import OrientedBox
+from eoam_sumo.world.lanes import body_band_m
 
 
 class Beams(Protocol):
@@ -152,6 +153,7 @@ class Coaster:
         s, d, road_yaw = project(box.x_m, box.y_m)
         road_speed = body.speed_mps * math.cos(box.yaw_rad - road_yaw)
         ahead = s > ego_s
+        band_m = body_band_m(band_m, body.width_m)
         category = radar.classify(ahead, d, body.speed_mps, road_speed, band_m, lane_width_m)
         head_on = radar.head_on(category, ahead, d, band_m)
         px, py = box.nearest_point(ox, oy)

@@ -70,6 +70,7 @@ from eoam_sumo.world.lanes import (
     ONCOMING_SPEED_MPS,
     STATIONARY_SPEED_MPS,
     RoadProjection,
+    body_band_m,
     lane_band_m,
 )
 
@@ -372,8 +373,9 @@ class Radar:
         road_speed = tgt.speed_mps * math.cos(box.yaw_rad - road_yaw)
         ahead = s > ego.s_m
         lateral = tgt.speed_mps * math.sin(box.yaw_rad - road_yaw)
+        band = body_band_m(ego.band_m, tgt.width_m)
         category = self.classify(
-            ahead, d, tgt.speed_mps, road_speed, ego.band_m, ego.lane_width_m, lateral
+            ahead, d, tgt.speed_mps, road_speed, band, ego.lane_width_m, lateral
         )
         return Detection(
             index,
@@ -386,7 +388,7 @@ class Radar:
             category,
             tgt.length_m,
             tgt.width_m,
-            self.head_on(category, ahead, d, ego.band_m),
+            self.head_on(category, ahead, d, band),
         )
 
     def _coasting(

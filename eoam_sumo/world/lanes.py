@@ -42,6 +42,18 @@ def lane_band_m(lane_width_m: float, margin_m: float = LANE_MARGIN_M) -> float:
     return 0.5 * lane_width_m + margin_m
 
 
+#: The width of the car ``LANE_MARGIN_M`` is set for: its centre at the band's edge puts 0.4 m
+#: of it in the lane [m].
+MARGIN_CAR_WIDTH_M = 1.8
+
+
+def body_band_m(band_m: float, width_m: float) -> float:
+    """The band for a road user ``width_m`` wide: one narrower than ``MARGIN_CAR_WIDTH_M`` (a
+    person, a bicycle) counts as in the lane only as far into it as that car (a person on the
+    pavement beside the lane, 0.1 m over its marker, is not in it); a wider one as the car."""
+    return band_m - 0.5 * max(MARGIN_CAR_WIDTH_M - width_m, 0.0)
+
+
 def crosses_lane(speed_mps: float, yaw_rad: float, road_yaw_rad: float) -> bool:
     """Whether a road user crosses the road rather than follows it: heading more than
     ``CROSSING_ANGLE_RAD`` off the road's direction (either way), faster than

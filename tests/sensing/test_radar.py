@@ -430,3 +430,24 @@ def test_the_nearest_standing_car_in_the_next_lane_is_reported():
     )
     assert 50.0 <= rep.next_lane_range_m < 51.0
     assert _scan([_ahead(40.0, LANE_M, CAR, 25.0)]).next_lane_range_m is None  # moving
+
+
+@pytest.mark.parametrize(
+    ("vclass", "dims", "d_m", "in_path"),
+    [
+        ("pedestrian", (0.3, 0.6), -2.07, False),  # on the pavement, 0.03 m over the marker
+        ("bicycle", (1.6, 0.65), -2.0, False),  # on a bike lane beside the ego's
+        ("pedestrian", (0.3, 0.6), -1.5, True),  # 0.55 m into the lane
+        ("passenger", CAR, -2.2, True),  # 0.46 m of the car in the lane: the margin's case
+    ],
+)
+def test_a_narrow_road_user_is_in_the_path_only_as_far_into_the_lane_as_a_car(
+    vclass, dims, d_m, in_path
+):
+    """The lane band (half a lane and 0.5 m) put a person walking on the pavement 2.07 m from
+    the lane centre in the path: the ego braked from 120 km/h to a stop for people beside the
+    road. A narrower road user now counts when it is as far into the lane as the 1.8 m car
+    the margin is set for (0.4 m)."""
+    person = Body("p", vclass, 60.0, d_m, math.pi, 1.2, *dims)
+    det = _scan([person]).detections
+    assert (det[0].category == "in_path") is in_path
