@@ -309,3 +309,66 @@ def test_an_ego_starting_on_a_curve_starts_turning_along_it(tmp_path):
     assert ts["yaw_rate_radps"].iloc[0] == pytest.approx(speed / radius, rel=0.02)
     assert abs(ts["heading_error_rad"].iloc[0]) < 0.002
     assert ts["lateral_offset_m"].abs().max() < 0.5
+
+
+def _ramp(tmp_path, route: str, depart_lane: int) -> object:
+    """A 2-lane motorway widening to 3 lanes, then an exit on the right and 2 lanes on."""
+    from tests.builders import netconvert
+
+    netconvert(
+        tmp_path,
+        "ramp",
+        '<nodes><node id="A" x="0" y="0"/><node id="B" x="1000" y="0"/>'
+        '<node id="C" x="1300" y="0"/><node id="D" x="3000" y="0"/>'
+        '<node id="X" x="1700" y="-80"/></nodes>',
+        '<edges><edge id="m1" from="A" to="B" numLanes="2" speed="33.33"/>'
+        '<edge id="dec" from="B" to="C" numLanes="3" speed="33.33"/>'
+        '<edge id="m2" from="C" to="D" numLanes="2" speed="33.33"/>'
+        '<edge id="exit" from="C" to="X" numLanes="1" speed="22.22"/></edges>',
+    )
+    (tmp_path / "ramp.rou.xml").write_text(
+        '<routes><vType id="car" length="4.9" width="1.85" sigma="0"/>'
+        f'<vehicle id="ego" type="car" depart="0" departLane="{depart_lane}" departPos="800" '
+        f'departSpeed="30"><route edges="{route}"/></vehicle></routes>'
+    )
+    return write_sumocfg(tmp_path / "ramp.sumocfg", "ramp.net.xml", "ramp.rou.xml")
+
+
+def test_an_exit_route_follows_the_lane_that_leads_to_the_exit(tmp_path):
+    """The lane straight ahead of the ego's on the widened edge does not lead to the exit on
+    its route: the connected lane that does is followed (the route was refused)."""
+    cfg = _ramp(tmp_path, "m1 dec exit", 0)
+    summary = run_case(cfg, ScenarioOverrides(ego_speed_mps=25.0, mu=1.0), tmp_path / "run")
+    assert summary["outcome"] == "none"
+
+
+def test_an_ego_lane_that_merges_away_is_refused_by_name(tmp_path):
+    """Straight on, the ego's right lane ends into the lane left of it (a connection file
+    merges it): the centre line jumped 3.5 m in 8 m and the ego swerved at 7.7 m/s^2 in mode
+    0 ("left the road")."""
+    from eoam_sumo.errors import InputError
+    from tests.builders import netconvert
+
+    (tmp_path / "merge.con.xml").write_text(
+        '<connections><connection from="e0" to="e1" fromLane="0" toLane="0"/></connections>'
+    )
+    netconvert(
+        tmp_path,
+        "merge",
+        '<nodes><node id="A" x="0" y="0"/><node id="B" x="500" y="0"/>'
+        '<node id="C" x="1500" y="0"/></nodes>',
+        '<edges><edge id="e0" from="A" to="B" numLanes="2" speed="33.33"/>'
+        '<edge id="e1" from="B" to="C" numLanes="1" speed="33.33"/></edges>',
+        "--connection-files",
+        str(tmp_path / "merge.con.xml"),
+    )
+    net = (tmp_path / "merge.net.xml").read_text()
+    assert 'from="e0" to="e1" fromLane="0"' in net  # the lane is connected: it merges
+    (tmp_path / "merge.rou.xml").write_text(
+        '<routes><vType id="car" length="4.9" width="1.85" sigma="0"/>'
+        '<vehicle id="ego" type="car" depart="0" departLane="0" departPos="50" '
+        'departSpeed="30"><route edges="e0 e1"/></vehicle></routes>'
+    )
+    cfg = write_sumocfg(tmp_path / "merge.sumocfg", "merge.net.xml", "merge.rou.xml")
+    with pytest.raises(InputError, match="lane e0_0 does not continue onto edge 'e1'"):
+        run_case(cfg, ScenarioOverrides(ego_speed_mps=30.0, mu=1.0))

@@ -181,15 +181,16 @@ def route_centreline(
     api, files: ScenarioFiles, start_lane_id: str, route_edges: list, lane_index: int
 ) -> np.ndarray:
     """Centre line of the ego's start lane followed along its route, lane by lane
-    (``_next_lane``): where the next route edge goes on straight, the lane that goes on
-    straight ahead of the ego's (a lane added or dropped beside it shifts SUMO's indices, which
-    count from the right, and netconvert may connect the lane elsewhere); at a turn, over
-    the connection (and the junction's internal lanes) to the lane it leads to."""
+    (``_next_lane``): where the next route edge goes on straight, the lane straight ahead of
+    the ego's (a lane added beside it shifts SUMO's indices, which count from the right, and
+    netconvert may connect the lane elsewhere); at a turn, over the connection (and the
+    junction's internal lanes) to the lane it leads to."""
     lanes = api.lane
     lane = start_lane_id
     points = [tuple(p) for p in lanes.getShape(lane)]
-    for edge in route_edges[1:]:
-        nxt, via = _next_lane(api, files, lane, edge, lane_index)
+    for k, edge in enumerate(route_edges[1:], start=1):
+        after = route_edges[k + 1] if k + 1 < len(route_edges) else None
+        nxt, via = _next_lane(api, files, lane, edge, after, lane_index)
         for _ in range(8):  # a junction's internal lanes, until the next normal lane
             if not via or not via.startswith(":"):
                 break
@@ -210,49 +211,60 @@ def route_centreline(
 STRAIGHT_ON_RAD = math.radians(20.0)
 
 
-def _next_lane(api, files: ScenarioFiles, lane: str, edge: str, lane_index: int):
+def _next_lane(api, files: ScenarioFiles, lane: str, edge: str, after: str | None, index: int):
     """The lane of route edge ``edge`` the ego's ``lane`` leads to, and the internal lane to
-    it (None: straight on without one): straight on, the lane whose centre starts within
-    half its width of the ego's lane's line, linked or not; else the linked lane that starts
-    nearest, then the one of the same index. InputError when the lane ends there."""
+    it (None: straight on without one). Where ``edge`` goes on straight: the lane whose centre
+    starts within half its width of the ego's lane's line (the connected one that continues
+    onto the route's edge ``after`` when that one does not); none: the ego's lane ends there
+    (a merge), refused. At a turn: the connected lane that continues onto ``after``, starts
+    nearest, then has the same index."""
     lanes = api.lane
     shape = lanes.getShape(lane)
     (x0, y0), (x1, y1) = shape[-2][:2], shape[-1][:2]
     heading = math.atan2(y1 - y0, x1 - x0)
     links = {link[0]: link[4] for link in lanes.getLinks(lane) if lanes.getEdgeID(link[0]) == edge}
-    ahead = _lane_straight_ahead(api, edge, (x1, y1), heading)
-    if ahead is not None:
+    straight, ahead = _lane_straight_ahead(api, edge, (x1, y1), heading)
+    if ahead is not None and (after is None or _continues(api, ahead, after) or not links):
         return ahead, links.get(ahead) or None
-    if not links:
+    if not links or (straight and ahead is None):
         raise InputError(
             f"{files.net_file}: the ego's lane {lane} does not continue onto "
-            f"edge '{edge}' of its route (no connection: the lane ends); start the ego "
-            "in a lane that continues"
+            f"edge '{edge}' of its route (no connection, or it merges into another lane: "
+            "the lane ends); start the ego in a lane that continues"
         )
     best = min(
         links,
         key=lambda k: (
+            after is not None and not _continues(api, k, after),
             round(_gap_m((x1, y1), lanes.getShape(k)[0]), 1),
-            abs(int(k.rsplit("_", 1)[1]) - lane_index),
+            abs(int(k.rsplit("_", 1)[1]) - index),
         ),
     )
     return best, links[best]
 
 
-def _lane_straight_ahead(api, edge: str, end: tuple, heading: float) -> str | None:
-    """The lane of ``edge`` whose start lies on the line ahead of ``end`` (within half its
-    width across it) when the edge goes on straight (``STRAIGHT_ON_RAD``), else None."""
+def _continues(api, lane: str, edge: str) -> bool:
+    """Whether ``lane`` has a connection onto ``edge``."""
+    return any(api.lane.getEdgeID(link[0]) == edge for link in api.lane.getLinks(lane))
+
+
+def _lane_straight_ahead(api, edge: str, end: tuple, heading: float) -> tuple[bool, str | None]:
+    """Whether ``edge`` goes on straight (a lane of it starts within ``STRAIGHT_ON_RAD`` of
+    ``heading``), and its lane whose start lies on the line ahead of ``end`` (within half its
+    width across it), if any."""
     c, s = math.cos(heading), math.sin(heading)
-    best, best_d = None, math.inf
+    straight, best, best_d = False, None, math.inf
     for k in range(api.edge.getLaneNumber(edge)):
         lane = f"{edge}_{k}"
         shape = api.lane.getShape(lane)
         (xa, ya), (xb, yb) = shape[0][:2], shape[1][:2]
-        turn = abs(math.remainder(math.atan2(yb - ya, xb - xa) - heading, math.tau))
+        if abs(math.remainder(math.atan2(yb - ya, xb - xa) - heading, math.tau)) > STRAIGHT_ON_RAD:
+            continue
+        straight = True
         across = abs(-(xa - end[0]) * s + (ya - end[1]) * c)
-        if turn <= STRAIGHT_ON_RAD and across <= 0.5 * api.lane.getWidth(lane) and across < best_d:
+        if across <= 0.5 * api.lane.getWidth(lane) and across < best_d:
             best, best_d = lane, across
-    return best
+    return straight, best
 
 
 def _gap_m(a, b) -> float:
