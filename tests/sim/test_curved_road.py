@@ -372,3 +372,38 @@ def test_an_ego_lane_that_merges_away_is_refused_by_name(tmp_path):
     cfg = write_sumocfg(tmp_path / "merge.sumocfg", "merge.net.xml", "merge.rou.xml")
     with pytest.raises(InputError, match="lane e0_0 does not continue onto edge 'e1'"):
         run_case(cfg, ScenarioOverrides(ego_speed_mps=30.0, mu=1.0))
+
+
+def test_a_braking_obstacle_keeps_its_lane(tmp_path):
+    """The scripted stop gave the obstacle its lane changes back when it began to brake: on a
+    road of two lanes each way SUMO moved it from the left lane to the right one in one 10 ms
+    step, into the lane the ego was evading into (the contact then counted as 'other')."""
+    network(
+        tmp_path,
+        "dual",
+        '<nodes><node id="A" x="0" y="0"/><node id="B" x="3000" y="0"/></nodes>',
+        '<edges><edge id="E" from="A" to="B" numLanes="2" speed="33.33" width="3.5"/>'
+        '<edge id="-E" from="B" to="A" numLanes="2" speed="33.33" width="3.5"/></edges>',
+    )
+    (tmp_path / "dual.rou.xml").write_text(
+        '<routes><vType id="car" length="4.9" width="1.85" decel="9" sigma="0"/>'
+        '<vehicle id="aro" type="car" depart="1" departLane="1" departPos="225" '
+        'departSpeed="16.67" insertionChecks="none"><route edges="E"/>'
+        '<param key="eoam.aro_hold_s" value="2.0"/><param key="eoam.aro_decel_mps2" value="8.0"/>'
+        "</vehicle>"
+        '<vehicle id="ego" type="car" depart="1" departLane="1" departPos="100" '
+        'departSpeed="33.33" insertionChecks="none"><route edges="E"/></vehicle></routes>'
+    )
+    cfg = write_sumocfg(tmp_path / "dual.sumocfg", "dual.net.xml", "dual.rou.xml")
+    out = tmp_path / "run"
+    summary = run_case(
+        cfg,
+        ScenarioOverrides(ego_speed_mps=120 / 3.6, mu=0.3, oncoming_start_m=250.0),
+        out,
+        RunSettings(max_time_s=20.0),
+    )
+    traffic = pd.read_csv(out / "traffic.csv")
+    aro = traffic[traffic["id"] == "aro"]
+    assert len(aro) > 100
+    assert aro["y_m"].max() - aro["y_m"].min() < 0.01
+    assert summary["collision_with"] in ("none", "aro")

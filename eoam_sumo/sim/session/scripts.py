@@ -39,7 +39,6 @@ class _Script:
     hold_end_s: float
     decel_mps2: float
     hold_speed_mps: float
-    lane_change_mode: int  # the vehicle's own, given back after the hold
     mu: float = 1.0
     last_cmd_mps: float = -1.0
     holding: bool = True
@@ -71,18 +70,17 @@ class StopScripts:
             veh.getDeparture(vid) + hold + self._insert_lag_s,
             decel,
             veh.getSpeed(vid),
-            veh.getLaneChangeMode(vid),
         )
         veh.setSpeedMode(vid, HOLD_SPEED_MODE)
         veh.setLaneChangeMode(vid, NO_LANE_CHANGES)
         watch(vid)
 
     def _release(self, vid: str, script: _Script) -> None:
-        """The hold is over: the stop regards the safe speed, the lane changes are the
-        vehicle's own again."""
+        """The hold is over: the stop regards the safe speed; the lane changes stay off
+        through the emergency stop (SUMO's lane-change model moved a braking obstacle a lane
+        over in one 10 ms step, into the lane the ego was evading into)."""
         script.holding = False
         self._veh.setSpeedMode(vid, SCRIPTED_SPEED_MODE)
-        self._veh.setLaneChangeMode(vid, script.lane_change_mode)
 
     def _stand(self, vid: str, script: _Script) -> None:
         """The stop is commanded to standstill: lane changes off, it stays in its lane."""
