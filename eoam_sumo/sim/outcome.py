@@ -406,11 +406,12 @@ def _contact_outcome(
     elif front_hit and not lane_change and direct_overlap >= DIRECT_HIT_MIN_OVERLAP:
         colour, reason = "yellow", f"{done}, front hit {what} at {v:.1f} m/s"
     elif front_hit:
+        offset = "offset " if direct_overlap < DIRECT_HIT_MIN_OVERLAP else ""
         colour, reason = (
             "orange",
             (
-                f"{done}, offset front hit {what} ({100 * direct_overlap:.0f} % of the narrower "
-                f"width in line) at {v:.1f} m/s"
+                f"{done}, {offset}front hit {what} ({100 * direct_overlap:.0f} % of the "
+                f"narrower width in line) at {v:.1f} m/s"
             ),
         )
     else:

@@ -174,3 +174,12 @@ def test_impact_angle_and_masses():
     assert road_user_mass_kg(1500.0, "passenger") == 1500.0
     with pytest.raises(ValueError, match="masses"):
         delta_v_mps(0.0, 1.0, 1.0)
+
+
+def test_a_direct_front_hit_after_a_lane_change_is_not_called_offset():
+    """After a lane change a front hit is orange (rule 3) however squarely it lands; the
+    reason called a 97 % hit "offset", which the docs keep for under 50 %."""
+    lane_change = [0, 2]
+    out = classify_outcome(lane_change, 2.0, LANE_M, REAR_HIT, "aro", direct_overlap=0.97)
+    assert out.colour == "orange"
+    assert "front hit the ARO (97 %" in out.reason and "offset" not in out.reason
