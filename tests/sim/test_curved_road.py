@@ -407,3 +407,91 @@ def test_a_braking_obstacle_keeps_its_lane(tmp_path):
     assert len(aro) > 100
     assert aro["y_m"].max() - aro["y_m"].min() < 0.01
     assert summary["collision_with"] in ("none", "aro")
+
+
+def test_a_bus_lane_beside_the_ego_further_on_closes_the_evasion(tmp_path):
+    """A lane added on the right shifts SUMO's indices: the lane beside the ego on the next
+    edge is its index + 1 there, a bus lane; the check took the start edge's index (the ego's
+    own lane there) and the ego evaded through the bus lane for 3.9 s (the connections as a
+    user wrote them: the lanes straight on, the added lane unconnected)."""
+    from tests.builders import netconvert
+
+    (tmp_path / "bus.con.xml").write_text(
+        '<connections><connection from="e1" to="e2" fromLane="0" toLane="1"/>'
+        '<connection from="e1" to="e2" fromLane="1" toLane="2"/></connections>'
+    )
+    netconvert(
+        tmp_path,
+        "bus",
+        '<nodes><node id="A" x="0" y="0"/><node id="B" x="500" y="0"/>'
+        '<node id="C" x="3000" y="0"/></nodes>',
+        '<edges><edge id="e1" from="A" to="B" numLanes="2" speed="33.33" width="3.5"/>'
+        '<edge id="e2" from="B" to="C" numLanes="3" speed="33.33" width="3.5">'
+        '<lane index="2" allow="bus"/></edge></edges>',
+        "--connection-files",
+        str(tmp_path / "bus.con.xml"),
+    )
+    (tmp_path / "bus.rou.xml").write_text(
+        '<routes><vType id="car" length="4.92" width="1.85" decel="9" sigma="0" speedDev="0"/>'
+        '<vType id="aro" length="5.09" width="1.99" accel="2.5" decel="9" emergencyDecel="12" '
+        'maxSpeed="50" sigma="0" speedDev="0"/>'
+        '<vehicle id="aro" type="aro" depart="1" departLane="0" departPos="490" '
+        'departSpeed="16.67" insertionChecks="none"><route edges="e1 e2"/>'
+        '<param key="eoam.aro_hold_s" value="2.0"/><param key="eoam.aro_decel_mps2" value="8.0"/>'
+        "</vehicle>"
+        '<vehicle id="ego" type="car" depart="1" departLane="0" departPos="370" '
+        'departSpeed="33.33" insertionChecks="none"><route edges="e1 e2"/></vehicle></routes>'
+    )
+    cfg = tmp_path / "bus.sumocfg"
+    cfg.write_text(
+        '<configuration><input><net-file value="bus.net.xml"/><route-files value="bus.rou.xml"/>'
+        '</input><time><begin value="0"/><step-length value="0.01"/></time></configuration>'
+    )
+    summary = run_case(cfg, ScenarioOverrides(mu=0.3), tmp_path / "o")
+    modes = summary["modes_visited"]
+    assert 1 in modes or 3 in modes  # it met the obstacle in its lane
+    assert 2 not in modes and 4 not in modes  # and did not evade through the bus lane
+    assert summary["time_in_next_lane_s"] == 0.0
+
+
+def test_a_lane_that_ends_beside_the_ego_is_no_way_out(tmp_path):
+    """The lanes beside the ego were judged on its start edge: the left lane ends 130 m
+    ahead, and the ego evaded into it and on beyond the road's edge (scored green). The side
+    must now lie beside the ego along the manoeuvre's reach: it brakes in its lane."""
+    from tests.builders import netconvert
+
+    (tmp_path / "drop.con.xml").write_text(
+        '<connections><connection from="e1" to="e2" fromLane="0" toLane="0"/></connections>'
+    )
+    netconvert(
+        tmp_path,
+        "drop",
+        '<nodes><node id="A" x="0" y="0"/><node id="B" x="500" y="0"/>'
+        '<node id="C" x="3000" y="0"/></nodes>',
+        '<edges><edge id="e1" from="A" to="B" numLanes="2" speed="33.33" width="3.5"/>'
+        '<edge id="e2" from="B" to="C" numLanes="1" speed="33.33" width="3.5" '
+        'shape="500,-3.5 3000,-3.5"/></edges>',
+        "--connection-files",
+        str(tmp_path / "drop.con.xml"),
+    )
+    (tmp_path / "drop.rou.xml").write_text(
+        '<routes><vType id="car" length="4.92" width="1.85" decel="9" sigma="0" speedDev="0"/>'
+        '<vType id="aro" length="5.09" width="1.99" accel="2.5" decel="9" emergencyDecel="12" '
+        'maxSpeed="50" sigma="0" speedDev="0"/>'
+        '<vehicle id="aro" type="aro" depart="1" departLane="0" departPos="490" '
+        'departSpeed="16.67" insertionChecks="none"><route edges="e1 e2"/>'
+        '<param key="eoam.aro_hold_s" value="2.0"/><param key="eoam.aro_decel_mps2" value="8.0"/>'
+        "</vehicle>"
+        '<vehicle id="ego" type="car" depart="1" departLane="0" departPos="370" '
+        'departSpeed="33.33" insertionChecks="none"><route edges="e1 e2"/></vehicle></routes>'
+    )
+    cfg = tmp_path / "drop.sumocfg"
+    cfg.write_text(
+        '<configuration><input><net-file value="drop.net.xml"/><route-files value="drop.rou.xml"/>'
+        '</input><time><begin value="0"/><step-length value="0.01"/></time></configuration>'
+    )
+    summary = run_case(cfg, ScenarioOverrides(mu=0.3), tmp_path / "o")
+    modes = summary["modes_visited"]
+    assert 1 in modes or 3 in modes
+    assert 2 not in modes and 4 not in modes
+    assert summary["left_road"] is False

@@ -41,6 +41,7 @@ class EgoStart:
     left_lane_exists: bool  # a lane of its own direction or the opposite one to its left
     front_xy: tuple[float, float]  # front bumper at insertion
     centreline: np.ndarray  # (N, 2) of its start lane followed along its route
+    route_lanes: tuple[str, ...] = ()  # the lane it follows on each route edge
 
 
 def without_repeats(edges) -> list[str]:
@@ -100,6 +101,7 @@ def place_ego(
         over_limit,
     )
     left_lane = lane_index < api.edge.getLaneNumber(edges[0]) - 1 or lane_id in files.opposite_lanes
+    centreline, route_lanes = route_centreline(api, files, lane_id, edges, lane_index)
     return EgoStart(
         type_id,
         edges,
@@ -108,7 +110,8 @@ def place_ego(
         float(lanes.getWidth(lane_id)),
         left_lane,
         lane_point(lanes, lane_id, pos)[:2],
-        route_centreline(api, files, lane_id, edges, lane_index),
+        centreline,
+        route_lanes,
     )
 
 
@@ -179,14 +182,16 @@ def _ego_speed(
 
 def route_centreline(
     api, files: ScenarioFiles, start_lane_id: str, route_edges: list, lane_index: int
-) -> np.ndarray:
+) -> tuple[np.ndarray, tuple[str, ...]]:
     """Centre line of the ego's start lane followed along its route, lane by lane
     (``_next_lane``): where the next route edge goes on straight, the lane straight ahead of
     the ego's (a lane added beside it shifts SUMO's indices, which count from the right, and
     netconvert may connect the lane elsewhere); at a turn, over the connection (and the
-    junction's internal lanes) to the lane it leads to."""
+    junction's internal lanes) to the lane it leads to. With the lane followed on each
+    route edge."""
     lanes = api.lane
     lane = start_lane_id
+    followed = [lane]
     points = [tuple(p) for p in lanes.getShape(lane)]
     for k, edge in enumerate(route_edges[1:], start=1):
         after = route_edges[k + 1] if k + 1 < len(route_edges) else None
@@ -198,12 +203,13 @@ def route_centreline(
             onward = lanes.getLinks(via)
             via = onward[0][0] if onward else None
         lane = nxt
+        followed.append(lane)
         points += [tuple(p) for p in lanes.getShape(lane)]
     line = [points[0]]
     for p in points[1:]:
         if math.hypot(p[0] - line[-1][0], p[1] - line[-1][1]) > 1e-6:
             line.append(p)
-    return np.array(line, dtype=float)
+    return np.array(line, dtype=float), tuple(followed)
 
 
 #: A next edge whose lanes start within this of the ego's lane's heading goes on straight

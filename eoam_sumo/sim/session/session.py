@@ -498,12 +498,12 @@ class SumoSession:
             lane_id = self._files.opposite_lanes.get(ego.lane_id, "")
         else:
             lane_id = ""
-        if not lane_id or not self._permits(lane_id) or not self._permitted_ahead(index):
+        if not lane_id or not self._permits(lane_id) or not self._permitted_ahead(side):
             return None
         if side > 0:
             opposing, limit = self.next_lane_traffic()
         else:
-            opposing, limit = False, self._side_limit(index)
+            opposing, limit = False, self._side_limit(side)
         return SideLane(lane_id, float(self._lane.getWidth(lane_id)), limit, opposing)
 
     def _permits(self, lane_id: str) -> bool:
@@ -514,27 +514,47 @@ class SumoSession:
             return vclass in allowed
         return vclass not in self._lane.getDisallowed(lane_id)
 
-    def _permitted_ahead(self, index: int) -> bool:
-        """The ego's class may use lane ``index`` on every edge of its route that begins
-        within ``PERMISSION_REACH_M`` of its start edge's start (where the lane exists): the
-        whole manoeuvre, not only its start."""
+    def _beside(self, side: int) -> list[tuple[str, str | None]]:
+        """(edge, lane) for each edge of the ego's route: the lane on ``side`` (+1 left, -1
+        right) of the lane the ego follows there (SUMO's indices shift where a lane is added
+        or dropped), on the left the opposite direction's ``<neigh>`` lane beyond the
+        edge's last; None where there is none."""
+        beside: list[tuple[str, str | None]] = []
+        for edge, lane in zip(self._ego.route_edges, self._ego.route_lanes, strict=False):
+            k = int(lane.rsplit("_", 1)[1]) + side
+            if 0 <= k < self._api.edge.getLaneNumber(edge):
+                beside.append((edge, f"{edge}_{k}"))
+            elif side > 0:
+                beside.append((edge, self._files.opposite_lanes.get(lane) or None))
+            else:
+                beside.append((edge, None))
+        return beside
+
+    def _permitted_ahead(self, side: int) -> bool:
+        """A lane on ``side`` of the ego's lies beside it, and its class may use it, on every
+        edge of its route that begins within ``PERMISSION_REACH_M`` of its start edge's start:
+        the whole manoeuvre, not only its start (a lane that ends on the way, an acceleration
+        lane, a bus lane after a lane added, close the side)."""
         begun_m = 0.0
-        for edge in self._ego.route_edges:
+        for edge, lane in self._beside(side):
             if begun_m > PERMISSION_REACH_M:
                 break
-            lane_id = f"{edge}_{index}"
-            if index < self._api.edge.getLaneNumber(edge) and not self._permits(lane_id):
+            if lane is None or not self._permits(lane):
                 return False
             begun_m += float(self._lane.getLength(f"{edge}_0"))
         return True
 
-    def _side_limit(self, index: int) -> float:
-        """The highest speed limit of lane ``index`` along the ego's route (0: none)."""
-        limit = 0.0
-        for edge in self._ego.route_edges:
-            if index < self._api.edge.getLaneNumber(edge):
-                limit = max(limit, float(self._lane.getMaxSpeed(f"{edge}_{index}")))
-        return limit
+    def _side_limit(self, side: int) -> float:
+        """The highest speed limit of the lane on ``side`` of the ego's along its route (0:
+        none)."""
+        return max(
+            (
+                float(self._lane.getMaxSpeed(lane))
+                for edge, lane in self._beside(side)
+                if lane is not None and lane.rsplit("_", 1)[0] == edge
+            ),
+            default=0.0,
+        )
 
     def lane_ids(self) -> list[str]:
         return list(self._lane.getIDList())
