@@ -550,6 +550,11 @@ def load_matrix(path: Path) -> Matrix:
     policy = _scenario_choice(path, scenario, "policy", POLICIES)
     policies = _swept_choices(path, doc, "policy", POLICIES)
     v2x = _v2x_link(path, scenario, policy, bool(policies))
+    if "v2x_range_m" in sampled and "policy" not in sampled and (policy != "safe" or policies):
+        raise InputError(
+            f"{path}: [sample] v2x_range_m: V2X informs the safe policy only; set "
+            'policy = "safe" in [scenario] (not a [sweep] of policies)'
+        )
     paper = None
     if "table" in doc.get("paper", {}):
         paper = _existing_file(path, "[paper] table", doc["paper"]["table"])
@@ -938,6 +943,7 @@ def check_matrix(matrix: Matrix, tables_dir: Path | None = None, ego_id: str = "
     the key and the value.
     """
     if matrix.sumocfg is None:  # generated per case: nothing to read yet
+        _check_generated_oncoming(matrix)
         _check_vehicles_tables(matrix, tables_dir)
         return
     try:
@@ -952,6 +958,18 @@ def check_matrix(matrix: Matrix, tables_dir: Path | None = None, ego_id: str = "
         raise InputError(f"{matrix.path}: [scenario] sumocfg: {exc}") from exc
     _check_oncoming_road(matrix, files, ego_id)
     _check_vehicles_tables(matrix, tables_dir)
+
+
+def _check_generated_oncoming(matrix: Matrix) -> None:
+    """An oncoming start on a generated motorway (one carriageway each way, apart: no lane
+    of the other direction beside the ego's) is refused before any case runs."""
+    for case in matrix.cases():
+        if case.road == "motorway" and case.oncoming_start_m is not None:
+            raise InputError(
+                f"{matrix.path}: oncoming_start_m = {case.oncoming_start_m:g} on a generated "
+                "motorway: its carriageways are apart, no lane of the other direction lies "
+                'beside the ego\'s (oncoming traffic needs road = "rural")'
+            )
 
 
 def _check_oncoming_road(matrix: Matrix, files: ScenarioFiles, ego_id: str) -> None:

@@ -10,8 +10,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from eoam_sumo.errors import InputError
-from eoam_sumo.matrix import DEFAULT_MAX_TIME_S, load_matrix, load_paper_table
+from eoam_sumo.matrix import DEFAULT_MAX_TIME_S, check_matrix, load_matrix, load_paper_table
 from eoam_sumo.sim.scenario import ScenarioOverrides
+from tests.builders import BASELINE
 
 ROOT = Path(__file__).resolve().parents[1]
 TABLE2 = ROOT / "scenarios" / "table2.toml"
@@ -403,3 +404,28 @@ def test_an_oncoming_start_on_a_one_way_road_is_refused_before_any_case(tmp_path
         plan_batch(path)
     path.write_text(f'[scenario]\nsumocfg = "s.sumocfg"\n[sweep]\n{sweep.replace(", 300", "")}')
     assert len(plan_batch(path).cases) == 1  # no oncoming car asked: the road is fine
+
+
+def test_a_sampled_v2x_range_needs_the_safe_policy(tmp_path):
+    """Refused before any case runs, as the same value in [scenario] is (every case failed at
+    run time, exit 1)."""
+    path = tmp_path / "m.toml"
+    path.write_text(
+        f'[scenario]\nsumocfg = "{BASELINE}"\n[sweep]\nego_speed_kmh = [120]\nmu = [0.7]\n'
+        "[sample]\ndraws = 2\nv2x_range_m = { uniform = [0, 300] }\n",
+        encoding="utf-8",
+    )
+    with pytest.raises(InputError, match=r"\[sample\] v2x_range_m: V2X informs the safe policy"):
+        load_matrix(path)
+
+
+def test_an_oncoming_start_on_a_generated_motorway_is_refused_up_front(tmp_path):
+    """A generated motorway's carriageways are apart: every case failed at run time."""
+    path = tmp_path / "m.toml"
+    path.write_text(
+        '[scenario]\nroad = "motorway"\nlos = "A"\n'
+        "[sweep]\nego_speed_kmh = [100]\nmu = [0.7]\noncoming_start_m = [300]\n",
+        encoding="utf-8",
+    )
+    with pytest.raises(InputError, match="oncoming_start_m = 300 on a generated motorway"):
+        check_matrix(load_matrix(path))

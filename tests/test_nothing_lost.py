@@ -252,3 +252,16 @@ def test_a_protocol_and_an_r157_study_never_replace_each_others_folder(tmp_path,
     assert main(["protocol", "unr152", "--points", "v10_", "--out", str(study)]) == 2
     assert "holds another command's output (runs)" in capsys.readouterr().err
     assert {p: snapshot(p) for p in (protocol, study)} == before
+
+
+def test_resume_reruns_a_finished_case_whose_folder_is_gone(tmp_path):
+    """A case folder deleted after the run: --resume kept its row, not run again, and the
+    report linked to a folder that did not exist."""
+    matrix = write_matrix(tmp_path / "m.toml", SWEEP, paper_table=True)
+    out = tmp_path / "out"
+    runner.run_batch(matrix, out, progress=False, case_func=fake_case)
+    gone = "onc-none_v120_mu1.0"
+    assert (out / "cases" / gone).is_dir()
+    shutil.rmtree(out / "cases" / gone)
+    runner.run_batch(matrix, out, resume=True, progress=False, case_func=fake_case)
+    assert (out / "cases" / gone).is_dir()  # run again

@@ -228,7 +228,12 @@ def kept_rows(path: Path, cases: list[Case]) -> pd.DataFrame:
         want.get(cid) == key
         for cid, key in zip(rows["case_id"], zip(*(rows[k] for k in RESUME_KEYS)))
     ]
-    keep = (rows["status"] == "ok").to_numpy() & pd.Series(same, dtype=bool).to_numpy()
+    kept_dirs = [(path.parent / case_dir_of(cid)).is_dir() for cid in rows["case_id"]]
+    keep = (
+        (rows["status"] == "ok").to_numpy()
+        & pd.Series(same, dtype=bool).to_numpy()
+        & pd.Series(kept_dirs, dtype=bool).to_numpy()
+    )
     others = (~rows["case_id"].isin(list(want))).to_numpy()
     return rows[keep | others].drop_duplicates("case_id", keep="last")
 

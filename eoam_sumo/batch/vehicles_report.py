@@ -29,7 +29,14 @@ VARIED = ("vehicle", "policy", "driver", "abs_fitted", "esc_fitted")
 def sweeps_vehicles(results: pd.DataFrame) -> bool:
     """Whether the batch varies the vehicle, its ABS/ESC, the policy or the driver
     (``VARIED``)."""
-    return any(col in results and results[col].dropna().astype(str).nunique() > 1 for col in VARIED)
+    return any(col in results and _values(results[col]).nunique() > 1 for col in VARIED)
+
+
+def _values(column: pd.Series) -> pd.Series:
+    """A column's values as text, a failed case's empty cell left out (it is no equipment
+    or policy of its own: one failed case made a plain batch a vehicles experiment)."""
+    text = column.dropna().astype(str)
+    return text[text != ""]
 
 
 def _switch(value) -> str:

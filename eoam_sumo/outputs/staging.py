@@ -73,6 +73,8 @@ def output_folder(
                 yield path
             return
         if not names or in_place:
+            if in_place and path.name not in ("", ".", ".."):
+                _remove_stale(path)  # a killed run's staging folder, as a plain re-run does
             yield path
             return
         plain = path.name not in ("", ".", "..") and not path.is_symlink()

@@ -17,6 +17,7 @@ import pandas as pd
 from eoam_sumo.errors import InputError
 from eoam_sumo.plotting.run_plots import load_run
 from eoam_sumo.plotting.view import FrameScene, Views, box_corners, plan_views
+from eoam_sumo.sim.runlog import written_as
 from eoam_sumo.sim.trafficlog import TRAFFIC_FILE, read_traffic
 
 ROLE_RANK = {"ego": 0, "aro": 1, "oncoming": 2, "parked": 3, "other": 4}
@@ -82,10 +83,11 @@ def _read(run_dir: Path):
     if not (run_dir / "summary.json").is_file():
         raise InputError(f"{run_dir}: not a run folder (no summary.json)")
     summary, ts = load_run(run_dir)
-    traffic_path = run_dir / TRAFFIC_FILE
+    traffic_path = written_as(run_dir / TRAFFIC_FILE)
     if not traffic_path.is_file():
         raise InputError(
-            f"{run_dir}: has no {TRAFFIC_FILE} (a run of an older eoam-sumo; run it again)"
+            f"{run_dir}: has no {TRAFFIC_FILE} (a run with --timeseries none, or of an older "
+            "eoam-sumo; run it again)"
         )
     traffic = read_traffic(traffic_path).sort_values("time_s", kind="stable")
     return summary, ts, traffic.reset_index(drop=True)

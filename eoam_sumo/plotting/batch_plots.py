@@ -33,7 +33,7 @@ from eoam_sumo.plotting.runfacts import (
 )
 from eoam_sumo.plotting.vehicle_plots import plot_vehicles
 from eoam_sumo.sim.margins import NEAR_MISS_GAP_M, NEAR_MISS_TTC_S
-from eoam_sumo.sim.runlog import read_timeseries
+from eoam_sumo.sim.runlog import read_timeseries, written_as
 
 _MISSING = "#ffffff"
 MARGINS_PNG = "margins.png"
@@ -118,6 +118,11 @@ def _draw_cell(ax, i: int, j: int, cell, halves: int) -> None:
                 (j + 0.03, i + 0.06), 0.94, 0.88, fill=False, edgecolor="black", linewidth=2.2
             )
         )
+
+
+def _has_series(batch_dir: Path, case_dir: str) -> bool:
+    """Whether the case wrote its time series (csv or parquet)."""
+    return written_as(Path(batch_dir) / case_dir / "timeseries.csv").is_file()
 
 
 def _offsets(batch_dir: Path, case_dir: str) -> pd.DataFrame:
@@ -329,8 +334,9 @@ def plot_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
     if is_sampled(results):  # its envelopes, no Table 2 grid
         return paths
     ok = results[results["status"] == "ok"]
+    ok = ok[[_has_series(batch_dir, d) for d in ok["case_dir"]]]  # --timeseries none: none
     for speed_kmh in pd.unique(ok["ego_speed_kmh"]):
-        fig25 = plot_lateral_offsets(batch_dir, results, out_dir, float(speed_kmh))
+        fig25 = plot_lateral_offsets(batch_dir, ok, out_dir, float(speed_kmh))
         if fig25 is not None:
             paths.append(fig25)
     return paths

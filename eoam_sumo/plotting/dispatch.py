@@ -23,8 +23,11 @@ def plot_folder(folder: Path, out_dir: Path) -> list[Path]:
     if (folder / "summary.json").is_file():
         from eoam_sumo.plotting.run_plots import plot_run
 
-        if not (folder / "timeseries.csv").is_file():
-            raise InputError(f"{folder}: has summary.json but no timeseries.csv")
+        if not any((folder / f"timeseries.{k}").is_file() for k in ("csv", "parquet")):
+            raise InputError(
+                f"{folder}: has summary.json but no time series (timeseries.csv or .parquet: "
+                "a run with --timeseries none has nothing to plot)"
+            )
         from eoam_sumo.plotting.traffic_plots import plot_traffic
 
         return [*plot_run(folder, out_dir), plot_traffic(folder, out_dir)]

@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from eoam_sumo.params import LANE_CHANGE_HEIGHT_M, PONR_FRACTION
+from eoam_sumo.sim.runlog import written_as
 from eoam_sumo.sim.trafficlog import TRAFFIC_FILE
 
 
@@ -51,15 +52,22 @@ def oncoming_seen(run_dir: Path) -> bool:
     """The run had oncoming traffic: a road user with role ``oncoming`` in traffic.csv, or
     (a run without traffic.csv) the radar reported oncoming traffic at some step."""
     run_dir = Path(run_dir)
-    traffic = run_dir / TRAFFIC_FILE
+    traffic = written_as(run_dir / TRAFFIC_FILE)
     try:
         if traffic.is_file():
-            roles = pd.read_csv(traffic, usecols=["role"], dtype=str)["role"]
+            roles = _column(traffic, "role")
             return bool((roles == "oncoming").any())
-        flags = pd.read_csv(run_dir / "timeseries.csv", usecols=["oncoming_detected"])
+        flags = _column(written_as(run_dir / "timeseries.csv"), "oncoming_detected")
     except (OSError, ValueError, pd.errors.EmptyDataError, pd.errors.ParserError):
         return False
-    return bool((flags["oncoming_detected"] == 1).any())
+    return bool((flags == 1).any())
+
+
+def _column(path: Path, name: str) -> pd.Series:
+    """One column of a run's csv or parquet file."""
+    if path.suffix == ".parquet":
+        return pd.read_parquet(path, columns=[name])[name]
+    return pd.read_csv(path, usecols=[name], dtype=str if name == "role" else None)[name]
 
 
 def traffic_text(oncoming_start_m, saw_oncoming: bool) -> str:

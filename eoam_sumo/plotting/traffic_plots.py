@@ -46,6 +46,7 @@ from eoam_sumo.plotting.roadtracks import (
 )
 from eoam_sumo.plotting.run_plots import load_run, run_title
 from eoam_sumo.plotting.runfacts import fit, lane_width_m
+from eoam_sumo.sim.runlog import written_as
 from eoam_sumo.sim.trafficlog import (
     TRAFFIC_COLUMNS,
     TRAFFIC_FILE,
@@ -125,7 +126,7 @@ def read_scene(run_dir: Path, summary: dict, ts: pd.DataFrame) -> TrafficScene:
 def _read_traffic(run_dir: Path) -> tuple[pd.DataFrame, str]:
     """traffic.csv's rows with a whole footprint (finite pose, positive size), or none and
     why (missing or empty); a damaged file is an InputError naming it."""
-    path = run_dir / TRAFFIC_FILE
+    path = written_as(run_dir / TRAFFIC_FILE)  # or traffic.parquet
     if not path.is_file():
         return _no_traffic(), f"no {TRAFFIC_FILE} in the run folder: the ego alone"
     if path.stat().st_size == 0:

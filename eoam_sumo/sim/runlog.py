@@ -313,16 +313,29 @@ def _column(rows: list, name: str, brake_gains: tuple[float, ...]) -> np.ndarray
 FINITE_COLUMNS = ("time_s", "x_m", "y_m", "yaw_rad", "vx_mps", "vy_mps", "yaw_rate_radps")
 
 
+def written_as(path: Path) -> Path:
+    """``path`` (a run's ``.csv``), or its ``.parquet`` beside it where the run wrote that
+    (``--timeseries parquet``) and no ``.csv``."""
+    path = Path(path)
+    parquet = path.with_suffix(".parquet")
+    return parquet if not path.exists() and parquet.exists() else path
+
+
 def read_timeseries(path: Path, columns: list[str] | None = None):
-    """A run's timeseries.csv as a DataFrame (``columns`` only, if given): InputError naming
-    the file when it is missing, empty, cut short or not numbers where numbers belong, and
-    naming the column and row of a non-finite value in ``FINITE_COLUMNS``."""
+    """A run's timeseries.csv (or its .parquet: ``written_as``) as a DataFrame (``columns``
+    only, if given): InputError naming the file when it is missing, empty, cut short or not
+    numbers where numbers belong, and naming the column and row of a non-finite value in
+    ``FINITE_COLUMNS``."""
     import pandas as pd
 
+    path = written_as(path)
     try:
-        frame = pd.read_csv(path, usecols=columns)
+        if path.suffix == ".parquet":
+            frame = pd.read_parquet(path, columns=columns)
+        else:
+            frame = pd.read_csv(path, usecols=columns)
     except (OSError, ValueError, pd.errors.EmptyDataError, pd.errors.ParserError) as exc:
-        raise InputError(f"{path}: cannot be read as a run's time series: {exc}") from exc
+        raise InputError(f"{path}: cannot be read as a run's time series: {exc}") from None
     numeric = [c for c in frame.columns if c != "sector"]
     if frame.empty or not all(pd.api.types.is_numeric_dtype(frame[c]) for c in numeric):
         raise InputError(

@@ -317,20 +317,25 @@ def _text_array(texts: list[str]):
 
 
 def read_traffic(path: Path):
-    """A run's traffic.csv as a DataFrame (numbers as floats); InputError naming the file
-    when it cannot be read, lacks a column or has text where numbers belong."""
+    """A run's traffic.csv (or its .parquet: ``runlog.written_as``) as a DataFrame (numbers
+    as floats); InputError naming the file when it cannot be read, lacks a column or has text
+    where numbers belong."""
     import pandas as pd
 
     from eoam_sumo.errors import InputError
-    from eoam_sumo.sim.runlog import check_finite
+    from eoam_sumo.sim.runlog import check_finite, written_as
 
+    path = written_as(path)
     try:
-        frame = pd.read_csv(
-            path,
-            dtype={"id": str, "vclass": str, "role": str, **dict.fromkeys(_DECIMALS, float)},
-            keep_default_na=False,
-            na_values={c: ["", "nan"] for c in _DECIMALS},
-        )
+        if path.suffix == ".parquet":
+            frame = pd.read_parquet(path)
+        else:
+            frame = pd.read_csv(
+                path,
+                dtype={"id": str, "vclass": str, "role": str, **dict.fromkeys(_DECIMALS, float)},
+                keep_default_na=False,
+                na_values={c: ["", "nan"] for c in _DECIMALS},
+            )
     except (OSError, ValueError, pd.errors.EmptyDataError, pd.errors.ParserError) as exc:
         raise InputError(f"{path}: cannot be read as a run's traffic log: {exc}") from exc
     missing = [c for c in TRAFFIC_COLUMNS if c not in frame.columns]

@@ -78,3 +78,11 @@ def test_only_a_varied_batch_is_a_vehicles_batch(tmp_path):
     table2 = FRAME[(FRAME["vehicle"] == "suv") & ~FRAME["abs_fitted"]]
     assert not sweeps_vehicles(table2)
     assert plot_vehicles(FRAME, tmp_path / "vehicles.png").stat().st_size > 0
+
+
+def test_a_failed_case_is_no_equipment_of_its_own():
+    """A failed case's ABS/ESC cells are empty: one failed case made a plain batch a vehicles
+    batch (vehicles.md with a row "ABS/ESC ?")."""
+    table2 = FRAME[(FRAME["vehicle"] == "suv") & ~FRAME["abs_fitted"]].astype({"abs_fitted": str})
+    failed = table2.iloc[:1].assign(abs_fitted="", esc_fitted="", status="failed")
+    assert not sweeps_vehicles(pd.concat([table2, failed]))

@@ -183,3 +183,13 @@ def test_a_failed_first_protocol_run_leaves_no_folder(tmp_path, monkeypatch):
             command.run(build_parser().parse_args(argv))
     assert sorted(p.name for p in tmp_path.iterdir()) == ["empty"]
     assert [p.name for p in (tmp_path / "empty").iterdir()] == [LOCK_NAME]
+
+
+def test_a_dead_runs_staging_folder_is_removed_by_a_resume_too(tmp_path):
+    """``batch --resume`` writes in place: a killed run's ``.partial-PID`` stayed beside it."""
+    out = tmp_path / "out"
+    _finished(out)
+    (tmp_path / "out.partial-1").mkdir()
+    with output_folder(out, KIND, in_place=True) as folder:
+        assert folder == out
+    assert _siblings(out) == []
