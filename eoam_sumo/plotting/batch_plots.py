@@ -16,6 +16,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch, Rectangle
 
 from eoam_sumo.batch.case import PARAMETERS
+from eoam_sumo.batch.probabilities import PROBABILITIES_FILE, group_of
 from eoam_sumo.batch.report import TABLE_PNG, mu_text, outcome_grid
 from eoam_sumo.batch.results import RESULTS_FILE, read_results
 from eoam_sumo.batch.vehicles_report import VEHICLES_PNG, sweeps_vehicles
@@ -322,6 +323,23 @@ def plot_batch_report(results: pd.DataFrame, out_dir: Path) -> list[Path]:
     return [rest[0], margins, *rest[1:]]
 
 
+def _batch_rows(batch_dir: Path, results: pd.DataFrame) -> pd.DataFrame:
+    """A sampled batch's own draws: per group the first ``n`` rows of results.csv, ``n`` the
+    group's in its outcome_probabilities.csv (the batch writes its matrix's rows first; rows
+    kept from a larger matrix by ``--resume`` follow, and were counted too). Other batches,
+    or one without that file: every row."""
+    path = batch_dir / PROBABILITIES_FILE
+    if not is_sampled(results) or not path.is_file():
+        return results
+    try:
+        sizes = pd.read_csv(path).groupby("group")["n"].first()
+    except (OSError, ValueError, KeyError, pd.errors.ParserError):
+        return results
+    group = results["case_id"].map(group_of)
+    rank = results.groupby(group).cumcount()
+    return results[rank < group.map(sizes).fillna(len(results))].reset_index(drop=True)
+
+
 def is_sampled(results: pd.DataFrame) -> bool:
     """Whether a results frame is of a sampled batch (its cases are numbered draws)."""
     return bool(results["draw"].notna().any())
@@ -329,7 +347,7 @@ def is_sampled(results: pd.DataFrame) -> bool:
 
 def plot_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
     """Every batch plot of a batch folder (has results.csv): Table 2 image and Figure 25."""
-    results = read_results(Path(batch_dir) / RESULTS_FILE)
+    results = _batch_rows(Path(batch_dir), read_results(Path(batch_dir) / RESULTS_FILE))
     paths = plot_batch_report(results, out_dir)
     if is_sampled(results):  # its envelopes, no Table 2 grid
         return paths

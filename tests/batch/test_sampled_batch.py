@@ -104,3 +104,19 @@ def test_parquet_time_series_equal_the_csv_ones(tmp_path):
                 from_pq[column].astype(float), from_csv[column], rtol=1e-8, atol=1e-12
             )
     assert not (pq_out / case_dir / "timeseries.csv").exists()
+
+
+def test_plot_draws_a_sampled_batch_from_its_own_draws(tmp_path):
+    """After --resume with fewer draws, results.csv keeps the larger matrix's extra draws
+    behind the batch's own; plot counted them all (12 draws where the batch had 3)."""
+    import pandas as pd
+
+    from eoam_sumo.batch.probabilities import PROBABILITIES_FILE
+    from eoam_sumo.plotting.batch_plots import _batch_rows
+
+    ids = [f"v120_mu0.7_d{k}" for k in range(3)] + [f"v120_mu0.7_d{k}" for k in range(3, 6)]
+    results = pd.DataFrame({"case_id": ids, "draw": range(6), "status": "ok"})
+    (tmp_path / PROBABILITIES_FILE).write_text("group,outcome,n\nv120_mu0.7,green,3\n")
+    assert list(_batch_rows(tmp_path, results)["case_id"]) == ids[:3]
+    (tmp_path / PROBABILITIES_FILE).unlink()
+    assert len(_batch_rows(tmp_path, results)) == 6
