@@ -92,10 +92,17 @@ def test_the_aro_holds_its_speed_and_lane_then_stops(tmp_path, aro_type, others,
     assert max(speeds) - min(speeds) <= 0.01
     assert speeds[0] == pytest.approx(SPEED_MPS, abs=0.01)
     assert {lane for _, lane in hold} == {"mw_1"}
-    # then the scripted stop: 8 m/s^2 down from the hold
-    after = [(t, v) for t, v, _ in log if t > DEPART_S + HOLD_S + 0.5]
-    t_end, v_end = after[-1]
-    assert v_end == pytest.approx(SPEED_MPS - 8.0 * (t_end - DEPART_S - HOLD_S), abs=0.1)
+    # then the scripted stop in its lane: 8 m/s^2 down from the hold, or harder where SUMO's
+    # safe speed brakes it for a slower car ahead (it no longer changes lanes to keep 8 m/s^2:
+    # a car in an emergency stop changing lanes moved into the ego's evasion lane)
+    after = [(t, v, lane) for t, v, lane in log if t > DEPART_S + HOLD_S + 0.5]
+    t_end, v_end, _ = after[-1]
+    profile = SPEED_MPS - 8.0 * (t_end - DEPART_S - HOLD_S)
+    if others:
+        assert v_end <= profile + 0.1
+    else:
+        assert v_end == pytest.approx(profile, abs=0.1)
+    assert {lane for _, _, lane in after} == {"mw_1"}
 
 
 def test_the_stopped_aro_stays_in_its_lane(tmp_path):
