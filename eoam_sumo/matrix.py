@@ -266,7 +266,8 @@ class Matrix:
 
     @staticmethod
     def _draws(groups: list[Case], sample: Sample) -> list[Case]:
-        width = len(str(sample.draws - 1))
+        """Each group's draws, ``<group>_d<k>``: a draw's id and values do not depend on how
+        many draws there are, so a study given more draws resumes (``--resume``) its own."""
         cases = []
         for group in groups:
             for k in range(sample.draws):
@@ -278,7 +279,7 @@ class Matrix:
                         seed=seed,
                         draw=k,
                         group_id=group.case_id,
-                        case_id=f"{group.case_id}_d{k:0{width}d}",
+                        case_id=f"{group.case_id}_d{k}",
                     )
                 )
         return cases

@@ -173,3 +173,15 @@ def test_policy_and_v2x_settings_can_be_sampled(tmp_path):
     cases = load_matrix(path).cases()
     assert {c.policy for c in cases} == {"paper", "safe"}
     assert all(0.5 <= c.v2x_penetration <= 1.0 for c in cases)
+
+
+def test_a_draw_keeps_its_id_and_values_when_more_draws_are_asked(tmp_path):
+    """Ids were zero-padded to the number of draws (_d0 with 6 draws, _d00 with 12): a study
+    extended with --resume ran every draw again and kept the old rows as duplicates."""
+    six = _matrix(tmp_path, "draws = 6\noncoming_start_m = { uniform = [250, 550] }")
+    few = load_matrix(six).cases()
+    twelve = _matrix(tmp_path, "draws = 12\noncoming_start_m = { uniform = [250, 550] }")
+    many = {c.case_id: c for c in load_matrix(twelve).cases()}
+    for case in few:
+        assert many[case.case_id].oncoming_start_m == case.oncoming_start_m
+        assert many[case.case_id].seed == case.seed
