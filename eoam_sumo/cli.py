@@ -669,9 +669,19 @@ def _cmd_plot(args) -> int:
     return 0
 
 
+#: The most frames per second of run time ``animate`` draws: one every 10 ms, the run's step
+#: and the finest delay between a GIF's frames (at 1000 fps a GIF's delays were 0).
+MAX_FPS = 100
+
+
 def _cmd_animate(args) -> int:
     from eoam_sumo.plotting.animate import animate_cli
 
+    if args.fps > MAX_FPS:
+        raise InputError(
+            f"--fps {args.fps}: at most {MAX_FPS} (a frame every 10 ms, the run's step and a "
+            "GIF's finest delay)"
+        )
     print(animate_cli(args.run_dir, args.out, args.fps, args.labels, args.at_s))
     return 0
 

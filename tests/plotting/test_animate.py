@@ -153,6 +153,16 @@ def test_animate_cli_bad_run_dir_is_one_line_and_exit_2(tmp_path, capsys):
     ]
 
 
+def test_animate_refuses_more_frames_than_the_runs_steps(tmp_path, capsys):
+    """--fps 1000 wrote a GIF whose frame delays were 0 (viewers then play it at their own
+    speed) while saying "1000 fps"."""
+    assert main(["animate", str(tmp_path), "--fps", "1000"]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "eoam-sumo: error: --fps 1000: at most 100 (a frame every 10 ms, the run's step and a "
+        "GIF's finest delay)"
+    )
+
+
 # --- on any road: the view follows the ego round a curve and along roads running every way
 
 
