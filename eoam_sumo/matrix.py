@@ -1078,6 +1078,8 @@ def _existing_file(path: Path, where: str, value) -> Path:
     if not isinstance(value, str) or not value.strip():
         raise InputError(f"{path}: {where} = {value!r} must be a file name (a string)")
     resolved = (path.parent / value).resolve()
+    if resolved.is_dir():
+        raise InputError(f"{path}: {where} = {value!r}: {resolved} is a folder, not a file")
     if not resolved.is_file():
         raise InputError(f"{path}: {where} = {value!r}: file {resolved} not found")
     return resolved

@@ -429,3 +429,13 @@ def test_an_oncoming_start_on_a_generated_motorway_is_refused_up_front(tmp_path)
     )
     with pytest.raises(InputError, match="oncoming_start_m = 300 on a generated motorway"):
         check_matrix(load_matrix(path))
+
+
+def test_a_folder_given_as_the_scenario_is_called_a_folder(tmp_path):
+    path = tmp_path / "m.toml"
+    path.write_text(
+        f'[scenario]\nsumocfg = "{tmp_path}"\n[sweep]\nego_speed_kmh = [120]\nmu = [0.7]\n',
+        encoding="utf-8",
+    )
+    with pytest.raises(InputError, match="is a folder, not a file"):
+        load_matrix(path)
