@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from eoam_sumo.errors import InputError
-from eoam_sumo.openscenario.expressions import ExpressionError, substitute
+from eoam_sumo.openscenario.expressions import ExpressionError, format_value, substitute
 from eoam_sumo.openscenario.subset import check_subset
 from eoam_sumo.openscenario.xmltree import Node, parse
 
@@ -131,9 +131,32 @@ def deterministic(dist: Node) -> Node:
     return det
 
 
+def distribution_range(kind: Node) -> tuple[float, float, int]:
+    """(lower limit, step, number of values) of a ``DistributionRange``: its values are
+    ``range_value(lower, step, k)``, k from 0; InputError when it has no Range or none."""
+    rng = kind.find("Range")
+    if rng is None:
+        raise InputError(f"{kind.where()}: a DistributionRange needs a Range")
+    lo, hi, step = rng.num("lowerLimit"), rng.num("upperLimit"), kind.num("stepWidth")
+    if step <= 0 or hi < lo:
+        raise InputError(f"{kind.where()}: range {lo:g}..{hi:g} by {step:g} is empty")
+    return lo, step, int((hi - lo) / step + 1e-9) + 1
+
+
+def range_value(lo: float, step: float, k: int) -> str:
+    """The k-th value of a range as an attribute's text, rounded to 12 decimals (lo + k step
+    carries the binary fractions' error: 0.1 + 2 x 0.1 = 0.30000000000000004)."""
+    return format_value(round(lo + k * step, 12))
+
+
 def _one_set(node: Node) -> dict[str, str]:
     """The values of a distribution with exactly one value (set)."""
     sets = [n for n in node.iter() if n.tag in ("Element", "ParameterValueSet", "Range")]
+    kind = node.children[0] if node.children else node
+    if len(sets) == 1 and kind.tag == "DistributionRange":
+        lo, step, count = distribution_range(kind)
+        if count == 1:
+            return {node.need("parameterName"): range_value(lo, step, 0)}
     if len(sets) != 1 or sets[0].tag == "Range":
         raise InputError(
             f"{node.where()}: {node.get('parameterName') or 'this distribution'} has many "

@@ -19,7 +19,12 @@ from pathlib import Path
 from eoam_sumo.errors import InputError
 from eoam_sumo.openscenario.conditions import RULES
 from eoam_sumo.openscenario.expressions import ExpressionError, format_value, substitute
-from eoam_sumo.openscenario.reader import declared_values, deterministic
+from eoam_sumo.openscenario.reader import (
+    declared_values,
+    deterministic,
+    distribution_range,
+    range_value,
+)
 from eoam_sumo.openscenario.xmltree import Node, parse
 from eoam_sumo.params import MU_MAX
 from eoam_sumo.sim.settings import MAX_TIME_LIMIT_S
@@ -151,17 +156,10 @@ def _axis(node: Node) -> list[dict[str, str]]:
     if kind.tag == "DistributionSet":
         return [{name: e.need("value")} for e in kind.findall("Element")]
     if kind.tag == "DistributionRange":
-        rng = kind.find("Range")
-        if rng is None:
-            raise InputError(f"{kind.where()}: a DistributionRange needs a Range")
-        lo, hi, step = rng.num("lowerLimit"), rng.num("upperLimit"), kind.num("stepWidth")
-        if step <= 0 or hi < lo:
-            raise InputError(f"{kind.where()}: range {lo:g}..{hi:g} by {step:g} is empty")
-        count = int((hi - lo) / step + 1e-9) + 1
+        lo, step, count = distribution_range(kind)
         if count > MAX_CASES:
             raise InputError(f"{kind.where()}: {count} values is too many")
-        # lo + k step carries the binary fractions' error (0.1 + 2 x 0.1 = 0.30000000000000004)
-        return [{name: format_value(round(lo + k * step, 12))} for k in range(count)]
+        return [{name: range_value(lo, step, k)} for k in range(count)]
     raise InputError(f"{kind.where()}: {kind.tag} is not a supported deterministic distribution")
 
 

@@ -140,3 +140,28 @@ def test_a_sweep_of_an_undeclared_parameter_names_the_matrix(tmp_path: Path) -> 
     matrix.write_text(f'[scenario]\nxosc = "{CUT_IN}"\n[sweep]\nNope = [1]\n', encoding="utf-8")
     with pytest.raises(InputError, match=r"m.toml: \[sweep\] Nope: no such parameter declared"):
         load_batch(matrix)
+
+
+@pytest.mark.parametrize(
+    ("limits", "step", "expect"),
+    [
+        ('lowerLimit="60.0" upperLimit="60.0"', "20.0", "60.0"),
+        ('lowerLimit="20.0" upperLimit="60.0"', "0", "is empty"),
+        ('lowerLimit="20.0" upperLimit="60.0"', "20.0", "has many values"),
+    ],
+)
+def test_run_reads_a_range_of_one_value_and_says_when_one_is_empty(tmp_path, limits, step, expect):
+    """`run` on a variation file called every range "many values", one of a single value or
+    none (a step of 0) too."""
+    from eoam_sumo.openscenario.reader import read_scenario
+
+    text = VARIATION.format(scenario=CUT_IN).replace('stepWidth="20.0"', f'stepWidth="{step}"')
+    text = text.replace('lowerLimit="20.0" upperLimit="60.0"', limits)
+    text = text.replace('<Element value="-50"/>', "")  # the set: one value
+    path = tmp_path / "v.xosc"
+    path.write_text(text, encoding="utf-8")
+    if expect[0].isdigit():
+        assert read_scenario(path).parameters["Ego_InitSpeed_Ve0_kph"] == expect
+    else:
+        with pytest.raises(InputError, match=expect):
+            read_scenario(path)
