@@ -47,6 +47,24 @@ def network(folder: Path, stem: str, nodes_xml: str, edges_xml: str) -> Path:
     return netbuild.build_network(folder / f"{stem}.nod.xml")
 
 
+def straight_road(folder: Path, name: str, widths: list[float], lanes: list[int]) -> None:
+    """``NAME.sumocfg``: a straight one-way road of 500 m edges ``e0``, ``e1``, ... with these
+    lane widths and lane counts, the ego alone on it (``NAME.rou.xml``, 30 m/s in lane 0)."""
+    nodes = "".join(f'<node id="n{k}" x="{500.0 * k}" y="0"/>' for k in range(len(widths) + 1))
+    edges = "".join(
+        f'<edge id="e{k}" from="n{k}" to="n{k + 1}" numLanes="{n}" speed="50" width="{w}"/>'
+        for k, (w, n) in enumerate(zip(widths, lanes))
+    )
+    network(folder, name, f"<nodes>{nodes}</nodes>", f"<edges>{edges}</edges>")
+    route = " ".join(f"e{k}" for k in range(len(widths)))
+    (folder / f"{name}.rou.xml").write_text(
+        '<routes><vType id="car" length="4.9" width="1.85" sigma="0"/>'
+        '<vehicle id="ego" type="car" depart="0" departPos="50" departLane="0" '
+        f'departSpeed="30"><route edges="{route}"/></vehicle></routes>'
+    )
+    write_sumocfg(folder / f"{name}.sumocfg", f"{name}.net.xml", f"{name}.rou.xml")
+
+
 def netconvert(folder: Path, stem: str, nodes_xml: str, edges_xml: str, *options: str) -> Path:
     """``STEM.net.xml`` built by plain netconvert with these options, as a user would build it
     (netconvert's defaults otherwise)."""

@@ -45,13 +45,14 @@ def group_of(case_id: str) -> str:
     return _DRAW_SUFFIX.sub("", case_id)
 
 
-def _outcomes(results: pd.DataFrame) -> pd.Series:
+def outcomes_of(results: pd.DataFrame) -> pd.Series:
+    """Each case's outcome colour name; a case that did not finish ``failed``."""
     return results["outcome"].where(results["status"] == "ok", FAILED).fillna(FAILED)
 
 
 def outcome_probabilities(results: pd.DataFrame) -> pd.DataFrame:
     """The outcome probabilities of a results frame (``runner.read_results``) of draws."""
-    results = results.assign(group=results["case_id"].map(group_of), _outcome=_outcomes(results))
+    results = results.assign(group=results["case_id"].map(group_of), _outcome=outcomes_of(results))
     seen = set(results["_outcome"])
     order = [o for o in OUTCOME_ORDER if o != "unfinished" or o in seen]  # listed at 0 too
     order += sorted(seen - set(order) - {FAILED}) + ([FAILED] if FAILED in seen else [])

@@ -5,12 +5,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import pandas as pd
+from matplotlib.figure import Figure
 
+from eoam_sumo.batch.probabilities import outcomes_of
 from eoam_sumo.colours import FAILED, HEX, OUTCOMES
 from eoam_sumo.errors import InputError
 
@@ -21,7 +19,7 @@ MAX_PANELS = 4
 
 def is_xosc_results(path: Path) -> bool:
     """Whether results.csv is an .xosc batch's (its header has ``param:NAME`` columns or
-    starts with the .xosc batch's first columns)."""
+    starts with the .xosc batch's first columns, ``openscenario.batch.FIRST``)."""
     try:
         with open(path, encoding="utf-8") as f:
             names = f.readline().rstrip("\n").split(",")
@@ -33,11 +31,6 @@ def is_xosc_results(path: Path) -> bool:
         "error",
         "outcome",
     ]
-
-
-def _outcomes(frame: pd.DataFrame) -> pd.Series:
-    """Each case's outcome colour name; a case that did not finish ``failed``."""
-    return frame["outcome"].where(frame["status"] == "ok", FAILED).fillna(FAILED)
 
 
 def _axis(values: pd.Series) -> tuple[pd.Series, list[str] | None]:
@@ -58,10 +51,11 @@ def plot_xosc_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
     if frame.empty:
         raise InputError(f"{path}: no cases to plot")
     params = [c for c in params if frame[c].nunique() > 1][:MAX_PANELS] or params[:1]
-    outcome = _outcomes(frame)
+    outcome = outcomes_of(frame)
     speed = pd.to_numeric(frame.get("impact_speed_mps"), errors="coerce").fillna(0.0)
     panels = max(len(params), 1)
-    fig, axes = plt.subplots(1, panels, figsize=(4.2 * panels + 1.0, 3.8), squeeze=False)
+    fig = Figure(figsize=(4.2 * panels + 1.0, 3.8), layout="constrained")
+    axes = fig.subplots(1, panels, squeeze=False)
     for ax, column in zip(axes[0], params or [None], strict=True):
         x, labels = _axis(frame[column]) if column else (pd.Series(range(len(frame))), None)
         for name in (*OUTCOMES, FAILED):
@@ -72,14 +66,13 @@ def plot_xosc_batch(batch_dir: Path, out_dir: Path) -> list[Path]:
             ax.set_xticks(range(len(labels)), labels, rotation=30, ha="right")
         ax.set_xlabel(column.removeprefix(PARAM) if column else "case")
         ax.set_ylabel("impact speed [m/s] (0: no contact)")
-        ax.set_ylim(0.0, max(float(speed.max()) * 1.1, 1.0))
+        top = max(float(speed.max()) * 1.1, 1.0)
+        ax.set_ylim(-0.04 * top, top)  # the no-contact cases' markers whole on the axis
         ax.grid(alpha=0.3)
     axes[0][-1].legend(title="outcome", fontsize=8, loc="best")
     fig.suptitle(f"{Path(batch_dir).name}: {len(frame)} cases of the .xosc's variations")
-    fig.tight_layout()
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     target = out_dir / OUT_NAME
     fig.savefig(target, dpi=110)
-    plt.close(fig)
     return [target]

@@ -61,21 +61,10 @@ def brake_in_turn(
     default_kmh = math.sqrt(ay0 * radius_m) * 3.6
     speed_mps = options.speed_mps(default_kmh)
     series = decelerations_mps2(options.mu)
-    why = None if series else _no_series(options.mu, speed_mps * speed_mps / radius_m)
-    runs, per_run = [], []
-    for decel in series:
-        run = _run(params, speed_mps, radius_m, decel, options.mu, vehicle)
-        runs.append(run)
-        why = _off_circle(run, speed_mps, radius_m, options.mu)
-        if why is not None:  # every run drives the same circle first: none is measured
-            break
-        why = _stopped_early(run, decel)
-        if why is not None:  # a harder brake stops sooner: the series ends here
-            runs.pop()
-            break
-        per_run.append(_figures(run, decel, radius_m))
-    if per_run and why is not None:
-        cut, why = why, None
+    runs, per_run, why = _series(params, options, vehicle, speed_mps, radius_m, series)
+    if not series:
+        why = _no_series(options.mu, speed_mps * speed_mps / radius_m)
+    cut, why = (why, None) if per_run else (None, why)  # the runs measured before it stand
     summary = header("brake-in-turn", params, options, speed_mps)
     summary["figures"] = {
         "radius_m": radius_m,
@@ -85,13 +74,40 @@ def brake_in_turn(
         "runs": per_run,
         "clause": c.CITE["turn_brake"],
     }
-    if per_run and len(per_run) < len(series):
+    if cut is not None:
         summary["figures"]["series_cut"] = cut
     summary["criteria"] = []
     summary["passed"] = None
     if why is not None:
         summary["figures"]["not_measured"] = summary["not_measured"] = why
     return VehicleTestResult("brake-in-turn", tuple(runs), summary)
+
+
+def _series(
+    params: VehicleParams,
+    options: VehicleTestOptions,
+    vehicle: Vehicle | None,
+    speed_mps: float,
+    radius_m: float,
+    series: list[float],
+) -> tuple[list[Run], list[dict], str | None]:
+    """The series' runs, the figures of those measured, and why it ended short (None: every
+    run measured): the car off the circle at the first brake's onset (every run drives the
+    same circle: none is measured, the run that shows it kept), or a brake that stops the car
+    before its figures (a harder one stops it sooner: the series ends there)."""
+    runs: list[Run] = []
+    per_run: list[dict] = []
+    for decel in series:
+        run = _run(params, speed_mps, radius_m, decel, options.mu, vehicle)
+        why = _off_circle(run, speed_mps, radius_m, options.mu)
+        if why is not None:
+            return [*runs, run], per_run, why
+        why = _stopped_early(run, decel)
+        if why is not None:
+            return runs, per_run, why
+        runs.append(run)
+        per_run.append(_figures(run, decel, radius_m))
+    return runs, per_run, None
 
 
 def _no_series(mu: float, ay_mps2: float) -> str:

@@ -242,7 +242,7 @@ def _next_lane(api, files: ScenarioFiles, lane: str, edge: str, after: str | Non
         links,
         key=lambda k: (
             after is not None and not _continues(api, k, after),
-            round(_gap_m((x1, y1), lanes.getShape(k)[0]), 1),
+            round(math.dist((x1, y1), lanes.getShape(k)[0][:2]), 1),
             abs(int(k.rsplit("_", 1)[1]) - index),
         ),
     )
@@ -271,10 +271,6 @@ def _lane_straight_ahead(api, edge: str, end: tuple, heading: float) -> tuple[bo
         if across <= 0.5 * api.lane.getWidth(lane) and across < best_d:
             best, best_d = lane, across
     return straight, best
-
-
-def _gap_m(a, b) -> float:
-    return math.hypot(b[0] - a[0], b[1] - a[1])
 
 
 def let_fast_vehicles_depart(api, errors: tuple, files: ScenarioFiles, ego_id: str) -> None:

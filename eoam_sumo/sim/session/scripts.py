@@ -8,10 +8,10 @@ The hold is exact whatever the vehicle's type: its speed is commanded with SUMO'
 (``HOLD_SPEED_MODE``) and its lane changes off, so that neither the driver's imperfection
 (``sigma``), its speed factor (``speedFactor``, ``speedDev``), a slower car ahead of it nor
 the lane-change model's cooperative slowing moves it off the departure speed or out of its
-lane. After the hold the stop keeps the safe speed (``SCRIPTED_SPEED_MODE``) and the
-vehicle's own lane-change mode is given back until its speed is commanded to zero: from then
-on its lane changes are off again, so that the standing vehicle stays in its lane (SUMO's
-keep-right would otherwise move it a whole lane sideways in one step).
+lane. After the hold the stop keeps the safe speed (``SCRIPTED_SPEED_MODE``); its lane changes
+stay off to the end, braking and standing (SUMO's lane-change model would otherwise move it a
+whole lane sideways in one step: into the lane the ego evades into, or by keep-right once
+standing).
 
 SUMO inserts a vehicle one step after its departure time, and it moves from then on: at
 SUMO's 10 ms reference step it moves ``hold_s - 0.01`` s before its stop begins. At a longer
@@ -42,7 +42,6 @@ class _Script:
     mu: float = 1.0
     last_cmd_mps: float = -1.0
     holding: bool = True
-    standing: bool = False  # commanded to standstill: lane changes off for good
 
 
 class StopScripts:
@@ -82,11 +81,6 @@ class StopScripts:
         script.holding = False
         self._veh.setSpeedMode(vid, SCRIPTED_SPEED_MODE)
 
-    def _stand(self, vid: str, script: _Script) -> None:
-        """The stop is commanded to standstill: lane changes off, it stays in its lane."""
-        script.standing = True
-        self._veh.setLaneChangeMode(vid, NO_LANE_CHANGES)
-
     def apply(self, t_next_s: float, dt_s: float, results: dict, friction, watch) -> None:
         """Command each running stop's speed at the end of the coming step, ending at
         ``t_next_s`` (``results``: this step's subscription results; ``friction(lane_id)``)."""
@@ -105,8 +99,6 @@ class StopScripts:
                     script.mu = friction(res[tc.VAR_LANE_ID])
                 decel = min(script.decel_mps2, script.mu * G_MPS2)
                 cmd = max(0.0, res[tc.VAR_SPEED] - decel * min(dt_s, t_next_s - script.hold_end_s))
-                if cmd == 0.0 and not script.standing:
-                    self._stand(vid, script)
             if cmd != script.last_cmd_mps:
                 set_speed(vid, cmd)
                 script.last_cmd_mps = cmd

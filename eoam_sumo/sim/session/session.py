@@ -547,14 +547,8 @@ class SumoSession:
     def _side_limit(self, side: int) -> float:
         """The highest speed limit of the lane on ``side`` of the ego's along its route (0:
         none)."""
-        return max(
-            (
-                float(self._lane.getMaxSpeed(lane))
-                for edge, lane in self._beside(side)
-                if lane is not None and lane.rsplit("_", 1)[0] == edge
-            ),
-            default=0.0,
-        )
+        limits = (float(self._lane.getMaxSpeed(lane)) for _, lane in self._beside(side) if lane)
+        return max(limits, default=0.0)
 
     def lane_ids(self) -> list[str]:
         return list(self._lane.getIDList())
