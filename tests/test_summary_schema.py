@@ -44,7 +44,7 @@ def test_results_columns_are_the_parameters_status_and_every_summary_field():
         == SUMMARY_COLUMNS
     )
     assert COLUMNS[: len(PARAMETERS) - 1] == PARAMETERS[:-1]
-    assert COLUMNS[-1] == "sumocfg" and len(set(COLUMNS)) == len(COLUMNS)
+    assert COLUMNS[-2:] == ("sumocfg", "inputs_sha256") and len(set(COLUMNS)) == len(COLUMNS)
     # numbers are the fields typed as numbers (or None), and nothing typed otherwise
     hints = {f.name: f.type for f in dataclasses.fields(RunSummary)}
     for name in FIELDS:

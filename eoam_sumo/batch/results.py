@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from eoam_sumo.batch.case import NUMERIC_PARAMETERS, PARAMETERS, CaseParameters
+from eoam_sumo.batch.inputs import INPUTS_COLUMN
 from eoam_sumo.batch.pool import TaskResult
 from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import write_atomic
@@ -43,6 +44,7 @@ COLUMNS = (
     "error",
     "case_dir",
     "sumocfg",
+    INPUTS_COLUMN,
 )
 #: Columns that measure the machine, not the physics: they differ between runs.
 TIMING_COLUMNS = TIMING_FIELDS
@@ -57,13 +59,20 @@ def case_dir_of(case_id: str) -> str:
     return f"{CASES_DIR}/{case_id}"
 
 
-def result_row(case: Case, result: TaskResult, paper_outcome: str | None = None) -> dict:
+def result_row(
+    case: Case,
+    result: TaskResult,
+    paper_outcome: str | None = None,
+    inputs_sha256: str | None = None,
+) -> dict:
     """One results.csv row from a case and its task result (failed rows: empty summary);
-    ``paper_outcome`` is the published colour of the case, if any."""
+    ``paper_outcome`` is the published colour of the case, if any; ``inputs_sha256`` the
+    digest of its files as they were when it ran (:mod:`eoam_sumo.batch.inputs`)."""
     row = dict.fromkeys(COLUMNS)
     params = CaseParameters.of(case)
     row.update({p: getattr(params, p) for p in PARAMETERS})
     row.update(paper_outcome=paper_outcome, case_dir=case_dir_of(case.case_id))
+    row[INPUTS_COLUMN] = inputs_sha256
     summary = result.value.get("summary") if isinstance(result.value, dict) else None
     if not result.ok or not isinstance(summary, dict):
         row.update(
@@ -217,16 +226,19 @@ def _case_keys(cases: list[Case]) -> dict[str, tuple[str, ...]]:
     return {r[0]: tuple(r[1:]) for r in text.itertuples(index=False)}
 
 
-def kept_rows(path: Path, cases: list[Case]) -> pd.DataFrame:
+def kept_rows(path: Path, cases: list[Case], inputs: dict[str, str]) -> pd.DataFrame:
     """Rows of an earlier run worth keeping (``--resume``): the matrix's cases finished and
-    still the same case (same id, and the same scenario file, time limit, radar range, policy
-    and V2X link as written in results.csv), then every row of a case not in the matrix (a
-    larger matrix's, whose case folders stay)."""
+    still the same case (same id, the same parameters as written in results.csv, and the
+    same bytes in its files: ``inputs``, case id -> ``inputs_sha256`` now) whose folder is
+    still there, then every row
+    of a case not in the matrix (a larger matrix's, whose case folders stay)."""
     rows = read_rows(path)
     want = _case_keys(cases)
     same = [
-        want.get(cid) == key
-        for cid, key in zip(rows["case_id"], zip(*(rows[k] for k in RESUME_KEYS)))
+        want.get(cid) == key and inputs.get(cid) == digest
+        for cid, key, digest in zip(
+            rows["case_id"], zip(*(rows[k] for k in RESUME_KEYS)), rows[INPUTS_COLUMN]
+        )
     ]
     kept_dirs = [(path.parent / case_dir_of(cid)).is_dir() for cid in rows["case_id"]]
     keep = (

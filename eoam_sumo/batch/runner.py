@@ -11,8 +11,8 @@ number of jobs or on the order cases finished. Only ``wall_time_s`` and ``realti
 differ between two runs of one matrix.
 
 ``resume`` keeps the rows of an existing results.csv whose status is ``ok`` and whose case
-is still in the matrix (same case id and scenario file), and runs every other case of the
-matrix again, failed ones included; the rows of cases not in the matrix stay, after the
+is still in the matrix (same case id and parameters, the same bytes in its files:
+``inputs_sha256``), and runs every other case of the matrix again, failed ones included; the rows of cases not in the matrix stay, after the
 matrix's (the report and the returned frame are the matrix's cases).
 """
 
@@ -36,6 +36,7 @@ from eoam_sumo.batch.case import (
     CaseTask,
     run_matrix_case,
 )
+from eoam_sumo.batch.inputs import InputDigests
 from eoam_sumo.batch.policy_report import policy_line, policy_title, sight_markdown
 from eoam_sumo.batch.pool import TaskResult, run_dask, run_local
 from eoam_sumo.batch.probabilities import write_probabilities
@@ -254,8 +255,10 @@ def run_cases(
     paper = paper or {}
     out_dir = _cases_folder(Path(out_dir))
     results_path = out_dir / RESULTS_FILE
+    digests = InputDigests()  # the files as they are now, before any case runs
+    inputs = {c.case_id: digests.of(c) for c in cases}
     kept = (
-        kept_rows(results_path, cases)
+        kept_rows(results_path, cases, inputs)
         if resume and results_path.is_file()
         else pd.DataFrame(columns=list(COLUMNS), dtype=str)
     )
@@ -269,7 +272,8 @@ def run_cases(
         for case, result in _results(
             to_run, out_dir, jobs, scheduler, timeout_s, case_func, tables_dir, timeseries
         ):
-            failed += _record(out_dir, log, case, result, paper.get(case.case_id))
+            row = result_row(case, result, paper.get(case.case_id), inputs[case.case_id])
+            failed += _record(out_dir, log, row, result)
             bar.set_postfix(failed=failed, refresh=False)
             bar.update(1)
             side.finished_one()
@@ -351,12 +355,11 @@ def _progress_bar(total: int, done: int, progress: bool) -> tqdm:
     )
 
 
-def _record(out_dir: Path, log: RowLog, case: Case, result: TaskResult, paper: str | None) -> bool:
+def _record(out_dir: Path, log: RowLog, row: dict, result: TaskResult) -> bool:
     """A finished case: its files into its folder, its row into results.csv; True if it
     failed."""
-    row = result_row(case, result, paper)
     ok = row["status"] == "ok"
-    _store_case_files(out_dir / case_dir_of(case.case_id), result, ok)
+    _store_case_files(out_dir / row["case_dir"], result, ok)
     log.add(row)
     return not ok
 

@@ -17,7 +17,7 @@ from eoam_sumo.batch.results import COLUMNS, TIMING_COLUMNS
 from eoam_sumo.batch.runner import run_batch
 from eoam_sumo.errors import InputError
 from eoam_sumo.plotting.batch_plots import plot_batch_report
-from tests.builders import write_matrix
+from tests.builders import BASELINE, write_matrix
 
 
 def _fake_summary(case) -> dict:
@@ -241,3 +241,43 @@ def test_meanwhile_runs_once_before_the_batch_returns_and_its_error_is_not_the_b
     )
     assert calls == [1]
     assert (res["status"] == "ok").all()
+
+
+def _scenario_copy(folder: Path) -> Path:
+    """The baseline scenario's files copied into ``folder`` (its sumocfg's paths kept)."""
+    for name in ("scenarios", "networks"):
+        (folder / name).mkdir(parents=True, exist_ok=True)
+    for src in BASELINE.parent.glob("*.xml"):
+        (folder / "scenarios" / src.name).write_bytes(src.read_bytes())
+    for src in (BASELINE.parent.parent / "networks").glob("highway*.xml"):
+        (folder / "networks" / src.name).write_bytes(src.read_bytes())
+    cfg = folder / "scenarios" / BASELINE.name
+    cfg.write_bytes(BASELINE.read_bytes())
+    return cfg
+
+
+def _calls(out: Path) -> list[int]:
+    return [
+        len((p / "calls.txt").read_text().splitlines()) for p in sorted((out / "cases").iterdir())
+    ]
+
+
+@pytest.mark.parametrize("edited", ["baseline.rou.xml", "vtypes.add.xml", "baseline.sumocfg"])
+def test_resume_reruns_cases_whose_scenario_files_changed(tmp_path, edited):
+    """A file the sumocfg names edited after the run: resumed, every case runs again (the
+    row's ``inputs_sha256`` no longer matches), then no more."""
+    cfg = _scenario_copy(tmp_path / "a")
+    sweep = "ego_speed_kmh = [120, 90]\nmu = [1.0]\n"
+    matrix = write_matrix(tmp_path / "a" / "m.toml", sweep, sumocfg=cfg)
+    out = tmp_path / "out"
+    run_batch(matrix, out, jobs=1, progress=False, case_func=fake_case)
+    digests = set(pd.read_csv(out / "results.csv")["inputs_sha256"])
+    assert len(digests) == 1 and len(digests.pop()) == 64
+    run_batch(matrix, out, jobs=1, resume=True, progress=False, case_func=fake_case)
+    assert _calls(out) == [1, 1]  # the same files: kept
+    path = cfg.parent / edited
+    path.write_bytes(path.read_bytes().replace(b"<!--", b"<!-- edited", 1) + b"\n")
+    run_batch(matrix, out, jobs=1, resume=True, progress=False, case_func=fake_case)
+    assert _calls(out) == [2, 2]
+    run_batch(matrix, out, jobs=1, resume=True, progress=False, case_func=fake_case)
+    assert _calls(out) == [2, 2]  # the rows now hold the edited files' digest
