@@ -459,6 +459,9 @@ def insert(
     veh.setSpeedMode(vid, speed_mode)
     veh.setLaneChangeMode(vid, NO_LANE_CHANGES)
     x, y, heading = lane_point(api.lane, f"{edges[0]}_{lane_index}", pos)
-    veh.moveToXY(vid, edges[0], lane_index, x, y, nav_angle_deg(heading), keepRoute=1)
+    # no lane index as a hint: on some nets converted from OpenDRIVE SUMO 1.28 maps a hinted
+    # index n onto another lane of the edge (lanes 1 and 2 of 3 swapped); the point lies on
+    # the lane's centre line, which SUMO's nearest-lane search on the route finds
+    veh.moveToXY(vid, edges[0], -1, x, y, nav_angle_deg(heading), keepRoute=1)
     veh.setPreviousSpeed(vid, speed)
     veh.setSpeed(vid, speed)

@@ -388,6 +388,12 @@ class SumoSession:
         self._sumo_step()
         if self.ego_id not in self._veh.getIDList():
             raise InputError(f"{spec.source}: SUMO did not insert vehicle '{self.ego_id}'")
+        placed = self._veh.getLaneID(self.ego_id)
+        if placed != ego.lane_id:
+            raise InputError(
+                f"{spec.source}: SUMO placed vehicle '{self.ego_id}' on lane {placed}, not on "
+                f"its departure lane {ego.lane_id}"
+            )
         for vid, speed in self._over_limit.items():  # departed at rest (see insert)
             self._veh.setPreviousSpeed(vid, speed)
         if self.gui is not None:
