@@ -7,13 +7,17 @@ Sources (found in the regulations' public texts and NHTSA's papers on them):
   80 km/h, 13.5 deg/s, to find A (the hand-wheel angle of 0.3 g). S7.9: sine with dwell, one
   0.7 Hz sine cycle with a 500 ms pause between its third and fourth quarter; amplitudes from
   1.5 A in steps of 0.5 A up to 6.5 A or 270 deg, at most 300 deg (S7.9.4). S5.2.1 / S5.2.2:
-  the yaw rate 1.0 s and 1.75 s after the completion of steer at most 35 % and 20 % of the
-  first yaw-rate peak after the second steering reversal. S5.2.3: from 5 A, a lateral
+  the yaw rate 1.0 s and 1.75 s after the completion of steer at most 35 % and 20 % of "the
+  first peak value of yaw rate recorded after the steering wheel angle changes sign (between
+  first and second peaks)" (the peak searched from the steering's zero crossing, BOS + T / 2,
+  not from the dwell; GB/T 30677-2014 5.1.2 and 7.10.9 word it the same: "the first local yaw
+  rate peak produced by the reversal of the steering wheel"). S5.2.3: from 5 A, a lateral
   displacement of the centre of gravity of at least 1.83 m (vehicles up to 3 500 kg gross;
   1.52 m above) 1.07 s after the beginning of steer. S3: light vehicles up to 4 536 kg
   (10 000 lb) gross. (The 300 deg cap and the heavier vehicles' 1.52 m as worded in GTR 8's
-  Chinese adoption, GB/T 30677-2014 7.7.6 and 5.1.4, ACEA's translation: the FMVSS text was
-  not in the search corpora.)
+  Chinese adoption, GB/T 30677-2014 7.7.6 and 5.1.4, ACEA's translation: the search corpora
+  hold 49 CFR 571.126, e.g. https://www.law.cornell.edu/cfr/text/49/571.126, but return only
+  its opening, S1-S4.)
 - UN Regulation No. 13-H (braking of passenger cars), harmonised with FMVSS No. 135. Annex 3
   (R13 Annex 4) para. 1.1.2: the stopping distance runs from the first actuation of the control
   to the stop; the mean fully developed deceleration is ``(vb^2 - ve^2) / (25.92 (se - sb))``

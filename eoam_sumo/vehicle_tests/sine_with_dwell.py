@@ -25,7 +25,11 @@ from eoam_sumo.vehicle_tests.common import (
 )
 from eoam_sumo.vehicle_tests.figures import crossing_value
 from eoam_sumo.vehicle_tests.harness import Controls, Run, Sample, Vehicle, simulate
-from eoam_sumo.vehicle_tests.steer_figures import lateral_displacement_m, yaw_rate_ratios
+from eoam_sumo.vehicle_tests.steer_figures import (
+    lateral_displacement_m,
+    steer_sign_change_s,
+    yaw_rate_ratios,
+)
 from eoam_sumo.vehicle_tests.steer_tests import slowly_increasing_steer
 
 PERIOD_S = 1.0 / c.SWD_FREQUENCY_HZ
@@ -164,10 +168,13 @@ def _swd_run(
 
 def _judge(run: Run, amp_deg: float, a_deg: float, mass_kg: float) -> tuple[dict, list[dict]]:
     """One run's figures and its criteria (the displacement from 5 A only, its limit by the
-    vehicle's mass: ``displacement_min_m``)."""
+    vehicle's mass: ``displacement_min_m``). The yaw-rate peak is searched from the steering's
+    sign change between its first and second peaks, measured on the run's hand-wheel angle
+    (FMVSS 126 S5.2.1; about ``SETTLE_S + PERIOD_S / 2``, the robot's lag later)."""
     time_s = run["time_s"]
+    sign_change_s = steer_sign_change_s(time_s, run["steer_wheel_deg"])
     ratios = yaw_rate_ratios(
-        time_s, run["yaw_rate_radps"], SETTLE_S + SECOND_REVERSAL_S, SETTLE_S + COMPLETION_S, -1.0
+        time_s, run["yaw_rate_radps"], sign_change_s, SETTLE_S + COMPLETION_S, -1.0
     )
     displacement = lateral_displacement_m(
         time_s, run["x_m"], run["y_m"], run["yaw_rad"], SETTLE_S, c.DISPLACEMENT_TIME_S
@@ -201,7 +208,9 @@ def _judge(run: Run, amp_deg: float, a_deg: float, mass_kg: float) -> tuple[dict
         "amplitude_deg": round(amp_deg, 3),
         "amplitude_A": round(amp_deg / a_deg, 3),
         "peak_steer_wheel_deg": round(float(np.max(np.abs(run["steer_wheel_deg"]))), 3),
+        "steer_sign_change_s": round(sign_change_s, 4),
         "peak_yaw_rate_degps": round(math.degrees(ratios.peak_radps), 3),
+        "peak_yaw_rate_time_s": round(ratios.peak_time_s, 3),
         "yaw_ratio_1s": round(ratios.ratio_1s, 4),
         "yaw_ratio_1.75s": round(ratios.ratio_175s, 4),
         "lateral_displacement_m": round(displacement, 4),

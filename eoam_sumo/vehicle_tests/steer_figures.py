@@ -124,36 +124,56 @@ def _first_crossing_time(time_s: np.ndarray, y: np.ndarray, level: float) -> flo
 
 class YawRatios(NamedTuple):
     """FMVSS 126 S5.2.1 / S5.2.2: the yaw rate 1.0 s and 1.75 s after the completion of steer
-    over the first yaw-rate peak after the second steering reversal (signed: a yaw rate that
-    keeps the peak's sign is positive; above 1 the vehicle is still yawing harder)."""
+    over the first peak value of yaw rate recorded after the steering wheel angle changes sign
+    (signed: a yaw rate that keeps the peak's sign is positive; above 1 the vehicle is still
+    yawing harder)."""
 
     peak_radps: float
+    peak_time_s: float
     ratio_1s: float
     ratio_175s: float
+
+
+def steer_sign_change_s(time_s: np.ndarray, steer: np.ndarray) -> float:
+    """When the steering changes sign between its first and second peaks (FMVSS 126 S5.2.1):
+    the first zero crossing after the first peak, interpolated between the samples. The first
+    half-wave's side is that of the first sample beyond half the largest angle."""
+    large = np.flatnonzero(np.abs(steer) > 0.5 * np.max(np.abs(steer)))
+    signed = math.copysign(1.0, float(steer[int(large[0])])) * steer
+    k_peak = int(np.argmax(signed))
+    k = k_peak + int(np.flatnonzero(signed[k_peak:] < 0.0)[0])
+    frac = signed[k - 1] / (signed[k - 1] - signed[k])
+    return float(time_s[k - 1] + frac * (time_s[k] - time_s[k - 1]))
+
+
+def first_peak_index(signed: np.ndarray) -> int:
+    """The first local peak of ``signed`` (positive, not below the sample before it in the
+    window, above the one after it); its first sample counts. With none (a yaw rate still
+    growing at the end: a spin) the largest sample."""
+    inner = signed[:-1]
+    before = np.concatenate(([-np.inf], signed[:-2]))
+    peaks = np.flatnonzero((inner > 0.0) & (inner >= before) & (inner > signed[1:]))
+    return int(peaks[0]) if peaks.size else int(np.argmax(signed))
 
 
 def yaw_rate_ratios(
     time_s: np.ndarray,
     yaw_rate_radps: np.ndarray,
-    second_reversal_s: float,
+    sign_change_s: float,
     completion_s: float,
     peak_sign: float,
 ) -> YawRatios:
-    """The yaw-rate ratios of one sine-with-dwell run. The peak is the first local maximum of
-    ``peak_sign * yaw rate`` after ``second_reversal_s`` (the start of the dwell), else the
-    largest after it."""
+    """The yaw-rate ratios of one sine-with-dwell run. The peak is "the first peak value of yaw
+    rate recorded after the steering wheel angle changes sign (between first and second
+    peaks)" (FMVSS 126 S5.2.1, S5.2.2): the first local peak of ``peak_sign * yaw rate`` from
+    ``sign_change_s`` on (``first_peak_index``: the window's first sample included)."""
     signed = peak_sign * yaw_rate_radps
-    after = np.flatnonzero(time_s >= second_reversal_s)
-    k0 = int(after[0])
-    middle = signed[k0 + 1 : -1]
-    rising = np.flatnonzero(
-        (middle > 0.0) & (middle >= signed[k0:-2]) & (middle > signed[k0 + 2 :])
-    )
-    k_peak = k0 + 1 + int(rising[0]) if rising.size else k0 + int(np.argmax(signed[k0:]))
+    k0 = int(np.flatnonzero(time_s >= sign_change_s)[0])
+    k_peak = k0 + first_peak_index(signed[k0:])
     peak = float(signed[k_peak])
     at_1s = float(np.interp(completion_s + 1.0, time_s, signed))
     at_175s = float(np.interp(completion_s + 1.75, time_s, signed))
-    return YawRatios(peak_sign * peak, at_1s / peak, at_175s / peak)
+    return YawRatios(peak_sign * peak, float(time_s[k_peak]), at_1s / peak, at_175s / peak)
 
 
 def lateral_displacement_m(

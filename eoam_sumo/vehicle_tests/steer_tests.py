@@ -4,6 +4,7 @@ and ``step-steer`` (ISO 7401 sec. 10). Clauses: ``clauses.py``; the sine with dw
 
 from __future__ import annotations
 
+import collections
 import math
 
 import numpy as np
@@ -41,9 +42,14 @@ is within 2 % of the one of steady turns at constant steer; at the 13.5 deg/s of
 slowly increasing steer the yaw response's lag adds about 0.1 deg/g)."""
 
 QUASI_STEADY_TOLERANCE = 0.1
-"""A ramp steer also ends when the lateral acceleration departs from ``vx r`` by more than this
-share: the turn is no longer quasi-steady (a spin, a slide, a wheel lifting), and ISO 4138
-describes steady turns."""
+"""A ramp steer also ends when the sideslip grows faster than in steady turns by more than this
+share of the lateral acceleration (``RampStop``): the turn is no longer quasi-steady (a spin,
+a slide, a wheel lifting), and ISO 4138 describes steady turns. The step steer's end is judged
+on ``ay - vx r`` with the same share (``step_sliding``)."""
+
+AY_RATE_WINDOW_S = 0.5
+"""The lateral acceleration's rate in the ramp's quasi-steady check is its change over this
+window [s] (ours: 50 samples, smooth on a ramp, short beside its many seconds)."""
 
 RAMP_MIN_PEAK_MU = 0.2
 """... judged once the peak is above this share of ``mu g`` (any car gets there; below it,
@@ -68,12 +74,14 @@ their limit) and the response is the friction's, not the car's transient respons
 def ramp_steer(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle | None = None):
     """ISO 4138 at constant speed: the hand wheel turned left at ``RAMP_STEER_RATE_DEGPS`` with
     the speed held, until the lateral acceleration stops growing or the turn stops being
-    quasi-steady. Figures over the linear range (``linear_range_g``: 0.1-0.4 g, at most half
-    the peak): the understeer gradient and the steering angle gradient (deg of road-wheel angle
-    per g; of hand-wheel angle: times the steering ratio); the peak lateral acceleration."""
+    quasi-steady (``RampStop``; ``ramp_end`` says which). Figures over the linear range
+    (``linear_range_g``: 0.1-0.4 g, at most half the peak): the understeer gradient and the
+    steering angle gradient (deg of road-wheel angle per g; of hand-wheel angle: times the
+    steering ratio); the peak lateral acceleration."""
     speed_mps = options.speed_mps(c.RAMP_SPEED_KMH)
+    stop = RampStop(params, speed_mps, options.mu, None)
     run = slowly_increasing_steer(
-        params, speed_mps, options.mu, vehicle, rate_degps=RAMP_STEER_RATE_DEGPS
+        params, speed_mps, options.mu, vehicle, rate_degps=RAMP_STEER_RATE_DEGPS, stop=stop
     )
     peak_mps2 = float(np.max(np.abs(run["ay_mps2"])))
     fit_range_g = linear_range_g(peak_mps2 / G_MPS2)
@@ -87,12 +95,14 @@ def ramp_steer(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehi
         f"{LINEAR_AY_RANGE_G[1]:g} g and {LINEAR_PEAK_FRACTION:g} of the peak",
         "peak_lateral_acceleration_mps2": round(peak_mps2, 4),
         "peak_lateral_acceleration_g": round(peak_mps2 / G_MPS2, 4),
+        "ramp_end": stop.reason,
         "clause": c.CITE["ramp"],
     }
     summary["criteria"] = []
     summary["passed"] = None
     if "not_measured" in gradients:
-        summary["not_measured"] = gradients["not_measured"]
+        summary["figures"]["not_measured"] += f"; the ramp ended: {stop.reason}"
+        summary["not_measured"] = summary["figures"]["not_measured"]
     return VehicleTestResult("ramp-steer", (run,), summary)
 
 
@@ -137,30 +147,90 @@ def slowly_increasing_steer(
     *,
     rate_degps: float = c.SIS_STEER_RATE_DEGPS,
     until_ay_g: float | None = None,
+    stop: RampStop | None = None,
 ) -> Run:
     """Hand wheel turned left at ``rate_degps`` from ``SETTLE_S`` with the speed held, until
     the lateral acceleration reaches ``until_ay_g`` (None: until it falls past its peak or the
-    turn is no longer quasi-steady)."""
+    turn is no longer quasi-steady, ``RampStop``; pass one to read why the run ended)."""
     keep = speed_keeper(params, speed_mps)
     rate_radps = math.radians(rate_degps) / params.steering_ratio
-    peak = [0.0]
+    stop = stop or RampStop(params, speed_mps, mu, until_ay_g)
 
     def driver(t_s: float, s: Sample) -> Controls:
         return Controls(rate_radps * max(t_s - SETTLE_S, 0.0), keep(s), 0.0)
 
-    def stop(t_s: float, s: Sample) -> bool:
-        peak[0] = max(peak[0], abs(s.ay_mps2))
-        if until_ay_g is not None:
-            return abs(s.ay_mps2) >= until_ay_g * G_MPS2
-        judged = peak[0] > RAMP_MIN_PEAK_MU * mu * G_MPS2
-        fell = abs(s.ay_mps2) < RAMP_END_FRACTION * peak[0]
-        unsteady = abs(s.ay_mps2 - s.vx_mps * s.yaw_rate_radps) > QUASI_STEADY_TOLERANCE * abs(
-            s.ay_mps2
-        )
-        return (judged and (fell or unsteady)) or s.vx_mps < 0.5 * speed_mps
-
     duration_s = SETTLE_S + params.max_steer_rad / rate_radps + 2.0
     return simulate(vehicle_for(params, vehicle), speed_mps, driver, duration_s, mu, stop=stop)
+
+
+def linear_sideslip_gain_s(params: VehicleParams, vx_mps: float) -> float:
+    """``d vy / d ay`` of steady turns in the linear single-track model [s]: ``vy = vx beta``,
+    ``beta = b / R - m a vx^2 / (L C_r R)`` (Gillespie ch. 6) and ``1 / R = ay / vx^2``, so
+    ``b / vx - m a vx / (L C_r)``. A ramp of ``ay`` grows the sideslip at this times its rate
+    (``ay - vx r = dvy / dt``): at 250 km/h the corrected sedan's -0.41 s. Beyond an
+    oversteering car's critical speed (``L + K_us vx^2 <= 0``) no turn is steady: 0, so that
+    any growth of the sideslip counts."""
+    if params.wheelbase_m + params.understeer_gradient_rad_per_mps2 * vx_mps**2 <= 0.0:
+        return 0.0
+    rear_share = params.mass_kg * params.cg_to_front_m / params.wheelbase_m
+    return params.cg_to_rear_m / vx_mps - rear_share * vx_mps / params.cornering_stiffness_rear_npr
+
+
+class RampStop:
+    """When a slowly increasing steer ends, and ``reason``: why it did. Quasi-steady means
+    that the sideslip grows as steady turns of the lateral acceleration reached would have it
+    (``linear_sideslip_gain_s`` times the lateral acceleration's rate), within
+    ``QUASI_STEADY_TOLERANCE`` of the lateral acceleration: a slide or a spin grows it faster.
+    (``ay - vx r`` alone, the sideslip's rate, tripped on a steady ramp at 250 km/h.)"""
+
+    def __init__(
+        self, params: VehicleParams, speed_mps: float, mu: float, until_ay_g: float | None
+    ) -> None:
+        self.params, self.speed_mps, self.until_ay_g = params, speed_mps, until_ay_g
+        self.judged_from_mps2 = RAMP_MIN_PEAK_MU * mu * G_MPS2
+        self.peak_mps2 = 0.0
+        self.recent: collections.deque[tuple[float, float]] = collections.deque()
+        self.reason = "the steering reached its largest angle"
+
+    def __call__(self, t_s: float, s: Sample) -> bool:
+        ay = abs(s.ay_mps2)
+        self.peak_mps2 = max(self.peak_mps2, ay)
+        self.recent.append((t_s, s.ay_mps2))
+        while t_s - self.recent[0][0] > AY_RATE_WINDOW_S:
+            self.recent.popleft()
+        if self.until_ay_g is not None:
+            return self._ends(ay >= self.until_ay_g * G_MPS2, f"{self.until_ay_g:g} g reached")
+        if s.vx_mps < 0.5 * self.speed_mps:
+            return self._ends(True, f"the speed fell to {s.vx_mps:.1f} m/s, below half")
+        if self.peak_mps2 <= self.judged_from_mps2:
+            return False
+        if ay < RAMP_END_FRACTION * self.peak_mps2:
+            return self._ends(
+                True,
+                f"the lateral acceleration fell below {RAMP_END_FRACTION:g} of its peak "
+                f"({self.peak_mps2 / G_MPS2:.3f} g): the limit was passed",
+            )
+        return self._ends(*self._slide(s))
+
+    def _slide(self, s: Sample) -> tuple[bool, str]:
+        """Whether the sideslip grows faster than steady turns' (a slide or a spin), and why."""
+        (t0, ay0), (t1, ay1) = self.recent[0], self.recent[-1]
+        ay_rate = (ay1 - ay0) / (t1 - t0) if t1 > t0 else 0.0
+        sideslip_rate = s.ay_mps2 - s.vx_mps * s.yaw_rate_radps
+        steady_rate = linear_sideslip_gain_s(self.params, s.vx_mps) * ay_rate
+        if abs(sideslip_rate - steady_rate) <= QUASI_STEADY_TOLERANCE * abs(s.ay_mps2):
+            return False, ""
+        return True, (
+            f"the turn stopped being quasi-steady at {abs(s.ay_mps2) / G_MPS2:.3f} g (a slide "
+            f"or a spin): the sideslip grew at dvy/dt = {sideslip_rate:+.3f} m/s^2 against "
+            f"{steady_rate:+.3f} m/s^2 in steady turns, more than {QUASI_STEADY_TOLERANCE:g} "
+            f"of the lateral acceleration"
+        )
+
+    def _ends(self, ended: bool, reason: str) -> bool:
+        if ended:
+            self.reason = reason
+        return ended
 
 
 def step_steer(params: VehicleParams, options: VehicleTestOptions, vehicle: Vehicle | None = None):

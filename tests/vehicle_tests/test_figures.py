@@ -21,8 +21,10 @@ from eoam_sumo.vehicle_tests.figures import (
     stop_time_s,
     stopping_distance_limit_m,
 )
+from eoam_sumo.vehicle_tests.harness import Run
 from eoam_sumo.vehicle_tests.sine_with_dwell import (
     COMPLETION_S,
+    PERIOD_S,
     SECOND_REVERSAL_S,
     amplitudes_deg,
     displacement_min_m,
@@ -32,6 +34,7 @@ from eoam_sumo.vehicle_tests.sine_with_dwell import (
 from eoam_sumo.vehicle_tests.steer_figures import (
     lateral_displacement_m,
     steer_angle_gradient_deg_per_g,
+    steer_sign_change_s,
     step_response,
     understeer_gradient_deg_per_g,
     yaw_rate_ratios,
@@ -220,6 +223,7 @@ def test_the_yaw_rate_ratios_of_a_decaying_yaw_rate():
     yaw = np.where(t < t_peak, rise, -peak * np.exp(-(t - t_peak) / tau))
     ratios = yaw_rate_ratios(t, yaw, t_rev, t_done, -1.0)
     assert ratios.peak_radps == pytest.approx(-peak, rel=1e-6)
+    assert ratios.peak_time_s == pytest.approx(t_peak, abs=DT)
     assert ratios.ratio_1s == pytest.approx(math.exp(-(t_done + 1.0 - t_peak) / tau), rel=1e-3)
     assert ratios.ratio_175s == pytest.approx(math.exp(-(t_done + 1.75 - t_peak) / tau), rel=1e-3)
 
@@ -234,3 +238,91 @@ def test_the_lateral_displacement_on_a_circle():
     y = radius * (1 - np.cos(arc))
     displacement = lateral_displacement_m(t, x, y, arc, begin, 1.07)
     assert displacement == pytest.approx(radius * (1 - math.cos(speed * 1.07 / radius)), rel=1e-4)
+
+
+# FMVSS 126 S5.2.1: the peak is "the first peak value of yaw rate recorded after the steering
+# wheel angle changes sign (between first and second peaks)". A 0.7 Hz sine with dwell from
+# the beginning of steer at BOS changes sign at BOS + T / 2; its dwell begins at BOS + 3 T / 4.
+BOS_S = 1.0
+SIGN_CHANGE_S = BOS_S + 0.5 * PERIOD_S
+DWELL_S = BOS_S + SECOND_REVERSAL_S
+END_S = BOS_S + COMPLETION_S
+
+
+def _swd_steer_deg(t: np.ndarray, amplitude_deg: float) -> np.ndarray:
+    return np.array([sine_with_dwell_steer(x - BOS_S, amplitude_deg) for x in t])
+
+
+def _yaw_peaked_before_the_dwell(t: np.ndarray) -> tuple[np.ndarray, float, float]:
+    """Yaw rate [rad/s]: the first half-wave's +0.3, then negative, a true peak of -1.2 at
+    1.96 s (on the 10 ms grid, before the dwell at 2.071 s), decaying, with a small late wiggle
+    that peaks at -0.02 near ``DWELL_S + 0.6``; the peak and its time."""
+    t_peak, peak = 1.96, 1.2
+    first = 0.3 * np.sin(math.pi * np.clip((t - BOS_S) / (SIGN_CHANGE_S - BOS_S), 0.0, 1.0))
+    rise = np.sin(0.5 * math.pi * np.clip((t - SIGN_CHANGE_S) / (t_peak - SIGN_CHANGE_S), 0, 1))
+    decay = np.exp(-np.maximum(t - t_peak, 0.0) / 0.3)
+    wiggle = 0.02 * np.exp(-(((t - DWELL_S - 0.6) / 0.1) ** 2))
+    second = np.where(t < t_peak, -peak * rise, -peak * decay - wiggle)
+    return np.where(t < SIGN_CHANGE_S, first, second), -peak, t_peak
+
+
+def test_the_steering_changes_sign_half_a_period_after_the_beginning_of_steer():
+    t = np.arange(0.0, 5.0, 0.01)
+    assert steer_sign_change_s(t, _swd_steer_deg(t, 100.0)) == pytest.approx(
+        SIGN_CHANGE_S, abs=1e-4
+    )
+    # the dwell holds the full amplitude, the first peak a hair less: still the first half-wave
+    steer = _swd_steer_deg(t, 100.0)
+    steer[steer > 0.0] *= 0.99
+    assert steer_sign_change_s(t, steer) == pytest.approx(SIGN_CHANGE_S, abs=1e-4)
+
+
+def test_a_yaw_rate_peak_before_the_dwell_is_the_first_peak_after_the_sign_change():
+    """The yaw rate peaks before the dwell begins and decays; the peak is the true one, not a
+    late wiggle (the search from the dwell's start took -0.02 rad/s and ratios above 1)."""
+    t = np.round(np.arange(0.0, 6.0, 0.01), 6)
+    yaw, peak, t_peak = _yaw_peaked_before_the_dwell(t)
+    assert t_peak < DWELL_S
+    ratios = yaw_rate_ratios(t, yaw, SIGN_CHANGE_S, END_S, -1.0)
+    assert ratios.peak_radps == pytest.approx(peak)
+    assert ratios.peak_time_s == pytest.approx(t_peak, abs=0.005)
+    expected_1s = float(np.interp(END_S + 1.0, t, yaw)) / peak
+    assert ratios.ratio_1s == pytest.approx(expected_1s, rel=1e-9)
+    assert ratios.ratio_1s < 0.35
+
+
+def test_the_windows_first_sample_can_be_the_peak():
+    """A yaw rate whose peak (-1.2 rad/s) is the first sample at or after the sign change, the
+    next ones decaying: that sample is the peak, not a later local one (-0.05 rad/s)."""
+    t = np.round(np.arange(0.0, 6.0, 0.01), 6)
+    k0 = int(np.flatnonzero(t >= SIGN_CHANGE_S)[0])
+    decay = -1.2 * np.exp(-np.maximum(t - t[k0], 0.0) / 0.3)
+    later = -0.05 * np.exp(-(((t - 3.5) / 0.1) ** 2))
+    yaw = np.where(t < t[k0], 0.2, decay + later)
+    ratios = yaw_rate_ratios(t, yaw, SIGN_CHANGE_S, END_S, -1.0)
+    assert ratios.peak_radps == pytest.approx(-1.2)
+    assert ratios.peak_time_s == pytest.approx(t[k0])
+
+
+def test_the_judged_run_searches_the_peak_from_the_steerings_sign_change():
+    """``sine_with_dwell._judge`` on a hand-made run whose yaw rate peaks before the dwell:
+    the figures' peak is the true first peak after the sign change, and the run passes."""
+    from eoam_sumo.vehicle_tests.sine_with_dwell import _judge
+
+    t = np.round(np.arange(0.0, END_S + 2.0, 0.01), 6)
+    yaw, peak, t_peak = _yaw_peaked_before_the_dwell(t)
+    straight = np.zeros_like(t)
+    columns = {
+        "time_s": t,
+        "steer_wheel_deg": _swd_steer_deg(t, 100.0),
+        "yaw_rate_radps": yaw,
+        "x_m": 22.0 * t,
+        "y_m": straight,
+        "yaw_rad": straight,
+    }
+    figures, judged = _judge(Run("amp_5A", columns), 100.0, 20.0, 1500.0)
+    assert figures["peak_yaw_rate_degps"] == pytest.approx(math.degrees(peak), abs=1e-3)
+    assert figures["peak_yaw_rate_time_s"] == pytest.approx(t_peak, abs=0.005)
+    assert figures["steer_sign_change_s"] == pytest.approx(SIGN_CHANGE_S, abs=1e-4)
+    ratios = {c["name"]: c["passed"] for c in judged}
+    assert ratios["amp_5A.yaw_ratio_1s"] and ratios["amp_5A.yaw_ratio_1.75s"]
