@@ -16,6 +16,10 @@ AIR_DENSITY_KGPM3 = 1.2  # sea level, 20 C [kg/m^3]
 MU_MAX = 1.2  # highest tyre-road friction accepted (lanes, runs, tables): dry asphalt [-]
 #: Lateral travel of the lane change, one lane (paper sec. 4.2: y_f = 3.5 m) [m].
 LANE_CHANGE_HEIGHT_M = 3.5
+#: A lane wider than this holds two cars side by side (Vector's NCAP road is one 28 m lane each
+#: way): a lane change from or into it swerves by the tables' ``LANE_CHANGE_HEIGHT_M`` (or as
+#: far as the obstacle needs), not to the far lane's centre (ours) [m].
+WIDE_LANE_M = 6.0
 #: Point of no return as a fraction of the lane change's lateral travel (paper sec. 8.1) [-].
 PONR_FRACTION = 0.3
 

@@ -14,7 +14,7 @@ from eoam_sumo.eoam_settings import EoamSettings
 from eoam_sumo.manoeuvre.lateral_state import course_state, lateral_state
 from eoam_sumo.manoeuvre.min_time_shift import MinTimeShift
 from eoam_sumo.manoeuvre.quintic_shift import QuinticShift
-from eoam_sumo.params import G_MPS2, VehicleParams
+from eoam_sumo.params import G_MPS2, LANE_CHANGE_HEIGHT_M, WIDE_LANE_M, VehicleParams
 
 
 def quintic_shift(
@@ -110,13 +110,20 @@ def lane_change_height_m(
     does not clear it (``clearing_offset_m``) by the side clearance from the body's corner,
     yawed as a lane change's body ends (``yawed_body_reach_m``), as long as the ego's body,
     its other corner as far out, stays inside the target lane; None: no offset within it
-    clears the obstacle (brake in lane)."""
+    clears the obstacle (brake in lane). Where either lane is wider than ``WIDE_LANE_M`` the
+    travel is the tables' ``LANE_CHANGE_HEIGHT_M``, or what clears the obstacle's track if
+    more, up to the target lane's centre (a 28 m lane: a swerve, not a 28 m lane change)."""
     centre = target_offset_m or meas.lane_width_m
+    target_width = 2.0 * centre - meas.lane_width_m  # centre to centre = half of both widths
+    far_edge = centre + 0.5 * target_width
     reach = yawed_body_reach_m(params, meas)  # a front corner in, the rear one out
     need = clearing_offset_m(params, settings, obstacle, meas) + reach
+    if max(meas.lane_width_m, target_width) > WIDE_LANE_M:
+        if obstacle is None:  # no track: a lane this wide gives no edge to clear
+            need = LANE_CHANGE_HEIGHT_M
+        centre = min(centre, max(need, LANE_CHANGE_HEIGHT_M))
     if need <= centre:
         return centre
-    target_width = 2.0 * centre - meas.lane_width_m  # centre to centre = half of both widths
-    if need + 0.5 * params.width_m + reach <= centre + 0.5 * target_width + 1e-9:
+    if need + 0.5 * params.width_m + reach <= far_edge + 1e-9:
         return need
     return None

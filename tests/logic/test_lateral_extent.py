@@ -65,3 +65,21 @@ def test_the_yawed_body_reaches_farther_on_more_friction():
     ]
     assert reaches == sorted(reaches) and reaches[0] > 0.0
     assert 0.5 * P.length_m * 0.05 < reaches[-1] < 0.5 * P.length_m * 0.07
+
+
+@pytest.mark.parametrize("own_m, target_offset_m", [(28.0, 0.0), (3.5, 15.75), (7.0, 0.0)])
+def test_a_lane_wider_than_two_cars_is_swerved_into_not_crossed(own_m, target_offset_m):
+    """From or into a lane wider than WIDE_LANE_M (Vector's NCAP road: one 28 m lane each way)
+    the lateral travel is the tables' 3.5 m, not the far lane's centre (28 m, 15.75 m); an
+    obstacle that sticks out farther is cleared by the side clearance, as in a normal lane."""
+    meas = _meas()._replace(lane_width_m=own_m)
+    assert lane_change_height_m(P, ST, None, meas, target_offset_m) == pytest.approx(3.5)
+    truck = ObstacleTrack(0.0, 50.0, 0.0, 3.0, 0.0, 12.0)  # its left side 3.0 m left of centre
+    height = lane_change_height_m(P, ST, truck, meas, target_offset_m)
+    clearance = height - 0.5 * P.width_m - yawed_body_reach_m(P, meas) - 3.0
+    assert clearance == pytest.approx(ST.side_clearance_m)
+
+
+def test_lanes_up_to_two_cars_wide_are_crossed_to_the_target_lane_centre():
+    meas = _meas()._replace(lane_width_m=6.0)
+    assert lane_change_height_m(P, ST, None, meas) == pytest.approx(6.0)
