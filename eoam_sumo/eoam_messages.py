@@ -26,6 +26,9 @@ class EgoMeasurement(NamedTuple):
     left_lane_available: bool = True  # map: a lane (either direction) left of the ego's lane
     # the friction believed for a lane change to the right (``mu``: to the left); 0: ``mu``
     mu_right: float = 0.0
+    # the friction believed under the ego, for braking in its lane (``mu`` is the lower of it
+    # and the lane a lane change takes, for planning one); 0: ``mu``
+    mu_lane: float = 0.0
 
 
 class ObjectState(NamedTuple):

@@ -11,7 +11,7 @@ from eoam_sumo.decision.modes import (
     UPDATE_STEER_BRAKE,
 )
 from eoam_sumo.eoam.parts import Parts
-from eoam_sumo.eoam.state import ControllerState, LateralOutput, LongitudinalOutput
+from eoam_sumo.eoam.state import ControllerState, Friction, LateralOutput, LongitudinalOutput
 from eoam_sumo.eoam_messages import EgoMeasurement
 from eoam_sumo.params import G_MPS2
 
@@ -25,23 +25,29 @@ def longitudinal_control(
     lateral: LateralOutput,
     dt_s: float,
 ) -> LongitudinalOutput:
-    """Mode 0 holds the set speed; 1 and 3 brake at the no-lock limit to standstill; 2 and 4
-    follow the path's acceleration profile, then (like 5) hold the speed at its end."""
+    """Mode 0 holds the set speed; 1 and 3 brake at the no-lock limit to standstill on the
+    friction under the ego (``state.lane_friction``: a lane a lane change would take does not
+    lower it); 2 and 4 follow the path's acceleration profile, then (like 5) hold the speed at
+    its end."""
     mode, v, mu = state.mode, meas.vx_mps, meas.mu
     long = parts.longitudinal
     tracking = lateral.in_path and mode in _STEERING  # the table's ax already fits the ellipse
-    drive_lim, brake_lim = force_limits(parts, state, meas, lateral.steer_rad, tracking)
+    braking = mode is UPDATE_BRAKE or mode is ONCOMING_BRAKE  # limit braking without locking
+    lane = state.lane_friction if braking and state.lane_friction is not None else None
+    drive_lim, brake_lim = force_limits(parts, state, meas, lateral.steer_rad, tracking, lane)
     if mode is NORMAL:
         target = following_speed_mps(parts, state, meas)
         drive, brake, ax_target = long.track_speed(target, v, mu, drive_lim, brake_lim, dt_s)
         return LongitudinalOutput(drive, brake, ax_target, target)
-    if mode is UPDATE_BRAKE or mode is ONCOMING_BRAKE:  # limit braking without locking
+    if braking:
         if mode is ONCOMING_BRAKE and shares_ellipse(parts, state, meas):
-            floor = parts.settings.limit_brake_floor * state.friction_now().brake_limit_n
+            friction = lane or state.friction_now()
+            floor = parts.settings.limit_brake_floor * friction.brake_limit_n
             # the brake has priority (the steering takes the ellipse's rest), below what
             # locks a wheel braking straight (only looked up when the floor would raise it)
             if not floor <= brake_lim:
-                brake_lim = max(brake_lim, min(floor, long.wheel_lock_limit_n(v, mu, 0.0)))
+                lock_n = long.wheel_lock_limit_n(v, friction.mu, 0.0)
+                brake_lim = max(brake_lim, min(floor, lock_n))
         return LongitudinalOutput(0.0, brake_lim, -brake_lim / parts.params.mass_kg, 0.0)
     if tracking:
         drive, brake = long.track_accel(
@@ -100,18 +106,23 @@ def shares_ellipse(parts: Parts, state: ControllerState, meas: EgoMeasurement) -
 
 
 def force_limits(
-    parts: Parts, state: ControllerState, meas: EgoMeasurement, steer_rad: float, tracking: bool
+    parts: Parts,
+    state: ControllerState,
+    meas: EgoMeasurement,
+    steer_rad: float,
+    tracking: bool,
+    friction: Friction | None = None,
 ) -> tuple[float, float]:
     """(drive, brake) limits from the friction ellipse with the lateral acceleration in use:
     measured, and outside the table's profile also the one this steering command asks for,
-    so that the brake yields before a turning axle locks."""
+    so that the brake yields before a turning axle locks; on ``friction`` (None: the
+    believed one, ``meas.mu``)."""
+    friction = friction or state.friction_now()
     ay_use = lateral_use_mps2(parts, meas, steer_rad, tracking)
     arrest_g = parts.settings.arrest_lateral_g
     if state.arrest and arrest_g is not None:  # the arrest's lateral share kept for it
         ay_use = max(ay_use, arrest_g * meas.mu * G_MPS2)
-    return parts.longitudinal.limits(
-        meas.vx_mps, meas.mu, ay_use, state.friction_now().brake_limit_n
-    )
+    return parts.longitudinal.limits(meas.vx_mps, friction.mu, ay_use, friction.brake_limit_n)
 
 
 def lateral_use_mps2(parts: Parts, meas: EgoMeasurement, steer_rad: float, tracking: bool) -> float:

@@ -30,6 +30,11 @@ def perceive(
     check_measurement(state, meas)
     if state.friction is None or meas.mu != state.friction.mu:
         state.friction = friction_at(parts, meas.mu)
+    lane_mu = meas.mu_lane if meas.mu_lane > 0.0 else meas.mu
+    if lane_mu == meas.mu:
+        state.lane_friction = state.friction
+    elif state.lane_friction is None or lane_mu != state.lane_friction.mu:
+        state.lane_friction = friction_at(parts, lane_mu)
     state.friction.curve.lateral_stop_factor = curve_stop_factor(parts, state, meas)
     rng = perception.aro_range_m
     rate = perception.aro_range_rate_mps

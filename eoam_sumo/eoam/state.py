@@ -38,6 +38,7 @@ class ControllerState:
     obstacle_decel: ObstacleDecel  # low-pass estimate of the obstacle's own braking
     initial_speed_mps: float = math.nan  # the set speed of mode 0 (nan: not reset yet)
     friction: Friction | None = None
+    lane_friction: Friction | None = None  # under the ego (``EgoMeasurement.mu_lane``)
     mode: Mode = NORMAL
     modes_visited: list[int] = field(default_factory=lambda: [0])  # in order of first visit
     fcw_raised: bool = False

@@ -399,6 +399,7 @@ class CoSimulation:
             self.lane_width_m,
             self.left_usable,  # yaw is continuous
             mu_right,
+            mu_true if self.belief.belief == "known" else mu,
         )
         return meas, perception
 
@@ -406,7 +407,8 @@ class CoSimulation:
         """The friction the EOAM believes for a lane change to the left (or to its only usable
         side) and to the right. Known friction: the lower of the ego's lane's and the lane
         that lane change takes (the net's, or --mu), so that a lane the EOAM does not evade
-        into does not lower it; that belief is recorded at ``decide``."""
+        into does not lower it; that belief is recorded at ``decide``. Braking in its lane,
+        the EOAM believes the friction under the ego (``EgoMeasurement.mu_lane``)."""
         if self.belief.belief != "known":
             mu = self.belief.mu(mu_true, self.t, self.ax, self.ay)
             return mu, mu
