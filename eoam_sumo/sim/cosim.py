@@ -819,8 +819,12 @@ def _start_curve(road: RoadFrame, x_m: float, y_m: float) -> tuple[float, float]
 def _side_frictions(session: SumoSession, side_lanes: tuple) -> tuple[float, float]:
     """The friction of the lane a lane change takes, (left, right): the left lane's, or the
     right lane's when only that one is usable (inf: neither); the right lane's (nan: not
-    usable, the EOAM does not evade right)."""
-    left, right = (session.lane_friction(lane.lane_id) if lane else math.nan for lane in side_lanes)
+    usable, the EOAM does not evade right). Each the lowest along the route within the
+    manoeuvre's reach (``SumoSession.side_friction``)."""
+    left, right = (
+        session.side_friction(side) if lane else math.nan
+        for side, lane in zip((1, -1), side_lanes, strict=True)
+    )
     if math.isnan(left):
         left = math.inf if math.isnan(right) else right
     return left, right

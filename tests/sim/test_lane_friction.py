@@ -58,3 +58,35 @@ def test_a_blocked_lane_change_brakes_at_the_friction_under_the_ego(tmp_path):
     series = pd.read_csv(out / "timeseries.csv")
     braking = series[series["mode"].isin([1, 3]) & (series["vx_mps"] > 5.0)]
     assert braking["ax_mps2"].min() < -0.7 * 9.81
+
+
+def test_a_lane_change_plans_on_the_icy_lane_it_takes_on_a_later_edge(tmp_path):
+    """The left lane is dry on the start edge and icy (0.15) on the next, where the obstacle
+    stops: the lane change's friction is the icy one (it planned a dry lane change and slid
+    off the road: orange), so the EOAM believes 0.15 at the trigger and ends with no
+    contact."""
+    edges = (
+        '<edges><edge id="E1" from="a" to="m" numLanes="2" speed="40" width="3.5"/>'
+        '<edge id="E2" from="m" to="b" numLanes="2" speed="40" width="3.5">'
+        '<lane index="0" friction="1.0"/><lane index="1" friction="0.15"/></edge></edges>'
+    )
+    nodes = (
+        '<nodes><node id="a" x="0" y="0"/><node id="m" x="500" y="0"/>'
+        '<node id="b" x="3000" y="0"/></nodes>'
+    )
+    network(tmp_path, "ice", nodes, edges)
+    routes = ROUTES.split('<vehicle id="ego"')[0] + (
+        '<vehicle id="ego" type="ego" depart="1" departLane="0" departPos="400" '
+        'departSpeed="38.89" insertionChecks="none"><route edges="E1 E2"/></vehicle>'
+        '<vehicle id="aro" type="aro" depart="1" departLane="0" departPos="25.09" '
+        'departSpeed="16.67" insertionChecks="none"><route edges="E2"/>'
+        '<param key="eoam.aro_hold_s" value="2"/><param key="eoam.aro_decel_mps2" value="8"/>'
+        "</vehicle></routes>"
+    )
+    (tmp_path / "s.rou.xml").write_text(routes)
+    cfg = write_sumocfg(tmp_path / "s.sumocfg", "ice.net.xml", "s.rou.xml")
+    out = tmp_path / "out"
+    assert main(["run", str(cfg), "--speed-kmh", "140", "--out", str(out)]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["mu_believed_at_trigger"] == pytest.approx(0.15)
+    assert summary["outcome"] == "green"

@@ -536,19 +536,33 @@ class SumoSession:
                 beside.append((edge, None))
         return beside
 
-    def _permitted_ahead(self, side: int) -> bool:
-        """A lane on ``side`` of the ego's lies beside it, and its class may use it, on every
-        edge of its route that begins within ``PERMISSION_REACH_M`` of its start edge's start:
-        the whole manoeuvre, not only its start (a lane that ends on the way, an acceleration
-        lane, a bus lane after a lane added, close the side)."""
-        begun_m = 0.0
+    def _beside_within_reach(self, side: int) -> list[str | None]:
+        """The lane on ``side`` of the ego's (``_beside``) on each edge of its route that
+        begins within ``PERMISSION_REACH_M`` of its start edge's start: where the manoeuvre
+        may take the ego."""
+        lanes, begun_m = [], 0.0
         for edge, lane in self._beside(side):
             if begun_m > PERMISSION_REACH_M:
                 break
-            if lane is None or not self._permits(lane):
-                return False
+            lanes.append(lane)
             begun_m += float(self._lane.getLength(f"{edge}_0"))
-        return True
+        return lanes
+
+    def _permitted_ahead(self, side: int) -> bool:
+        """A lane on ``side`` of the ego's lies beside it, and its class may use it, on every
+        edge within the manoeuvre's reach (``_beside_within_reach``), not only at its start (a
+        lane that ends on the way, an acceleration lane, a bus lane after a lane added, close
+        the side)."""
+        return all(
+            lane is not None and self._permits(lane) for lane in self._beside_within_reach(side)
+        )
+
+    def side_friction(self, side: int) -> float:
+        """The lowest friction of the lane on ``side`` of the ego's within the manoeuvre's
+        reach (``_beside_within_reach``; nan: no lane there): a lane that turns icy on a later
+        edge is the lane change's friction too."""
+        lanes = [lane for lane in self._beside_within_reach(side) if lane]
+        return min((self._friction(lane) for lane in lanes), default=math.nan)
 
     def _side_limit(self, side: int) -> float:
         """The highest speed limit of the lane on ``side`` of the ego's along its route (0:
