@@ -1,4 +1,4 @@
-"""The ``eoam-sumo`` command line: tables, run, batch, plot, animate, bench.
+"""The ``eoam-sumo`` command line (its commands: ``eoam-sumo --help``).
 
 Bad input ends with one line on stderr naming the file or value and exit status 2; the
 library raises, only this module prints and exits.
@@ -28,6 +28,7 @@ from eoam_sumo.openscenario.command import (
     run_xosc_command,
     xosc_arguments,
 )
+from eoam_sumo.outputs.staging import OutputKind, output_folder
 from eoam_sumo.seeds import seed_argument
 from eoam_sumo.sim.settings import (
     DEFAULT_MAX_TIME_S,
@@ -39,13 +40,20 @@ from eoam_sumo.traffic_levels.command import add_scenario_arguments, cmd_scenari
 from eoam_sumo.vehicle_tests import command as vehicle_test_command
 
 EXIT_BAD_INPUT = 2
+PROG = "eoam-sumo"
+DESCRIPTION = (
+    "Emergency obstacle avoidance (brake, steer around, or brake in lane) at highway speeds, "
+    "in SUMO co-simulations: build the tables, run scenarios, batches, protocols and "
+    "vehicle tests, and plot them."
+)
 
 
 class _Parser(argparse.ArgumentParser):
     """argparse that reports a usage error as one line (no usage block) with status 2."""
 
     def error(self, message: str):
-        raise InputError(f"{self.prog}: {message}")
+        command = self.prog.removeprefix(PROG).strip()  # "run" of "eoam-sumo run"
+        raise InputError(f"{command}: {message}" if command else message)
 
 
 def _positive_int(text: str) -> int:
@@ -83,7 +91,7 @@ def _distance_or_none(text: str) -> float | None:
 
 def build_parser() -> argparse.ArgumentParser:
     """The ``eoam-sumo`` parser: one sub-command per job, each with its own arguments."""
-    parser = _Parser(prog="eoam-sumo", description=__doc__.splitlines()[0])
+    parser = _Parser(prog=PROG, description=DESCRIPTION)
     parser.add_argument("--version", action="version", version=f"eoam-sumo {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     for add_arguments in (
@@ -389,23 +397,24 @@ def _cmd_run(args) -> int:
         from eoam_sumo.sim.scenario.files import check_scenario
 
         check_scenario(args.cfg, args.ego or "ego")  # a file that is no sumocfg: nothing written
-    out = writable_dir(args.out)
-    settings = _run_settings(args, out)
-    if is_xosc(args):
-        s = run_xosc_command(args, xosc, out, settings)
-    else:
-        overrides = ScenarioOverrides(
-            ego_speed_mps=None if args.speed_kmh is None else args.speed_kmh / 3.6,
-            mu=args.mu,
-            oncoming_start_m=args.oncoming_m,
-        )
-        s = run_case(args.cfg, overrides, out, settings)
+    # a refused or failed run leaves no folder; a re-run replaces a run folder once complete
+    with output_folder(args.out, RUN_OUTPUT, keep_partial=False) as out:
+        settings = _run_settings(args, out)
+        if is_xosc(args):
+            s = run_xosc_command(args, xosc, out, settings)
+        else:
+            overrides = ScenarioOverrides(
+                ego_speed_mps=None if args.speed_kmh is None else args.speed_kmh / 3.6,
+                mu=args.mu,
+                oncoming_start_m=args.oncoming_m,
+            )
+            s = run_case(args.cfg, overrides, out, settings)
     print(
         f"{s['outcome']}: collision_with={s['collision_with']} "
         f"impact={s['impact_speed_mps']:.1f} m/s modes={s['modes_visited']} "
         f"fcw={s['fcw_raised']} mu={s['mu']:.2f} policy={s['policy']} "
         f"{_sight_text(s)}sim={s['sim_time_s']:.2f} s "
-        f"rtf={s['realtime_factor']:.0f} -> {out}"
+        f"rtf={s['realtime_factor']:.0f} -> {args.out}"
     )
     if s.get("sumo_overrides"):
         options = ", ".join(f"{k}={v}" for k, v in s["sumo_overrides"].items())
@@ -413,6 +422,16 @@ def _cmd_run(args) -> int:
     if args.gui and settings.gui_settings.keep_open:
         print("eoam-sumo: the sumo-gui window stays open until you close it", file=sys.stderr)
     return 0
+
+
+#: What shows a folder holds a run's output (``eoam-sumo run``, a .sumocfg's or an .xosc's):
+#: a re-run over it is staged and replaces it once complete; a batch's, a protocol's or a
+#: study's folder is refused.
+RUN_OUTPUT = OutputKind(
+    "run",
+    ("summary.json", "timeseries.csv", "timeseries.parquet", "traffic.csv", "road.csv"),
+    foreign=("results.csv", "cases", "runs", "batch", "scenarios", "scorecard.md"),
+)
 
 
 def _check_run_args(args) -> None:
