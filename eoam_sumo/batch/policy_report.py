@@ -11,7 +11,7 @@ import math
 
 import pandas as pd
 
-from eoam_sumo.batch.report import mu_text, traffic_label
+from eoam_sumo.batch.report import grid_layout, mu_text
 
 
 def _first(results: pd.DataFrame, column: str, default=None):
@@ -21,22 +21,39 @@ def _first(results: pd.DataFrame, column: str, default=None):
     return values.iloc[0] if len(values) else default
 
 
+def _policies(results: pd.DataFrame) -> list[str]:
+    """The batch's decision policies in its order (none recorded: the paper's)."""
+    if "policy" not in results:
+        return ["paper"]
+    return [str(p) for p in pd.unique(results["policy"].dropna())] or ["paper"]
+
+
 def policy_title(results: pd.DataFrame) -> str:
-    """'Table 2, policy safe, V2X 1000 m' (the paper policy without V2X: 'Table 2')."""
-    policy = _first(results, "policy", "paper") or "paper"
+    """'Table 2, policy safe, V2X 1000 m' (the paper policy without V2X: 'Table 2'; policies
+    swept: 'Table 2, policies paper and safe'). Whose outcomes it shows, the EOAM's or a
+    reference driver's, the grid's ``subject`` says after it."""
+    policies = _policies(results)
     v2x = _first(results, "v2x_range_m", 0.0)
-    title = "Table 2" if policy == "paper" else f"Table 2, policy {policy}"
+    if len(policies) > 1:
+        title = f"Table 2, policies {' and '.join(policies)}"
+    else:
+        title = "Table 2" if policies[0] == "paper" else f"Table 2, policy {policies[0]}"
     if v2x and v2x > 0:
         title += f", V2X {v2x:g} m"
     return title
 
 
 def policy_line(results: pd.DataFrame) -> str:
-    """One line naming the policy, the radar range and the V2X link."""
-    policy = _first(results, "policy", "paper") or "paper"
+    """One line naming the policy (policies swept: each, a row each), the radar range and
+    the V2X link."""
+    policies = _policies(results)
     radar = _first(results, "radar_range_m")
     radar_text = "100 m (default)" if radar is None or not math.isfinite(radar) else f"{radar:g} m"
-    line = f"Policy **{policy}**; forward radar {radar_text}"
+    if len(policies) > 1:
+        line = f"Policies {', '.join(f'**{p}**' for p in policies)} (a row each)"
+    else:
+        line = f"Policy **{policies[0]}**"
+    line += f"; forward radar {radar_text}"
     v2x = _first(results, "v2x_range_m", 0.0)
     if v2x and v2x > 0:
         line += (
@@ -44,7 +61,7 @@ def policy_line(results: pd.DataFrame) -> str:
             f"loss {_first(results, 'v2x_loss'):g}, penetration "
             f"{_first(results, 'v2x_penetration'):g}"
         )
-    elif policy == "safe":
+    elif "safe" in policies:
         line += "; no V2X"
     return line + "."
 
@@ -62,17 +79,11 @@ def _sight_cell(row) -> str:
 
 def sight_markdown(results: pd.DataFrame) -> str:
     """The sight distance each case needed and knew free at its first lane-change request,
-    in Table 2's grid (empty text when no case asked the gate)."""
+    in Table 2's grid (``report.grid_layout``; empty text when no case asked the gate)."""
     if "sight_gate" not in results or not (results["sight_gate"].fillna("") != "").any():
         return ""
-    rows, mus, cells = [], [], {}
-    for _, row in results.iterrows():
-        key = (traffic_label(row["oncoming_start_m"]), f"{row['ego_speed_kmh']:g} km/h")
-        if key not in rows:
-            rows.append(key)
-        if row["mu"] not in mus:
-            mus.append(row["mu"])
-        cells[(rows.index(key), mus.index(row["mu"]))] = _sight_cell(row)
+    grid = grid_layout(results)
+    cells = {place: _sight_cell(row) for place, (_, row) in zip(grid.places, results.iterrows())}
     lines = [
         "## Sight distance of each lane change (safe policy)",
         "",
@@ -84,13 +95,13 @@ def sight_markdown(results: pd.DataFrame) -> str:
         ),
         "",
         "| Traffic | Initial ego speed | "
-        + " | ".join(f"{mu_text(mu)} surface mu" for mu in mus)
+        + " | ".join(f"{mu_text(mu)} surface mu" for mu in grid.mus)
         + " |",
-        "|---|---|" + "---|" * len(mus),
+        "|---|---|" + "---|" * len(grid.mus),
     ]
     previous = None
-    for i, (traffic, speed) in enumerate(rows):
-        cols = [cells.get((i, j), "") for j in range(len(mus))]
+    for i, (traffic, speed) in enumerate(grid.rows):
+        cols = [cells.get((i, j), "") for j in range(len(grid.mus))]
         lines.append(
             f"| {traffic if traffic != previous else ''} | {speed} | " + " | ".join(cols) + " |"
         )

@@ -11,7 +11,9 @@ no event gives a small probability with a finite band instead of a diverging fit
 the GLM's Wald interval of the linear predictor mapped through the logistic function. The map
 covers the observed range only. Degenerate data fall back to the overall Wilson interval
 (:func:`eoam_sumo.sampling.wilson_interval`) at every grid point, the ``model`` column saying
-why: no event or only events, fewer than ``MIN_DRAWS`` draws, or no fit converged.
+why: no event or only events, fewer than ``MIN_DRAWS`` draws, or no fit converged. One map
+per slice (``slices``): the draws of two settings (policy, vehicle, driver, ...) are never one
+fit.
 """
 
 from __future__ import annotations
@@ -23,6 +25,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from eoam_sumo.batch.probabilities import group_of
+from eoam_sumo.batch.report import SETTINGS, setting_text, varying_settings
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.sampling import wilson_interval
 
@@ -32,7 +36,10 @@ GRID_POINTS = 21  # per varying parameter
 MIN_DRAWS = 10  # fewer finished draws: no map, the overall rate
 EVENTS_PER_PARAMETER = 5.0
 SPLINE_MIN_DISTINCT = 6  # distinct values a parameter needs for a spline term
-SLICE_COLUMNS = ("road", "los")  # generated-scenario studies: one map per road and level
+#: A generated scenario's road and level of service: columns of the CSV whenever set.
+SCENARIO_COLUMNS = ("road", "los")
+#: A drawn setting with more distinct values is a continuous draw: pooled like a scenario's.
+MAX_DRAWN_LEVELS = 8
 
 #: outcome -> whether each finished draw had it
 OUTCOMES: dict[str, Callable[[pd.DataFrame], pd.Series]] = {
@@ -130,24 +137,51 @@ def fit_map(draws: pd.DataFrame) -> pd.DataFrame:
     )
 
 
-def _slices(ok: pd.DataFrame) -> list[tuple[dict, pd.DataFrame]]:
-    """(slice values, draws) per road and level of service of a generated-scenario study,
-    else one slice of every draw."""
-    keys = [c for c in SLICE_COLUMNS if c in ok and ok[c].fillna("").astype(str).ne("").any()]
+def slice_columns(ok: pd.DataFrame) -> list[str]:
+    """The settings (``report.SETTINGS``) that get a map each: every one that varies among
+    the draws but the map's axes (X, Y) and a drawn scenario value (``pooled``, varying
+    within a group of swept values) or continuous draw (more than ``MAX_DRAWN_LEVELS``
+    values); a generated scenario's road and level of service always."""
+    groups = ok["case_id"].map(group_of) if "case_id" in ok else pd.Series(0, index=ok.index)
+    columns = []
+    for setting in varying_settings(ok, leave_out=(X, Y)):
+        values = ok[setting.column]
+        drawn = bool((values.groupby(groups).nunique(dropna=False) > 1).any())
+        if not drawn or not (setting.pooled or values.nunique() > MAX_DRAWN_LEVELS):
+            columns.append(setting.column)
+    named = {c for c in SCENARIO_COLUMNS if c in ok and ok[c].fillna("").astype(str).ne("").any()}
+    return [s.column for s in SETTINGS if s.column in named or s.column in columns]
+
+
+def slices(ok: pd.DataFrame) -> list[tuple[dict, pd.DataFrame]]:
+    """(slice values, draws) per combination of the ``slice_columns``, else one slice of
+    every draw."""
+    keys = slice_columns(ok)
     if not keys:
         return [({}, ok)]
     return [
         (dict(zip(keys, values if isinstance(values, tuple) else (values,))), draws)
-        for values, draws in ok.groupby(keys, sort=True)
+        for values, draws in ok.groupby(keys, sort=True, dropna=False)
     ]
 
 
+def slice_name(values: dict, leave_out: tuple[str, ...] = ()) -> str:
+    """'safe policy, LoS E': a slice's values (but ``leave_out``) as a report names them."""
+    texts = (
+        setting_text(s, values[s.column])
+        for s in SETTINGS
+        if s.column in values and s.column not in leave_out
+    )
+    return ", ".join(t for t in texts if t)
+
+
 def probability_map(results: pd.DataFrame) -> pd.DataFrame:
-    """Every outcome's map over the finished draws of a results frame (``read_results``):
-    [road, los,] ego_speed_kmh, mu, outcome, p, p_low, p_high, n, events, model."""
+    """Every outcome's map over the finished draws of a results frame (``read_results``),
+    one per slice (``slices``): the slice's columns, ego_speed_kmh, mu, outcome, p, p_low,
+    p_high, n, events, model."""
     ok = results[results["status"] == "ok"]
     frames = []
-    for values, draws in _slices(ok):
+    for values, draws in slices(ok):
         data = draws[[X, Y]].astype(float).reset_index(drop=True)
         for outcome, event in OUTCOMES.items():
             data["event"] = event(draws).astype(float).to_numpy()
@@ -159,7 +193,7 @@ def probability_map(results: pd.DataFrame) -> pd.DataFrame:
             )
     if not frames:
         return pd.DataFrame()
-    columns = [c for c in SLICE_COLUMNS if c in frames[0]]
+    columns = [s.column for s in SETTINGS if s.column in frames[0] and s.column not in (X, Y)]
     columns += [X, Y, "outcome", "p", "p_low", "p_high", "n", "events", "model"]
     return pd.concat(frames, ignore_index=True)[columns]
 

@@ -1,12 +1,13 @@
 """Table 2 of a batch: our outcome colours beside the paper's (markdown and image).
 
 Rows are the traffic (no oncoming car, then each oncoming start distance) by initial ego
-speed, columns the surface friction, as in the paper's Table 2; rows and columns follow the
-order of the results (the matrix's order). Each cell holds our colour and the paper's; every
-cell that differs is numbered and listed below the table with a link to the case's
-``summary.json`` and the reason for its outcome. A batch without a published counterpart (a
-user's own sweep) gets the same grid with our colours only, and the list covers every case
-that was not green.
+speed, columns the surface friction, as in the paper's Table 2; a row more for each other
+combination of the settings that vary (``SETTINGS``: vehicle, policy, driver, road, ...),
+named in its label; rows and columns follow the order of the results (the matrix's order).
+Each cell holds our colour and the paper's; every cell that differs is numbered and listed
+below the table with a link to the case's ``summary.json`` and the reason for its outcome. A
+batch without a published counterpart (a user's own sweep) gets the same grid with our
+colours only, and the list covers every case that was not green.
 """
 
 from __future__ import annotations
@@ -21,14 +22,96 @@ from eoam_sumo.colours import FAILED, LEGEND, MARKERS, OUTCOMES
 NEAR_MISS_MARK = "⚡"
 TABLE_MD = "table2.md"
 TABLE_PNG = "table2.png"
-_EXTRA_PARAMS = (
-    ("aro_hold_s", "ARO hold {:g} s"),
-    ("aro_decel_mps2", "ARO decel {:g} m/s²"),
-    ("vehicle", "{}"),
-    ("abs_fitted", "ABS {}"),
-    ("esc_fitted", "ESC {}"),
-    ("policy", "{} policy"),
+
+
+@dataclass(frozen=True)
+class Setting:
+    """A results.csv column that changes the system under test or its scenario and that a
+    matrix may sweep or sample; ``label`` formats its value in a report's row; ``pooled``:
+    a drawn value is an uncertain scenario input that one probability map pools over."""
+
+    column: str
+    label: str
+    pooled: bool = False
+
+
+#: Every setting a matrix may sweep or sample (``matrix.SCHEMA``'s [sweep] keys and
+#: ``matrix.SAMPLED``, ``abs``/``esc``/``abs_esc`` as ``abs_fitted``/``esc_fitted``), in
+#: the order a row's label names them. Results of two combinations of them never share a
+#: cell of a report or a fit; a report leaves out the ones it lays out itself (its axes).
+SETTINGS = (
+    Setting("aro_hold_s", "ARO hold {:g} s", pooled=True),
+    Setting("aro_decel_mps2", "ARO decel {:g} m/s²", pooled=True),
+    Setting("vehicle", "{}"),
+    Setting("abs_fitted", "ABS {}"),
+    Setting("esc_fitted", "ESC {}"),
+    Setting("policy", "{} policy"),
+    Setting("driver", "driver {}"),
+    Setting("road", "{} road"),
+    Setting("los", "LoS {}"),
+    Setting("lanes", "{:g} lanes", pooled=True),
+    Setting("speed_limit_kmh", "limit {:g} km/h", pooled=True),
+    Setting("curve_radius_m", "curve radius {:g} m", pooled=True),
+    Setting("mu_belief", "believed mu {}"),
+    Setting("radar_model", "{} radar"),
+    Setting("radar_range_m", "radar {:g} m"),
+    Setting("v2x_range_m", "V2X {:g} m"),
+    Setting("v2x_latency_s", "V2X latency {:g} s"),
+    Setting("v2x_loss", "V2X loss {:g}"),
+    Setting("v2x_penetration", "V2X share {:g}"),
+    Setting("max_time_s", "time limit {:g} s"),
+    Setting("after_stop_s", "{:g} s after the stop"),
+    Setting("sumo_step_s", "SUMO step {:g} s"),
+    Setting("ego_speed_kmh", "{:g} km/h", pooled=True),
+    Setting("mu", "mu {:g}", pooled=True),
+    Setting("oncoming_start_m", "oncoming car at {:g} m", pooled=True),
 )
+#: Table 2's own axes: the rows' traffic and speed, the columns' friction.
+GRID_AXES = ("oncoming_start_m", "ego_speed_kmh", "mu")
+
+
+def _known(results: pd.DataFrame, column: str) -> pd.Series:
+    """A setting's values, but the empty cell of a failed case (a summary field it never
+    wrote, such as ``abs_fitted``: no value of its own)."""
+    failed = results["status"] != "ok" if "status" in results else False
+    return results.loc[~(failed & results[column].isna()), column]
+
+
+def varying_settings(results: pd.DataFrame, leave_out: tuple[str, ...] = ()) -> list[Setting]:
+    """The ``SETTINGS`` (but ``leave_out``) that take more than one value in ``results``
+    (an empty cell, the default, is a value of its own)."""
+    return [
+        s
+        for s in SETTINGS
+        if s.column in results
+        and s.column not in leave_out
+        and _known(results, s.column).nunique(dropna=False) > 1
+    ]
+
+
+def setting_text(setting: Setting, value) -> str:
+    """A setting's value as a row names it ('' for an empty cell)."""
+    if value is None or (not isinstance(value, str) and pd.isna(value)):
+        return ""
+    return setting.label.format(value)
+
+
+def settings_label(row, settings: list[Setting]) -> str:
+    """'sedan, safe policy, driver r157-cc': the row's values of ``settings``."""
+    return ", ".join(t for t in (setting_text(s, row[s.column]) for s in settings) if t)
+
+
+def subject_of(results: pd.DataFrame) -> str:
+    """Whose outcomes a report shows: 'EOAM outcomes', one reference driver's ('r157-cc
+    outcomes'), or 'outcomes per driver (eoam, r157-cc)'."""
+    drivers = (
+        list(pd.unique(_known(results, "driver").fillna("eoam"))) if "driver" in results else []
+    )
+    if drivers in ([], ["eoam"]):
+        return "EOAM outcomes"
+    if len(drivers) == 1:
+        return f"{drivers[0]} outcomes"
+    return f"outcomes per driver ({', '.join(map(str, drivers))})"
 
 
 @dataclass(frozen=True)
@@ -60,6 +143,7 @@ class OutcomeGrid:
     mus: tuple[float, ...]
     cells: dict[tuple[int, int], Cell]
     has_paper: bool
+    subject: str = "EOAM outcomes"  # whose outcomes: ``subject_of``
 
     @property
     def agreeing(self) -> int:
@@ -121,40 +205,63 @@ def _margins(row) -> str:
     )
 
 
-def outcome_grid(results: pd.DataFrame) -> OutcomeGrid:
-    """The grid of a results frame (``runner.read_results``), the paper's colours from its
-    ``paper_outcome`` column (empty where unpublished)."""
-    varying = [
-        (col, fmt)
-        for col, fmt in _EXTRA_PARAMS
-        if col in results and results[col].notna().any() and results[col].nunique(dropna=False) > 1
-    ]
-    rows: list[tuple[str, str]] = []
-    mus: list[float] = []
-    cells = {}
+@dataclass(frozen=True)
+class GridLayout:
+    """Where each case of a results frame goes in Table 2's grid: ``rows`` (traffic, speed
+    and settings label), ``mus`` (the columns), and per case (in the frame's order) its
+    (row, column)."""
+
+    rows: tuple[tuple[str, str], ...]
+    mus: tuple[float, ...]
+    places: tuple[tuple[int, int], ...]
+
+
+def grid_layout(results: pd.DataFrame) -> GridLayout:
+    """A row per traffic, speed and combination of the other settings that vary
+    (``SETTINGS``, labelled after the speed), a column per friction; in the frame's order."""
+    varying = varying_settings(results, leave_out=GRID_AXES)
     no_car = results["oncoming_start_m"].isna()
-    scenario_traffic = bool((results.loc[no_car, "oncoming_traffic"].astype(str) == "True").any())
+    seen = results.loc[no_car, "oncoming_traffic"] if "oncoming_traffic" in results else []
+    scenario_traffic = bool((pd.Series(seen, dtype=object).astype(str) == "True").any())
+    rows: list[tuple[str, str]] = []
+    row_of: dict[tuple, int] = {}
+    mus: list[float] = []
+    places = []
     for _, row in results.iterrows():
+        traffic = traffic_label(row["oncoming_start_m"], scenario_traffic)
         speed = f"{row['ego_speed_kmh']:g} km/h"
-        extra = [fmt.format(row[col]) for col, fmt in varying if pd.notna(row[col])]
-        key = (traffic_label(row["oncoming_start_m"], scenario_traffic), ", ".join([speed, *extra]))
-        if key not in rows:
-            rows.append(key)
+        identity = (traffic, speed, *(_identity(row[s.column]) for s in varying))
+        if identity not in row_of:
+            row_of[identity] = len(rows)
+            rows.append((traffic, ", ".join(t for t in (speed, settings_label(row, varying)) if t)))
         if row["mu"] not in mus:
             mus.append(row["mu"])
-        ours = row["outcome"] if row["status"] == "ok" else FAILED
-        cells[(rows.index(key), mus.index(row["mu"]))] = Cell(
+        places.append((row_of[identity], mus.index(row["mu"])))
+    return GridLayout(tuple(rows), tuple(mus), tuple(places))
+
+
+def _identity(value):
+    """A setting's value as a row's key: an empty cell is one value (NaN is not NaN)."""
+    return None if value is None or (not isinstance(value, str) and pd.isna(value)) else value
+
+
+def outcome_grid(results: pd.DataFrame) -> OutcomeGrid:
+    """The grid of a results frame (``runner.read_results``; layout: ``grid_layout``), the
+    paper's colours from its ``paper_outcome`` column (empty where unpublished)."""
+    layout = grid_layout(results)
+    cells = {}
+    for place, (_, row) in zip(layout.places, results.iterrows()):
+        cells[place] = Cell(
             row["case_id"],
-            ours,
+            row["outcome"] if row["status"] == "ok" else FAILED,
             row["paper_outcome"] or None,
             row["case_dir"],
             _detail(row),
             str(row.get("near_miss", "")) == "True",
             _margins(row),
         )
-    return OutcomeGrid(
-        tuple(rows), tuple(mus), cells, has_paper=any(c.paper for c in cells.values())
-    )
+    has_paper = any(c.paper for c in cells.values())
+    return OutcomeGrid(layout.rows, layout.mus, cells, has_paper, subject_of(results))
 
 
 def mu_text(mu: float) -> str:
@@ -178,7 +285,7 @@ def _ref(cell: Cell, n: int) -> str:
 def table2_markdown(grid: OutcomeGrid, title: str = "Table 2") -> str:
     """The grid as markdown: ours / paper per cell, the agreement count, the differences."""
     lines = [
-        f"# {title}: EOAM outcomes" + (" — this run / the paper" if grid.has_paper else ""),
+        f"# {title}: {grid.subject}" + (" — this run / the paper" if grid.has_paper else ""),
         "",
         *_counts_markdown(grid),
         *_grid_markdown(grid),

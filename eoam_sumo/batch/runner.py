@@ -12,8 +12,9 @@ differ between two runs of one matrix.
 
 ``resume`` keeps the rows of an existing results.csv whose status is ``ok`` and whose case
 is still in the matrix (same case id and parameters, the same bytes in its files:
-``inputs_sha256``), and runs every other case of the matrix again, failed ones included; the rows of cases not in the matrix stay, after the
-matrix's (the report and the returned frame are the matrix's cases).
+``inputs_sha256``), and runs every other case of the matrix again, failed ones included;
+the rows of cases not in the matrix stay, after the matrix's (the report and the returned
+frame are the matrix's cases).
 """
 
 from __future__ import annotations

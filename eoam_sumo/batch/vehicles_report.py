@@ -1,10 +1,11 @@
 """The vehicles report of a batch (``vehicles.md``): Table 2 per vehicle, ABS/ESC and policy.
 
-For each (vehicle, ABS/ESC, policy) of a results frame, the outcome colour counts beside the
-paper's Table 2 counts (Lowe & Guvenc 2022, sec. 11.2, the ``[paper]`` table) and how many
-cells agree with the paper; then, per vehicle and policy, every Table 2 cell whose colour
-ABS/ESC changes (its colour without, with, and the run's reason with). Built from results.csv
-alone, so a finished batch can be reported again.
+For each (vehicle, ABS/ESC, policy or driver, and any other setting that varies) of a
+results frame, the outcome colour counts beside the paper's Table 2 counts (Lowe & Guvenc
+2022, sec. 11.2, the ``[paper]`` table) and how many cells agree with the paper; then, per
+vehicle and policy, every Table 2 cell whose colour ABS/ESC changes (its colour without,
+with, and the run's reason with). Built from results.csv alone, so a finished batch can be
+reported again.
 """
 
 from __future__ import annotations
@@ -13,15 +14,21 @@ from pathlib import Path
 
 import pandas as pd
 
+from eoam_sumo.batch.report import GRID_AXES, settings_label, varying_settings
 from eoam_sumo.colours import FAILED, MARKERS, OUTCOMES
 from eoam_sumo.fileio import write_atomic
+from eoam_sumo.matrix import POLICIES
 
 VEHICLES_MD = "vehicles.md"
 VEHICLES_PNG = "vehicles.png"
 #: The paper's colours, counted in every row of the report.
 COUNTED = ("green", "yellow", "orange", "red")
-#: The keys one row of the report stands for.
+#: The keys one row of the report stands for: ``policy`` names the policy or the reference
+#: driver, and every other setting that varies (``report.SETTINGS``).
 GROUP = ("vehicle", "equipment", "policy")
+#: The settings a row names in columns of their own (``vehicle``, ``equipment``) or as the
+#: policy or driver; with Table 2's cell (speed, friction, oncoming car) left out of its label.
+_OWN_COLUMNS = ("vehicle", "abs_fitted", "esc_fitted", "policy", "driver", *GRID_AXES)
 #: The columns whose variation makes a batch a vehicles experiment.
 VARIED = ("vehicle", "policy", "driver", "abs_fitted", "esc_fitted")
 
@@ -62,8 +69,7 @@ def cell_id(row) -> str:
 
 def labelled(results: pd.DataFrame) -> pd.DataFrame:
     """The frame with the report's columns: ``equipment``, ``colour`` (``failed`` for a case
-    that did not finish) and ``cell``; ``policy`` names a reference driver's runs by the
-    driver (it has no decision policy: it only brakes in its lane)."""
+    that did not finish), ``cell`` and ``policy`` as a row names it (``policy_label``)."""
     frame = results.copy()
     for col in VARIED:
         if col not in frame:
@@ -77,9 +83,24 @@ def labelled(results: pd.DataFrame) -> pd.DataFrame:
     frame["cell"] = [cell_id(row) for _, row in frame.iterrows()]
     frame["vehicle"] = frame["vehicle"].fillna("sedan")
     frame["policy"] = frame["policy"].fillna("paper")
-    driver = frame["driver"].fillna("eoam")
-    frame["policy"] = frame["policy"].where(driver == "eoam", driver)
+    frame["driver"] = frame["driver"].fillna("eoam")
+    frame["policy"] = policy_label(frame)
     return frame
+
+
+def policy_label(frame: pd.DataFrame) -> list[str]:
+    """Each row's third column: the policy of the EOAM's runs, the driver of a reference
+    driver's (it has no decision policy), with the policy when policies are swept too (its
+    runs under each are rows of their own), then any other setting that varies."""
+    policies = frame["policy"].nunique() > 1
+    others = varying_settings(frame, leave_out=_OWN_COLUMNS)
+    labels = []
+    for _, row in frame.iterrows():
+        parts = [str(row["policy"])]
+        if row["driver"] != "eoam":
+            parts = [str(row["driver"]), *([f"{row['policy']} policy"] if policies else [])]
+        labels.append(", ".join(t for t in (*parts, settings_label(row, others)) if t))
+    return labels
 
 
 def colour_counts(results: pd.DataFrame) -> pd.DataFrame:
@@ -155,7 +176,8 @@ def _changed_table(changed: pd.DataFrame) -> list[str]:
         return ["ABS/ESC changes no cell's colour."]
     lines = []
     for (vehicle, policy), group in changed.groupby(["vehicle", "policy"], sort=False):
-        lines += [f"### {vehicle}, {policy} policy", "", "| cell | change | reason |"]
+        named = f"{policy} policy" if policy in POLICIES else policy
+        lines += [f"### {vehicle}, {named}", "", "| cell | change | reason |"]
         lines.append("|---|---|---|")
         for _, row in group.iterrows():
             change = (

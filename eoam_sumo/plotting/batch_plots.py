@@ -73,12 +73,12 @@ def plot_table2(grid, path: Path) -> Path:
         spine.set_visible(False)
     if grid.has_paper:
         title = (
-            f"EOAM outcomes: each cell ours | paper (Table 2) — "
+            f"{grid.subject}: each cell ours | paper (Table 2) — "
             f"{grid.agreeing}/{grid.compared} cells agree (differences framed)"
         )
     else:
-        title = f"EOAM outcomes ({len(grid.cells)} cases)"
-    ax.set_title(title, fontsize=11)
+        title = f"{grid.subject} ({len(grid.cells)} cases)"
+    ax.set_title(fit(title, 1.9 * n_cols, 11), fontsize=11)  # centred on the cells
     present = {c.ours for c in grid.cells.values()} | {c.paper for c in grid.cells.values()}
     handles = [
         Patch(facecolor=OUTCOME_COLOURS[c], label=c) for c in OUTCOME_COLOURS if c in present

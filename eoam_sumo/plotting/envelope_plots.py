@@ -4,8 +4,9 @@ Per outcome (any contact, red, near miss) a row of three panels: the draws poole
 (:mod:`eoam_sumo.plotting.envelope_bins`; each cell ``events/draws``, empty cells hatched),
 the probability map (:mod:`eoam_sumo.batch.probability_map`, a binomial GLM; the draws
 marked) and the width of its 95 % band. An outcome no draw had is named in the title instead
-of drawn. Generated-scenario studies: one ``envelope_<road>.png`` per road, a row per level of
-service and outcome. The map's values go to ``outcome_probability_map.csv`` beside them.
+of drawn. A row per slice of the map (``probability_map.slices``: policy, vehicle, level of
+service, ...) and outcome; generated-scenario studies: one ``envelope_<road>.png`` per road.
+The map's values go to ``outcome_probability_map.csv`` beside them.
 """
 
 from __future__ import annotations
@@ -23,6 +24,8 @@ from eoam_sumo.batch.probability_map import (
     X,
     Y,
     probability_map,
+    slice_name,
+    slices,
     write_probability_map,
 )
 from eoam_sumo.plotting.envelope_bins import Axis, axes_of, cell_counts, cell_probability
@@ -205,13 +208,33 @@ def _title(results: pd.DataFrame, what: str) -> str:
     )
 
 
-def _one_slice(ok: pd.DataFrame, fitted: pd.DataFrame):
-    yield "", ok, fitted
+def _matching(fitted: pd.DataFrame, values: dict) -> pd.DataFrame:
+    """The map's rows of one slice (an empty value matches an empty cell)."""
+    keep = pd.Series(True, index=fitted.index)
+    for column, value in values.items():
+        same = fitted[column].isna() if pd.isna(value) else fitted[column] == value
+        keep &= same
+    return fitted[keep]
+
+
+def _slices_of(results: pd.DataFrame, road: str | None = None):
+    """The rows' source: per slice of the map (``probability_map.slices`` of every finished
+    draw; of one road only when given), its name, draws and maps."""
+    every = slices(results[results["status"] == "ok"])
+
+    def slice_of(_ok: pd.DataFrame, fitted: pd.DataFrame):
+        for values, draws in every:
+            if road is None or values.get("road") == road:
+                name = slice_name(values, leave_out=("road",) if road else ())
+                yield (f"{name}: " if name else ""), draws, _matching(fitted, values)
+
+    return slice_of
 
 
 def plot_envelopes(results: pd.DataFrame, out_dir: Path) -> list[Path]:
-    """``envelope.png`` and ``outcome_probability_map.csv``; for generated scenarios (a
-    ``road`` column) one ``envelope_<road>.png`` per road instead."""
+    """``envelope.png`` and ``outcome_probability_map.csv``, a row of panels per slice of
+    the map and outcome; for generated scenarios (a ``road`` column) one
+    ``envelope_<road>.png`` per road instead."""
     if not (results["status"] == "ok").any():
         return []
     fitted = probability_map(results)
@@ -219,24 +242,19 @@ def plot_envelopes(results: pd.DataFrame, out_dir: Path) -> list[Path]:
     roads = results["road"].fillna("").astype(str) if "road" in results else pd.Series()
     if (roads != "").any():
         return [
-            _road_envelopes(results[roads == road], fitted, road, out_dir)
+            _road_envelopes(results, roads == road, fitted, road, out_dir)
             for road in sorted(set(roads) - {""})
         ]
-    rows, notes = _rows(results, fitted, _one_slice)
+    rows, notes = _rows(results, fitted, _slices_of(results))
     path = Path(out_dir) / ENVELOPE_PNG
     return [_figure(rows, notes, _title(results, "Outcome envelopes"), path)]
 
 
-def _road_envelopes(results: pd.DataFrame, fitted: pd.DataFrame, road: str, out_dir) -> Path:
-    """``envelope_<road>.png``: per level of service and outcome, the three panels."""
-
-    def per_level(ok: pd.DataFrame, fitted: pd.DataFrame):
-        for level in sorted(set(ok["los"].fillna("").astype(str))):
-            mine = fitted[fitted["road"].astype(str) == road]
-            if level:
-                mine = mine[mine["los"].astype(str) == level]
-            yield (f"LoS {level}: " if level else ""), ok[ok["los"].fillna("") == level], mine
-
-    rows, notes = _rows(results, fitted, per_level)
-    title = _title(results, f"Outcome envelopes, {road} road")
+def _road_envelopes(
+    results: pd.DataFrame, on_road: pd.Series, fitted: pd.DataFrame, road: str, out_dir
+) -> Path:
+    """``envelope_<road>.png``: per slice of the road's maps (its level of service, ...)
+    and outcome, the three panels."""
+    rows, notes = _rows(results[on_road], fitted, _slices_of(results, road))
+    title = _title(results[on_road], f"Outcome envelopes, {road} road")
     return _figure(rows, notes, title, Path(out_dir) / f"envelope_{road}.png")

@@ -1,0 +1,97 @@
+"""One probability map per combination of the settings that vary, but the map's own axes and
+the scenario values a study draws: two policies' draws are never one fit (the review's
+sampled batch over paper and safe)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from eoam_sumo.batch.probability_map import X, Y, probability_map, slice_columns
+
+DRAWS = 15
+
+
+def _draws(groups: dict[str, dict], seed: int = 7, **sampled) -> pd.DataFrame:
+    """``DRAWS`` fabricated draws per group (its swept values), speed and friction uniform,
+    ``sampled`` columns drawn per draw from their choices; contacts more likely fast and on
+    low friction, red only in a group whose ``red`` is set."""
+    rng = np.random.default_rng(seed)
+    frames = []
+    for group, values in groups.items():
+        speed, mu = rng.uniform(90, 165, DRAWS), rng.uniform(0.1, 1.0, DRAWS)
+        hit = rng.uniform(size=DRAWS) < 1 / (1 + np.exp(-(0.05 * (speed - 125) - 3 * (mu - 0.5))))
+        red = hit & values.pop("red", False)
+        frame = pd.DataFrame(
+            {
+                "case_id": [f"{group}_d{k}" for k in range(DRAWS)],
+                X: speed,
+                Y: mu,
+                "status": "ok",
+                "collision_with": np.where(hit, "oncoming", "none"),
+                "outcome": np.where(red, "red", np.where(hit, "yellow", "green")),
+                "near_miss": "False",
+                "oncoming_start_m": rng.choice([300.0, 400.0], DRAWS),
+                **values,
+            }
+        )
+        for column, choices in sampled.items():
+            frame[column] = rng.choice(choices, DRAWS)
+        frames.append(frame)
+    return pd.concat(frames, ignore_index=True)
+
+
+def _fits(frame: pd.DataFrame, outcome: str) -> pd.DataFrame:
+    """One row per fit of ``outcome``: its slice's columns, n and events."""
+    chosen = frame[frame["outcome"] == outcome]
+    keys = [c for c in chosen.columns if c not in (X, Y, "p", "p_low", "p_high", "model")]
+    return chosen[keys].drop_duplicates().reset_index(drop=True)
+
+
+def test_two_policies_get_a_map_each():
+    results = _draws({"paper": {"policy": "paper", "red": True}, "safe": {"policy": "safe"}})
+    frame = probability_map(results)
+    assert list(frame.columns[:3]) == ["policy", X, Y]
+    for outcome in ("contact", "red"):
+        fits = _fits(frame, outcome).set_index("policy")
+        assert list(fits.index) == ["paper", "safe"] and (fits["n"] == DRAWS).all()
+        for policy, draws in results.groupby("policy"):
+            events = draws["collision_with"] != "none" if outcome == "contact" else None
+            events = draws["outcome"] == "red" if events is None else events
+            assert fits.loc[policy, "events"] == int(events.sum())
+    assert _fits(frame, "red").set_index("policy").loc["safe", "events"] == 0
+
+
+def test_a_drawn_scenario_value_is_pooled_and_a_swept_one_is_not():
+    """The sampled oncoming distance (a choice per draw) is one of the map's uncertain
+    inputs; swept (a value per group), each value is a map of its own."""
+    drawn = _draws({"g": {}})
+    assert slice_columns(drawn) == [] and probability_map(drawn)["n"].eq(DRAWS).all()
+    swept = _draws({"onc-300": {}, "onc-400": {}})
+    swept["oncoming_start_m"] = np.where(swept["case_id"].str.startswith("onc-300"), 300.0, 400.0)
+    fits = _fits(probability_map(swept), "contact")
+    assert list(fits["oncoming_start_m"]) == [300.0, 400.0] and (fits["n"] == DRAWS).all()
+
+
+def test_a_drawn_choice_of_systems_is_split_and_a_continuous_draw_pooled():
+    """mu_belief known or estimate (two systems) gets a map each; a normal draw of the
+    believed friction (a value per draw) is pooled."""
+    choice = _draws({"g": {}, "h": {}}, mu_belief=["known", "estimate"], radar_model=["ideal"])
+    assert slice_columns(choice) == ["mu_belief"]
+    fits = _fits(probability_map(choice), "contact")
+    assert sorted(fits["mu_belief"]) == ["estimate", "known"] and fits["n"].sum() == 2 * DRAWS
+    continuous = _draws({"g": {}, "h": {}})
+    continuous["mu_belief"] = np.linspace(0.3, 1.0, len(continuous))
+    assert slice_columns(continuous) == []
+
+
+def test_road_and_level_stay_columns_and_a_driver_splits_them():
+    results = _draws(
+        {
+            "rural_A_eoam": {"road": "rural", "los": "A", "driver": "eoam"},
+            "rural_A_cc": {"road": "rural", "los": "A", "driver": "r157-cc"},
+        }
+    )
+    frame = probability_map(results)
+    assert list(frame.columns[:3]) == ["driver", "road", "los"]
+    assert list(_fits(frame, "contact")["driver"]) == ["eoam", "r157-cc"]
