@@ -14,6 +14,7 @@ from matplotlib.patches import Patch
 
 from eoam_sumo.batch.vehicles_report import GROUP, colour_counts, paper_counts
 from eoam_sumo.colours import HEX
+from eoam_sumo.matrix import POLICIES
 from eoam_sumo.plotting.figures import save
 
 _HATCHES = ("", "//", "..", "xx")
@@ -46,7 +47,8 @@ def _panel(ax, counts: pd.DataFrame, paper: dict[str, int], colours: list[str], 
         x += 1.0
     ax.set_xticks(ticks, labels, rotation=30, ha="right")
     ax.set_ylabel("cells")
-    ax.set_title(f"{title} policy")
+    # the EOAM's runs are labelled by their policy alone, a reference driver's by its name
+    ax.set_title(f"{title} policy" if title in POLICIES else title)
 
 
 def plot_vehicles(results: pd.DataFrame, path: Path) -> Path:
