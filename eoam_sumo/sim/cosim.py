@@ -503,16 +503,18 @@ class CoSimulation:
             circles_m = centres_m - ego_box_radius - b.box.radius_m - GAP_ROUNDING_M
             if circles_m > reach_m and circles_m >= min_gap_aro:
                 continue  # the box gap can be neither the ARO's least nor a contact
-            # a parked car cannot be the ARO: its role is worked out only if it is hit
+            # a parked car cannot be the ARO: its role is worked out only if it is hit; the
+            # obstacle keeps its identity once it left the lane band (a person crossing on)
             role = None if b.parked else self._role(b)
-            if circles_m > reach_m and role != "aro":
+            aro = role == "aro" or b.vid in self._obstacles
+            if circles_m > reach_m and not aro:
                 continue
             if ego_box is None:
                 ego_box = OrientedBox.from_axis_point(
                     Xn, Yn, yawn, p.length_m, p.width_m, self._front
                 )
             bound_m = gap_lower_bound(ego_box, b.box) - GAP_ROUNDING_M  # tighter, dearer
-            if bound_m > reach_m and (role != "aro" or bound_m >= min_gap_aro):
+            if bound_m > reach_m and (not aro or bound_m >= min_gap_aro):
                 continue
             known = gaps.get(b.vid)  # the same boxes as at the last step: the same gap
             gap = (
@@ -521,7 +523,7 @@ class CoSimulation:
                 else box_distance(ego_box, b.box)
             )
             self._gaps[b.vid] = (b.box, gap)
-            if role == "aro" and gap < self.min_gap_aro_m and self._met_ahead_of(b, ego_cx, ego_cy):
+            if aro and gap < self.min_gap_aro_m and self._met_ahead_of(b, ego_cx, ego_cy):
                 self.min_gap_aro_m = gap
             # contact during the step is possible only if the gap is within both moves
             if self.first_contact is None and gap <= reach_m:
