@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 from eoam_sumo.outputs.staging import OutputKind, output_folder
@@ -64,4 +65,11 @@ def cmd_scenario(args: argparse.Namespace) -> int:
         f"{spec.road} LoS {spec.los}: measured {measured['measure']} = {measured['value']:g} "
         f"(level {measured['level']}) -> {args.out / SCENARIO_CFG}"
     )
+    if measured["level"] != spec.los:
+        print(
+            f"eoam-sumo: the traffic settled at level {measured['level']}, not {spec.los}, "
+            f"after {measured['attempts']} warm-ups; another --seed may reach {spec.los} "
+            "(scenario.json records the level measured)",
+            file=sys.stderr,
+        )
     return 0
