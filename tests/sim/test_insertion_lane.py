@@ -14,7 +14,7 @@ pytestmark = pytest.mark.sumo
 LANES = "".join(
     f'<lane id="{i}" type="driving" level="false"><link/>'
     '<width sOffset="0" a="3.5" b="0" c="0" d="0"/></lane>'
-    for i in (3, 2, 1)
+    for i in (3, 2, 1, -1, -2, -3)  # in descending order of id (OpenDRIVE 1.6 sec. 9.3)
 )
 XODR = f"""<?xml version="1.0" standalone="yes"?>
 <OpenDRIVE>
@@ -23,9 +23,9 @@ XODR = f"""<?xml version="1.0" standalone="yes"?>
     <link/><type s="0" type="motorway"/>
     <planView><geometry s="0" x="0" y="0" hdg="0" length="1000"><line/></geometry></planView>
     <lanes><laneSection s="0">
-      <left>{LANES}</left>
+      <left>{LANES.split('<lane id="-1"')[0]}</left>
       <center><lane id="0" type="none" level="false"><link/></lane></center>
-      <right>{LANES.replace('id="', 'id="-')}</right>
+      <right><lane id="-1"{LANES.split('<lane id="-1"')[1]}</right>
     </laneSection></lanes>
   </road>
 </OpenDRIVE>

@@ -75,7 +75,7 @@ def test_a_lane_change_plans_on_the_icy_lane_it_takes_on_a_later_edge(tmp_path):
         '<node id="b" x="3000" y="0"/></nodes>'
     )
     network(tmp_path, "ice", nodes, edges)
-    routes = ROUTES.split('<vehicle id="ego"')[0] + (
+    routes = ROUTES.split('<vehicle id="ego"', maxsplit=1)[0] + (
         '<vehicle id="ego" type="ego" depart="1" departLane="0" departPos="400" '
         'departSpeed="38.89" insertionChecks="none"><route edges="E1 E2"/></vehicle>'
         '<vehicle id="aro" type="aro" depart="1" departLane="0" departPos="25.09" '

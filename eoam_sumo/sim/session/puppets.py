@@ -17,12 +17,15 @@ NO_LANE_CHANGES = 0
 class Puppets:
     """The puppets of a session and the ego's place on its lane (for the storyboard)."""
 
-    def __init__(self, api, calls: StepCalls, ego_id: str, pending: list) -> None:
+    def __init__(self, api, calls: StepCalls, ego_id: str, pending: list, placed: set[str]) -> None:
         self._veh, self._calls, self._ego = api.vehicle, calls, ego_id
         self._pending = pending  # the session's: applied just before its next step
+        self._placed = placed  # the road users' tracking's: read by id, on a lane or not
 
     def take(self, vid: str) -> None:
-        """From now on only :meth:`place` moves ``vid``."""
+        """From now on only :meth:`place` moves ``vid`` (placed off every lane, SUMO's context
+        of the ego no longer holds it: the tracking reads it by id)."""
+        self._placed.add(vid)
         self._veh.setSpeedMode(vid, FREE_SPEED_MODE)
         self._veh.setLaneChangeMode(vid, NO_LANE_CHANGES)
 

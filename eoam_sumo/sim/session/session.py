@@ -586,7 +586,7 @@ class SumoSession:
         """The road users an outside storyboard moves (OpenSCENARIO), and the ego's lane."""
         self._check_open()
         if self._puppets is None:
-            self._puppets = Puppets(self._api, self._calls, self.ego_id, [])
+            self._puppets = Puppets(self._api, self._calls, self.ego_id, [], self._users.placed)
         return self._puppets
 
     def size_ego(self, length_m: float, width_m: float, mass_kg: float) -> None:

@@ -55,6 +55,8 @@ class RoadUsers:
         self._bodies: dict[str, tuple] = {}  # vid -> (values, Body) of the last step's near
         self._context_radius_m: float | None = None  # radius the context range was set for
         self._context_diagonal_m = 0.0  # the vehicles' largest diagonal it was set for
+        # vehicles placed by moveToXY anywhere, lanes or not (puppets): read by id if need be
+        self.placed: set[str] = set()
         self._diagonal_m = 0.0  # largest diagonal of the vehicles SUMO has had (``start`` on)
         self._persons: dict[str, tuple | None] = {}  # pid -> (results, front, Body) once read
         # type -> length, width, vClass, diagonal (twice the box's bounding radius)
@@ -189,10 +191,34 @@ class RoadUsers:
         (ex, ey) (the ego's position): their SUMO position (front) within ``radius_m`` plus
         their diagonal (no point of a box is farther from its front), so that a long vehicle
         is found as soon as its nearest point can be in reach."""
-        near = self._vehicles_near(self._context(radius_m), ex, ey, radius_m)
+        results = self._context(radius_m)
+        if self.placed:
+            results = self._with_placed(results)
+        near = self._vehicles_near(results, ex, ey, radius_m)
         if self._persons:
             near += self._persons_near(ex, ey, radius_m)
         return near
+
+    def _with_placed(self, results: dict[str, dict[int, Any]]) -> dict[str, dict[int, Any]]:
+        """The context's results and the placed vehicles (``placed``: puppets) it lacks, read
+        by id: SUMO's context holds the vehicles on its lanes, and a puppet placed off every
+        lane (beyond the road's edge, in a median) is on none."""
+        missing = [vid for vid in self.placed if vid not in results]
+        if not missing:
+            return results
+        veh, tc = self._veh, self._tc
+        present = set(veh.getIDList())
+        extra: dict[str, dict[int, Any]] = {}
+        for vid in missing:
+            if vid in present:
+                extra[vid] = {
+                    tc.VAR_POSITION: veh.getPosition(vid),
+                    tc.VAR_TYPE: veh.getTypeID(vid),
+                    tc.VAR_ANGLE: veh.getAngle(vid),
+                    tc.VAR_SPEED: veh.getSpeed(vid),
+                    tc.VAR_STOPSTATE: veh.getStopState(vid),
+                }
+        return {**results, **extra}
 
     def everyone(self) -> list:
         """Bodies of all road users, wherever they are (getters: not for the step loop)."""
