@@ -14,7 +14,7 @@ from matplotlib.patches import Patch
 
 from eoam_sumo.batch.vehicles_report import GROUP, colour_counts, paper_counts
 from eoam_sumo.colours import HEX
-from eoam_sumo.matrix import POLICIES
+from eoam_sumo.decision.policy import POLICIES
 from eoam_sumo.plotting.figures import save
 
 _HATCHES = ("", "//", "..", "xx")
