@@ -47,7 +47,10 @@ from eoam_sumo.manoeuvre.quintic_shift import QuinticShift
 from eoam_sumo.params import G_MPS2
 
 POLICIES = ("paper", "safe")
-ONCOMING_MPS = 0.5  # a road user moving towards the ego faster than this is oncoming [m/s]
+#: A road user in the target lane is oncoming moving towards the ego at this or faster,
+#: standing slower either way, else moving the ego's way (:func:`next_lane_motion`) [m/s]
+STANDING_MPS = 0.5
+STANDING, ONCOMING, WITH = "standing", "oncoming", "with"
 #: A road user behind in the target lane: it may brake at 3 m/s^2 from 0.4 s after the lane
 #: change begins, and keeps 1 s of its own travel as the gap. The project's
 #: assumption, modelled on the "critical situation" of a lane change in UN Regulation No. 79
@@ -115,6 +118,19 @@ class SightNeed(NamedTuple):
         if t_s <= t_lc:
             return self.lane_change_m * t_s / t_lc if t_lc > 0.0 else 0.0
         return self.lane_change_m + self.end_speed_mps * (t_s - t_lc)
+
+
+def next_lane_motion(road_speed_mps: float) -> str:
+    """The class of a road user in the target lane by its road speed: ``ONCOMING``, ``STANDING``
+    or ``WITH`` (``STANDING_MPS``). The radar's classes, ``world.lanes.next_lane_motion``, which
+    the layers keep the EOAM from importing (tests/logic/test_commit_check_classes.py keeps the
+    two equal): the classes meet, so the paper's rules judge the first two and the commit
+    check the third."""
+    if road_speed_mps <= -STANDING_MPS:
+        return ONCOMING
+    if road_speed_mps < STANDING_MPS:
+        return STANDING
+    return WITH
 
 
 def escape_time_s(lateral_m: float, mu: float) -> float:
@@ -393,20 +409,22 @@ class SafePolicy:
     ) -> str:
         """A road user ahead in the target lane (at its own speed) that the ego would come
         within ``margin_m`` of during ``t_s``, or that would reach the ego (oncoming); one
-        beside the ego always closes the lane. ``moving_only``: the oncoming and standing
-        road users ahead are left out (the paper's own rules judge them)."""
+        beside the ego always closes the lane. ``moving_only``: only those moving the ego's
+        way (``next_lane_motion``); the oncoming and standing ones are the radar's classes,
+        which the paper's own rules judge."""
         margin = self.settings.margin_m
         times = (0.0, min(need.t_lane_change_s, t_s), t_s)
         for gap, speed, accel in view.users_ahead_accel():
             if gap <= 0.0:
                 return "a road user beside the ego in the target lane"
-            if moving_only and speed <= ONCOMING_MPS:
+            motion = next_lane_motion(speed)
+            if moving_only and motion != WITH:
                 continue
             if any(
                 gap + road_user_travel_m(speed, accel, t) - need.ego_travel_m(t) <= margin
                 for t in times
             ):
-                if speed < -ONCOMING_MPS:
+                if motion == ONCOMING:
                     return "an oncoming road user in the target lane"
                 return "a road user ahead in the target lane"
         return ""

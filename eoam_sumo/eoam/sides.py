@@ -12,7 +12,7 @@ manoeuvre runs (modes 0 and 1) and held from the lane change until the hand-back
 from __future__ import annotations
 
 from eoam_sumo.decision.modes import NORMAL, UPDATE_BRAKE
-from eoam_sumo.decision.policy import ONCOMING_MPS
+from eoam_sumo.decision.policy import ONCOMING, STANDING, next_lane_motion
 from eoam_sumo.eoam.parts import Parts
 from eoam_sumo.eoam.state import ControllerState
 from eoam_sumo.eoam_messages import Command, EgoMeasurement, NextLaneView, Perception
@@ -96,14 +96,16 @@ def mirrored_measurement(meas: EgoMeasurement) -> EgoMeasurement:
 
 def mirrored_perception(perception: Perception) -> Perception:
     """The perception in the mirrored frame: the right lane's view as the next lane, its
-    oncoming and standing road users (from that view), the obstacle's offset negated."""
+    oncoming and standing road users (from that view: the whole lane, whatever its width; the
+    classes of ``decision.policy.next_lane_motion``, the radar's on the left), the obstacle's
+    offset negated."""
     view = perception.right_lane
     obj = perception.aro_object
     oncoming, standing_m = False, None
     if view is not None:
-        users = view.users_ahead()
-        oncoming = any(speed < -ONCOMING_MPS for _gap, speed in users)
-        standing = [gap for gap, speed in users if abs(speed) <= ONCOMING_MPS]
+        motions = [(gap, next_lane_motion(speed)) for gap, speed in view.users_ahead()]
+        oncoming = any(motion == ONCOMING for _gap, motion in motions)
+        standing = [gap for gap, motion in motions if motion == STANDING]
         standing_m = standing[0] if standing else None
     return perception._replace(
         aro_object=None if obj is None else obj._replace(d_m=-obj.d_m),

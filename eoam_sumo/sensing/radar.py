@@ -25,21 +25,27 @@ relative to the lane the ego started in, also while it is in the other lane or r
 ARO stays the in-path object the DMM tracks until it leaves the field of view (paper sec. 6.1).
 
 Classification (lane band half-width = lane_width_m / 2 + lane_margin_m, on the centre's d;
-road speed = target speed times the cosine of its heading relative to the road):
+road speed = target speed times the cosine of its heading relative to the road; the next lane's
+band runs from the lane band's edge one next-lane width to the left: ``next_lane_width_m``, the
+width of the lane a lane change would take, or the ego lane's when not given):
 
 * ``oncoming``: road speed below -oncoming_speed_mps and the centre in the lane band or in
-  the next lane's to its left (up to one lane width beyond the band, as ``in_next_lane``):
-  in the ego lane (a wrong-way driver counts) or in the lane a lane change would take. A road
-  user moving against the road further left (the other carriageway of a divided road, a
-  jogger on the far pavement) is ``other``: it is not in the way of the lane change;
+  the next lane's band: in the ego lane (a wrong-way driver counts) or in the lane a lane
+  change would take; in the next lane's band also any road user moving towards the ego at
+  stationary_speed_mps or more (:func:`~eoam_sumo.world.lanes.next_lane_motion`: a van
+  creeping at 1.5 m/s). A road user moving against the road further left (the other
+  carriageway of a divided road, a jogger on the far pavement) is ``other``: it is not in the
+  way of the lane change;
 * ``in_path``: centre ahead of the ego's front bumper along the road, inside the lane band,
   and not oncoming (road speed above -oncoming_speed_mps): stopped, moving with the road, or
   slowly towards the ego (a person walking towards it in its lane, a car backing up); also a
   car ahead in a neighbouring lane cutting in (``cutting_in``: moving towards the ego's lane,
   past ``CUT_IN_WANDER_M`` from its lane's centre for ``CUT_IN_PERCEPTION_S``);
-* ``in_next_lane``: stopped (speed below stationary_speed_mps), ahead, and the centre in the
-  band of the next lane to the left (from the lane band's edge to one lane width beyond it):
-  a standing car in the lane an evasive lane change would take;
+* ``in_next_lane``: ahead, the centre in the next lane's band and standing along the road
+  (road speed below stationary_speed_mps either way; a person walking across the lane
+  counts, cross traffic faster than ``ONCOMING_SPEED_MPS`` does not): a standing road user
+  in the lane an evasive lane change would take. So in the next lane every road user is
+  oncoming, standing, or moving the ego's way (the paper policy's commit check judges those);
 * ``stationary_side``: speed below stationary_speed_mps and the centre outside the lane band
   otherwise (parked cars; never in path, never oncoming);
 * ``other``: everything else (e.g. traffic in another lane moving with the ego).
@@ -66,12 +72,16 @@ from eoam_sumo.sensing.coasting import Coaster
 from eoam_sumo.world.bodies import Body
 from eoam_sumo.world.geometry import OrientedBox, slab_entry
 from eoam_sumo.world.lanes import (
+    CROSSING_ANGLE_RAD,
     LANE_MARGIN_M,
+    ONCOMING,
     ONCOMING_SPEED_MPS,
+    STANDING,
     STATIONARY_SPEED_MPS,
     RoadProjection,
     body_band_m,
     lane_band_m,
+    next_lane_motion,
 )
 
 CATEGORIES = ("in_path", "oncoming", "in_next_lane", "stationary_side", "other")
@@ -90,6 +100,9 @@ class RadarSettings:
     lane_margin_m: float = LANE_MARGIN_M
     near_range_m: float = 0.0  # a second, wide near-range beam this long (0: none) [m]
     near_fov_deg: float = 90.0  # its full horizontal field of view [deg]
+    # the width of the lane a lane change would take, left of the ego's (0: the ego lane's):
+    # the session's, given per run (a wider target lane's far side is in the next lane) [m]
+    next_lane_width_m: float = 0.0
 
     def __post_init__(self) -> None:
         for name in (
@@ -100,6 +113,7 @@ class RadarSettings:
             "lane_margin_m",
             "near_range_m",
             "near_fov_deg",
+            "next_lane_width_m",
         ):
             v = getattr(self, name)
             if not math.isfinite(v) or v < 0.0:
@@ -446,7 +460,8 @@ class Radar:
         ego's lane beyond ``CUT_IN_WANDER_M`` of its lane centre for ``CUT_IN_PERCEPTION_S``
         is in the path (a cut-in, :func:`cutting_in`)."""
         st = self.settings
-        if road_speed_mps < -st.oncoming_speed_mps and -band_m < d_m < band_m + lane_width_m:
+        next_edge_m = band_m + (st.next_lane_width_m or lane_width_m)
+        if road_speed_mps < -st.oncoming_speed_mps and -band_m < d_m < next_edge_m:
             return "oncoming"
         if abs(d_m) < band_m:
             if ahead:  # not oncoming (tested above)
@@ -454,9 +469,14 @@ class Radar:
             return "other"
         if ahead and cutting_in(d_m, lateral_mps, lane_width_m, band_m):
             return "in_path"
+        if band_m <= d_m < next_edge_m and not crossing(speed_mps, road_speed_mps):
+            motion = next_lane_motion(road_speed_mps, st.stationary_speed_mps)
+            if motion == ONCOMING:
+                return "oncoming"
+            if motion == STANDING:
+                return "in_next_lane" if ahead else "stationary_side"
+            return "other"
         if abs(speed_mps) < st.stationary_speed_mps:
-            if ahead and d_m < band_m + lane_width_m and d_m > 0.0:
-                return "in_next_lane"
             return "stationary_side"
         return "other"
 
@@ -464,6 +484,13 @@ class Radar:
         """Whether a target of ``category`` is oncoming with its centre ahead inside the lane
         band: a wrong-way road user in the ego's lane, the in-path obstacle as well."""
         return category == "oncoming" and ahead and abs(d_m) < band_m
+
+
+def crossing(speed_mps: float, road_speed_mps: float) -> bool:
+    """Cross traffic: faster than ``ONCOMING_SPEED_MPS``, heading more than
+    ``CROSSING_ANGLE_RAD`` off the road (as ``world.lanes.crosses_lane``, from the speeds)."""
+    speed = abs(speed_mps)
+    return speed > ONCOMING_SPEED_MPS and abs(road_speed_mps) < speed * math.cos(CROSSING_ANGLE_RAD)
 
 
 def cutting_in(d_m: float, lateral_mps: float, lane_width_m: float, band_m: float) -> bool:

@@ -199,7 +199,9 @@ class CoSimulation:
         self._check_departure()
         st = self.settings
         self.belief = self._new_belief()
-        self.radar = make_radar(st.radar_model, st.radar, st.seed)  # fresh state per run
+        left = self.side_lanes[0]  # the radar's next lane is the lane to the left, as wide
+        radar = st.radar if left is None else replace(st.radar, next_lane_width_m=left.width_m)
+        self.radar = make_radar(st.radar_model, radar, st.seed)  # fresh state per run
         self.mu_true = self.mu_start
         self._start_observers()
         self._loop0 = time.perf_counter()

@@ -140,7 +140,7 @@ def test_oncoming_at_80_m_in_the_left_lane():
         (_ahead(40.0, 0.0, CAR, 0.0), "in_path"),  # stopped in the lane
         (_ahead(40.0, 0.0, CAR, 15.0, reverse=True), "oncoming"),  # wrong-way in the ego lane
         (_ahead(40.0, LANE_M, CAR, 25.0), "other"),  # overtaking in the left lane
-        (_ahead(40.0, LANE_M, CAR, 1.0, reverse=True), "other"),  # creeping, not oncoming
+        (_ahead(40.0, LANE_M, CAR, 1.0, reverse=True), "oncoming"),  # creeping towards it
         (_ahead(40.0, 0.0, CAR, 1.5, reverse=True), "in_path"),  # backing up in the ego lane
         (_ahead(40.0, 0.0, (0.5, 0.6), 1.4, reverse=True), "in_path"),  # walking towards it
         (_ahead(40.0, LANE_M, CAR, 0.0), "in_next_lane"),  # stopped in the left lane
