@@ -55,15 +55,45 @@ class Actor:
         self.still_s = self.still_s + dt_s if speed_mps < 1e-3 else 0.0
 
 
+def s_span_m(actor: Actor) -> tuple[float, float]:
+    """The s of the actor's two box ends, the lower first, whatever its heading."""
+    front, rear = actor.front_s_m(), actor.rear_s_m()
+    return (front, rear) if front < rear else (rear, front)
+
+
 def longitudinal_gap_m(me: Actor, other: Actor, freespace: bool) -> float:
     """``other`` ahead of ``me`` along ``me``'s direction (negative: behind), reference point
-    to reference point or, with ``freespace``, bumper to bumper (0 when they overlap)."""
+    to reference point or, with ``freespace``, between the nearer ends of the two boxes
+    (0 when they overlap): OpenSCENARIO 1.2's freespace distance, "between the bounding
+    boxes", so for an entity facing ``me`` its front, not its rear."""
     ds = (other.s_m - me.s_m) * me.direction
     if not freespace:
         return ds
-    if ds >= 0:
-        return max(0.0, (other.rear_s_m() - me.front_s_m()) * me.direction)
-    return min(0.0, (other.front_s_m() - me.rear_s_m()) * me.direction)
+    (me_lo, me_hi), (it_lo, it_hi) = s_span_m(me), s_span_m(other)
+    if it_lo > me_hi:  # other wholly further along s
+        return (it_lo - me_hi) * me.direction
+    if it_hi < me_lo:
+        return (it_hi - me_lo) * me.direction
+    return 0.0
+
+
+def gap_rate_mps(me: Actor, other: Actor) -> float:
+    """How fast :func:`longitudinal_gap_m` grows: ``other``'s velocity along ``me``'s
+    direction less ``me``'s speed (for entities heading opposite ways, minus the sum of
+    their speeds)."""
+    return other.speed_mps * other.direction * me.direction - me.speed_mps
+
+
+def leading_s_m(ref: Actor, actor: Actor, gap_m: float, freespace: bool) -> float:
+    """The s of ``actor``'s reference point ``gap_m`` ahead of ``ref`` along ``ref``'s
+    direction (``LongitudinalDistanceAction``, displacement leadingReferencedEntity):
+    reference point to reference point or, with ``freespace``, from ``ref``'s front to
+    ``actor``'s nearer end (its rear when it heads as ``ref``, else its front)."""
+    if not freespace:
+        return ref.s_m + ref.direction * gap_m
+    same = actor.direction == ref.direction
+    near = actor.body.rear_ahead_m if same else -actor.body.front_ahead_m
+    return ref.s_m + ref.direction * (ref.body.front_ahead_m + gap_m - near)
 
 
 def lateral_gap_m(lat_me: float, lat_other: float, me: Actor, other: Actor, free: bool) -> float:

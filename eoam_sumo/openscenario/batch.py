@@ -17,6 +17,7 @@ from eoam_sumo.errors import InputError
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.openscenario.checks import check_places
 from eoam_sumo.openscenario.compile import compile_plan
+from eoam_sumo.openscenario.departures import check_departures
 from eoam_sumo.openscenario.geometry import LaneMap
 from eoam_sumo.openscenario.reader import read_scenario
 from eoam_sumo.openscenario.variations import XoscBatch
@@ -31,15 +32,18 @@ def case_id(index: int) -> str:
 
 
 def check_cases(batch: XoscBatch) -> None:
-    """Read and compile every case and check its places on its road (each road converted
-    once): InputError naming the first case outside the subset."""
-    from eoam_sumo.openscenario.runner import road_map
+    """Read and compile every case, check its departure speeds and its places on its road
+    (each road converted once): InputError naming the first case refused."""
+    from eoam_sumo.openscenario.runner import ego_speed_range_mps, road_map
+    from eoam_sumo.sim.settings import RunSettings
 
     roads: dict[Path, LaneMap] = {}
+    ego_range = ego_speed_range_mps(RunSettings())  # the cases run on the default tables
     for k, params in enumerate(batch.cases):
         try:
             scenario = read_scenario(batch.scenario, params)
             plan = compile_plan(scenario)
+            check_departures(scenario.root, plan, ego_range)
             if scenario.road not in roads:
                 roads[scenario.road] = road_map(scenario.road)[1]
             check_places(scenario.root, plan.places, roads[scenario.road])

@@ -30,8 +30,11 @@ def xosc_arguments(p) -> None:
 
 
 def is_xosc(args) -> bool:
-    """Whether ``run`` was given an OpenSCENARIO file."""
-    return args.cfg.suffix.lower() == ".xosc"
+    """Whether ``run`` was given an OpenSCENARIO file (.xosc, .xosp, or any file whose root
+    is ``<OpenSCENARIO>``; a folder is not one)."""
+    from eoam_sumo.openscenario.reader import is_openscenario
+
+    return not args.cfg.is_dir() and is_openscenario(args.cfg)
 
 
 def parse_params(items: list[str]) -> dict[str, str]:
@@ -52,7 +55,21 @@ def prepare_command(args) -> Loaded:
             raise InputError(f"{flag} does not apply to an .xosc (set its parameters: --param)")
     from eoam_sumo.openscenario.runner import load  # the engine: only for an .xosc
 
-    return load(args.cfg, parse_params(args.param), args.ego)
+    return load(args.cfg, parse_params(args.param), args.ego, _ego_speed_range(args))
+
+
+def _ego_speed_range(args) -> tuple[float, float]:
+    """The ego's departure speeds the run's tables cover (``--vehicle``, ``--tables``)."""
+    from eoam_sumo.openscenario.runner import ego_speed_range_mps
+    from eoam_sumo.sim.settings import RunSettings
+    from eoam_sumo.sim.vehicle import load_vehicle  # via sim (tests/test_layers.py)
+
+    settings = RunSettings(tables_dir=args.tables)
+    if args.vehicle is not None:
+        settings = replace(
+            settings, vehicle=load_vehicle(args.vehicle), vehicle_id=str(args.vehicle)
+        )
+    return ego_speed_range_mps(settings)
 
 
 def run_xosc_command(args, loaded: Loaded, out, settings) -> dict:

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from eoam_sumo.errors import InputError
-from eoam_sumo.openscenario.actors import lane_plus
+from eoam_sumo.openscenario.actors import Actor, lane_plus, leading_s_m
 from eoam_sumo.openscenario.checks import check_references
 from eoam_sumo.openscenario.model import Body, Place, Plan
 from eoam_sumo.openscenario.reader import Scenario
@@ -185,18 +185,23 @@ def _placed(plan: Plan, name: str, node: Node) -> Place:
 
 
 def _distance_place(plan: Plan, name: str, node: Node) -> Place:
-    """``name`` ahead of the referenced entity by the distance or time gap (freespace: bumper
-    to bumper; otherwise reference point to reference point)."""
+    """``name`` ahead of the referenced entity by the distance or time gap (freespace: from
+    the reference's front to ``name``'s nearer end; otherwise reference point to reference
+    point), along the road in ``name``'s own lane and lateral offset: a longitudinal action
+    (OpenSCENARIO 1.2 ``LongitudinalDistanceAction``; esmini moves the entity along s).
+    An entity not placed before, or on another road, takes the reference's lane."""
     other = node.need("entityRef")
     ref = _placed(plan, other, node)
     if node.get("distance") is not None:
         gap = node.num("distance")
     else:
         gap = node.num("timeGap") * plan.speeds_mps.get(other, 0.0)
-    if node.get("freespace") in ("true", "1"):
-        me, it = plan.bodies[name], plan.bodies[other]
-        gap += it.front_ahead_m - me.rear_ahead_m
-    return Place(ref.road, ref.lane, ref.s_m + (1 if ref.lane < 0 else -1) * gap, node)
+    own = plan.places.get(name)
+    at = own if own is not None and own.road == ref.road else ref
+    it = Actor(other, plan.bodies[other], ref.road, ref.lane, ref.s_m, ref.offset_m, 0.0)
+    me = Actor(name, plan.bodies[name], at.road, at.lane, at.s_m, at.offset_m, 0.0)
+    s_m = leading_s_m(it, me, gap, node.get("freespace") in ("true", "1"))
+    return Place(at.road, at.lane, s_m, node, at.offset_m)
 
 
 def _speed(plan: Plan, name: str, node: Node, t_s: float) -> float:

@@ -10,7 +10,13 @@ import operator
 from collections.abc import Callable
 from typing import Any
 
-from eoam_sumo.openscenario.actors import Actor, euclid, lateral_gap_m, longitudinal_gap_m
+from eoam_sumo.openscenario.actors import (
+    Actor,
+    euclid,
+    gap_rate_mps,
+    lateral_gap_m,
+    longitudinal_gap_m,
+)
 from eoam_sumo.openscenario.subset import refuse
 from eoam_sumo.openscenario.xmltree import Node
 
@@ -64,6 +70,11 @@ def by_entity(cond: Node) -> Callable[[Any], bool]:
     check = ENTITY.get(inner.tag)
     if check is None:
         raise refuse(inner, f"{inner.tag} is not supported at run time")
+    if inner.tag == "RelativeSpeedCondition" and inner.get("direction") not in (
+        None,
+        "longitudinal",
+    ):
+        raise refuse(inner, "only direction=longitudinal (or none) is supported")
     combine = any if trig.get("triggeringEntitiesRule", "any") == "any" else all
 
     def holds(world) -> bool:
@@ -96,13 +107,19 @@ def _headway(node: Node, world, me: Actor) -> bool:
 
 
 def _ttc(node: Node, world, me: Actor) -> bool:
+    """``TimeToCollisionCondition`` to an entity: the gap along ``me``'s direction (reference
+    points, or freespace) over the speed it closes at, both velocities taken along that
+    direction (heading towards each other: the sum of the speeds). Infinite while the gap
+    opens (once they have passed), as esmini (``Object::TimeToCollision``: undefined when
+    moving away); boxes overlapping (freespace 0) close or open by their reference points."""
     target = node.find("TimeToCollisionConditionTarget")
     ref = None if target is None else target.find("EntityRef")
     if ref is None:
         raise refuse(node, "only an entity as the time-to-collision target is supported")
     other = world.actors[ref.need("entityRef")]
     gap = longitudinal_gap_m(me, other, _free(node))
-    closing = (me.speed_mps - other.speed_mps) * (1 if gap >= 0 else -1)
+    side = gap if gap != 0.0 else longitudinal_gap_m(me, other, False)
+    closing = -gap_rate_mps(me, other) * (1 if side >= 0 else -1)
     return compare(node, abs(gap) / closing if closing > 0 else math.inf)
 
 
@@ -117,7 +134,15 @@ def _reach(node: Node, world, me: Actor) -> bool:
 
 
 def _relative_speed(node: Node, world, me: Actor) -> bool:
-    return compare(node, me.speed_mps - world.actors[node.need("entityRef")].speed_mps)
+    """``RelativeSpeedCondition``: "speed_rel = speed(triggering entity) - speed(reference
+    entity)" (OpenSCENARIO 1.2), the speeds' difference whatever the headings (towards each
+    other at 20 and 10 m/s: +10 m/s, not the approach); with ``direction="longitudinal"``
+    the projection on that axis "with the triggering entity as the reference": its speed
+    less the reference's velocity along its heading (towards each other: the sum)."""
+    other = world.actors[node.need("entityRef")]
+    if node.get("direction") == "longitudinal":
+        return compare(node, -gap_rate_mps(me, other))
+    return compare(node, me.speed_mps - other.speed_mps)
 
 
 ENTITY: dict[str, Callable[[Node, Any, Actor], bool]] = {

@@ -53,6 +53,7 @@ class SpeedMotion:
         self.shape = self.dyn.need("dynamicsShape")
         self.dim = self.dyn.get("dynamicsDimension", "time")
         self.value = self.dyn.num("value", 0.0)
+        self.said_negative = False
 
     def _target_mps(self, world) -> float:
         t = self.target
@@ -61,8 +62,14 @@ class SpeedMotion:
             return 0.0 if value < STOP_MPS else value
         ref = world.actors[t.need("entityRef")].speed_mps
         if t.get("speedTargetValueType", "delta") == "factor":
-            return ref * t.num("value")
-        return ref + t.num("value")
+            value = ref * t.num("value")
+        else:
+            value = ref + t.num("value")
+        if value < 0.0 and not self.said_negative:  # said once (a continuous target: each step)
+            self.said_negative = True
+            print(f"eoam-sumo: {t.where()} at {world.time_s:.2f} s: target speed {value:.3g} m/s "
+                  "run as a stop", file=sys.stderr)  # fmt: skip
+        return max(value, 0.0)
 
     def start(self, world, actor: Actor) -> None:
         self.v0, self.t0 = actor.speed_mps, world.time_s
@@ -72,9 +79,14 @@ class SpeedMotion:
         self.duration = 0.0
         if self.shape != "step" and self.dim == "time":
             self.duration = self.value
+        elif self.shape != "step" and self.dim == "rate" and self.value == 0 and delta > 1e-6:
+            self.duration = math.inf  # never there: the speed kept (ALKS 4.4_1's "no change")
+            print(f"eoam-sumo: {self.node.where()} at {world.time_s:.2f} s: a rate of 0 never "
+                  f"reaches the target speed {self.goal:.3g} m/s: {actor.name} keeps "
+                  f"{self.v0:.3g} m/s", file=sys.stderr)  # fmt: skip
         elif self.shape != "step" and self.dim == "rate":
             self.duration = (
-                math.inf if self.value == 0 else delta * PEAK_SLOPE[self.shape] / abs(self.value)
+                0.0 if self.value == 0 else delta * PEAK_SLOPE[self.shape] / abs(self.value)
             )
         elif self.shape != "step":
             raise refuse(self.node, f"dynamicsDimension={self.dim} is not supported for a speed")

@@ -1,10 +1,11 @@
 """Placements during the run: ``TeleportAction`` and a ``LongitudinalDistanceAction``
-(the entity put at the distance or time gap from the referenced one, in its lane; continuous
-keeping of the distance is refused by :mod:`.subset`)."""
+(the entity put at the distance or time gap ahead of the referenced one along the road, in
+its own lane and lateral offset: a longitudinal action; continuous keeping of the distance
+is refused by :mod:`.subset`)."""
 
 from __future__ import annotations
 
-from eoam_sumo.openscenario.actors import Actor, lane_plus
+from eoam_sumo.openscenario.actors import Actor, lane_plus, leading_s_m
 from eoam_sumo.openscenario.xmltree import Node
 
 
@@ -38,7 +39,6 @@ def place_now(world, actor: Actor, action: Node) -> None:
         if inner.get("distance") is not None
         else inner.num("timeGap") * ref.speed_mps
     )
-    if inner.get("freespace") in ("true", "1"):
-        gap += ref.body.front_ahead_m - actor.body.rear_ahead_m
-    actor.road, actor.lane, actor.offset_m = ref.road, ref.lane, ref.offset_m
-    actor.s_m = ref.s_m + ref.direction * gap
+    if actor.road != ref.road:  # s is one road's: onto the reference's road and lane
+        actor.road, actor.lane, actor.direction = ref.road, ref.lane, ref.direction
+    actor.s_m = leading_s_m(ref, actor, gap, inner.get("freespace") in ("true", "1"))

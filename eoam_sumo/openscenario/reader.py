@@ -16,7 +16,7 @@ from pathlib import Path
 from eoam_sumo.errors import InputError
 from eoam_sumo.openscenario.expressions import ExpressionError, format_value, substitute
 from eoam_sumo.openscenario.subset import check_subset
-from eoam_sumo.openscenario.xmltree import Node, parse
+from eoam_sumo.openscenario.xmltree import Node, parse, root_tag
 
 UNRESOLVED = ("ParameterDeclarations", "ParameterValueDistribution")
 # attributes nothing refers to, kept as written (esmini's files build a condition's name
@@ -48,11 +48,21 @@ def read_scenario(path: Path, overrides: dict[str, str] | None = None) -> Scenar
         _distributed_declared(root, chosen, dist, path)
     if root.find("Storyboard") is None:
         raise InputError(f"{path}: not an OpenSCENARIO scenario (no <Storyboard>)")
-    values = declared_values(root.find("ParameterDeclarations"), given, path)
+    values = declared_values(root.find("ParameterDeclarations"), given, path, check_types=True)
     catalogs = _catalog_dirs(root, values, path.parent)
     tree = _resolve(root, values, catalogs, scoped=True)
     check_subset(tree)
     return Scenario(path, values, tree, _road(tree, path))
+
+
+# the suffixes of OpenSCENARIO files: a scenario, a parameter variation file (esmini's .xosp)
+SUFFIXES = (".xosc", ".xosp")
+
+
+def is_openscenario(path: Path) -> bool:
+    """Whether ``path`` is an OpenSCENARIO file: by its suffix (.xosc, .xosp), else by its
+    root element ``<OpenSCENARIO>`` (whatever the file is called)."""
+    return Path(path).suffix.lower() in SUFFIXES or root_tag(path) == "OpenSCENARIO"
 
 
 def _distributed_declared(root: Node, chosen: dict[str, str], dist: Node, path: Path) -> None:
@@ -67,19 +77,63 @@ def _distributed_declared(root: Node, chosen: dict[str, str], dist: Node, path: 
 
 
 def declared_values(
-    decls: Node | None, given: dict[str, str], path: Path, outer: dict[str, str] | None = None
+    decls: Node | None,
+    given: dict[str, str],
+    path: Path,
+    outer: dict[str, str] | None = None,
+    check_types: bool = False,
 ) -> dict[str, str]:
     """Parameter name -> value: declarations in order, ``given`` replacing declared values
-    (``outer``: the values of the enclosing scope, which a declaration's value may use)."""
+    (``outer``: the values of the enclosing scope, which a declaration's value may use;
+    ``check_types``: each given value must be of its declared type, :func:`typed_value`)."""
     values: dict[str, str] = {}
     for decl in [] if decls is None else decls.findall("ParameterDeclaration"):
         name = decl.need("name")
         text = given[name] if name in given else decl.need("value")
-        values[name] = _finite(_sub(text, {**(outer or {}), **values}, decl), name, decl)
+        value = _finite(_sub(text, {**(outer or {}), **values}, decl), name, decl)
+        values[name] = typed_value(value, decl, checked=check_types and name in given)
     unknown = sorted(set(given) - set(values))
     if unknown:
         raise InputError(f"--param {unknown[0]}: no such parameter declared in {path}")
     return values
+
+
+# xsd:boolean's lexical forms (OpenSCENARIO's ParameterType boolean), as the words compared
+BOOLEANS = {"true": "true", "false": "false", "1": "true", "0": "false"}
+# ParameterType (OpenSCENARIO 1.0 "integer", 1.1+ "int") -> what a value of it must be
+TYPES = {"integer": "an integer", "int": "an integer", "unsignedInt": "an integer >= 0",
+         "unsignedShort": "an integer in [0, 65535]", "double": "a number",
+         "boolean": "a boolean (true, false, 1 or 0)"}  # fmt: skip
+
+
+def typed_value(text: str, decl: Node, checked: bool = True) -> str:
+    """``text`` as a value of the declaration's ``parameterType`` (a boolean written
+    ``true``/``false``, so that 1 and true compare equal); ``checked``: InputError in one
+    line naming the parameter when it is not of that type (a value given by ``--param`` or
+    a distribution)."""
+    kind = decl.get("parameterType", "string")
+    if kind == "boolean" and text.strip() in BOOLEANS:
+        return BOOLEANS[text.strip()]
+    if not checked or kind not in TYPES or _of_type(text.strip(), kind):
+        return text
+    raise InputError(f"{decl.where()}: parameter {decl.get('name')} = {text!r} is not "
+                     f"{TYPES[kind]}, its declared parameterType {kind}")  # fmt: skip
+
+
+def _of_type(text: str, kind: str) -> bool:
+    if kind == "boolean":
+        return False  # not one of BOOLEANS
+    try:
+        value = float(text)
+    except ValueError:
+        return False
+    if kind == "double":
+        return True
+    whole = value.is_integer()  # 30.0 too: a range's or a TOML sweep's value
+    low, top = {"unsignedInt": (0, 2**32 - 1), "unsignedShort": (0, 65535)}.get(
+        kind, (-(2**31), 2**31 - 1)
+    )
+    return whole and low <= value <= top
 
 
 def _finite(text: str, name: str, decl: Node) -> str:
@@ -196,7 +250,11 @@ def _resolve(
         k: v if (node.tag, k) in UNUSED else _sub(v, values, node) for k, v in node.attrib.items()
     }
     kids = [c if c.tag in UNRESOLVED else _resolve(c, values, catalogs, via) for c in node.children]
-    scope = values if node.tag == "ParameterCondition" else None  # sec. 8.4.1: its scope
+    scope = None
+    if node.tag == "ParameterCondition":  # sec. 8.4.1: its scope; a boolean's 1/0 as words
+        scope, have = values, values.get(attrib.get("parameterRef", ""))
+        if have in ("true", "false") and attrib.get("value", "").strip() in BOOLEANS:
+            attrib["value"] = BOOLEANS[attrib["value"].strip()]
     return Node(node.tag, attrib, node.file, node.line, kids, via, scope)
 
 

@@ -20,6 +20,8 @@ from eoam_sumo.openscenario.model import Body, Plan
 from eoam_sumo.openscenario.road import SumoLane, locate
 
 DEPART_S = 1.0
+SUMOCFG = "scenario.sumocfg"
+MAX_SPEED_MPS = 70.0  # a target's SUMO type's maxSpeed, unless it departs faster
 VCLASS = {"car": "passenger", "van": "delivery", "truck": "truck", "bus": "bus",
           "motorbike": "motorcycle", "bicycle": "bicycle"}  # fmt: skip
 # the storyboard alone moves a target across lanes: SUMO's own lane changes (strategic,
@@ -32,11 +34,14 @@ EGO_VTYPE = (
 )
 
 
-def _vtype(body: Body, vid: str) -> str:
+def _vtype(body: Body, vid: str, speed_mps: float = 0.0) -> str:
+    """A target's type (its ``maxSpeed`` at least its departure speed: SUMO refuses a
+    departure above its type's)."""
     vclass = VCLASS.get(body.category, "passenger")
+    top = max(MAX_SPEED_MPS, speed_mps)
     return (
         f'<vType id="t_{vid}" vClass="{vclass}" length="{body.length_m:g}" '
-        f'width="{body.width_m:g}" minGap="1.00" maxSpeed="70.00" accel="2.50" decel="10.00" '
+        f'width="{body.width_m:g}" minGap="1.00" maxSpeed="{top:.2f}" accel="2.50" decel="10.00" '
         f'emergencyDecel="12.00" sigma="0" speedDev="0" speedFactor="4" {NO_OWN_LANE_CHANGES}/>'
     )
 
@@ -67,6 +72,20 @@ def _nearest_lane(lanes: LaneMap, place) -> int:
     return min(side, key=miss)
 
 
+def ego_offset_notes(plan: Plan, lanes: LaneMap) -> list[str]:
+    """The note on an ego placed off its lane's centre: the plant starts on the centre of
+    its departure lane (the lane nearest the offset), the offset not applied."""
+    place = plan.places.get(plan.ego)
+    if place is None or abs(place.offset_m) < 1e-9:
+        return []
+    lane = _nearest_lane(lanes, place)
+    where = f"lane {lane}'s centre" + ("" if lane == place.lane else ", the lane nearest it")
+    return [
+        f"the ego {plan.ego}'s lateral offset {place.offset_m:g} m from lane {place.lane} "
+        f"(line {place.node.line}) not applied: it starts on {where}"
+    ]
+
+
 def _vehicle(plan: Plan, name: str, lanes: LaneMap, net) -> str:
     place, body = plan.places[name], plan.bodies[name]
     lane_id = _nearest_lane(lanes, place)
@@ -94,7 +113,9 @@ def write_sumo(plan: Plan, net_file: Path, lanes: LaneMap, folder: Path, source:
     net = sumolib.net.readNet(str(net_file))
     others = [n for n in plan.bodies if n != plan.ego]
     ids = plan.sumo_ids()
-    vtypes = [EGO_VTYPE] + [_vtype(plan.bodies[n], ids[n]) for n in others]
+    vtypes = [EGO_VTYPE] + [
+        _vtype(plan.bodies[n], ids[n], plan.speeds_mps.get(n, 0.0)) for n in others
+    ]
     head = f'<?xml version="1.0" encoding="UTF-8"?>\n<!-- from {source.name} -->\n'
     write_atomic(
         folder / "scenario_vtypes.add.xml",
@@ -112,4 +133,4 @@ def write_sumo(plan: Plan, net_file: Path, lanes: LaneMap, folder: Path, source:
         end_s=end,
         comment=f"from {source.name} by eoam_sumo {__version__}",
     )
-    return write_atomic(folder / "scenario.sumocfg", cfg)
+    return write_atomic(folder / SUMOCFG, cfg)

@@ -23,6 +23,7 @@ from eoam_sumo.openscenario.reader import (
     declared_values,
     deterministic,
     distribution_range,
+    is_openscenario,
     range_value,
 )
 from eoam_sumo.openscenario.xmltree import Node, parse
@@ -46,8 +47,9 @@ class XoscBatch:
 
 
 def is_xosc_batch(path: Path) -> bool:
-    """An .xosc file, or a TOML matrix whose ``[scenario]`` names an ``xosc``."""
-    if path.suffix.lower() == ".xosc":
+    """An OpenSCENARIO file (.xosc, .xosp, or an ``<OpenSCENARIO>`` root), or a TOML matrix
+    whose ``[scenario]`` names an ``xosc``."""
+    if is_openscenario(path):
         return True
     try:
         with Path(path).open("rb") as fh:
@@ -60,7 +62,7 @@ def is_xosc_batch(path: Path) -> bool:
 def load_batch(path: Path) -> XoscBatch:
     """The batch of ``path`` (a distribution file or a TOML matrix); InputError in one line."""
     path = Path(path)
-    if path.suffix.lower() == ".xosc":
+    if is_openscenario(path):
         scenario, combos = _distribution_cases(path)
         return _kept(XoscBatch(scenario, combos, 0))
     with path.open("rb") as fh:

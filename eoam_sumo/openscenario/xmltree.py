@@ -6,6 +6,7 @@ built from expat's events.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import xml.parsers.expat
 from dataclasses import dataclass, field
@@ -102,3 +103,24 @@ def parse(path: Path) -> Node:
     except xml.parsers.expat.ExpatError as exc:
         raise InputError(f"{path}:{exc.lineno}: not well-formed XML: {exc}") from exc
     return roots[0]
+
+
+def root_tag(path: Path, limit: int = 65536) -> str | None:
+    """The tag of the file's root element (read from its first ``limit`` bytes), None when
+    the file cannot be read or does not start as XML (a TOML matrix, a binary file)."""
+    try:
+        with Path(path).open("rb") as fh:
+            data = fh.read(limit)
+    except OSError:
+        return None
+    found: list[str] = []
+    parser = xml.parsers.expat.ParserCreate()
+
+    def start(tag: str, attrib: dict[str, str]) -> None:
+        found.append(tag)
+        raise StopIteration  # the root is all that is wanted
+
+    parser.StartElementHandler = start
+    with contextlib.suppress(StopIteration, xml.parsers.expat.ExpatError):
+        parser.Parse(data, False)
+    return found[0] if found else None
