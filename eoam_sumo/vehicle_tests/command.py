@@ -51,8 +51,8 @@ def add_arguments(subparsers) -> None:
     p.add_argument(
         "--vehicle", default="sedan", help="a catalogue name or a vehicle file (default: sedan)"
     )
-    p.add_argument("--abs", choices=("on", "off"), default="off", help="ABS (default off)")
-    p.add_argument("--esc", choices=("on", "off"), default="off", help="ESC (default off)")
+    p.add_argument("--abs", choices=("on", "off"), help="ABS (default: the vehicle's own)")
+    p.add_argument("--esc", choices=("on", "off"), help="ESC (default: the vehicle's own)")
     p.add_argument(
         "--speed-kmh",
         type=vehicle_test_speed_kmh,
@@ -73,7 +73,12 @@ def run(args) -> int:
     from eoam_sumo.vehicle_tests.output import write_result
     from eoam_sumo.vehicle_tests.procedures import TESTS, VehicleTestOptions
 
-    params = equipped(load_vehicle(args.vehicle), args.abs == "on", args.esc == "on")
+    vehicle = load_vehicle(args.vehicle)
+    params = equipped(
+        vehicle,
+        vehicle.abs_fitted if args.abs is None else args.abs == "on",
+        vehicle.esc_fitted if args.esc is None else args.esc == "on",
+    )
     out = writable_dir(args.out)
     result = TESTS[args.test](params, VehicleTestOptions(speed_kmh=args.speed_kmh, mu=args.mu))
     summary = write_result(result, out)

@@ -80,3 +80,22 @@ def test_an_output_folder_that_cannot_be_written_is_one_line(tmp_path, capsys):
     blocker.write_text("")
     assert main(["vehicle-test", "brake", "--out", str(blocker / "out")]) == 2
     assert "cannot be written" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("flags, expected", [([], (True, True)), (["--esc", "off"], (True, False))])
+def test_the_equipment_is_the_vehicle_s_own_unless_given(tmp_path, monkeypatch, flags, expected):
+    """The compact's file fits ABS and ESC: the test runs with them unless switched off (it
+    ran without both unless given, and a car carrying ESC failed sine with dwell)."""
+    from eoam_sumo.vehicle_tests import procedures
+
+    seen = []
+
+    def spy(params, options):
+        seen.append((params.abs_fitted, params.esc_fitted))
+        return real(params, options)
+
+    real = procedures.TESTS["brake"]
+    monkeypatch.setitem(procedures.TESTS, "brake", spy)
+    argv = ["vehicle-test", "brake", "--vehicle", "compact", *flags, "--out", str(tmp_path / "o")]
+    assert main(argv) == 0
+    assert seen == [expected]
