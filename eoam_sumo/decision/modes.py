@@ -13,7 +13,11 @@ the controller derives from perception and ego motion in one step:
 * 3 ONCOMING BRAKE: terminal (limit braking in lane to standstill).
 * 4 ONCOMING STEER+BRAKE -> 5 once the desired position in the next lane is reached: the ego
   is clear of the obstacle it steers around, so that the return cannot meet it.
-* 5 RETURN -> 0 once settled in the original lane (hand-back to the high-level system).
+* 5 RETURN -> 3 when the DMM asks for more than a warning (sectors A-D) on another obstacle
+  than the one steered around, a second one in the lane the ego returns to (ours: the paper's
+  mode 5 has no exit but the hand-back): limit braking while the return ends on its path;
+  -> 0 once settled in the original lane (hand-back to the high-level system). Mode 4
+  reaches it through 5 once clear (one step later).
 """
 
 from __future__ import annotations
@@ -38,6 +42,8 @@ class Mode(IntEnum):
 NORMAL, UPDATE_BRAKE, UPDATE_STEER_BRAKE, ONCOMING_BRAKE, ONCOMING_STEER_BRAKE, RETURN = Mode
 
 _BRAKING = (BRAKE, LIMIT_BRAKE)
+#: The DMM's actions beyond a warning (sectors A-D): in mode 5 each is limit braking in lane
+_ACTING = (BRAKE, LIMIT_BRAKE, STEER)
 
 
 def next_mode(
@@ -51,8 +57,10 @@ def next_mode(
     clear_of_obstacle: bool,
     settled: bool,
     threat_gone: bool,
+    another_obstacle: bool = False,
 ) -> Mode:
-    """The mode after one step; at most one transition per call."""
+    """The mode after one step; at most one transition per call (``another_obstacle``: in
+    mode 5, the DMM's obstacle is not the one the lane change steered around)."""
     if mode is NORMAL:
         if action is STEER:
             return ONCOMING_BRAKE if oncoming else UPDATE_STEER_BRAKE
@@ -76,6 +84,8 @@ def next_mode(
     if mode is ONCOMING_STEER_BRAKE:
         return RETURN if clear_of_obstacle else mode
     if mode is RETURN:
+        if another_obstacle and action in _ACTING:
+            return ONCOMING_BRAKE  # a second obstacle in the lane the ego returns to
         return NORMAL if settled else mode
     if mode is ONCOMING_BRAKE and threat_gone and not oncoming:
         return NORMAL  # the obstacle drives away: follow it (mode 0, 1), do not stop for it

@@ -93,13 +93,15 @@ def following_speed_mps(parts: Parts, state: ControllerState, meas: EgoMeasureme
 
 def shares_ellipse(parts: Parts, state: ControllerState, meas: EgoMeasurement) -> bool:
     """Mode 3 above ``limit_brake_floor_speed_mps`` with the ego's body inside its own lane
-    (a lateral correction, not an escape from the next lane, nor an arrest): the brake keeps
+    (a lateral correction, not an escape from the next lane, nor an arrest, nor the return
+    mode 5 began, whose path keeps the ellipse's share it was laid out with): the brake keeps
     ``limit_brake_floor`` of the limit, the steering the rest of the friction ellipse (paper
     eqs. 25, 28: (Fx / mu Fz)^2 + (Fy / mu Fz)^2 <= 1)."""
     st = parts.settings
     return (
         st.limit_brake_floor > 0.0
         and not state.arrest
+        and not state.braking_return
         and meas.vx_mps > st.limit_brake_floor_speed_mps
         and abs(meas.d_m) + 0.5 * parts.params.width_m <= 0.5 * meas.lane_width_m
     )

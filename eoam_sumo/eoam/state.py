@@ -51,9 +51,11 @@ class ControllerState:
     settle_since_s: float | None = None  # mode 5: since when the ego is settled
     hold_speed_mps: float | None = None  # the speed held after a manoeuvre's profile
     urgent_return: bool = False  # mode 5's return runs at the evasive lateral acceleration
+    braking_return: bool = False  # mode 3 entered from 5: the return's path, braking on
     stop_path: QuinticShift | None = None  # the lateral stop judged for the point of no return
     arrest: float = 0.0  # mode 3: sign of the lateral motion being arrested (0: none)
     obstacle: ObstacleTrack | None = None  # the in-path obstacle as last sensed
+    avoided: ObstacleTrack | None = None  # mode 5: the obstacle modes 2 and 4 steered around
     oncoming_choice: Choice | None = None  # the commit/abort decision, when made
     side: int = 1  # the side of the lane change: +1 left, -1 right (the step mirrored)
     target_offset_m: float = 0.0  # the target lane's centre from the ego's (0: a lane width)

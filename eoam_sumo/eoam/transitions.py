@@ -56,10 +56,11 @@ def advance_mode(
         clear_of_obstacle=clear,
         settled=settled,
         threat_gone=threat_gone and (mode is not ONCOMING_BRAKE or released(parts, meas, decision)),
+        another_obstacle=mode is RETURN and another_obstacle(parts, state),
     )
     if new is not mode:
         enter(parts, state, new, meas)
-    elif mode is RETURN:
+    elif mode is RETURN or state.braking_return:
         if oncoming and not state.urgent_return:
             start_return(parts, state, meas, urgent=True)  # oncoming traffic seen meanwhile
     elif mode is ONCOMING_BRAKE:
@@ -77,6 +78,16 @@ def released(parts: Parts, meas: EgoMeasurement, decision: Decision) -> bool:
         and abs(meas.d_m) <= st.settle_offset_m
         and heading_settled(st, parts.steering, meas)
     )
+
+
+def another_obstacle(parts: Parts, state: ControllerState) -> bool:
+    """Mode 5: the obstacle sensed in the path is not the one modes 2 and 4 steered around
+    (its front more than ``track_gate_m`` off that one's prediction, as the lane change's
+    track gate judges it): a second obstacle in the lane the ego returns to."""
+    sensed, avoided = state.obstacle, state.avoided
+    if sensed is None or avoided is None:
+        return sensed is not None
+    return abs(sensed.front_s_m - avoided.at(sensed.time_s)[0]) > parts.settings.track_gate_m
 
 
 def settled_in_lane(
@@ -130,9 +141,11 @@ def passes_on(
 
 
 def enter(parts: Parts, state: ControllerState, mode: Mode, meas: EgoMeasurement) -> None:
-    """Entry actions of a new mode (mode 4 keeps the lane change of mode 2 going)."""
+    """Entry actions of a new mode (mode 4 keeps the lane change of mode 2 going; mode 3
+    from 5 keeps the return's path: limit braking while it ends in the lane, ours)."""
     previous = state.mode
     state.arrest = 0.0
+    state.braking_return = mode is ONCOMING_BRAKE and previous is RETURN
     if mode is NORMAL and (
         previous is ONCOMING_BRAKE
         or (previous is UPDATE_BRAKE and parts.settings.follow_after_brake)
@@ -149,6 +162,7 @@ def enter(parts: Parts, state: ControllerState, mode: Mode, meas: EgoMeasurement
         traj = parts.tables.trajectory(meas.mu, meas.vx_mps)  # clamped to the speed grid
         start_path(parts, state, meas, traj, height)
     elif mode is RETURN:
+        state.avoided = state.obstacle  # the track modes 2 and 4 followed
         state.hold_speed_mps = meas.vx_mps
         start_return(parts, state, meas, urgent=previous is ONCOMING_STEER_BRAKE)
     elif mode is ONCOMING_STEER_BRAKE:
@@ -157,6 +171,8 @@ def enter(parts: Parts, state: ControllerState, mode: Mode, meas: EgoMeasurement
         )
         shift = parts.escapes.shift(target, meas, parts.settings.evasive_lateral_g)
         start_path(parts, state, meas, shift, None)
+    elif state.braking_return:
+        state.stop_path = None  # the return goes on, the brake takes what it leaves
     elif mode is ONCOMING_BRAKE:
         abort = parts.escapes.abort_path(state, meas)
         if abort is None:

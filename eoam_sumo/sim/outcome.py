@@ -216,6 +216,8 @@ def _manoeuvre_phrase(modes: set[int], lane_change: bool) -> str:
     steered = bool(modes & {2, 4, 5})
     if lane_change:
         return "lane change"
+    if 3 in modes and 5 in modes:  # mode 5 hands over to 3 for a second obstacle
+        return "lane change and return, then limit braking for another obstacle in the lane"
     if 3 in modes:
         chosen = "lane change aborted for limit braking" if steered else "limit braking chosen"
         return f"{chosen} (next lane not free before the point of no return: {NEXT_LANE_CLOSED})"

@@ -157,6 +157,16 @@ def test_the_reason_names_a_lane_change_begun_after_braking():
     assert braked.reason.startswith("limit braking chosen (next lane not free")
 
 
+def test_the_reason_names_braking_for_another_obstacle_after_the_return():
+    """Mode 5 hands over to 3 for a second obstacle in the lane the ego returned to: the
+    reason says so, not that the next lane was found closed before the point of no return."""
+    out = _classify([0, 1, 2, 5, 3], 0.1, _hit("rear_end", speed=9.0), "aro")
+    assert out.colour == "yellow"
+    assert out.reason.startswith(
+        "lane change and return, then limit braking for another obstacle in the lane"
+    )
+
+
 def test_yellow_limit_braking_by_the_dmm_and_without_intervention():
     out = _classify(BRAKE_ONLY, 0.0, _hit("rear_end", speed=11.0), "aro")
     assert out.colour == "yellow" and "by the DMM" in out.reason
