@@ -56,6 +56,7 @@ MU_EST_HIGH = 1.0  # the friction estimate starts at, and returns to, a dry road
 MU_EST_MIN = 0.05  # the ABS and ESC thresholds use at least this friction estimate
 MU_EST_TAU_S = 0.1  # the estimate rises to an achieved |a| / g above it this fast
 MU_EST_FALL_S = 0.5  # a wheel at its limit: it falls to the achieved |a| / g this slowly
+MU_EST_ESC_FALL_S = 0.1  # ... the front axle at its limit (ESC sees understeer): this fast
 MU_EST_RECOVER_S = 3.0  # no wheel at its limit: the estimate returns to MU_EST_HIGH this slowly
 BETA_EST_LEAK_S = 2.0  # the kinematic sideslip estimate's integration leaks over this time
 
@@ -285,14 +286,17 @@ def _unbraked_pull(refs, v_est, cap, drive_n, p: VehicleParams, ops):
     return coasting_pull + driving * (driving_pull - coasting_pull)
 
 
-def mu_estimate_rate(mu_est, accel_g, active, ops):
+def mu_estimate_rate(mu_est, accel_g, active, understeer, ops):
     """Rate of the friction estimate: while a tyre is at its limit (``active``: ABS slip past
     its threshold, or ESC seeing understeer) it falls to the acceleration the car achieves,
     ``|a| / g`` from the accelerometer (at least ``MU_EST_MIN``), averaging over the ABS's
-    cycles; otherwise it returns
-    slowly to a dry road's; it rises at once to any acceleration achieved above it."""
+    cycles (``MU_EST_FALL_S``); with the front axle at its limit (``understeer``: a steady
+    lateral acceleration, no cycles to average) within ``MU_EST_ESC_FALL_S``, before the ESC
+    brakes a rear wheel for a yaw rate the road cannot give; otherwise it returns slowly to
+    a dry road's; it rises at once to any acceleration achieved above it."""
     rise = ops.fmax(accel_g - mu_est, 0.0) / MU_EST_TAU_S
-    follow = active * ops.fmin(ops.fmax(accel_g, MU_EST_MIN) - mu_est, 0.0) / MU_EST_FALL_S
+    fall_s = MU_EST_FALL_S + understeer * (MU_EST_ESC_FALL_S - MU_EST_FALL_S)
+    follow = active * ops.fmin(ops.fmax(accel_g, MU_EST_MIN) - mu_est, 0.0) / fall_s
     return follow + (1.0 - active) * (MU_EST_HIGH - mu_est) / MU_EST_RECOVER_S + rise
 
 

@@ -310,13 +310,14 @@ def _estimate_rates(x, u, accel, steer, abs_active, p: VehicleParams, ops) -> li
     v_rate = ch_.speed_estimate_rate(
         v_est, ax, wheel_mps, r, steer, pressure, drive_n, mu_est, p, ch, ops
     )
-    active = abs_active
+    understeer = 0.0
     if p.esc_fitted:
-        active = ops.fmax(active, ch_.esc_understeer(v_est, r, x[ESC_REF], p, ops))
+        understeer = ch_.esc_understeer(v_est, r, x[ESC_REF], p, ops)
+    active = ops.fmax(abs_active, understeer)
     accel_g = ops.sqrt(ax * ax + ay * ay) / G_MPS2
     return [
         v_rate,
-        ch_.mu_estimate_rate(mu_est, accel_g, active, ops),
+        ch_.mu_estimate_rate(mu_est, accel_g, active, understeer, ops),
         ch_.sideslip_estimate_rate(x[BETA_EST], ay, r, v_est, ops),
     ]
 
