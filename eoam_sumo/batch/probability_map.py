@@ -41,7 +41,11 @@ SCENARIO_COLUMNS = ("road", "los")
 #: A drawn setting with more distinct values is a continuous draw: pooled like a scenario's.
 MAX_DRAWN_LEVELS = 8
 
-#: outcome -> whether each finished draw had it
+#: A draw cut off with this outcome says nothing of how it would have ended (docs/outcomes.md):
+#: neither an event nor a non-event, it is left out of every map, as a failed draw is.
+UNDECIDED = "unfinished"
+
+#: outcome -> whether each decided draw had it
 OUTCOMES: dict[str, Callable[[pd.DataFrame], pd.Series]] = {
     "contact": lambda r: r["collision_with"].fillna("none").astype(str) != "none",
     "red": lambda r: r["outcome"].astype(str) == "red",
@@ -175,11 +179,17 @@ def slice_name(values: dict, leave_out: tuple[str, ...] = ()) -> str:
     return ", ".join(t for t in texts if t)
 
 
+def decided(results: pd.DataFrame) -> pd.DataFrame:
+    """The draws whose run ended and decided its outcome: not failed, not ``UNDECIDED`` (cut
+    off at the time limit before anything was decided)."""
+    return results[(results["status"] == "ok") & (results["outcome"].astype(str) != UNDECIDED)]
+
+
 def probability_map(results: pd.DataFrame) -> pd.DataFrame:
-    """Every outcome's map over the finished draws of a results frame (``read_results``),
-    one per slice (``slices``): the slice's columns, ego_speed_kmh, mu, outcome, p, p_low,
-    p_high, n, events, model."""
-    ok = results[results["status"] == "ok"]
+    """Every outcome's map over the decided draws of a results frame (``read_results``,
+    ``decided``), one per slice (``slices``): the slice's columns, ego_speed_kmh, mu, outcome,
+    p, p_low, p_high, n, events, model."""
+    ok = decided(results)
     frames = []
     for values, draws in slices(ok):
         data = draws[[X, Y]].astype(float).reset_index(drop=True)

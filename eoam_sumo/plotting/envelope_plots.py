@@ -21,8 +21,10 @@ from matplotlib.transforms import Bbox
 
 from eoam_sumo.batch.probability_map import (
     OUTCOMES,
+    UNDECIDED,
     X,
     Y,
+    decided,
     probability_map,
     slice_name,
     slices,
@@ -171,7 +173,7 @@ def _curve(ax, fitted: pd.DataFrame, draws: pd.DataFrame, event, model: str) -> 
 def _rows(results: pd.DataFrame, fitted: pd.DataFrame, slice_of) -> tuple[list, list[str]]:
     """(slice name, draws, outcome, its map) per drawn row; notes on outcomes none had."""
     rows, notes = [], []
-    ok = results[results["status"] == "ok"]
+    ok = decided(results)
     for outcome, event in OUTCOMES.items():
         hits = event(ok)
         if not hits.any():
@@ -201,9 +203,11 @@ def _figure(rows: list, notes: list[str], title: str, path: Path) -> Path:
 
 def _title(results: pd.DataFrame, what: str) -> str:
     failed = int((results["status"] != "ok").sum())
+    undecided = int((results["status"] == "ok").sum()) - len(decided(results))
+    left_out = [f"{failed} failed"] * bool(failed) + [f"{undecided} {UNDECIDED}"] * bool(undecided)
     return (
-        f"{what}: {int((results['status'] == 'ok').sum())} draws"
-        + (f" ({failed} failed, left out)" if failed else "")
+        f"{what}: {len(decided(results))} draws"
+        + (f" ({', '.join(left_out)}, left out)" if left_out else "")
         + "; hatched cells: no draw"
     )
 
@@ -220,7 +224,7 @@ def _matching(fitted: pd.DataFrame, values: dict) -> pd.DataFrame:
 def _slices_of(results: pd.DataFrame, road: str | None = None):
     """The rows' source: per slice of the map (``probability_map.slices`` of every finished
     draw; of one road only when given), its name, draws and maps."""
-    every = slices(results[results["status"] == "ok"])
+    every = slices(decided(results))
 
     def slice_of(_ok: pd.DataFrame, fitted: pd.DataFrame):
         for values, draws in every:
@@ -235,7 +239,7 @@ def plot_envelopes(results: pd.DataFrame, out_dir: Path) -> list[Path]:
     """``envelope.png`` and ``outcome_probability_map.csv``, a row of panels per slice of
     the map and outcome; for generated scenarios (a ``road`` column) one
     ``envelope_<road>.png`` per road instead."""
-    if not (results["status"] == "ok").any():
+    if decided(results).empty:
         return []
     fitted = probability_map(results)
     write_probability_map(Path(out_dir), fitted)

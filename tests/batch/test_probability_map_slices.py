@@ -95,3 +95,19 @@ def test_road_and_level_stay_columns_and_a_driver_splits_them():
     frame = probability_map(results)
     assert list(frame.columns[:3]) == ["driver", "road", "los"]
     assert list(_fits(frame, "contact")["driver"]) == ["eoam", "r157-cc"]
+
+
+def test_unfinished_draws_are_neither_events_nor_non_events():
+    """A draw cut off at the time limit before anything was decided says nothing of how it
+    would have ended: left out of n as a failed draw is (it counted as a draw without a
+    contact, a map biased low)."""
+    results = _draws({"paper": {"policy": "paper"}})
+    cut = results.index[:4]
+    results.loc[cut, "outcome"] = "unfinished"
+    results.loc[cut, "collision_with"] = "none"
+    results.loc[results.index[4], "status"] = "failed"
+    frame = probability_map(results)
+    kept = results.drop(index=[*cut, results.index[4]])
+    contact = frame[frame["outcome"] == "contact"]
+    assert (contact["n"] == len(kept)).all()
+    assert (contact["events"] == int((kept["collision_with"] != "none").sum())).all()
