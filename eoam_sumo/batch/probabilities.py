@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from eoam_sumo.batch.report import SETTINGS
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.sampling import wilson_interval
 
@@ -50,6 +51,13 @@ def outcomes_of(results: pd.DataFrame) -> pd.Series:
     return results["outcome"].where(results["status"] == "ok", FAILED).fillna(FAILED)
 
 
+def _group_columns(results: pd.DataFrame) -> list[str]:
+    """``GROUP_COLUMNS``, then every other setting a matrix may sweep (``report.SETTINGS``:
+    policy, driver, vehicle, ABS/ESC, V2X, SUMO step, ...) that the results hold."""
+    extra = [s.column for s in SETTINGS if s.column not in GROUP_COLUMNS]
+    return [c for c in (*GROUP_COLUMNS, *extra) if c in results]
+
+
 def outcome_probabilities(results: pd.DataFrame) -> pd.DataFrame:
     """The outcome probabilities of a results frame (``runner.read_results``) of draws."""
     results = results.assign(group=results["case_id"].map(group_of), _outcome=outcomes_of(results))
@@ -58,7 +66,7 @@ def outcome_probabilities(results: pd.DataFrame) -> pd.DataFrame:
     order += sorted(seen - set(order) - {FAILED}) + ([FAILED] if FAILED in seen else [])
     keep = [
         c
-        for c in GROUP_COLUMNS
+        for c in _group_columns(results)
         if (results.groupby("group", sort=False)[c].nunique(dropna=False) <= 1).all()
     ]
     rows = []

@@ -111,3 +111,19 @@ def test_unfinished_draws_are_neither_events_nor_non_events():
     contact = frame[frame["outcome"] == "contact"]
     assert (contact["n"] == len(kept)).all()
     assert (contact["events"] == int((kept["collision_with"] != "none").sum())).all()
+
+
+def test_outcome_probabilities_name_the_swept_settings_of_each_group():
+    """outcome_probabilities.csv holds every parameter constant within each group: a swept
+    policy or driver too (the groups were told apart by their names only)."""
+    from eoam_sumo.batch.probabilities import outcome_probabilities
+
+    results = _draws({"paper": {"policy": "paper"}, "safe": {"policy": "safe"}})
+    results["case_id"] = [f"{p}_v120_mu0.3_d{k % DRAWS}" for k, p in enumerate(results["policy"])]
+    results["driver"] = "eoam"
+    table = outcome_probabilities(results)
+    assert {"policy", "driver"} <= set(table.columns)
+    assert set(zip(table["group"], table["policy"])) == {
+        ("paper_v120_mu0.3", "paper"),
+        ("safe_v120_mu0.3", "safe"),
+    }
