@@ -163,6 +163,17 @@ def _run_arguments(sub) -> None:
         help="add an oncoming car this far ahead (m), or 'none'",
     )
     p.add_argument(
+        "--aro-hold-s",
+        type=finite,
+        help="the obstacle (eoam.role=aro) holds its speed this long before its stop "
+        "(default: the route file's; a matrix's aro_hold_s)",
+    )
+    p.add_argument(
+        "--aro-decel-mps2",
+        type=finite,
+        help="the obstacle's stop deceleration (default: the route file's; aro_decel_mps2)",
+    )
+    p.add_argument(
         "--ego", help="the ego vehicle's id (default: ego); of an .xosc, the ego entity's name"
     )
     xosc_arguments(p)
@@ -407,6 +418,8 @@ def _cmd_run(args) -> int:
                 ego_speed_mps=None if args.speed_kmh is None else args.speed_kmh / 3.6,
                 mu=args.mu,
                 oncoming_start_m=args.oncoming_m,
+                aro_hold_s=args.aro_hold_s,
+                aro_decel_mps2=args.aro_decel_mps2,
             )
             s = run_case(args.cfg, overrides, out, settings)
     print(

@@ -50,7 +50,13 @@ def parse_params(items: list[str]) -> dict[str, str]:
 
 def prepare_command(args) -> Loaded:
     """Check the options an .xosc run takes and load the scenario (refusals before output)."""
-    for flag, value in (("--speed-kmh", args.speed_kmh), ("--oncoming-m", args.oncoming_m)):
+    given = (
+        ("--speed-kmh", args.speed_kmh),
+        ("--oncoming-m", args.oncoming_m),
+        ("--aro-hold-s", getattr(args, "aro_hold_s", None)),
+        ("--aro-decel-mps2", getattr(args, "aro_decel_mps2", None)),
+    )
+    for flag, value in given:
         if value is not None:
             raise InputError(f"{flag} does not apply to an .xosc (set its parameters: --param)")
     from eoam_sumo.openscenario.runner import load  # the engine: only for an .xosc

@@ -4,6 +4,7 @@ parquet time series equal to the csv ones."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -120,3 +121,45 @@ def test_plot_draws_a_sampled_batch_from_its_own_draws(tmp_path):
     assert list(_batch_rows(tmp_path, results)["case_id"]) == ids[:3]
     (tmp_path / PROBABILITIES_FILE).unlink()
     assert len(_batch_rows(tmp_path, results)) == 6
+
+
+def test_run_with_a_row_s_values_repeats_its_draw(tmp_path):
+    """docs/monte-carlo.md: ``eoam-sumo run ... --seed N`` with the row's values repeats one
+    draw, the obstacle's drawn hold and deceleration included (``--aro-hold-s``,
+    ``--aro-decel-mps2``: without them a draw of monte_carlo.toml could not be repeated)."""
+    matrix = tmp_path / "m.toml"
+    matrix.write_text(
+        MATRIX.replace("mu = [0.7, 0.3]", "mu = [0.7]")
+        .replace("draws = 3", "draws = 1")
+        .replace(
+            'mu_belief = { choice = ["known", 1.0] }',
+            "aro_hold_s = { uniform = [1.0, 3.0] }\naro_decel_mps2 = { uniform = [5.0, 9.0] }",
+        )
+    )
+    out = tmp_path / "b"
+    assert (
+        main(["batch", str(matrix), "--out", str(out), "--no-progress", "--timeseries", "none"])
+        == 0
+    )
+    row = read_results(out / RESULTS_FILE).iloc[0]
+    argv = ["run", str(REPO / "scenarios" / "baseline.sumocfg"), "--out", str(tmp_path / "r")]
+    argv += ["--speed-kmh", repr(float(row["ego_speed_kmh"])), "--mu", repr(float(row["mu"]))]
+    argv += ["--oncoming-m", repr(float(row["oncoming_start_m"])), "--seed", str(int(row["seed"]))]
+    argv += [
+        "--aro-hold-s",
+        repr(float(row["aro_hold_s"])),
+        "--aro-decel-mps2",
+        repr(float(row["aro_decel_mps2"])),
+    ]
+    argv += [
+        "--radar-model",
+        "automotive",
+        "--max-time-s",
+        "20",
+        "--sumo-step-s",
+        repr(float(row["sumo_step_s"])),
+    ]
+    assert main(argv) == 0
+    run = json.loads((tmp_path / "r" / "summary.json").read_text())
+    for key in ("outcome", "collision_with", "impact_speed_mps", "trigger_time_s", "min_gap_aro_m"):
+        assert run[key] == (None if pd.isna(row[key]) else row[key]), key
