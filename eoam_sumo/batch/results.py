@@ -226,12 +226,15 @@ def _case_keys(cases: list[Case]) -> dict[str, tuple[str, ...]]:
     return {r[0]: tuple(r[1:]) for r in text.itertuples(index=False)}
 
 
-def kept_rows(path: Path, cases: list[Case], inputs: dict[str, str]) -> pd.DataFrame:
+def kept_rows(
+    path: Path, cases: list[Case], inputs: dict[str, str], files: tuple[str, ...] = ()
+) -> pd.DataFrame:
     """Rows of an earlier run worth keeping (``--resume``): the matrix's cases finished and
     still the same case (same id, the same parameters as written in results.csv, and the
     same bytes in its files: ``inputs``, case id -> ``inputs_sha256`` now) whose folder is
-    still there, then every row
-    of a case not in the matrix (a larger matrix's, whose case folders stay)."""
+    still there with ``files`` in it (the case files of the ``--timeseries`` asked for now),
+    then every row of a case not in the matrix (a larger matrix's, whose case folders
+    stay)."""
     rows = read_rows(path)
     want = _case_keys(cases)
     same = [
@@ -240,7 +243,7 @@ def kept_rows(path: Path, cases: list[Case], inputs: dict[str, str]) -> pd.DataF
             rows["case_id"], zip(*(rows[k] for k in RESUME_KEYS)), rows[INPUTS_COLUMN]
         )
     ]
-    kept_dirs = [(path.parent / case_dir_of(cid)).is_dir() for cid in rows["case_id"]]
+    kept_dirs = [_has_files(path.parent / case_dir_of(cid), files) for cid in rows["case_id"]]
     keep = (
         (rows["status"] == "ok").to_numpy()
         & pd.Series(same, dtype=bool).to_numpy()
@@ -248,6 +251,10 @@ def kept_rows(path: Path, cases: list[Case], inputs: dict[str, str]) -> pd.DataF
     )
     others = (~rows["case_id"].isin(list(want))).to_numpy()
     return rows[keep | others].drop_duplicates("case_id", keep="last")
+
+
+def _has_files(folder: Path, files: tuple[str, ...]) -> bool:
+    return folder.is_dir() and all((folder / name).is_file() for name in files)
 
 
 def finalise(path: Path, cases: list[Case], paper: dict[str, str]) -> pd.DataFrame:

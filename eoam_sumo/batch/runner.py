@@ -32,6 +32,7 @@ from tqdm import tqdm
 
 from eoam_sumo.batch.case import (
     ALL_CASE_FILES,
+    CASE_FILES_OF,
     PRELOAD,
     TIMESERIES_FORMATS,
     CaseTask,
@@ -259,7 +260,7 @@ def run_cases(
     digests = InputDigests()  # the files as they are now, before any case runs
     inputs = {c.case_id: digests.of(c) for c in cases}
     kept = (
-        kept_rows(results_path, cases, inputs)
+        kept_rows(results_path, cases, inputs, CASE_FILES_OF[timeseries])
         if resume and results_path.is_file()
         else pd.DataFrame(columns=list(COLUMNS), dtype=str)
     )

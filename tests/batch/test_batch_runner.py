@@ -45,6 +45,8 @@ def fake_case(task):
     files = {
         "summary.json": json.dumps(summary).encode(),
         "timeseries.csv": b"time_s,lateral_offset_m,mode\n0.0,0.0,0\n",
+        "traffic.csv": b"time_s,id\n0.0,ego\n",
+        "road.csv": b"s_m,x_m,y_m\n0.0,0.0,0.0\n",
     }
     if task.case_dir is None:
         return {"summary": summary, "files": files}
@@ -281,3 +283,20 @@ def test_resume_reruns_cases_whose_scenario_files_changed(tmp_path, edited):
     assert _calls(out) == [2, 2]
     run_batch(matrix, out, jobs=1, resume=True, progress=False, case_func=fake_case)
     assert _calls(out) == [2, 2]  # the rows now hold the edited files' digest
+
+
+def test_resume_with_another_timeseries_format_reruns_the_cases_without_it(tmp_path, matrix):
+    """Resumed with ``--timeseries csv`` over a batch run with ``none``, the cases that have
+    no time series run again (they were kept: a folder of mixed formats, some cases not
+    plottable); resumed with ``none`` over csv cases, they are kept."""
+    out = tmp_path / "t"
+    run_batch(matrix, out, jobs=1, progress=False, case_func=fake_case, timeseries="none")
+    for case in (out / "cases").iterdir():  # what a --timeseries none case holds
+        for name in ("timeseries.csv", "traffic.csv", "road.csv"):
+            (case / name).unlink()
+    run_batch(matrix, out, jobs=1, resume=True, progress=False, case_func=fake_case)
+    assert _calls(out) == [2] * 8
+    run_batch(
+        matrix, out, jobs=1, resume=True, progress=False, case_func=fake_case, timeseries="none"
+    )
+    assert _calls(out) == [2] * 8
