@@ -39,6 +39,7 @@ from eoam_sumo.plotting.animation_frames import ROLE_RANK, RunFrames, load_frame
 from eoam_sumo.plotting.figures import save
 from eoam_sumo.plotting.roadmap import read_road_map
 from eoam_sumo.plotting.run_plots import MODE_NAMES
+from eoam_sumo.plotting.runfacts import fit
 from eoam_sumo.plotting.view import radar_cone
 
 ROLE_COLOURS = {
@@ -49,6 +50,7 @@ ROLE_COLOURS = {
     "other": "#43a047",
 }
 CONTACT_COLOUR = "#d50000"
+TITLE_FONTSIZE = 8.0  # the run's reason and outcome above the picture, wrapped to its width
 PLAN_AHEAD_S = 3.0  # the planned path drawn this far ahead of the frame's time [s]
 DEFAULT_FPS = 10
 AXES_BOX = (0.01, 0.09, 0.98, 0.76)  # the picture within the figure (left, bottom, w, h)
@@ -272,7 +274,8 @@ class Scene:
             ncols=len(handles),
             frameon=False,
         )
-        over.suptitle(self._title(self.summary), fontsize=8, y=0.985)
+        title = fit(self._title(self.summary), size_in[0], TITLE_FONTSIZE)
+        over.suptitle(title, fontsize=TITLE_FONTSIZE, y=0.985)
         canvas = FigureCanvasAgg(over)
         canvas.draw()
         self.fig.figimage(np.asarray(canvas.buffer_rgba()), origin="upper", zorder=10)
