@@ -156,23 +156,7 @@ def _run_arguments(sub) -> None:
     p.add_argument("cfg", type=Path, help="the scenario's .sumocfg, or an OpenSCENARIO .xosc")
     p.add_argument("--speed-kmh", type=speed_kmh, help="ego initial speed (km/h)")
     p.add_argument("--mu", type=mu, help="surface friction for every lane")
-    p.add_argument(
-        "--oncoming-m",
-        type=_distance_or_none,
-        default=None,
-        help="add an oncoming car this far ahead (m), or 'none'",
-    )
-    p.add_argument(
-        "--aro-hold-s",
-        type=finite,
-        help="the obstacle (eoam.role=aro) holds its speed this long before its stop "
-        "(default: the route file's; a matrix's aro_hold_s)",
-    )
-    p.add_argument(
-        "--aro-decel-mps2",
-        type=finite,
-        help="the obstacle's stop deceleration (default: the route file's; aro_decel_mps2)",
-    )
+    _scenario_override_arguments(p)
     p.add_argument(
         "--ego", help="the ego vehicle's id (default: ego); of an .xosc, the ego entity's name"
     )
@@ -218,6 +202,27 @@ def _run_arguments(sub) -> None:
     p.add_argument("--gui", action="store_true", help="run in sumo-gui through TraCI")
     _policy_arguments(p)
     _gui_arguments(p)
+
+
+def _scenario_override_arguments(p: argparse.ArgumentParser) -> None:
+    """``run``'s overrides of a sumocfg's scenario: an oncoming car, the obstacle's stop."""
+    p.add_argument(
+        "--oncoming-m",
+        type=_distance_or_none,
+        default=None,
+        help="add an oncoming car this far ahead (m), or 'none'",
+    )
+    p.add_argument(
+        "--aro-hold-s",
+        type=finite,
+        help="the obstacle (eoam.role=aro) holds its speed this long before its stop "
+        "(default: the route file's; a matrix's aro_hold_s)",
+    )
+    p.add_argument(
+        "--aro-decel-mps2",
+        type=finite,
+        help="the obstacle's stop deceleration (default: the route file's; aro_decel_mps2)",
+    )
 
 
 def _after_stop_argument(p: argparse.ArgumentParser) -> None:
