@@ -79,3 +79,19 @@ def test_the_ego_starts_on_its_lane_centre(tmp_path, lane):
     first = pd.read_csv(out / "timeseries.csv").iloc[0]
     assert first["lateral_offset_m"] == pytest.approx(0.0, abs=1e-6)
     assert first["y_m"] == pytest.approx(pd.read_csv(out / "road.csv")["y_m"].iloc[0], abs=1e-6)
+
+
+@pytest.mark.parametrize("step_s", ["0.07", "0.08"])
+def test_a_sumo_step_that_does_not_divide_the_departure_is_refused(tmp_path, capsys, step_s):
+    """SUMO inserts a vehicle one of its steps after the step its departure falls in: at
+    0.07 s from a departure at 1 s the run's clock started before the ego's departure and the
+    obstacle ran 1.5 m behind the 10 ms reference. Such a step is refused in one line naming
+    the vehicle; one that divides the departure runs."""
+    from tests.builders import BASELINE
+
+    argv = ["run", str(BASELINE), "--max-time-s", "1", "--sumo-step-s", step_s]
+    assert main([*argv, "--out", str(tmp_path / "a")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "vehicle 'ego' departs at 1 s" in err
+    assert not (tmp_path / "a").exists()
+    assert main([*argv[:-1], "0.05", "--out", str(tmp_path / "b")]) == 0

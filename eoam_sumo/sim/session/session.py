@@ -62,7 +62,7 @@ from eoam_sumo.sim.session.launch import (
     traci_connect,
 )
 from eoam_sumo.sim.session.puppets import Puppets
-from eoam_sumo.sim.session.scripts import StopScripts
+from eoam_sumo.sim.session.scripts import REFERENCE_STEP_S, StopScripts
 from eoam_sumo.sim.session.tracking import RoadUsers
 from eoam_sumo.world.bodies import PEDESTRIAN, Body
 
@@ -348,6 +348,30 @@ class SumoSession:
             raise InputError(detail) from exc
         return session
 
+    def _check_departures_on_steps(self, ego_depart_s: float) -> None:
+        """At a SUMO step longer than the 10 ms reference, the ego's and every scripted
+        vehicle's departure must fall on one of SUMO's steps from the begin: SUMO inserts a
+        vehicle one of its steps after the step its departure falls in, which the run's clock
+        and the scripted holds take as one step after the departure (at 0.07 s from a
+        departure at 1 s the ego's first row came before its departure and the obstacle ran
+        1.5 m behind the reference). InputError naming the vehicle and its departure."""
+        step_ms = round(self._dt * 1000.0)
+        if step_ms <= round(REFERENCE_STEP_S * 1000.0):
+            return
+        departs = {self.ego_id: ego_depart_s}
+        for vid in self._scripts.ids:
+            spec = self._files.vehicles[vid]
+            departs[vid] = float_attr(spec, "depart", spec.attrs.get("depart", "0"))
+        for vid, depart in departs.items():
+            offset_ms = (depart - self._time_s) * 1000.0
+            if abs(offset_ms - step_ms * round(offset_ms / step_ms)) > 1e-6:
+                raise InputError(
+                    f"{self._files.vehicles[vid].source}: vehicle '{vid}' departs at {depart:g} "
+                    f"s, not on a SUMO step of {self._dt:g} s from the begin "
+                    f"({self._time_s:g} s): give a SUMO step that divides it (0.01 s always "
+                    "does)"
+                )
+
     def _set_up(self) -> None:
         spec = self._files.vehicles[self.ego_id]
         depart = float_attr(spec, "depart", spec.attrs.get("depart", "0"))
@@ -356,6 +380,7 @@ class SumoSession:
                 f"{spec.source}: vehicle '{self.ego_id}' departs at {depart:g} s, "
                 f"before the simulation begins ({self._time_s:g} s)"
             )
+        self._check_departures_on_steps(depart)
         if self._overrides.mu is not None:
             settable = True
             for lane_id in self._lane.getIDList():
