@@ -5,8 +5,9 @@ cut-out; closing faster than 1 m/s: a car first seen ahead at about the ego's sp
 or the lead braking. A car cutting in is perceived when the forward radar classes it in the
 path: 0.4 s after it crossed the lateral wandering threshold of 0.375 m
 (``sensing.radar.cutting_in``, ``CUT_IN_PERCEPTION_S``: the radar holds R157's perception
-for every controller). A cut-in is then critical only when TTC < 2 s or the time headway
-< 2 s (esmini ``ReferenceDriver::CheckCritical``; JRC-FSM ``CC_check_safety_cut_in``: TTC);
+for every controller). A cut-in is then critical only when TTC < 2 s (esmini
+``ReferenceDriver::CheckCriticalCutIn``, JRC-FSM ``CC_check_safety_cut_in``: the time headway
+gates esmini's cut-out and deceleration, not the cut-in);
 a revealed vehicle or a braking lead always is (JRC-FSM ``CC_check_safety``). The driver
 reacts for ``reaction_s`` (0.75 s) coasting at 0.4 m/s^2, then brakes, the deceleration
 rising from 0.4 m/s^2 to 0.774 g at 12.65 m/s^3 (0.774 g in 0.6 s), until the lead is no
@@ -34,13 +35,11 @@ class CarefulDriver:
 
     def reset(self) -> None:
         self.perceived_at_s: float | None = None  # when the risk is perceived
-        self.gated = False  # a cut-in: critical only below the TTC or headway
+        self.gated = False  # a cut-in: critical only below the TTC
         self.response.stop()
 
     def critical(self, lead: Lead, v_mps: float) -> bool:
-        p = self.p
-        thw = lead.gap_m / v_mps if v_mps > 0.0 else float("inf")
-        return time_to_collision_s(lead, v_mps) < p.critical_ttc_s or thw < p.critical_thw_s
+        return time_to_collision_s(lead, v_mps) < self.p.critical_ttc_s
 
     def step(self, t_s: float, v_mps: float, a_mps2: float, lead: Lead | None, dt_s: float):
         p, resp = self.p, self.response

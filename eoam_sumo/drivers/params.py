@@ -49,8 +49,7 @@ class CarefulDriverParams:
     #                          (esmini ``release_deceleration_``; JRC CC_release_deceleration)
     decel_mps2: float = CAREFUL_DECEL_MPS2  # [m/s^2] full braking, 0.774 g
     jerk_mps3: float = CAREFUL_JERK_MPS3  # [m/s^3] 0.774 g reached in 0.6 s
-    critical_ttc_s: float = 2.0  # [s] critical below this TTC (esmini ``critical_ttc_``)
-    critical_thw_s: float = 2.0  # [s] ... or below this time headway (esmini ``critical_thw_``)
+    critical_ttc_s: float = 2.0  # [s] a cut-in critical below this TTC (esmini ``critical_ttc_``)
     lead_braking_mps2: float = 1.0  # [m/s^2] a lead braking harder is a risk (assumption)
     closing_mps: float = 1.0  # [m/s] a car revealed ahead closing faster is a risk (assumption)
 
