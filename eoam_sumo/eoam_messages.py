@@ -7,6 +7,25 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import NamedTuple
 
+#: The motion classes of a road user in the lane a lane change would take
+#: (:func:`next_lane_motion`), shared by the radar's classes and the decision policy's checks.
+STANDING, ONCOMING, WITH = "standing", "oncoming", "with"
+#: ... standing below this road speed either way [m/s]
+NEXT_LANE_STANDING_MPS = 0.5
+
+
+def next_lane_motion(road_speed_mps: float, stationary_mps: float = NEXT_LANE_STANDING_MPS) -> str:
+    """The motion class of a road user in the lane a lane change would take, by its road speed:
+    ``ONCOMING`` towards the ego at ``stationary_mps`` or more, ``STANDING`` below it either
+    way, ``WITH`` the ego's way at it or more. The classes meet: a van creeping towards the ego
+    at 1.5 m/s is oncoming (the radar's and the paper's rules judge the first two, the paper
+    policy's commit check ``WITH``)."""
+    if road_speed_mps <= -stationary_mps:
+        return ONCOMING
+    if road_speed_mps < stationary_mps:
+        return STANDING
+    return WITH
+
 
 class EgoMeasurement(NamedTuple):
     """Ego state in the road frame of its original lane (s along, d left of its centre)."""

@@ -42,15 +42,11 @@ from typing import NamedTuple
 
 from mypy_extensions import mypyc_attr
 
-from eoam_sumo.eoam_messages import NextLaneView
+from eoam_sumo.eoam_messages import ONCOMING, WITH, NextLaneView, next_lane_motion
 from eoam_sumo.manoeuvre.quintic_shift import QuinticShift
 from eoam_sumo.params import G_MPS2
 
 POLICIES = ("paper", "safe")
-#: A road user in the target lane is oncoming moving towards the ego at this or faster,
-#: standing slower either way, else moving the ego's way (:func:`next_lane_motion`) [m/s]
-STANDING_MPS = 0.5
-STANDING, ONCOMING, WITH = "standing", "oncoming", "with"
 #: A road user behind in the target lane: it may brake at 3 m/s^2 from 0.4 s after the lane
 #: change begins, and keeps 1 s of its own travel as the gap. The project's
 #: assumption, modelled on the "critical situation" of a lane change in UN Regulation No. 79
@@ -118,19 +114,6 @@ class SightNeed(NamedTuple):
         if t_s <= t_lc:
             return self.lane_change_m * t_s / t_lc if t_lc > 0.0 else 0.0
         return self.lane_change_m + self.end_speed_mps * (t_s - t_lc)
-
-
-def next_lane_motion(road_speed_mps: float) -> str:
-    """The class of a road user in the target lane by its road speed: ``ONCOMING``, ``STANDING``
-    or ``WITH`` (``STANDING_MPS``). The radar's classes, ``world.lanes.next_lane_motion``, which
-    the layers keep the EOAM from importing (tests/logic/test_commit_check_classes.py keeps the
-    two equal): the classes meet, so the paper's rules judge the first two and the commit
-    check the third."""
-    if road_speed_mps <= -STANDING_MPS:
-        return ONCOMING
-    if road_speed_mps < STANDING_MPS:
-        return STANDING
-    return WITH
 
 
 def escape_time_s(lateral_m: float, mu: float) -> float:

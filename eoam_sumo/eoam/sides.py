@@ -12,10 +12,17 @@ manoeuvre runs (modes 0 and 1) and held from the lane change until the hand-back
 from __future__ import annotations
 
 from eoam_sumo.decision.modes import NORMAL, UPDATE_BRAKE
-from eoam_sumo.decision.policy import ONCOMING, STANDING, next_lane_motion
 from eoam_sumo.eoam.parts import Parts
 from eoam_sumo.eoam.state import ControllerState
-from eoam_sumo.eoam_messages import Command, EgoMeasurement, NextLaneView, Perception
+from eoam_sumo.eoam_messages import (
+    ONCOMING,
+    STANDING,
+    Command,
+    EgoMeasurement,
+    NextLaneView,
+    Perception,
+    next_lane_motion,
+)
 
 LEFT = 1
 RIGHT = -1
@@ -97,7 +104,7 @@ def mirrored_measurement(meas: EgoMeasurement) -> EgoMeasurement:
 def mirrored_perception(perception: Perception) -> Perception:
     """The perception in the mirrored frame: the right lane's view as the next lane, its
     oncoming and standing road users (from that view: the whole lane, whatever its width; the
-    classes of ``decision.policy.next_lane_motion``, the radar's on the left), the obstacle's
+    classes of ``eoam_messages.next_lane_motion``, the radar's on the left), the obstacle's
     offset negated."""
     view = perception.right_lane
     obj = perception.aro_object

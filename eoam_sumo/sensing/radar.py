@@ -32,7 +32,7 @@ width of the lane a lane change would take, or the ego lane's when not given):
 * ``oncoming``: road speed below -oncoming_speed_mps and the centre in the lane band or in
   the next lane's band: in the ego lane (a wrong-way driver counts) or in the lane a lane
   change would take; in the next lane's band also any road user moving towards the ego at
-  stationary_speed_mps or more (:func:`~eoam_sumo.world.lanes.next_lane_motion`: a van
+  stationary_speed_mps or more (:func:`~eoam_sumo.eoam_messages.next_lane_motion`: a van
   creeping at 1.5 m/s). A road user moving against the road further left (the other
   carriageway of a divided road, a jogger on the far pavement) is ``other``: it is not in the
   way of the lane change;
@@ -68,20 +68,18 @@ from typing import NamedTuple
 
 from mypy_extensions import mypyc_attr
 
+from eoam_sumo.eoam_messages import ONCOMING, STANDING, next_lane_motion
 from eoam_sumo.sensing.coasting import Coaster
 from eoam_sumo.world.bodies import Body
 from eoam_sumo.world.geometry import OrientedBox, slab_entry
 from eoam_sumo.world.lanes import (
     CROSSING_ANGLE_RAD,
     LANE_MARGIN_M,
-    ONCOMING,
     ONCOMING_SPEED_MPS,
-    STANDING,
     STATIONARY_SPEED_MPS,
     RoadProjection,
     body_band_m,
     lane_band_m,
-    next_lane_motion,
 )
 
 CATEGORIES = ("in_path", "oncoming", "in_next_lane", "stationary_side", "other")

@@ -6,8 +6,8 @@ a road user's centre offset d in the road frame of that lane (:class:`RoadProjec
 positive to the left). A road user's road speed is its speed times the cosine of its heading
 relative to the road: below ``-ONCOMING_SPEED_MPS`` it is oncoming traffic to the radar, and
 under ``STATIONARY_SPEED_MPS`` (in absolute value) it is standing. In the lane a lane change
-would take the two classes meet (:func:`next_lane_motion`): there every road user is standing,
-oncoming, or moving the ego's way.
+would take the two classes meet (:func:`eoam_sumo.eoam_messages.next_lane_motion`): there
+every road user is standing, oncoming, or moving the ego's way.
 """
 
 from __future__ import annotations
@@ -37,24 +37,6 @@ class RoadProjection(Protocol):
     def project(self, x: float, y: float) -> tuple[float, float, float]:
         """(s_m, d_m, road_yaw_rad) of a network point; d positive to the left."""
         ...
-
-
-#: The motion classes of a road user in the lane a lane change would take
-#: (:func:`next_lane_motion`).
-STANDING, ONCOMING, WITH = "standing", "oncoming", "with"
-
-
-def next_lane_motion(road_speed_mps: float, stationary_mps: float = STATIONARY_SPEED_MPS) -> str:
-    """The motion class of a road user in the lane a lane change would take, by its road speed:
-    ``ONCOMING`` towards the ego at ``stationary_mps`` or more, ``STANDING`` below it either
-    way, ``WITH`` the ego's way at it or more. The classes meet: a van creeping towards the ego
-    at 1.5 m/s is oncoming. The EOAM's twin is ``decision.policy.next_lane_motion`` (the paper
-    policy's commit check judges ``WITH`` only; a test keeps the two equal)."""
-    if road_speed_mps <= -stationary_mps:
-        return ONCOMING
-    if road_speed_mps < stationary_mps:
-        return STANDING
-    return WITH
 
 
 def lane_band_m(lane_width_m: float, margin_m: float = LANE_MARGIN_M) -> float:

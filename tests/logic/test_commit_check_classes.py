@@ -8,14 +8,19 @@ import math
 
 import pytest
 
-from eoam_sumo.decision import policy
 from eoam_sumo.decision.policy import PolicySettings, SafePolicy
 from eoam_sumo.eoam import EgoMeasurement, EoamSettings, ObjectState, Perception
-from eoam_sumo.eoam_messages import NextLaneView
+from eoam_sumo.eoam_messages import (
+    NEXT_LANE_STANDING_MPS,
+    ONCOMING,
+    STANDING,
+    WITH,
+    NextLaneView,
+    next_lane_motion,
+)
 from eoam_sumo.offline.tables import LookupTables, default_tables_dir
 from eoam_sumo.params import ego_e_class_sedan
 from eoam_sumo.sensing.radar import Radar, RadarSettings
-from eoam_sumo.world import lanes
 from eoam_sumo.world.bodies import Body
 
 P = ego_e_class_sedan()
@@ -66,21 +71,12 @@ def test_each_road_user_ahead_in_the_target_lane_is_judged_once(tables, speed_mp
         assert reason == "a road user ahead in the target lane"
 
 
-def test_the_commit_check_still_names_an_oncoming_road_user_it_judges():
-    """The safe policy's checks (no ``moving_only``) name the classes the same way."""
-    assert policy.next_lane_motion(-0.5) == policy.ONCOMING
-    assert policy.next_lane_motion(-0.49) == policy.STANDING
-    assert policy.next_lane_motion(0.5) == policy.WITH
-
-
-@pytest.mark.parametrize("speed_mps", [*BOUNDARY_MPS, -0.5000001, -0.4999999, 0.4999999])
-def test_the_eoams_classes_are_the_radars(speed_mps):
-    """The layers keep the EOAM from importing ``world``: its twin must agree."""
-    assert policy.STANDING_MPS == lanes.STATIONARY_SPEED_MPS
-    assert RadarSettings().stationary_speed_mps == policy.STANDING_MPS
-    assert policy.next_lane_motion(speed_mps) == lanes.next_lane_motion(speed_mps)
-    assert (policy.STANDING, policy.ONCOMING, policy.WITH) == (
-        lanes.STANDING,
-        lanes.ONCOMING,
-        lanes.WITH,
-    )
+def test_the_classes_meet_at_the_radar_s_standing_speed():
+    """Towards the ego at 0.5 m/s or more oncoming, slower either way standing, else the ego's
+    way: one function for the radar and the EOAM (``eoam_messages.next_lane_motion``), at the
+    radar's default standing speed."""
+    assert next_lane_motion(-0.5) == ONCOMING
+    assert next_lane_motion(-0.4999999) == STANDING
+    assert next_lane_motion(0.4999999) == STANDING
+    assert next_lane_motion(0.5) == WITH
+    assert RadarSettings().stationary_speed_mps == NEXT_LANE_STANDING_MPS

@@ -155,6 +155,27 @@ def _arc(radius_m: float, length_m: float, reverse: bool = False) -> str:
     return " ".join(f"{x:.3f},{y:.3f}" for x, y in (reversed(xy) if reverse else xy))
 
 
+def _arc_road(folder, radius_m: float, length_m: float, two_way: bool = False) -> None:
+    """``arc.net.xml``: a left arc of ``radius_m`` and ``length_m``, one 3.5 m lane (edge
+    ``fwd``), and with ``two_way`` the opposite lane beside it (edge ``bwd``, ``<neigh>``)."""
+    end_x, end_y = (
+        radius_m * math.sin(length_m / radius_m),
+        radius_m * (1 - math.cos(length_m / radius_m)),
+    )
+    nodes = f'<nodes><node id="a" x="0" y="0"/><node id="b" x="{end_x:.3f}" y="{end_y:.3f}"/>'
+    edge = '<edge id="{}" from="{}" to="{}" numLanes="1" speed="50" width="3.5" shape="{}">'
+    fwd = edge.format("fwd", "a", "b", _arc(radius_m, length_m))
+    if not two_way:
+        network(folder, "arc", nodes + "</nodes>", f"<edges>{fwd}</edge></edges>")
+        return
+    bwd = edge.format("bwd", "b", "a", _arc(radius_m, length_m, True))
+    edges = (
+        f'<edges>{fwd}<lane index="0"><neigh lane="bwd_0"/></lane></edge>'
+        f'{bwd}<lane index="0"><neigh lane="fwd_0"/></lane></edge></edges>'
+    )
+    network(folder, "arc", nodes + "</nodes>", edges)
+
+
 def test_a_queue_on_a_600_m_curve_at_130_kmh_is_stopped_for(tmp_path):
     """A 600 m left curve at 130 km/h on mu 1.0, a car halted in the ego's lane and one beside
     it in the opposite lane (no lane to change into): first seen at the radar's 100 m, which
@@ -163,18 +184,7 @@ def test_a_queue_on_a_600_m_curve_at_130_kmh_is_stopped_for(tmp_path):
     once and stops short; with the straight road's boundaries it braked 3 m later and hit at
     2.5 m/s."""
     radius, length, pos = 600.0, 1000.0, 600.0
-    end = (radius * math.sin(length / radius), radius * (1 - math.cos(length / radius)))
-    network(
-        tmp_path,
-        "arc",
-        f'<nodes><node id="a" x="0" y="0"/><node id="b" x="{end[0]:.3f}" y="{end[1]:.3f}"/>'
-        "</nodes>",
-        f'<edges><edge id="fwd" from="a" to="b" numLanes="1" speed="50" width="3.5" '
-        f'shape="{_arc(radius, length)}"><lane index="0"><neigh lane="bwd_0"/></lane></edge>'
-        f'<edge id="bwd" from="b" to="a" numLanes="1" speed="50" width="3.5" '
-        f'shape="{_arc(radius, length, True)}"><lane index="0"><neigh lane="fwd_0"/></lane>'
-        "</edge></edges>",
-    )
+    _arc_road(tmp_path, radius, length, two_way=True)
     (tmp_path / "arc.rou.xml").write_text(
         f'<routes><vType id="car" length="4.6" width="1.8" decel="9" sigma="0"/>'
         f'<vehicle id="stalled" type="car" depart="0" departPos="{pos}" departSpeed="0">'
@@ -219,15 +229,7 @@ def test_an_ego_starting_on_a_curve_starts_turning_along_it(tmp_path):
     with SUMO's angle (its 20 m chord's, 0.025 rad off the curve) and drifted 1.3 m in mode
     0. It now starts on the curve: the yaw rate v / R, along the road's heading."""
     radius, length = 400.0, 1200.0
-    end = (radius * math.sin(length / radius), radius * (1 - math.cos(length / radius)))
-    network(
-        tmp_path,
-        "arc",
-        f'<nodes><node id="a" x="0" y="0"/><node id="b" x="{end[0]:.3f}" y="{end[1]:.3f}"/>'
-        "</nodes>",
-        f'<edges><edge id="fwd" from="a" to="b" numLanes="1" speed="50" width="3.5" '
-        f'shape="{_arc(radius, length)}"/></edges>',
-    )
+    _arc_road(tmp_path, radius, length)
     (tmp_path / "arc.rou.xml").write_text(
         '<routes><vType id="car" length="4.6" width="1.8" sigma="0"/>'
         '<vehicle id="ego" type="car" depart="0" departPos="100" departSpeed="30">'
