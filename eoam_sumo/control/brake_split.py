@@ -41,55 +41,87 @@ def wheel_lock_brake_n(
     lateral_share: float,
     equivalent_mass_kg: float,
 ) -> float:
-    """The largest brake command [N] (the split's total at the road) that locks neither
-    axle's inner wheel while the car takes ``lateral_accel_mps2`` and its resistances
-    (drag, rolling) ``resistance_n``; ``lateral_share`` is q, the share of each tyre's
-    friction ellipse cornering takes (clipped to [0, 1]). ``math.inf`` when no wheel can lock."""
-    p = params
-    phi = p.brake_front_share
-    q = min(max(lateral_share, 0.0), 1.0)
-    ellipse = math.sqrt(1.0 - q * q)
-    lateral_n = p.mass_kg * abs(lateral_accel_mps2) * p.cg_height_m / p.track_m
-    d_front = lateral_n * p.roll_stiffness_front_share
-    axles = (
-        (0.5 * phi, p.cg_to_rear_m, 1.0, d_front),
-        (0.5 * (1.0 - phi), p.cg_to_front_m, -1.0, lateral_n - d_front),
-    )
-    front, rear = axles
-    return min(
-        _inner_wheel_limit_n(p, mu, ellipse, *front, resistance_n, equivalent_mass_kg),
-        _inner_wheel_limit_n(p, mu, ellipse, *rear, resistance_n, equivalent_mass_kg),
+    """``BrakeSplit(params).limit_n(...)``: the largest brake command [N] that locks neither
+    axle's inner wheel."""
+    return BrakeSplit(params).limit_n(
+        mu, lateral_accel_mps2, resistance_n, lateral_share, equivalent_mass_kg
     )
 
 
-def _inner_wheel_limit_n(
-    p: VehicleParams,
-    mu: float,
-    ellipse: float,
-    share: float,
-    lever_m: float,
-    sign: float,
-    d_lat_n: float,
-    resistance_n: float,
-    m_eq: float,
-) -> float:
-    """One axle's limit: ``share F <= k Fz(F)``, k = mu_x(Fz) sqrt(1 - q^2) - c_rr, Fz(F) =
-    m (g lever + sign h (F + R) / m_eq) / (2 L) - dFz_lat (sign +1 front, -1 rear)."""
-    m, h, wb = p.mass_kg, p.cg_height_m, p.wheelbase_m
-    static = m * G_MPS2 * lever_m / (2.0 * wb) - d_lat_n
-    per_force = sign * m * h / (2.0 * wb * m_eq)  # load per N of deceleration force
-    load = static + per_force * resistance_n
-    limit = math.inf
-    for _ in range(_PASSES):
-        k = (
-            peak_friction(mu, max(load, 0.0), p.tyre_nominal_load_n) * ellipse
-            - p.rolling_resistance_coeff
+class BrakeSplit:
+    """A vehicle's fixed brake split and what loads its inner wheels: the parameters
+    ``limit_n`` reads at every control step, kept as plain floats."""
+
+    def __init__(self, params: VehicleParams) -> None:
+        p = params
+        self.front_share = p.brake_front_share
+        self.mass_kg, self.cg_height_m, self.track_m = p.mass_kg, p.cg_height_m, p.track_m
+        self.roll_front_share = p.roll_stiffness_front_share
+        self.cg_to_front_m, self.cg_to_rear_m = p.cg_to_front_m, p.cg_to_rear_m
+        self.wheelbase_m = p.wheelbase_m
+        self.nominal_load_n = p.tyre_nominal_load_n
+        self.rolling_resistance_coeff = p.rolling_resistance_coeff
+
+    def limit_n(
+        self,
+        mu: float,
+        lateral_accel_mps2: float,
+        resistance_n: float,
+        lateral_share: float,
+        equivalent_mass_kg: float,
+    ) -> float:
+        """The largest brake command [N] (the split's total at the road) that locks neither
+        axle's inner wheel while the car takes ``lateral_accel_mps2`` and its resistances
+        (drag, rolling) ``resistance_n``; ``lateral_share`` is q, the share of each tyre's
+        friction ellipse cornering takes (clipped to [0, 1]). ``math.inf`` when no wheel can
+        lock."""
+        phi = self.front_share
+        q = min(max(lateral_share, 0.0), 1.0)
+        ellipse = math.sqrt(1.0 - q * q)
+        lateral_n = self.mass_kg * abs(lateral_accel_mps2) * self.cg_height_m / self.track_m
+        d_front = lateral_n * self.roll_front_share
+        m_eq = equivalent_mass_kg
+        front = self._inner_wheel_limit_n(
+            mu, ellipse, 0.5 * phi, self.cg_to_rear_m, 1.0, d_front, resistance_n, m_eq
         )
-        if k <= 0.0:
-            return 0.0
-        slope = share - k * per_force
-        if slope <= 0.0:
-            return math.inf  # the load grows faster with braking than the brake force
-        limit = max(k * (static + per_force * resistance_n) / slope, 0.0)
-        load = static + per_force * (limit + resistance_n)
-    return limit
+        rear = self._inner_wheel_limit_n(
+            mu,
+            ellipse,
+            0.5 * (1.0 - phi),
+            self.cg_to_front_m,
+            -1.0,
+            lateral_n - d_front,
+            resistance_n,
+            m_eq,
+        )
+        return min(front, rear)
+
+    def _inner_wheel_limit_n(
+        self,
+        mu: float,
+        ellipse: float,
+        share: float,
+        lever_m: float,
+        sign: float,
+        d_lat_n: float,
+        resistance_n: float,
+        m_eq: float,
+    ) -> float:
+        """One axle's limit: ``share F <= k Fz(F)``, k = mu_x(Fz) sqrt(1 - q^2) - c_rr, Fz(F) =
+        m (g lever + sign h (F + R) / m_eq) / (2 L) - dFz_lat (sign +1 front, -1 rear)."""
+        m, h, wb = self.mass_kg, self.cg_height_m, self.wheelbase_m
+        nominal_load_n, c_rr = self.nominal_load_n, self.rolling_resistance_coeff
+        static = m * G_MPS2 * lever_m / (2.0 * wb) - d_lat_n
+        per_force = sign * m * h / (2.0 * wb * m_eq)  # load per N of deceleration force
+        load = static + per_force * resistance_n
+        limit = math.inf
+        for _ in range(_PASSES):
+            k = peak_friction(mu, max(load, 0.0), nominal_load_n) * ellipse - c_rr
+            if k <= 0.0:
+                return 0.0
+            slope = share - k * per_force
+            if slope <= 0.0:
+                return math.inf  # the load grows faster with braking than the brake force
+            limit = max(k * (static + per_force * resistance_n) / slope, 0.0)
+            load = static + per_force * (limit + resistance_n)
+        return limit

@@ -26,7 +26,7 @@ from dataclasses import dataclass, fields
 
 from mypy_extensions import mypyc_attr
 
-from eoam_sumo.control.brake_split import wheel_lock_brake_n
+from eoam_sumo.control.brake_split import BrakeSplit
 from eoam_sumo.params import (
     AIR_DENSITY_KGPM3,
     G_MPS2,
@@ -108,12 +108,12 @@ class LongitudinalController:
         "_abs",
         "_accel",
         "_alim_g",
+        "_brake_split",
         "_drag",
         "_fmax",
         "_lock",
         "_m",
         "_margin",
-        "_params",
         "_pmax",
         "_rear_n",
         "_res0",
@@ -140,7 +140,8 @@ class LongitudinalController:
             g.speed_kp_per_s, g.speed_ki_per_s2, g.speed_kd, g.speed_integral_limit_mps2
         )
         self._alim_g = g.speed_accel_limit_g * G_MPS2
-        self._params, self._abs, self._lock = params, params.abs_fitted, g.wheel_lock_fraction
+        self._abs, self._lock = params.abs_fitted, g.wheel_lock_fraction
+        self._brake_split = BrakeSplit(params)
 
     def reset(self) -> None:
         """Clear both integrators (called at every switch of longitudinal loop)."""
@@ -160,7 +161,7 @@ class LongitudinalController:
             return math.inf
         q = self._margin * abs(lateral_accel_mps2) / mu
         res = self.resistance_n(speed_mps)
-        lock = wheel_lock_brake_n(self._params, mu, lateral_accel_mps2, res, q, self._m)
+        lock = self._brake_split.limit_n(mu, lateral_accel_mps2, res, q, self._m)
         return self._lock * lock
 
     def limits(

@@ -37,7 +37,8 @@ from mypy_extensions import mypyc_attr
 
 from eoam_sumo.eoam_messages import NextLaneView
 from eoam_sumo.sensing.v2x import V2XObject, V2XReceiver, V2XSettings
-from eoam_sumo.world.geometry import OrientedBox, slab_entry
+from eoam_sumo.world.bodies import Body
+from eoam_sumo.world.geometry import OrientedBox, nearest_point, slab_entry
 
 MIN_OVERLAP_M = 0.1  # a road user reaching this far into the lane is in it [m]
 FUSION_GATE_M = 3.0  # radar and V2X objects closer than this (centre, plus half lengths) [m]
@@ -214,7 +215,7 @@ class NextLaneSensing:
         """Append the ``received`` V2X objects in the lane that no radar object (nor the
         in-path obstacle) already stands for."""
         for o in received:
-            s, d, ryaw = self._project(road, o)
+            s, d, ryaw = self._project(road, o.x_m, o.y_m, o.speed_mps)
             if not self._in_lane(d, o.width_m, lane_lo, lane_hi):
                 continue
             if in_path is not None and _same(s, o.length_m, in_path.s_m, in_path.length_m):
@@ -279,7 +280,16 @@ class NextLaneSensing:
         )
 
     def _corner_objects(
-        self, front_xy, s_f, yaw_rad, road, bodies, lane_lo, lane_hi, known, in_path
+        self,
+        front_xy,
+        s_f: float,
+        yaw_rad: float,
+        road,
+        bodies: Sequence[Body],
+        lane_lo: float,
+        lane_hi: float,
+        known: list,
+        in_path,
     ) -> list:
         """Road users the corner radars see in the lane (or beside the body), not already
         known."""
@@ -291,46 +301,55 @@ class NextLaneSensing:
         out: list[tuple[float, float, float, float, float]] = []
         reach = c.range_m + self.ego_length_m
         for b in bodies:
-            if math.hypot(b.x_m - fx, b.y_m - fy) > reach + b.box.radius_m:
+            _, _, bx, by, yaw_rad, speed_mps, length_m, width_m, _, box = b  # ``_BodyFields``
+            _, _, _, _, _, _, _, _, _, radius_m = box
+            if math.hypot(bx - fx, by - fy) > reach + radius_m:
                 continue  # beyond both corner radars and not beside the body
-            s, d, ryaw = self._project(road, b)
+            s, d, ryaw = self._project(road, bx, by, speed_mps)
             # the cheap tests first (all are pure): in the lane, not the obstacle, then seen
-            if not self._in_lane(d, b.width_m, lane_lo, lane_hi):
+            if not self._in_lane(d, width_m, lane_lo, lane_hi):
                 continue
-            if in_path is not None and _same(s, b.length_m, in_path.s_m, in_path.length_m):
+            if in_path is not None and _same(s, length_m, in_path.s_m, in_path.length_m):
                 continue
             beside = (
-                s - 0.5 * b.length_m <= s_f + BESIDE_M
-                and s + 0.5 * b.length_m >= s_f - self.ego_length_m - BESIDE_M
+                s - 0.5 * length_m <= s_f + BESIDE_M
+                and s + 0.5 * length_m >= s_f - self.ego_length_m - BESIDE_M
             )
-            if not beside and not any(self._corner_sees(b, *corner) for corner in corners):
+            if not beside and not self._corners_see(box, corners):
                 continue
             if any(
-                _same(s, b.length_m, q[0], q[3]) and abs(d - q[1]) < FUSION_GATE_M
+                _same(s, length_m, q[0], q[3]) and abs(d - q[1]) < FUSION_GATE_M
                 for q in (*known, *out)
             ):
                 continue
-            out.append((s, d, b.speed_mps * math.cos(b.yaw_rad - ryaw), b.length_m, b.width_m))
+            out.append((s, d, speed_mps * math.cos(yaw_rad - ryaw), length_m, width_m))
         return out
 
     @staticmethod
-    def _corner_sees(b, ox: float, oy: float, look: float, half_fov: float, range_m: float) -> bool:
-        """Some part of the road user's box lies within the corner radar's range, at a
-        bearing inside its field of view (its nearest point)."""
-        if math.hypot(b.x_m - ox, b.y_m - oy) > range_m + b.box.radius_m:
-            return False
-        return sees(ox, oy, look, half_fov, range_m, *b.box.nearest_point(ox, oy))
+    def _corners_see(box: OrientedBox, corners: tuple[Sensor, Sensor]) -> bool:
+        """Some part of the road user's box lies within a corner radar's range, at a bearing
+        inside its field of view (its nearest point)."""
+        bx, by, _, _, _, _, _, _, _, radius_m = box  # see ``_BoxFields``
+        for ox, oy, look, half_fov, range_m in corners:
+            if math.hypot(bx - ox, by - oy) > range_m + radius_m:
+                continue
+            px, py = nearest_point(box, ox, oy)
+            if sees(ox, oy, look, half_fov, range_m, px, py):
+                return True
+        return False
 
-    def _project(self, road, obj) -> tuple[float, float, float]:
+    def _project(
+        self, road, x_m: float, y_m: float, speed_mps: float
+    ) -> tuple[float, float, float]:
         """Road-frame (s, d, road yaw) of a road user's centre; kept for standing ones."""
-        if obj.speed_mps != 0.0:
-            return road.project(obj.x_m, obj.y_m)
-        key = (obj.x_m, obj.y_m)
+        if speed_mps != 0.0:
+            return road.project(x_m, y_m)
+        key = (x_m, y_m)
         hit = self._standing.get(key)
         if hit is None:
             if len(self._standing) > STANDING_CACHE:
                 self._standing.clear()
-            hit = self._standing[key] = road.project(obj.x_m, obj.y_m)
+            hit = self._standing[key] = road.project(x_m, y_m)
         return hit
 
     def _sensors(self, front_xy, yaw_rad: float) -> tuple[Sensor, Sensor, Sensor]:

@@ -71,7 +71,7 @@ from mypy_extensions import mypyc_attr
 from eoam_sumo.eoam_messages import ONCOMING, STANDING, next_lane_motion
 from eoam_sumo.sensing.coasting import Coaster
 from eoam_sumo.world.bodies import Body
-from eoam_sumo.world.geometry import OrientedBox, slab_entry
+from eoam_sumo.world.geometry import OrientedBox, nearest_point, slab_entry
 from eoam_sumo.world.lanes import (
     CROSSING_ANGLE_RAD,
     LANE_MARGIN_M,
@@ -181,10 +181,12 @@ EMPTY_REPORT = RadarReport(None, None, False, ())  # immutable: one for every em
 
 def ray_entry_m(box: OrientedBox, ox: float, oy: float, ux: float, uy: float) -> float:
     """Distance along the ray (origin o, unit direction u) to where it enters the box, or inf."""
-    lox, loy = box.to_local(ox, oy)
-    lux = box.cos_yaw * ux + box.sin_yaw * uy
-    luy = -box.sin_yaw * ux + box.cos_yaw * uy
-    return slab_entry(((lox, lux, box.half_length_m), (loy, luy, box.half_width_m)), math.inf)
+    bx, by, _, _, _, c, s, hl, hw, _ = box  # see ``_BoxFields``
+    dx, dy = ox - bx, oy - by
+    lox, loy = c * dx + s * dy, -s * dx + c * dy  # ``to_local``
+    lux = c * ux + s * uy
+    luy = -s * ux + c * uy
+    return slab_entry(((lox, lux, hl), (loy, luy, hw)), math.inf)
 
 
 def report_of(detections: list[Detection]) -> RadarReport:
@@ -293,7 +295,7 @@ class Radar:
         box: OrientedBox,
     ) -> tuple[float, float, float]:
         """(distance, x, y) of the point of ``box`` inside the cone nearest to the radar."""
-        px, py = box.nearest_point(ox, oy)
+        px, py = nearest_point(box, ox, oy)
         rx, ry = px - ox, py - oy
         r = math.hypot(rx, ry)
         if r <= 1e-9 or rx * cos_yaw + ry * sin_yaw >= r * self._cos_half_fov - 1e-12:
@@ -347,15 +349,16 @@ class Radar:
         bounding circle out of range or (one beam) wholly outside the cone first."""
         range_m = self.settings.range_m
         ox, oy, bx, by = ego.x_m, ego.y_m, ego.cos_yaw, ego.sin_yaw
-        dx, dy = box.x_m - ox, box.y_m - oy
-        reach = range_m + box.radius_m
+        box_x, box_y, _, _, _, _, _, _, _, radius_m = box  # see ``_BoxFields``
+        dx, dy = box_x - ox, box_y - oy
+        reach = range_m + radius_m
         if dx * dx + dy * dy > reach * reach:
             return None
         if self._near is not None:
             seen = self.seen_point(ox, oy, ego.yaw_rad, bx, by, box)
             return None if seen[0] == math.inf else seen
         along, across = dx * bx + dy * by, abs(dy * bx - dx * by)
-        if along * self._sin_half_fov - across * self._cos_half_fov < -box.radius_m:
+        if along * self._sin_half_fov - across * self._cos_half_fov < -radius_m:
             return None
         seen = self.visible_point(ox, oy, ego.yaw_rad, bx, by, box)
         return None if seen[0] > range_m else seen
@@ -369,26 +372,25 @@ class Radar:
         road_frame: RoadProjection,
     ) -> Detection:
         """The measurements and class of target ``index`` seen at (distance, x, y) ``seen``."""
-        box = tgt.box
+        _, _, _, _, _, speed_mps, length_m, width_m, _, box = tgt  # see ``_BodyFields``
+        box_x, box_y, box_yaw, _, _, box_c, box_s, _, _, _ = box
         ox, oy, bx, by = ego.x_m, ego.y_m, ego.cos_yaw, ego.sin_yaw
         rng, px, py = seen
         if rng > 1e-9:
             lx, ly = (px - ox) / rng, (py - oy) / rng
         else:
-            dx, dy = box.x_m - ox, box.y_m - oy
+            dx, dy = box_x - ox, box_y - oy
             norm = math.hypot(dx, dy)
             lx, ly = (dx / norm, dy / norm) if norm > 1e-9 else (bx, by)
-        tvx, tvy = tgt.speed_mps * box.cos_yaw, tgt.speed_mps * box.sin_yaw
+        tvx, tvy = speed_mps * box_c, speed_mps * box_s
         range_rate = (tvx - ego.vx_mps) * lx + (tvy - ego.vy_mps) * ly
         bearing = math.atan2(bx * ly - by * lx, bx * lx + by * ly)
-        s, d, road_yaw = road_frame.project(box.x_m, box.y_m)
-        road_speed = tgt.speed_mps * math.cos(box.yaw_rad - road_yaw)
+        s, d, road_yaw = road_frame.project(box_x, box_y)
+        road_speed = speed_mps * math.cos(box_yaw - road_yaw)
         ahead = s > ego.s_m
-        lateral = tgt.speed_mps * math.sin(box.yaw_rad - road_yaw)
-        band = body_band_m(ego.band_m, tgt.width_m)
-        category = self.classify(
-            ahead, d, tgt.speed_mps, road_speed, band, ego.lane_width_m, lateral
-        )
+        lateral = speed_mps * math.sin(box_yaw - road_yaw)
+        band = body_band_m(ego.band_m, width_m)
+        category = self.classify(ahead, d, speed_mps, road_speed, band, ego.lane_width_m, lateral)
         return Detection(
             index,
             rng,
@@ -398,8 +400,8 @@ class Radar:
             d,
             road_speed,
             category,
-            tgt.length_m,
-            tgt.width_m,
+            length_m,
+            width_m,
             self.head_on(category, ahead, d, band),
         )
 

@@ -112,8 +112,8 @@ class CoSimulation:
     meas: EgoMeasurement
     perception: Perception
     cmd: Command
-    bodies: list
-    bodies_before: list
+    bodies: list[Body]
+    bodies_before: list[Body]
 
     def __init__(
         self,
@@ -495,36 +495,34 @@ class CoSimulation:
         self._gaps, self._gaps_pose = {}, (Xn, Yn, yawn)
         min_gap_aro = self.min_gap_aro_m
         for b in self.bodies:
-            centres_m = math.hypot(b.x_m - ego_cx, b.y_m - ego_cy)
+            vid, _, bx, by, _, speed_mps, _, _, parked, box = b  # see ``_BodyFields``
+            _, _, _, _, _, _, _, _, _, radius_m = box
+            centres_m = math.hypot(bx - ego_cx, by - ego_cy)
             # the box gap's bound beyond the watch (the same as centres - ego radius -
             # max(radius, WATCH_RADIUS_M) > GAP_WATCH_M - ego radius - WATCH_RADIUS_M)
-            if centres_m - max(b.box.radius_m - WATCH_RADIUS_M, 0.0) > GAP_WATCH_M:
+            if centres_m - max(radius_m - WATCH_RADIUS_M, 0.0) > GAP_WATCH_M:
                 continue
-            reach_m = ego_move + b.speed_mps * step_s + self._reach_pad_m
+            reach_m = ego_move + speed_mps * step_s + self._reach_pad_m
             # the bounding circles' gap is a lower bound of the boxes' gap
-            circles_m = centres_m - ego_box_radius - b.box.radius_m - GAP_ROUNDING_M
+            circles_m = centres_m - ego_box_radius - radius_m - GAP_ROUNDING_M
             if circles_m > reach_m and circles_m >= min_gap_aro:
                 continue  # the box gap can be neither the ARO's least nor a contact
             # a parked car cannot be the ARO: its role is worked out only if it is hit; the
             # obstacle keeps its identity once it left the lane band (a person crossing on)
-            role = None if b.parked else self._role(b)
-            aro = role == "aro" or b.vid in self._obstacles
+            role = None if parked else self._role(b)
+            aro = role == "aro" or vid in self._obstacles
             if circles_m > reach_m and not aro:
                 continue
             if ego_box is None:
                 ego_box = OrientedBox.from_axis_point(
                     Xn, Yn, yawn, p.length_m, p.width_m, self._front
                 )
-            bound_m = gap_lower_bound(ego_box, b.box) - GAP_ROUNDING_M  # tighter, dearer
+            bound_m = gap_lower_bound(ego_box, box) - GAP_ROUNDING_M  # tighter, dearer
             if bound_m > reach_m and (not aro or bound_m >= min_gap_aro):
                 continue
-            known = gaps.get(b.vid)  # the same boxes as at the last step: the same gap
-            gap = (
-                known[1]
-                if known is not None and known[0] is b.box
-                else box_distance(ego_box, b.box)
-            )
-            self._gaps[b.vid] = (b.box, gap)
+            known = gaps.get(vid)  # the same boxes as at the last step: the same gap
+            gap = known[1] if known is not None and known[0] is box else box_distance(ego_box, box)
+            self._gaps[vid] = (box, gap)
             if aro and gap < self.min_gap_aro_m and self._met_ahead_of(b, ego_cx, ego_cy):
                 self.min_gap_aro_m = gap
             # contact during the step is possible only if the gap is within both moves

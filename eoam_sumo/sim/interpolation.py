@@ -38,26 +38,29 @@ def between(b0: Body, b1: Body, tau_s: float, step_s: float) -> Body:
     moved."""
     if tau_s >= step_s or b0 is b1:
         return b1
-    v0, v1 = b0.speed_mps, b1.speed_mps
+    _, _, x0, y0, yaw0, v0, _, _, _, _ = b0  # see ``_BodyFields``
+    vid, vclass, x1, y1, yaw1, v1, length_m, width_m, parked, _ = b1
     accel = (v1 - v0) / step_s
     whole_m = 0.5 * (v0 + v1) * step_s
     part_m = v0 * tau_s + 0.5 * accel * tau_s * tau_s
     w = part_m / whole_m if whole_m > 1e-9 else tau_s / step_s
-    turn = math.remainder(b1.yaw_rad - b0.yaw_rad, 2.0 * math.pi)
+    turn = math.remainder(yaw1 - yaw0, 2.0 * math.pi)
     return Body(
-        b1.vid,
-        b1.vclass,
-        b0.x_m + w * (b1.x_m - b0.x_m),
-        b0.y_m + w * (b1.y_m - b0.y_m),
-        b0.yaw_rad + turn * (tau_s / step_s),
+        vid,
+        vclass,
+        x0 + w * (x1 - x0),
+        y0 + w * (y1 - y0),
+        yaw0 + turn * (tau_s / step_s),
         v0 + accel * tau_s,
-        b1.length_m,
-        b1.width_m,
-        b1.parked,
+        length_m,
+        width_m,
+        parked,
     )
 
 
-def interpolate_reports(report0: list, report1: list, tau_s: float, step_s: float) -> list:
+def interpolate_reports(
+    report0: list[Body], report1: list[Body], tau_s: float, step_s: float
+) -> list[Body]:
     """The road users of SUMO's later report ``report1`` ``tau_s`` after the earlier one
     (:func:`between`); one not in ``report0`` (just departed or come within reach) as
     ``report1`` has it."""

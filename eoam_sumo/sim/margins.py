@@ -183,14 +183,10 @@ class Margins(StepObserver):
         cr, sr = math.cos(road_yaw), math.sin(road_yaw)
         ego_box = None
         for b in sim.bodies:
-            box = b.box
-            bound = (
-                math.hypot(box.x_m - ex, box.y_m - ey)
-                - self._radius_m
-                - box.radius_m
-                - GAP_ROUNDING_M
-            )
-            opposite = not b.parked and box.cos_yaw * cr + box.sin_yaw * sr < 0.0
+            vid, _, _, _, _, _, _, _, parked, box = b  # see ``_BodyFields``
+            bx, by, _, _, _, bc, bs, _, _, b_radius = box
+            bound = math.hypot(bx - ex, by - ey) - self._radius_m - b_radius - GAP_ROUNDING_M
+            opposite = not parked and bc * cr + bs * sr < 0.0
             near = bound < NEAR_MISS_GAP_M
             if not (near or (opposite and bound < self.min_gap_oncoming_m)):
                 continue
@@ -206,7 +202,7 @@ class Margins(StepObserver):
                 if gap < 0.0 and gap_lower_bound(ego_box, box) - GAP_ROUNDING_M < NEAR_MISS_GAP_M:
                     gap = box_distance(ego_box, box)
                 if 0.0 <= gap < self.closest_gap_m:
-                    self.closest_gap_m, self.closest_id = gap, b.vid
+                    self.closest_gap_m, self.closest_id = gap, vid
 
     def _along_lanes(self, sim: RunView) -> None:
         """Times to collision along the lanes, and the follower's measures.
@@ -218,42 +214,43 @@ class Margins(StepObserver):
         by the heading relative to the road, give the time to contact
         (``geometry.time_to_contact``)."""
         ego, ego_v = self._ego_in_frame(sim)
+        ego_st, ego_d = ego.x_m, ego.y_m
         follower: tuple[float, Body, float, tuple[float, float]] | None = None
         project, band = self._frame.project, self._band_m
         for b in sim.bodies:
-            if b.parked:
+            _, _, x_m, y_m, yaw_rad, speed_mps, length_m, width_m, parked, b_box = b
+            _, _, _, _, _, _, _, _, _, radius = b_box
+            if parked:
                 continue
-            st, d, road_yaw = project(b.x_m, b.y_m)
-            rel = b.yaw_rad - road_yaw
+            st, d, road_yaw = project(x_m, y_m)
+            rel = yaw_rad - road_yaw
             if math.cos(rel) < 0.0:  # opposite direction
-                v = self._rates(b, st, d, rel)
-                radius = b.box.radius_m
+                v = self._rates(speed_mps, st, d, rel)
                 if _apart(ego, st, d, radius, ego_v, v, self.min_ttc_oncoming_s):
                     continue  # never on a collision course within the smallest yet
-                box = OrientedBox(st, d, rel, b.length_m, b.width_m)
+                box = OrientedBox(st, d, rel, length_m, width_m)
                 ttc = time_to_contact(ego, box, ego_v, v, self.min_ttc_oncoming_s)
                 self.min_ttc_oncoming_s = min(self.min_ttc_oncoming_s, ttc)
                 self.min_ttc_s = min(self.min_ttc_s, ttc)
                 continue
-            behind_m = ego.x_m - st
+            behind_m = ego_st - st
             if behind_m < 0.0 and abs(d) < band:
                 continue  # the obstacle ahead in the ego's lane: its margin is the gap
             horizon = min(self.min_ttc_s, TTC_HORIZON_S)
             if behind_m > 0.0:
                 horizon = max(horizon, min(self.min_ttc_rear_s, TTC_HORIZON_S))
-            v = self._rates(b, st, d, rel)
+            v = self._rates(speed_mps, st, d, rel)
             # the box in the frame only when its bounding circle may meet the ego's
-            radius = b.box.radius_m
             if _apart(ego, st, d, radius, ego_v, v, horizon):
                 ttc = math.inf
             else:
-                box = OrientedBox(st, d, rel, b.length_m, b.width_m)
+                box = OrientedBox(st, d, rel, length_m, width_m)
                 ttc = time_to_contact(ego, box, ego_v, v, horizon)
             self.min_ttc_s = min(self.min_ttc_s, ttc)
             if behind_m <= 0.0:
                 continue
             self.min_ttc_rear_s = min(self.min_ttc_rear_s, ttc)
-            overlap = abs(d - ego.y_m) < 0.5 * (self.width_m + b.width_m)
+            overlap = abs(d - ego_d) < 0.5 * (self.width_m + width_m)
             if (
                 overlap
                 and behind_m < FOLLOWER_REACH_M
@@ -275,11 +272,11 @@ class Margins(StepObserver):
         v = ((vx * cr - vy * sr) / stretch, vx * sr + vy * cr)
         return OrientedBox(st, d, rel, self.length_m, self.width_m), v
 
-    def _rates(self, b: Body, st: float, d: float, rel: float) -> tuple[float, float]:
+    def _rates(self, speed_mps: float, st: float, d: float, rel: float) -> tuple[float, float]:
         """A road user's rates (s', d') in the road frame, at station ``st``, offset ``d``,
-        heading ``rel`` to the road."""
+        heading ``rel`` to the road, at its speed."""
         stretch = 1.0 - self._frame.curvature_at(st) * d
-        return (b.speed_mps * math.cos(rel) / stretch, b.speed_mps * math.sin(rel))
+        return (speed_mps * math.cos(rel) / stretch, speed_mps * math.sin(rel))
 
     def _follower(
         self,
@@ -323,9 +320,10 @@ def _apart(
     moving at these rates, cannot touch within ``t_s`` (infinite: ever): along either axis
     of the frame their centres are farther apart than their bounding circles, by more than
     the rate between them closes in that time (not at all when it opens or holds)."""
-    reach = a.radius_m + radius_m + GAP_ROUNDING_M
-    return _axis_apart(x_m - a.x_m, vb[0] - va[0], reach, t_s) or _axis_apart(
-        y_m - a.y_m, vb[1] - va[1], reach, t_s
+    ax, ay, _, _, _, _, _, _, _, a_radius = a
+    reach = a_radius + radius_m + GAP_ROUNDING_M
+    return _axis_apart(x_m - ax, vb[0] - va[0], reach, t_s) or _axis_apart(
+        y_m - ay, vb[1] - va[1], reach, t_s
     )
 
 

@@ -24,6 +24,7 @@ from mypy_extensions import mypyc_attr
 
 from eoam_sumo.eoam import Command, EgoMeasurement, Perception
 from eoam_sumo.sim.runlog import RunLog
+from eoam_sumo.world.bodies import Body
 from eoam_sumo.world.lanes import lane_band_m
 
 _LANE_CHANGE_MODES = (2, 4)  # the EOAM's modes that begin a lane change
@@ -61,9 +62,9 @@ class RunView(Protocol):
     @property
     def x(self) -> list[float]: ...  # plant state now
     @property
-    def bodies(self) -> Sequence[Any]: ...  # the road users near the ego now (``Body``)
+    def bodies(self) -> Sequence[Body]: ...  # the road users near the ego now
     @property
-    def bodies_before(self) -> Sequence[Any]: ...  # the road users at the last step's start
+    def bodies_before(self) -> Sequence[Body]: ...  # the road users at the last step's start
     @property
     def session(self) -> Any: ...  # the SUMO session (queries only)
     @property

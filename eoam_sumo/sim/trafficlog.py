@@ -44,6 +44,7 @@ import numpy as np
 from eoam_sumo.fileio import write_atomic
 from eoam_sumo.sim.observers import RunView, StepObserver
 from eoam_sumo.sim.roadframe import RoadFrame
+from eoam_sumo.world.bodies import Body
 from eoam_sumo.world.lanes import ONCOMING_SPEED_MPS, crosses_lane, lane_band_m
 
 TRAFFIC_FILE = "traffic.csv"
@@ -140,8 +141,8 @@ class TrafficLog(StepObserver):
         r2 = self._r2
         rows: dict[str, list] = {}
         for _ti, ex, ey, _yaw, _vx, bodies in self._steps:
-            for b in bodies:
-                if (b.x_m - ex) * (b.x_m - ex) + (b.y_m - ey) * (b.y_m - ey) <= r2 and not b.parked:
+            for b in _within(bodies, ex, ey, r2):
+                if not b.parked:
                     rows.setdefault(b.vid, []).append(b)
         if not rows:
             return False
@@ -174,9 +175,7 @@ class TrafficLog(StepObserver):
         times: list[float] = []
         counts: list[int] = []
         for ti, ex, ey, yaw, vx, bodies in self._steps:
-            near = [
-                b for b in bodies if (b.x_m - ex) * (b.x_m - ex) + (b.y_m - ey) * (b.y_m - ey) <= r2
-            ]
+            near = _within(bodies, ex, ey, r2)
             rows.append(
                 (
                     self.ego_id,
@@ -343,3 +342,13 @@ def read_traffic(path: Path):
         raise InputError(f"{path}: cannot be read as a run's traffic log: no column {missing[0]}")
     check_finite(path, frame, ("time_s", "x_m", "y_m"))
     return frame
+
+
+def _within(bodies: Sequence[Body], ex: float, ey: float, r2: float) -> list[Body]:
+    """The road users whose centre is within sqrt(``r2``) of (ex, ey), in their order."""
+    near = []
+    for b in bodies:
+        _, _, x_m, y_m, _, _, _, _, _, _ = b  # see ``_BodyFields``
+        if (x_m - ex) * (x_m - ex) + (y_m - ey) * (y_m - ey) <= r2:
+            near.append(b)
+    return near

@@ -27,7 +27,9 @@ PEDESTRIAN = "pedestrian"  # SUMO's vClass of persons
 
 class _BodyFields(NamedTuple):
     """Body's fields, typed so that compiled code reads them as floats (hypothesis' ``builds``
-    would ask for every field: build bodies with the constructor)."""
+    would ask for every field: build bodies with the constructor). The functions of the step
+    loop unpack a body (``vid, _, x, y, ... = b``): compiled code then reads the tuple's items
+    directly, a field by name through Python's attribute lookup."""
 
     vid: str
     vclass: str

@@ -56,7 +56,9 @@ CONTACT_KINDS = ("head_on", "rear_end", "side", "oblique")
 
 class _BoxFields(NamedTuple):
     """OrientedBox's fields, typed so that compiled code reads them as floats (hypothesis'
-    ``builds`` would ask for every field: build boxes with the constructor)."""
+    ``builds`` would ask for every field: build boxes with the constructor). The functions of
+    the step loop unpack a box (``x, y, _, _, _, c, s, hl, hw, _ = box``): compiled code then
+    reads the tuple's items directly, a field by name through Python's attribute lookup."""
 
     x_m: float
     y_m: float
@@ -175,7 +177,7 @@ class OrientedBox(_BoxFields):
 
     def nearest_point(self, x_m: float, y_m: float) -> tuple[float, float]:
         """The point of the box (boundary or inside) closest to a world point."""
-        return _nearest_point(self, x_m, y_m)
+        return nearest_point(self, x_m, y_m)
 
     def distance_to_point(self, x_m: float, y_m: float) -> float:
         """Euclidean distance from a world point to the box (0 inside)."""
@@ -200,25 +202,23 @@ class Contact:
 
 
 def _axes(a: OrientedBox, b: OrientedBox) -> tuple[tuple[float, float], ...]:
-    return (
-        (a.cos_yaw, a.sin_yaw),
-        (-a.sin_yaw, a.cos_yaw),
-        (b.cos_yaw, b.sin_yaw),
-        (-b.sin_yaw, b.cos_yaw),
-    )
+    _, _, _, _, _, ac, asin, _, _, _ = a
+    _, _, _, _, _, bc, bsin, _, _, _ = b
+    return ((ac, asin), (-asin, ac), (bc, bsin), (-bsin, bc))
 
 
 def _half_extent(box: OrientedBox, nx: float, ny: float) -> float:
     """Half the length of the box's projection on the unit axis (nx, ny)."""
-    return box.half_length_m * abs(box.cos_yaw * nx + box.sin_yaw * ny) + box.half_width_m * abs(
-        -box.sin_yaw * nx + box.cos_yaw * ny
-    )
+    _, _, _, _, _, c, s, hl, hw, _ = box
+    return hl * abs(c * nx + s * ny) + hw * abs(-s * nx + c * ny)
 
 
 def boxes_overlap(a: OrientedBox, b: OrientedBox, tol_m: float = CONTACT_TOLERANCE_M) -> bool:
     """True when the boxes overlap or touch (within ``tol_m``); separating-axis test."""
-    dx, dy = b.x_m - a.x_m, b.y_m - a.y_m
-    reach = a.radius_m + b.radius_m + tol_m
+    ax, ay, _, _, _, _, _, _, _, a_radius = a
+    bx, by, _, _, _, _, _, _, _, b_radius = b
+    dx, dy = bx - ax, by - ay
+    reach = a_radius + b_radius + tol_m
     if dx * dx + dy * dy > reach * reach:
         return False
     for nx, ny in _axes(a, b):
@@ -232,9 +232,9 @@ def gap_lower_bound(a: OrientedBox, b: OrientedBox) -> float:
     axes (an axis separates the boxes by at most their distance; <= 0 when they overlap along
     every axis), equal to the gap for boxes end to end in one lane or side by side. The four
     projections of ``boxes_overlap`` written out, far cheaper than ``box_distance``."""
-    dx, dy = b.x_m - a.x_m, b.y_m - a.y_m
-    ac, asin, bc, bsin = a.cos_yaw, a.sin_yaw, b.cos_yaw, b.sin_yaw
-    ahl, ahw, bhl, bhw = a.half_length_m, a.half_width_m, b.half_length_m, b.half_width_m
+    ax, ay, _, _, _, ac, asin, ahl, ahw, _ = a
+    bx, by, _, _, _, bc, bsin, bhl, bhw, _ = b
+    dx, dy = bx - ax, by - ay
     c, s = abs(ac * bc + asin * bsin), abs(ac * bsin - asin * bc)  # b's yaw relative to a's
     return max(
         abs(dx * ac + dy * asin) - ahl - bhl * c - bhw * s,
@@ -244,12 +244,19 @@ def gap_lower_bound(a: OrientedBox, b: OrientedBox) -> float:
     )
 
 
-def _nearest_point(box: OrientedBox, x_m: float, y_m: float) -> tuple[float, float]:
-    """``OrientedBox.nearest_point`` (a module function: compiled code calls it directly)."""
-    c, s = box.cos_yaw, box.sin_yaw
-    dx, dy = x_m - box.x_m, y_m - box.y_m
+def nearest_point(box: OrientedBox, x_m: float, y_m: float) -> tuple[float, float]:
+    """``OrientedBox.nearest_point`` as a module function: compiled code calls it directly
+    (the method of a tuple subclass goes through Python's call)."""
+    bx, by, _, _, _, c, s, hl, hw, _ = box
+    return _nearest_point_of(bx, by, c, s, hl, hw, x_m, y_m)
+
+
+def _nearest_point_of(
+    bx: float, by: float, c: float, s: float, hl: float, hw: float, x_m: float, y_m: float
+) -> tuple[float, float]:
+    """``nearest_point`` of the box centred at (bx, by), heading (c, s), half sizes hl, hw."""
+    dx, dy = x_m - bx, y_m - by
     lx, ly = c * dx + s * dy, -s * dx + c * dy  # to_local, to_world inlined (hot path)
-    hl, hw = box.half_length_m, box.half_width_m
     if lx > hl:  # clamp to the box (comparisons: min/max calls cost more here)
         lx = hl
     elif lx < -hl:
@@ -258,17 +265,17 @@ def _nearest_point(box: OrientedBox, x_m: float, y_m: float) -> tuple[float, flo
         ly = hw
     elif ly < -hw:
         ly = -hw
-    return box.x_m + c * lx - s * ly, box.y_m + s * lx + c * ly
+    return bx + c * lx - s * ly, by + s * lx + c * ly
 
 
 def _nearest_corner(src: OrientedBox, dst: OrientedBox) -> tuple[float, float, float, float, float]:
     """(distance, x, y of the corner, x, y of its nearest point of dst) of the first corner of
     ``src`` nearest to ``dst`` (distance inf, zeros if none is finite); ``corners`` written
     out, the same arithmetic: the margins and the contact check ask this every step."""
-    c, s = src.cos_yaw, src.sin_yaw
-    fx, fy = c * src.half_length_m, s * src.half_length_m
-    lx, ly = -s * src.half_width_m, c * src.half_width_m
-    x, y = src.x_m, src.y_m
+    x, y, _, _, _, c, s, hl, hw, _ = src
+    dst_x, dst_y, _, _, _, dst_c, dst_s, dst_hl, dst_hw, _ = dst
+    fx, fy = c * hl, s * hl
+    lx, ly = -s * hw, c * hw
     best = (math.inf, 0.0, 0.0, 0.0, 0.0)
     for cx, cy in (
         (x + fx + lx, y + fy + ly),
@@ -276,7 +283,7 @@ def _nearest_corner(src: OrientedBox, dst: OrientedBox) -> tuple[float, float, f
         (x - fx - lx, y - fy - ly),
         (x + fx - lx, y + fy - ly),
     ):
-        px, py = _nearest_point(dst, cx, cy)
+        px, py = _nearest_point_of(dst_x, dst_y, dst_c, dst_s, dst_hl, dst_hw, cx, cy)
         dist = math.hypot(cx - px, cy - py)
         if dist < best[0]:
             best = (dist, cx, cy, px, py)
@@ -454,10 +461,10 @@ def time_to_contact(
 
     Separating-axis test of the moving pair: on each of the four box axes the gap between
     the projections changes linearly with time; contact needs every axis closed at once."""
-    dx, dy = b.x_m - a.x_m, b.y_m - a.y_m
+    ax, ay, _, _, _, ac, asn, ahl, ahw, _ = a
+    bx, by, _, _, _, bc, bsn, bhl, bhw, _ = b
+    dx, dy = bx - ax, by - ay
     rvx, rvy = vb[0] - va[0], vb[1] - va[1]
-    ac, asn, ahl, ahw = a.cos_yaw, a.sin_yaw, a.half_length_m, a.half_width_m
-    bc, bsn, bhl, bhw = b.cos_yaw, b.sin_yaw, b.half_length_m, b.half_width_m
     # b's centre on each axis relative to a's, its rate, and the pair's reach on that axis
     # (``_axes`` and ``_half_extent`` written out, the same arithmetic)
     return slab_entry(

@@ -2,13 +2,13 @@
 users found in it, on a straight road (closed-form geometry; no SUMO)."""
 
 import math
-from collections import namedtuple
 
 import pytest
 
 from eoam_sumo.sensing.next_lane import COVERAGE_STEP_M, NextLaneSensing, hides, sees
 from eoam_sumo.sensing.radar import Radar, RadarSettings
 from eoam_sumo.sensing.v2x import V2XSettings
+from eoam_sumo.world.bodies import Body
 from eoam_sumo.world.geometry import OrientedBox
 
 LANE = 3.5
@@ -40,10 +40,8 @@ class LeftCurve:
         return self.r * a, self.r - math.hypot(x, self.r - y), a
 
 
-class Body(namedtuple("Body", "vid x_m y_m yaw_rad speed_mps length_m width_m")):
-    @property
-    def box(self):
-        return OrientedBox(self.x_m, self.y_m, self.yaw_rad, self.length_m, self.width_m)
+def _body(vid, x_m, y_m, yaw_rad, speed_mps, length_m, width_m):
+    return Body(vid, "passenger", x_m, y_m, yaw_rad, speed_mps, length_m, width_m)
 
 
 def test_a_sensor_sees_within_its_range_and_field_of_view():
@@ -98,7 +96,7 @@ def test_on_a_left_curve_the_lane_leaves_the_forward_radars_field_sooner():
 
 
 def test_the_obstacle_ahead_hides_the_lane_beyond_its_shadow():
-    aro = Body("aro", 42.5, 0.0, 0.0, 0.0, 5.0, 2.0)
+    aro = _body("aro", 42.5, 0.0, 0.0, 0.0, 5.0, 2.0)
     view = _view(_sensing(), [aro])
     near = 0.5 * LANE + 0.25  # the near line is hidden from x = 2.0 * 40 / 1.0 = 80 m
     assert view.coverage_ahead_m == pytest.approx(near * 40.0 / 1.0, abs=COVERAGE_STEP_M)
@@ -108,7 +106,7 @@ def test_the_obstacle_ahead_hides_the_lane_beyond_its_shadow():
 @pytest.mark.parametrize("speed", [-1.5, 0.0, 1.5, -20.0])
 def test_any_road_user_in_the_next_lane_limits_the_free_length_whatever_its_speed(speed):
     yaw = math.pi if speed < 0 else 0.0
-    van = Body("van", 62.5, LANE, yaw, abs(speed), 5.0, 2.0)
+    van = _body("van", 62.5, LANE, yaw, abs(speed), 5.0, 2.0)
     view = _view(_sensing(), [van])
     assert view.nearest_ahead_m == pytest.approx(60.0)
     assert view.known_free_ahead_m == pytest.approx(60.0)
@@ -116,18 +114,18 @@ def test_any_road_user_in_the_next_lane_limits_the_free_length_whatever_its_spee
 
 
 def test_a_person_beside_the_ego_is_found_by_the_corner_radar():
-    walker = Body("p", -2.0, LANE, 0.0, 1.2, 0.5, 0.5)  # beside the ego's body
+    walker = _body("p", -2.0, LANE, 0.0, 1.2, 0.5, 0.5)  # beside the ego's body
     view = _view(_sensing(), [walker])
     assert view.nearest_ahead_m == 0.0  # overlapping the ego's stations: blocks at once
 
 
 def test_a_car_closing_from_behind_is_found_by_the_rear_corner_radar():
-    car = Body("c", -40.0, LANE, 0.0, 40.0, 4.7, 1.8)
+    car = _body("c", -40.0, LANE, 0.0, 40.0, 4.7, 1.8)
     view = _view(_sensing(), [car])
     assert view.nearest_behind_m == pytest.approx(40.0 - 4.92 - 2.35)
     assert view.nearest_behind_speed_mps == pytest.approx(40.0)
     assert (
-        _view(_sensing(), [Body("c", -90.0, LANE, 0.0, 40.0, 4.7, 1.8)]).nearest_behind_m is None
+        _view(_sensing(), [_body("c", -90.0, LANE, 0.0, 40.0, 4.7, 1.8)]).nearest_behind_m is None
     )  # beyond the corner radar's 80 m
 
 
@@ -141,11 +139,11 @@ def test_full_penetration_v2x_proves_the_range_free_less_its_blind_distance():
 
 def test_a_v2x_car_beyond_the_radar_limits_the_free_length_and_is_fused_when_seen():
     sensing = _sensing(V2XSettings(range_m=1000.0, latency_s=0.0))
-    car = Body("c", 402.35, LANE, math.pi, 20.0, 4.7, 1.8)
+    car = _body("c", 402.35, LANE, math.pi, 20.0, 4.7, 1.8)
     view = _view(sensing, [car])
     assert view.nearest_ahead_m == pytest.approx(400.0)
     assert view.known_free_ahead_m == pytest.approx(400.0)
-    near = Body("c", 52.35, LANE, math.pi, 20.0, 4.7, 1.8)  # seen by radar and V2X: one
+    near = _body("c", 52.35, LANE, math.pi, 20.0, 4.7, 1.8)  # seen by radar and V2X: one
     view = _view(sensing, [near], t=0.1)
     assert view.nearest_ahead_m == pytest.approx(50.0)
 
@@ -165,12 +163,12 @@ def _right_sensing(target_width_m=LANE):
 
 
 def test_the_right_lane_is_sensed_as_the_left_one_mirrored():
-    car = Body("c", -40.0, -LANE, 0.0, 40.0, 4.7, 1.8)  # behind, in the right lane
+    car = _body("c", -40.0, -LANE, 0.0, 40.0, 4.7, 1.8)  # behind, in the right lane
     view = _view(_right_sensing(), [car])
     assert view.side == -1
     assert view.nearest_behind_m == pytest.approx(40.0 - 4.92 - 2.35)
     assert (
-        _view(_right_sensing(), [Body("c", -40.0, LANE, 0.0, 40.0, 4.7, 1.8)]).nearest_behind_m
+        _view(_right_sensing(), [_body("c", -40.0, LANE, 0.0, 40.0, 4.7, 1.8)]).nearest_behind_m
         is None
     )
     left = _view(_sensing(), [])
@@ -181,7 +179,7 @@ def test_the_right_lane_is_sensed_as_the_left_one_mirrored():
 def test_a_wider_right_lane_reaches_further_out():
     sensing = _right_sensing(target_width_m=4.0)
     assert sensing.band_m == pytest.approx((-(0.5 * LANE + 4.0), -0.5 * LANE))
-    van = Body("van", 62.5, -(0.5 * LANE + 3.7), 0.0, 10.0, 5.0, 1.0)  # in its outer half
+    van = _body("van", 62.5, -(0.5 * LANE + 3.7), 0.0, 10.0, 5.0, 1.0)  # in its outer half
     view = _view(sensing, [van])
     assert view.nearest_ahead_m == pytest.approx(60.0)
     assert view.lane_width_m == 4.0
@@ -193,7 +191,7 @@ def test_a_road_users_acceleration_is_its_speed_change_over_the_baseline():
     x = 60.0
     views = []
     for k, v in enumerate(speeds):
-        car = Body("c", x, LANE, 0.0, v, 4.7, 1.8)
+        car = _body("c", x, LANE, 0.0, v, 4.7, 1.8)
         views.append(_view(sensing, [car], t=0.1 * k))
         x += v * 0.1
     assert views[0].users_ahead_accel()[0][2] == 0.0  # not followed long enough yet

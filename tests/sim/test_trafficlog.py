@@ -4,7 +4,6 @@ straight east-bound lane centred on y = -1.75, 3.5 m wide)."""
 from __future__ import annotations
 
 import math
-from collections import namedtuple
 
 import pytest
 from hypothesis import given, settings
@@ -12,9 +11,9 @@ from hypothesis import strategies as st
 
 from eoam_sumo.errors import InputError
 from eoam_sumo.sim.trafficlog import TRAFFIC_COLUMNS, TrafficLog, read_traffic
+from eoam_sumo.world.bodies import Body
 
-# the fields the log reads of a road user (the session's Body has these and its box)
-User = namedtuple("User", "vid vclass x_m y_m yaw_rad speed_mps length_m width_m parked")
+User = Body  # a road user as the session gives it
 
 LANE = [(0.0, -1.75), (1000.0, -1.75)]
 EGO_LEN, EGO_WID, TO_CENTRE = 4.92, 1.85, 0.5
@@ -165,18 +164,25 @@ def test_bad_radius_is_refused():
 
 CURVE = [(200.0 * math.sin(a / 20), 200.0 * (1 - math.cos(a / 20)) - 1.75) for a in range(40)]
 coord = st.floats(-250.0, 250.0, allow_nan=False)
+
+
+def _user(*fields):
+    """A road user from its first nine fields (``builds(Body)`` would ask for its box too)."""
+    return User(*fields)
+
+
 users = st.lists(
     st.builds(
-        User,
-        vid=st.sampled_from(["a", "b", "c", "z"]),
-        vclass=st.just("passenger"),
-        x_m=coord,
-        y_m=coord,
-        yaw_rad=st.floats(-4.0, 4.0),
-        speed_mps=st.floats(0.0, 40.0),
-        length_m=st.just(4.5),
-        width_m=st.just(1.8),
-        parked=st.booleans(),
+        _user,
+        st.sampled_from(["a", "b", "c", "z"]),
+        st.just("passenger"),
+        coord,
+        coord,
+        st.floats(-4.0, 4.0),
+        st.floats(0.0, 40.0),
+        st.just(4.5),
+        st.just(1.8),
+        st.booleans(),
     ),
     max_size=4,
     unique_by=lambda u: u.vid,
