@@ -9,8 +9,10 @@ each combination into a group of draws, in turn.
 Two levels of checks, both raising ``InputError`` naming the matrix file and the key:
 :func:`load_matrix` checks the TOML on its own (keys, types, ranges, files exist);
 :func:`check_matrix` then checks it against what a run will use (the scenario's files parse
-and hold the ego; every speed and friction is covered by the lookup tables), so a batch
-refuses bad input before any case runs.
+and hold the ego; every speed and friction is covered by the lookup tables, without ``mu``
+the network's own frictions where the ego departs), so a batch refuses bad input before any
+case runs. Without ``mu`` every case runs on each lane's own friction, as ``run`` without
+``--mu`` does.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import difflib
 import itertools
 import math
 import tomllib
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -32,7 +35,8 @@ from eoam_sumo.seeds import check_seed
 from eoam_sumo.sensing.automotive import parse_radar_model
 from eoam_sumo.sensing.friction import parse_mu_belief
 from eoam_sumo.sim.scenario import ScenarioFiles, ScenarioOverrides, check_scenario, scripted_stops
-from eoam_sumo.sim.scenario.routes import check_oncoming_road
+from eoam_sumo.sim.scenario.routes import check_oncoming_road, ego_route_edges
+from eoam_sumo.sim.scenario.xmlread import xml_source
 from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S, MAX_TIME_LIMIT_S, check_sumo_step_s
 from eoam_sumo.sim.vehicle import vehicle_name, vehicle_tables, vehicle_tables_dir
 from eoam_sumo.textfiles import not_utf8
@@ -91,7 +95,8 @@ SCHEMA = {
     "paper": ("table",),
     "sample": (),  # draws, seed and the sampled keys: checked by sampling.parse_sample
 }
-REQUIRED = {"scenario": (), "sweep": ("ego_speed_kmh", "mu")}  # unless sampled
+#: ``mu`` may be left out: every case then runs on each lane's own friction (the network's)
+REQUIRED = {"scenario": (), "sweep": ("ego_speed_kmh",)}  # unless sampled
 PAPER_COLUMNS = ("oncoming_start_m", "ego_speed_kmh", "mu", "outcome")
 POLICIES = ("paper", "safe")
 #: The equipment keys: ``abs`` and ``esc`` switch one system, ``abs_esc`` both together;
@@ -125,7 +130,7 @@ class Case:
     case_id: str
     sumocfg: Path
     ego_speed_kmh: float
-    mu: float
+    mu: float | None  # None: each lane's own friction, as the network sets it
     oncoming_start_m: float | None
     aro_hold_s: float | None
     aro_decel_mps2: float | None
@@ -190,7 +195,7 @@ class Matrix:
     sumocfg: Path | None  # None: a generated scenario (``traffic_axes``)
     max_time_s: float
     ego_speeds_kmh: tuple[float, ...]
-    mus: tuple[float, ...]
+    mus: tuple[float, ...]  # (): each lane's own friction (the network's) in every case
     oncoming_starts_m: tuple[float | None, ...]
     aro_holds_s: tuple[float, ...]
     aro_decels_mps2: tuple[float, ...]
@@ -234,7 +239,7 @@ class Matrix:
                 tuple(sorted(self.oncoming_starts_m, key=lambda d: d is not None)),
             ),
             ("ego_speed_kmh", self.ego_speeds_kmh),
-            ("mu", self.mus),
+            ("mu", self.mus or (None,)),
             ("aro_hold_s", self.aro_holds_s or (None,)),
             ("aro_decel_mps2", self.aro_decels_mps2 or (None,)),
         )
@@ -556,9 +561,7 @@ def load_matrix(path: Path) -> Matrix:
             f"{path}: [sample] v2x_range_m: V2X informs the safe policy only; set "
             'policy = "safe" in [scenario] (not a [sweep] of policies)'
         )
-    paper = None
-    if "table" in doc.get("paper", {}):
-        paper = _existing_file(path, "[paper] table", doc["paper"]["table"])
+    paper = _paper_table(path, doc, sampled)
     settings = _sensing_settings(path, scenario)
     seed = check_seed(scenario.get("seed", 0), f"{path}: [scenario] seed")
     return Matrix(
@@ -582,6 +585,19 @@ def load_matrix(path: Path) -> Matrix:
         policy=policy,
         v2x=v2x,
     )
+
+
+def _paper_table(path: Path, doc: dict, sampled: tuple[str, ...]) -> Path | None:
+    """[paper] table (None: not given); refused without a swept or sampled ``mu``: the
+    paper's cells are per friction, and a case on the network's own has none to match."""
+    if "table" not in doc.get("paper", {}):
+        return None
+    if "mu" not in doc.get("sweep", {}) and "mu" not in sampled:
+        raise InputError(
+            f"{path}: [paper] table needs [sweep] mu: the paper's cells are per friction, "
+            "and without mu every case runs on the network's own lane frictions"
+        )
+    return _existing_file(path, "[paper] table", doc["paper"]["table"])
 
 
 def _after_stop(path: Path, scenario: dict) -> float | None:
@@ -907,7 +923,9 @@ def _swept_values(path: Path, sweep: dict, sampled: tuple[str, ...]) -> dict:
         ),
         "mus": (None,)
         if "mu" in sampled
-        else _number_list(path, "mu", sweep["mu"], minimum=0.0, inclusive=False, maximum=MU_MAX),
+        else _number_list(path, "mu", sweep["mu"], minimum=0.0, inclusive=False, maximum=MU_MAX)
+        if "mu" in sweep
+        else (),
         "oncoming_starts_m": (None,)
         if "oncoming_start_m" in sampled
         else _number_list(
@@ -940,8 +958,9 @@ def check_matrix(matrix: Matrix, tables_dir: Path | None = None, ego_id: str = "
     vehicle ``ego_id`` (``sim.scenario.check_scenario``, no SUMO started); every swept
     speed and friction must be one the lookup tables in ``tables_dir`` (default: the folder
     the co-simulation uses, ``$EOAM_TABLES_DIR`` or the repository's ``tables/``) cover, by
-    the same ``LookupTables.check_run`` each run applies. InputError names the matrix file,
-    the key and the value.
+    the same ``LookupTables.check_run`` each run applies; without ``mu`` (each lane's own
+    friction) the frictions of the lanes the ego may depart on (``start_frictions``), as a
+    run checks the one under the ego. InputError names the matrix file, the key and the value.
     """
     if matrix.sumocfg is None:  # generated per case: nothing to read yet
         _check_generated_oncoming(matrix)
@@ -958,7 +977,40 @@ def check_matrix(matrix: Matrix, tables_dir: Path | None = None, ego_id: str = "
     except InputError as exc:
         raise InputError(f"{matrix.path}: [scenario] sumocfg: {exc}") from exc
     _check_oncoming_road(matrix, files, ego_id)
-    _check_vehicles_tables(matrix, tables_dir)
+    own = not matrix.mus and not _extremes(matrix, "mu")
+    lanes = StartFrictions(files.net_file, start_frictions(files, ego_id)) if own else None
+    _check_vehicles_tables(matrix, tables_dir, lanes)
+
+
+@dataclass(frozen=True)
+class StartFrictions:
+    """The network's own frictions a matrix without ``mu`` starts its cases on: (lane id,
+    friction) of each lane of ``net_file`` the ego may depart on."""
+
+    net_file: Path
+    lanes: tuple[tuple[str, float], ...]
+
+
+def start_frictions(files: ScenarioFiles, ego_id: str = "ego") -> tuple[tuple[str, float], ...]:
+    """(lane id, friction) of each lane the ego may depart on, as its network writes them
+    (SUMO's default 1 where a lane has none): its ``departLane`` on its first route edge (a
+    trip's ``from``); every lane of that edge when the lane is no number (``free``, ...);
+    every lane of the network when the edge is not known before SUMO routes the ego."""
+    spec = files.vehicles[ego_id]
+    route = ego_route_edges(files, ego_id)
+    edge = route[0] if route else spec.attrs.get("from")
+    lane = spec.attrs.get("departLane", "")
+    frictions, current = [], None
+    for event, elem in ET.iterparse(xml_source(files.net_file), events=("start", "end")):
+        if event == "start" and elem.tag == "edge":
+            normal = elem.get("function") in (None, "normal")
+            current = elem.get("id") if normal and edge in (None, elem.get("id")) else None
+        elif event == "start" and elem.tag == "lane" and current is not None:
+            if not lane.isdigit() or elem.get("index") == lane:
+                frictions.append((elem.get("id", ""), float(elem.get("friction", "1"))))
+        elif event == "end" and elem.tag in ("edge", "junction", "connection", "tlLogic"):
+            elem.clear()
+    return tuple(frictions)
 
 
 def _check_generated_oncoming(matrix: Matrix) -> None:
@@ -986,10 +1038,13 @@ def _check_oncoming_road(matrix: Matrix, files: ScenarioFiles, ego_id: str) -> N
         raise InputError(f"{matrix.path}: oncoming_start_m = {asked[0]:g}: {exc}") from exc
 
 
-def _check_vehicles_tables(matrix: Matrix, tables_dir: Path | None) -> None:
+def _check_vehicles_tables(
+    matrix: Matrix, tables_dir: Path | None, lanes: StartFrictions | None = None
+) -> None:
     """Every vehicle of the matrix (swept, or any its sample may choose; none named: the
     sedan) has its lookup tables under ``tables_dir`` (``sim.vehicle.vehicle_tables_dir``),
-    built for its parameters, covering every speed and friction of the matrix."""
+    built for its parameters, covering every speed and friction of the matrix (``lanes``:
+    the network's, without ``mu``)."""
     dist = matrix.sample.of("vehicle") if matrix.sample else None
     named = {v for v in (*matrix.vehicles, *(dist.extremes() if dist else ())) if v is not None}
     switches = itertools.product(_switched(matrix, "abs"), _switched(matrix, "esc"))
@@ -1002,7 +1057,7 @@ def _check_vehicles_tables(matrix: Matrix, tables_dir: Path | None) -> None:
             if vehicle is None and abs_fitted is None:
                 raise
             raise InputError(f"{matrix.path}: vehicle {name!r}: {exc}") from None
-        check_within_tables(matrix, tables, vehicle_tables_dir(name, tables_dir, params))
+        check_within_tables(matrix, tables, vehicle_tables_dir(name, tables_dir, params), lanes)
 
 
 def _switched(matrix: Matrix, system: str) -> tuple[bool | None, ...]:
@@ -1027,8 +1082,11 @@ def vehicle_params(
     return params
 
 
-def check_within_tables(matrix: Matrix, tables, folder: Path | str | None = None) -> None:
-    """InputError for the first swept speed or friction ``tables.check_run`` refuses.
+def check_within_tables(
+    matrix: Matrix, tables, folder: Path | str | None = None, lanes: StartFrictions | None = None
+) -> None:
+    """InputError for the first swept speed or friction ``tables.check_run`` refuses, then
+    for the first of the network's own frictions ``lanes`` (a matrix without ``mu``).
 
     Speeds are checked at the tables' highest friction and frictions at their lowest speed,
     so the error names the key at fault (``check_run`` refuses speeds above the grid and
@@ -1066,6 +1124,23 @@ def check_within_tables(matrix: Matrix, tables, folder: Path | str | None = None
                     f"{matrix.path}: {table} {key} value {value:g} is outside the lookup "
                     f"tables{where}: {exc}"
                 ) from exc
+    if lanes is not None:
+        _check_start_frictions(matrix, tables, folder, lanes)
+
+
+def _check_start_frictions(matrix: Matrix, tables, folder, lanes: StartFrictions) -> None:
+    """InputError for the first of the network's own frictions where the ego departs that
+    ``tables.check_run`` refuses (a matrix without ``mu``)."""
+    for lane, mu in lanes.lanes:
+        try:
+            tables.check_run(mu, tables.speed_grid_mps[0])
+        except InputError as exc:
+            where = "" if folder is None else f" in {folder}"
+            raise InputError(
+                f"{matrix.path}: no mu in [sweep], so the cases run on the network's own "
+                f"frictions, and lane '{lane}' of {lanes.net_file} (where the ego departs) has "
+                f"friction {mu:g}, outside the lookup tables{where}: {exc}"
+            ) from exc
 
 
 def _extremes(matrix: Matrix, key: str) -> tuple:

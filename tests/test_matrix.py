@@ -170,7 +170,7 @@ BAD = [
     ),
     ("sumocfg not a string", "[scenario]\nsumocfg = 3\n" + GOOD_SWEEP, "sumocfg", None),
     ("no sumocfg key", "[scenario]\nmax_time_s = 10.0\n" + GOOD_SWEEP, "sumocfg", None),
-    ("no mu key", GOOD_SCENARIO + "[sweep]\nego_speed_kmh = [120]\n", "mu", None),
+    ("no speed key", GOOD_SCENARIO + "[sweep]\nmu = [1.0]\n", "ego_speed_kmh", None),
     ("no scenario table", GOOD_SWEEP, "scenario", None),
     (
         "bad max time",
@@ -356,7 +356,7 @@ def test_a_matrix_sampling_every_swept_key_needs_no_sweep_table(tmp_path):
     assert len(ids) == 2
     # only sampling every required key leaves it out
     half = tmp_path / "half.toml"
-    half.write_text(scenario + sample.replace("mu = { choice = [0.3, 0.7] }\n", ""))
+    half.write_text(scenario + sample.replace("ego_speed_kmh = { uniform = [60, 140] }\n", ""))
     with pytest.raises(InputError, match=r"half\.toml: missing table \[sweep\]"):
         load_matrix(half)
 

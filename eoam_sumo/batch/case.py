@@ -58,7 +58,9 @@ class CaseParameters:
 
     case_id: str
     ego_speed_kmh: float
-    mu: float  # the friction asked for (the summary's ``mu`` is the one under the ego)
+    # the friction asked for, None: each lane's own (the summary's ``mu`` is the one under
+    # the ego at its start, results.csv's ``mu_at_start``)
+    mu: float | None
     oncoming_start_m: float | None  # None: no oncoming car added
     aro_hold_s: float | None  # None: the route file's value
     aro_decel_mps2: float | None  # None: the route file's value

@@ -9,9 +9,11 @@ McCulloch 2007). Each draw is shrunk towards the overall rate by k/n pseudo-draw
 1991: y* = (y + p k/n) / (1 + k/n), k coefficients, n draws), so that a parameter range with
 no event gives a small probability with a finite band instead of a diverging fit. The band is
 the GLM's Wald interval of the linear predictor mapped through the logistic function. The map
-covers the observed range only. Degenerate data fall back to the overall Wilson interval
-(:func:`eoam_sumo.sampling.wilson_interval`) at every grid point, the ``model`` column saying
-why: no event or only events, fewer than ``MIN_DRAWS`` draws, or no fit converged. One map
+covers the observed range only; the friction of a draw on the network's own (a matrix without
+``mu``) is the one under the ego at its start (``mu_at_start``). Degenerate data fall back
+to the overall Wilson interval (:func:`eoam_sumo.sampling.wilson_interval`) at every grid
+point, the ``model`` column saying why: no event or only events, fewer than ``MIN_DRAWS``
+draws, or no fit converged. One map
 per slice (``slices``): the draws of two settings (policy, vehicle, driver, ...) are never one
 fit.
 """
@@ -181,8 +183,12 @@ def slice_name(values: dict, leave_out: tuple[str, ...] = ()) -> str:
 
 def decided(results: pd.DataFrame) -> pd.DataFrame:
     """The draws whose run ended and decided its outcome: not failed, not ``UNDECIDED`` (cut
-    off at the time limit before anything was decided)."""
-    return results[(results["status"] == "ok") & (results["outcome"].astype(str) != UNDECIDED)]
+    off at the time limit before anything was decided); a draw on the network's own
+    frictions (``mu`` empty) has the friction under the ego at its start as its ``mu``."""
+    ok = results[(results["status"] == "ok") & (results["outcome"].astype(str) != UNDECIDED)]
+    if "mu_at_start" not in ok or not ok[Y].isna().any():
+        return ok
+    return ok.assign(**{Y: ok[Y].fillna(ok["mu_at_start"])})
 
 
 def probability_map(results: pd.DataFrame) -> pd.DataFrame:

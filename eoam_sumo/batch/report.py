@@ -1,7 +1,8 @@
 """Table 2 of a batch: our outcome colours beside the paper's (markdown and image).
 
 Rows are the traffic (no oncoming car, then each oncoming start distance) by initial ego
-speed, columns the surface friction, as in the paper's Table 2; a row more for each other
+speed, columns the surface friction, as in the paper's Table 2 (a matrix without ``mu``: one
+column, the network's own lane frictions); a row more for each other
 combination of the settings that vary (``SETTINGS``: vehicle, policy, driver, road, ...),
 named in its label; rows and columns follow the order of the results (the matrix's order).
 Each cell holds our colour and the paper's; every cell that differs is numbered and listed
@@ -140,10 +141,12 @@ class OutcomeGrid:
     """Rows x friction columns of cells; ``rows[i]`` is (traffic label, speed label)."""
 
     rows: tuple[tuple[str, str], ...]
-    mus: tuple[float, ...]
+    mus: tuple[float | None, ...]  # None: each lane's own friction (the network's)
     cells: dict[tuple[int, int], Cell]
     has_paper: bool
     subject: str = "EOAM outcomes"  # whose outcomes: ``subject_of``
+    # the frictions under the ego at the start of the cases on the network's own
+    net_mus_at_start: tuple[float, ...] = ()
 
     @property
     def agreeing(self) -> int:
@@ -212,7 +215,7 @@ class GridLayout:
     (row, column)."""
 
     rows: tuple[tuple[str, str], ...]
-    mus: tuple[float, ...]
+    mus: tuple[float | None, ...]  # None: each lane's own friction (the network's)
     places: tuple[tuple[int, int], ...]
 
 
@@ -225,7 +228,7 @@ def grid_layout(results: pd.DataFrame) -> GridLayout:
     scenario_traffic = bool((pd.Series(seen, dtype=object).astype(str) == "True").any())
     rows: list[tuple[str, str]] = []
     row_of: dict[tuple, int] = {}
-    mus: list[float] = []
+    mus: list[float | None] = []
     places = []
     for _, row in results.iterrows():
         traffic = traffic_label(row["oncoming_start_m"], scenario_traffic)
@@ -234,9 +237,10 @@ def grid_layout(results: pd.DataFrame) -> GridLayout:
         if identity not in row_of:
             row_of[identity] = len(rows)
             rows.append((traffic, ", ".join(t for t in (speed, settings_label(row, varying)) if t)))
-        if row["mu"] not in mus:
-            mus.append(row["mu"])
-        places.append((row_of[identity], mus.index(row["mu"])))
+        mu = _identity(row["mu"])  # empty: the network's own frictions
+        if mu not in mus:
+            mus.append(mu)
+        places.append((row_of[identity], mus.index(mu)))
     return GridLayout(tuple(rows), tuple(mus), tuple(places))
 
 
@@ -261,12 +265,38 @@ def outcome_grid(results: pd.DataFrame) -> OutcomeGrid:
             _margins(row),
         )
     has_paper = any(c.paper for c in cells.values())
-    return OutcomeGrid(layout.rows, layout.mus, cells, has_paper, subject_of(results))
+    return OutcomeGrid(
+        layout.rows, layout.mus, cells, has_paper, subject_of(results), net_mus_at_start(results)
+    )
 
 
-def mu_text(mu: float) -> str:
-    """Friction as the paper writes it: 1.0, 0.7, 0.35."""
+def net_mus_at_start(results: pd.DataFrame) -> tuple[float, ...]:
+    """The distinct frictions under the ego at the start (``mu_at_start``) of the finished
+    cases that ran on the network's own frictions (``mu`` empty), in the frame's order."""
+    if "mu_at_start" not in results:
+        return ()
+    own = results["mu"].isna() & (results["status"] == "ok")
+    return tuple(float(m) for m in pd.unique(results.loc[own, "mu_at_start"].dropna()))
+
+
+def mu_text(mu: float | None) -> str:
+    """Friction as the paper writes it: 1.0, 0.7, 0.35; "network's" for each lane's own (None
+    or an empty cell)."""
+    if mu is None or math.isnan(mu):
+        return "network's"
     return f"{mu:.1f}" if round(mu, 1) == mu else f"{mu:g}"
+
+
+def net_mu_line(grid: OutcomeGrid) -> list[str]:
+    """The line saying what the network's own friction was (none when every case set mu)."""
+    if None not in grid.mus:
+        return []
+    start = ", ".join(mu_text(m) for m in grid.net_mus_at_start) or "not recorded"
+    return [
+        "Surface mu: each lane's own, as the network sets it (no mu in the matrix); under "
+        f"the ego at its start: {start}.",
+        "",
+    ]
 
 
 def _mark(colour: str | None) -> str:
@@ -288,6 +318,7 @@ def table2_markdown(grid: OutcomeGrid, title: str = "Table 2") -> str:
         f"# {title}: {grid.subject}" + (" — this run / the paper" if grid.has_paper else ""),
         "",
         *_counts_markdown(grid),
+        *net_mu_line(grid),
         *_grid_markdown(grid),
         "",
         "Legend: "
@@ -368,9 +399,8 @@ def _differing_markdown(grid: OutcomeGrid) -> list[str]:
             if cell.ours == FAILED
             else f" [{cell.case_dir}/summary.json]({cell.case_dir}/summary.json)"
         )
-        lines.append(
-            f"{n}. **{traffic}, {speed}, mu {mu_text(mu)}** — {versus}: {cell.detail}.{link}"
-        )
+        surface = "network's mu" if mu is None else f"mu {mu_text(mu)}"
+        lines.append(f"{n}. **{traffic}, {speed}, {surface}** — {versus}: {cell.detail}.{link}")
     if not differing:
         lines.append("None.")
     return lines

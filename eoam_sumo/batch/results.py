@@ -30,7 +30,8 @@ from eoam_sumo.textfiles import read_utf8
 RESULTS_FILE = "results.csv"
 CASES_DIR = "cases"
 #: summary.json key -> results.csv column where the names differ (the case's own ``mu`` is
-#: the requested friction; the summary's is the one measured under the ego at the start).
+#: the requested friction, empty for a case on each lane's own; the summary's is the one
+#: measured under the ego at the start).
 RENAMED = {"mu": "mu_at_start"}
 #: results.csv columns: the case's parameters, its status, the summary fields, where it lives.
 PARAM_COLUMNS = tuple(p for p in PARAMETERS if p != "sumocfg")

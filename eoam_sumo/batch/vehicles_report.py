@@ -61,10 +61,12 @@ def equipment_label(abs_fitted, esc_fitted) -> str:
 
 
 def cell_id(row) -> str:
-    """The Table 2 cell of a row, as Table 2's case ids name it: ``onc-none_v165_mu1.0``."""
+    """The Table 2 cell of a row, as Table 2's case ids name it: ``onc-none_v165_mu1.0``
+    (``onc-none_v165`` on the network's own frictions, ``mu`` empty)."""
     onc = row["oncoming_start_m"]
     onc_text = "none" if pd.isna(onc) else f"{float(onc):g}"
-    return f"onc-{onc_text}_v{float(row['ego_speed_kmh']):g}_mu{float(row['mu'])!r}"
+    mu = "" if pd.isna(row["mu"]) else f"_mu{float(row['mu'])!r}"
+    return f"onc-{onc_text}_v{float(row['ego_speed_kmh']):g}{mu}"
 
 
 def labelled(results: pd.DataFrame) -> pd.DataFrame:

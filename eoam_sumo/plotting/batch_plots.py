@@ -65,7 +65,7 @@ def plot_table2(grid, path: Path) -> Path:
     ax.set_yticks(np.arange(n_rows) + 0.5, labels, fontsize=9)
     sub = "\nours | paper" if halves == 2 else ""
     ax.set_xticks(
-        np.arange(n_cols) + 0.5, [f"μ = {mu_text(mu)}{sub}" for mu in grid.mus], fontsize=10
+        np.arange(n_cols) + 0.5, [_mu_tick(grid, mu) + sub for mu in grid.mus], fontsize=10
     )
     ax.xaxis.tick_top()
     ax.tick_params(length=0)
@@ -85,6 +85,15 @@ def plot_table2(grid, path: Path) -> Path:
     ]
     fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), frameon=False)
     return save(fig, path)
+
+
+def _mu_tick(grid, mu: float | None) -> str:
+    """A column's friction: "μ = 0.7", or each lane's own with the one under the ego at
+    the start ("μ: the network's\n(0.4 at the ego's start)")."""
+    if mu is not None:
+        return f"μ = {mu_text(mu)}"
+    start = ", ".join(mu_text(m) for m in grid.net_mus_at_start)
+    return "μ: the network's" + (f"\n({start} at the ego's start)" if start else "")
 
 
 def _draw_cell(ax, i: int, j: int, cell, halves: int) -> None:
@@ -152,7 +161,7 @@ def swept_keys(results: pd.DataFrame) -> list[str]:
 def _key_text(row, key: str) -> str:
     value = row[key]
     if key == "mu":
-        return f"μ = {mu_text(value)}"
+        return "the network's μ" if pd.isna(value) else f"μ = {mu_text(value)}"
     if key == "sumocfg":
         return Path(str(value)).name
     if pd.isna(value):
@@ -267,11 +276,10 @@ def plot_lateral_offsets(
         return None
     facts = _CaseFacts(batch_dir)
     keys = [k for k in swept_keys(results) if k != "ego_speed_kmh"]
-    top_mu = float(at_speed["mu"].max())
+    top_mu = float(at_speed["mu"].max())  # NaN: each lane's own friction (the network's)
     no_onc = at_speed[at_speed["oncoming_start_m"].isna()].sort_values("mu", ascending=False)
-    dry = at_speed[at_speed["mu"] == top_mu].sort_values(
-        "oncoming_start_m", ascending=False, na_position="first"
-    )
+    top = at_speed["mu"].isna() if np.isnan(top_mu) else at_speed["mu"] == top_mu
+    dry = at_speed[top].sort_values("oncoming_start_m", ascending=False, na_position="first")
     left_keys = [k for k in keys if k != "oncoming_start_m"] or ["mu"]
     across = ", ".join(_KEY_NAMES.get(k, k) for k in left_keys)
     if any(facts(c)[2] for c in no_onc["case_dir"]):
@@ -285,9 +293,8 @@ def plot_lateral_offsets(
     _panel(left, batch_dir, no_onc, lambda r: _label(r, left_keys, facts), "Blues", facts)
     left.set_title(fit(f"{speed_kmh:g} km/h, {left_title}, across {across}", 6.3, 12))
     _panel(right, batch_dir, dry, lambda r: _label(r, right_keys, facts), "Purples", facts)
-    right.set_title(
-        fit(f"{speed_kmh:g} km/h, μ = {mu_text(top_mu)}, across oncoming settings", 6.3, 12)
-    )
+    surface = "the network's μ" if np.isnan(top_mu) else f"μ = {mu_text(top_mu)}"
+    right.set_title(fit(f"{speed_kmh:g} km/h, {surface}, across oncoming settings", 6.3, 12))
     fig.suptitle("Ego lateral position during the EOAM (cf. paper Figure 25)")
     return save(fig, Path(out_dir) / f"lateral_offsets_{speed_kmh:g}kmh.png")
 

@@ -205,10 +205,12 @@ def _title(results: pd.DataFrame, what: str) -> str:
     failed = int((results["status"] != "ok").sum())
     undecided = int((results["status"] == "ok").sum()) - len(decided(results))
     left_out = [f"{failed} failed"] * bool(failed) + [f"{undecided} {UNDECIDED}"] * bool(undecided)
+    own = Y in results and bool(results[Y].isna().any())  # no mu: the network's frictions
     return (
         f"{what}: {len(decided(results))} draws"
         + (f" ({', '.join(left_out)}, left out)" if left_out else "")
         + "; hatched cells: no draw"
+        + ("; mu: the network's own, under the ego at its start" if own else "")
     )
 
 
