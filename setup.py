@@ -62,6 +62,7 @@ COMPILED = [
     "eoam_sumo/sim/outcome.py",
     "eoam_sumo/sensing/radar.py",
     "eoam_sumo/sim/roadframe.py",
+    "eoam_sumo/sim/runlog.py",
     "eoam_sumo/sim/settings.py",
     "eoam_sumo/sim/severity.py",
     "eoam_sumo/sim/trafficlog.py",
