@@ -301,7 +301,7 @@ class NextLaneSensing:
         out: list[tuple[float, float, float, float, float]] = []
         reach = c.range_m + self.ego_length_m
         for b in bodies:
-            _, _, bx, by, yaw_rad, speed_mps, length_m, width_m, _, box = b  # ``_BodyFields``
+            _, _, bx, by, b_yaw, speed_mps, length_m, width_m, _, box = b  # ``_BodyFields``
             _, _, _, _, _, _, _, _, _, radius_m = box
             if math.hypot(bx - fx, by - fy) > reach + radius_m:
                 continue  # beyond both corner radars and not beside the body
@@ -322,7 +322,7 @@ class NextLaneSensing:
                 for q in (*known, *out)
             ):
                 continue
-            out.append((s, d, speed_mps * math.cos(yaw_rad - ryaw), length_m, width_m))
+            out.append((s, d, speed_mps * math.cos(b_yaw - ryaw), length_m, width_m))
         return out
 
     @staticmethod
