@@ -11,7 +11,7 @@ from eoam_sumo.batch.vehicles_report import (
     sweeps_vehicles,
     vehicles_markdown,
 )
-from eoam_sumo.plotting.vehicle_plots import plot_vehicles
+from eoam_sumo.plotting.vehicle_plots import plot_vehicles, vehicles_figure
 
 CELLS = [(None, 165.0, 1.0, "green"), (None, 120.0, 0.1, "yellow"), (300.0, 90.0, 0.7, "red")]
 
@@ -86,3 +86,18 @@ def test_a_failed_case_is_no_equipment_of_its_own():
     table2 = FRAME[(FRAME["vehicle"] == "suv") & ~FRAME["abs_fitted"]].astype({"abs_fitted": str})
     failed = table2.iloc[:1].assign(abs_fitted="", esc_fitted="", status="failed")
     assert not sweeps_vehicles(pd.concat([table2, failed]))
+
+
+def test_one_vehicle_without_a_paper_table_gets_readable_panels():
+    """One vehicle, two policies, no paper table: the panels keep their width (they were
+    squeezed to a sliver beside the legend, the bars invisible) and no empty paper bar."""
+    one = FRAME[FRAME["vehicle"] == "suv"].assign(paper_outcome=None)
+    one = pd.concat([one, one.assign(policy="safe")], ignore_index=True)
+    fig = vehicles_figure(one)
+    axes = [ax for ax in fig.axes if ax.get_title().endswith("policy")]
+    assert len(axes) == 2
+    for ax in axes:
+        assert ax.get_position().width * fig.get_figwidth() >= 2.0  # inches
+        assert [t.get_text() for t in ax.get_xticklabels()] == ["suv"]
+        # the bars are drawn: two equipments of three cells each
+        assert sum(p.get_height() for p in ax.patches) == 6
