@@ -280,8 +280,9 @@ def plot_lateral_offsets(
     no_onc = at_speed[at_speed["oncoming_start_m"].isna()].sort_values("mu", ascending=False)
     top = at_speed["mu"].isna() if np.isnan(top_mu) else at_speed["mu"] == top_mu
     dry = at_speed[top].sort_values("oncoming_start_m", ascending=False, na_position="first")
-    left_keys = [k for k in keys if k != "oncoming_start_m"] or ["mu"]
-    across = ", ".join(_KEY_NAMES.get(k, k) for k in left_keys)
+    varied = [k for k in keys if k != "oncoming_start_m"]
+    left_keys = varied or ["mu"]
+    across = f", across {', '.join(_KEY_NAMES.get(k, k) for k in varied)}" if varied else ""
     if any(facts(c)[2] for c in no_onc["case_dir"]):
         left_keys.append("oncoming_start_m")  # the scenario's own traffic: say which saw it
         left_title = "no oncoming car added"
@@ -291,7 +292,7 @@ def plot_lateral_offsets(
     fig = Figure(figsize=(13, 5.2), layout="constrained")
     left, right = fig.subplots(1, 2, sharey=True)
     _panel(left, batch_dir, no_onc, lambda r: _label(r, left_keys, facts), "Blues", facts)
-    left.set_title(fit(f"{speed_kmh:g} km/h, {left_title}, across {across}", 6.3, 12))
+    left.set_title(fit(f"{speed_kmh:g} km/h, {left_title}{across}", 6.3, 12))
     _panel(right, batch_dir, dry, lambda r: _label(r, right_keys, facts), "Purples", facts)
     surface = "the network's μ" if np.isnan(top_mu) else f"μ = {mu_text(top_mu)}"
     right.set_title(fit(f"{speed_kmh:g} km/h, {surface}, across oncoming settings", 6.3, 12))

@@ -10,6 +10,7 @@ import pytest
 
 from eoam_sumo.batch.results import RESULTS_FILE
 from eoam_sumo.batch.runner import run_batch
+from eoam_sumo.plotting import batch_plots
 from eoam_sumo.plotting.dispatch import plot_folder
 from tests.builders import write_matrix
 from tests.test_matrix_network_friction import baseline_on_frictions
@@ -80,3 +81,14 @@ def test_a_swept_mu_sets_every_lanes_friction_where_none_keeps_the_networks(
     assert results["mu"].tolist() == [1.0] and results["mu_at_start"].tolist() == [1.0]
     assert set(_series(tmp_path / "out", "onc-none_v90_mu1.0")["mu"]) == {1.0}
     assert own.loc[own["ego_speed_kmh"] == 90, "mu_at_start"].tolist() == [EGO_LANE_MU]
+
+
+def test_the_lateral_offset_titles_name_only_what_varied(own_friction, tmp_path, monkeypatch):
+    """Only the speed swept: the left panel's title is not "across frictions" (one ran)."""
+    _, _, out, results = own_friction
+    figures = []
+    monkeypatch.setattr(batch_plots, "save", lambda fig, path: figures.append(fig) or path)
+    batch_plots.plot_lateral_offsets(out, results, tmp_path, 120.0)
+    titles = [ax.get_title() for ax in figures[0].axes]
+    assert titles[0] == "120 km/h, no oncoming traffic"
+    assert not any("across frictions" in t for t in titles)
