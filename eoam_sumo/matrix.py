@@ -22,7 +22,6 @@ import difflib
 import itertools
 import math
 import tomllib
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -36,7 +35,6 @@ from eoam_sumo.sensing.automotive import parse_radar_model
 from eoam_sumo.sensing.friction import parse_mu_belief
 from eoam_sumo.sim.scenario import ScenarioFiles, ScenarioOverrides, check_scenario, scripted_stops
 from eoam_sumo.sim.scenario.routes import check_oncoming_road, ego_route_edges
-from eoam_sumo.sim.scenario.xmlread import xml_source
 from eoam_sumo.sim.settings import DEFAULT_MAX_TIME_S, MAX_TIME_LIMIT_S, check_sumo_step_s
 from eoam_sumo.sim.vehicle import vehicle_name, vehicle_tables, vehicle_tables_dir
 from eoam_sumo.textfiles import not_utf8
@@ -993,24 +991,20 @@ class StartFrictions:
 
 def start_frictions(files: ScenarioFiles, ego_id: str = "ego") -> tuple[tuple[str, float], ...]:
     """(lane id, friction) of each lane the ego may depart on, as its network writes them
-    (SUMO's default 1 where a lane has none): its ``departLane`` on its first route edge (a
-    trip's ``from``); every lane of that edge when the lane is no number (``free``, ...);
-    every lane of the network when the edge is not known before SUMO routes the ego."""
+    (``ScenarioFiles.edge_lanes``): its ``departLane`` on its first route edge (a trip's
+    ``from``); every lane of that edge when the lane is no number (``free``, ...); every lane
+    of the network when the edge is not known before SUMO routes the ego."""
     spec = files.vehicles[ego_id]
     route = ego_route_edges(files, ego_id)
     edge = route[0] if route else spec.attrs.get("from")
     lane = spec.attrs.get("departLane", "")
-    frictions, current = [], None
-    for event, elem in ET.iterparse(xml_source(files.net_file), events=("start", "end")):
-        if event == "start" and elem.tag == "edge":
-            normal = elem.get("function") in (None, "normal")
-            current = elem.get("id") if normal and edge in (None, elem.get("id")) else None
-        elif event == "start" and elem.tag == "lane" and current is not None:
-            if not lane.isdigit() or elem.get("index") == lane:
-                frictions.append((elem.get("id", ""), float(elem.get("friction", "1"))))
-        elif event == "end" and elem.tag in ("edge", "junction", "connection", "tlLogic"):
-            elem.clear()
-    return tuple(frictions)
+    edges = files.edge_lanes.values() if edge is None else [files.edge_lanes.get(edge, [])]
+    return tuple(
+        (lane_id, mu)
+        for lanes in edges
+        for lane_id, index, mu in lanes
+        if not lane.isdigit() or index == int(lane)
+    )
 
 
 def _check_generated_oncoming(matrix: Matrix) -> None:

@@ -169,3 +169,21 @@ def write_matrix(
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(text)
     return path
+
+
+def right_lane_sensing(lane_width_m: float, target_width_m: float):
+    """The corner radars' sensing of the lane right of the ego's (same direction, 36 m/s
+    limit, a 100 m / 18 deg forward radar, the sedan's 4.92 x 1.85 m body)."""
+    from eoam_sumo.sensing.next_lane import NextLaneSensing
+
+    return NextLaneSensing(
+        opposing=False,
+        speed_limit_mps=36.0,
+        lane_width_m=lane_width_m,
+        radar_range_m=100.0,
+        radar_fov_deg=18.0,
+        ego_length_m=4.92,
+        ego_width_m=1.85,
+        side=-1,
+        target_width_m=target_width_m,
+    )

@@ -33,21 +33,6 @@ def peak_friction(mu: float, load_n: float, nominal_load_n: float) -> float:
     return mu * (1.0 + PLANT_TYRE_PEAK_LOAD_SENSITIVITY * dfz)
 
 
-def wheel_lock_brake_n(
-    params: VehicleParams,
-    mu: float,
-    lateral_accel_mps2: float,
-    resistance_n: float,
-    lateral_share: float,
-    equivalent_mass_kg: float,
-) -> float:
-    """``BrakeSplit(params).limit_n(...)``: the largest brake command [N] that locks neither
-    axle's inner wheel."""
-    return BrakeSplit(params).limit_n(
-        mu, lateral_accel_mps2, resistance_n, lateral_share, equivalent_mass_kg
-    )
-
-
 class BrakeSplit:
     """A vehicle's fixed brake split and what loads its inner wheels: the parameters
     ``limit_n`` reads at every control step, kept as plain floats."""

@@ -9,7 +9,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from eoam_sumo.control import LongitudinalGains, equivalent_mass_kg
-from eoam_sumo.control.brake_split import wheel_lock_brake_n
+from eoam_sumo.control.brake_split import BrakeSplit
 from eoam_sumo.decision import SECTOR_ORDER, Action, Mode, Sector, dmm_sector
 from eoam_sumo.decision.obstacle import ObstacleDecel
 from eoam_sumo.decision.policy import PolicySettings, SafePolicy
@@ -73,7 +73,7 @@ def stop_scale(tables, mu):
     eq33 = equivalent_mass_kg(p) * tables.limit_brake_decel_mps2(mu)
     rolling = p.rolling_resistance_coeff * p.mass_kg * 9.81
     drag = 0.5 * AIR_DENSITY_KGPM3 * p.drag_area_m2  # at 1 m/s, as the controller takes it
-    lock = wheel_lock_brake_n(p, mu, 0.0, rolling + drag, 0.0, equivalent_mass_kg(p))
+    lock = BrakeSplit(p).limit_n(mu, 0.0, rolling + drag, 0.0, equivalent_mass_kg(p))
     return eq33 / min(eq33, LongitudinalGains().wheel_lock_fraction * lock)
 
 

@@ -28,16 +28,16 @@ V0_MPS = 100.0 / 3.6
 def test_without_the_chassis_terms_the_limit_is_eq_33(monkeypatch, name, mu):
     monkeypatch.setattr(brake_split, "PLANT_TYRE_PEAK_LOAD_SENSITIVITY", 0.0)
     p = dataclasses.replace(load_vehicle(name), rolling_resistance_coeff=0.0)
-    limit = brake_split.wheel_lock_brake_n(p, mu, 0.0, 0.0, 0.0, p.mass_kg)
+    limit = brake_split.BrakeSplit(p).limit_n(mu, 0.0, 0.0, 0.0, p.mass_kg)
     assert limit == pytest.approx(p.mass_kg * max_decel_no_lock_mps2(p, mu), rel=1e-9)
 
 
 def test_cornering_and_load_transfer_lower_the_limit(params):
     m_eq = equivalent_mass_kg(params)
-    straight = brake_split.wheel_lock_brake_n(params, 0.3, 0.0, 300.0, 0.0, m_eq)
-    turning = brake_split.wheel_lock_brake_n(params, 0.3, 1.5, 300.0, 0.5, m_eq)
+    straight = brake_split.BrakeSplit(params).limit_n(0.3, 0.0, 300.0, 0.0, m_eq)
+    turning = brake_split.BrakeSplit(params).limit_n(0.3, 1.5, 300.0, 0.5, m_eq)
     assert 0.0 < turning < np.sqrt(1.0 - 0.5**2) * straight
-    assert brake_split.wheel_lock_brake_n(params, 0.3, 2.9, 300.0, 1.0, m_eq) == 0.0
+    assert brake_split.BrakeSplit(params).limit_n(0.3, 2.9, 300.0, 1.0, m_eq) == 0.0
 
 
 def _locked_while_moving(plant, mu, brake_n):
@@ -56,8 +56,8 @@ def _assert_the_limit_is_sharp(plant, params, mu):
     ctrl = LongitudinalController(params)
     rolling_n = params.rolling_resistance_coeff * params.mass_kg * G_MPS2
     m_eq = equivalent_mass_kg(params)
-    low = brake_split.wheel_lock_brake_n(params, mu, 0.0, rolling_n, 0.0, m_eq)
-    high = brake_split.wheel_lock_brake_n(params, mu, 0.0, ctrl.resistance_n(V0_MPS), 0.0, m_eq)
+    low = brake_split.BrakeSplit(params).limit_n(mu, 0.0, rolling_n, 0.0, m_eq)
+    high = brake_split.BrakeSplit(params).limit_n(mu, 0.0, ctrl.resistance_n(V0_MPS), 0.0, m_eq)
     assert not _locked_while_moving(plant, mu, 0.99 * low)
     assert _locked_while_moving(plant, mu, 1.05 * high)
 

@@ -10,6 +10,7 @@ from eoam_sumo.sensing.radar import Radar, RadarSettings
 from eoam_sumo.sensing.v2x import V2XSettings
 from eoam_sumo.world.bodies import Body
 from eoam_sumo.world.geometry import OrientedBox
+from tests.builders import right_lane_sensing
 
 LANE = 3.5
 HALF_FOV = math.radians(9.0)
@@ -149,17 +150,7 @@ def test_a_v2x_car_beyond_the_radar_limits_the_free_length_and_is_fused_when_see
 
 
 def _right_sensing(target_width_m=LANE):
-    return NextLaneSensing(
-        opposing=False,
-        speed_limit_mps=36.0,
-        lane_width_m=LANE,
-        radar_range_m=100.0,
-        radar_fov_deg=18.0,
-        ego_length_m=4.92,
-        ego_width_m=1.85,
-        side=-1,
-        target_width_m=target_width_m,
-    )
+    return right_lane_sensing(LANE, target_width_m)
 
 
 def test_the_right_lane_is_sensed_as_the_left_one_mirrored():

@@ -10,10 +10,10 @@ import pytest
 
 from eoam_sumo.eoam.sides import mirrored_perception
 from eoam_sumo.eoam_messages import Perception
-from eoam_sumo.sensing.next_lane import NextLaneSensing
 from eoam_sumo.sensing.radar import Radar, RadarSettings
 from eoam_sumo.sim.roadframe import RoadFrame
 from eoam_sumo.world.bodies import Body
+from tests.builders import right_lane_sensing
 
 LANE_M = 3.5
 CAR = (4.70, 1.82)
@@ -110,17 +110,7 @@ def test_settings_refuse_a_bad_target_lane_width():
 
 def _right_view(body: Body):
     """The right lane's view (5 m wide beside the 3 m ego lane) with ``body`` in it."""
-    sensing = NextLaneSensing(
-        opposing=False,
-        speed_limit_mps=36.0,
-        lane_width_m=EGO_LANE_M,
-        radar_range_m=100.0,
-        radar_fov_deg=18.0,
-        ego_length_m=4.92,
-        ego_width_m=1.85,
-        side=-1,
-        target_width_m=WIDE_M,
-    )
+    sensing = right_lane_sensing(EGO_LANE_M, WIDE_M)
     report = Radar().scan((0.0, 0.0), 0.0, 30.0, ROAD, [body], EGO_LANE_M)
     return sensing.update(0.0, (0.0, 0.0), 0.0, ROAD, report, [body])
 

@@ -34,6 +34,7 @@ class ScenarioFiles:
     vehicles: dict  # vid -> VehicleSpec
     opposite_lanes: dict  # lane id -> id of its <neigh> (opposite-direction) lane
     options: dict = field(default_factory=dict)  # option name -> value as the sumocfg sets it
+    edge_lanes: dict = field(default_factory=dict)  # normal edge -> (lane id, index, friction)s
 
 
 def _option_files(root: ET.Element, cfg: Path, option: str) -> tuple[Path, ...]:
@@ -61,7 +62,7 @@ def check_scenario(cfg: Path, ego_id: str = "ego") -> ScenarioFiles:
     nets = _option_files(root, cfg, "net-file")
     if len(nets) != 1:
         raise InputError(f"{cfg}: needs exactly one <net-file value=...>, found {len(nets)}")
-    opposite = read_net(nets[0])
+    opposite, edge_lanes = read_net(nets[0])
     routes = _option_files(root, cfg, "route-files")
     additionals = _option_files(root, cfg, "additional-files")
     vehicles, flows = _vehicles(routes, additionals)
@@ -78,7 +79,7 @@ def check_scenario(cfg: Path, ego_id: str = "ego") -> ScenarioFiles:
         )
     options = _options(root)
     _check_end_after_departure(cfg, options, vehicles[ego_id])
-    return ScenarioFiles(cfg, nets[0], routes, additionals, vehicles, opposite, options)
+    return ScenarioFiles(cfg, nets[0], routes, additionals, vehicles, opposite, options, edge_lanes)
 
 
 def _seconds(text: str | None) -> float | None:

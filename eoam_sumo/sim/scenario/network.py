@@ -20,10 +20,12 @@ from eoam_sumo.sim.roadframe import arclength, point_at, project
 from eoam_sumo.sim.scenario.xmlread import xml_source
 
 
-def read_net(path: Path) -> dict:
-    """Lane id -> opposite lane id, streaming through the network file: each ``<neigh>``, and
-    for a two-way road built without them the leftmost lanes of an edge and its reverse edge
-    (swapped junctions) when they lie side by side (``_side_by_side``). InputError for a file
+def read_net(path: Path) -> tuple[dict, dict]:
+    """(lane id -> opposite lane id, normal edge id -> its lanes as (lane id, index, friction)),
+    streaming through the network file once. Opposite: each ``<neigh>``, and for a two-way
+    road built without them the leftmost lanes of an edge and its reverse edge (swapped
+    junctions) when they lie side by side (``_side_by_side``). Friction: SUMO's default 1
+    where a lane has none. InputError for a file
     that is missing, malformed, not a network, left-hand traffic, or has a lane number out of
     range (``_check_lane_numbers``)."""
     if not path.is_file():
@@ -31,6 +33,7 @@ def read_net(path: Path) -> dict:
     opposite, lane_id, first = {}, None, True
     # normal edge id -> (from, to, leftmost lane (index, id, width, shape))
     edges: dict[str, tuple[str | None, str | None, tuple | None]] = {}
+    edge_lanes: dict[str, list[tuple[str, int, float]]] = {}
     edge_id = None
     try:
         for event, elem in ET.iterparse(xml_source(path), events=("start", "end")):
@@ -53,6 +56,8 @@ def read_net(path: Path) -> dict:
                 if edge_id is not None:
                     frm, to, left = edges[edge_id]
                     index = int(elem.get("index", "0"))
+                    friction = float(elem.get("friction", "1"))
+                    edge_lanes.setdefault(edge_id, []).append((lane_id or "", index, friction))
                     if left is None or index > left[0]:
                         edges[edge_id] = (
                             frm,
@@ -74,7 +79,7 @@ def read_net(path: Path) -> dict:
         if _side_by_side(left, back):
             opposite[left[1]] = back[1]
             opposite[back[1]] = left[1]
-    return opposite
+    return opposite, edge_lanes
 
 
 def _side_by_side(lane: tuple, other: tuple) -> bool:
